@@ -1,0 +1,28 @@
+// Small helpers every subcommand uses: parsing comma-separated numbers with errors that name the
+// option, and printing JSON or text.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "deflex/model/robot_model.hpp"
+
+namespace deflex::cli {
+
+/// "1, 2.5,3" -> {1, 2.5, 3}. Throws InputError naming `option` on a bad number, NaN/inf, or when
+/// `expected` (if non-zero) does not match the count.
+std::vector<double> parse_numbers(const std::string& text, const std::string& option, std::size_t expected = 0);
+
+/// Joint values given in degrees on the command line, to rad, checked against the robot's dof.
+JointVector parse_joints_deg(const std::string& text, const RobotModel& model, const std::string& option);
+
+/// JSON array of an Eigen vector or matrix (row-major nested arrays for matrices).
+nlohmann::json to_json(const Eigen::Ref<const Eigen::MatrixXd>& m);
+nlohmann::json vector_to_json(const Eigen::Ref<const Eigen::VectorXd>& v);
+
+/// Prints a JSON document on stdout (only the document, so scripts can pipe it).
+void print_json(const nlohmann::json& doc);
+
+}  // namespace deflex::cli

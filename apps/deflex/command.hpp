@@ -1,0 +1,37 @@
+// Subcommand registry of the deflex program. Each apps/deflex/cmd_*.cpp registers its subcommands
+// with a static DEFLEX_COMMAND(...) object, so adding a subcommand touches no shared file.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+namespace deflex::cli {
+
+/// Adds options to the subcommand and sets its callback. The callback returns the exit code
+/// (0 success, 1 the job failed, 2 bad input); deflex::Error thrown from it is reported as
+/// "deflex NAME: error: ..." with exit code 2.
+using CommandSetup = std::function<void(CLI::App& sub, int& exit_code)>;
+
+struct CommandInfo {
+  std::string name;
+  std::string help;
+  CommandSetup setup;
+  int order = 100;  ///< position in --help
+};
+
+std::vector<CommandInfo>& command_registry();
+
+struct CommandRegistrar {
+  CommandRegistrar(std::string name, std::string help, CommandSetup setup, int order = 100);
+};
+
+}  // namespace deflex::cli
+
+#define DEFLEX_CLI_CONCAT2(a, b) a##b
+#define DEFLEX_CLI_CONCAT(a, b) DEFLEX_CLI_CONCAT2(a, b)
+/// DEFLEX_COMMAND("name", "help", setup [, order]) at namespace scope in a cmd_*.cpp file.
+#define DEFLEX_COMMAND(...) \
+  static const ::deflex::cli::CommandRegistrar DEFLEX_CLI_CONCAT(deflex_command_, __LINE__)(__VA_ARGS__)

@@ -1,0 +1,28 @@
+# deflex_module(NAME [DEPENDS m1 m2 ...])
+# Builds src/deflex/NAME/*.cpp into the static library deflex_NAME (nothing if the folder has no
+# sources yet), and tests/NAME/*_test.cpp into the test program deflex_NAME_tests. Adding a file
+# to a module needs no edit here: new files are found at configure time (CONFIGURE_DEPENDS).
+set(DEFLEX_MODULE_TARGETS "" CACHE INTERNAL "")
+
+function(deflex_module name)
+  cmake_parse_arguments(ARG "" "" "DEPENDS" ${ARGN})
+  set(dir ${PROJECT_SOURCE_DIR}/src/deflex/${name})
+  file(GLOB sources CONFIGURE_DEPENDS ${dir}/*.cpp)
+  if(NOT sources)
+    return()
+  endif()
+  set(target deflex_${name})
+  add_library(${target} STATIC ${sources})
+  target_include_directories(${target} PUBLIC ${PROJECT_SOURCE_DIR}/src ${PROJECT_BINARY_DIR}/generated)
+  target_link_libraries(${target} PUBLIC Eigen3::Eigen fmt::fmt PRIVATE deflex_warnings)
+  foreach(dep IN LISTS ARG_DEPENDS)
+    if(TARGET deflex_${dep})
+      target_link_libraries(${target} PUBLIC deflex_${dep})
+    endif()
+  endforeach()
+  # Per-module extras (generated sources, extra packages) live beside the module's sources.
+  if(EXISTS ${dir}/module.cmake)
+    include(${dir}/module.cmake)
+  endif()
+  set(DEFLEX_MODULE_TARGETS ${DEFLEX_MODULE_TARGETS} ${target} CACHE INTERNAL "")
+endfunction()

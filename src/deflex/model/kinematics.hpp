@@ -1,0 +1,52 @@
+// Forward kinematics and the geometric Jacobian of a serial chain. All functions run on a
+// preallocated Workspace and never allocate.
+#pragma once
+
+#include <array>
+
+#include "deflex/model/robot_model.hpp"
+
+namespace deflex {
+
+/// Per-call scratch for one RobotModel (Pinocchio's Model/Data split). Create one per thread;
+/// it holds the results of the last forward_kinematics() call.
+struct Workspace {
+  explicit Workspace(const RobotModel& model);
+
+  int dof = 0;
+  JointVector q;                                  ///< configuration of the last FK call, rad
+  std::array<Vector3, kMaxJoints> axis_base{};    ///< joint axes in the base frame (unit)
+  std::array<Vector3, kMaxJoints> origin_base{};  ///< a point on each joint axis, base frame, m
+  Pose base_T_flange = Pose::Identity();
+  Pose base_T_tcp = Pose::Identity();
+  Pose base_T_wap = Pose::Identity();
+  Jacobian jacobian;  ///< scratch for algorithms built on FK
+};
+
+/// Computes every joint frame and the flange, TCP and WAP poses at q (rad), in the robot base
+/// frame. Precondition: q.size() == model.dof() and finite (checked by callers at the edge).
+void forward_kinematics(const RobotModel& model, Workspace& ws, const JointVector& q);
+
+/// Geometric Jacobian of the point `point_base` (m, base frame) rigidly attached to the last link,
+/// using the frames of the last forward_kinematics() call. Linear rows first.
+void point_jacobian(const Workspace& ws, const Vector3& point_base, Jacobian& J);
+
+/// Which point of the end effector a Jacobian or a deflection refers to.
+enum class EndPoint { kFlange, kTcp, kWap };
+
+/// Pose of the chosen end point after the last forward_kinematics() call.
+[[nodiscard]] const Pose& end_pose(const Workspace& ws, EndPoint point);
+
+/// FK then the Jacobian of the chosen end point, in one call.
+void jacobian(const RobotModel& model, Workspace& ws, const JointVector& q, EndPoint point, Jacobian& J);
+
+/// Pose of the TCP in the robot base frame at q (convenience; same as FK then ws.base_T_tcp).
+[[nodiscard]] Pose tcp_pose(const RobotModel& model, Workspace& ws, const JointVector& q);
+
+/// Small rigid displacement between two poses: [p_b - p_a; rotation vector of R_b R_a^T], base frame.
+[[nodiscard]] Displacement pose_difference(const Pose& a, const Pose& b);
+
+/// Applies a small base-frame displacement [dp; drot] to a pose (exact rotation via angle-axis).
+[[nodiscard]] Pose apply_displacement(const Pose& pose, const Displacement& d);
+
+}  // namespace deflex

@@ -1,0 +1,302 @@
+// Robot description files: deflex YAML, URDF chains, the built-in IRB6700.
+#include "deflex/model/robot_io.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include "deflex/model/errors.hpp"
+#include "deflex/model/yaml_fields.hpp"
+
+namespace deflex {
+
+// Defined in the source generated from data/robots/abb_irb6700_300_270.yaml (module.cmake).
+extern const char* const kBuiltinIrb6700Yaml;
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Units {
+  double length = 1.0;  // to m
+  double angle = 1.0;   // to rad
+};
+
+Units parse_units(const yaml::Field& root) {
+  Units u;
+  if (!root.has("units")) {
+    root.fail("missing 'units' (say {length: m|mm, angle: deg|rad}, so no number is read in the wrong unit)");
+  }
+  const yaml::Field f = root.at("units");
+  f.only_keys({"length", "angle"});
+  const std::string len = f.at("length").as_string();
+  const std::string ang = f.at("angle").as_string();
+  if (len == "m") {
+    u.length = 1.0;
+  } else if (len == "mm") {
+    u.length = 1e-3;
+  } else {
+    f.at("length").fail(fmt::format("unknown length unit '{}' (use m or mm)", len));
+  }
+  if (ang == "rad") {
+    u.angle = 1.0;
+  } else if (ang == "deg") {
+    u.angle = kPi / 180.0;
+  } else {
+    f.at("angle").fail(fmt::format("unknown angle unit '{}' (use deg or rad)", ang));
+  }
+  return u;
+}
+
+Pose urdf_pose(const urdf::Pose& p) {
+  Pose out = Pose::Identity();
+  out.translation() = Vector3(p.position.x, p.position.y, p.position.z);
+  out.linear() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).normalized().toRotationMatrix();
+  return out;
+}
+
+}  // namespace
+
+RobotDescription load_urdf_chain(const std::string& path, const std::string& base_link, const std::string& tip_link) {
+  std::ifstream in(path);
+  if (!in) {
+    throw ModelError(fmt::format("{}: cannot read the URDF file", path));
+  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const urdf::ModelInterfaceSharedPtr urdf_model = urdf::parseURDF(ss.str());
+  if (!urdf_model) {
+    throw ModelError(fmt::format("{}: not a valid URDF document (urdfdom could not parse it)", path));
+  }
+  urdf::LinkConstSharedPtr root = base_link.empty() ? urdf_model->getRoot() : urdf_model->getLink(base_link);
+  if (!root) {
+    throw ModelError(fmt::format("{}: base link '{}' not found", path, base_link));
+  }
+  urdf::LinkConstSharedPtr tip;
+  if (tip_link.empty()) {
+    // Follow the only child down to the only leaf; a branch needs an explicit tip.
+    tip = root;
+    while (!tip->child_links.empty()) {
+      if (tip->child_links.size() > 1) {
+        throw ModelError(fmt::format("{}: link '{}' branches; name the chain's end with tip_link", path, tip->name));
+      }
+      tip = tip->child_links.front();
+    }
+  } else {
+    tip = urdf_model->getLink(tip_link);
+    if (!tip) {
+      throw ModelError(fmt::format("{}: tip link '{}' not found", path, tip_link));
+    }
+  }
+  std::vector<urdf::JointConstSharedPtr> chain;
+  for (urdf::LinkConstSharedPtr l = tip; l != root; l = l->getParent()) {
+    if (!l->parent_joint) {
+      throw ModelError(fmt::format("{}: tip link '{}' is not below base link '{}'", path, tip->name, root->name));
+    }
+    chain.insert(chain.begin(), l->parent_joint);
+  }
+  RobotDescription d;
+  d.name = urdf_model->getName();
+  d.source = path;
+  d.urdf_file = fs::absolute(path).string();
+  d.urdf_base_link = root->name;
+  d.urdf_tip_link = tip->name;
+  Pose pending = Pose::Identity();
+  for (const auto& j : chain) {
+    const Pose origin = urdf_pose(j->parent_to_joint_origin_transform);
+    switch (j->type) {
+      case urdf::Joint::FIXED:
+        pending = pending * origin;
+        break;
+      case urdf::Joint::REVOLUTE:
+      case urdf::Joint::CONTINUOUS: {
+        JointSpec s;
+        s.name = j->name;
+        s.parent_T_joint = pending * origin;
+        s.axis = Vector3(j->axis.x, j->axis.y, j->axis.z);
+        if (s.axis.norm() < 1e-9) {
+          throw ModelError(fmt::format("{}: joint '{}': axis has zero length", path, j->name));
+        }
+        s.axis.normalize();
+        if (j->type == urdf::Joint::REVOLUTE && j->limits) {
+          s.lower_rad = j->limits->lower;
+          s.upper_rad = j->limits->upper;
+        } else {
+          s.lower_rad = -HUGE_VAL;
+          s.upper_rad = HUGE_VAL;
+        }
+        d.joints.push_back(s);
+        pending = Pose::Identity();
+        break;
+      }
+      default:
+        throw ModelError(fmt::format("{}: joint '{}': only revolute, continuous and fixed joints are supported",
+                                     path, j->name));
+    }
+  }
+  d.last_T_flange = pending;
+  return d;
+}
+
+RobotModel load_robot_yaml_text(const std::string& text, const std::string& source, const std::string& base_dir) {
+  const yaml::Field root = yaml::Field::load_string(text, source);
+  if (!root.is_map()) {
+    root.fail("a robot file is a YAML map (see docs/robot-file.md)");
+  }
+  root.only_keys({"deflex_robot", "name", "units", "kinematics", "joint_stiffness_Nm_per_rad", "stiffness_note",
+                  "base_frame", "tool_frame", "wap_frame", "sources"});
+  const int version = root.at("deflex_robot").as_int();
+  if (version != 1) {
+    root.at("deflex_robot").fail(fmt::format("format version {} is not known (this deflex reads 1)", version));
+  }
+  const Units u = parse_units(root);
+  RobotDescription d;
+  const yaml::Field kin = root.at("kinematics");
+  const std::string convention = kin.at("convention").as_string();
+  if (convention == "standard_dh" || convention == "modified_dh") {
+    kin.only_keys({"convention", "joints"});
+    const yaml::Field joints = kin.at("joints");
+    if (!joints.is_sequence() || joints.size() == 0) {
+      joints.fail("expected a list with one entry a joint");
+    }
+    std::vector<DhRow> rows;
+    std::vector<double> lo;
+    std::vector<double> hi;
+    for (std::size_t i = 0; i < joints.size(); ++i) {
+      const yaml::Field j = joints.at(i);
+      j.only_keys({"a", "alpha", "d", "offset", "min", "max"});
+      DhRow r;
+      r.a_m = j.at("a").as_double() * u.length;
+      r.alpha_rad = j.at("alpha").as_double() * u.angle;
+      r.d_m = j.at("d").as_double() * u.length;
+      r.theta_offset_rad = j.get("offset", 0.0) * u.angle;
+      rows.push_back(r);
+      lo.push_back(j.at("min").as_double() * u.angle);
+      hi.push_back(j.at("max").as_double() * u.angle);
+      if (!(lo.back() < hi.back())) {
+        j.fail("'min' must be below 'max'");
+      }
+    }
+    set_dh_chain(d, convention == "standard_dh" ? DhConvention::kStandard : DhConvention::kModified, rows, lo, hi);
+  } else if (convention == "urdf") {
+    kin.only_keys({"convention", "file", "base_link", "tip_link"});
+    fs::path file = kin.at("file").as_string();
+    if (file.is_relative()) {
+      file = fs::path(base_dir) / file;
+    }
+    d = load_urdf_chain(file.string(), kin.get("base_link", std::string()), kin.get("tip_link", std::string()));
+  } else {
+    kin.at("convention").fail(fmt::format("unknown convention '{}' (standard_dh, modified_dh or urdf)", convention));
+  }
+  d.source = source;
+  d.name = root.get("name", d.name.empty() ? std::string("unnamed robot") : d.name);
+  if (root.has("joint_stiffness_Nm_per_rad")) {
+    const yaml::Field k = root.at("joint_stiffness_Nm_per_rad");
+    d.stiffness_nm_per_rad = k.as_doubles(d.joints.size());
+    for (std::size_t i = 0; i < d.stiffness_nm_per_rad.size(); ++i) {
+      if (d.stiffness_nm_per_rad[i] <= 0.0) {
+        k.at(i).fail("stiffness must be positive (Nm/rad)");
+      }
+    }
+  }
+  d.stiffness_note = root.get("stiffness_note", std::string());
+  if (root.has("base_frame")) {
+    d.base_T_chain = yaml::parse_pose(root.at("base_frame"), u.length, u.angle);
+  }
+  if (root.has("tool_frame")) {
+    d.flange_T_tcp = yaml::parse_pose(root.at("tool_frame"), u.length, u.angle);
+  }
+  if (root.has("wap_frame")) {
+    d.flange_T_wap = yaml::parse_pose(root.at("wap_frame"), u.length, u.angle);
+  }
+  return RobotModel(std::move(d));
+}
+
+RobotModel load_robot(const std::string& path) {
+  const std::string ext = fs::path(path).extension().string();
+  if (ext == ".urdf") {
+    return RobotModel(load_urdf_chain(path));
+  }
+  if (ext != ".yaml" && ext != ".yml") {
+    throw ModelError(fmt::format("{}: unknown robot file type '{}' (use .yaml, .yml or .urdf)", path, ext));
+  }
+  std::ifstream in(path);
+  if (!in) {
+    throw ModelError(fmt::format("{}: cannot read the robot file", path));
+  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return load_robot_yaml_text(ss.str(), path, fs::path(path).parent_path().string());
+}
+
+const std::string& builtin_irb6700_yaml() {
+  static const std::string text(kBuiltinIrb6700Yaml);
+  return text;
+}
+
+RobotModel builtin_irb6700() { return load_robot_yaml_text(builtin_irb6700_yaml(), "<built-in IRB6700>"); }
+
+RobotModel load_robot_or_builtin(const std::string& path) { return path.empty() ? builtin_irb6700() : load_robot(path); }
+
+namespace {
+std::string pose_yaml(const Pose& p) {
+  const Eigen::Quaterniond q(p.linear());
+  const Vector3 t = p.translation();
+  return fmt::format("{{position: [{:.9g}, {:.9g}, {:.9g}], quaternion_wxyz: [{:.12g}, {:.12g}, {:.12g}, {:.12g}]}}",
+                     t.x(), t.y(), t.z(), q.w(), q.x(), q.y(), q.z());
+}
+}  // namespace
+
+std::string robot_to_yaml(const RobotModel& model) {
+  const RobotDescription& d = model.description();
+  std::string out = "# deflex robot description (docs/robot-file.md)\ndeflex_robot: 1\n";
+  out += fmt::format("name: \"{}\"\nunits: {{length: m, angle: deg}}\nkinematics:\n", d.name);
+  if (d.dh_convention) {
+    out += fmt::format("  convention: {}\n  joints:\n",
+                       *d.dh_convention == DhConvention::kStandard ? "standard_dh" : "modified_dh");
+    for (std::size_t i = 0; i < d.dh.size(); ++i) {
+      const DhRow& r = d.dh[i];
+      out += fmt::format("    - {{a: {:.9g}, alpha: {:.9g}, d: {:.9g}, offset: {:.9g}, min: {:.9g}, max: {:.9g}}}\n", r.a_m,
+                         rad_to_deg(r.alpha_rad), r.d_m, rad_to_deg(r.theta_offset_rad),
+                         rad_to_deg(d.joints[i].lower_rad), rad_to_deg(d.joints[i].upper_rad));
+    }
+  } else if (!d.urdf_file.empty()) {
+    out += fmt::format("  convention: urdf\n  file: \"{}\"\n  base_link: \"{}\"\n  tip_link: \"{}\"\n", d.urdf_file,
+                       d.urdf_base_link, d.urdf_tip_link);
+  } else {
+    throw InputError("robot_to_yaml: the chain was built in code (neither DH nor URDF) and has no file form");
+  }
+  if (model.has_stiffness()) {
+    out += "joint_stiffness_Nm_per_rad: [";
+    for (int i = 0; i < model.dof(); ++i) {
+      out += fmt::format("{}{:.9g}", i ? ", " : "", model.stiffness()[i]);
+    }
+    out += "]\n";
+  }
+  if (!d.stiffness_note.empty()) {
+    out += fmt::format("stiffness_note: \"{}\"\n", d.stiffness_note);
+  }
+  out += "base_frame: " + pose_yaml(d.base_T_chain) + "\n";
+  out += "tool_frame: " + pose_yaml(d.flange_T_tcp) + "\n";
+  if (d.flange_T_wap) {
+    out += "wap_frame: " + pose_yaml(*d.flange_T_wap) + "\n";
+  }
+  return out;
+}
+
+void write_robot_yaml(const RobotModel& model, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) {
+    throw Error(fmt::format("{}: cannot write the robot file", path));
+  }
+  out << robot_to_yaml(model);
+  if (!out) {
+    throw Error(fmt::format("{}: write failed", path));
+  }
+}
+
+}  // namespace deflex

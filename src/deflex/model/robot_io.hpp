@@ -1,0 +1,39 @@
+// Loading and writing robot descriptions: deflex's YAML format, URDF serial chains, and the
+// built-in ABB IRB 6700-300/2.70. Format reference: docs/robot-file.md.
+#pragma once
+
+#include <string>
+
+#include "deflex/model/robot_model.hpp"
+
+namespace deflex {
+
+/// Loads a robot from a `.yaml`/`.yml` (deflex format) or `.urdf` file. Throws ModelError naming
+/// the file, line and field. A bare URDF carries no joint stiffness (has_stiffness() is false).
+RobotModel load_robot(const std::string& path);
+
+/// Parses deflex robot YAML from text. `source` names it in errors; relative URDF paths are
+/// resolved against `base_dir`.
+RobotModel load_robot_yaml_text(const std::string& text, const std::string& source, const std::string& base_dir = ".");
+
+/// The built-in ABB IRB 6700-300/2.70 (data/robots/abb_irb6700_300_270.yaml, compiled in).
+RobotModel builtin_irb6700();
+/// The built-in robot's YAML text.
+const std::string& builtin_irb6700_yaml();
+
+/// `path` if non-empty (load_robot), else the built-in IRB6700.
+RobotModel load_robot_or_builtin(const std::string& path);
+
+/// Serial chain of a URDF from `base_link` to `tip_link` (empty: the root, and the only leaf).
+/// Fixed joints fold into the transforms; revolute and continuous joints become JointSpecs.
+RobotDescription load_urdf_chain(const std::string& path, const std::string& base_link = "",
+                                 const std::string& tip_link = "");
+
+/// deflex YAML for a model (lengths m, angles deg): DH table or URDF reference, limits,
+/// stiffness with its note, base, tool and WAP frames. load_robot_yaml_text() reads it back.
+std::string robot_to_yaml(const RobotModel& model);
+
+/// Writes robot_to_yaml() to a file. Throws Error when the file cannot be written.
+void write_robot_yaml(const RobotModel& model, const std::string& path);
+
+}  // namespace deflex

@@ -1,0 +1,67 @@
+// Reading YAML configuration with errors that name the file, the line and the field. Every deflex
+// YAML reader (robot, sensor, case files) goes through these, so messages look the same everywhere.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "deflex/model/types.hpp"
+
+namespace deflex::yaml {
+
+/// A YAML node with the file it came from and its dotted path, for error messages.
+class Field {
+ public:
+  Field(YAML::Node node, std::string file, std::string path);
+
+  /// Parses a whole file; throws ModelError "FILE: cannot read" or "FILE:LINE: YAML syntax error".
+  static Field load_file(const std::string& path);
+  /// Parses text; `source` names it in messages.
+  static Field load_string(const std::string& text, const std::string& source);
+
+  [[nodiscard]] bool has(const std::string& key) const;
+  /// Child that must exist. Throws ModelError "FILE:LINE: field 'a.b': missing".
+  [[nodiscard]] Field at(const std::string& key) const;
+  /// Child by index of a sequence.
+  [[nodiscard]] Field at(std::size_t index) const;
+  [[nodiscard]] std::size_t size() const;
+  [[nodiscard]] bool is_sequence() const { return node_.IsSequence(); }
+  [[nodiscard]] bool is_map() const { return node_.IsMap(); }
+
+  [[nodiscard]] double as_double() const;  ///< finite number, else ModelError
+  [[nodiscard]] int as_int() const;
+  [[nodiscard]] bool as_bool() const;
+  [[nodiscard]] std::string as_string() const;
+  [[nodiscard]] std::vector<double> as_doubles(std::size_t expected_size = 0) const;  ///< 0: any size
+  [[nodiscard]] Vector3 as_vector3() const;
+
+  double get(const std::string& key, double fallback) const;
+  int get(const std::string& key, int fallback) const;
+  bool get(const std::string& key, bool fallback) const;
+  std::string get(const std::string& key, const std::string& fallback) const;
+
+  /// Fails on any key of this map not in `allowed` (catches typos like 'stifness').
+  void only_keys(const std::vector<std::string>& allowed) const;
+
+  /// Throws ModelError "FILE:LINE: field 'PATH': MESSAGE".
+  [[noreturn]] void fail(const std::string& message) const;
+
+  [[nodiscard]] const std::string& file() const { return file_; }
+  [[nodiscard]] const std::string& path() const { return path_; }
+  [[nodiscard]] int line() const;  ///< 1-based, 0 if unknown
+  [[nodiscard]] const YAML::Node& node() const { return node_; }
+
+ private:
+  YAML::Node node_;
+  std::string file_;
+  std::string path_;
+};
+
+/// A pose written as {position: [x, y, z], quaternion_wxyz: [w, x, y, z]} or
+/// {position: [...], rpy: [roll, pitch, yaw]} (fixed-axis X-Y-Z, i.e. R = Rz(yaw) Ry(pitch) Rx(roll)).
+/// `length_scale` converts the file's length unit to m, `angle_scale` its angle unit to rad.
+Pose parse_pose(const Field& f, double length_scale, double angle_scale);
+
+}  // namespace deflex::yaml
