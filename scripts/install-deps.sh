@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs what deflex needs to build and test, from Debian 12's packages only. Safe to run again:
+# apt-get skips what is already installed. Run as root (or with sudo available).
+set -euo pipefail
+packages=(
+  build-essential cmake pkg-config
+  libeigen3-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev
+  protobuf-compiler libprotobuf-dev liburdfdom-dev
+  libgtest-dev libgmock-dev libbenchmark-dev liborocos-kdl-dev
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present" >&2
+  exit 0
+fi
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then sudo=sudo; fi
+echo "install-deps: installing ${missing[*]}" >&2
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "install-deps: done" >&2
