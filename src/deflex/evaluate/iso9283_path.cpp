@@ -1,0 +1,141 @@
+// ISO 9283 path accuracy and repeatability from repeated runs.
+#include "deflex/evaluate/iso9283_path.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "deflex/model/errors.hpp"
+
+namespace deflex {
+namespace {
+
+// Point at arc length s along a polyline with cumulative lengths `cum`.
+Vector3 point_at(const TrackerTrace& path, const std::vector<double>& cum, double s) {
+  s = std::clamp(s, 0.0, cum.back());
+  const auto it = std::upper_bound(cum.begin(), cum.end(), s);
+  std::size_t k = it == cum.begin() ? 0 : static_cast<std::size_t>(it - cum.begin()) - 1;
+  if (k + 1 >= path.size()) {
+    return path.back().p_m;
+  }
+  const double len = cum[k + 1] - cum[k];
+  const double f = len > 0.0 ? (s - cum[k]) / len : 0.0;
+  return path[k].p_m + f * (path[k + 1].p_m - path[k].p_m);
+}
+
+// Of the run's crossings of the plane through c with normal n, the one nearest to c; NaN if none.
+Vector3 nearest_crossing(const TrackerTrace& run, const Vector3& c, const Vector3& n) {
+  Vector3 best = Vector3::Constant(std::numeric_limits<double>::quiet_NaN());
+  double best_d2 = std::numeric_limits<double>::infinity();
+  double f_prev = (run[0].p_m - c).dot(n);
+  for (std::size_t k = 0; k + 1 < run.size(); ++k) {
+    const double f_next = (run[k + 1].p_m - c).dot(n);
+    if ((f_prev <= 0.0 && f_next >= 0.0) || (f_prev >= 0.0 && f_next <= 0.0)) {
+      const double denom = f_prev - f_next;
+      const double a = denom != 0.0 ? f_prev / denom : 0.0;
+      const Vector3 x = run[k].p_m + a * (run[k + 1].p_m - run[k].p_m);
+      const double d2 = (x - c).squaredNorm();
+      if (d2 < best_d2) {
+        best_d2 = d2;
+        best = x;
+      }
+    }
+    f_prev = f_next;
+  }
+  return best;
+}
+
+}  // namespace
+
+Iso9283Path iso9283_path(const std::vector<TrackerTrace>& repeated_runs, const TrackerTrace& reference,
+                         int evaluation_points, double max_offset_m) {
+  if (repeated_runs.empty()) {
+    throw InputError("ISO 9283 path figures: no run given");
+  }
+  if (evaluation_points < 1) {
+    throw InputError(fmt::format("ISO 9283 path figures: {} evaluation points (need at least 1)", evaluation_points));
+  }
+  if (!(max_offset_m > 0.0)) {
+    throw InputError("ISO 9283 path figures: the largest offset of a run from the path must be positive");
+  }
+  if (reference.size() < 2) {
+    throw InputError("ISO 9283 path figures: the reference path needs at least 2 samples");
+  }
+  for (std::size_t j = 0; j < repeated_runs.size(); ++j) {
+    if (repeated_runs[j].size() < 2) {
+      throw InputError(fmt::format("ISO 9283 path figures: run {} has fewer than 2 samples", j + 1));
+    }
+  }
+  std::vector<double> cum(reference.size(), 0.0);
+  for (std::size_t k = 1; k < reference.size(); ++k) {
+    if (!reference[k].p_m.allFinite()) {
+      throw InputError(fmt::format("ISO 9283 path figures: reference sample {} is not finite", k));
+    }
+    cum[k] = cum[k - 1] + (reference[k].p_m - reference[k - 1].p_m).norm();
+  }
+  const double length = cum.back();
+  if (!(length > 0.0)) {
+    throw InputError("ISO 9283 path figures: the reference path has zero length");
+  }
+
+  Iso9283Path out;
+  out.runs = static_cast<int>(repeated_runs.size());
+  const auto n_runs = static_cast<double>(repeated_runs.size());
+  const double h = 0.01 * length;
+  double accuracy_sum = 0.0;
+  std::vector<Vector3> x(repeated_runs.size());
+  for (int i = 0; i < evaluation_points; ++i) {
+    const double s = (i + 0.5) * length / evaluation_points;
+    const Vector3 c = point_at(reference, cum, s);
+    const Vector3 chord = point_at(reference, cum, s + h) - point_at(reference, cum, s - h);
+    if (!(chord.norm() > 0.0)) {
+      ++out.skipped_points;
+      continue;
+    }
+    const Vector3 n = chord.normalized();
+    bool all = true;
+    for (std::size_t j = 0; j < repeated_runs.size() && all; ++j) {
+      x[j] = nearest_crossing(repeated_runs[j], c, n);
+      all = x[j].allFinite() && (x[j] - c).norm() <= max_offset_m;
+    }
+    if (!all) {
+      ++out.skipped_points;
+      continue;
+    }
+    Vector3 bary = Vector3::Zero();
+    for (const auto& xj : x) {
+      bary += xj;
+    }
+    bary /= n_runs;
+    const double at = (bary - c).norm();
+    double l_mean = 0.0;
+    for (const auto& xj : x) {
+      l_mean += (xj - bary).norm();
+    }
+    l_mean /= n_runs;
+    double s_l = 0.0;
+    if (repeated_runs.size() > 1) {
+      for (const auto& xj : x) {
+        const double dl = (xj - bary).norm() - l_mean;
+        s_l += dl * dl;
+      }
+      s_l = std::sqrt(s_l / (n_runs - 1.0));
+    }
+    out.accuracy_m = std::max(out.accuracy_m, at);
+    out.repeatability_m = std::max(out.repeatability_m, l_mean + 3.0 * s_l);
+    accuracy_sum += at;
+    ++out.evaluation_points;
+  }
+  if (out.evaluation_points == 0) {
+    throw InputError(fmt::format(
+        "ISO 9283 path figures: no plane normal to the reference path is crossed by every run within {} mm of "
+        "the path (do the runs follow the reference?)",
+        max_offset_m * 1e3));
+  }
+  out.mean_accuracy_m = accuracy_sum / out.evaluation_points;
+  return out;
+}
+
+}  // namespace deflex

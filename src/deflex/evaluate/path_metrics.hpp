@@ -1,0 +1,62 @@
+// Distances between measured paths: the paper's mean deformation (mean distance of a loaded path's
+// points from the unloaded path) and its companions (max, RMS, standard deviation).
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "deflex/evaluate/tracker_trace.hpp"
+
+namespace deflex {
+
+/// Nearest point on a reference path made of one or more polylines (each trace is one polyline: the
+/// last sample of one trace is not joined to the first of the next). Built once, then queried many
+/// times: a k-d tree over the vertices finds every segment that can hold the nearest point, so a
+/// query costs O(log n) for the dense paths a tracker records. The answer is exact (the same as a
+/// brute-force search over all segments).
+class PolylineIndex {
+ public:
+  /// Throws InputError when there is no sample at all or a position is not finite.
+  explicit PolylineIndex(const TrackerTrace& reference);
+  explicit PolylineIndex(const std::vector<TrackerTrace>& pieces);
+  ~PolylineIndex();
+  PolylineIndex(PolylineIndex&&) noexcept;
+  PolylineIndex& operator=(PolylineIndex&&) noexcept;
+  PolylineIndex(const PolylineIndex&) = delete;
+  PolylineIndex& operator=(const PolylineIndex&) = delete;
+
+  struct Nearest {
+    double distance_m = 0.0;
+    Vector3 point_m = Vector3::Zero();  ///< nearest point on the path
+    std::size_t segment = 0;            ///< index of the segment's first vertex (all pieces concatenated)
+    double fraction = 0.0;              ///< 0..1 along that segment
+  };
+  [[nodiscard]] Nearest nearest(const Vector3& p_m) const;
+  /// Vertices of all pieces, concatenated in order.
+  [[nodiscard]] const std::vector<Vector3>& vertices() const;
+
+ private:
+  struct Impl;
+  Impl* impl_;
+};
+
+/// The paper's figure of merit: the mean, over all points of `loaded`, of the distance to the
+/// nearest point of the `reference` polyline (m). Throws InputError on an empty trace.
+double mean_distance_to_path_m(const TrackerTrace& loaded, const TrackerTrace& reference);
+
+struct PathDeviationStats {
+  double mean_m = 0.0;  ///< the paper's mean deformation
+  double max_m = 0.0;
+  double rms_m = 0.0;
+  double std_m = 0.0;  ///< sample standard deviation of the distances
+  std::size_t samples = 0;
+};
+PathDeviationStats path_deviation(const TrackerTrace& loaded, const TrackerTrace& reference);
+/// Several loaded laps against a reference made of several laps (each its own polyline).
+PathDeviationStats path_deviation(const std::vector<TrackerTrace>& loaded, const std::vector<TrackerTrace>& reference);
+
+/// Compensation achieved: 1 - C/UC (0.67 means 67% of the uncompensated deviation removed). NaN when
+/// UC is not a positive finite number (compensation is then undefined; tables print "n/a").
+double compensation_ratio(double uc, double c);
+
+}  // namespace deflex

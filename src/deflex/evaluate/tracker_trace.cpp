@@ -1,0 +1,60 @@
+// Laser-tracker traces and their CSV form.
+#include "deflex/evaluate/tracker_trace.hpp"
+
+#include <fmt/format.h>
+
+#include "deflex/model/csv_table.hpp"
+#include "deflex/model/errors.hpp"
+
+namespace deflex {
+namespace {
+
+TrackerTrace from_table(const CsvTable& table) {
+  table.require({"t_s", "x_mm", "y_mm", "z_mm"});
+  const std::size_t ct = table.column("t_s");
+  const std::size_t cx = table.column("x_mm");
+  const std::size_t cy = table.column("y_mm");
+  const std::size_t cz = table.column("z_mm");
+  if (table.rows() == 0) {
+    throw DataError(fmt::format("{}: no samples (only a header row)", table.source()));
+  }
+  TrackerTrace trace;
+  trace.reserve(table.rows());
+  for (std::size_t r = 0; r < table.rows(); ++r) {
+    TrackerSample s;
+    s.t_s = table.at(r, ct);
+    s.p_m = Vector3(table.at(r, cx), table.at(r, cy), table.at(r, cz)) * 1e-3;
+    // Equal times are allowed (a tracker may repeat a stamp); going back means the rows are
+    // shuffled or two files were concatenated, and distances along the path would be wrong.
+    if (!trace.empty() && s.t_s < trace.back().t_s) {
+      table.fail(r, "t_s", fmt::format("time goes backwards ({} s after {} s)", s.t_s, trace.back().t_s));
+    }
+    trace.push_back(s);
+  }
+  return trace;
+}
+
+}  // namespace
+
+TrackerTrace read_tracker_csv(const std::string& path) { return from_table(CsvTable::read_file(path)); }
+
+TrackerTrace parse_tracker_csv(const std::string& text, const std::string& source) {
+  return from_table(CsvTable::parse(text, source));
+}
+
+void write_tracker_csv(const TrackerTrace& trace, const std::string& path) {
+  CsvWriter w(path, {"t_s", "x_mm", "y_mm", "z_mm"});
+  for (const auto& s : trace) {
+    w.row({s.t_s, s.p_m.x() * 1e3, s.p_m.y() * 1e3, s.p_m.z() * 1e3});
+  }
+}
+
+double trace_length_m(const TrackerTrace& trace) {
+  double length = 0.0;
+  for (std::size_t i = 1; i < trace.size(); ++i) {
+    length += (trace[i].p_m - trace[i - 1].p_m).norm();
+  }
+  return length;
+}
+
+}  // namespace deflex

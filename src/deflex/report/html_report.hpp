@@ -1,0 +1,34 @@
+// The case study's report: one self-contained HTML file (inline SVG and CSS, no scripts, no
+// network) plus the figures as separate SVG files.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "deflex/evaluate/study_tables.hpp"
+#include "deflex/report/error_budget.hpp"
+#include "deflex/report/svg_charts.hpp"
+
+namespace deflex {
+
+struct ReportContent {
+  std::string title = "deflex case study";
+  /// The setup in words: one paragraph an entry (robot, path, loads, speeds, cell effects, seed).
+  std::vector<std::string> setup_paragraphs;
+  StudyResult study;
+  std::vector<PathPlot> path_plots;
+  std::vector<ErrorBudget> error_budgets;
+  /// Honest notes: where our figures differ from the paper's and why; one paragraph an entry.
+  std::vector<std::string> notes;
+  /// Optional: the case file as given (shown verbatim in a <pre> block).
+  std::string case_text;
+};
+
+std::string html_report(const ReportContent& content);
+
+/// Writes out_dir/report.html, figure5.svg, speed_sweep.svg (when there is a sweep),
+/// path_<n>.svg, tables.md and tables.csv; creates out_dir if needed. Throws Error when a file
+/// cannot be written.
+void write_report(const ReportContent& content, const std::string& out_dir);
+
+}  // namespace deflex

@@ -1,0 +1,33 @@
+// SVG charts of a case study: the paper's Figure 5 (grouped bars), path plots with magnified
+// deviations, and the speed sweep. Each function returns one standalone <svg> element (no scripts,
+// no external resources) that can be saved as a file or inlined in HTML.
+#pragma once
+
+#include <string>
+
+#include "deflex/evaluate/study_tables.hpp"
+#include "deflex/evaluate/tracker_trace.hpp"
+
+namespace deflex {
+
+/// Figure 5 of the paper: mean deformation after compensation (and before, lighter) per load, one
+/// group of bars per setup and load, one bar per speed; the paper's values marked beside ours.
+std::string svg_figure5(const StudyResult& study);
+
+/// A path in the plane of best fit of the unloaded path: the unloaded path, the loaded uncompensated
+/// (UC) and compensated (C) paths, each drawn at unloaded + magnification * (its deviation from the
+/// unloaded path). magnification <= 0 picks one so the largest UC deviation is 8% of the path's size.
+struct PathPlot {
+  std::string title;
+  TrackerTrace unloaded, uc, c;
+  double magnification = 0.0;
+};
+std::string svg_path_plot(const PathPlot& plot);
+
+/// Compensation (or residual) versus TCP speed, one line per setup and load in the sweep.
+std::string svg_speed_sweep(const StudyResult& study);
+
+/// Escapes &, <, >, " and ' for XML text and attributes.
+std::string xml_escape(const std::string& text);
+
+}  // namespace deflex
