@@ -1,0 +1,233 @@
+// `deflex offline`: compensate a planned path for a force model and write the CSV, the RAPID module
+// and a summary (paper, Figure 2).
+#include <iostream>
+#include <memory>
+
+#include <fmt/format.h>
+
+#include "cli_util.hpp"
+#include "command.hpp"
+#include "deflex/force/force_spec.hpp"
+#include "deflex/force/ldbb_force_model.hpp"
+#include "deflex/model/errors.hpp"
+#include "deflex/model/robot_io.hpp"
+#include "deflex/offline/compensate_path.hpp"
+#include "deflex/offline/offline_csv.hpp"
+#include "deflex/offline/offline_summary.hpp"
+#include "deflex/offline/rapid_module.hpp"
+#include "deflex/paths/path_ik.hpp"
+#include "deflex/paths/path_spec.hpp"
+#include "deflex/paths/pose_path_csv.hpp"
+
+namespace deflex::cli {
+namespace {
+
+struct Opts {
+  std::string robot, circle, line, path_csv, orientation = "0,0,1,0", config, seed, csv_out, rapid_out;
+  std::vector<std::string> forces;
+  std::string motion = "absj", zone = "fine", tool = "tool0", wobj = "wobj0", module = "DeflexOffline";
+  double speed_mm_s = 10.0;
+  bool circle_given = false, json = false;
+};
+
+/// "out.csv" + "ldbb_125N_push" -> "out_ldbb_125N_push.csv" (one file per load when several).
+std::string suffixed(const std::string& path, const std::string& label) {
+  const auto slash = path.find_last_of('/');
+  const auto dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) {
+    return path + "_" + label;
+  }
+  return path.substr(0, dot) + "_" + label + path.substr(dot);
+}
+
+std::string identifier_safe(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  }
+  return out;
+}
+
+void run(const Opts& o, int& exit_code) {
+  const int sources = (o.circle_given ? 1 : 0) + (o.line.empty() ? 0 : 1) + (o.path_csv.empty() ? 0 : 1);
+  if (sources != 1) {
+    throw InputError("give exactly one path: --circle [SPEC], --line SPEC or --path FILE.csv");
+  }
+  if (o.forces.empty()) {
+    throw InputError("give a force model: --force ldbb:...|constant:...|table:FILE.csv");
+  }
+  const RobotModel model = load_robot_or_builtin(o.robot);
+
+  // Path.
+  ForceSpecContext context;
+  std::vector<Pose> poses;
+  std::string path_text;
+  if (!o.path_csv.empty()) {
+    poses = read_pose_path_csv(o.path_csv);
+    path_text = fmt::format("poses from {}", o.path_csv);
+  } else {
+    const auto qv = parse_numbers(o.orientation, "--orientation-wxyz", 4);
+    const Eigen::Quaterniond orientation =
+        checked_unit_quaternion(Eigen::Quaterniond(qv[0], qv[1], qv[2], qv[3]), "option --orientation-wxyz", 1e-3);
+    if (o.circle_given) {
+      const CirclePath c = parse_circle_spec(o.circle == "default" ? "" : o.circle);
+      context.circle = c;
+      poses = sample_circle(c, orientation);
+      path_text = fmt::format("circle centre ({:.1f}, {:.1f}, {:.1f}) mm, radius {:.1f} mm, normal ({:g}, {:g}, {:g}), "
+                              "{}, {} points",
+                              c.centre_m.x() * 1e3, c.centre_m.y() * 1e3, c.centre_m.z() * 1e3, c.radius_m * 1e3,
+                              c.normal.x(), c.normal.y(), c.normal.z(), c.clockwise ? "clockwise" : "counter-clockwise",
+                              c.points);
+    } else {
+      const LinePath l = parse_line_spec(o.line);
+      poses = sample_line(l, orientation);
+      path_text = fmt::format("line from ({:.1f}, {:.1f}, {:.1f}) mm to ({:.1f}, {:.1f}, {:.1f}) mm, {} points",
+                              l.start_m.x() * 1e3, l.start_m.y() * 1e3, l.start_m.z() * 1e3, l.end_m.x() * 1e3,
+                              l.end_m.y() * 1e3, l.end_m.z() * 1e3, l.points);
+    }
+  }
+
+  // Inverse kinematics along the path, one configuration kept.
+  IkRequest first;
+  if (!o.config.empty()) {
+    const auto c = parse_numbers(o.config, "--config", 4);
+    if (c[3] < 0 || c[3] > 7) {
+      throw InputError("option --config: cfx must be 0..7");
+    }
+    first.configuration =
+        ArmConfiguration{static_cast<int>(c[0]), static_cast<int>(c[1]), static_cast<int>(c[2]), static_cast<int>(c[3])};
+  }
+  if (!o.seed.empty()) {
+    first.seed = parse_joints_deg(o.seed, model, "--seed-deg");
+  }
+  const JointPath joints = solve_path_ik(model, poses, first);
+
+  // Force models: several --force options, or several force_N values, give one run per load.
+  std::vector<std::unique_ptr<ForceModel>> forces;
+  for (const std::string& spec : o.forces) {
+    for (auto& m : parse_force_specs(spec, context)) {
+      forces.push_back(std::move(m));
+    }
+  }
+
+  RapidOptions rapid;
+  if (o.motion == "absj") {
+    rapid.motion = RapidMotion::kMoveAbsJ;
+  } else if (o.motion == "movel") {
+    rapid.motion = RapidMotion::kMoveL;
+  } else {
+    throw InputError(fmt::format("option --motion: '{}' is neither absj nor movel", o.motion));
+  }
+  rapid.speed_mm_s = o.speed_mm_s;
+  rapid.zone = o.zone;
+  rapid.tool = o.tool;
+  rapid.wobj = o.wobj;
+  rapid.note = fmt::format("Path: {}; arm configuration [cf1,cf4,cf6,cfx] at the start [{},{},{},{}].", path_text,
+                           joints.configuration.cf1, joints.configuration.cf4, joints.configuration.cf6,
+                           joints.configuration.cfx);
+
+  nlohmann::json runs = nlohmann::json::array();
+  const bool several = forces.size() > 1;
+  for (std::size_t k = 0; k < forces.size(); ++k) {
+    const ForceModel& force = *forces[k];
+    const OfflineResult result = compensate_path(model, joints, poses, force);
+    const std::string label = several ? identifier_safe(force.label()) : "";
+    nlohmann::json run{{"force", force.describe()},
+                       {"points", result.points.size()},
+                       {"max_deflection_mm", result.max_deflection_m * 1e3},
+                       {"mean_deflection_mm", result.mean_deflection_m * 1e3},
+                       {"max_residual_mm", result.max_residual_m * 1e3},
+                       {"max_correction_mm", result.max_correction_m * 1e3},
+                       {"max_joint_correction_deg", rad_to_deg(result.max_joint_correction_rad)}};
+    std::string extra;
+    if (const auto* ldbb = dynamic_cast<const LdbbForceModel*>(&force)) {
+      double lmin = HUGE_VAL, lmax = 0.0, pmin = HUGE_VAL, pmax = -HUGE_VAL;
+      for (const Pose& p : poses) {
+        lmin = std::min(lmin, ldbb->bar_length_m(p));
+        lmax = std::max(lmax, ldbb->bar_length_m(p));
+        pmin = std::min(pmin, ldbb->inclination_rad(p));
+        pmax = std::max(pmax, ldbb->inclination_rad(p));
+      }
+      extra = fmt::format("LDBB bar: length {:.2f}..{:.2f} mm, inclination to the XY plane {:.2f}..{:.2f} deg\n",
+                          lmin * 1e3, lmax * 1e3, rad_to_deg(pmin), rad_to_deg(pmax));
+      run["bar_length_mm"] = {lmin * 1e3, lmax * 1e3};
+      run["bar_inclination_deg"] = {rad_to_deg(pmin), rad_to_deg(pmax)};
+    }
+    if (!o.csv_out.empty()) {
+      const std::string file = several ? suffixed(o.csv_out, label) : o.csv_out;
+      write_offline_csv(result, file);
+      run["csv"] = file;
+      extra += fmt::format("wrote {}\n", file);
+    }
+    if (!o.rapid_out.empty()) {
+      const std::string file = several ? suffixed(o.rapid_out, label) : o.rapid_out;
+      rapid.module_name = several ? o.module + "_" + label : o.module;
+      if (rapid.module_name.size() > 32) {
+        rapid.module_name = (o.module + "_" + std::to_string(k + 1)).substr(0, 32);
+      }
+      write_rapid_module(result, rapid, file);
+      run["rapid"] = file;
+      extra += fmt::format("wrote {} (module {})\n", file, rapid.module_name);
+    }
+    runs.push_back(run);
+    if (!o.json) {
+      std::cout << (k == 0 ? "" : "\n") << offline_summary(result) << extra;
+    } else {
+      std::cerr << extra;
+    }
+  }
+  if (o.json) {
+    print_json({{"robot", model.name()},
+                {"path", path_text},
+                {"configuration", {joints.configuration.cf1, joints.configuration.cf4, joints.configuration.cf6,
+                                   joints.configuration.cfx}},
+                {"runs", runs}});
+  }
+  exit_code = 0;
+}
+
+void setup_offline(CLI::App& sub, int& exit_code) {
+  auto o = std::make_shared<Opts>();
+  sub.add_option("--robot", o->robot,
+                 "Robot file (.yaml deflex format or .urdf) with joint stiffness; default: the built-in ABB IRB 6700");
+  sub.add_option("--circle", o->circle,
+                 "Circle path \"centre_mm=X;Y;Z,radius_mm=R,normal=NX;NY;NZ,start_deg=A,direction=ccw|cw,points=N\"; "
+                 "every key optional (default: centre 1500;0;1000 mm, radius 100 mm, normal +z, ccw, 81 points, the "
+                 "last repeating the first); \"--circle default\" takes them all")
+      ->expected(0, 1);
+  sub.add_option("--line", o->line, "Straight path \"start_mm=X;Y;Z,end_mm=X;Y;Z,points=N\"");
+  sub.add_option("--path", o->path_csv, "Path CSV with columns x_mm,y_mm,z_mm,qw,qx,qy,qz (base frame)");
+  sub.add_option("--orientation-wxyz", o->orientation,
+                 "TCP orientation held along a circle or line, unit quaternion \"w,x,y,z\" (default 0,0,1,0: tool "
+                 "z axis pointing down for the IRB6700's tool0)");
+  sub.add_option("--config", o->config, "ABB confdata \"cf1,cf4,cf6,cfx\" at the first point (cfx kept along the path)");
+  sub.add_option("--seed-deg", o->seed, "Preferred joint values at the first point, degrees \"j1,...,j6\"");
+  sub.add_option("--force", o->forces,
+                 "Force model (repeatable): \"ldbb:pivot_mm=X;Y;Z,force_N=F[;F2..],mode=push|pull\", "
+                 "\"ldbb:phi_deg=A,force_N=...\" (circle only: pivot on the circle's axis, bar inclined by A), "
+                 "\"constant:fx_N=..,fy_N=..,fz_N=..,mx_Nm=..,my_Nm=..,mz_Nm=..\", \"table:FILE.csv\"")
+      ->required();
+  sub.add_option("--speed-mm-s", o->speed_mm_s, "TCP speed for the RAPID speeddata, mm/s (default 10)");
+  sub.add_option("--zone", o->zone, "RAPID zonedata: fine (default) or z0, z1, z5, z10, ...");
+  sub.add_option("--motion", o->motion, "RAPID motion: absj (MoveAbsJ over jointtargets, default) or movel "
+                                        "(MoveL over robtargets with confdata)");
+  sub.add_option("--tool", o->tool, "RAPID tooldata name (default tool0)");
+  sub.add_option("--wobj", o->wobj, "RAPID wobjdata name (default wobj0)");
+  sub.add_option("--module", o->module, "RAPID module name (default DeflexOffline; the load is appended when several)");
+  sub.add_option("-o,--output", o->csv_out, "Write the per-point CSV here (one file per load when several)");
+  sub.add_option("--rapid", o->rapid_out, "Write the ABB RAPID module here (.mod; one per load when several)");
+  sub.add_flag("--json", o->json, "Print one JSON document on stdout");
+  sub.callback([o, &exit_code, &sub] {
+    o->circle_given = sub.count("--circle") > 0;
+    run(*o, exit_code);
+  });
+}
+
+}  // namespace
+
+DEFLEX_COMMAND("offline",
+               "Offline compensation: a path (circle, line or CSV) and a force model to compensated joints, CSV and an "
+               "ABB RAPID module",
+               setup_offline, 30);
+
+}  // namespace deflex::cli

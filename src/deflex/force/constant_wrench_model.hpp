@@ -1,0 +1,21 @@
+// A constant process wrench (e.g. a drilling thrust): the same base-frame wrench at every point.
+#pragma once
+
+#include "deflex/force/force_model.hpp"
+
+namespace deflex {
+
+class ConstantWrenchModel final : public ForceModel {
+ public:
+  /// [Fx Fy Fz Mx My Mz], N and Nm, base frame, moment about the TCP. Throws InputError if not finite.
+  explicit ConstantWrenchModel(const Wrench& wrench_base);
+
+  [[nodiscard]] Wrench wrench_at(std::size_t index, const Pose& base_T_tcp) const override;
+  [[nodiscard]] std::string describe() const override;
+  [[nodiscard]] std::string label() const override { return "constant"; }
+
+ private:
+  Wrench wrench_;
+};
+
+}  // namespace deflex

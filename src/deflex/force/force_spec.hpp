@@ -1,0 +1,47 @@
+// Force models from a one-line text specification (command-line option, case file):
+//
+//   ldbb:pivot_mm=X;Y;Z,force_N=F[;F2;...],mode=push|pull
+//   ldbb:phi_deg=A,force_N=F[;F2;...],mode=push|pull        (needs a circle path, see below)
+//   constant:fx_N=..,fy_N=..,fz_N=..,mx_Nm=..,my_Nm=..,mz_Nm=..   (absent components are 0)
+//   table:FILE.csv                                          (see wrench_table_model.hpp)
+//
+// Keys are separated by ',' and the components of one value by ';'. Every unit is in the key's
+// name; positions in mm, forces in N, moments in Nm (moment about the TCP), base frame. mode
+// defaults to push. Several force_N values give one model per load (the paper's 125;375;625).
+//
+// phi_deg places the LDBB pivot on the circle's axis so the bar is inclined by phi to the circle's
+// plane: pivot = centre - normal * radius * tan(phi), i.e. below the circle for phi > 0 and a normal
+// of +z (paper, Figure 4). The bar length is then radius / cos(phi) at every point, as a real DBB
+// demands (the ball runs on a sphere round the pivot).
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "deflex/force/force_model.hpp"
+#include "deflex/paths/circle_path.hpp"
+
+namespace deflex {
+
+/// What the path knows that a spec may refer to.
+struct ForceSpecContext {
+  std::optional<CirclePath> circle;  ///< enables ldbb:phi_deg=...
+};
+
+/// Every model the spec describes (more than one only for several force_N values). Throws
+/// InputError quoting the spec and the key at fault (unknown or repeated key, bad number, missing
+/// key, phi_deg without a circle); a table spec throws DataError from the CSV reader.
+[[nodiscard]] std::vector<std::unique_ptr<ForceModel>> parse_force_specs(const std::string& spec,
+                                                                         const ForceSpecContext& context = {});
+
+/// Exactly one model; InputError when the spec gives several loads.
+[[nodiscard]] std::unique_ptr<ForceModel> parse_force_spec(const std::string& spec,
+                                                           const ForceSpecContext& context = {});
+
+/// The LDBB pivot for a bar inclined by phi (rad) to the circle's plane (see the file comment), m.
+/// Throws InputError unless |phi| < 89 deg.
+[[nodiscard]] Vector3 ldbb_pivot_for_circle(const CirclePath& circle, double phi_rad);
+
+}  // namespace deflex

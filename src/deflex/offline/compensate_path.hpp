@@ -1,0 +1,67 @@
+// Offline compensation of a planned path (paper, Figure 2): the process wrench expected at each
+// point, the deflection the lumped joint-compliance model predicts, and the command that makes the
+// deflected arm end where the task wants it.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "deflex/force/force_model.hpp"
+#include "deflex/model/inverse_kinematics.hpp"
+#include "deflex/paths/path_ik.hpp"
+
+namespace deflex {
+
+/// One compensated path point. Joint values in rad, poses and displacements in the base frame (m,
+/// rad), wrench in N and Nm.
+struct OfflinePoint {
+  JointVector q_desired;  ///< from the path's inverse kinematics
+  JointVector q_command;  ///< compensated command, exact form: q_desired - K^-1 J_wap(q_desired)^T W
+  Pose tcp_desired;       ///< the pose the task wants (the path's pose)
+  Pose tcp_command;       ///< FK(q_command): the equivalent compensated Cartesian target
+  ArmConfiguration configuration_command;  ///< confdata of q_command (for robtargets)
+  /// The wrench the model uses: base frame, moment about the robot's wrench application point
+  /// (the force model's moment about the TCP, moved to the WAP when the two differ).
+  Wrench wrench_base;
+  /// Uncompensated: the TCP displacement when the loaded arm is commanded to q_desired, from
+  /// FK(q_desired) to FK(q_actual), q_actual solving q = q_desired + K^-1 J_wap(q)^T W (the core's
+  /// deflected_configuration, not the first-order J dtheta). [m; rad].
+  Displacement predicted_deflection = Displacement::Zero();
+  /// After compensation: from tcp_desired to FK(deflected_configuration(q_command, W)). Zero up to
+  /// the IK and fixed-point tolerances when the model is the robot; a check of the exact form.
+  Displacement predicted_residual = Displacement::Zero();
+};
+
+struct OfflineResult {
+  std::vector<OfflinePoint> points;
+  double max_deflection_m = 0.0;   ///< largest |translation| of predicted_deflection
+  double mean_deflection_m = 0.0;  ///< mean |translation| of predicted_deflection over all points
+  double max_deflection_rad = 0.0;
+  double max_residual_m = 0.0;  ///< largest |translation| of predicted_residual
+  double max_residual_rad = 0.0;
+  double max_correction_m = 0.0;        ///< largest |p_command - p_desired|
+  double max_joint_correction_rad = 0.0;  ///< largest |q_command - q_desired| over joints and points
+  std::string robot_name;
+  std::string stiffness_note;
+  std::string force_description;
+  bool predicted = true;  ///< false when OfflineOptions::predict was off (deflection figures unset)
+};
+
+struct OfflineOptions {
+  /// Predict the uncompensated deflection and the residual (two fixed-point solves and FKs a
+  /// point). Off, only the compensation itself runs (q_command, tcp_command, wrench).
+  bool predict = true;
+};
+
+/// Compensates every point of `path` (joint values from solve_path_ik) whose desired poses are
+/// `tcp_poses`, under the wrench `force` predicts at each point. Throws InputError when the sizes
+/// disagree, the force model has data for a different number of points, the robot has no joint
+/// stiffness, a compensated joint leaves its limits, or the deflection does not converge (a load far
+/// beyond the model's range); each names the path point (0-based).
+[[nodiscard]] OfflineResult compensate_path(const RobotModel& model, const JointPath& path,
+                                            const std::vector<Pose>& tcp_poses, const ForceModel& force,
+                                            const OfflineOptions& options);
+[[nodiscard]] OfflineResult compensate_path(const RobotModel& model, const JointPath& path,
+                                            const std::vector<Pose>& tcp_poses, const ForceModel& force);
+
+}  // namespace deflex

@@ -1,0 +1,84 @@
+// Writing offline compensation results as CSV.
+#include "deflex/offline/offline_csv.hpp"
+
+#include <fmt/format.h>
+
+#include "deflex/model/csv_table.hpp"
+#include "deflex/model/errors.hpp"
+
+namespace deflex {
+namespace {
+
+void add_pose(std::vector<double>& row, const Pose& p) {
+  Eigen::Quaterniond q(p.linear());
+  if (q.w() < 0.0) {
+    q.coeffs() = -q.coeffs();  // same rotation; w >= 0 reads more easily and matches RAPID output
+  }
+  const Vector3 t = p.translation() * 1e3;
+  row.insert(row.end(), {t.x(), t.y(), t.z(), q.w(), q.x(), q.y(), q.z()});
+}
+
+}  // namespace
+
+std::vector<std::string> offline_csv_columns(int dof) {
+  std::vector<std::string> c{"index"};
+  for (const char* which : {"des", "cmd"}) {
+    for (int j = 1; j <= dof; ++j) {
+      c.push_back(fmt::format("q{}_{}_deg", j, which));
+    }
+  }
+  for (const char* which : {"des", "cmd"}) {
+    for (const char* axis : {"x", "y", "z"}) {
+      c.push_back(fmt::format("{}_{}_mm", axis, which));
+    }
+    for (const char* comp : {"qw", "qx", "qy", "qz"}) {
+      c.push_back(fmt::format("{}_{}", comp, which));
+    }
+  }
+  c.insert(c.end(), {"cf1_cmd", "cf4_cmd", "cf6_cmd", "cfx_cmd", "fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm",
+                     "deflection_x_mm", "deflection_y_mm", "deflection_z_mm", "deflection_rx_mrad",
+                     "deflection_ry_mrad", "deflection_rz_mrad", "deflection_mm", "residual_mm", "residual_mrad"});
+  return c;
+}
+
+void write_offline_csv(const OfflineResult& result, const std::string& path) {
+  if (result.points.empty()) {
+    throw InputError(fmt::format("{}: no compensated points to write", path));
+  }
+  const int dof = static_cast<int>(result.points.front().q_desired.size());
+  const auto columns = offline_csv_columns(dof);
+  CsvWriter out(path, columns);
+  out.comment(fmt::format("deflex offline: robot {}; force {}; wrench in the base frame, moment about the WAP; "
+                          "deflection = loaded minus unloaded TCP pose when commanded to the desired joints{}",
+                          result.robot_name, result.force_description,
+                          result.predicted ? "" : " (not predicted: columns are zero)"));
+  std::vector<double> row;
+  row.reserve(columns.size());
+  for (std::size_t i = 0; i < result.points.size(); ++i) {
+    const OfflinePoint& p = result.points[i];
+    row.clear();
+    row.push_back(static_cast<double>(i));
+    for (const JointVector* q : {&p.q_desired, &p.q_command}) {
+      for (int j = 0; j < dof; ++j) {
+        row.push_back(rad_to_deg((*q)[j]));
+      }
+    }
+    add_pose(row, p.tcp_desired);
+    add_pose(row, p.tcp_command);
+    const ArmConfiguration& c = p.configuration_command;
+    row.insert(row.end(), {static_cast<double>(c.cf1), static_cast<double>(c.cf4), static_cast<double>(c.cf6),
+                           static_cast<double>(c.cfx)});
+    for (int k = 0; k < 6; ++k) {
+      row.push_back(p.wrench_base[k]);
+    }
+    for (int k = 0; k < 6; ++k) {
+      row.push_back(p.predicted_deflection[k] * 1e3);  // m -> mm, rad -> mrad
+    }
+    row.push_back(p.predicted_deflection.head<3>().norm() * 1e3);
+    row.push_back(p.predicted_residual.head<3>().norm() * 1e3);
+    row.push_back(p.predicted_residual.tail<3>().norm() * 1e3);
+    out.row(row);
+  }
+}
+
+}  // namespace deflex

@@ -1,0 +1,82 @@
+// Inverse kinematics along a path with one configuration kept.
+#include "deflex/paths/path_ik.hpp"
+
+#include <fmt/format.h>
+
+#include "deflex/model/errors.hpp"
+
+namespace deflex {
+namespace {
+
+[[noreturn]] void fail_point(std::size_t index, const IkResult& r) {
+  const char* reason = "failed";
+  switch (r.status) {
+    case IkStatus::kUnreachable:
+      reason = "unreachable";
+      break;
+    case IkStatus::kOutsideJointLimits:
+      reason = "outside the joint limits";
+      break;
+    case IkStatus::kConfigurationUnavailable:
+      reason = "no solution with the path's arm configuration";
+      break;
+    case IkStatus::kNearSingular:
+      reason = "singular";
+      break;
+    case IkStatus::kNotConverged:
+      reason = "inverse kinematics did not converge";
+      break;
+    case IkStatus::kInvalidInput:
+      reason = "invalid pose";
+      break;
+    case IkStatus::kOk:
+      break;
+  }
+  throw InputError(fmt::format("path point {}: {} ({})", index, reason, r.message));
+}
+
+}  // namespace
+
+JointPath solve_path_ik(const RobotModel& model, const std::vector<Pose>& poses, const IkRequest& first) {
+  return solve_path_ik(model, poses, first, PathIkOptions{});
+}
+
+JointPath solve_path_ik(const RobotModel& model, const std::vector<Pose>& poses, const IkRequest& first,
+                        const PathIkOptions& options) {
+  if (poses.empty()) {
+    throw InputError("path: no points");
+  }
+  Workspace ws(model);
+  JointPath path;
+  path.q.reserve(poses.size());
+  IkRequest request = first;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const IkResult r = inverse_kinematics(model, ws, poses[i], request);
+    if (!r.ok() || (r.status == IkStatus::kNearSingular && !options.allow_near_singular)) {
+      fail_point(i, r);
+    }
+    if (i == 0) {
+      path.configuration = r.configuration;
+      // From here on the branch (cfx) is fixed and the nearest solution wins: the quadrants follow
+      // the joints continuously instead of being forced.
+      request.configuration = r.configuration;
+      request.match_quadrants = false;
+    } else {
+      const JointVector& prev = path.q.back();
+      for (int j = 0; j < model.dof(); ++j) {
+        const double step = std::abs(r.q[j] - prev[j]);
+        if (step > options.max_joint_step_rad) {
+          throw InputError(fmt::format(
+              "path point {}: joint {} moves {:.2f} deg from point {} (limit {:.2f} deg): the path passes a "
+              "singularity or a joint limit with this configuration, or it is sampled too coarsely",
+              i, j + 1, rad_to_deg(step), i - 1, rad_to_deg(options.max_joint_step_rad)));
+        }
+      }
+    }
+    path.q.push_back(r.q);
+    request.seed = r.q;
+  }
+  return path;
+}
+
+}  // namespace deflex

@@ -1,0 +1,40 @@
+// Inverse kinematics along a sampled TCP path with one arm configuration kept, so the robot does not
+// swing between solutions in the middle of a path.
+#pragma once
+
+#include <vector>
+
+#include "deflex/model/inverse_kinematics.hpp"
+
+namespace deflex {
+
+/// Joint values along a path, rad, one entry a pose, and the arm configuration (confdata) chosen at
+/// the first point. cfx (the branch: shoulder, elbow, wrist flip) is the same at every point; the
+/// quadrants cf1, cf4, cf6 may change along the way when a joint crosses a multiple of 90 degrees,
+/// as they do on a real controller.
+struct JointPath {
+  std::vector<JointVector> q;
+  ArmConfiguration configuration;
+};
+
+struct PathIkOptions {
+  /// Largest change of any joint between neighbouring points. A larger step means the nearest
+  /// solution lies on the other side of a singularity or a joint wrapped: the path is not
+  /// followable with the chosen configuration, or it is sampled too coarsely. 30 deg by default
+  /// (a circle of 81 points moves the IRB6700's joints by about 1 deg a point).
+  double max_joint_step_rad = deg_to_rad(30.0);
+  /// Near-singular poses stop the path (IK there is ill-conditioned and the compensation would
+  /// move joints by large amounts); set true to accept them.
+  bool allow_near_singular = false;
+};
+
+/// Solves every pose of `poses` (base_T_tcp). The first point uses `first` as given (its
+/// configuration and seed pick the solution); every later point keeps the first point's cfx and is
+/// the solution closest to the previous point. Throws InputError "path point I: REASON" (I 0-based)
+/// when a point is unreachable, near a singularity, outside the joint limits, has no solution with
+/// the configuration, or jumps by more than max_joint_step_rad; and when `poses` is empty.
+[[nodiscard]] JointPath solve_path_ik(const RobotModel& model, const std::vector<Pose>& poses, const IkRequest& first,
+                                      const PathIkOptions& options);
+[[nodiscard]] JointPath solve_path_ik(const RobotModel& model, const std::vector<Pose>& poses, const IkRequest& first);
+
+}  // namespace deflex
