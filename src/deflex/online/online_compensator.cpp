@@ -1,0 +1,187 @@
+// The online compensation cycle (see online_compensator.hpp).
+#include "deflex/online/online_compensator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "deflex/model/compliance.hpp"
+#include "deflex/model/errors.hpp"
+
+namespace deflex {
+
+void OnlineConfig::validate() const {
+  const auto positive = [](double v, const char* name) {
+    if (!std::isfinite(v) || !(v > 0.0)) {
+      throw InputError(fmt::format("online configuration: {} must be finite and > 0 (got {})", name, v));
+    }
+  };
+  positive(period_s, "period_s");
+  positive(max_joint_correction_rad, "max_joint_correction_rad");
+  positive(max_tcp_correction_m, "max_tcp_correction_m");
+  positive(max_correction_rate_rad_s, "max_correction_rate_rad_s");
+  positive(watchdog_s, "watchdog_s");
+  if (!std::isfinite(fault_hold_s) || fault_hold_s < 0.0) {
+    throw InputError("online configuration: fault_hold_s must be finite and >= 0");
+  }
+}
+
+const char* to_string(CycleStatus s) {
+  switch (s) {
+    case CycleStatus::kOk: return "ok";
+    case CycleStatus::kNoForceYet: return "no_force_yet";
+    case CycleStatus::kStaleForce: return "stale_force";
+    case CycleStatus::kForceFault: return "force_fault";
+    case CycleStatus::kInvalidInput: return "invalid_input";
+  }
+  return "unknown";
+}
+
+namespace {
+Pose sensor_T_wap_of(const RobotModel& model, const SensorConfig& sensor) {
+  return sensor.flange_T_sensor.inverse() * model.flange_T_wap();
+}
+}  // namespace
+
+OnlineCompensator::OnlineCompensator(const RobotModel& model, const SensorConfig& sensor, const OnlineConfig& config)
+    : model_(model),
+      config_(config),
+      flange_T_sensor_(sensor.flange_T_sensor),
+      pipeline_(sensor, sensor_T_wap_of(model, sensor)),
+      ws_(model_),
+      jac_(6, model.dof()) {
+  config_.validate();
+  (void)model_.stiffness();  // throws ModelError when the robot file gives no stiffness
+  correction_ = JointVector::Zero(model_.dof());
+}
+
+void OnlineCompensator::push_force(const ForceSample& sample) noexcept {
+  if (queue_count_ == kQueueSize) {
+    queue_head_ = (queue_head_ + 1) % kQueueSize;  // drop the oldest
+    --queue_count_;
+    ++counters_.samples_dropped;
+  }
+  queue_[static_cast<std::size_t>((queue_head_ + queue_count_) % kQueueSize)] = sample;
+  ++queue_count_;
+}
+
+void OnlineCompensator::drain(ForceSource& source) noexcept {
+  ForceSample s;
+  // Bounded so that a source flooding faster than we read cannot stall the cycle.
+  for (int i = 0; i < 4 * kQueueSize && source.latest(s); ++i) {
+    push_force(s);
+  }
+}
+
+CycleOutput OnlineCompensator::step(const CycleInput& input, ForceSource& source) noexcept {
+  drain(source);
+  return step(input);
+}
+
+void OnlineCompensator::reset() noexcept {
+  queue_head_ = 0;
+  queue_count_ = 0;
+  correction_.setZero();
+  have_force_ = false;
+  wrench_base_.setZero();
+  last_fault_t_s_ = -1e300;
+  have_cycle_ = false;
+  pipeline_.reset();
+}
+
+CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
+  CycleOutput out;
+  const int n = model_.dof();
+  ++counters_.cycles;
+  if (in.q_planned.size() != n || in.q_feedback.size() != n || !in.q_planned.allFinite() ||
+      !in.q_feedback.allFinite() || !std::isfinite(in.t_s) || (have_cycle_ && in.t_s < last_cycle_t_s_)) {
+    ++counters_.invalid_inputs;
+    out.status = CycleStatus::kInvalidInput;
+    out.q_command = JointVector::Zero(n);
+    out.dtheta = JointVector::Zero(n);
+    return out;
+  }
+  // Time since the last cycle; a first cycle or a jump (pause, debugger) counts as one period so the
+  // rate bound never lets a large step through.
+  double dt = config_.period_s;
+  if (have_cycle_) {
+    dt = std::min(in.t_s - last_cycle_t_s_, 10.0 * config_.period_s);
+  }
+  last_cycle_t_s_ = in.t_s;
+  have_cycle_ = true;
+
+  // Sensor orientation from the configuration the arm has now.
+  forward_kinematics(model_, ws_, in.q_feedback);
+  const Matrix3 base_R_sensor = ws_.base_T_flange.linear() * flange_T_sensor_.linear();
+
+  // Condition every queued sample with this cycle's orientation.
+  while (queue_count_ > 0) {
+    const ForceSample& s = queue_[static_cast<std::size_t>(queue_head_)];
+    queue_head_ = (queue_head_ + 1) % kQueueSize;
+    --queue_count_;
+    const ConditionedWrench c = pipeline_.step(s, base_R_sensor);
+    ++out.samples_used;
+    if (c.status == PipelineStatus::kFault) {
+      ++counters_.samples_fault;
+      last_fault_t_s_ = in.t_s;
+    } else if (c.status == PipelineStatus::kInvalidSample) {
+      ++counters_.samples_invalid;
+    } else {
+      ++counters_.samples_ok;
+      wrench_base_ = c.wrench_base;
+      have_force_ = true;
+      last_force_t_s_ = in.t_s;
+    }
+  }
+
+  // Target correction: the model's deflection, or zero when the force cannot be trusted.
+  JointVector target = JointVector::Zero(n);
+  out.force_age_s = have_force_ ? in.t_s - last_force_t_s_ : 0.0;
+  if (!have_force_) {
+    out.status = CycleStatus::kNoForceYet;
+  } else if (in.t_s - last_fault_t_s_ <= config_.fault_hold_s) {
+    out.status = CycleStatus::kForceFault;
+  } else if (out.force_age_s > config_.watchdog_s) {
+    out.status = CycleStatus::kStaleForce;
+  } else {
+    out.status = CycleStatus::kOk;
+    const JointVector& q_model = config_.jacobian_at == JacobianAt::kPlanned ? in.q_planned : in.q_feedback;
+    joint_deflection(model_, ws_, q_model, wrench_base_, target);
+    if (!target.allFinite()) {
+      target.setZero();
+    }
+    // Size bounds: per joint, then the TCP translation it produces (scaled as a whole, so the
+    // direction of the correction is kept).
+    for (int i = 0; i < n; ++i) {
+      const double clamped = std::clamp(target[i], -config_.max_joint_correction_rad, config_.max_joint_correction_rad);
+      out.size_limited = out.size_limited || clamped != target[i];
+      target[i] = clamped;
+    }
+    point_jacobian(ws_, ws_.base_T_tcp.translation(), jac_);
+    const double tcp_m = (jac_.topRows<3>() * target).norm();
+    if (tcp_m > config_.max_tcp_correction_m) {
+      target *= config_.max_tcp_correction_m / tcp_m;
+      out.size_limited = true;
+    }
+  }
+  out.wrench_base = wrench_base_;
+
+  // Rate bound; also the ramp to zero when the target dropped to zero.
+  const double max_step = config_.max_correction_rate_rad_s * dt;
+  for (int i = 0; i < n; ++i) {
+    const double change = target[i] - correction_[i];
+    const double limited = std::clamp(change, -max_step, max_step);
+    out.rate_limited = out.rate_limited || limited != change;
+    correction_[i] += limited;
+  }
+  out.dtheta = correction_;
+  out.q_command = in.q_planned - correction_;
+  if (out.status != CycleStatus::kOk) {
+    point_jacobian(ws_, ws_.base_T_tcp.translation(), jac_);  // FK is at q_feedback here
+  }
+  out.tcp_correction_m = (jac_.topRows<3>() * correction_).norm();
+  return out;
+}
+
+}  // namespace deflex

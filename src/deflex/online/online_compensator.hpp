@@ -1,0 +1,115 @@
+// The online compensation cycle (paper, Figure 3): every cycle the latest conditioned wrench and the
+// current configuration give dtheta = K^-1 J^T W by the lumped model, and theta_c = theta_planned -
+// dtheta goes to the controller. Bounded in size and rate; stale or faulty force data ramp the
+// correction to zero. step() never allocates, locks or throws (tests prove it with AllocationGuard).
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "deflex/model/kinematics.hpp"
+#include "deflex/online/force_pipeline.hpp"
+
+namespace deflex {
+
+/// Where the Jacobian of dtheta = K^-1 J(q)^T W is evaluated.
+enum class JacobianAt {
+  kPlanned,   ///< q_planned: the exact compensation form (compliance.hpp, compensated_configuration)
+  kFeedback,  ///< q_feedback: the configuration the arm has now (the paper's "current pose")
+};
+
+struct OnlineConfig {
+  double period_s = 0.004;                    ///< nominal cycle (4 ms EGM; 0.1 s like the paper)
+  double max_joint_correction_rad = 0.01;     ///< per joint |dtheta_i| bound
+  double max_tcp_correction_m = 0.005;        ///< bound on |J_p dtheta| (TCP translation)
+  double max_correction_rate_rad_s = 0.05;    ///< per joint |d(dtheta_i)/dt| bound, also the ramp to zero
+  double watchdog_s = 0.05;                   ///< no valid force sample for this long: ramp to zero
+  double fault_hold_s = 0.5;                  ///< after a fault sample, hold the correction target at zero
+  JacobianAt jacobian_at = JacobianAt::kPlanned;
+
+  /// Throws InputError on a non-positive or non-finite value.
+  void validate() const;
+};
+
+/// KDL's sign convention: >= 0 the output is usable (positive: degraded), < 0 nothing to send.
+enum class CycleStatus : int {
+  kOk = 0,
+  kNoForceYet = 1,    ///< no valid force sample since start: correction zero
+  kStaleForce = 2,    ///< watchdog expired: correction ramping to zero
+  kForceFault = 3,    ///< a fault sample was seen within fault_hold_s: correction ramping to zero
+  kInvalidInput = -1, ///< wrong joint count or non-finite joints/time: q_command must not be sent
+};
+
+[[nodiscard]] const char* to_string(CycleStatus s);
+
+struct CycleInput {
+  double t_s = 0.0;         ///< cycle time (s), monotonic (the caller's clock)
+  JointVector q_planned;    ///< rad
+  JointVector q_feedback;   ///< rad; the sensor orientation comes from it
+};
+
+struct CycleOutput {
+  JointVector q_command;                ///< q_planned - dtheta, rad
+  JointVector dtheta;                   ///< applied correction (after bounds), rad
+  Wrench wrench_base = Wrench::Zero();  ///< conditioned wrench used (base frame, at the WAP)
+  CycleStatus status = CycleStatus::kNoForceYet;
+  bool size_limited = false;            ///< the joint or TCP bound cut the correction
+  bool rate_limited = false;            ///< the rate bound cut the change of correction
+  double tcp_correction_m = 0.0;        ///< |J_p dtheta|, m
+  double force_age_s = 0.0;             ///< time since the last valid force sample
+  int samples_used = 0;                 ///< force samples conditioned during this cycle
+};
+
+struct CompensatorCounters {
+  std::uint64_t cycles = 0, invalid_inputs = 0;
+  std::uint64_t samples_ok = 0, samples_fault = 0, samples_invalid = 0, samples_dropped = 0;
+};
+
+class OnlineCompensator {
+ public:
+  /// Throws ModelError when the model has no stiffness, InputError on a bad configuration.
+  OnlineCompensator(const RobotModel& model, const SensorConfig& sensor, const OnlineConfig& config);
+
+  /// Queues one raw sample (conditioned at the next step() with that cycle's orientation). A full
+  /// queue drops the oldest sample and counts it. Never allocates.
+  void push_force(const ForceSample& sample) noexcept;
+  /// Pulls every new sample of `source` into the queue.
+  void drain(ForceSource& source) noexcept;
+
+  /// One cycle. Never allocates, locks or throws.
+  CycleOutput step(const CycleInput& input) noexcept;
+  /// step() after drain(source).
+  CycleOutput step(const CycleInput& input, ForceSource& source) noexcept;
+
+  /// Back to the start state: zero correction, empty queue, filter unprimed (controller restart).
+  void reset() noexcept;
+
+  [[nodiscard]] const CompensatorCounters& counters() const { return counters_; }
+  [[nodiscard]] const RobotModel& model() const { return model_; }
+  [[nodiscard]] const OnlineConfig& config() const { return config_; }
+  [[nodiscard]] const ForcePipeline& pipeline() const { return pipeline_; }
+
+ private:
+  static constexpr int kQueueSize = 64;
+
+  RobotModel model_;  // a copy: the compensator may outlive the caller's model
+  OnlineConfig config_;
+  Pose flange_T_sensor_;
+  ForcePipeline pipeline_;
+  Workspace ws_;
+  Jacobian jac_;
+
+  std::array<ForceSample, kQueueSize> queue_{};
+  int queue_head_ = 0, queue_count_ = 0;
+
+  JointVector correction_;
+  bool have_force_ = false;
+  Wrench wrench_base_ = Wrench::Zero();
+  double last_force_t_s_ = 0.0;
+  double last_fault_t_s_ = -1e300;
+  double last_cycle_t_s_ = 0.0;
+  bool have_cycle_ = false;
+  CompensatorCounters counters_;
+};
+
+}  // namespace deflex
