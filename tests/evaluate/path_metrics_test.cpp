@@ -1,0 +1,186 @@
+// The paper's mean-distance figure and its companions against closed forms, an independent
+// brute-force nearest-segment search and the statistics of known noise.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "deflex/evaluate/path_metrics.hpp"
+#include "deflex/model/errors.hpp"
+#include "synthetic_paths.hpp"
+
+namespace deflex {
+namespace {
+
+// Independent of the library: the distance from p to every segment of every piece.
+double brute_force_distance(const std::vector<TrackerTrace>& pieces, const Vector3& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& piece : pieces) {
+    if (piece.size() == 1) {
+      best = std::min(best, (piece[0].p_m - p).norm());
+    }
+    for (std::size_t i = 0; i + 1 < piece.size(); ++i) {
+      const Vector3 a = piece[i].p_m;
+      const Vector3 ab = piece[i + 1].p_m - a;
+      double t = ab.squaredNorm() > 0.0 ? (p - a).dot(ab) / ab.squaredNorm() : 0.0;
+      t = std::max(0.0, std::min(1.0, t));
+      best = std::min(best, (a + t * ab - p).norm());
+    }
+  }
+  return best;
+}
+
+TEST(PathMetrics, CircleLiftedOutOfItsPlaneIsAtTheLiftEverywhere) {
+  // Every point of a circle lifted by h along its axis is exactly h from the original circle.
+  const double r = 0.1;
+  const double h = 0.3e-3;
+  const int n = 20000;
+  const TrackerTrace ref = test::closed_circle(r, Vector3(1.2, 0.3, 0.9), n);
+  const TrackerTrace loaded = test::shifted(test::circle(r, Vector3(1.2, 0.3, 0.9), 7001, 1.0, false, 0.123),
+                                            Vector3(0, 0, h));
+  // The polyline lies inside the circle by at most the sagitta r (1 - cos(pi / n)).
+  const double sagitta = r * (1.0 - std::cos(kPi / n));
+  const PathDeviationStats st = path_deviation(loaded, ref);
+  EXPECT_NEAR(st.mean_m, h, sagitta + 1e-12);
+  EXPECT_NEAR(st.max_m, h, sagitta + 1e-12);
+  EXPECT_NEAR(st.rms_m, h, sagitta + 1e-12);
+  EXPECT_LT(st.std_m, 1e-9);
+  EXPECT_EQ(st.samples, 7001u);
+  EXPECT_NEAR(mean_distance_to_path_m(loaded, ref), h, sagitta + 1e-12);
+}
+
+TEST(PathMetrics, ConcentricCircleOfLargerRadius) {
+  const double r = 0.08;
+  const double dr = 0.5e-3;
+  const TrackerTrace ref = test::closed_circle(r, Vector3::Zero(), 30000);
+  const TrackerTrace loaded = test::circle(r + dr, Vector3::Zero(), 5000, 1.0, true);
+  EXPECT_NEAR(mean_distance_to_path_m(loaded, ref), dr, r * (1.0 - std::cos(kPi / 30000)) + 1e-12);
+}
+
+TEST(PathMetrics, CircleShiftedInItsPlaneMatchesTheIntegral) {
+  // A circle shifted by a in its plane: the distance of its point at angle t from the original
+  // circle is | |p(t)| - r |, |p(t)|^2 = r^2 + a^2 + 2 a r cos t. Its mean over t is computed here by
+  // a fine midpoint rule, independently of the library.
+  const double r = 0.1;
+  const double a = 0.4e-3;
+  const int m = 200000;
+  double integral = 0.0;
+  for (int i = 0; i < m; ++i) {
+    const double t = 2.0 * kPi * (i + 0.5) / m;
+    integral += std::abs(std::sqrt(r * r + a * a + 2.0 * a * r * std::cos(t)) - r);
+  }
+  integral /= m;
+  const TrackerTrace ref = test::closed_circle(r, Vector3::Zero(), 40000);
+  const TrackerTrace loaded = test::shifted(test::circle(r, Vector3::Zero(), 9000), Vector3(a, 0, 0));
+  EXPECT_NEAR(mean_distance_to_path_m(loaded, ref), integral, 2e-8);
+  EXPECT_NEAR(integral, 2.0 * a / kPi, 1e-6);  // the small-shift limit |a cos t|, a sanity check of the test
+}
+
+TEST(PathMetrics, IsotropicNoiseAboutALineGivesTheRayleighMean) {
+  // Points on a line with 3D Gaussian noise sigma: the distance to the line is Rayleigh distributed
+  // (two perpendicular components), mean sigma sqrt(pi/2), RMS sigma sqrt(2).
+  TrackerTrace ref;
+  for (int i = 0; i <= 2000; ++i) {
+    ref.push_back({i * 1e-3, Vector3(-0.1 + 1.2 * i / 2000.0, 0.2, 0.5)});
+  }
+  TrackerTrace clean;
+  for (int i = 0; i < 100000; ++i) {
+    clean.push_back({i * 1e-3, Vector3(1.0 * i / 100000.0, 0.2, 0.5)});
+  }
+  const double sigma = 20e-6;
+  const TrackerTrace loaded = test::with_noise(clean, sigma, 42);
+  const PathDeviationStats st = path_deviation(loaded, ref);
+  // Standard error of the mean is sigma * 0.52 / sqrt(1e5) ~ 0.17% of the mean: 1% is > 5 sigma.
+  EXPECT_NEAR(st.mean_m, sigma * std::sqrt(kPi / 2.0), 0.01 * sigma * std::sqrt(kPi / 2.0));
+  EXPECT_NEAR(st.rms_m, sigma * std::sqrt(2.0), 0.01 * sigma * std::sqrt(2.0));
+  EXPECT_NEAR(st.std_m, sigma * std::sqrt(2.0 - kPi / 2.0), 0.02 * sigma * std::sqrt(2.0 - kPi / 2.0));
+}
+
+TEST(PathMetrics, StatisticsOfKnownDistances) {
+  const TrackerTrace ref{{0.0, Vector3(0, 0, 0)}, {1.0, Vector3(1, 0, 0)}};
+  const TrackerTrace loaded{{0.0, Vector3(0.2, 1e-3, 0)}, {0.1, Vector3(0.5, 0, 2e-3)}, {0.2, Vector3(0.7, -3e-3, 0)}};
+  const PathDeviationStats st = path_deviation(loaded, ref);
+  EXPECT_NEAR(st.mean_m, 2e-3, 1e-15);
+  EXPECT_NEAR(st.max_m, 3e-3, 1e-15);
+  EXPECT_NEAR(st.rms_m, std::sqrt(14.0 / 3.0) * 1e-3, 1e-15);
+  EXPECT_NEAR(st.std_m, 1e-3, 1e-15);
+  // Beyond the end of the path, the distance is to the end point.
+  const TrackerTrace beyond{{0.0, Vector3(1.003, 0.004, 0)}};
+  EXPECT_NEAR(mean_distance_to_path_m(beyond, ref), 5e-3, 1e-15);
+}
+
+TEST(PathMetrics, IndexAgreesWithBruteForceOnRandomPaths) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    // Pieces of random walks with mixed step sizes, repeated points (a robot standing still),
+    // an occasional jump (tracker drop-out) and a single-sample piece.
+    std::vector<TrackerTrace> pieces;
+    const int n_pieces = 1 + trial % 3;
+    for (int k = 0; k < n_pieces; ++k) {
+      TrackerTrace piece;
+      Vector3 p(u(rng), u(rng), u(rng));
+      const double step = (trial % 4 == 0) ? 0.2 : 2e-3;
+      for (int i = 0; i < 600; ++i) {
+        if (i % 97 == 0) {
+          piece.push_back({i * 1e-3, p});  // a repeated sample: zero-length segment
+        }
+        p += step * Vector3(u(rng), u(rng), u(rng));
+        if (i == 300 && trial % 2 == 1) {
+          p += Vector3(0.5, -0.3, 0.2);  // a jump
+        }
+        piece.push_back({i * 1e-3, p});
+      }
+      pieces.push_back(piece);
+    }
+    pieces.push_back({{0.0, Vector3(u(rng), u(rng), u(rng))}});
+    const PolylineIndex index(pieces);
+    for (int q = 0; q < 400; ++q) {
+      const double scale = (q % 3 == 0) ? 2.0 : 0.05;  // far and near queries
+      const Vector3 base = pieces[static_cast<std::size_t>(q) % pieces.size()]
+                               [static_cast<std::size_t>(q * 7) % pieces[static_cast<std::size_t>(q) % pieces.size()].size()]
+                                   .p_m;
+      const Vector3 p = base + scale * Vector3(u(rng), u(rng), u(rng));
+      const auto near = index.nearest(p);
+      ASSERT_NEAR(near.distance_m, brute_force_distance(pieces, p), 1e-12) << "trial " << trial << " query " << q;
+      ASSERT_NEAR((near.point_m - p).norm(), near.distance_m, 1e-12);
+    }
+  }
+}
+
+TEST(PathMetrics, PiecesAreNotJoined) {
+  // Two parallel lines as separate pieces: a point between their ends is far from both, though it
+  // would lie on a segment joining the end of one to the start of the other.
+  const TrackerTrace a{{0.0, Vector3(0, 0, 0)}, {1.0, Vector3(1, 0, 0)}};
+  const TrackerTrace b{{0.0, Vector3(1, 1, 0)}, {1.0, Vector3(0, 1, 0)}};
+  const PolylineIndex index(std::vector<TrackerTrace>{a, b});
+  EXPECT_NEAR(index.nearest(Vector3(1.0, 0.5, 0)).distance_m, 0.5, 1e-15);
+}
+
+TEST(PathMetrics, CompensationRatio) {
+  EXPECT_NEAR(compensation_ratio(0.12, 0.04), 2.0 / 3.0, 1e-15);
+  EXPECT_NEAR(compensation_ratio(1.10, 0.22), 0.8, 1e-15);
+  EXPECT_NEAR(compensation_ratio(0.2, 0.3), -0.5, 1e-15);  // worse than uncompensated: negative
+  EXPECT_TRUE(std::isnan(compensation_ratio(0.0, 0.01)));
+  EXPECT_TRUE(std::isnan(compensation_ratio(std::numeric_limits<double>::quiet_NaN(), 0.01)));
+}
+
+TEST(PathMetrics, BadInputIsAnError) {
+  const TrackerTrace ok{{0.0, Vector3(0, 0, 0)}, {1.0, Vector3(1, 0, 0)}};
+  EXPECT_THROW(mean_distance_to_path_m(ok, TrackerTrace{}), InputError);
+  EXPECT_THROW(mean_distance_to_path_m(TrackerTrace{}, ok), InputError);
+  TrackerTrace bad = ok;
+  bad[1].p_m.x() = std::numeric_limits<double>::quiet_NaN();
+  try {
+    mean_distance_to_path_m(ok, bad);
+    FAIL() << "no error for a NaN reference sample";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("sample 1"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(mean_distance_to_path_m(bad, ok), InputError);
+}
+
+}  // namespace
+}  // namespace deflex
