@@ -1,0 +1,45 @@
+// The three-component force sensor and its DAQ (HBM MSC10-class on an NI-9237-class bridge module):
+// it measures the force between flange and end effector in its own frame, i.e. the process force
+// plus the end effector's weight, through a crosstalk matrix, with bias and noise, at the DAQ rate.
+// It also says what a calibrated user would know about it (the decoupling matrix, the end
+// effector's mass) with the calibration's residual errors.
+#pragma once
+
+#include <cstdint>
+#include <random>
+
+#include "deflex/cell/case_config.hpp"
+
+namespace deflex::cell {
+
+/// What the sensor's calibration gives the online strategy (close to, never exactly, the truth).
+struct SensorCalibration {
+  Matrix3 decoupling = Matrix3::Identity();  ///< measured -> decoupled, sensor frame
+  Vector3 bias_n = Vector3::Zero();
+  double ee_mass_kg = 0.0;
+  Vector3 ee_cog_m = Vector3::Zero();
+};
+
+class ForceSensorDaq {
+ public:
+  ForceSensorDaq(const SensorConfig& sensor, const ToolConfig& tool, std::uint64_t seed);
+
+  /// One DAQ sample (N, sensor frame = flange frame) for the process force on the TCP (base frame)
+  /// at the flange orientation base_R_flange.
+  [[nodiscard]] Vector3 sample(const Vector3& process_force_base_n, const Matrix3& base_R_flange);
+  [[nodiscard]] const SensorCalibration& calibration() const { return calibration_; }
+  [[nodiscard]] const Matrix3& crosstalk() const { return crosstalk_; }
+
+ private:
+  SensorConfig config_;
+  ToolConfig tool_;
+  Matrix3 crosstalk_;
+  SensorCalibration calibration_;
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+};
+
+/// Standard gravity, m/s^2.
+inline constexpr double kGravity = 9.80665;
+
+}  // namespace deflex::cell

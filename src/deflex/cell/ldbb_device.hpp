@@ -1,0 +1,41 @@
+// The Loaded Double Ball Bar of the simulated cell (paper, Figure 4): a bar from a table pivot to the
+// TCP ball, pneumatic force with a set-point, first-order response, ripple and noise, and the force
+// errors the offline force model does not know (magnitude bias, pivot position error, ball-joint
+// friction that opposes the bar's rotation and so depends on the direction of travel).
+#pragma once
+
+#include <cstdint>
+#include <random>
+
+#include "deflex/cell/case_config.hpp"
+
+namespace deflex::cell {
+
+class LdbbDevice {
+ public:
+  /// `nominal_pivot_m`: the pivot the force model assumes; the true pivot adds config.pivot_error_m.
+  LdbbDevice(const LdbbConfig& config, const Vector3& nominal_pivot_m, double setpoint_n, std::uint64_t seed);
+
+  /// Advances the pneumatic force by dt (s): first-order response to the set-point times (1 + bias).
+  void advance(double dt_s);
+  /// Sets the pneumatic force to its settled value (skip the build-up).
+  void settle();
+  /// Force magnitude now, N (first-order state plus ripple and noise).
+  [[nodiscard]] double magnitude_n();
+  /// Wrench on the TCP ball (base frame, moment about the TCP = 0): magnitude along the bar from
+  /// the true pivot, plus ball friction opposing the TCP's motion (`tcp_velocity_m_s`).
+  [[nodiscard]] Wrench wrench(const Vector3& tcp_m, const Vector3& tcp_velocity_m_s);
+  [[nodiscard]] const Vector3& true_pivot_m() const { return pivot_; }
+  [[nodiscard]] double time_s() const { return t_; }
+
+ private:
+  LdbbConfig config_;
+  Vector3 pivot_;
+  double setpoint_n_;
+  double state_n_ = 0.0;
+  double t_ = 0.0;
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+};
+
+}  // namespace deflex::cell

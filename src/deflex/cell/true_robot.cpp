@@ -1,0 +1,150 @@
+// The true robot of the simulated cell (see true_robot.hpp).
+#include "deflex/cell/true_robot.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "deflex/model/robot_io.hpp"
+
+namespace deflex::cell {
+
+double LostMotion::update(double joint_torque_nm) {
+  const double x = joint_torque_nm / torque_nm;
+  state = std::clamp(state, x - 1.0, x + 1.0);
+  return offset_rad();
+}
+
+double LostMotion::offset_rad() const { return half_width_rad * std::clamp(state, -1.0, 1.0); }
+
+Pose setup_flange_T_tcp(const CaseConfig& config, bool sensor_mounted) {
+  Pose t = Pose::Identity();
+  t.translation() = Vector3(0, 0, config.tool.ee_length_m + (sensor_mounted ? config.sensor.height_m : 0.0));
+  return t;
+}
+
+TrueRobot::TrueRobot(const CaseConfig& config, bool sensor_mounted, std::uint64_t seed)
+    : config_(config), sensor_mounted_(sensor_mounted) {
+  const RobotModel base = load_robot_or_builtin(config.robot_file);
+  const Pose flange_T_tcp = setup_flange_T_tcp(config, sensor_mounted);
+  nominal_ = std::make_shared<const RobotModel>(base.with_tool(flange_T_tcp));
+
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  RobotDescription desc = base.description();
+  const int n = base.dof();
+  if (desc.dh_convention && (config.robot.dh_length_sigma_m > 0 || config.robot.dh_angle_sigma_rad > 0)) {
+    std::vector<DhRow> rows = desc.dh;
+    for (auto& r : rows) {
+      r.a_m += config.robot.dh_length_sigma_m * normal(rng);
+      r.d_m += config.robot.dh_length_sigma_m * normal(rng);
+      r.alpha_rad += config.robot.dh_angle_sigma_rad * normal(rng);
+      r.theta_offset_rad += config.robot.dh_angle_sigma_rad * normal(rng);
+    }
+    std::vector<double> lower, upper;
+    for (const auto& j : desc.joints) {
+      lower.push_back(j.lower_rad);
+      upper.push_back(j.upper_rad);
+    }
+    set_dh_chain(desc, *desc.dh_convention, rows, lower, upper);
+  }
+  std::vector<double> k_true(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const double factor = std::exp(config.robot.stiffness_spread * normal(rng));
+    k_true[static_cast<std::size_t>(i)] = base.stiffness()[i] * config.robot.stiffness_scale * factor;
+  }
+  desc.stiffness_nm_per_rad = k_true;
+  desc.stiffness_note = "true stiffness of the simulated cell";
+  desc.flange_T_tcp = flange_T_tcp;
+  desc.flange_T_wap.reset();
+  true_ = std::make_shared<const RobotModel>(desc);
+  if (!desc.dh.empty()) {
+    last_d_m_ = desc.dh.back().d_m;
+  }
+
+  JointMatrix K = JointMatrix::Zero(n, n);
+  for (int i = 0; i < n; ++i) {
+    K(i, i) = k_true[static_cast<std::size_t>(i)];
+  }
+  if (n >= 3) {
+    K(1, 2) = K(2, 1) = config.robot.coupling_23 * std::sqrt(K(1, 1) * K(2, 2));
+  }
+  joint_compliance_ = K.inverse();
+}
+
+TrueRobotState TrueRobot::initial_state(const JointVector& q_cmd) const {
+  TrueRobotState s;
+  s.q_actual = q_cmd;
+  s.q_cmd_last = q_cmd;
+  const auto& lm = config_.robot.lost_motion_rad;
+  for (int i = 0; i < true_->dof(); ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    s.lost_motion[k].half_width_rad = k < lm.size() ? lm[k] : 0.0;
+    s.lost_motion[k].torque_nm = k < config_.robot.lost_motion_torque_nm.size() ? config_.robot.lost_motion_torque_nm[k] : 1.0;
+    s.lost_motion[k].state = 0.0;
+  }
+  return s;
+}
+
+Vector3 TrueRobot::structural_displacement(const Workspace& ws, const Wrench& w) const {
+  Vector3 d = Vector3::Zero();
+  const Vector3 p_tcp = ws.base_T_tcp.translation();
+  const Vector3 F = w.head<3>();
+  const Vector3 M = w.tail<3>();
+  if (config_.robot.forearm_ei_nm2 > 0.0 && ws.dof >= 6) {
+    // Cantilever from the elbow to the wrist centre along the axis of joint 4.
+    const Matrix3& R = ws.base_T_flange.linear();
+    const Vector3 p_wc = ws.base_T_flange.translation() - last_d_m_ * R.col(2);
+    const Vector3 a = ws.axis_base[3];
+    const Vector3 M_wc = M + (p_tcp - p_wc).cross(F);
+    const Vector3 F_perp = F - a * a.dot(F);
+    const Vector3 M_perp = M_wc - a * a.dot(M_wc);
+    const double L = config_.robot.forearm_length_m;
+    const double ei = config_.robot.forearm_ei_nm2;
+    const Vector3 delta = F_perp * (L * L * L / (3 * ei)) + M_perp.cross(a) * (L * L / (2 * ei));
+    const Vector3 theta = a.cross(F_perp) * (L * L / (2 * ei)) + M_perp * (L / ei);
+    d += delta + theta.cross(p_tcp - p_wc);
+  }
+  if (sensor_mounted_) {
+    const auto& s = config_.sensor;
+    const Matrix3& R = ws.base_T_flange.linear();
+    const Vector3 p_s = ws.base_T_flange.translation() + R.col(2) * s.height_m;
+    const Vector3 F_s = R.transpose() * F;
+    const Vector3 M_s = R.transpose() * (M + (p_tcp - p_s).cross(F));
+    const Vector3 dt(s.lateral_compliance_m_per_n * F_s.x(), s.lateral_compliance_m_per_n * F_s.y(),
+                     s.axial_compliance_m_per_n * F_s.z());
+    const Vector3 phi = M_s * s.rotational_compliance_rad_per_nm;
+    d += R * dt + (R * phi).cross(p_tcp - p_s);
+  }
+  return d;
+}
+
+Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd, const Wrench& wrench_base,
+                         TrueRobotState& state) const {
+  const RobotModel& m = *true_;
+  const int n = m.dof();
+  Jacobian J(6, n);
+  JointVector q = state.q_actual + (q_cmd - state.q_cmd_last);
+  jacobian(m, ws, q, EndPoint::kTcp, J);
+  JointVector tau = J.transpose() * wrench_base;
+  JointVector lost(n);
+  for (int i = 0; i < n; ++i) {
+    lost[i] = state.lost_motion[static_cast<std::size_t>(i)].update(tau[i]);
+  }
+  for (int it = 0; it < 30; ++it) {
+    const JointVector q_new = q_cmd + joint_compliance_ * tau + lost;
+    const double step = (q_new - q).cwiseAbs().maxCoeff();
+    q = q_new;
+    if (step < 1e-12) {
+      break;
+    }
+    jacobian(m, ws, q, EndPoint::kTcp, J);
+    tau = J.transpose() * wrench_base;
+  }
+  forward_kinematics(m, ws, q);
+  state.q_actual = q;
+  state.q_cmd_last = q_cmd;
+  return ws.base_T_tcp.translation() + structural_displacement(ws, wrench_base);
+}
+
+}  // namespace deflex::cell

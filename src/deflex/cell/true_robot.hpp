@@ -1,0 +1,73 @@
+// The simulated cell's true robot: what the compensators never see. IRB6700 kinematics with small
+// seeded DH errors, a true joint stiffness (coupled between joints 2 and 3), forearm bending, the
+// force sensor as an elastic element between flange and end effector, and direction-dependent lost
+// motion. The deflection is solved at the deflected configuration (fixed point).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "deflex/cell/case_config.hpp"
+#include "deflex/model/kinematics.hpp"
+
+namespace deflex::cell {
+
+/// Lost motion of one joint as a play operator with saturation: the joint torque must exceed
+/// `torque_nm` in the new direction before the joint travels across its band of +-half_width_rad,
+/// so the offset depends on the sign of the torque and on its history (CW and CCW laps differ).
+struct LostMotion {
+  double half_width_rad = 0.0;
+  double torque_nm = 1.0;
+  double state = 0.0;  ///< play-operator output in torque units / torque_nm, clamped to [-1, 1] on use
+  /// Advances with the joint torque and returns the angular offset (rad).
+  double update(double joint_torque_nm);
+  [[nodiscard]] double offset_rad() const;
+};
+
+/// Per-run mutable state of the true robot (one per simulated run).
+struct TrueRobotState {
+  JointVector q_actual;      ///< last solved configuration (warm start of the next solve)
+  JointVector q_cmd_last;    ///< command of the last solve
+  std::array<LostMotion, kMaxJoints> lost_motion{};
+};
+
+class TrueRobot {
+ public:
+  /// `sensor_mounted` puts the sensor's height and compliance between flange and end effector.
+  /// `seed` draws the per-joint stiffness factors and the DH errors.
+  TrueRobot(const CaseConfig& config, bool sensor_mounted, std::uint64_t seed);
+
+  /// The nominal model the compensators start from: built-in kinematics, the setup's tool, the
+  /// built-in (assumed) stiffness. Nothing of the true robot leaks into it.
+  [[nodiscard]] const RobotModel& nominal_model() const { return *nominal_; }
+  /// True kinematics with the true diagonal stiffness (for the model-consistent test cell).
+  [[nodiscard]] const RobotModel& true_model() const { return *true_; }
+  [[nodiscard]] const JointMatrix& joint_compliance() const { return joint_compliance_; }
+
+  [[nodiscard]] TrueRobotState initial_state(const JointVector& q_cmd) const;
+
+  /// Solves the configuration the arm takes when commanded to q_cmd under `wrench_base` (N, Nm at the
+  /// TCP, base frame) and returns the TCP position (m, base frame) including the link-bending and
+  /// sensor displacements. Updates the lost motion once per call (one call per servo cycle).
+  Vector3 solve(Workspace& ws, const JointVector& q_cmd, const Wrench& wrench_base, TrueRobotState& state) const;
+
+  [[nodiscard]] const CaseConfig& config() const { return config_; }
+  [[nodiscard]] bool sensor_mounted() const { return sensor_mounted_; }
+
+  /// Cartesian displacement (m) of the TCP from the link and sensor compliances at the current
+  /// FK in `ws`: exposed for tests against the cantilever and sensor closed forms.
+  [[nodiscard]] Vector3 structural_displacement(const Workspace& ws, const Wrench& wrench_base) const;
+
+ private:
+  CaseConfig config_;
+  bool sensor_mounted_;
+  std::shared_ptr<const RobotModel> nominal_;
+  std::shared_ptr<const RobotModel> true_;
+  JointMatrix joint_compliance_;
+  double last_d_m_ = 0.0;  ///< wrist centre to flange along the flange z axis
+};
+
+/// Flange to TCP of a setup: end effector, plus the sensor's height when it is mounted.
+[[nodiscard]] Pose setup_flange_T_tcp(const CaseConfig& config, bool sensor_mounted);
+
+}  // namespace deflex::cell
