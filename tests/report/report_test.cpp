@@ -1,0 +1,211 @@
+// The report's charts and HTML: well-formed, self-contained, and drawing what they claim (bar
+// heights proportional to the values, magnified deviations at the stated factor).
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "deflex/evaluate/tracker_trace.hpp"
+#include "deflex/model/errors.hpp"
+#include "deflex/report/html_report.hpp"
+#include "synthetic_study.hpp"
+#include "xml_check.hpp"
+
+namespace deflex {
+namespace {
+
+TEST(XmlCheck, CatchesMalformedDocuments) {
+  EXPECT_EQ(test::xml_problem("<a x=\"1\"><b/>t &amp; u</a>"), "");
+  EXPECT_NE(test::xml_problem("<a><b></a></b>"), "");
+  EXPECT_NE(test::xml_problem("<a>"), "");
+  EXPECT_NE(test::xml_problem("<a>x < y</a>"), "");
+  EXPECT_NE(test::xml_problem("<a>fish & chips</a>"), "");
+  EXPECT_NE(test::xml_problem("<a x=\"1>"), "");
+  EXPECT_NE(test::xml_problem("<a>1 > 0</a>"), "");
+}
+
+// (value, height) of every bar carrying a data-value.
+std::vector<std::pair<double, double>> bars(const std::string& svg) {
+  std::vector<std::pair<double, double>> out;
+  const std::regex re(R"re(<rect [^>]*height="([0-9.]+)"[^>]*data-value="([0-9.]+)")re");
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), re); it != std::sregex_iterator(); ++it) {
+    out.emplace_back(std::stod((*it)[2]), std::stod((*it)[1]));
+  }
+  return out;
+}
+
+TEST(Figure5, OneBarPerSetupLoadAndSpeedScaledToItsValue) {
+  const StudyResult s = test::synthetic_study();
+  const std::string svg = svg_figure5(s);
+  EXPECT_EQ(test::xml_problem(svg), "");
+  const auto b = bars(svg);
+  ASSERT_EQ(b.size(), 27u);  // 3 setups x 3 loads x 3 speeds
+  // Scale from the tallest bar (least rounding), then every bar must follow it.
+  const auto tallest = *std::max_element(b.begin(), b.end(), [](auto x, auto y) { return x.second < y.second; });
+  const double px_per_mm = tallest.second / tallest.first;
+  for (const auto& [v, h] : b) {
+    EXPECT_NEAR(h, v * px_per_mm, 0.012) << v;  // heights are written with 2 decimals
+  }
+  EXPECT_NEAR(b[0].first, s.setups[0].loads[0].c_mm.at(10), 1e-4);
+  // The paper's C values are marked on the offline and online bars (18), plus one legend sample.
+  EXPECT_EQ(test::count_of(svg, R"(fill="white" stroke="#111")"), 19u);
+  EXPECT_NE(svg.find("offline (OFF)"), std::string::npos);
+  EXPECT_NE(svg.find("online (ON)"), std::string::npos);
+  EXPECT_NE(svg.find("(mm)"), std::string::npos);  // the axis says its unit
+  // 625 N offline: UC = 0.00098 * 625 * (1 + 0.002 v), mean over 10, 30, 50 mm/s = 0.6125 * 1.06 = 0.649.
+  EXPECT_NE(svg.find("UC 0.65 (0.62)"), std::string::npos) << "625 N offline UC beside the paper's";
+}
+
+TEST(Figure5, EmptyStudyStillDraws) {
+  const std::string svg = svg_figure5(StudyResult{});
+  EXPECT_EQ(test::xml_problem(svg), "");
+  EXPECT_NE(svg.find("no results"), std::string::npos);
+}
+
+// Points of the n-th polyline drawn in `colour`.
+std::vector<std::pair<double, double>> polyline_points(const std::string& svg, const std::string& colour, int n) {
+  const std::regex re("<polyline points=\"([^\"]*)\" fill=\"none\" stroke=\"" + colour + "\"");
+  int k = 0;
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), re); it != std::sregex_iterator(); ++it, ++k) {
+    if (k != n) {
+      continue;
+    }
+    std::vector<std::pair<double, double>> pts;
+    std::stringstream ss((*it)[1].str());
+    std::string pair;
+    while (ss >> pair) {
+      const auto comma = pair.find(',');
+      pts.emplace_back(std::stod(pair.substr(0, comma)), std::stod(pair.substr(comma + 1)));
+    }
+    return pts;
+  }
+  return {};
+}
+
+double mean_radius(const std::vector<std::pair<double, double>>& pts, double cx, double cy) {
+  double r = 0.0;
+  for (const auto& [x, y] : pts) {
+    r += std::hypot(x - cx, y - cy);
+  }
+  return r / static_cast<double>(pts.size());
+}
+
+TEST(PathPlot, DeviationsAreMagnifiedByTheStatedFactor) {
+  // Unloaded: a circle of 100 mm in a tilted plane; UC: radius + 0.5 mm; C: radius + 0.1 mm. With
+  // magnification 40 the drawn UC circle has radius 100 + 40 * 0.5 = 120 mm against the unloaded
+  // one's 100 mm, C 104 mm, whatever the pixel scale.
+  const Eigen::AngleAxisd tilt(0.4, Vector3(0.3, 1.0, 0.0).normalized());
+  const Vector3 centre(1.5, 0.2, 0.9);
+  auto circle = [&](double r) {
+    TrackerTrace t;
+    for (int i = 0; i <= 3000; ++i) {
+      const double a = 2.0 * kPi * i / 3000;
+      t.push_back({i * 1e-3, centre + tilt * Vector3(r * std::cos(a), r * std::sin(a), 0.0)});
+    }
+    return t;
+  };
+  PathPlot p{"test", circle(0.1), circle(0.1005), circle(0.1001), 40.0};
+  const std::string svg = svg_path_plot(p);
+  EXPECT_EQ(test::xml_problem(svg), "");
+  EXPECT_NE(svg.find("magnified x40"), std::string::npos);
+  // The first polyline of each colour is the left panel's (legend swatches are lines).
+  const auto unloaded = polyline_points(svg, "#888888", 0);
+  const auto uc = polyline_points(svg, "#D62728", 0);
+  const auto c = polyline_points(svg, "#1F77B4", 0);
+  ASSERT_GT(unloaded.size(), 100u);
+  ASSERT_GT(uc.size(), 100u);
+  ASSERT_GT(c.size(), 100u);
+  double cx = 0.0, cy = 0.0;
+  for (const auto& [x, y] : unloaded) {
+    cx += x;
+    cy += y;
+  }
+  cx /= static_cast<double>(unloaded.size());
+  cy /= static_cast<double>(unloaded.size());
+  const double r0 = mean_radius(unloaded, cx, cy);
+  EXPECT_NEAR(mean_radius(uc, cx, cy) / r0, 1.20, 0.005);
+  EXPECT_NEAR(mean_radius(c, cx, cy) / r0, 1.04, 0.005);
+  // Legend: the mean deviations at true scale.
+  EXPECT_NE(svg.find("UC (mean 0.500 mm)"), std::string::npos);
+  EXPECT_NE(svg.find("C (mean 0.100 mm)"), std::string::npos);
+}
+
+TEST(PathPlot, AutomaticMagnificationAndBadInput) {
+  // Largest deviation 1.0 mm on a path 200 mm across: 8% of 200 / 1.0 = 16 -> the nice factor 10.
+  PathPlot p = test::synthetic_path_plot(1.0, 0.2, 5);
+  double max_dev = 0.0;
+  for (std::size_t i = 0; i < p.uc.size(); ++i) {
+    max_dev = std::max(max_dev, (p.uc[i].p_m - p.unloaded[i].p_m).norm());
+  }
+  ASSERT_LT(max_dev, 1.01e-3);  // the synthetic field's largest UC deviation (test's own check)
+  const std::string svg = svg_path_plot(p);
+  EXPECT_EQ(test::xml_problem(svg), "");
+  EXPECT_NE(svg.find("magnified x10"), std::string::npos);
+  p.unloaded.resize(1);
+  EXPECT_THROW(svg_path_plot(p), InputError);
+}
+
+TEST(SpeedSweep, OneLinePerSeriesInBothPanels) {
+  const std::string svg = svg_speed_sweep(test::synthetic_study());
+  EXPECT_EQ(test::xml_problem(svg), "");
+  EXPECT_NE(svg.find("online 650 N"), std::string::npos);
+  EXPECT_NE(svg.find("online-latency-comp 650 N"), std::string::npos);
+  EXPECT_NE(svg.find("TCP speed (mm/s)"), std::string::npos);
+  EXPECT_EQ(test::count_of(svg, "<circle"), 24u);  // 2 series x 6 speeds x 2 panels
+  EXPECT_EQ(test::xml_problem(svg_speed_sweep(StudyResult{})), "");
+}
+
+TEST(HtmlReport, SelfContainedWellFormedAndComplete) {
+  const ReportContent content = test::synthetic_report();
+  const std::string html = html_report(content);
+  EXPECT_EQ(test::xml_problem(html), "");
+  for (const char* needle : {"Table 1: offline compensation", "Table 2: online compensation",
+                             "Table 3: hybrid (beyond the paper)", "Figure 5", "ISO 9283", "Error budget",
+                             "Speed sweep", "Path plots", "Notes", "force sensor compliance &lt;unmodelled&gt;",
+                             "LDBB loads 125-650 N &amp; speeds", "<span class=\"paper\">(0.12)</span>",
+                             "<span class=\"paper\">(1.10)</span>"}) {
+    EXPECT_NE(html.find(needle), std::string::npos) << needle;
+  }
+  EXPECT_EQ(test::count_of(html, "<svg "), 3u);  // Figure 5, one path plot, the sweep
+  // Nothing to fetch: no scripts, no external resources.
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_EQ(html.find("src="), std::string::npos);
+  EXPECT_EQ(html.find("href="), std::string::npos);
+  EXPECT_EQ(html.find("@import"), std::string::npos);
+  EXPECT_EQ(test::count_of(html, "http"), test::count_of(html, "xmlns=\"http://www.w3.org/2000/svg\""));
+}
+
+TEST(HtmlReport, WritesTheReportAndFigures) {
+  // DEFLEX_REPORT_EXAMPLE_DIR keeps the example (to look at it in a browser); otherwise a temp dir.
+  const char* keep = std::getenv("DEFLEX_REPORT_EXAMPLE_DIR");
+  const std::filesystem::path dir =
+      keep != nullptr ? std::filesystem::path(keep) : std::filesystem::temp_directory_path() / "deflex_report_test";
+  const ReportContent content = test::synthetic_report();
+  write_report(content, dir.string());
+  for (const char* f : {"report.html", "figure5.svg", "speed_sweep.svg", "path_1.svg", "tables.md", "tables.csv"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  }
+  std::ifstream in(dir / "report.html");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_EQ(ss.str(), html_report(content));
+  if (keep == nullptr) {
+    std::filesystem::remove_all(dir);
+  }
+  // A path that cannot be a directory is a clear error.
+  EXPECT_THROW(write_report(content, "/proc/deflex-cannot-write-here"), Error);
+}
+
+TEST(ErrorBudget, ResidualShare) {
+  EXPECT_NEAR(residual_share(0.20, 0.12), 0.4, 1e-15);
+  EXPECT_NEAR(residual_share(0.20, 0.25), -0.25, 1e-15);  // switching it off made things worse
+  EXPECT_TRUE(std::isnan(residual_share(0.0, 0.1)));
+}
+
+}  // namespace
+}  // namespace deflex
