@@ -50,6 +50,13 @@ TEST(OfflineCsv, RowsReadBackInMillimetresAndDegrees) {
     EXPECT_NEAR(t.at(i, "deflection_rx_mrad"), p.predicted_deflection[3] * 1000.0, 1e-9);
     EXPECT_LT(t.at(i, "residual_mm"), 1e-6);
   }
+  // Quaternion signs: the tool points down (0, 0, 1, 0) and the command tilts it by under 1 mrad, so
+  // desired and commanded quaternions must both stay near +(0, 0, 1, 0), never flip to the
+  // equivalent negative (a reader would see a 360 deg jump).
+  for (std::size_t i = 0; i < t.rows(); ++i) {
+    EXPECT_NEAR(t.at(i, "qy_des"), 1.0, 1e-12) << i;
+    EXPECT_GT(t.at(i, "qy_cmd"), 0.999) << i;
+  }
   std::remove(path.c_str());
   EXPECT_THROW(write_offline_csv(c.result, "/nonexistent/dir/out.csv"), Error);
 }
@@ -96,6 +103,7 @@ TEST(RapidModule, MoveLModuleCarriesPosesAndConfdata) {
     Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
     EXPECT_LT(q.angularDistance(Eigen::Quaterniond(p.tcp_command.linear())), 1e-7);
     EXPECT_EQ(static_cast<int>(v[10]), p.configuration_command.cfx);
+    EXPECT_GT(v[5], 0.999);  // sign continuous along the path, near +(0, 0, 1, 0)
   }
   EXPECT_NE(text.find("ConfL\\On;"), std::string::npos);
 }

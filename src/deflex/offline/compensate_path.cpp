@@ -53,14 +53,16 @@ OfflineResult compensate_path(const RobotModel& model, const JointPath& path, co
     if (!wrench_tcp.allFinite()) {
       throw InputError(fmt::format("path point {}: the force model gave a non-finite wrench", i));
     }
-    forward_kinematics(model, ws, pt.q_desired);
     pt.wrench_base = wrench_tcp;
-    // Moment about the WAP of a force acting at the TCP: M_wap = M_tcp + (p_tcp - p_wap) x F.
-    pt.wrench_base.tail<3>() +=
-        (ws.base_T_tcp.translation() - ws.base_T_wap.translation()).cross(Vector3(wrench_tcp.head<3>()));
-    const Pose tcp_at_desired = ws.base_T_tcp;
+    if (!model.wap_is_tcp()) {
+      // Moment about the WAP of a force acting at the TCP: M_wap = M_tcp + (p_tcp - p_wap) x F.
+      forward_kinematics(model, ws, pt.q_desired);
+      pt.wrench_base.tail<3>() +=
+          (ws.base_T_tcp.translation() - ws.base_T_wap.translation()).cross(Vector3(wrench_tcp.head<3>()));
+    }
 
     compensated_configuration(model, ws, pt.q_desired, pt.wrench_base, pt.q_command);
+    const Pose tcp_at_desired = ws.base_T_tcp;  // compensated_configuration ran FK at q_desired
     if (!model.within_limits(pt.q_command)) {
       throw InputError(fmt::format("path point {}: the compensated configuration leaves the joint limits", i));
     }

@@ -1,21 +1,24 @@
 // Writing offline compensation results as CSV.
 #include "deflex/offline/offline_csv.hpp"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
+#include "deflex/offline/quaternion_sign.hpp"
 
 namespace deflex {
 namespace {
 
-void add_pose(std::vector<double>& row, const Pose& p) {
-  Eigen::Quaterniond q(p.linear());
-  if (q.w() < 0.0) {
-    q.coeffs() = -q.coeffs();  // same rotation; w >= 0 reads more easily and matches RAPID output
-  }
+// Rounding noise (1e-15 mm, -0 deg) written as 0, so files diff and read cleanly.
+double clean(double v) { return std::abs(v) < 1e-11 ? 0.0 : v; }
+
+void add_pose(std::vector<double>& row, const Pose& p, const Eigen::Quaterniond& q) {
   const Vector3 t = p.translation() * 1e3;
-  row.insert(row.end(), {t.x(), t.y(), t.z(), q.w(), q.x(), q.y(), q.z()});
+  row.insert(row.end(), {clean(t.x()), clean(t.y()), clean(t.z()), clean(q.w()), clean(q.x()), clean(q.y()),
+                         clean(q.z())});
 }
 
 }  // namespace
@@ -54,25 +57,28 @@ void write_offline_csv(const OfflineResult& result, const std::string& path) {
                           result.predicted ? "" : " (not predicted: columns are zero)"));
   std::vector<double> row;
   row.reserve(columns.size());
+  Eigen::Quaterniond q_desired = canonical_quaternion(result.points.front().tcp_desired);
   for (std::size_t i = 0; i < result.points.size(); ++i) {
     const OfflinePoint& p = result.points[i];
     row.clear();
     row.push_back(static_cast<double>(i));
     for (const JointVector* q : {&p.q_desired, &p.q_command}) {
       for (int j = 0; j < dof; ++j) {
-        row.push_back(rad_to_deg((*q)[j]));
+        row.push_back(clean(rad_to_deg((*q)[j])));
       }
     }
-    add_pose(row, p.tcp_desired);
-    add_pose(row, p.tcp_command);
+    // Signs follow the path and the command follows its desired pose: no flips between columns.
+    q_desired = quaternion_near(p.tcp_desired, q_desired);
+    add_pose(row, p.tcp_desired, q_desired);
+    add_pose(row, p.tcp_command, quaternion_near(p.tcp_command, q_desired));
     const ArmConfiguration& c = p.configuration_command;
     row.insert(row.end(), {static_cast<double>(c.cf1), static_cast<double>(c.cf4), static_cast<double>(c.cf6),
                            static_cast<double>(c.cfx)});
     for (int k = 0; k < 6; ++k) {
-      row.push_back(p.wrench_base[k]);
+      row.push_back(clean(p.wrench_base[k]));
     }
     for (int k = 0; k < 6; ++k) {
-      row.push_back(p.predicted_deflection[k] * 1e3);  // m -> mm, rad -> mrad
+      row.push_back(clean(p.predicted_deflection[k] * 1e3));  // m -> mm, rad -> mrad
     }
     row.push_back(p.predicted_deflection.head<3>().norm() * 1e3);
     row.push_back(p.predicted_residual.head<3>().norm() * 1e3);

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/offline/quaternion_sign.hpp"
 
 namespace deflex {
 namespace {
@@ -19,12 +20,7 @@ const char* const kZones[] = {"fine", "z0",  "z1",  "z5",  "z10", "z15",  "z20",
 // Writes 0.0 for -0.0 and tiny values, so RAPID never sees "-0.0000".
 double clean(double v, double resolution) { return std::abs(v) < 0.5 * resolution ? 0.0 : v; }
 
-std::string quaternion_text(const Pose& p) {
-  Eigen::Quaterniond q(p.linear());
-  q.normalize();
-  if (q.w() < 0.0) {
-    q.coeffs() = -q.coeffs();
-  }
+std::string quaternion_text(const Eigen::Quaterniond& q) {
   return fmt::format("[{:.8f},{:.8f},{:.8f},{:.8f}]", clean(q.w(), 1e-8), clean(q.x(), 1e-8), clean(q.y(), 1e-8),
                      clean(q.z(), 1e-8));
 }
@@ -113,6 +109,9 @@ std::string rapid_module(const OfflineResult& result, const RapidOptions& option
   // ABB's predefined speeddata use 500 deg/s reorientation and 5000 mm/s, 1000 deg/s external axes.
   s += fmt::format("  CONST speeddata vDeflex:=[{:g},500,5000,1000];\n", options.speed_mm_s);
   const std::string eax = "[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]";
+  // Quaternion signs continue from point to point (the controller takes either sign; readers and
+  // diff tools see no flips).
+  Eigen::Quaterniond q_previous = canonical_quaternion(result.points.front().tcp_desired);
   for (std::size_t i = 0; i < n; ++i) {
     const OfflinePoint& p = result.points[i];
     if (joint) {
@@ -124,8 +123,9 @@ std::string rapid_module(const OfflineResult& result, const RapidOptions& option
     } else {
       const Vector3 t = p.tcp_command.translation() * 1e3;
       const ArmConfiguration& c = p.configuration_command;
+      q_previous = quaternion_near(p.tcp_command, q_previous);
       s += fmt::format("  CONST robtarget {}:=[[{:.4f},{:.4f},{:.4f}],{},[{},{},{},{}],{}];\n", target_name(i),
-                       clean(t.x(), 1e-4), clean(t.y(), 1e-4), clean(t.z(), 1e-4), quaternion_text(p.tcp_command),
+                       clean(t.x(), 1e-4), clean(t.y(), 1e-4), clean(t.z(), 1e-4), quaternion_text(q_previous),
                        c.cf1, c.cf4, c.cf6, c.cfx, eax);
     }
   }
