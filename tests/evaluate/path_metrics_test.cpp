@@ -137,6 +137,7 @@ TEST(PathMetrics, IndexAgreesWithBruteForceOnRandomPaths) {
     }
     pieces.push_back({{0.0, Vector3(u(rng), u(rng), u(rng))}});
     const PolylineIndex index(pieces);
+    PolylineIndex::Nearest previous;
     for (int q = 0; q < 400; ++q) {
       const double scale = (q % 3 == 0) ? 2.0 : 0.05;  // far and near queries
       const Vector3 base = pieces[static_cast<std::size_t>(q) % pieces.size()]
@@ -146,6 +147,13 @@ TEST(PathMetrics, IndexAgreesWithBruteForceOnRandomPaths) {
       const auto near = index.nearest(p);
       ASSERT_NEAR(near.distance_m, brute_force_distance(pieces, p), 1e-12) << "trial " << trial << " query " << q;
       ASSERT_NEAR((near.point_m - p).norm(), near.distance_m, 1e-12);
+      // Seeded with the answer for another point (a bound only): the same answer.
+      if (q > 0) {
+        const auto seeded = index.nearest(p, &previous);
+        ASSERT_NEAR(seeded.distance_m, near.distance_m, 1e-12) << "trial " << trial << " query " << q;
+        ASSERT_NEAR((seeded.point_m - p).norm(), seeded.distance_m, 1e-12);
+      }
+      previous = near;
     }
   }
 }

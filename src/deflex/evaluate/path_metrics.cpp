@@ -14,7 +14,7 @@
 namespace deflex {
 namespace {
 
-constexpr std::size_t kLeafSize = 8;
+constexpr std::uint32_t kLeafSize = 4;
 
 // Closest point of segment [a, b] to p, as the fraction along it.
 double segment_fraction(const Vector3& a, const Vector3& b, const Vector3& p) {
@@ -28,128 +28,98 @@ double segment_fraction(const Vector3& a, const Vector3& b, const Vector3& p) {
 
 }  // namespace
 
-// The search rests on one bound: if the nearest point c of the path lies on a segment s, the
-// endpoint of s nearer to c is within |s|/2 of c, so within d* + |s|/2 of the query, where
-// d* <= d_v, the distance to the nearest vertex. A radius search of d_v + max|s|/2 around the query
-// therefore finds an endpoint of the right segment. Rare long segments (tracker drop-outs, sparse
-// commanded paths mixed with dense ones) would inflate max|s| for every query, so they are kept
-// apart and checked one by one.
+// A bounding-volume hierarchy over the segments: each node holds the box around its segments, and
+// a query descends nearer child first, skipping every node whose box is farther than the best
+// distance found so far. Boxes bound the segments exactly, so the answer is exact, whatever the mix
+// of segment lengths (dense tracker laps, sparse commanded points, drop-outs). Seeding the search
+// with the previous query's segment (consecutive tracker points are close) prunes from the start.
 struct PolylineIndex::Impl {
+  struct Segment {
+    std::uint32_t a, b;  // vertex indices; a == b for a piece of a single sample
+  };
+  struct Node {
+    Vector3 lo, hi;
+    std::uint32_t start = 0, end = 0;  // leaf: segments [start, end)
+    std::uint32_t left = 0, right = 0; // inner node: children (0 = none: the root is never a child)
+  };
   std::vector<Vector3> vertices;
-  std::vector<std::uint8_t> segment_valid;  // segment i joins vertex i and i+1 (same piece)
-  std::vector<std::size_t> long_segments;
-  double half_max_short_length = 0.0;
-  // k-d tree: points in tree order, their vertex indices, the split dimension at each median.
-  std::vector<Vector3> tree_points;
-  std::vector<std::uint32_t> tree_index;
-  std::vector<std::uint8_t> split_dim;
+  std::vector<Segment> segments;
+  std::vector<Node> nodes;
 
-  void build(std::size_t lo, std::size_t hi) {
-    if (hi - lo <= kLeafSize) {
-      return;
+  std::uint32_t build(std::uint32_t start, std::uint32_t end) {
+    Node node;
+    node.lo = node.hi = vertices[segments[start].a];
+    for (std::uint32_t i = start; i < end; ++i) {
+      for (const std::uint32_t v : {segments[i].a, segments[i].b}) {
+        node.lo = node.lo.cwiseMin(vertices[v]);
+        node.hi = node.hi.cwiseMax(vertices[v]);
+      }
     }
-    Vector3 lo_c = tree_points[lo];
-    Vector3 hi_c = tree_points[lo];
-    for (std::size_t i = lo; i < hi; ++i) {
-      lo_c = lo_c.cwiseMin(tree_points[i]);
-      hi_c = hi_c.cwiseMax(tree_points[i]);
+    const auto index = static_cast<std::uint32_t>(nodes.size());
+    nodes.push_back(node);
+    if (end - start <= kLeafSize) {
+      nodes[index].start = start;
+      nodes[index].end = end;
+      return index;
     }
     int dim = 0;
-    (hi_c - lo_c).maxCoeff(&dim);
-    const std::size_t mid = lo + (hi - lo) / 2;
-    // Sort an index range, then apply it, so points and indices stay together.
-    std::vector<std::uint32_t> order(hi - lo);
-    std::iota(order.begin(), order.end(), 0u);
-    std::nth_element(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(mid - lo), order.end(),
-                     [&](std::uint32_t a, std::uint32_t b) {
-                       return tree_points[lo + a][dim] < tree_points[lo + b][dim];
+    (node.hi - node.lo).maxCoeff(&dim);
+    const std::uint32_t mid = start + (end - start) / 2;
+    std::nth_element(segments.begin() + start, segments.begin() + mid, segments.begin() + end,
+                     [&](const Segment& x, const Segment& y) {
+                       return vertices[x.a][dim] + vertices[x.b][dim] < vertices[y.a][dim] + vertices[y.b][dim];
                      });
-    std::vector<Vector3> pts(hi - lo);
-    std::vector<std::uint32_t> idx(hi - lo);
-    for (std::size_t i = 0; i < order.size(); ++i) {
-      pts[i] = tree_points[lo + order[i]];
-      idx[i] = tree_index[lo + order[i]];
-    }
-    std::copy(pts.begin(), pts.end(), tree_points.begin() + static_cast<std::ptrdiff_t>(lo));
-    std::copy(idx.begin(), idx.end(), tree_index.begin() + static_cast<std::ptrdiff_t>(lo));
-    split_dim[mid] = static_cast<std::uint8_t>(dim);
-    build(lo, mid);
-    build(mid + 1, hi);
+    const std::uint32_t left = build(start, mid);
+    const std::uint32_t right = build(mid, end);
+    nodes[index].left = left;
+    nodes[index].right = right;
+    return index;
   }
 
-  void nearest_vertex(std::size_t lo, std::size_t hi, const Vector3& q, double& best2) const {
-    if (hi - lo <= kLeafSize) {
-      for (std::size_t i = lo; i < hi; ++i) {
-        best2 = std::min(best2, (tree_points[i] - q).squaredNorm());
-      }
-      return;
-    }
-    const std::size_t mid = lo + (hi - lo) / 2;
-    best2 = std::min(best2, (tree_points[mid] - q).squaredNorm());
-    const double diff = q[split_dim[mid]] - tree_points[mid][split_dim[mid]];
-    if (diff < 0.0) {
-      nearest_vertex(lo, mid, q, best2);
-      if (diff * diff < best2) {
-        nearest_vertex(mid + 1, hi, q, best2);
-      }
-    } else {
-      nearest_vertex(mid + 1, hi, q, best2);
-      if (diff * diff < best2) {
-        nearest_vertex(lo, mid, q, best2);
-      }
-    }
+  static double box_distance2(const Node& n, const Vector3& q) {
+    const Vector3 d = (n.lo - q).cwiseMax(q - n.hi).cwiseMax(0.0);
+    return d.squaredNorm();
   }
 
-  void consider_segment(std::size_t s, const Vector3& q, Nearest& best, double& best2) const {
-    const Vector3& a = vertices[s];
-    const Vector3& b = vertices[s + 1];
+  void consider(const Segment& s, const Vector3& q, Nearest& best, double& best2) const {
+    const Vector3& a = vertices[s.a];
+    const Vector3& b = vertices[s.b];
     const double f = segment_fraction(a, b, q);
     const Vector3 c = a + f * (b - a);
     const double d2 = (c - q).squaredNorm();
     if (d2 < best2) {
       best2 = d2;
       best.point_m = c;
-      best.segment = s;
-      best.fraction = f;
+      best.segment = s.a;
+      best.fraction = s.a == s.b ? 0.0 : f;
     }
   }
 
-  void consider_vertex(std::size_t v, const Vector3& q, Nearest& best, double& best2) const {
-    if (v > 0 && segment_valid[v - 1] != 0) {
-      consider_segment(v - 1, q, best, best2);
-    }
-    if (v + 1 < vertices.size() && segment_valid[v] != 0) {
-      consider_segment(v, q, best, best2);
-    }
-    const double d2 = (vertices[v] - q).squaredNorm();
-    if (d2 < best2) {  // an isolated vertex (a piece of one sample)
-      best2 = d2;
-      best.point_m = vertices[v];
-      best.segment = v;
-      best.fraction = 0.0;
-    }
-  }
-
-  void radius_search(std::size_t lo, std::size_t hi, const Vector3& q, double r2, Nearest& best,
-                     double& best2) const {
-    if (hi - lo <= kLeafSize) {
-      for (std::size_t i = lo; i < hi; ++i) {
-        if ((tree_points[i] - q).squaredNorm() <= r2) {
-          consider_vertex(tree_index[i], q, best, best2);
-        }
+  void search(const Vector3& q, Nearest& best, double& best2) const {
+    std::uint32_t stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const Node& n = nodes[stack[--top]];
+      if (box_distance2(n, q) >= best2) {
+        continue;
       }
-      return;
-    }
-    const std::size_t mid = lo + (hi - lo) / 2;
-    if ((tree_points[mid] - q).squaredNorm() <= r2) {
-      consider_vertex(tree_index[mid], q, best, best2);
-    }
-    const double diff = q[split_dim[mid]] - tree_points[mid][split_dim[mid]];
-    if (diff <= 0.0 || diff * diff <= r2) {
-      radius_search(lo, mid, q, r2, best, best2);
-    }
-    if (diff >= 0.0 || diff * diff <= r2) {
-      radius_search(mid + 1, hi, q, r2, best, best2);
+      if (n.left == 0) {
+        for (std::uint32_t i = n.start; i < n.end; ++i) {
+          consider(segments[i], q, best, best2);
+        }
+        continue;
+      }
+      const double dl = box_distance2(nodes[n.left], q);
+      const double dr = box_distance2(nodes[n.right], q);
+      // Push the farther child first so the nearer one is searched first.
+      if (dl < dr) {
+        if (dr < best2) stack[top++] = n.right;
+        if (dl < best2) stack[top++] = n.left;
+      } else {
+        if (dl < best2) stack[top++] = n.left;
+        if (dr < best2) stack[top++] = n.right;
+      }
     }
   }
 };
@@ -158,7 +128,21 @@ PolylineIndex::PolylineIndex(const TrackerTrace& reference) : PolylineIndex(std:
 
 PolylineIndex::PolylineIndex(const std::vector<TrackerTrace>& pieces) : impl_(new Impl) {
   Impl& m = *impl_;
+  std::size_t total = 0;
   for (const auto& piece : pieces) {
+    total += piece.size();
+  }
+  if (total == 0) {
+    delete impl_;
+    throw InputError("reference path: no samples");
+  }
+  if (total >= std::numeric_limits<std::uint32_t>::max() / 2) {
+    delete impl_;
+    throw InputError("reference path: too many samples");
+  }
+  m.vertices.reserve(total);
+  for (const auto& piece : pieces) {
+    const auto first = static_cast<std::uint32_t>(m.vertices.size());
     for (std::size_t i = 0; i < piece.size(); ++i) {
       if (!piece[i].p_m.allFinite()) {
         delete impl_;
@@ -166,47 +150,16 @@ PolylineIndex::PolylineIndex(const std::vector<TrackerTrace>& pieces) : impl_(ne
                                      piece[i].t_s));
       }
       m.vertices.push_back(piece[i].p_m);
-      m.segment_valid.push_back(i + 1 < piece.size() ? 1 : 0);
+    }
+    if (piece.size() == 1) {
+      m.segments.push_back({first, first});
+    }
+    for (std::uint32_t i = 0; i + 1 < piece.size(); ++i) {
+      m.segments.push_back({first + i, first + i + 1});
     }
   }
-  if (m.vertices.empty()) {
-    delete impl_;
-    throw InputError("reference path: no samples");
-  }
-  if (m.vertices.size() > std::numeric_limits<std::uint32_t>::max()) {
-    delete impl_;
-    throw InputError("reference path: too many samples");
-  }
-  // Segments longer than 4x the 90th percentile of lengths are "long" (see the bound above).
-  std::vector<double> lengths;
-  for (std::size_t s = 0; s + 1 < m.vertices.size(); ++s) {
-    if (m.segment_valid[s] != 0) {
-      lengths.push_back((m.vertices[s + 1] - m.vertices[s]).norm());
-    }
-  }
-  double threshold = 0.0;
-  if (!lengths.empty()) {
-    std::vector<double> sorted = lengths;
-    const auto k = static_cast<std::ptrdiff_t>(static_cast<double>(sorted.size() - 1) * 0.9);
-    std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
-    threshold = 4.0 * sorted[static_cast<std::size_t>(k)];
-  }
-  for (std::size_t s = 0; s + 1 < m.vertices.size(); ++s) {
-    if (m.segment_valid[s] == 0) {
-      continue;
-    }
-    const double len = (m.vertices[s + 1] - m.vertices[s]).norm();
-    if (len > threshold) {
-      m.long_segments.push_back(s);
-    } else {
-      m.half_max_short_length = std::max(m.half_max_short_length, 0.5 * len);
-    }
-  }
-  m.tree_points = m.vertices;
-  m.tree_index.resize(m.vertices.size());
-  std::iota(m.tree_index.begin(), m.tree_index.end(), 0u);
-  m.split_dim.assign(m.vertices.size(), 0);
-  m.build(0, m.vertices.size());
+  m.nodes.reserve(2 * m.segments.size() / kLeafSize + 2);
+  m.build(0, static_cast<std::uint32_t>(m.segments.size()));
 }
 
 PolylineIndex::~PolylineIndex() { delete impl_; }
@@ -218,7 +171,9 @@ PolylineIndex& PolylineIndex::operator=(PolylineIndex&& other) noexcept {
 
 const std::vector<Vector3>& PolylineIndex::vertices() const { return impl_->vertices; }
 
-PolylineIndex::Nearest PolylineIndex::nearest(const Vector3& p_m) const {
+PolylineIndex::Nearest PolylineIndex::nearest(const Vector3& p_m) const { return nearest(p_m, nullptr); }
+
+PolylineIndex::Nearest PolylineIndex::nearest(const Vector3& p_m, const Nearest* hint) const {
   const Impl& m = *impl_;
   Nearest best;
   double best2 = std::numeric_limits<double>::infinity();
@@ -226,14 +181,12 @@ PolylineIndex::Nearest PolylineIndex::nearest(const Vector3& p_m) const {
     best.distance_m = std::numeric_limits<double>::quiet_NaN();
     return best;
   }
-  double dv2 = std::numeric_limits<double>::infinity();
-  m.nearest_vertex(0, m.tree_points.size(), p_m, dv2);
-  // A hair more than the bound, so rounding never drops the segment that holds the answer.
-  const double r = (std::sqrt(dv2) + m.half_max_short_length) * (1.0 + 1e-12) + 1e-15;
-  m.radius_search(0, m.tree_points.size(), p_m, r * r, best, best2);
-  for (const std::size_t s : m.long_segments) {
-    m.consider_segment(s, p_m, best, best2);
+  if (hint != nullptr && hint->segment < m.vertices.size()) {
+    // The hint's vertex is a point of the path, so its distance bounds the answer. Inflated a hair,
+    // so the search still finds (and records) a point at least as near, even the vertex itself.
+    best2 = (m.vertices[hint->segment] - p_m).squaredNorm() * (1.0 + 1e-9) + 1e-30;
   }
+  m.search(p_m, best, best2);
   best.distance_m = std::sqrt(best2);
   return best;
 }
@@ -245,13 +198,15 @@ PathDeviationStats stats_of(const std::vector<TrackerTrace>& loaded, const Polyl
   double sum = 0.0;
   double sum2 = 0.0;
   std::vector<double> d;
+  PolylineIndex::Nearest hint;
   for (const auto& trace : loaded) {
     for (std::size_t i = 0; i < trace.size(); ++i) {
       if (!trace[i].p_m.allFinite()) {
         throw InputError(fmt::format("loaded path: sample {} (t = {} s) has a position that is not finite", i,
                                      trace[i].t_s));
       }
-      const double di = index.nearest(trace[i].p_m).distance_m;
+      hint = index.nearest(trace[i].p_m, i > 0 ? &hint : nullptr);
+      const double di = hint.distance_m;
       d.push_back(di);
       sum += di;
       sum2 += di * di;

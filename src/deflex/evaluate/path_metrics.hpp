@@ -11,9 +11,9 @@ namespace deflex {
 
 /// Nearest point on a reference path made of one or more polylines (each trace is one polyline: the
 /// last sample of one trace is not joined to the first of the next). Built once, then queried many
-/// times: a k-d tree over the vertices finds every segment that can hold the nearest point, so a
-/// query costs O(log n) for the dense paths a tracker records. The answer is exact (the same as a
-/// brute-force search over all segments).
+/// times: a bounding-box hierarchy over the segments skips every part of the path farther than the
+/// best point found so far, so a query costs about O(log n) for the dense paths a tracker records.
+/// The answer is exact (the same as a brute-force search over all segments).
 class PolylineIndex {
  public:
   /// Throws InputError when there is no sample at all or a position is not finite.
@@ -28,10 +28,13 @@ class PolylineIndex {
   struct Nearest {
     double distance_m = 0.0;
     Vector3 point_m = Vector3::Zero();  ///< nearest point on the path
-    std::size_t segment = 0;            ///< index of the segment's first vertex (all pieces concatenated)
+    std::size_t segment = 0;            ///< index of the nearest segment's first vertex (all pieces concatenated)
     double fraction = 0.0;              ///< 0..1 along that segment
   };
   [[nodiscard]] Nearest nearest(const Vector3& p_m) const;
+  /// The same, seeded with the answer for a nearby point (the previous tracker sample): same result,
+  /// found faster. A NaN distance when p_m is not finite.
+  [[nodiscard]] Nearest nearest(const Vector3& p_m, const Nearest* hint) const;
   /// Vertices of all pieces, concatenated in order.
   [[nodiscard]] const std::vector<Vector3>& vertices() const;
 
