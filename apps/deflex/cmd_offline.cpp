@@ -1,5 +1,8 @@
 // `deflex offline`: compensate a planned path for a force model and write the CSV, the RAPID module
 // and a summary (paper, Figure 2).
+#include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <iostream>
 #include <memory>
 
@@ -128,10 +131,18 @@ void run(const Opts& o, int& exit_code) {
 
   nlohmann::json runs = nlohmann::json::array();
   const bool several = forces.size() > 1;
+  std::vector<std::string> labels;  // file-name labels, made unique so no run overwrites another
+  for (std::size_t k = 0; k < forces.size(); ++k) {
+    std::string label = identifier_safe(forces[k]->label());
+    if (std::find(labels.begin(), labels.end(), label) != labels.end()) {
+      label += "_" + std::to_string(k + 1);
+    }
+    labels.push_back(label);
+  }
   for (std::size_t k = 0; k < forces.size(); ++k) {
     const ForceModel& force = *forces[k];
     const OfflineResult result = compensate_path(model, joints, poses, force);
-    const std::string label = several ? identifier_safe(force.label()) : "";
+    const std::string& label = labels[k];
     nlohmann::json run{{"force", force.describe()},
                        {"points", result.points.size()},
                        {"max_deflection_mm", result.max_deflection_m * 1e3},

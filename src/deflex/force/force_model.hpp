@@ -24,8 +24,8 @@ class ForceModel {
   [[nodiscard]] virtual Wrench wrench_at(std::size_t index, const Pose& base_T_tcp) const = 0;
   /// One line for humans and report headers, with units.
   [[nodiscard]] virtual std::string describe() const = 0;
-  /// Short name usable in file names ("ldbb_625N_push").
-  [[nodiscard]] virtual std::string label() const = 0;
+  /// Short name usable in file names ("ldbb_625N_push"); models outside deflex may keep the default.
+  [[nodiscard]] virtual std::string label() const { return "force"; }
   /// Number of path points the model has data for, when it is limited (tables); none otherwise.
   [[nodiscard]] virtual std::optional<std::size_t> points() const { return std::nullopt; }
 
