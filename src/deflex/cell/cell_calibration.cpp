@@ -1,6 +1,7 @@
 // Compliance calibration on the simulated cell (see cell_calibration.hpp).
 #include "deflex/cell/cell_calibration.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -26,7 +27,8 @@ CellCalibration calibrate_setup(const TrueRobot& robot, std::uint64_t seed) {
   plan_options.load_n = c.calibration.load_n;
   plan_options.poses = c.calibration.poses;
   plan_options.orientation = Eigen::Quaterniond(c.circle.tcp_orientation.linear());
-  plan_options.noise_m = c.tracker.noise_m / std::sqrt(static_cast<double>(c.calibration.samples));
+  // The planner predicts standard errors from the noise; a noiseless cell still needs a positive one.
+  plan_options.noise_m = std::max(1e-9, c.tracker.noise_m / std::sqrt(static_cast<double>(c.calibration.samples)));
   const CalibrationPlan plan = plan_calibration(nominal, plan_options);
 
   std::mt19937_64 rng(seed);
