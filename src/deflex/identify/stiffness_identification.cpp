@@ -269,8 +269,6 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
     }
   }
   if (estimated.empty()) {
-    est.unidentifiable_joints = left_out;
-    std::for_each(est.unidentifiable_joints.begin(), est.unidentifiable_joints.end(), [](int& j) { ++j; });
     throw InputError(fmt::format("identify_stiffness: no joint can be identified from these data: {}",
                                  fmt::join(est.warnings, "; ")));
   }

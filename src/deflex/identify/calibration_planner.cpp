@@ -1,0 +1,294 @@
+// Greedy maximin selection of calibration poses and loads from a grid of reachable candidates.
+#include "deflex/identify/calibration_planner.hpp"
+
+#include <cmath>
+#include <limits>
+#include <tuple>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+#include <fmt/format.h>
+
+#include "deflex/identify/stiffness_identification.hpp"
+#include "deflex/model/csv_table.hpp"
+#include "deflex/model/errors.hpp"
+#include "deflex/model/inverse_kinematics.hpp"
+
+namespace deflex {
+namespace {
+
+struct Candidate {
+  Wrench wrench;
+  Vector3 load_point;
+  Eigen::MatrixXd block;  // 3 x n, columns scaled by the nominal compliance (m)
+};
+
+struct CandidatePose {
+  JointVector q;
+  Pose base_T_tcp;
+  std::vector<Candidate> loads;
+  bool used = false;
+};
+
+double min_eigenvalue(const Eigen::MatrixXd& G) {
+  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(G, Eigen::EigenvaluesOnly).eigenvalues()[0];
+}
+
+double log_det(const Eigen::MatrixXd& G) { return G.ldlt().vectorD().array().abs().log().sum(); }
+
+void check_options(const CalibrationPlanOptions& o) {
+  if (!o.region_min_m.allFinite() || !o.region_max_m.allFinite() ||
+      (o.region_max_m - o.region_min_m).minCoeff() < 0.0) {
+    throw InputError("plan_calibration: the region's minimum must not exceed its maximum on any axis");
+  }
+  if (!(o.load_n > 0.0) || !std::isfinite(o.load_n)) {
+    throw InputError("plan_calibration: the load must be a force > 0 N");
+  }
+  if (o.poses < 1 || o.loads_per_pose < 1 || o.loads_per_pose > 30) {
+    throw InputError("plan_calibration: poses must be >= 1 and loads per pose 1..30");
+  }
+  if (!(o.lever_m >= 0.0) || !std::isfinite(o.lever_m)) {
+    throw InputError("plan_calibration: the lever must be >= 0 m");
+  }
+  if (o.grid_per_axis < 1 || o.grid_per_axis > 50 || o.spin_rad.empty()) {
+    throw InputError("plan_calibration: grid per axis must be 1..50 and at least one tool spin given");
+  }
+  if (std::abs(o.orientation.norm() - 1.0) > 1e-3) {
+    throw InputError("plan_calibration: the orientation is not a unit quaternion");
+  }
+  if (!(o.noise_m > 0.0)) {
+    throw InputError("plan_calibration: the noise must be > 0 m");
+  }
+}
+
+}  // namespace
+
+CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanOptions& o) {
+  check_options(o);
+  if (!model.has_stiffness()) {
+    throw InputError(fmt::format("plan_calibration: robot '{}' has no joint stiffness; nominal values (even rough "
+                                 "ones) are needed to weigh the joints against each other",
+                                 model.name()));
+  }
+  const int n = model.dof();
+  const JointVector c_nom = model.compliance();
+  Workspace ws(model);
+  CalibrationPlan plan;
+
+  // Candidate loads in the tool's own terms: a force along +-x, +-y, +-z of the base frame, applied
+  // at the WAP or at the end of a lever along +-x or +-y of the tool.
+  std::vector<Vector3> directions;
+  for (int a = 0; a < 3; ++a) {
+    directions.push_back(Vector3::Unit(a));
+    directions.push_back(-Vector3::Unit(a));
+  }
+  const Eigen::Quaterniond base_q = o.orientation.normalized();
+  const int g = o.grid_per_axis;
+  std::vector<CandidatePose> poses;
+  Jacobian block(6, n);
+  for (int ix = 0; ix < g; ++ix) {
+    for (int iy = 0; iy < g; ++iy) {
+      for (int iz = 0; iz < g; ++iz) {
+        const Eigen::Array3d t(g == 1 ? 0.5 : ix / double(g - 1), g == 1 ? 0.5 : iy / double(g - 1),
+                               g == 1 ? 0.5 : iz / double(g - 1));
+        const Vector3 p = o.region_min_m + ((o.region_max_m - o.region_min_m).array() * t).matrix();
+        for (double spin : o.spin_rad) {
+          ++plan.candidate_poses;
+          Pose target = Pose::Identity();
+          target.linear() = (base_q * Eigen::AngleAxisd(spin, Vector3::UnitZ())).toRotationMatrix();
+          target.translation() = p;
+          const IkResult ik = inverse_kinematics(model, ws, target);
+          if (ik.status != IkStatus::kOk || !model.within_limits(ik.q)) {
+            continue;
+          }
+          CandidatePose cp;
+          cp.q = ik.q;
+          forward_kinematics(model, ws, cp.q);
+          cp.base_T_tcp = ws.base_T_tcp;
+          const Pose base_T_wap = ws.base_T_wap;
+          std::vector<Vector3> levers = {Vector3::Zero()};
+          if (o.lever_m > 0.0) {
+            for (int a = 0; a < 2; ++a) {
+              levers.push_back(o.lever_m * base_T_wap.linear().col(a));
+              levers.push_back(-o.lever_m * base_T_wap.linear().col(a));
+            }
+          }
+          for (const Vector3& d : directions) {
+            for (const Vector3& r : levers) {
+              if (r.norm() > 0.0 && r.cross(d).norm() < 1e-6 * r.norm()) {
+                continue;  // force along the lever: the same as no lever
+              }
+              Candidate c;
+              c.wrench.head<3>() = o.load_n * d;
+              c.wrench.tail<3>() = r.cross(c.wrench.head<3>());
+              c.load_point = base_T_wap.translation() + r;
+              stiffness_regressor(model, ws, cp.q, c.wrench, block);
+              c.block = block.topRows(3) * c_nom.asDiagonal();
+              cp.loads.push_back(std::move(c));
+            }
+          }
+          poses.push_back(std::move(cp));
+        }
+      }
+    }
+  }
+  plan.reachable_poses = static_cast<int>(poses.size());
+  if (poses.empty()) {
+    throw InputError(fmt::format("plan_calibration: no pose of the region is reachable with the requested tool "
+                                 "orientation inside the joint limits and away from singularities ({} tried)",
+                                 plan.candidate_poses));
+  }
+  int wanted = o.poses;
+  if (wanted > plan.reachable_poses) {
+    plan.warnings.push_back(fmt::format("only {} reachable poses in the region; the plan uses all of them",
+                                        plan.reachable_poses));
+    wanted = plan.reachable_poses;
+  }
+
+  // Regulariser for the log-determinant while A^T A is singular: tiny against any real information.
+  double info_scale = 0.0;
+  for (const auto& cp : poses) {
+    for (const auto& c : cp.loads) {
+      info_scale = std::max(info_scale, c.block.squaredNorm());
+    }
+  }
+  const Eigen::MatrixXd eps = 1e-9 * info_scale * Eigen::MatrixXd::Identity(n, n);
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);
+  // Picks the best load among candidates; returns {pose, load} or {-1, -1}.
+  auto pick = [&](int only_pose) {
+    int best_p = -1, best_l = -1;
+    double best_min = -1.0, best_ld = -std::numeric_limits<double>::infinity();
+    std::vector<std::tuple<int, int, double, double>> scores;
+    for (int pi = 0; pi < static_cast<int>(poses.size()); ++pi) {
+      const CandidatePose& cp = poses[static_cast<std::size_t>(pi)];
+      if (only_pose >= 0 ? pi != only_pose : cp.used) {
+        continue;
+      }
+      for (int li = 0; li < static_cast<int>(cp.loads.size()); ++li) {
+        const Eigen::MatrixXd& B = cp.loads[static_cast<std::size_t>(li)].block;
+        const Eigen::MatrixXd Gn = G + B.transpose() * B;
+        scores.emplace_back(pi, li, min_eigenvalue(Gn), log_det(Gn + eps));
+      }
+    }
+    for (const auto& [pi, li, mn, ld] : scores) {
+      best_min = std::max(best_min, mn);
+    }
+    // Until the information matrix has full rank every smallest eigenvalue is ~0; then the
+    // log-determinant (D-optimality) spreads the information over the missing directions.
+    const bool use_min = best_min > 1e-6 * info_scale;
+    double best = -std::numeric_limits<double>::infinity();
+    for (const auto& [pi, li, mn, ld] : scores) {
+      const double s = use_min ? mn : ld;
+      if (s > best) {
+        best = s;
+        best_p = pi;
+        best_l = li;
+      }
+    }
+    (void)best_ld;
+    return std::pair<int, int>(best_p, best_l);
+  };
+  for (int k = 0; k < wanted; ++k) {
+    auto [pi, li] = pick(-1);
+    if (pi < 0) {
+      break;
+    }
+    CandidatePose& cp = poses[static_cast<std::size_t>(pi)];
+    cp.used = true;
+    for (int l = 0; l < o.loads_per_pose && !cp.loads.empty(); ++l) {
+      if (l > 0) {
+        li = pick(pi).second;
+      }
+      const Candidate& c = cp.loads[static_cast<std::size_t>(li)];
+      G += c.block.transpose() * c.block;
+      CalibrationPoint pt;
+      pt.pose = k + 1;
+      pt.q = cp.q;
+      pt.base_T_tcp = cp.base_T_tcp;
+      pt.wrench_base = c.wrench;
+      pt.load_point_base = c.load_point;
+      pt.expected_dp_m = c.block.rowwise().sum();  // sum_j c_nom_j * column_j
+      plan.points.push_back(pt);
+      cp.loads.erase(cp.loads.begin() + li);
+    }
+  }
+
+  // Figures of the chosen design.
+  const Eigen::VectorXd eig = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(G, Eigen::EigenvaluesOnly).eigenvalues();
+  plan.min_singular_value_m = std::sqrt(std::max(0.0, eig[0]));
+  const Eigen::VectorXd d = G.diagonal().cwiseSqrt();
+  Eigen::MatrixXd Gn = G;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      Gn(i, j) = d[i] > 0.0 && d[j] > 0.0 ? G(i, j) / (d[i] * d[j]) : 0.0;
+    }
+  }
+  const Eigen::VectorXd en = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Gn, Eigen::EigenvaluesOnly).eigenvalues();
+  plan.condition_number = en[0] > 0.0 ? std::sqrt(en[n - 1] / en[0]) : std::numeric_limits<double>::infinity();
+  plan.predicted_relative_std_error.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::infinity());
+  if (eig[0] > 1e-12 * eig[n - 1]) {
+    const Eigen::MatrixXd cov = G.inverse();
+    for (int j = 0; j < n; ++j) {
+      plan.predicted_relative_std_error[static_cast<std::size_t>(j)] = o.noise_m * std::sqrt(cov(j, j));
+    }
+  }
+  for (int j = 0; j < n; ++j) {
+    const double r = plan.predicted_relative_std_error[static_cast<std::size_t>(j)];
+    if (!(r < 0.1)) {
+      plan.warnings.push_back(fmt::format(
+          "joint {}: predicted relative standard error {} with {:.0f} um tracker noise; use more poses, a larger "
+          "load, a longer lever or a larger region",
+          j + 1, std::isfinite(r) ? fmt::format("{:.0f}%", 100.0 * r)
+                           : std::string("unbounded: not observable (no load turns it, or the TCP lies on its axis)"),
+          o.noise_m * 1e6));
+    }
+  }
+  return plan;
+}
+
+void write_calibration_plan(const std::string& path, const CalibrationPlan& plan,
+                            const std::vector<std::string>& comments) {
+  const Eigen::Index n = plan.points.empty() ? 0 : plan.points.front().q.size();
+  std::vector<std::string> cols = {"pose"};
+  for (Eigen::Index j = 1; j <= n; ++j) {
+    cols.push_back(fmt::format("q{}_deg", j));
+  }
+  for (const char* c : {"x_mm", "y_mm", "z_mm", "qw", "qx", "qy", "qz", "fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm",
+                        "mz_Nm", "load_x_mm", "load_y_mm", "load_z_mm", "expected_dx_mm", "expected_dy_mm",
+                        "expected_dz_mm"}) {
+    cols.emplace_back(c);
+  }
+  CsvWriter w(path, cols);
+  for (const auto& c : comments) {
+    w.comment(c);
+  }
+  std::vector<double> row;
+  for (const CalibrationPoint& p : plan.points) {
+    row.clear();
+    row.push_back(p.pose);
+    for (Eigen::Index j = 0; j < n; ++j) {
+      row.push_back(rad_to_deg(p.q[j]));
+    }
+    const Vector3 x = p.base_T_tcp.translation() * 1e3;
+    const Eigen::Quaterniond q(p.base_T_tcp.linear());
+    row.insert(row.end(), {x.x(), x.y(), x.z(), q.w(), q.x(), q.y(), q.z()});
+    for (int k = 0; k < 6; ++k) {
+      row.push_back(p.wrench_base[k]);
+    }
+    for (int k = 0; k < 3; ++k) {
+      row.push_back(p.load_point_base[k] * 1e3);
+    }
+    for (int k = 0; k < 3; ++k) {
+      row.push_back(p.expected_dp_m[k] * 1e3);
+    }
+    // Round-off dust (1e-15 deg) would only distract the operator.
+    for (double& v : row) {
+      if (std::abs(v) < 1e-9) {
+        v = 0.0;
+      }
+    }
+    w.row(row);
+  }
+}
+
+}  // namespace deflex
