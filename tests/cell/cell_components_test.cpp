@@ -1,0 +1,228 @@
+// Components of the simulated cell against closed forms: LDBB force direction, first-order response
+// and ball friction; lost motion's sign and history; the sensor's compliance; the true robot's fixed
+// point against the core's deflected configuration; the controller's program and schedule.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "deflex/cell/case_config.hpp"
+#include "deflex/cell/controller.hpp"
+#include "deflex/cell/force_sensor.hpp"
+#include "deflex/cell/ldbb_device.hpp"
+#include "deflex/cell/true_robot.hpp"
+#include "deflex/model/compliance.hpp"
+#include "deflex/model/errors.hpp"
+
+namespace deflex::cell {
+namespace {
+
+LdbbConfig quiet_ldbb() {
+  LdbbConfig c;
+  c.bar_length_m = 0.15;
+  c.inclination_rad = deg_to_rad(30.0);
+  c.time_constant_s = 0.3;
+  c.ripple = 0.0;
+  c.noise = 0.0;
+  c.force_bias = 0.0;
+  c.ball_friction = 0.0;
+  return c;
+}
+
+TEST(LdbbDevice, PushesAlongTheBarFromTheTruePivot) {
+  LdbbConfig c = quiet_ldbb();
+  c.pivot_error_m = Vector3(0.002, -0.001, 0.0);
+  LdbbDevice d(c, Vector3(1.8, 0.0, 0.825), 400.0, 1);
+  d.settle();
+  const Vector3 tcp(1.8 + 0.1299, 0.0, 0.9);
+  const Wrench w = d.wrench(tcp, Vector3::Zero());
+  const Vector3 bar = tcp - Vector3(1.802, -0.001, 0.825);
+  EXPECT_NEAR((w.head<3>() - 400.0 * bar.normalized()).norm(), 0.0, 1e-9);
+  EXPECT_TRUE(w.tail<3>().isZero());
+  c.push = false;
+  LdbbDevice pull(c, Vector3(1.8, 0.0, 0.825), 400.0, 1);
+  pull.settle();
+  EXPECT_NEAR((pull.wrench(tcp, Vector3::Zero()).head<3>() + 400.0 * bar.normalized()).norm(), 0.0, 1e-9);
+}
+
+TEST(LdbbDevice, FirstOrderResponseToTheSetPointWithBias) {
+  LdbbConfig c = quiet_ldbb();
+  c.force_bias = -0.1;
+  LdbbDevice d(c, Vector3::Zero(), 500.0, 1);
+  const double dt = 0.001;
+  for (int i = 0; i < 300; ++i) d.advance(dt);  // one time constant
+  EXPECT_NEAR(d.magnitude_n(), 450.0 * (1.0 - std::exp(-1.0)), 1e-6);
+  for (int i = 0; i < 3000; ++i) d.advance(dt);
+  EXPECT_NEAR(d.magnitude_n(), 450.0 * (1.0 - std::exp(-11.0)), 1e-6);
+}
+
+TEST(LdbbDevice, BallFrictionOpposesTheMotionAcrossTheBar) {
+  LdbbConfig c = quiet_ldbb();
+  c.ball_friction = 0.1;
+  c.ball_radius_m = 0.0127;
+  LdbbDevice d(c, Vector3::Zero(), 600.0, 1);
+  d.settle();
+  const Vector3 tcp(0.0, 0.0, 0.15);            // bar along +z, length 0.15
+  const Vector3 v(0.05, 0.0, 0.0);             // moving along +x, across the bar
+  const Wrench w = d.wrench(tcp, v);
+  EXPECT_NEAR(w[2], 600.0, 1e-9);
+  EXPECT_NEAR(w[0], -2.0 * 0.1 * 600.0 * 0.0127 / 0.15, 1e-9);
+  EXPECT_NEAR(w[1], 0.0, 1e-12);
+}
+
+TEST(LostMotion, FollowsTheSignOfTheTorqueWithHistory) {
+  LostMotion lm;
+  lm.half_width_rad = 20e-6;
+  lm.torque_nm = 100.0;
+  EXPECT_DOUBLE_EQ(lm.update(50.0), 0.0);     // below the band: nothing moves
+  EXPECT_DOUBLE_EQ(lm.update(150.0), 10e-6);  // half-way across
+  EXPECT_DOUBLE_EQ(lm.update(300.0), 20e-6);  // across, saturated
+  EXPECT_DOUBLE_EQ(lm.update(0.0), 20e-6);    // unloading keeps the side it was pushed to
+  EXPECT_DOUBLE_EQ(lm.update(-100.0), 0.0);   // reversing the torque walks back through the band
+  EXPECT_DOUBLE_EQ(lm.update(-250.0), -20e-6);
+  EXPECT_DOUBLE_EQ(lm.update(-50.0), -20e-6);
+}
+
+CaseConfig bare_case() {
+  CaseConfig c = paper_case();
+  c = model_consistent(c, false);
+  c.exact_model = false;
+  c.robot.stiffness_spread = 0.0;
+  c.robot.stiffness_scale = 1.0;
+  return c;
+}
+
+JointVector test_pose() {
+  JointVector q(6);
+  q << 0.1, deg_to_rad(25.0), deg_to_rad(5.0), 0.2, deg_to_rad(55.0), -0.3;
+  return q;
+}
+
+TEST(TrueRobot, LumpedOnlyMatchesTheCoresDeflectedConfiguration) {
+  const CaseConfig c = bare_case();
+  const TrueRobot robot(c, false, 7);
+  Workspace ws(robot.true_model());
+  const JointVector q = test_pose();
+  Wrench w;
+  w << 300.0, -200.0, 500.0, 0.0, 0.0, 0.0;
+  TrueRobotState s = robot.initial_state(q);
+  const Vector3 p = robot.solve(ws, q, w, s);
+  JointVector q_actual;
+  ASSERT_EQ(deflected_configuration(robot.true_model(), ws, q, w, q_actual), DeflectionStatus::kConverged);
+  EXPECT_NEAR((p - tcp_pose(robot.true_model(), ws, q_actual).translation()).norm(), 0.0, 1e-10);
+  // And the true stiffness is the built-in one when scale 1 and spread 0.
+  for (int j = 0; j < 6; ++j) {
+    EXPECT_DOUBLE_EQ(robot.true_model().stiffness()[j], robot.nominal_model().stiffness()[j]);
+  }
+}
+
+TEST(TrueRobot, SensorComplianceAddsTheCantileverDeflection) {
+  CaseConfig c = bare_case();
+  c.sensor.lateral_compliance_m_per_n = 0.5e-6;
+  c.sensor.rotational_compliance_rad_per_nm = 4e-6;
+  c.sensor.axial_compliance_m_per_n = 0.0;
+  const TrueRobot robot(c, true, 7);
+  Workspace ws(robot.true_model());
+  forward_kinematics(robot.true_model(), ws, test_pose());
+  // A force along the flange x axis at the TCP, which sits ee_length beyond the sensor origin along
+  // flange z: the sensor shears by c_lat F and tilts by c_rot F L, which moves the TCP by c_rot F L^2.
+  const Vector3 x_flange = ws.base_T_flange.linear().col(0);
+  Wrench w;
+  w << 200.0 * x_flange, Vector3::Zero();
+  const double L = c.tool.ee_length_m;
+  const Vector3 d = robot.structural_displacement(ws, w);
+  EXPECT_NEAR((d - x_flange * 200.0 * (0.5e-6 + 4e-6 * L * L)).norm(), 0.0, 1e-12);
+  // Without the sensor mounted, nothing is added.
+  const TrueRobot bare(c, false, 7);
+  Workspace ws2(bare.true_model());
+  forward_kinematics(bare.true_model(), ws2, test_pose());
+  EXPECT_NEAR(bare.structural_displacement(ws2, w).norm(), 0.0, 1e-15);
+}
+
+TEST(ForceSensorDaq, MeasuresProcessForceAndWeightInTheSensorFrame) {
+  SensorConfig s;
+  s.crosstalk = 0.0;
+  s.noise_n = 0.0;
+  s.bias_n = Vector3(1.0, 2.0, 3.0);
+  ToolConfig tool;
+  tool.ee_mass_kg = 5.0;
+  ForceSensorDaq daq(s, tool, 3);
+  const Matrix3 R = Eigen::AngleAxisd(kPi, Vector3::UnitY()).toRotationMatrix();  // tool pointing down
+  const Vector3 f = daq.sample(Vector3(10.0, 0.0, 100.0), R);
+  // In the flipped frame x and z change sign; the weight (-z in the base) reads +z in the sensor.
+  EXPECT_NEAR(f.x(), -10.0 + 1.0, 1e-12);
+  EXPECT_NEAR(f.y(), 0.0 + 2.0, 1e-12);
+  EXPECT_NEAR(f.z(), -100.0 + 5.0 * kGravity + 3.0, 1e-12);
+}
+
+TEST(ForceSensorDaq, DecouplingUndoesTheCrosstalkUpToTheCalibrationResidual) {
+  SensorConfig s;
+  s.crosstalk = 0.02;
+  s.crosstalk_calibration_residual = 0.0;
+  s.noise_n = 0.0;
+  ForceSensorDaq daq(s, ToolConfig{}, 5);
+  EXPECT_GT((daq.crosstalk() - Matrix3::Identity()).norm(), 1e-3);
+  const Vector3 raw = daq.sample(Vector3(100.0, -50.0, 20.0), Matrix3::Identity());
+  EXPECT_NEAR((daq.calibration().decoupling * raw - Vector3(100.0, -50.0, 20.0)).norm(), 0.0, 1e-9);
+}
+
+TEST(JointProgram, PassesThroughItsPointsAndInterpolatesSmoothly) {
+  std::vector<JointVector> pts;
+  const int n = 80;
+  for (int k = 0; k < n; ++k) {
+    JointVector q(2);
+    const double a = 2.0 * kPi * k / n;
+    q << std::sin(a), 0.3 * std::cos(2.0 * a);
+    pts.push_back(q);
+  }
+  const JointProgram program(pts);
+  JointVector q;
+  program.at(2.0 * kPi * 5 / n, q);
+  EXPECT_NEAR((q - pts[5]).norm(), 0.0, 1e-12);
+  program.at(-2.0 * kPi * 3 / n, q);  // periodic: negative angles wrap
+  EXPECT_NEAR((q - pts[n - 3]).norm(), 0.0, 1e-12);
+  double worst = 0.0;
+  for (int i = 0; i < 1000; ++i) {
+    const double a = 2.0 * kPi * i / 1000.0;
+    program.at(a, q);
+    worst = std::max(worst, std::abs(q[0] - std::sin(a)));
+  }
+  EXPECT_LT(worst, 1e-4);  // cubic accuracy with 4.5 deg steps
+  EXPECT_THROW(JointProgram(std::vector<JointVector>(3, JointVector::Zero(2))), InputError);
+}
+
+TEST(LapSchedule, ClockwiseThenAnticlockwiseAfterSettling) {
+  LapSchedule s;
+  s.omega_rad_s = 0.5;
+  s.settle_s = 2.0;
+  s.laps_cw = 3;
+  s.laps_ccw = 3;
+  const double lap = 2.0 * kPi / 0.5;
+  EXPECT_DOUBLE_EQ(s.angle(1.0), 0.0);
+  EXPECT_EQ(s.direction(1.0), 0);
+  EXPECT_NEAR(s.angle(2.0 + lap), -2.0 * kPi, 1e-12);
+  EXPECT_EQ(s.direction(2.0 + lap), -1);
+  EXPECT_NEAR(s.angle(2.0 + 3 * lap), -6.0 * kPi, 1e-12);
+  EXPECT_EQ(s.direction(2.0 + 4 * lap), 1);
+  EXPECT_NEAR(s.angle(s.duration_s()), 0.0, 1e-9);
+  EXPECT_NEAR(s.duration_s(), 2.0 + 6 * lap, 1e-9);
+}
+
+TEST(CorrectionChannel, KeepsTheNewestArrivedMessage) {
+  CorrectionChannel ch(4);
+  for (int i = 0; i < 3; ++i) {
+    CorrectionMessage m;
+    m.arrival_s = 0.1 * i;
+    m.reference_s = i;
+    m.q_target = JointVector::Constant(1, i);
+    EXPECT_TRUE(ch.push(m));
+  }
+  CorrectionMessage out;
+  EXPECT_TRUE(ch.pop_arrived(0.15, out));
+  EXPECT_DOUBLE_EQ(out.reference_s, 1.0);
+  EXPECT_FALSE(ch.pop_arrived(0.15, out));
+  EXPECT_TRUE(ch.pop_arrived(1.0, out));
+  EXPECT_DOUBLE_EQ(out.reference_s, 2.0);
+}
+
+}  // namespace
+}  // namespace deflex::cell
