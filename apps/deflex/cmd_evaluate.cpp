@@ -1,0 +1,130 @@
+// `deflex evaluate`: the paper's mean deformation and ISO 9283 path figures from tracker files.
+#include <iostream>
+#include <memory>
+
+#include <fmt/format.h>
+
+#include "cli_util.hpp"
+#include "command.hpp"
+#include "deflex/evaluate/iso9283_path.hpp"
+#include "deflex/evaluate/path_metrics.hpp"
+#include "deflex/evaluate/tracker_trace.hpp"
+#include "deflex/model/errors.hpp"
+
+namespace deflex::cli {
+namespace {
+
+std::vector<TrackerTrace> read_all(const std::vector<std::string>& paths) {
+  std::vector<TrackerTrace> out;
+  for (const auto& p : paths) {
+    out.push_back(read_tracker_csv(p));
+  }
+  return out;
+}
+
+std::size_t samples_of(const std::vector<TrackerTrace>& traces) {
+  std::size_t n = 0;
+  for (const auto& t : traces) {
+    n += t.size();
+  }
+  return n;
+}
+
+nlohmann::json iso_json(const Iso9283Path& iso, const std::string& reference) {
+  return {{"reference", reference},
+          {"accuracy_mm", iso.accuracy_m * 1e3},
+          {"mean_accuracy_mm", iso.mean_accuracy_m * 1e3},
+          {"repeatability_mm", iso.runs > 1 ? nlohmann::json(iso.repeatability_m * 1e3) : nlohmann::json(nullptr)},
+          {"runs", iso.runs},
+          {"evaluation_points", iso.evaluation_points},
+          {"skipped_points", iso.skipped_points}};
+}
+
+std::string iso_text(const std::string& what, const Iso9283Path& iso) {
+  std::string rt = iso.runs > 1 ? fmt::format("{:.4f} mm", iso.repeatability_m * 1e3)
+                                : "n/a (one run: give each lap as its own file)";
+  std::string out = fmt::format(
+      "{}:\n  path accuracy AT_p      {:.4f} mm  (mean over the planes {:.4f} mm)\n"
+      "  path repeatability RT_p {}\n  {} runs, {} planes normal to the path",
+      what, iso.accuracy_m * 1e3, iso.mean_accuracy_m * 1e3, rt, iso.runs, iso.evaluation_points);
+  if (iso.skipped_points > 0) {
+    out += fmt::format(" ({} planes left out: not crossed by every run)", iso.skipped_points);
+  }
+  return out + "\n";
+}
+
+void setup_evaluate(CLI::App& sub, int& exit_code) {
+  struct Opts {
+    std::vector<std::string> unloaded, loaded;
+    std::string commanded;
+    int points = 81;
+    double max_offset_mm = 10.0;
+    bool json = false;
+  };
+  auto o = std::make_shared<Opts>();
+  sub.add_option("--unloaded", o->unloaded,
+                 "Tracker CSV (t_s,x_mm,y_mm,z_mm) of the unloaded path; repeat the option for several laps/runs")
+      ->required();
+  sub.add_option("--loaded", o->loaded,
+                 "Tracker CSV of the loaded path (uncompensated or compensated); repeat for several laps/runs "
+                 "(each file is one run for ISO 9283 repeatability)")
+      ->required();
+  sub.add_option("--commanded", o->commanded,
+                 "CSV of the commanded path (same columns; t_s may be 0): ISO 9283 accuracy is then taken against "
+                 "it instead of the first unloaded run");
+  sub.add_option("--evaluation-points", o->points, "ISO 9283: planes normal to the path (default 81, the paper's)")
+      ->check(CLI::Range(1, 100000));
+  sub.add_option("--max-offset-mm", o->max_offset_mm,
+                 "ISO 9283: a run crossing a plane farther than this from the path does not count there (default 10)");
+  sub.add_flag("--json", o->json, "Print one JSON document on stdout");
+  sub.callback([o, &exit_code] {
+    if (!(o->max_offset_mm > 0.0)) {
+      throw InputError("option --max-offset-mm: must be a positive number of mm");
+    }
+    const std::vector<TrackerTrace> unloaded = read_all(o->unloaded);
+    const std::vector<TrackerTrace> loaded = read_all(o->loaded);
+    const PathDeviationStats dev = path_deviation(loaded, unloaded);
+    // ISO 9283 wants one reference path: the commanded one when given, else the first unloaded run.
+    const bool have_commanded = !o->commanded.empty();
+    const TrackerTrace reference = have_commanded ? read_tracker_csv(o->commanded) : unloaded.front();
+    const std::string ref_name = have_commanded ? "commanded" : "unloaded (first run)";
+    const Iso9283Path iso_loaded = iso9283_path(loaded, reference, o->points, o->max_offset_mm * 1e-3);
+    Iso9283Path iso_unloaded;
+    if (have_commanded) {
+      iso_unloaded = iso9283_path(unloaded, reference, o->points, o->max_offset_mm * 1e-3);
+    }
+    if (o->json) {
+      nlohmann::json doc{{"mean_deformation_mm", dev.mean_m * 1e3},
+                         {"max_mm", dev.max_m * 1e3},
+                         {"rms_mm", dev.rms_m * 1e3},
+                         {"std_mm", dev.std_m * 1e3},
+                         {"loaded_samples", dev.samples},
+                         {"unloaded_samples", samples_of(unloaded)},
+                         {"iso9283_loaded", iso_json(iso_loaded, ref_name)}};
+      if (have_commanded) {
+        doc["iso9283_unloaded"] = iso_json(iso_unloaded, ref_name);
+      }
+      print_json(doc);
+    } else {
+      std::cout << fmt::format(
+          "Distance of the loaded path from the unloaded path ({} loaded points, {} file{}; {} unloaded points, {} "
+          "file{}):\n  mean (the paper's mean deformation) {:.4f} mm\n  max {:.4f} mm   RMS {:.4f} mm   std {:.4f} mm\n",
+          dev.samples, loaded.size(), loaded.size() > 1 ? "s" : "", samples_of(unloaded), unloaded.size(),
+          unloaded.size() > 1 ? "s" : "", dev.mean_m * 1e3, dev.max_m * 1e3, dev.rms_m * 1e3, dev.std_m * 1e3);
+      std::cout << iso_text(fmt::format("ISO 9283 (loaded runs against the {} path)", ref_name), iso_loaded);
+      if (have_commanded) {
+        std::cout << iso_text("ISO 9283 (unloaded runs against the commanded path)", iso_unloaded);
+      }
+    }
+    exit_code = 0;
+  });
+}
+
+}  // namespace
+
+DEFLEX_COMMAND("evaluate",
+               "Judge a path from tracker CSV files: the paper's mean deformation (loaded vs unloaded) and ISO 9283 "
+               "path accuracy and repeatability, in mm",
+               setup_evaluate, 60);
+
+}  // namespace deflex::cli
