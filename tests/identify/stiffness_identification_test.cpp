@@ -15,6 +15,7 @@
 #include "deflex/model/robot_io.hpp"
 #include "model/kdl_chain.hpp"
 #include "model/test_robots.hpp"
+#include "support/allocation_guard.hpp"
 
 namespace deflex {
 namespace {
@@ -274,6 +275,40 @@ TEST(IdentifyStiffness, FixedJointsAreHeldAndTheRestRecovered) {
   // A wrong fixed value shows up as residual, not silently absorbed into a perfect fit.
   opt.fixed_stiffness_nm_per_rad[0] = 0.5 * k_true[0];
   EXPECT_GT(identify_stiffness(model, data, opt).residual_rms_m, 1e-6);
+}
+
+TEST(IdentifyStiffness, AWeightOfTwoCountsLikeTheMeasurementTakenTwice) {
+  const RobotModel truth = kr210();
+  auto data = deflected_data(truth, 40, 20e-6, 21);
+  auto doubled = data;
+  for (std::size_t i = 0; i < data.size(); i += 3) {
+    data[i].weight = 2.0;
+    doubled.push_back(doubled[i]);
+  }
+  IdentificationOptions plain;
+  plain.robust = false;
+  const StiffnessEstimate a = identify_stiffness(truth, data, plain);
+  const StiffnessEstimate b = identify_stiffness(truth, doubled, plain);
+  for (std::size_t j = 0; j < 6; ++j) {
+    EXPECT_NEAR(a.stiffness_nm_per_rad[j] / b.stiffness_nm_per_rad[j], 1.0, 1e-10) << "joint " << j + 1;
+  }
+}
+
+TEST(IdentifyStiffness, RegressorBlockIsTheTcpMotionPerUnitComplianceAndDoesNotAllocate) {
+  const RobotModel model = kr210();
+  Workspace ws(model);
+  std::mt19937 rng(2);
+  const JointVector q = random_configuration(model, rng);
+  const Wrench w = random_wrench(rng, true);
+  Jacobian block(6, 6);
+  {
+    test::AllocationGuard guard;
+    stiffness_regressor(model, ws, q, w, block);
+    EXPECT_EQ(guard.allocations(), 0u);
+  }
+  // Column j times c_j summed over j: the core's first-order TCP deflection.
+  const Displacement dx = tcp_deflection(model, ws, q, w);
+  EXPECT_LT((block * model.compliance() - dx).norm(), 1e-12 * dx.norm());
 }
 
 TEST(IdentifyStiffness, BadInputIsAnErrorNamingTheMeasurement) {

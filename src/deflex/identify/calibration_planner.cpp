@@ -154,6 +154,22 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
   }
   const Eigen::MatrixXd eps = 1e-9 * info_scale * Eigen::MatrixXd::Identity(n, n);
   Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);
+  // A joint no candidate can observe would pin the smallest eigenvalue at zero and blind the
+  // criterion to the others: give it a large constant in the selection only.
+  Eigen::MatrixXd unobservable_pad = Eigen::MatrixXd::Zero(n, n);
+  {
+    Eigen::VectorXd all_diag = Eigen::VectorXd::Zero(n);
+    for (const auto& cp : poses) {
+      for (const auto& c : cp.loads) {
+        all_diag += c.block.colwise().squaredNorm().transpose();
+      }
+    }
+    for (int j = 0; j < n; ++j) {
+      if (all_diag[j] <= 1e-16 * all_diag.maxCoeff()) {
+        unobservable_pad(j, j) = 1e6 * info_scale;
+      }
+    }
+  }
   // Picks the best load among candidates; returns {pose, load} or {-1, -1}.
   auto pick = [&](int only_pose) {
     int best_p = -1, best_l = -1;
@@ -166,7 +182,7 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
       }
       for (int li = 0; li < static_cast<int>(cp.loads.size()); ++li) {
         const Eigen::MatrixXd& B = cp.loads[static_cast<std::size_t>(li)].block;
-        const Eigen::MatrixXd Gn = G + B.transpose() * B;
+        const Eigen::MatrixXd Gn = G + unobservable_pad + B.transpose() * B;
         scores.emplace_back(pi, li, min_eigenvalue(Gn), log_det(Gn + eps));
       }
     }
@@ -213,34 +229,57 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
     }
   }
 
-  // Figures of the chosen design.
+  // Figures of the chosen design. A joint whose column is negligible (no load turns it, or the
+  // TCP lies on its axis) is unobservable; the others are judged on their own.
   const Eigen::VectorXd eig = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(G, Eigen::EigenvaluesOnly).eigenvalues();
   plan.min_singular_value_m = std::sqrt(std::max(0.0, eig[0]));
-  const Eigen::VectorXd d = G.diagonal().cwiseSqrt();
-  Eigen::MatrixXd Gn = G;
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      Gn(i, j) = d[i] > 0.0 && d[j] > 0.0 ? G(i, j) / (d[i] * d[j]) : 0.0;
+  const double max_diag = G.diagonal().maxCoeff();
+  std::vector<int> observable;
+  for (int j = 0; j < n; ++j) {
+    if (G(j, j) > 1e-16 * max_diag) {
+      observable.push_back(j);
     }
   }
-  const Eigen::VectorXd en = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Gn, Eigen::EigenvaluesOnly).eigenvalues();
-  plan.condition_number = en[0] > 0.0 ? std::sqrt(en[n - 1] / en[0]) : std::numeric_limits<double>::infinity();
-  plan.predicted_relative_std_error.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::infinity());
-  if (eig[0] > 1e-12 * eig[n - 1]) {
-    const Eigen::MatrixXd cov = G.inverse();
-    for (int j = 0; j < n; ++j) {
-      plan.predicted_relative_std_error[static_cast<std::size_t>(j)] = o.noise_m * std::sqrt(cov(j, j));
+  const auto no = static_cast<Eigen::Index>(observable.size());
+  Eigen::MatrixXd Go(no, no), Gn(no, no);
+  for (Eigen::Index a = 0; a < no; ++a) {
+    for (Eigen::Index b = 0; b < no; ++b) {
+      const int ja = observable[static_cast<std::size_t>(a)], jb = observable[static_cast<std::size_t>(b)];
+      Go(a, b) = G(ja, jb);
+      Gn(a, b) = G(ja, jb) / std::sqrt(G(ja, ja) * G(jb, jb));
+    }
+  }
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  plan.condition_number = kInf;
+  plan.predicted_relative_std_error.assign(static_cast<std::size_t>(n), kInf);
+  if (no > 0) {
+    const Eigen::VectorXd en =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Gn, Eigen::EigenvaluesOnly).eigenvalues();
+    const bool full_rank = en[0] > 1e-12 * en[no - 1];
+    if (full_rank && no == n) {
+      plan.condition_number = std::sqrt(en[no - 1] / en[0]);
+    }
+    if (full_rank) {
+      const Eigen::MatrixXd cov = Go.inverse();
+      for (Eigen::Index a = 0; a < no; ++a) {
+        plan.predicted_relative_std_error[static_cast<std::size_t>(observable[static_cast<std::size_t>(a)])] =
+            o.noise_m * std::sqrt(cov(a, a));
+      }
     }
   }
   for (int j = 0; j < n; ++j) {
     const double r = plan.predicted_relative_std_error[static_cast<std::size_t>(j)];
-    if (!(r < 0.1)) {
+    if (!std::isfinite(r)) {
       plan.warnings.push_back(fmt::format(
-          "joint {}: predicted relative standard error {} with {:.0f} um tracker noise; use more poses, a larger "
-          "load, a longer lever or a larger region",
-          j + 1, std::isfinite(r) ? fmt::format("{:.0f}%", 100.0 * r)
-                           : std::string("unbounded: not observable (no load turns it, or the TCP lies on its axis)"),
-          o.noise_m * 1e6));
+          "joint {}: not observable with this plan (no load turns it, its turning never moves the TCP, or it is "
+          "confounded with other joints); use a lever (--lever-mm), a TCP off the flange axis, more spins or a "
+          "larger region",
+          j + 1));
+    } else if (r > 0.1) {
+      plan.warnings.push_back(fmt::format(
+          "joint {}: predicted relative standard error {:.0f}% with {:.0f} um tracker noise; use more poses, a "
+          "larger load, a longer lever or a larger region",
+          j + 1, 100.0 * r, o.noise_m * 1e6));
     }
   }
   return plan;

@@ -179,7 +179,7 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
 
   // Joints held at a known value: move their contribution to the right-hand side.
   Eigen::VectorXd b = s.b;
-  std::vector<int> free;
+  std::vector<int> free_joints;
   for (int j = 0; j < n; ++j) {
     const auto ju = static_cast<std::size_t>(j);
     if (!options.fixed_stiffness_nm_per_rad.empty() && options.fixed_stiffness_nm_per_rad[ju]) {
@@ -194,10 +194,10 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
       est.compliance_std_error_rad_per_nm[ju] = 0.0;
       est.fixed_joints.push_back(j + 1);
     } else {
-      free.push_back(j);
+      free_joints.push_back(j);
     }
   }
-  if (free.empty()) {
+  if (free_joints.empty()) {
     throw InputError("identify_stiffness: every joint is fixed; nothing to identify");
   }
 
@@ -207,7 +207,7 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
   Eigen::VectorXd col_norm = s.A.colwise().norm().transpose();
   const double max_norm = [&] {
     double v = 0.0;
-    for (int j : free) {
+    for (int j : free_joints) {
       v = std::max(v, col_norm[j]);
     }
     return v;
@@ -217,7 +217,7 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
   }
   std::vector<int> estimated;
   std::vector<int> left_out;
-  for (int j : free) {
+  for (int j : free_joints) {
     if (col_norm[j] < options.min_relative_excitation * max_norm) {
       left_out.push_back(j);
       est.warnings.push_back(fmt::format(
