@@ -213,7 +213,7 @@ TEST(CorrectionChannel, KeepsTheNewestArrivedMessage) {
     CorrectionMessage m;
     m.arrival_s = 0.1 * i;
     m.reference_s = i;
-    m.q_target = JointVector::Constant(1, i);
+    m.offset_rad = JointVector::Constant(1, i);
     EXPECT_TRUE(ch.push(m));
   }
   CorrectionMessage out;

@@ -41,12 +41,13 @@ struct LapSchedule {
   [[nodiscard]] int direction(double t_s) const;
 };
 
-/// One joint correction in flight: the absolute target the compensator sent, the planned
-/// configuration it refers to (by time stamp), and when it reaches the servo.
+/// One joint correction in flight: the offset from the planned joints that the compensator's
+/// target amounts to (decoded from its EGM reply), the time of the cycle it came from, and when it
+/// reaches the servo.
 struct CorrectionMessage {
   double arrival_s = 0.0;
   double reference_s = 0.0;
-  JointVector q_target;
+  JointVector offset_rad;
 };
 
 /// Fixed-capacity FIFO of corrections in flight (no allocation once built).

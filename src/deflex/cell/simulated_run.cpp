@@ -1,6 +1,7 @@
 // One protocol run on the simulated cell (see simulated_run.hpp).
 #include "deflex/cell/simulated_run.hpp"
 
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -8,6 +9,7 @@
 
 #include "deflex/cell/force_sensor.hpp"
 #include "deflex/cell/ldbb_device.hpp"
+#include "deflex/egm/egm_codec.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/offline/compensate_path.hpp"
@@ -163,7 +165,7 @@ RunOutput simulate_run(const SetupCell& setup, const RunSpec& spec) {
   out.simulated_s = schedule.duration_s();
   Workspace ws(robot.true_model());
   const int n = robot.true_model().dof();
-  JointVector q_plan(n), q_cmd(n), q_ref(n), offset = JointVector::Zero(n), offset_target = JointVector::Zero(n);
+  JointVector q_plan(n), q_cmd(n), offset = JointVector::Zero(n), offset_target = JointVector::Zero(n);
   program.at(0.0, q_plan);
   TrueRobotState state = robot.initial_state(q_plan);
   Vector3 p_prev = robot.solve(ws, q_plan, Wrench::Zero(), state);
@@ -181,6 +183,11 @@ RunOutput simulate_run(const SetupCell& setup, const RunSpec& spec) {
   bool lap_open = false;
   int lap_direction = 0;
   CorrectionMessage msg;
+  EgmCodec codec(n);
+  std::array<unsigned char, 2048> packet{};
+  std::array<JointVector, 64> planned_sent;
+  planned_sent.fill(JointVector::Zero(n));
+  std::uint32_t seqno = 0;
 
   auto model_force_base = [&](double t_s) {
     Pose p = Pose::Identity();
@@ -192,8 +199,7 @@ RunOutput simulate_run(const SetupCell& setup, const RunSpec& spec) {
     const double t = static_cast<double>(k) * dt;
     program.at(schedule.angle(t), q_plan);
     if (channel.pop_arrived(t, msg)) {
-      program.at(schedule.angle(msg.reference_s), q_ref);
-      offset_target = msg.q_target - q_ref;
+      offset_target = msg.offset_rad;  // the correction as an offset from the planned joints
     }
     offset += (offset_target - offset) * filter_alpha;
     q_cmd = q_plan + offset;
@@ -224,20 +230,55 @@ RunOutput simulate_run(const SetupCell& setup, const RunSpec& spec) {
       }
       if (t + 1e-12 >= next_cycle) {
         next_cycle += c.online.cycle_s;
+        // Controller -> sensor: EgmRobot with the feedback (motor-side command) and planned joints,
+        // through the same codec a real UDP link uses.
+        ++seqno;
+        EgmRobotMessage robot_msg;
+        robot_msg.seqno = seqno;
+        robot_msg.tm_ms = static_cast<std::uint32_t>(t * 1e3);
+        robot_msg.feedback_joints_deg = q_cmd * (180.0 / kPi);
+        robot_msg.planned_joints_deg = q_plan * (180.0 / kPi);
+        robot_msg.motor_state = 1;
+        robot_msg.mci_state = 3;
+        robot_msg.rapid_exec_state = 2;
+        planned_sent[seqno % planned_sent.size()] = q_plan;
+        const std::size_t robot_bytes = codec.encode_robot(robot_msg, packet.data(), packet.size());
+        EgmRobotMessage received;
+        if (robot_bytes == 0 || codec.decode_robot(packet.data(), robot_bytes, received) != EgmDecodeStatus::kOk) {
+          ++out.corrections_dropped;
+          continue;
+        }
+        // Sensor side: the compensation cycle. The latency-compensated strategy evaluates the
+        // deflection where the arm will be when the correction takes effect.
         CycleInput in;
         in.t_s = t;
-        program.at(schedule.angle(t + lead_s), in.q_planned);
-        in.q_feedback = q_cmd;
+        in.q_feedback = received.feedback_joints_deg * (kPi / 180.0);
+        if (lead_s > 0.0) {
+          program.at(schedule.angle(t + lead_s), in.q_planned);
+        } else {
+          in.q_planned = received.planned_joints_deg * (kPi / 180.0);
+        }
         const CycleOutput o = compensator->step(in);
         ++out.online_cycles;
         out.max_tcp_correction_m = std::max(out.max_tcp_correction_m, o.tcp_correction_m);
-        if (static_cast<int>(o.status) >= 0) {
-          CorrectionMessage m;
-          m.arrival_s = t + c.online.compute_delay_s + c.controller.egm_delay_s;
-          m.reference_s = t + lead_s;
-          m.q_target = o.q_command;
-          if (!channel.push(m)) ++out.corrections_dropped;
+        if (static_cast<int>(o.status) < 0) continue;
+        EgmSensorMessage reply;
+        reply.seqno = received.seqno;
+        reply.tm_ms = received.tm_ms;
+        reply.planned_joints_deg = received.planned_joints_deg - o.dtheta * (180.0 / kPi);
+        const std::size_t sensor_bytes = codec.encode_sensor(reply, packet.data(), packet.size());
+        // Controller: decodes the target and turns it into an offset from the planned joints it
+        // reported under that sequence number.
+        EgmSensorMessage target;
+        if (sensor_bytes == 0 || !codec.decode_sensor(packet.data(), sensor_bytes, target)) {
+          ++out.corrections_dropped;
+          continue;
         }
+        CorrectionMessage m;
+        m.reference_s = t;
+        m.arrival_s = t + c.online.compute_delay_s + c.controller.egm_delay_s;
+        m.offset_rad = target.planned_joints_deg * (kPi / 180.0) - planned_sent[target.seqno % planned_sent.size()];
+        if (!channel.push(m)) ++out.corrections_dropped;
       }
     }
 
