@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <numeric>
 
 #include <fmt/format.h>
@@ -124,28 +125,35 @@ struct PolylineIndex::Impl {
   }
 };
 
-PolylineIndex::PolylineIndex(const TrackerTrace& reference) : PolylineIndex(std::vector<TrackerTrace>{reference}) {}
+PolylineIndex::PolylineIndex(const TrackerTrace& reference) : impl_(nullptr) { init({&reference}); }
 
-PolylineIndex::PolylineIndex(const std::vector<TrackerTrace>& pieces) : impl_(new Impl) {
-  Impl& m = *impl_;
-  std::size_t total = 0;
+PolylineIndex::PolylineIndex(const std::vector<TrackerTrace>& pieces) : impl_(nullptr) {
+  std::vector<const TrackerTrace*> p;
   for (const auto& piece : pieces) {
-    total += piece.size();
+    p.push_back(&piece);
+  }
+  init(p);
+}
+
+void PolylineIndex::init(const std::vector<const TrackerTrace*>& piece_ptrs) {
+  auto owner = std::make_unique<Impl>();  // freed if a check below throws
+  Impl& m = *owner;
+  std::size_t total = 0;
+  for (const auto* piece : piece_ptrs) {
+    total += piece->size();
   }
   if (total == 0) {
-    delete impl_;
     throw InputError("reference path: no samples");
   }
   if (total >= std::numeric_limits<std::uint32_t>::max() / 2) {
-    delete impl_;
     throw InputError("reference path: too many samples");
   }
   m.vertices.reserve(total);
-  for (const auto& piece : pieces) {
+  for (const auto* piece_ptr : piece_ptrs) {
+    const TrackerTrace& piece = *piece_ptr;
     const auto first = static_cast<std::uint32_t>(m.vertices.size());
     for (std::size_t i = 0; i < piece.size(); ++i) {
       if (!piece[i].p_m.allFinite()) {
-        delete impl_;
         throw InputError(fmt::format("reference path: sample {} (t = {} s) has a position that is not finite", i,
                                      piece[i].t_s));
       }
@@ -158,8 +166,9 @@ PolylineIndex::PolylineIndex(const std::vector<TrackerTrace>& pieces) : impl_(ne
       m.segments.push_back({first + i, first + i + 1});
     }
   }
-  m.nodes.reserve(2 * m.segments.size() / kLeafSize + 2);
+  m.nodes.reserve(m.segments.size() + 1);  // a balanced tree with leaves of 2-4 segments has fewer nodes
   m.build(0, static_cast<std::uint32_t>(m.segments.size()));
+  impl_ = owner.release();
 }
 
 PolylineIndex::~PolylineIndex() { delete impl_; }
@@ -193,13 +202,14 @@ PolylineIndex::Nearest PolylineIndex::nearest(const Vector3& p_m, const Nearest*
 
 namespace {
 
-PathDeviationStats stats_of(const std::vector<TrackerTrace>& loaded, const PolylineIndex& index) {
+PathDeviationStats stats_of(const std::vector<const TrackerTrace*>& loaded, const PolylineIndex& index) {
   PathDeviationStats st;
   double sum = 0.0;
   double sum2 = 0.0;
   std::vector<double> d;
   PolylineIndex::Nearest hint;
-  for (const auto& trace : loaded) {
+  for (const auto* trace_ptr : loaded) {
+    const TrackerTrace& trace = *trace_ptr;
     for (std::size_t i = 0; i < trace.size(); ++i) {
       if (!trace[i].p_m.allFinite()) {
         throw InputError(fmt::format("loaded path: sample {} (t = {} s) has a position that is not finite", i,
@@ -232,11 +242,16 @@ PathDeviationStats stats_of(const std::vector<TrackerTrace>& loaded, const Polyl
 
 PathDeviationStats path_deviation(const std::vector<TrackerTrace>& loaded, const std::vector<TrackerTrace>& reference) {
   const PolylineIndex index(reference);
-  return stats_of(loaded, index);
+  std::vector<const TrackerTrace*> runs;
+  for (const auto& t : loaded) {
+    runs.push_back(&t);
+  }
+  return stats_of(runs, index);
 }
 
 PathDeviationStats path_deviation(const TrackerTrace& loaded, const TrackerTrace& reference) {
-  return path_deviation(std::vector<TrackerTrace>{loaded}, std::vector<TrackerTrace>{reference});
+  const PolylineIndex index(reference);
+  return stats_of({&loaded}, index);
 }
 
 double mean_distance_to_path_m(const TrackerTrace& loaded, const TrackerTrace& reference) {

@@ -39,6 +39,7 @@ class PolylineIndex {
   [[nodiscard]] const std::vector<Vector3>& vertices() const;
 
  private:
+  void init(const std::vector<const TrackerTrace*>& pieces);
   struct Impl;
   Impl* impl_;
 };

@@ -31,7 +31,8 @@ td.l, th.l { text-align: left; }
 .paper { color: #777; font-size: 12px; }
 .good { color: #2e7d32; } .bad { color: #c62828; }
 .bar { display: inline-block; height: 10px; background: #4C78A8; vertical-align: middle; }
-.fig { margin: 10px 0 22px 0; overflow-x: auto; }
+.fig { margin: 10px 0 22px 0; }
+.fig svg { max-width: 100%; height: auto; }
 .note { background: #fff8e1; border-left: 4px solid #f0b429; padding: 8px 12px; margin: 8px 0; }
 pre { background: #f6f6f6; padding: 10px; overflow-x: auto; font-size: 12px; }
 .caption { color: #555; font-size: 13px; }
