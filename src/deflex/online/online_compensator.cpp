@@ -6,7 +6,6 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/compliance.hpp"
 #include "deflex/model/errors.hpp"
 
 namespace deflex {
@@ -146,8 +145,13 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
     out.status = CycleStatus::kStaleForce;
   } else {
     out.status = CycleStatus::kOk;
-    const JointVector& q_model = config_.jacobian_at == JacobianAt::kPlanned ? in.q_planned : in.q_feedback;
-    joint_deflection(model_, ws_, q_model, wrench_base_, target);
+    // dtheta = K^-1 J_wap(q)^T W. FK is already at q_feedback; a second FK only when the Jacobian is
+    // wanted at a different planned configuration.
+    if (config_.jacobian_at == JacobianAt::kPlanned && in.q_planned != in.q_feedback) {
+      forward_kinematics(model_, ws_, in.q_planned);
+    }
+    point_jacobian(ws_, ws_.base_T_wap.translation(), jac_);
+    target = model_.compliance().cwiseProduct(jac_.transpose() * wrench_base_);
     if (!target.allFinite()) {
       target.setZero();
     }
@@ -158,7 +162,9 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
       out.size_limited = out.size_limited || clamped != target[i];
       target[i] = clamped;
     }
-    point_jacobian(ws_, ws_.base_T_tcp.translation(), jac_);
+    if (!model_.wap_is_tcp()) {
+      point_jacobian(ws_, ws_.base_T_tcp.translation(), jac_);
+    }
     const double tcp_m = (jac_.topRows<3>() * target).norm();
     if (tcp_m > config_.max_tcp_correction_m) {
       target *= config_.max_tcp_correction_m / tcp_m;
