@@ -30,7 +30,7 @@ struct Opts {
   std::vector<std::string> forces;
   std::string motion = "absj", zone = "fine", tool = "tool0", wobj = "wobj0", module = "DeflexOffline";
   double speed_mm_s = 10.0;
-  bool circle_given = false, json = false;
+  bool circle_given = false, orientation_given = false, json = false;
 };
 
 /// "out.csv" + "ldbb_125N_push" -> "out_ldbb_125N_push.csv" (one file per load when several).
@@ -68,6 +68,9 @@ void run(const Opts& o, int& exit_code) {
   if (!o.path_csv.empty()) {
     poses = read_pose_path_csv(o.path_csv);
     path_text = fmt::format("poses from {}", o.path_csv);
+    if (o.orientation_given) {
+      std::cerr << "deflex offline: warning: --orientation-wxyz is ignored: the path file gives the orientation\n";
+    }
   } else {
     const auto qv = parse_numbers(o.orientation, "--orientation-wxyz", 4);
     const Eigen::Quaterniond orientation =
@@ -230,6 +233,7 @@ void setup_offline(CLI::App& sub, int& exit_code) {
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code, &sub] {
     o->circle_given = sub.count("--circle") > 0;
+    o->orientation_given = sub.count("--orientation-wxyz") > 0;
     run(*o, exit_code);
   });
 }
