@@ -128,6 +128,10 @@ void run(const Opts& o, int& exit_code) {
   rapid.zone = o.zone;
   rapid.tool = o.tool;
   rapid.wobj = o.wobj;
+  if (!o.rapid_out.empty()) {
+    rapid.module_name = o.module;
+    check_rapid_options(rapid);  // before anything is computed or written
+  }
   rapid.note = fmt::format("Path: {}; arm configuration [cf1,cf4,cf6,cfx] at the start [{},{},{},{}].", path_text,
                            joints.configuration.cf1, joints.configuration.cf4, joints.configuration.cf6,
                            joints.configuration.cfx);

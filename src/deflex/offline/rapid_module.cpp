@@ -39,7 +39,7 @@ bool is_rapid_identifier(const std::string& name) {
   return true;
 }
 
-std::string rapid_module(const OfflineResult& result, const RapidOptions& options) {
+void check_rapid_options(const RapidOptions& options) {
   for (const auto& [what, name] : {std::pair{"module name", &options.module_name}, std::pair{"tool", &options.tool},
                                    std::pair{"work object", &options.wobj}}) {
     if (!is_rapid_identifier(*name)) {
@@ -59,6 +59,10 @@ std::string rapid_module(const OfflineResult& result, const RapidOptions& option
     throw InputError(fmt::format("RAPID zone '{}' is not a predefined zonedata (fine, z0, z1, z5, z10, ... z200)",
                                  options.zone));
   }
+}
+
+std::string rapid_module(const OfflineResult& result, const RapidOptions& options) {
+  check_rapid_options(options);
   if (result.points.empty()) {
     throw InputError("RAPID export: no compensated points");
   }

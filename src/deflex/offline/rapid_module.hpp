@@ -31,6 +31,10 @@ struct RapidOptions {
 /// external axes 9E+09 (unused), as ABB's own programs write them.
 [[nodiscard]] std::string rapid_module(const OfflineResult& result, const RapidOptions& options);
 
+/// The option checks of rapid_module() alone (names, speed, zone), so a caller can fail before it
+/// computes or writes anything. Throws InputError.
+void check_rapid_options(const RapidOptions& options);
+
 /// rapid_module() to a file. Throws Error when it cannot be written.
 void write_rapid_module(const OfflineResult& result, const RapidOptions& options, const std::string& path);
 
