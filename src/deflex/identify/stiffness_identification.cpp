@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Cholesky>
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <fmt/format.h>
@@ -281,14 +282,51 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
   Eigen::VectorXd scaled(p);  // compliance times column norm
   Eigen::Array<bool, Eigen::Dynamic, 1> at_bound;
   std::vector<double> d(m), d_over(m);
-  auto solve = [&] {
-    const Eigen::MatrixXd M = scaled_columns(s, estimated, col_norm, omega);
-    const Eigen::VectorXd y = weighted_rhs(s, b, omega);
-    // One QR of the tall system reduces NNLS to a p x p triangular problem with the same solution.
-    Eigen::HouseholderQR<Eigen::MatrixXd> qr(M);
-    const Eigen::MatrixXd R = qr.matrixQR().topRows(p).triangularView<Eigen::Upper>();
-    const Eigen::VectorXd qty = (qr.householderQ().transpose() * y).head(p);
-    const NnlsResult r = nonnegative_least_squares(R, qty);
+  // Per-measurement normal-equation pieces of the scaled system, so a re-weighting iteration costs
+  // a matrix-vector product instead of a QR of the tall system; the final solve is done by QR.
+  Eigen::MatrixXd gram_parts, rhs_parts;
+  if (options.robust) {
+    gram_parts.resize(p * p, static_cast<Eigen::Index>(m));
+    rhs_parts.resize(p, static_cast<Eigen::Index>(m));
+    using Block = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, kMaxJoints>;
+    using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxJoints, kMaxJoints>;
+    Block Ai;
+    for (std::size_t i = 0; i < m; ++i) {
+      Ai.resize(s.rows[i], p);
+      for (Eigen::Index k = 0; k < p; ++k) {
+        const int j = estimated[static_cast<std::size_t>(k)];
+        Ai.col(k) = s.A.col(j).segment(s.start[i], s.rows[i]) / col_norm[j];
+      }
+      const Small Gi = Ai.transpose() * Ai;
+      gram_parts.col(static_cast<Eigen::Index>(i)) = Eigen::Map<const Eigen::VectorXd>(Gi.data(), p * p);
+      rhs_parts.col(static_cast<Eigen::Index>(i)) = Ai.transpose() * b.segment(s.start[i], s.rows[i]);
+    }
+  }
+  auto solve = [&](bool exact) {
+    NnlsResult r;
+    bool done = false;
+    if (!exact) {
+      const Eigen::VectorXd w = Eigen::Map<const Eigen::VectorXd>(omega.data(), static_cast<Eigen::Index>(m));
+      const Eigen::VectorXd gv = gram_parts * w;
+      const Eigen::Map<const Eigen::MatrixXd> G(gv.data(), p, p);
+      const Eigen::LLT<Eigen::MatrixXd> llt(G);
+      if (llt.info() == Eigen::Success) {
+        // min ||R s - y|| with R = L^T, y = L^-1 h has the normal equations G s = h.
+        const Eigen::MatrixXd R = llt.matrixU();
+        const Eigen::VectorXd y = llt.matrixL().solve(rhs_parts * w);
+        r = nonnegative_least_squares(R, y);
+        done = true;
+      }
+    }
+    if (!done) {
+      const Eigen::MatrixXd M = scaled_columns(s, estimated, col_norm, omega);
+      const Eigen::VectorXd y = weighted_rhs(s, b, omega);
+      // One QR of the tall system reduces NNLS to a p x p triangular problem with the same solution.
+      Eigen::HouseholderQR<Eigen::MatrixXd> qr(M);
+      const Eigen::MatrixXd R = qr.matrixQR().topRows(p).triangularView<Eigen::Upper>();
+      const Eigen::VectorXd qty = (qr.householderQ().transpose() * y).head(p);
+      r = nonnegative_least_squares(R, qty);
+    }
     scaled = r.x;
     at_bound = r.at_bound;
     Eigen::VectorXd c_full = Eigen::VectorXd::Zero(n);
@@ -303,7 +341,7 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
     return res;
   };
   auto chi_median = [](int k) { return std::sqrt(chi_square_quantile(k, 0.0)); };
-  Eigen::VectorXd res = solve();
+  Eigen::VectorXd res = solve(true);
   if (options.robust) {
     const double rhs_scale = b.norm() / std::sqrt(static_cast<double>(b.size()));
     double sigma = 0.0;
@@ -330,13 +368,14 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
           }
         }
         const Eigen::VectorXd before = scaled;
-        res = solve();
+        res = solve(false);
         ++est.iterations;
         if ((scaled - before).norm() <= 1e-10 * scaled.norm()) {
           break;
         }
       }
     }
+    res = solve(true);
   }
 
   // Fit figures. The residual covariance: sigma^2 = sum omega r^2 / (sum omega k - p), the usual
