@@ -95,6 +95,27 @@ TEST(InverseKinematics, NearWristSingularityIsReportedAndStillExact) {
   }
 }
 
+TEST(InverseKinematics, ExactlyWristSingularPoseKeepsItsBranch) {
+  // Regression: at q5 = 0 exactly, acos(cos q5) lost half the digits and the FK check dropped
+  // the right branch, so a far-away configuration came back as "ok".
+  const RobotModel m = builtin_irb6700();
+  Workspace ws(m);
+  JointVector q(6);
+  q << 0, deg_to_rad(10), deg_to_rad(-10), 0, 0, 0;
+  const Pose target = tcp_pose(m, ws, q);
+  for (const bool with_seed : {true, false}) {
+    IkRequest req;
+    if (with_seed) {
+      req.seed = q;
+    }
+    const IkResult r = inverse_kinematics(m, ws, target, req);
+    ASSERT_TRUE(r.ok()) << r.message;
+    EXPECT_EQ(r.singularity, Singularity::kWrist);
+    EXPECT_LT((r.q - q).cwiseAbs().maxCoeff(), 1e-9) << "seeded: " << with_seed;
+    EXPECT_LT(pose_error(m, ws, r.q, target), 1e-12);
+  }
+}
+
 TEST(InverseKinematics, StretchedElbowIsReported) {
   const RobotModel m = builtin_irb6700();
   Workspace ws(m);

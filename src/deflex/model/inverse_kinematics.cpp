@@ -83,8 +83,10 @@ bool analytic_branches(const RobotModel& model, const Pose& base_T_tcp, const Jo
       const Matrix3 R03 = rot_z(q1p) * rot_x(dh[0].alpha_rad) * rot_z(q2p) * rot_x(dh[1].alpha_rad) * rot_z(q3p) *
                           rot_x(dh[2].alpha_rad);
       const Matrix3 M = R03.transpose() * R06 * rot_x(-a6);
-      const double c5 = std::clamp(-s4 * s5 * M(2, 2), -1.0, 1.0);
-      const double sin5_abs = std::sqrt(std::max(0.0, 1.0 - c5 * c5));
+      // |sin q5| from the third column (M(0,2), M(1,2) = s5 sin q5 [cos q4, sin q4]) and cos q5 from
+      // M(2,2): atan2 keeps full precision near q5 = 0, where acos(cos q5) would lose half the digits.
+      const double c5 = -s4 * s5 * M(2, 2);
+      const double sin5_abs = std::hypot(M(0, 2), M(1, 2));
       Singularity sing = Singularity::kNone;
       if (h_abs < near_tol) {
         sing = Singularity::kShoulder;
@@ -93,21 +95,18 @@ bool analytic_branches(const RobotModel& model, const Pose& base_T_tcp, const Jo
       } else if (sin5_abs < near_tol) {
         sing = Singularity::kWrist;
       }
+      const bool wrist_singular = sin5_abs < 1e-12;
       for (const double wrist : {1.0, -1.0}) {
-        const double q5p = wrist * std::acos(c5);
-        double q4p = 0.0;
-        double q6p = 0.0;
-        if (sin5_abs > 1e-9) {
-          q4p = std::atan2(wrist * s5 * M(1, 2), wrist * s5 * M(0, 2));
-          q6p = std::atan2(-wrist * s4 * M(2, 1), wrist * s4 * M(2, 0));
-        } else {
-          // Wrist singular: only a combination of q4 and q6 is fixed. Keep q4 at the seed (or zero)
-          // and give the rest to q6.
-          q4p = seed ? (*seed)[3] + dh[3].theta_offset_rad : 0.0;
-          const Matrix3 A = rot_z(q4p) * rot_x(dh[3].alpha_rad) * rot_z(q5p) * rot_x(dh[4].alpha_rad);
-          const Matrix3 Rz6 = A.transpose() * M;
-          q6p = std::atan2(Rz6(1, 0), Rz6(0, 0));
-        }
+        const double q5p = wrist * std::atan2(sin5_abs, c5);
+        // q4 from the third column; at the singularity only q4 + q6 is fixed: keep q4 at the seed
+        // (or zero) and give the rest to q6.
+        const double q4p = wrist_singular ? (seed ? (*seed)[3] + dh[3].theta_offset_rad : 0.0)
+                                          : std::atan2(wrist * s5 * M(1, 2), wrist * s5 * M(0, 2));
+        // q6 from what remains of the rotation once q4 and q5 are taken out: exact whatever the
+        // precision of q4 near the singularity.
+        const Matrix3 A = rot_z(q4p) * rot_x(dh[3].alpha_rad) * rot_z(q5p) * rot_x(dh[4].alpha_rad);
+        const Matrix3 Rz6 = A.transpose() * M;
+        const double q6p = std::atan2(Rz6(1, 0), Rz6(0, 0));
         Branch b;
         const std::array<double, 6> qp{q1p, q2p, q3p, q4p, q5p, q6p};
         for (std::size_t i = 0; i < 6; ++i) {
@@ -115,7 +114,7 @@ bool analytic_branches(const RobotModel& model, const Pose& base_T_tcp, const Jo
         }
         b.singularity = sing;
         out.push_back(b);
-        if (sin5_abs <= 1e-9) {
+        if (wrist_singular) {
           break;  // both wrist signs give the same pose family
         }
       }
