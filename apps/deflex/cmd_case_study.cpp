@@ -99,6 +99,14 @@ void run(const Opts& o, int& exit_code) {
     print_json(study_to_json(result.study));
   } else {
     std::cout << study_tables_text(result.study);
+    if (!result.study.speed_sweep.empty()) {
+      std::cout << "\nSpeed sweep (beyond the paper): mean distance from the unloaded path, mm\n"
+                << "  setup            load    speed mm/s  UC mm   C mm    compensation\n";
+      for (const auto& p : result.study.speed_sweep) {
+        std::cout << fmt::format("  {:<15} {:>5.0f} N  {:>10.0f}  {:.3f}   {:.3f}   {:.0f}%\n", p.setup, p.load_N,
+                                 p.speed_mm_s, p.uc_mm, p.c_mm, 100.0 * p.compensation);
+      }
+    }
     for (const auto& b : result.budgets) {
       std::cout << fmt::format("\nError budget, {} {:.0f} N at {:.0f} mm/s: C = {:.3f} mm with every effect (UC {:.3f} mm)\n",
                                b.setup, b.load_n, b.speed_mm_s, b.residual_mm_all, b.uc_mm);

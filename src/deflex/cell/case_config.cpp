@@ -252,7 +252,7 @@ CaseConfig paper_case() { return load_case_text(paper_case_yaml(), "<built-in pa
 
 const char* to_string(Effect e) {
   switch (e) {
-    case Effect::kStiffnessMismatch: return "true joint stiffness differs from the assumed";
+    case Effect::kStiffnessMismatch: return "per-joint spread of the true stiffness";
     case Effect::kJointCoupling: return "coupled stiffness of joints 2-3";
     case Effect::kLinkBending: return "forearm bending (link compliance)";
     case Effect::kSensorCompliance: return "force sensor compliance";
@@ -270,8 +270,7 @@ const char* to_string(Effect e) {
 
 std::string effect_size(const CaseConfig& c, Effect e) {
   switch (e) {
-    case Effect::kStiffnessMismatch:
-      return fmt::format("scale {:.2f}, spread {:.0f} %", c.robot.stiffness_scale, c.robot.stiffness_spread * 100);
+    case Effect::kStiffnessMismatch: return fmt::format("{:.0f} % (1 sigma, log-normal)", c.robot.stiffness_spread * 100);
     case Effect::kJointCoupling: return fmt::format("k23 coupling {:.2f}", c.robot.coupling_23);
     case Effect::kLinkBending: return fmt::format("EI {:.2g} Nm^2", c.robot.forearm_ei_nm2);
     case Effect::kSensorCompliance:
@@ -304,7 +303,8 @@ CaseConfig without_effect(const CaseConfig& config, Effect e) {
   CaseConfig c = config;
   switch (e) {
     case Effect::kStiffnessMismatch:
-      c.robot.stiffness_scale = 1.0;
+      // The overall scale is the robot itself (identification finds it); the per-joint spread is
+      // what makes the true ratios between joints differ from the assumed ones.
       c.robot.stiffness_spread = 0.0;
       break;
     case Effect::kJointCoupling: c.robot.coupling_23 = 0.0; break;

@@ -156,7 +156,7 @@ const std::string& paper_case_yaml();
 
 /// Every effect of the cell that the error budget switches off one at a time.
 enum class Effect {
-  kStiffnessMismatch,   ///< true stiffness differs from the built-in (identification must find it)
+  kStiffnessMismatch,   ///< per-joint spread of the true stiffness around the scaled built-in one
   kJointCoupling,
   kLinkBending,
   kSensorCompliance,

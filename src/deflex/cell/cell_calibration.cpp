@@ -22,8 +22,8 @@ CellCalibration calibrate_setup(const TrueRobot& robot, std::uint64_t seed) {
   }
   CalibrationPlanOptions plan_options;
   const double r = c.radius_m();
-  plan_options.region_min_m = c.circle.center_m - Vector3(r, r, 0.05);
-  plan_options.region_max_m = c.circle.center_m + Vector3(r, r, 0.05);
+  plan_options.region_min_m = c.circle.center_m - Vector3(r, r, 0.1);
+  plan_options.region_max_m = c.circle.center_m + Vector3(r, r, 0.1);
   plan_options.load_n = c.calibration.load_n;
   plan_options.poses = c.calibration.poses;
   plan_options.orientation = Eigen::Quaterniond(c.circle.tcp_orientation.linear());

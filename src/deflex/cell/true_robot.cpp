@@ -33,14 +33,16 @@ TrueRobot::TrueRobot(const CaseConfig& config, bool sensor_mounted, std::uint64_
   std::normal_distribution<double> normal(0.0, 1.0);
   RobotDescription desc = base.description();
   const int n = base.dof();
+  // Every draw is made whatever its size, so switching one effect off (error budget) leaves the
+  // draws of the others unchanged: the same robot with one effect less.
+  std::vector<DhRow> rows = desc.dh;
+  for (auto& r : rows) {
+    r.a_m += config.robot.dh_length_sigma_m * normal(rng);
+    r.d_m += config.robot.dh_length_sigma_m * normal(rng);
+    r.alpha_rad += config.robot.dh_angle_sigma_rad * normal(rng);
+    r.theta_offset_rad += config.robot.dh_angle_sigma_rad * normal(rng);
+  }
   if (desc.dh_convention && (config.robot.dh_length_sigma_m > 0 || config.robot.dh_angle_sigma_rad > 0)) {
-    std::vector<DhRow> rows = desc.dh;
-    for (auto& r : rows) {
-      r.a_m += config.robot.dh_length_sigma_m * normal(rng);
-      r.d_m += config.robot.dh_length_sigma_m * normal(rng);
-      r.alpha_rad += config.robot.dh_angle_sigma_rad * normal(rng);
-      r.theta_offset_rad += config.robot.dh_angle_sigma_rad * normal(rng);
-    }
     std::vector<double> lower, upper;
     for (const auto& j : desc.joints) {
       lower.push_back(j.lower_rad);
