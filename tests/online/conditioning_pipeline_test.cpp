@@ -225,3 +225,40 @@ TEST(SensorConfig, ExampleLoadsAndBadFieldsNameTheLine) {
 
 }  // namespace
 }  // namespace deflex
+
+namespace deflex {
+namespace {
+
+TEST(SensorConfig, WrittenYamlReadsBackTheSameConfiguration) {
+  SensorConfig c;
+  c.name = "round trip";
+  c.components = 6;
+  c.crosstalk(1, 4) = 0.02;
+  c.flange_T_sensor.translation() = Vector3(0.01, -0.02, 0.07);
+  c.flange_T_sensor.linear() = Eigen::AngleAxisd(0.4, Vector3(1, 1, 0).normalized()).toRotationMatrix();
+  c.payload_mass_kg = 7.25;
+  c.payload_cog_sensor_m = Vector3(0.001, 0.002, 0.11);
+  c.bias_sensor << 1, -2, 3, 0.1, -0.2, 0.3;
+  c.lowpass_order = 3;
+  c.lowpass_cutoff_hz = 30;
+  c.dead_band_N = 4;
+  c.fault_threshold_N = 1500;
+  const std::string path = ::testing::TempDir() + "/round_trip_sensor.yaml";
+  FILE* f = std::fopen(path.c_str(), "w");
+  std::fputs(sensor_config_to_yaml(c).c_str(), f);
+  std::fclose(f);
+  const SensorConfig r = load_sensor_config(path);
+  EXPECT_EQ(r.name, c.name);
+  EXPECT_TRUE(r.crosstalk.isApprox(c.crosstalk, 1e-12));
+  EXPECT_TRUE(r.flange_T_sensor.isApprox(c.flange_T_sensor, 1e-9));
+  EXPECT_NEAR(r.payload_mass_kg, 7.25, 1e-12);
+  EXPECT_TRUE(r.payload_cog_sensor_m.isApprox(c.payload_cog_sensor_m, 1e-9));
+  EXPECT_TRUE(r.bias_sensor.isApprox(c.bias_sensor, 1e-9));
+  EXPECT_EQ(r.lowpass_order, 3);
+  EXPECT_EQ(r.lowpass_cutoff_hz, 30.0);
+  EXPECT_EQ(r.dead_band_N, 4.0);
+  EXPECT_EQ(r.fault_threshold_N, 1500.0);
+}
+
+}  // namespace
+}  // namespace deflex
