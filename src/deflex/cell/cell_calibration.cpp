@@ -48,7 +48,11 @@ CellCalibration calibrate_setup(const TrueRobot& robot, std::uint64_t seed) {
     m.dp_m = p1 - p0 + tracker_sigma * Vector3(normal(rng), normal(rng), normal(rng)) * std::sqrt(2.0);
     data.push_back(m);
   }
-  CellCalibration out{nominal, identify_stiffness(nominal, data), static_cast<int>(data.size()), {}};
+  // Plain least squares: the cell's misfit is systematic (sensor compliance, lost motion), not
+  // gross outliers, and a robust re-weighting would throw good measurements away for it.
+  IdentificationOptions id_options;
+  id_options.robust = false;
+  CellCalibration out{nominal, identify_stiffness(nominal, data, id_options), static_cast<int>(data.size()), {}};
   std::vector<double> k(static_cast<std::size_t>(nominal.dof()));
   for (int j = 0; j < nominal.dof(); ++j) {
     const double kj = out.estimate.stiffness_nm_per_rad[static_cast<std::size_t>(j)];
