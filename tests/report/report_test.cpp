@@ -146,6 +146,11 @@ TEST(PathPlot, AutomaticMagnificationAndBadInput) {
   const std::string svg = svg_path_plot(p);
   EXPECT_EQ(test::xml_problem(svg), "");
   EXPECT_NE(svg.find("magnified x10"), std::string::npos);
+  PathPlot only_unloaded{"no loaded runs", p.unloaded, {}, {}, 0.0};
+  const std::string empty = svg_path_plot(only_unloaded);
+  EXPECT_EQ(test::xml_problem(empty), "");
+  EXPECT_NE(empty.find("UC (no data)"), std::string::npos);
+  EXPECT_EQ(empty.find("nan"), std::string::npos);
   p.unloaded.resize(1);
   EXPECT_THROW(svg_path_plot(p), InputError);
 }

@@ -158,7 +158,7 @@ std::string iso_table(const StudyResult& study) {
   if (rows.empty()) {
     return "";
   }
-  return "<h2>ISO 9283 path accuracy and repeatability</h2>\n"
+  return "<h2 id=\"iso\">ISO 9283 path accuracy and repeatability</h2>\n"
          "<p class=\"caption\">AT<sub>p</sub>: largest distance, over 81 planes normal to the unloaded path, "
          "between the barycentre of the runs' crossing points and the unloaded path; RT<sub>p</sub>: largest "
          "l&#772; + 3 S<sub>l</sub> of the crossing points about their barycentre (ISO 9283:1998, 7.2). The "
@@ -174,7 +174,7 @@ std::string budget_tables(const std::vector<ErrorBudget>& budgets) {
     return "";
   }
   std::string h =
-      "<h2>Error budget</h2>\n<p class=\"caption\">Each effect of the simulated cell that the compensators' model "
+      "<h2 id=\"budget\">Error budget</h2>\n<p class=\"caption\">Each effect of the simulated cell that the compensators' model "
       "lacks, its size, and the compensated residual when that effect alone is switched off. Its share is "
       "(residual with all effects - residual without it) / residual with all effects; shares need not add up to "
       "100% (effects interact, and tracker noise stays in every run).</p>\n";
@@ -228,7 +228,7 @@ std::string html_report(const ReportContent& content) {
                    "(offline and online compliance compensation of an ABB IRB6700 on a loaded circle).</p>\n",
                    sub);
   if (!content.setup_paragraphs.empty()) {
-    h += "<h2>Setup</h2>\n";
+    h += "<h2 id=\"setup\">Setup</h2>\n";
     for (const auto& p : content.setup_paragraphs) {
       h += fmt::format("<p>{}</p>\n", esc(p));
     }
@@ -236,15 +236,15 @@ std::string html_report(const ReportContent& content) {
   if (!content.case_text.empty()) {
     h += fmt::format("<details><summary>Case file</summary>\n<pre>{}</pre>\n</details>\n", esc(content.case_text));
   }
-  h += "<h2>Results beside the paper</h2>\n";
+  h += "<h2 id=\"results\">Results beside the paper</h2>\n";
   h += results_tables(study);
-  h += "<h2>Figure 5: mean deformation after compensation</h2>\n";
+  h += "<h2 id=\"figure5\">Figure 5: mean deformation after compensation</h2>\n";
   h += "<div class=\"fig\">\n" + svg_figure5(study) + "</div>\n";
   h += "<p class=\"caption\">Bars: our residual after compensation per load and speed; black markers: the "
        "paper's values; grey labels above each group: the uncompensated deviation (the paper's in brackets).</p>\n";
   h += iso_table(study);
   if (!content.path_plots.empty()) {
-    h += "<h2>Path plots</h2>\n";
+    h += "<h2 id=\"paths\">Path plots</h2>\n";
     for (const auto& p : content.path_plots) {
       h += "<div class=\"fig\">\n" + svg_path_plot(p) + "</div>\n";
     }
@@ -254,17 +254,17 @@ std::string html_report(const ReportContent& content) {
   }
   h += budget_tables(content.error_budgets);
   if (!study.speed_sweep.empty()) {
-    h += "<h2>Speed sweep</h2>\n<div class=\"fig\">\n" + svg_speed_sweep(study) + "</div>\n";
+    h += "<h2 id=\"sweep\">Speed sweep</h2>\n<div class=\"fig\">\n" + svg_speed_sweep(study) + "</div>\n";
     h += "<p class=\"caption\">Beyond the paper's 10-50 mm/s (shaded): how each strategy's compensation holds up "
          "as the TCP speed grows and the compensation cycle and delay start to matter.</p>\n";
   }
   if (!content.notes.empty()) {
-    h += "<h2>Notes</h2>\n";
+    h += "<h2 id=\"notes\">Notes</h2>\n";
     for (const auto& n : content.notes) {
       h += fmt::format("<div class=\"note\">{}</div>\n", esc(n));
     }
   }
-  h += "<h2>How the figures are computed</h2>\n<ul>\n"
+  h += "<h2 id=\"method\">How the figures are computed</h2>\n<ul>\n"
        "<li>Mean deformation (the paper's figure): for every tracker point of a loaded run, the distance to the "
        "nearest point of the unloaded path's polyline at the same speed; the mean over all points of all laps.</li>\n"
        "<li>Compensation = 1 - C/UC.</li>\n"

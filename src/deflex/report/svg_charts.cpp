@@ -319,9 +319,12 @@ std::string svg_path_plot(const PathPlot& plot) {
   c.title(plot.title.empty() ? "Paths: unloaded, loaded uncompensated (UC) and compensated (C)" : plot.title);
   double lx = 70.0;
   lx = legend_entry(c, lx, 50.0, "line", kUnloadedColour, "unloaded");
-  lx = legend_entry(c, lx, 50.0, "line", kUcColour,
-                    fmt::format("UC (mean {:.3f} mm)", mean_dev(uc) * 1e3));
-  legend_entry(c, lx, 50.0, "line", kCColour, fmt::format("C (mean {:.3f} mm)", mean_dev(cc) * 1e3));
+  auto mean_text = [&](const char* name, const std::vector<Dev>& ds) {
+    const double m = mean_dev(ds);
+    return std::isfinite(m) ? fmt::format("{} (mean {:.3f} mm)", name, m * 1e3) : fmt::format("{} (no data)", name);
+  };
+  lx = legend_entry(c, lx, 50.0, "line", kUcColour, mean_text("UC", uc));
+  legend_entry(c, lx, 50.0, "line", kCColour, mean_text("C", cc));
 
   // Left panel: the path in its plane, equal scales, deviations magnified.
   const double pl = 80.0, pt = 80.0, pw = 400.0, ph = 400.0;
