@@ -421,6 +421,11 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
         cell.calibration.estimate.residual_rms_m * 1e6,
         families[f].sensor ? "sensor compliance, joint coupling, forearm bending, lost motion"
                            : "joint coupling, forearm bending, lost motion"));
+    for (const auto& note : cell.calibration.notes) {
+      if (note.find("kept the assumed") != std::string::npos || note.find("poorly") != std::string::npos) {
+        out.setup_paragraphs.back() += " Calibration: " + note + ".";
+      }
+    }
   }
   out.setup_paragraphs.push_back(fmt::format(
       "Circle of radius {:.1f} mm around ({:.0f}, {:.0f}, {:.0f}) mm in the base XY plane, tool pointing down; LDBB bar "
