@@ -177,6 +177,10 @@ TEST(HtmlReport, SelfContainedWellFormedAndComplete) {
     EXPECT_NE(html.find(needle), std::string::npos) << needle;
   }
   EXPECT_EQ(test::count_of(html, "<svg "), 3u);  // Figure 5, one path plot, the sweep
+  // Budget shares: (0.20 - 0.12) / 0.20 = 40%; a share of -0.2% rounds to 0%, never "-0%".
+  EXPECT_NE(html.find("<td>0.120</td><td>40%</td>"), std::string::npos);
+  EXPECT_NE(html.find("<td>0.200</td><td>0%</td>"), std::string::npos);
+  EXPECT_EQ(html.find("-0%"), std::string::npos);
   // Nothing to fetch: no scripts, no external resources.
   EXPECT_EQ(html.find("<script"), std::string::npos);
   EXPECT_EQ(html.find("src="), std::string::npos);

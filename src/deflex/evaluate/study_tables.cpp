@@ -69,7 +69,14 @@ double paper_compensation(const PaperRow& r) {
 }
 
 std::string mm(double v) { return std::isfinite(v) ? fmt::format("{:.3f}", v) : "n/a"; }
-std::string pct(double v) { return std::isfinite(v) ? fmt::format("{:.0f}%", v * 100.0) : "n/a"; }
+// Whole percent; a value that rounds to zero prints "0%", not "-0%".
+std::string pct(double v) {
+  if (!std::isfinite(v)) {
+    return "n/a";
+  }
+  const double p = std::round(v * 100.0);
+  return fmt::format("{:.0f}%", p == 0.0 ? 0.0 : p);
+}
 std::string paper_mm(double v) { return std::isfinite(v) ? fmt::format("{:.2f}", v) : ""; }
 
 std::string cell_with_paper(const std::string& ours, const std::string& paper) {

@@ -46,7 +46,14 @@ double get(const std::map<int, double>& m, int key) {
 }
 
 std::string mm(double v) { return std::isfinite(v) ? fmt::format("{:.3f}", v) : "n/a"; }
-std::string pct(double v) { return std::isfinite(v) ? fmt::format("{:.0f}%", v * 100.0) : "n/a"; }
+// Whole percent; a value that rounds to zero prints "0%", not "-0%".
+std::string pct(double v) {
+  if (!std::isfinite(v)) {
+    return "n/a";
+  }
+  const double p = std::round(v * 100.0);
+  return fmt::format("{:.0f}%", p == 0.0 ? 0.0 : p);
+}
 
 std::vector<int> speeds_of(const StudyResult& study) {
   if (!study.speeds_mm_s.empty()) {
