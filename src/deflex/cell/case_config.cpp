@@ -2,6 +2,7 @@
 #include "deflex/cell/case_config.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -240,7 +241,12 @@ CaseConfig load_case(const std::string& path) {
   }
   std::ostringstream text;
   text << in.rdbuf();
-  return load_case_text(text.str(), path);
+  CaseConfig c = load_case_text(text.str(), path);
+  // A robot file named in the case is found next to the case file, as users expect.
+  if (!c.robot_file.empty() && std::filesystem::path(c.robot_file).is_relative()) {
+    c.robot_file = (std::filesystem::path(path).parent_path() / c.robot_file).string();
+  }
+  return c;
 }
 
 const std::string& paper_case_yaml() {
