@@ -45,8 +45,9 @@ std::string iso_text(const std::string& what, const Iso9283Path& iso) {
                                 : "n/a (one run: give each lap as its own file)";
   std::string out = fmt::format(
       "{}:\n  path accuracy AT_p      {:.4f} mm  (mean over the planes {:.4f} mm)\n"
-      "  path repeatability RT_p {}\n  {} runs, {} planes normal to the path",
-      what, iso.accuracy_m * 1e3, iso.mean_accuracy_m * 1e3, rt, iso.runs, iso.evaluation_points);
+      "  path repeatability RT_p {}\n  {} run{}, {} planes normal to the path",
+      what, iso.accuracy_m * 1e3, iso.mean_accuracy_m * 1e3, rt, iso.runs, iso.runs == 1 ? "" : "s",
+      iso.evaluation_points);
   if (iso.skipped_points > 0) {
     out += fmt::format(" ({} planes left out: not crossed by every run)", iso.skipped_points);
   }
