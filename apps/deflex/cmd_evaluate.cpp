@@ -7,6 +7,7 @@
 #include "cli_util.hpp"
 #include "command.hpp"
 #include "deflex/evaluate/iso9283_path.hpp"
+#include "deflex/evaluate/lap_split.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
 #include "deflex/evaluate/tracker_trace.hpp"
 #include "deflex/model/errors.hpp"
@@ -14,10 +15,26 @@
 namespace deflex::cli {
 namespace {
 
-std::vector<TrackerTrace> read_all(const std::vector<std::string>& paths) {
+// Each file is one run, or with --split-laps each lap of a closed path in a file is one run.
+std::vector<TrackerTrace> read_all(const std::vector<std::string>& paths, bool split, const char* what) {
   std::vector<TrackerTrace> out;
   for (const auto& p : paths) {
-    out.push_back(read_tracker_csv(p));
+    TrackerTrace t = read_tracker_csv(p);
+    if (!split) {
+      out.push_back(std::move(t));
+      continue;
+    }
+    LapSplit s = split_laps(t);
+    if (s.laps.empty()) {
+      throw InputError(fmt::format("{}: --split-laps found no full lap of a closed path in the {} run", p, what));
+    }
+    std::cerr << fmt::format("deflex evaluate: {}: {} lap{}{}\n", p, s.laps.size(), s.laps.size() == 1 ? "" : "s",
+                             s.dropped_partial > 0 ? fmt::format(" ({} partial piece{} left out)", s.dropped_partial,
+                                                                 s.dropped_partial == 1 ? "" : "s")
+                                                   : "");
+    for (auto& lap : s.laps) {
+      out.push_back(std::move(lap));
+    }
   }
   return out;
 }
@@ -60,7 +77,7 @@ void setup_evaluate(CLI::App& sub, int& exit_code) {
     std::string commanded;
     int points = 81;
     double max_offset_mm = 10.0;
-    bool json = false;
+    bool json = false, split = false;
   };
   auto o = std::make_shared<Opts>();
   sub.add_option("--unloaded", o->unloaded,
@@ -77,13 +94,16 @@ void setup_evaluate(CLI::App& sub, int& exit_code) {
       ->check(CLI::Range(1, 100000));
   sub.add_option("--max-offset-mm", o->max_offset_mm,
                  "ISO 9283: a run crossing a plane farther than this from the path does not count there (default 10)");
+  sub.add_flag("--split-laps", o->split,
+               "Split each file of a closed path (a circle) into its laps, each lap one run (a lap ends after a "
+               "full turn or where the direction reverses)");
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code] {
     if (!(o->max_offset_mm > 0.0)) {
       throw InputError("option --max-offset-mm: must be a positive number of mm");
     }
-    const std::vector<TrackerTrace> unloaded = read_all(o->unloaded);
-    const std::vector<TrackerTrace> loaded = read_all(o->loaded);
+    const std::vector<TrackerTrace> unloaded = read_all(o->unloaded, o->split, "unloaded");
+    const std::vector<TrackerTrace> loaded = read_all(o->loaded, o->split, "loaded");
     const PathDeviationStats dev = path_deviation(loaded, unloaded);
     // ISO 9283 wants one reference path: the commanded one when given, else the first unloaded run.
     const bool have_commanded = !o->commanded.empty();
@@ -108,8 +128,8 @@ void setup_evaluate(CLI::App& sub, int& exit_code) {
       print_json(doc);
     } else {
       std::cout << fmt::format(
-          "Distance of the loaded path from the unloaded path ({} loaded points, {} file{}; {} unloaded points, {} "
-          "file{}):\n  mean (the paper's mean deformation) {:.4f} mm\n  max {:.4f} mm   RMS {:.4f} mm   std {:.4f} mm\n",
+          "Distance of the loaded path from the unloaded path ({} loaded points, {} run{}; {} unloaded points, {} "
+          "run{}):\n  mean (the paper's mean deformation) {:.4f} mm\n  max {:.4f} mm   RMS {:.4f} mm   std {:.4f} mm\n",
           dev.samples, loaded.size(), loaded.size() > 1 ? "s" : "", samples_of(unloaded), unloaded.size(),
           unloaded.size() > 1 ? "s" : "", dev.mean_m * 1e3, dev.max_m * 1e3, dev.rms_m * 1e3, dev.std_m * 1e3);
       std::cout << iso_text(fmt::format("ISO 9283 (loaded runs against the {} path)", ref_name), iso_loaded);

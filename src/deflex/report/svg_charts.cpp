@@ -6,9 +6,9 @@
 #include <limits>
 #include <map>
 
-#include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 
+#include "deflex/evaluate/lap_split.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/report/svg_canvas.hpp"
@@ -235,29 +235,11 @@ std::string svg_path_plot(const PathPlot& plot) {
   if (plot.unloaded.size() < 2) {
     throw InputError(fmt::format("path plot '{}': the unloaded path needs at least 2 samples", plot.title));
   }
-  // The plane of best fit of the unloaded path: its normal is the covariance's weakest direction.
-  Vector3 centroid = Vector3::Zero();
-  for (const auto& s : plot.unloaded) {
-    centroid += s.p_m;
-  }
-  centroid /= static_cast<double>(plot.unloaded.size());
-  Matrix3 cov = Matrix3::Zero();
-  for (const auto& s : plot.unloaded) {
-    cov += (s.p_m - centroid) * (s.p_m - centroid).transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Matrix3> eig(cov);
-  Vector3 n = eig.eigenvectors().col(0);
-  if (n.z() < 0.0) {
-    n = -n;
-  }
-  // In-plane axes that follow the base frame where they can (x first), so a horizontal circle is
-  // drawn as seen from above with x to the right.
-  Vector3 u = Vector3::UnitX() - Vector3::UnitX().dot(n) * n;
-  if (u.norm() < 0.3) {
-    u = Vector3::UnitY() - Vector3::UnitY().dot(n) * n;
-  }
-  u.normalize();
-  const Vector3 v = n.cross(u);
+  // Drawn in the plane of best fit of the unloaded path, axes following the base frame.
+  const PathPlane plane = best_fit_plane(plot.unloaded);
+  const Vector3& centroid = plane.centroid_m;
+  const Vector3& u = plane.u;
+  const Vector3& v = plane.v;
 
   const PolylineIndex index(plot.unloaded);
   struct Dev {

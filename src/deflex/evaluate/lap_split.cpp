@@ -1,0 +1,94 @@
+// Laps of a closed path from the angle turned about its centre.
+#include "deflex/evaluate/lap_split.hpp"
+
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+
+#include "deflex/model/errors.hpp"
+
+namespace deflex {
+
+PathPlane best_fit_plane(const TrackerTrace& path) {
+  if (path.size() < 2) {
+    throw InputError("plane of a path: fewer than 2 samples");
+  }
+  PathPlane pl;
+  for (const auto& s : path) {
+    pl.centroid_m += s.p_m;
+  }
+  pl.centroid_m /= static_cast<double>(path.size());
+  Matrix3 cov = Matrix3::Zero();
+  for (const auto& s : path) {
+    cov += (s.p_m - pl.centroid_m) * (s.p_m - pl.centroid_m).transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Matrix3> eig(cov);
+  pl.normal = eig.eigenvectors().col(0);
+  if (pl.normal.z() < 0.0) {
+    pl.normal = -pl.normal;
+  }
+  Vector3 u = Vector3::UnitX() - Vector3::UnitX().dot(pl.normal) * pl.normal;
+  if (u.norm() < 0.3) {
+    u = Vector3::UnitY() - Vector3::UnitY().dot(pl.normal) * pl.normal;
+  }
+  pl.u = u.normalized();
+  pl.v = pl.normal.cross(pl.u);
+  return pl;
+}
+
+LapSplit split_laps(const TrackerTrace& trace, double min_turn_rad, double reversal_rad) {
+  const PathPlane pl = best_fit_plane(trace);
+  auto angle_of = [&](const Vector3& p) {
+    const Vector3 r = p - pl.centroid_m;
+    return std::atan2(r.dot(pl.v), r.dot(pl.u));
+  };
+  // Unwrapped angle of every sample.
+  std::vector<double> theta(trace.size());
+  theta[0] = angle_of(trace[0].p_m);
+  for (std::size_t i = 1; i < trace.size(); ++i) {
+    double d = angle_of(trace[i].p_m) - angle_of(trace[i - 1].p_m);
+    d = std::remainder(d, 2.0 * kPi);
+    theta[i] = theta[i - 1] + d;
+  }
+  LapSplit out;
+  auto close_lap = [&](std::size_t first, std::size_t last) {  // samples [first, last]
+    if (last > first && std::abs(theta[last] - theta[first]) >= min_turn_rad) {
+      out.laps.emplace_back(trace.begin() + static_cast<std::ptrdiff_t>(first),
+                            trace.begin() + static_cast<std::ptrdiff_t>(last) + 1);
+    } else {
+      ++out.dropped_partial;
+    }
+  };
+  std::size_t start = 0;
+  std::size_t extreme = 0;  // sample of the largest turn from `start` so far
+  for (std::size_t i = 1; i < trace.size(); ++i) {
+    const double turned = theta[i] - theta[start];
+    const double best = theta[extreme] - theta[start];
+    if (std::abs(turned) > std::abs(best)) {
+      extreme = i;
+    }
+    if (std::abs(theta[i] - theta[start]) >= 2.0 * kPi) {
+      close_lap(start, i);
+      start = extreme = i;
+    } else if (std::abs(theta[extreme] - theta[i]) > reversal_rad &&
+               std::abs(theta[i] - theta[start]) < std::abs(theta[extreme] - theta[start])) {
+      // Fell back from the extreme: the path reversed there.
+      close_lap(start, extreme);
+      start = extreme;
+      // The new lap's extreme is the furthest point since the reversal.
+      std::size_t e = start;
+      for (std::size_t k = start; k <= i; ++k) {
+        if (std::abs(theta[k] - theta[start]) > std::abs(theta[e] - theta[start])) {
+          e = k;
+        }
+      }
+      extreme = e;
+    }
+  }
+  if (start + 1 < trace.size()) {
+    close_lap(start, trace.size() - 1);
+  }
+  return out;
+}
+
+}  // namespace deflex
