@@ -20,7 +20,8 @@ namespace {
 struct Candidate {
   Wrench wrench;
   Vector3 load_point;
-  Eigen::MatrixXd block;  // 3 x n, columns scaled by the nominal compliance (m)
+  // 3 x n, columns scaled by the nominal compliance (m); fixed capacity, so scoring never allocates.
+  Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, kMaxJoints> block;
 };
 
 struct CandidatePose {
@@ -30,11 +31,11 @@ struct CandidatePose {
   bool used = false;
 };
 
-double min_eigenvalue(const Eigen::MatrixXd& G) {
-  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(G, Eigen::EigenvaluesOnly).eigenvalues()[0];
+double min_eigenvalue(const JointMatrix& G) {
+  return Eigen::SelfAdjointEigenSolver<JointMatrix>(G, Eigen::EigenvaluesOnly).eigenvalues()[0];
 }
 
-double log_det(const Eigen::MatrixXd& G) { return G.ldlt().vectorD().array().abs().log().sum(); }
+double log_det(const JointMatrix& G) { return Eigen::LDLT<JointMatrix>(G).vectorD().array().abs().log().sum(); }
 
 void check_options(const CalibrationPlanOptions& o) {
   if (!o.region_min_m.allFinite() || !o.region_max_m.allFinite() ||
@@ -152,11 +153,11 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
       info_scale = std::max(info_scale, c.block.squaredNorm());
     }
   }
-  const Eigen::MatrixXd eps = 1e-9 * info_scale * Eigen::MatrixXd::Identity(n, n);
-  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);
+  const JointMatrix eps = 1e-9 * info_scale * JointMatrix::Identity(n, n);
+  JointMatrix G = JointMatrix::Zero(n, n);
   // A joint no candidate can observe would pin the smallest eigenvalue at zero and blind the
   // criterion to the others: give it a large constant in the selection only.
-  Eigen::MatrixXd unobservable_pad = Eigen::MatrixXd::Zero(n, n);
+  JointMatrix unobservable_pad = JointMatrix::Zero(n, n);
   {
     Eigen::VectorXd all_diag = Eigen::VectorXd::Zero(n);
     for (const auto& cp : poses) {
@@ -173,35 +174,39 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
   // Picks the best load among candidates; returns {pose, load} or {-1, -1}.
   auto pick = [&](int only_pose) {
     int best_p = -1, best_l = -1;
-    double best_min = -1.0, best_ld = -std::numeric_limits<double>::infinity();
-    std::vector<std::tuple<int, int, double, double>> scores;
+    double best_min = -1.0;
+    std::vector<std::tuple<int, int, double>> scores;
     for (int pi = 0; pi < static_cast<int>(poses.size()); ++pi) {
       const CandidatePose& cp = poses[static_cast<std::size_t>(pi)];
       if (only_pose >= 0 ? pi != only_pose : cp.used) {
         continue;
       }
       for (int li = 0; li < static_cast<int>(cp.loads.size()); ++li) {
-        const Eigen::MatrixXd& B = cp.loads[static_cast<std::size_t>(li)].block;
-        const Eigen::MatrixXd Gn = G + unobservable_pad + B.transpose() * B;
-        scores.emplace_back(pi, li, min_eigenvalue(Gn), log_det(Gn + eps));
+        const auto& B = cp.loads[static_cast<std::size_t>(li)].block;
+        const JointMatrix Gn = G + unobservable_pad + B.transpose() * B;
+        const double mn = min_eigenvalue(Gn);
+        best_min = std::max(best_min, mn);
+        scores.emplace_back(pi, li, mn);
       }
-    }
-    for (const auto& [pi, li, mn, ld] : scores) {
-      best_min = std::max(best_min, mn);
     }
     // Until the information matrix has full rank every smallest eigenvalue is ~0; then the
     // log-determinant (D-optimality) spreads the information over the missing directions.
     const bool use_min = best_min > 1e-6 * info_scale;
     double best = -std::numeric_limits<double>::infinity();
-    for (const auto& [pi, li, mn, ld] : scores) {
-      const double s = use_min ? mn : ld;
-      if (s > best) {
-        best = s;
+    for (const auto& [pi, li, mn] : scores) {
+      double score = mn;
+      if (!use_min) {
+        const auto& B = poses[static_cast<std::size_t>(pi)].loads[static_cast<std::size_t>(li)].block;
+        score = log_det(G + unobservable_pad + B.transpose() * B + eps);
+      }
+      // Mirror-image loads score the same up to round-off: keep the first, so plans do not depend
+      // on the compiler's rounding.
+      if (best_p < 0 || score > best + 1e-9 * std::abs(best)) {
+        best = score;
         best_p = pi;
         best_l = li;
       }
     }
-    (void)best_ld;
     return std::pair<int, int>(best_p, best_l);
   };
   for (int k = 0; k < wanted; ++k) {
@@ -229,9 +234,12 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
     }
   }
 
+  if (plan.points.empty()) {
+    throw InputError("plan_calibration: no load could be chosen (no candidate has a finite score)");
+  }
   // Figures of the chosen design. A joint whose column is negligible (no load turns it, or the
   // TCP lies on its axis) is unobservable; the others are judged on their own.
-  const Eigen::VectorXd eig = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(G, Eigen::EigenvaluesOnly).eigenvalues();
+  const Eigen::VectorXd eig = Eigen::SelfAdjointEigenSolver<JointMatrix>(G, Eigen::EigenvaluesOnly).eigenvalues();
   plan.min_singular_value_m = std::sqrt(std::max(0.0, eig[0]));
   const double max_diag = G.diagonal().maxCoeff();
   std::vector<int> observable;
