@@ -136,7 +136,7 @@ TEST(PathPlot, DeviationsAreMagnifiedByTheStatedFactor) {
 }
 
 TEST(PathPlot, AutomaticMagnificationAndBadInput) {
-  // Largest deviation 1.0 mm on a path 200 mm across: 8% of 200 / 1.0 = 16 -> the nice factor 10.
+  // Largest deviation 1.0 mm on a path 200 mm across: 12% of 200 / 1.0 = 24 -> the nice factor 20.
   PathPlot p = test::synthetic_path_plot(1.0, 0.2, 5);
   double max_dev = 0.0;
   for (std::size_t i = 0; i < p.uc.size(); ++i) {
@@ -145,7 +145,7 @@ TEST(PathPlot, AutomaticMagnificationAndBadInput) {
   ASSERT_LT(max_dev, 1.01e-3);  // the synthetic field's largest UC deviation (test's own check)
   const std::string svg = svg_path_plot(p);
   EXPECT_EQ(test::xml_problem(svg), "");
-  EXPECT_NE(svg.find("magnified x10"), std::string::npos);
+  EXPECT_NE(svg.find("magnified x20"), std::string::npos);
   PathPlot only_unloaded{"no loaded runs", p.unloaded, {}, {}, 0.0};
   const std::string empty = svg_path_plot(only_unloaded);
   EXPECT_EQ(test::xml_problem(empty), "");

@@ -286,7 +286,7 @@ std::string svg_path_plot(const PathPlot& plot) {
     }
   }
   const double mag = plot.magnification > 0.0 ? plot.magnification
-                     : max_dev > 0.0             ? nice_floor(0.08 * size / max_dev)
+                     : max_dev > 0.0             ? nice_floor(0.12 * size / max_dev)
                                                  : 1.0;
   auto mean_dev = [](const std::vector<Dev>& ds) {
     double s = 0.0;
@@ -333,7 +333,7 @@ std::string svg_path_plot(const PathPlot& plot) {
       pts.push_back(plot.unloaded[i].p_m);
     }
     pts.push_back(plot.unloaded.back().p_m);
-    draw_path(pts, kUnloadedColour, 3.0);
+    draw_path(pts, kUnloadedColour, 4.5);  // wide, so it shows beside a C path lying on it
   }
   for (const auto& [set, col] : {std::pair{&uc, kUcColour}, std::pair{&cc, kCColour}}) {
     std::vector<Vector3> pts;

@@ -16,7 +16,8 @@ std::string svg_figure5(const StudyResult& study);
 
 /// A path in the plane of best fit of the unloaded path: the unloaded path, the loaded uncompensated
 /// (UC) and compensated (C) paths, each drawn at unloaded + magnification * (its deviation from the
-/// unloaded path). magnification <= 0 picks one so the largest UC deviation is 8% of the path's size.
+/// unloaded path). magnification <= 0 picks a nice factor (1, 2 or 5 x 10^k) that draws the largest deviation at up
+/// to 12% of the path's size.
 struct PathPlot {
   std::string title;
   TrackerTrace unloaded, uc, c;
