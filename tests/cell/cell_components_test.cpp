@@ -82,6 +82,17 @@ TEST(LostMotion, FollowsTheSignOfTheTorqueWithHistory) {
   EXPECT_DOUBLE_EQ(lm.update(-50.0), -20e-6);
 }
 
+TEST(LostMotion, GravityPreloadKeepsAJointOnOneSide) {
+  LostMotion lm;
+  lm.half_width_rad = 20e-6;
+  lm.torque_nm = 300.0;
+  const double gravity = 9000.0;
+  EXPECT_DOUBLE_EQ(lm.update(gravity), 20e-6);
+  for (double process : {1200.0, -1200.0, 500.0, -2000.0}) {
+    EXPECT_DOUBLE_EQ(lm.update(gravity + process), 20e-6) << process;  // never crosses its band
+  }
+}
+
 CaseConfig bare_case() {
   CaseConfig c = paper_case();
   c = model_consistent(c, false);

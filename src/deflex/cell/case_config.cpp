@@ -128,7 +128,8 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
 
   const auto r = root.at("true_robot");
   r.only_keys({"stiffness_scale", "stiffness_spread_pct", "coupling_23", "forearm_EI_Nm2", "forearm_length_mm",
-               "lost_motion_urad", "lost_motion_torque_Nm", "dh_length_sigma_mm", "dh_angle_sigma_deg"});
+               "lost_motion_urad", "lost_motion_torque_Nm", "gravity_torque_Nm", "dh_length_sigma_mm",
+               "dh_angle_sigma_deg"});
   c.robot.stiffness_scale = positive(r.at("stiffness_scale"));
   c.robot.stiffness_spread = non_negative(r.at("stiffness_spread_pct")) / 100.0;
   c.robot.coupling_23 = r.at("coupling_23").as_double();
@@ -143,6 +144,9 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   c.robot.lost_motion_torque_nm = r.at("lost_motion_torque_Nm").as_doubles(c.robot.lost_motion_rad.size());
   for (double v : c.robot.lost_motion_torque_nm) {
     if (!(v > 0)) r.at("lost_motion_torque_Nm").fail("must be positive");
+  }
+  if (r.has("gravity_torque_Nm")) {
+    c.robot.gravity_torque_nm = r.at("gravity_torque_Nm").as_doubles(c.robot.lost_motion_rad.size());
   }
   c.robot.dh_length_sigma_m = non_negative(r.at("dh_length_sigma_mm")) * kMm;
   c.robot.dh_angle_sigma_rad = deg_to_rad(non_negative(r.at("dh_angle_sigma_deg")));

@@ -39,6 +39,9 @@ struct TrueRobotConfig {
   double forearm_length_m = 1.2125;      ///< cantilever length, elbow to wrist centre
   std::vector<double> lost_motion_rad;   ///< half-width of each joint's lost motion band
   std::vector<double> lost_motion_torque_nm;  ///< joint torque that moves a joint across its band
+  /// Static joint torque from gravity at the operating space (Nm): it preloads the lost motion, so a
+  /// joint that gravity holds to one side (2, 3) never crosses its band under the process load.
+  std::vector<double> gravity_torque_nm;
   double dh_length_sigma_m = 0.0;        ///< kinematic errors: 1-sigma of a, d
   double dh_angle_sigma_rad = 0.0;       ///< 1-sigma of alpha, offset
 };

@@ -85,6 +85,12 @@ TrueRobotState TrueRobot::initial_state(const JointVector& q_cmd) const {
     s.lost_motion[k].torque_nm = k < config_.robot.lost_motion_torque_nm.size() ? config_.robot.lost_motion_torque_nm[k] : 1.0;
     s.lost_motion[k].state = 0.0;
   }
+  s.gravity_torque_nm = JointVector::Zero(true_->dof());
+  for (int i = 0; i < true_->dof(); ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (k < config_.robot.gravity_torque_nm.size()) s.gravity_torque_nm[i] = config_.robot.gravity_torque_nm[k];
+    s.lost_motion[k].update(s.gravity_torque_nm[i]);  // the arm settled under its own weight
+  }
   return s;
 }
 
@@ -131,7 +137,7 @@ Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd, const Wrench& 
   JointVector tau = J.transpose() * wrench_base;
   JointVector lost(n);
   for (int i = 0; i < n; ++i) {
-    lost[i] = state.lost_motion[static_cast<std::size_t>(i)].update(tau[i]);
+    lost[i] = state.lost_motion[static_cast<std::size_t>(i)].update(tau[i] + state.gravity_torque_nm[i]);
   }
   for (int it = 0; it < 30; ++it) {
     const JointVector q_new = q_cmd + joint_compliance_ * tau + lost;

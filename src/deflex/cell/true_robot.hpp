@@ -29,6 +29,7 @@ struct TrueRobotState {
   JointVector q_actual;      ///< last solved configuration (warm start of the next solve)
   JointVector q_cmd_last;    ///< command of the last solve
   std::array<LostMotion, kMaxJoints> lost_motion{};
+  JointVector gravity_torque_nm;  ///< preload of the lost motion (constant)
 };
 
 class TrueRobot {
