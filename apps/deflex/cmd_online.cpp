@@ -2,6 +2,7 @@
 // SIGTERM) and `identify-payload` (end-effector mass, centre of gravity and sensor bias from static
 // poses).
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -92,6 +93,16 @@ void setup_online(CLI::App& sub, int& exit_code) {
     if (o->egm_port < 0 || o->egm_port > 65535) {
       throw InputError("option --egm-port: must be 0..65535");
     }
+    const auto positive = [](double v, const char* option) {
+      if (!std::isfinite(v) || !(v > 0.0)) {
+        throw InputError(fmt::format("option {}: must be a number > 0 (got {})", option, v));
+      }
+    };
+    positive(o->period_ms, "--period-ms");
+    positive(o->max_joint_deg, "--max-joint-correction-deg");
+    positive(o->max_tcp_mm, "--max-tcp-correction-mm");
+    positive(o->max_rate_deg_s, "--max-rate-deg-s");
+    positive(o->watchdog_ms, "--watchdog-ms");
     OnlineConfig cfg;
     cfg.period_s = o->period_ms * 1e-3;
     cfg.max_joint_correction_rad = deg_to_rad(o->max_joint_deg);

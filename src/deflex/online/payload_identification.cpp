@@ -103,6 +103,10 @@ std::vector<PayloadObservation> read_payload_observations(const std::string& csv
     t.require({"mx_Nm", "my_Nm", "mz_Nm"});
   }
   const bool quaternion = t.has("qw");
+  if (!quaternion && !t.has("q1_deg")) {
+    throw DataError(csv_path + ": no orientation columns: give the sensor orientation as qw,qx,qy,qz (base_R_sensor) "
+                               "or the robot joints as q1_deg..qN_deg");
+  }
   if (quaternion) {
     t.require({"qw", "qx", "qy", "qz"});
   } else {
