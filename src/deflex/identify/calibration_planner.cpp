@@ -1,6 +1,7 @@
 // Greedy maximin selection of calibration poses and loads from a grid of reachable candidates.
 #include "deflex/identify/calibration_planner.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -172,10 +173,17 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
     }
   }
   // Picks the best load among candidates; returns {pose, load} or {-1, -1}.
+  struct Scored {
+    int pose, load;
+    double bound;
+  };
   auto pick = [&](int only_pose) {
-    int best_p = -1, best_l = -1;
-    double best_min = -1.0;
-    std::vector<std::tuple<int, int, double>> scores;
+    const JointMatrix G0 = G + unobservable_pad;
+    const Eigen::SelfAdjointEigenSolver<JointMatrix> es(G0);
+    const JointVector v0 = es.eigenvectors().col(0);
+    // lambda_min(G0 + B^T B) <= v0^T (G0 + B^T B) v0 = lambda_min(G0) + |B v0|^2: a tight upper
+    // bound that lets most candidates be skipped without an eigenvalue solve.
+    std::vector<Scored> items;
     for (int pi = 0; pi < static_cast<int>(poses.size()); ++pi) {
       const CandidatePose& cp = poses[static_cast<std::size_t>(pi)];
       if (only_pose >= 0 ? pi != only_pose : cp.used) {
@@ -183,28 +191,39 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
       }
       for (int li = 0; li < static_cast<int>(cp.loads.size()); ++li) {
         const auto& B = cp.loads[static_cast<std::size_t>(li)].block;
-        const JointMatrix Gn = G + unobservable_pad + B.transpose() * B;
-        const double mn = min_eigenvalue(Gn);
-        best_min = std::max(best_min, mn);
-        scores.emplace_back(pi, li, mn);
+        items.push_back({pi, li, es.eigenvalues()[0] + (B * v0).squaredNorm()});
       }
+    }
+    const auto block_of = [&](const Scored& it) -> const auto& {
+      return poses[static_cast<std::size_t>(it.pose)].loads[static_cast<std::size_t>(it.load)].block;
+    };
+    // Mirror-image loads score the same up to round-off: keep the first, so plans do not depend
+    // on the compiler's rounding.
+    int best_p = -1, best_l = -1;
+    double best = -std::numeric_limits<double>::infinity();
+    auto consider = [&](const Scored& it, double score) {
+      if (best_p < 0 || score > best + 1e-9 * std::abs(best)) {
+        best = score;
+        best_p = it.pose;
+        best_l = it.load;
+      }
+    };
+    std::vector<Scored> by_bound = items;
+    std::stable_sort(by_bound.begin(), by_bound.end(), [](const Scored& x, const Scored& y) { return x.bound > y.bound; });
+    for (const Scored& it : by_bound) {
+      if (best_p >= 0 && it.bound <= best) {
+        break;  // no remaining candidate can beat the best
+      }
+      const auto& B = block_of(it);
+      consider(it, min_eigenvalue(G0 + B.transpose() * B));
     }
     // Until the information matrix has full rank every smallest eigenvalue is ~0; then the
     // log-determinant (D-optimality) spreads the information over the missing directions.
-    const bool use_min = best_min > 1e-6 * info_scale;
-    double best = -std::numeric_limits<double>::infinity();
-    for (const auto& [pi, li, mn] : scores) {
-      double score = mn;
-      if (!use_min) {
-        const auto& B = poses[static_cast<std::size_t>(pi)].loads[static_cast<std::size_t>(li)].block;
-        score = log_det(G + unobservable_pad + B.transpose() * B + eps);
-      }
-      // Mirror-image loads score the same up to round-off: keep the first, so plans do not depend
-      // on the compiler's rounding.
-      if (best_p < 0 || score > best + 1e-9 * std::abs(best)) {
-        best = score;
-        best_p = pi;
-        best_l = li;
+    if (!(best > 1e-6 * info_scale)) {
+      best_p = -1;
+      for (const Scored& it : items) {
+        const auto& B = block_of(it);
+        consider(it, log_det(G0 + B.transpose() * B + eps));
       }
     }
     return std::pair<int, int>(best_p, best_l);
