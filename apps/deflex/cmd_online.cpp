@@ -38,7 +38,8 @@ SensorConfig sensor_or_default(const std::string& path) {
   return load_sensor_config(path);
 }
 
-std::unique_ptr<ForceSource> make_force_source(const std::string& spec, bool loop, std::string& description) {
+std::unique_ptr<ForceSource> make_force_source(const std::string& spec, bool loop, const std::string& bind,
+                                               std::string& description) {
   const std::size_t colon = spec.find(':');
   const std::string kind = spec.substr(0, colon);
   const std::string arg = colon == std::string::npos ? "" : spec.substr(colon + 1);
@@ -47,7 +48,7 @@ std::unique_ptr<ForceSource> make_force_source(const std::string& spec, bool loo
     if (port < 0 || port > 65535 || port != std::floor(port)) {
       throw InputError(fmt::format("option --force-source: '{}' is not a UDP port", arg));
     }
-    auto src = std::make_unique<UdpForceSource>(static_cast<std::uint16_t>(port), "0.0.0.0");
+    auto src = std::make_unique<UdpForceSource>(static_cast<std::uint16_t>(port), bind);
     description = fmt::format("UDP force samples on port {}", src->port());
     return src;
   }
@@ -73,7 +74,7 @@ void setup_online(CLI::App& sub, int& exit_code) {
                  "Force-sensor YAML (docs/online.md); default: identity crosstalk, no payload, no bias, at the flange");
   sub.add_option("--egm-port", o->egm_port, "UDP port the controller's EGM messages arrive on (ABB examples: 6510)")
       ->required();
-  sub.add_option("--bind", o->bind, "Address to bind the EGM port to (0.0.0.0 for a real controller)")->capture_default_str();
+  sub.add_option("--bind", o->bind, "Address to bind the EGM and UDP force ports to (0.0.0.0 for a real cell)")->capture_default_str();
   sub.add_option("--force-source", o->force, "udp:PORT (docs/online.md, UDP force-sample format) or csv:FILE")
       ->required();
   sub.add_flag("--loop", o->loop, "With csv:FILE, replay the file again and again");
@@ -119,7 +120,7 @@ void setup_online(CLI::App& sub, int& exit_code) {
     cfg.validate();
     OnlineCompensator comp(model, sensor, cfg);
     std::string source_text;
-    const std::unique_ptr<ForceSource> source = make_force_source(o->force, o->loop, source_text);
+    const std::unique_ptr<ForceSource> source = make_force_source(o->force, o->loop, o->bind, source_text);
     EgmEndpointConfig ec;
     ec.bind_address = o->bind;
     ec.port = static_cast<std::uint16_t>(o->egm_port);

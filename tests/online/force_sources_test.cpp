@@ -109,6 +109,22 @@ TEST(UdpForceSource, NonFiniteValuesArriveFlaggedInvalidAndPollingDoesNotAllocat
   EXPECT_EQ(guard.allocations(), 0u);
 }
 
+TEST(UdpForceSource, ARestartedSenderIsAcceptedAgain) {
+  UdpForceSource src(0);
+  Sender tx(src.port());
+  std::array<unsigned char, kForceDatagramBytes> enc{};
+  ForceSample s;
+  for (std::uint32_t seq : {500u, 501u, 1u, 2u}) {
+    s.t_s = seq;
+    encode_force_datagram(s, seq, enc);
+    tx.send(enc.data(), enc.size());
+  }
+  std::vector<ForceSample> got;
+  ASSERT_EQ(receive(src, got, 4), 4);
+  EXPECT_EQ(got[2].t_s, 1.0);
+  EXPECT_EQ(src.counters().out_of_order, 0u);
+}
+
 TEST(CsvForceReplay, ReplaysByTheClockAndLoops) {
   const std::string path = ::testing::TempDir() + "/replay.csv";
   std::ofstream(path) << "t_s,fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm\n10.0,1,0,0,0,0,0.5\n10.1,2,0,0,0,0,0\n10.2,3,0,0,0,0,0\n";

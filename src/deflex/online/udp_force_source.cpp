@@ -93,10 +93,11 @@ bool UdpForceSource::latest(ForceSample& out) noexcept {
       ++counters_.malformed;
       continue;
     }
-    // Wrap-safe ordering: a sample not newer than the last one is dropped. A big backwards jump is a
-    // restarted sender, accepted.
+    // Wrap-safe ordering: a sample not newer than the last one is dropped. A restarted sender (a jump
+    // back to a small sequence number, or a big backwards jump) is accepted.
     const auto diff = static_cast<std::int32_t>(seq - last_sequence_);
-    if (have_sequence_ && diff <= 0 && diff > -1000) {
+    const bool restarted = diff <= -1000 || (seq <= 16 && last_sequence_ > seq + 16);
+    if (have_sequence_ && diff <= 0 && !restarted) {
       ++counters_.out_of_order;
       continue;
     }
