@@ -105,6 +105,27 @@ TEST(SimulatedRun, ModelConsistentCellIsCompensatedDownToTheTrackerNoise) {
   }
 }
 
+TEST(SimulatedRun, OnlineCycleCostsAtSpeedAndLatencyCompensationRecoversIt) {
+  // Noise-free, model-consistent cell: what is left of the online residual is the lag of the
+  // 100 ms cycle and the delays, which grows with the TCP speed; predicting one delay ahead along
+  // the planned path removes most of it.
+  CaseConfig c = model_consistent(short_case(paper_case()), false);
+  const SetupCell cell = build_setup_cell(c, true);
+  auto residual = [&](Strategy s, double speed) {
+    RunSpec r = spec(RunKind::kUnloaded, s, 0.0, 5);
+    r.speed_m_s = speed;
+    const RunOutput unloaded = simulate_run(cell, r);
+    r.kind = RunKind::kCompensated;
+    r.load_n = 650.0;
+    return mean_distance_to_path_m(simulate_run(cell, r).trace, unloaded.trace);
+  };
+  const double slow = residual(Strategy::kOnline, 0.02);
+  const double fast = residual(Strategy::kOnline, 0.2);
+  const double fast_predicted = residual(Strategy::kOnlineLatency, 0.2);
+  EXPECT_GT(fast, 3.0 * slow) << slow << " " << fast;
+  EXPECT_LT(fast_predicted, 0.5 * fast) << fast_predicted << " " << fast;
+}
+
 TEST(CaseStudy, SameSeedGivesTheSameFiguresOnAnyNumberOfThreads) {
   CaseConfig c = short_case(paper_case());
   c.setups[0].loads_n = {650.0};
