@@ -1,11 +1,11 @@
 // `deflex case-study`: the paper's experiment on the simulated cell (issue 7): Tables 1 and 2 beside
 // the paper's, Figure 5, path plots, the error budget and the HTML report.
+#include <fmt/format.h>
+
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
-
-#include <fmt/format.h>
 
 #include "cli_util.hpp"
 #include "command.hpp"
@@ -48,8 +48,9 @@ std::vector<std::string> honest_notes(const cell::CaseConfig& config, const Stud
           if (std::abs(sc.loads_n[i] - l.load_N) > 0.5) continue;
           const double ratio = l.uc_mean_mm() / sc.paper_uc_mm[i];
           if (std::abs(ratio - 1.0) > 0.25) {
-            notes.push_back(fmt::format("{} {:.0f} N: our UC {:.3f} mm is {:.0f}% of the paper's {:.2f} mm (outside 25%).",
-                                        s.setup, l.load_N, l.uc_mean_mm(), ratio * 100, sc.paper_uc_mm[i]));
+            notes.push_back(
+                fmt::format("{} {:.0f} N: our UC {:.3f} mm is {:.0f}% of the paper's {:.2f} mm (outside 25%).", s.setup,
+                            l.load_N, l.uc_mean_mm(), ratio * 100, sc.paper_uc_mm[i]));
           }
         }
       }
@@ -86,10 +87,11 @@ std::vector<std::string> honest_notes(const cell::CaseConfig& config, const Stud
     }
   }
   if (std::isfinite(offline_high) && std::isfinite(online_high)) {
-    notes.push_back(fmt::format("At the highest load the online strategy compensates {:.0f}% and the offline {:.0f}%: "
-                                "online {} offline, {} the paper.",
-                                online_high * 100, offline_high * 100, online_high > offline_high ? "ahead of" : "behind",
-                                online_high > offline_high ? "as in" : "unlike"));
+    notes.push_back(
+        fmt::format("At the highest load the online strategy compensates {:.0f}% and the offline {:.0f}%: "
+                    "online {} offline, {} the paper.",
+                    online_high * 100, offline_high * 100, online_high > offline_high ? "ahead of" : "behind",
+                    online_high > offline_high ? "as in" : "unlike"));
   }
   return notes;
 }
@@ -144,16 +146,18 @@ void run(const Opts& o, int& exit_code) {
       }
     }
     for (const auto& b : result.budgets) {
-      std::cout << fmt::format("\nError budget, {} {:.0f} N at {:.0f} mm/s: C = {:.3f} mm with every effect (UC {:.3f} mm)\n",
-                               b.setup, b.load_n, b.speed_mm_s, b.residual_mm_all, b.uc_mm);
+      std::cout << fmt::format(
+          "\nError budget, {} {:.0f} N at {:.0f} mm/s: C = {:.3f} mm with every effect (UC {:.3f} mm)\n", b.setup,
+          b.load_n, b.speed_mm_s, b.residual_mm_all, b.uc_mm);
       for (const auto& r : b.rows) {
         std::cout << fmt::format("  {:<48} {:<34} C without it {:.3f} mm ({:+.0f}% of C)\n", r.name, r.size,
                                  r.residual_mm_without,
                                  100.0 * residual_share(b.residual_mm_all, r.residual_mm_without));
       }
     }
-    std::cout << fmt::format("\n{} runs, {:.0f} s of robot time simulated in {:.1f} s wall time; report in {}/report.html\n",
-                             result.runs, result.simulated_s, result.study.wall_time_s, o.out_dir);
+    std::cout << fmt::format(
+        "\n{} runs, {:.0f} s of robot time simulated in {:.1f} s wall time; report in {}/report.html\n", result.runs,
+        result.simulated_s, result.study.wall_time_s, o.out_dir);
   }
   exit_code = 0;
 }
@@ -161,9 +165,12 @@ void run(const Opts& o, int& exit_code) {
 void setup(CLI::App& sub, int& exit_code) {
   auto o = std::make_shared<Opts>();
   sub.add_option("--case", o->case_file, "Case file (YAML, see data/cases/paper.yaml); default: the paper's case");
-  sub.add_option("--seed", o->seed, "Seed of every random effect (default: the case file's)")->check(CLI::NonNegativeNumber);
-  sub.add_option("--out", o->out_dir, "Directory for report.html, the SVG figures and the tables (default ./case-study-out)");
-  sub.add_option("--threads", o->threads, "Worker threads (default: one per hardware thread)")->check(CLI::NonNegativeNumber);
+  sub.add_option("--seed", o->seed, "Seed of every random effect (default: the case file's)")
+      ->check(CLI::NonNegativeNumber);
+  sub.add_option("--out", o->out_dir,
+                 "Directory for report.html, the SVG figures and the tables (default ./case-study-out)");
+  sub.add_option("--threads", o->threads, "Worker threads (default: one per hardware thread)")
+      ->check(CLI::NonNegativeNumber);
   sub.add_flag("--json", o->json, "Print only the JSON document of the results on stdout");
   sub.add_flag("--quick", o->quick, "One clockwise and one anticlockwise lap per run instead of the protocol's 3 + 3");
   sub.add_flag("--no-sweep", o->no_sweep, "Skip the speed sweep");

@@ -1,8 +1,9 @@
 // The case file: the built-in paper case loads, errors name the file, line and field, and the
 // effect switches switch off what they say.
+#include "deflex/cell/case_config.hpp"
+
 #include <gtest/gtest.h>
 
-#include "deflex/cell/case_config.hpp"
 #include "deflex/model/errors.hpp"
 
 namespace deflex::cell {

@@ -1,11 +1,12 @@
 // Short cases of the protocol on the simulated cell (one speed, one lap each way): the tracker's
 // noise statistics, the uncompensated deviation growing with the load, the model-consistent cell
 // compensated down to the tracker's noise floor, and reproducibility from the seed.
-#include <cmath>
+#include "deflex/cell/case_study.hpp"
 
 #include <gtest/gtest.h>
 
-#include "deflex/cell/case_study.hpp"
+#include <cmath>
+
 #include "deflex/cell/simulated_run.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
 
@@ -73,12 +74,10 @@ TEST(SimulatedRun, UncompensatedDeviationGrowsWithLoad) {
   for (bool sensor : {false, true}) {
     const SetupCell cell = build_setup_cell(c, sensor);
     const RunOutput unloaded = simulate_run(cell, spec(RunKind::kUnloaded, Strategy::kOffline, 0.0, 1));
-    const double low =
-        mean_distance_to_path_m(simulate_run(cell, spec(RunKind::kUncompensated, Strategy::kOffline, 150.0, 2)).trace,
-                                unloaded.trace);
-    const double high =
-        mean_distance_to_path_m(simulate_run(cell, spec(RunKind::kUncompensated, Strategy::kOffline, 650.0, 2)).trace,
-                                unloaded.trace);
+    const double low = mean_distance_to_path_m(
+        simulate_run(cell, spec(RunKind::kUncompensated, Strategy::kOffline, 150.0, 2)).trace, unloaded.trace);
+    const double high = mean_distance_to_path_m(
+        simulate_run(cell, spec(RunKind::kUncompensated, Strategy::kOffline, 650.0, 2)).trace, unloaded.trace);
     EXPECT_GT(high, 2.5 * low) << "sensor " << sensor;  // roughly proportional to the load
     EXPECT_GT(low, 5e-5);
   }

@@ -1,9 +1,9 @@
 // Components of the simulated cell against closed forms: LDBB force direction, first-order response
 // and ball friction; lost motion's sign and history; the sensor's compliance; the true robot's fixed
 // point against the core's deflected configuration; the controller's program and schedule.
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "deflex/cell/case_config.hpp"
 #include "deflex/cell/controller.hpp"
@@ -61,8 +61,8 @@ TEST(LdbbDevice, BallFrictionOpposesTheMotionAcrossTheBar) {
   c.ball_radius_m = 0.0127;
   LdbbDevice d(c, Vector3::Zero(), 600.0, 1);
   d.settle();
-  const Vector3 tcp(0.0, 0.0, 0.15);            // bar along +z, length 0.15
-  const Vector3 v(0.05, 0.0, 0.0);             // moving along +x, across the bar
+  const Vector3 tcp(0.0, 0.0, 0.15);  // bar along +z, length 0.15
+  const Vector3 v(0.05, 0.0, 0.0);    // moving along +x, across the bar
   const Wrench w = d.wrench(tcp, v);
   EXPECT_NEAR(w[2], 600.0, 1e-9);
   EXPECT_NEAR(w[0], -2.0 * 0.1 * 600.0 * 0.0127 / 0.15, 1e-9);

@@ -1,14 +1,14 @@
 // `deflex case-study` end to end through the real binary (DEFLEX_CLI) on a short case: the JSON
 // layout of issue 7, the files of the report, the paper's figures beside ours, and a clear error
 // for a bad case file.
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 namespace {
 

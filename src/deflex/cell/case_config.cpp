@@ -1,12 +1,12 @@
 // Case file reader, the built-in paper case, and the effect switches of the error budget.
 #include "deflex/cell/case_config.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-
-#include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
 #include "deflex/model/yaml_fields.hpp"
@@ -55,10 +55,14 @@ std::vector<double> speeds(const yaml::Field& f) {
 
 const char* to_string(Strategy s) {
   switch (s) {
-    case Strategy::kOffline: return "offline";
-    case Strategy::kOnline: return "online";
-    case Strategy::kHybrid: return "hybrid";
-    case Strategy::kOnlineLatency: return "online_latency";
+    case Strategy::kOffline:
+      return "offline";
+    case Strategy::kOnline:
+      return "online";
+    case Strategy::kHybrid:
+      return "hybrid";
+    case Strategy::kOnlineLatency:
+      return "online_latency";
   }
   return "?";
 }
@@ -109,7 +113,8 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
     sc.name = s.at("name").as_string();
     sc.strategy = parse_strategy(s.at("strategy"));
     sc.sensor_mounted = s.at("sensor").as_bool();
-    if (sc.strategy != Strategy::kOffline && !sc.sensor_mounted) s.at("sensor").fail("online strategies need the sensor");
+    if (sc.strategy != Strategy::kOffline && !sc.sensor_mounted)
+      s.at("sensor").fail("online strategies need the sensor");
     sc.loads_n = s.at("loads_N").as_doubles();
     for (double l : sc.loads_n) {
       if (!(l > 0.0)) s.at("loads_N").fail("loads must be positive");
@@ -204,8 +209,8 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   c.controller.egm_filter_s = non_negative(ct.at("egm_filter_ms")) * kMm;
 
   const auto on = root.at("online");
-  on.only_keys({"cycle_ms", "compute_delay_ms", "lowpass_Hz", "threshold_low_N", "threshold_high_N",
-                "max_correction_mrad"});
+  on.only_keys(
+      {"cycle_ms", "compute_delay_ms", "lowpass_Hz", "threshold_low_N", "threshold_high_N", "max_correction_mrad"});
   c.online.cycle_s = positive(on.at("cycle_ms")) * kMm;
   c.online.compute_delay_s = non_negative(on.at("compute_delay_ms")) * kMm;
   c.online.lowpass_hz = positive(on.at("lowpass_Hz"));
@@ -262,27 +267,42 @@ CaseConfig paper_case() { return load_case_text(paper_case_yaml(), "<built-in pa
 
 const char* to_string(Effect e) {
   switch (e) {
-    case Effect::kStiffnessMismatch: return "per-joint spread of the true stiffness";
-    case Effect::kJointCoupling: return "coupled stiffness of joints 2-3";
-    case Effect::kLinkBending: return "forearm bending (link compliance)";
-    case Effect::kSensorCompliance: return "force sensor compliance";
-    case Effect::kLostMotion: return "lost motion (direction-dependent)";
-    case Effect::kKinematicErrors: return "kinematic (DH) errors";
-    case Effect::kLdbbForceError: return "LDBB force error (bias, pivot, ball friction)";
-    case Effect::kLdbbRipple: return "LDBB ripple and noise";
-    case Effect::kSensorErrors: return "sensor crosstalk, noise, bias, gravity";
-    case Effect::kTrackerNoise: return "laser tracker noise";
-    case Effect::kCalibrationNoise: return "calibration load error";
-    case Effect::kLatency: return "online cycle and delays";
+    case Effect::kStiffnessMismatch:
+      return "per-joint spread of the true stiffness";
+    case Effect::kJointCoupling:
+      return "coupled stiffness of joints 2-3";
+    case Effect::kLinkBending:
+      return "forearm bending (link compliance)";
+    case Effect::kSensorCompliance:
+      return "force sensor compliance";
+    case Effect::kLostMotion:
+      return "lost motion (direction-dependent)";
+    case Effect::kKinematicErrors:
+      return "kinematic (DH) errors";
+    case Effect::kLdbbForceError:
+      return "LDBB force error (bias, pivot, ball friction)";
+    case Effect::kLdbbRipple:
+      return "LDBB ripple and noise";
+    case Effect::kSensorErrors:
+      return "sensor crosstalk, noise, bias, gravity";
+    case Effect::kTrackerNoise:
+      return "laser tracker noise";
+    case Effect::kCalibrationNoise:
+      return "calibration load error";
+    case Effect::kLatency:
+      return "online cycle and delays";
   }
   return "?";
 }
 
 std::string effect_size(const CaseConfig& c, Effect e) {
   switch (e) {
-    case Effect::kStiffnessMismatch: return fmt::format("{:.0f} % (1 sigma, log-normal)", c.robot.stiffness_spread * 100);
-    case Effect::kJointCoupling: return fmt::format("k23 coupling {:.2f}", c.robot.coupling_23);
-    case Effect::kLinkBending: return fmt::format("EI {:.2g} Nm^2", c.robot.forearm_ei_nm2);
+    case Effect::kStiffnessMismatch:
+      return fmt::format("{:.0f} % (1 sigma, log-normal)", c.robot.stiffness_spread * 100);
+    case Effect::kJointCoupling:
+      return fmt::format("k23 coupling {:.2f}", c.robot.coupling_23);
+    case Effect::kLinkBending:
+      return fmt::format("EI {:.2g} Nm^2", c.robot.forearm_ei_nm2);
     case Effect::kSensorCompliance:
       return fmt::format("{:.2f} um/N lateral, {:.2f} urad/Nm", c.sensor.lateral_compliance_m_per_n * 1e6,
                          c.sensor.rotational_compliance_rad_per_nm * 1e6);
@@ -297,11 +317,14 @@ std::string effect_size(const CaseConfig& c, Effect e) {
     case Effect::kLdbbForceError:
       return fmt::format("{:+.0f} %, pivot {:.1f} mm, friction {:.2f}", c.ldbb.force_bias * 100,
                          c.ldbb.pivot_error_m.norm() * 1e3, c.ldbb.ball_friction);
-    case Effect::kLdbbRipple: return fmt::format("{:.1f} % at {:.1f} Hz", c.ldbb.ripple * 100, c.ldbb.ripple_hz);
+    case Effect::kLdbbRipple:
+      return fmt::format("{:.1f} % at {:.1f} Hz", c.ldbb.ripple * 100, c.ldbb.ripple_hz);
     case Effect::kSensorErrors:
       return fmt::format("crosstalk {:.1f} %, noise {:.2f} N", c.sensor.crosstalk * 100, c.sensor.noise_n);
-    case Effect::kTrackerNoise: return fmt::format("{:.1f} um (1 sigma)", c.tracker.noise_m * 1e6);
-    case Effect::kCalibrationNoise: return fmt::format("{:.1f} % load error", c.calibration.load_error * 100);
+    case Effect::kTrackerNoise:
+      return fmt::format("{:.1f} um (1 sigma)", c.tracker.noise_m * 1e6);
+    case Effect::kCalibrationNoise:
+      return fmt::format("{:.1f} % load error", c.calibration.load_error * 100);
     case Effect::kLatency:
       return fmt::format("cycle {:.0f} ms + {:.0f} ms", c.online.cycle_s * 1e3,
                          (c.online.compute_delay_s + c.controller.egm_delay_s) * 1e3);
@@ -317,8 +340,12 @@ CaseConfig without_effect(const CaseConfig& config, Effect e) {
       // what makes the true ratios between joints differ from the assumed ones.
       c.robot.stiffness_spread = 0.0;
       break;
-    case Effect::kJointCoupling: c.robot.coupling_23 = 0.0; break;
-    case Effect::kLinkBending: c.robot.forearm_ei_nm2 = 0.0; break;
+    case Effect::kJointCoupling:
+      c.robot.coupling_23 = 0.0;
+      break;
+    case Effect::kLinkBending:
+      c.robot.forearm_ei_nm2 = 0.0;
+      break;
     case Effect::kSensorCompliance:
       c.sensor.lateral_compliance_m_per_n = 0.0;
       c.sensor.axial_compliance_m_per_n = 0.0;
@@ -347,8 +374,12 @@ CaseConfig without_effect(const CaseConfig& config, Effect e) {
       c.sensor.bias_n.setZero();
       c.sensor.gravity_mass_error = 0.0;
       break;
-    case Effect::kTrackerNoise: c.tracker.noise_m = 0.0; break;
-    case Effect::kCalibrationNoise: c.calibration.load_error = 0.0; break;
+    case Effect::kTrackerNoise:
+      c.tracker.noise_m = 0.0;
+      break;
+    case Effect::kCalibrationNoise:
+      c.calibration.load_error = 0.0;
+      break;
     case Effect::kLatency:
       c.online.cycle_s = c.controller.servo_period_s;
       c.online.compute_delay_s = 0.0;

@@ -26,43 +26,43 @@ struct SetupConfig {
   Strategy strategy = Strategy::kOffline;
   bool sensor_mounted = false;
   std::vector<double> loads_n;
-  std::vector<double> paper_uc_mm;                 ///< paper's UC per load (empty: none)
-  std::vector<std::array<double, 3>> paper_c_mm;   ///< paper's C1..C3 per load
+  std::vector<double> paper_uc_mm;                ///< paper's UC per load (empty: none)
+  std::vector<std::array<double, 3>> paper_c_mm;  ///< paper's C1..C3 per load
 };
 
 /// The true robot: what the compensators never see.
 struct TrueRobotConfig {
-  double stiffness_scale = 1.0;          ///< true K = built-in K * scale * seeded factor per joint
-  double stiffness_spread = 0.0;         ///< 1-sigma of the seeded log-factor per joint
-  double coupling_23 = 0.0;              ///< off-diagonal K23/sqrt(K22 K33) (coupled joint stiffness)
-  double forearm_ei_nm2 = 0.0;           ///< forearm bending stiffness EI (0: rigid link)
-  double forearm_length_m = 1.2125;      ///< cantilever length, elbow to wrist centre
-  std::vector<double> lost_motion_rad;   ///< half-width of each joint's lost motion band
+  double stiffness_scale = 1.0;               ///< true K = built-in K * scale * seeded factor per joint
+  double stiffness_spread = 0.0;              ///< 1-sigma of the seeded log-factor per joint
+  double coupling_23 = 0.0;                   ///< off-diagonal K23/sqrt(K22 K33) (coupled joint stiffness)
+  double forearm_ei_nm2 = 0.0;                ///< forearm bending stiffness EI (0: rigid link)
+  double forearm_length_m = 1.2125;           ///< cantilever length, elbow to wrist centre
+  std::vector<double> lost_motion_rad;        ///< half-width of each joint's lost motion band
   std::vector<double> lost_motion_torque_nm;  ///< joint torque that moves a joint across its band
   /// Static joint torque from gravity at the operating space (Nm): it preloads the lost motion, so a
   /// joint that gravity holds to one side (2, 3) never crosses its band under the process load.
   std::vector<double> gravity_torque_nm;
-  double dh_length_sigma_m = 0.0;        ///< kinematic errors: 1-sigma of a, d
-  double dh_angle_sigma_rad = 0.0;       ///< 1-sigma of alpha, offset
+  double dh_length_sigma_m = 0.0;   ///< kinematic errors: 1-sigma of a, d
+  double dh_angle_sigma_rad = 0.0;  ///< 1-sigma of alpha, offset
 };
 
 struct ToolConfig {
-  double ee_length_m = 0.25;      ///< mounting face (flange or sensor top) to TCP ball centre
+  double ee_length_m = 0.25;  ///< mounting face (flange or sensor top) to TCP ball centre
   double ee_mass_kg = 0.0;
   Vector3 ee_cog_m = Vector3::Zero();  ///< in the mounting-face frame
 };
 
 struct SensorConfig {
-  double height_m = 0.06;                ///< flange to sensor top (adds overhang)
+  double height_m = 0.06;                 ///< flange to sensor top (adds overhang)
   double lateral_compliance_m_per_n = 0;  ///< sensor + adapter plates, x/y of the sensor frame
   double axial_compliance_m_per_n = 0;
   double rotational_compliance_rad_per_nm = 0;
-  double crosstalk = 0.0;                ///< largest off-diagonal of the true crosstalk matrix
+  double crosstalk = 0.0;                       ///< largest off-diagonal of the true crosstalk matrix
   double crosstalk_calibration_residual = 0.0;  ///< left after the decoupling matrix is applied
-  double noise_n = 0.0;                  ///< 1-sigma per channel, per sample
+  double noise_n = 0.0;                         ///< 1-sigma per channel, per sample
   Vector3 bias_n = Vector3::Zero();
   double rate_hz = 1000.0;
-  double gravity_mass_error = 0.0;       ///< relative error of the identified EE mass
+  double gravity_mass_error = 0.0;  ///< relative error of the identified EE mass
 };
 
 struct LdbbConfig {
@@ -72,29 +72,29 @@ struct LdbbConfig {
   double time_constant_s = 0.3;  ///< pneumatic first-order response
   double ripple = 0.0;           ///< relative amplitude
   double ripple_hz = 2.0;
-  double noise = 0.0;            ///< relative 1-sigma per servo cycle
-  double force_bias = 0.0;       ///< true force = set-point * (1 + bias): unknown to the force model
+  double noise = 0.0;                       ///< relative 1-sigma per servo cycle
+  double force_bias = 0.0;                  ///< true force = set-point * (1 + bias): unknown to the force model
   Vector3 pivot_error_m = Vector3::Zero();  ///< true pivot minus the force model's pivot
-  double ball_friction = 0.0;    ///< friction coefficient of the ball joints
+  double ball_friction = 0.0;               ///< friction coefficient of the ball joints
   double ball_radius_m = 0.0127;
-  double settle_s = 2.0;         ///< force build-up before the laps start
+  double settle_s = 2.0;  ///< force build-up before the laps start
 };
 
 struct TrackerConfig {
-  double noise_m = 0.0;   ///< 1-sigma per axis per sample
+  double noise_m = 0.0;  ///< 1-sigma per axis per sample
   double rate_hz = 1000.0;
 };
 
 struct ControllerConfig {
   double servo_period_s = 0.004;
-  int program_points = 81;        ///< points of the programmed circle (paper: 81)
-  double egm_delay_s = 0.0;       ///< corrections reach the servo this much later
-  double egm_filter_s = 0.0;      ///< controller's low-pass on corrections (time constant)
+  int program_points = 81;    ///< points of the programmed circle (paper: 81)
+  double egm_delay_s = 0.0;   ///< corrections reach the servo this much later
+  double egm_filter_s = 0.0;  ///< controller's low-pass on corrections (time constant)
 };
 
 struct OnlineConfig {
-  double cycle_s = 0.1;           ///< compensation cycle (paper: about 100 ms)
-  double compute_delay_s = 0.0;   ///< from the force sample to the correction leaving the PC
+  double cycle_s = 0.1;          ///< compensation cycle (paper: about 100 ms)
+  double compute_delay_s = 0.0;  ///< from the force sample to the correction leaving the PC
   double lowpass_hz = 25.0;
   double threshold_low_n = 0.0;
   double threshold_high_n = 5000.0;
@@ -102,10 +102,10 @@ struct OnlineConfig {
 };
 
 struct CalibrationConfig {
-  int poses = 12;                 ///< around the circle
-  double load_n = 500.0;          ///< in +-x, +-y, +-z of the base
-  double load_error = 0.0;        ///< relative 1-sigma of the applied calibration load
-  int samples = 1000;             ///< tracker samples averaged per measurement
+  int poses = 12;           ///< around the circle
+  double load_n = 500.0;    ///< in +-x, +-y, +-z of the base
+  double load_error = 0.0;  ///< relative 1-sigma of the applied calibration load
+  int samples = 1000;       ///< tracker samples averaged per measurement
 };
 
 struct CircleConfig {
@@ -159,23 +159,23 @@ const std::string& paper_case_yaml();
 
 /// Every effect of the cell that the error budget switches off one at a time.
 enum class Effect {
-  kStiffnessMismatch,   ///< per-joint spread of the true stiffness around the scaled built-in one
+  kStiffnessMismatch,  ///< per-joint spread of the true stiffness around the scaled built-in one
   kJointCoupling,
   kLinkBending,
   kSensorCompliance,
   kLostMotion,
   kKinematicErrors,
-  kLdbbForceError,      ///< magnitude bias, pivot error, ball friction
-  kLdbbRipple,          ///< ripple and noise of the pneumatic force
-  kSensorErrors,        ///< crosstalk, noise, bias, gravity-compensation error
+  kLdbbForceError,  ///< magnitude bias, pivot error, ball friction
+  kLdbbRipple,      ///< ripple and noise of the pneumatic force
+  kSensorErrors,    ///< crosstalk, noise, bias, gravity-compensation error
   kTrackerNoise,
-  kCalibrationNoise,    ///< load error of the calibration experiment
-  kLatency,             ///< online cycle, compute delay, EGM delay and filter
+  kCalibrationNoise,  ///< load error of the calibration experiment
+  kLatency,           ///< online cycle, compute delay, EGM delay and filter
 };
 inline constexpr std::array<Effect, 12> kAllEffects = {
-    Effect::kStiffnessMismatch, Effect::kJointCoupling, Effect::kLinkBending,   Effect::kSensorCompliance,
-    Effect::kLostMotion,        Effect::kKinematicErrors, Effect::kLdbbForceError, Effect::kLdbbRipple,
-    Effect::kSensorErrors,      Effect::kTrackerNoise,  Effect::kCalibrationNoise, Effect::kLatency};
+    Effect::kStiffnessMismatch, Effect::kJointCoupling,   Effect::kLinkBending,      Effect::kSensorCompliance,
+    Effect::kLostMotion,        Effect::kKinematicErrors, Effect::kLdbbForceError,   Effect::kLdbbRipple,
+    Effect::kSensorErrors,      Effect::kTrackerNoise,    Effect::kCalibrationNoise, Effect::kLatency};
 [[nodiscard]] const char* to_string(Effect e);
 /// Short description of the effect's size in `config` (for the error budget table).
 [[nodiscard]] std::string effect_size(const CaseConfig& config, Effect e);

@@ -1,6 +1,8 @@
 // The protocol runner of the simulated case study (see case_study.hpp).
 #include "deflex/cell/case_study.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -10,8 +12,6 @@
 #include <mutex>
 #include <optional>
 #include <thread>
-
-#include <fmt/format.h>
 
 #include "deflex/cell/simulated_run.hpp"
 #include "deflex/evaluate/iso9283_path.hpp"
@@ -212,7 +212,8 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
   }
   for (const auto& j : loaded) progress.total += run_cost(config, j.speed, laps);
   for (std::size_t i = 0; i < budget_jobs.size(); ++i) {
-    progress.total += 5.0 + (i == 0 || !budget_jobs[i].off ? 3.0 : 2.0) * run_cost(config, config.budget.speed_m_s, budget_laps);
+    progress.total +=
+        5.0 + (i == 0 || !budget_jobs[i].off ? 3.0 : 2.0) * run_cost(config, config.budget.speed_m_s, budget_laps);
   }
 
   // Phase 1: calibrations.
@@ -254,7 +255,8 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
   {
     std::vector<std::size_t> order(loaded.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return loaded[a].speed < loaded[b].speed; });
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return loaded[a].speed < loaded[b].speed; });
     std::vector<std::function<void()>> jobs;
     for (std::size_t i : order) {
       jobs.emplace_back([&, i] {
@@ -319,8 +321,8 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
   for (double v : config.speeds_m_s) study.speeds_mm_s.push_back(mm_s(v));
   auto find = [&](int fam, RunKind kind, Strategy st, double load, double v) -> const LoadedJob* {
     for (const auto& j : loaded) {
-      if (j.family == fam && j.kind == kind && (kind != RunKind::kCompensated || j.strategy == st) && j.load_n == load &&
-          mm_s(j.speed) == mm_s(v)) {
+      if (j.family == fam && j.kind == kind && (kind != RunKind::kCompensated || j.strategy == st) &&
+          j.load_n == load && mm_s(j.speed) == mm_s(v)) {
         return &j;
       }
     }
@@ -331,10 +333,18 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
     SetupResult sr;
     sr.setup = s.name;
     switch (s.strategy) {
-      case Strategy::kOffline: sr.description = "offline compensation from the LDBB force model (paper, Figure 2)"; break;
-      case Strategy::kOnline: sr.description = "online compensation from the force sensor (paper, Figure 3)"; break;
-      case Strategy::kHybrid: sr.description = "hybrid: offline feed-forward + online correction of measured minus modelled force"; break;
-      case Strategy::kOnlineLatency: sr.description = "online with the wrench and pose predicted one delay ahead"; break;
+      case Strategy::kOffline:
+        sr.description = "offline compensation from the LDBB force model (paper, Figure 2)";
+        break;
+      case Strategy::kOnline:
+        sr.description = "online compensation from the force sensor (paper, Figure 3)";
+        break;
+      case Strategy::kHybrid:
+        sr.description = "hybrid: offline feed-forward + online correction of measured minus modelled force";
+        break;
+      case Strategy::kOnlineLatency:
+        sr.description = "online with the wrench and pose predicted one delay ahead";
+        break;
     }
     for (double load : s.loads_n) {
       LoadResult lr;
@@ -377,7 +387,8 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
     const LoadedJob* c = find(fam, RunKind::kCompensated, s.strategy, s.loads_n.back(), config.speeds_m_s.front());
     if (uc && c && !uc->keep.trace.empty() && !c->keep.trace.empty()) {
       PlotTraces pt;
-      pt.title = fmt::format("{}: {:.0f} N at {} mm/s (last lap)", s.name, s.loads_n.back(), mm_s(config.speeds_m_s.front()));
+      pt.title =
+          fmt::format("{}: {:.0f} N at {} mm/s (last lap)", s.name, s.loads_n.back(), mm_s(config.speeds_m_s.front()));
       pt.unloaded = thin_lap(families[fam].unloaded.at(mm_s(config.speeds_m_s.front())), 1500);
       pt.uc = thin_lap(uc->keep, 1500);
       pt.c = thin_lap(c->keep, 1500);
@@ -428,12 +439,14 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
     }
   }
   out.setup_paragraphs.push_back(fmt::format(
-      "Circle of radius {:.1f} mm around ({:.0f}, {:.0f}, {:.0f}) mm in the base XY plane, tool pointing down; LDBB bar "
-      "{:.0f} mm inclined by {:.0f} deg (pivot below the centre); {} clockwise + {} anticlockwise laps per run; tracker "
+      "Circle of radius {:.1f} mm around ({:.0f}, {:.0f}, {:.0f}) mm in the base XY plane, tool pointing down; LDBB "
+      "bar "
+      "{:.0f} mm inclined by {:.0f} deg (pivot below the centre); {} clockwise + {} anticlockwise laps per run; "
+      "tracker "
       "at {:.0f} Hz with {:.1f} um noise; servo {:.0f} ms; online cycle {:.0f} ms. Seed {}.",
       config.radius_m() * 1e3, config.circle.center_m.x() * 1e3, config.circle.center_m.y() * 1e3,
-      config.circle.center_m.z() * 1e3, config.ldbb.bar_length_m * 1e3, rad_to_deg(config.ldbb.inclination_rad), laps_cw,
-      laps_ccw, config.tracker.rate_hz, config.tracker.noise_m * 1e6, config.controller.servo_period_s * 1e3,
+      config.circle.center_m.z() * 1e3, config.ldbb.bar_length_m * 1e3, rad_to_deg(config.ldbb.inclination_rad),
+      laps_cw, laps_ccw, config.tracker.rate_hz, config.tracker.noise_m * 1e6, config.controller.servo_period_s * 1e3,
       config.online.cycle_s * 1e3, config.seed));
   out.runs = static_cast<int>(loaded.size()) + static_cast<int>(budget_jobs.size()) * 2;
   for (int f = 0; f < 2; ++f) out.runs += need[f] ? static_cast<int>(speeds.size()) : 0;

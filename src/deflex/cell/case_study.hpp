@@ -16,10 +16,10 @@
 namespace deflex::cell {
 
 struct CaseStudyOptions {
-  bool quick = false;         ///< one clockwise and one anticlockwise lap per run
+  bool quick = false;  ///< one clockwise and one anticlockwise lap per run
   bool speed_sweep = true;
   bool error_budget = true;
-  int threads = 0;            ///< 0: one per hardware thread
+  int threads = 0;  ///< 0: one per hardware thread
   /// Progress in [0, 1] with a short label; called from worker threads, one call at a time.
   std::function<void(double fraction, const std::string& label)> progress;
 };

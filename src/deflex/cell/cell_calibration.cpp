@@ -1,11 +1,11 @@
 // Compliance calibration on the simulated cell (see cell_calibration.hpp).
 #include "deflex/cell/cell_calibration.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <random>
-
-#include <fmt/format.h>
 
 #include "deflex/identify/calibration_planner.hpp"
 
@@ -17,7 +17,9 @@ CellCalibration calibrate_setup(const TrueRobot& robot, std::uint64_t seed) {
   if (c.exact_model) {
     const auto& k = robot.true_model().stiffness();
     std::vector<double> kv(k.data(), k.data() + k.size());
-    return CellCalibration{nominal.with_stiffness(kv, "exact true stiffness (model-consistent cell)"), {}, 0,
+    return CellCalibration{nominal.with_stiffness(kv, "exact true stiffness (model-consistent cell)"),
+                           {},
+                           0,
                            {"exact stiffness given: model-consistent cell"}};
   }
   CalibrationPlanOptions plan_options;

@@ -31,9 +31,7 @@ void JointProgram::at(double angle_rad, JointVector& q) const {
              (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * s3);
 }
 
-double LapSchedule::motion_s() const {
-  return omega_rad_s > 0 ? 2.0 * kPi * (laps_cw + laps_ccw) / omega_rad_s : 0.0;
-}
+double LapSchedule::motion_s() const { return omega_rad_s > 0 ? 2.0 * kPi * (laps_cw + laps_ccw) / omega_rad_s : 0.0; }
 
 double LapSchedule::angle(double t_s) const {
   const double tm = t_s - settle_s;

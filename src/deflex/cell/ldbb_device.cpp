@@ -5,8 +5,7 @@
 
 namespace deflex::cell {
 
-LdbbDevice::LdbbDevice(const LdbbConfig& config, const Vector3& nominal_pivot_m, double setpoint_n,
-                       std::uint64_t seed)
+LdbbDevice::LdbbDevice(const LdbbConfig& config, const Vector3& nominal_pivot_m, double setpoint_n, std::uint64_t seed)
     : config_(config), pivot_(nominal_pivot_m + config.pivot_error_m), setpoint_n_(setpoint_n), rng_(seed) {}
 
 void LdbbDevice::advance(double dt_s) {

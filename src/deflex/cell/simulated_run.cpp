@@ -1,11 +1,11 @@
 // One protocol run on the simulated cell (see simulated_run.hpp).
 #include "deflex/cell/simulated_run.hpp"
 
+#include <fmt/format.h>
+
 #include <array>
 #include <cmath>
 #include <random>
-
-#include <fmt/format.h>
 
 #include "deflex/cell/force_sensor.hpp"
 #include "deflex/cell/ldbb_device.hpp"
@@ -81,8 +81,8 @@ JointProgram offline_program(const SetupCell& setup, double load_n) {
   const LdbbForceModel force(c.pivot_m(), load_n, c.ldbb.push);
   OfflineOptions options;
   options.predict = false;
-  const OfflineResult r = compensate_path(setup.calibration.identified, setup.nominal_path, setup.circle_poses, force,
-                                          options);
+  const OfflineResult r =
+      compensate_path(setup.calibration.identified, setup.nominal_path, setup.circle_poses, force, options);
   std::vector<JointVector> q;
   q.reserve(r.points.size());
   for (const auto& p : r.points) {
@@ -97,7 +97,8 @@ std::vector<TrackerTrace> split_laps(const RunOutput& run) {
     const std::size_t b = run.lap_start[i];
     const std::size_t e = i + 1 < run.lap_start.size() ? run.lap_start[i + 1] : run.trace.size();
     if (e > b + 1) {
-      laps.emplace_back(run.trace.begin() + static_cast<std::ptrdiff_t>(b), run.trace.begin() + static_cast<std::ptrdiff_t>(e));
+      laps.emplace_back(run.trace.begin() + static_cast<std::ptrdiff_t>(b),
+                        run.trace.begin() + static_cast<std::ptrdiff_t>(e));
     }
   }
   return laps;
@@ -221,7 +222,8 @@ RunOutput simulate_run(const SetupCell& setup, const RunSpec& spec) {
           raw -= coupling * (base_R_flange.transpose() * model_force_base(next_daq));
         } else if (spec.strategy == Strategy::kOnlineLatency) {
           // Predicted wrench: the measurement plus the model's change over the lead along the path.
-          raw += coupling * (base_R_flange.transpose() * (model_force_base(next_daq + lead_s) - model_force_base(next_daq)));
+          raw += coupling *
+                 (base_R_flange.transpose() * (model_force_base(next_daq + lead_s) - model_force_base(next_daq)));
         }
         ForceSample s;
         s.t_s = next_daq;
@@ -230,55 +232,59 @@ RunOutput simulate_run(const SetupCell& setup, const RunSpec& spec) {
       }
       if (t + 1e-12 >= next_cycle) {
         next_cycle += c.online.cycle_s;
-        // Controller -> sensor: EgmRobot with the feedback (motor-side command) and planned joints,
-        // through the same codec a real UDP link uses.
-        ++seqno;
-        EgmRobotMessage robot_msg;
-        robot_msg.seqno = seqno;
-        robot_msg.tm_ms = static_cast<std::uint32_t>(t * 1e3);
-        robot_msg.feedback_joints_deg = q_cmd * (180.0 / kPi);
-        robot_msg.planned_joints_deg = q_plan * (180.0 / kPi);
-        robot_msg.motor_state = 1;
-        robot_msg.mci_state = 3;
-        robot_msg.rapid_exec_state = 2;
-        planned_sent[seqno % planned_sent.size()] = q_plan;
-        const std::size_t robot_bytes = codec.encode_robot(robot_msg, packet.data(), packet.size());
-        EgmRobotMessage received;
-        if (robot_bytes == 0 || codec.decode_robot(packet.data(), robot_bytes, received) != EgmDecodeStatus::kOk) {
-          ++out.corrections_dropped;
-          continue;
-        }
-        // Sensor side: the compensation cycle. The latency-compensated strategy evaluates the
-        // deflection where the arm will be when the correction takes effect.
-        CycleInput in;
-        in.t_s = t;
-        in.q_feedback = received.feedback_joints_deg * (kPi / 180.0);
-        if (lead_s > 0.0) {
-          program.at(schedule.angle(t + lead_s), in.q_planned);
-        } else {
-          in.q_planned = received.planned_joints_deg * (kPi / 180.0);
-        }
-        const CycleOutput o = compensator->step(in);
-        ++out.online_cycles;
-        out.max_tcp_correction_m = std::max(out.max_tcp_correction_m, o.tcp_correction_m);
-        if (static_cast<int>(o.status) < 0) continue;
-        EgmSensorMessage reply;
-        reply.seqno = received.seqno;
-        reply.tm_ms = received.tm_ms;
-        reply.planned_joints_deg = received.planned_joints_deg - o.dtheta * (180.0 / kPi);
-        const std::size_t sensor_bytes = codec.encode_sensor(reply, packet.data(), packet.size());
-        // Controller: decodes the target and turns it into an offset from the planned joints it
-        // reported under that sequence number.
-        EgmSensorMessage target;
-        if (sensor_bytes == 0 || !codec.decode_sensor(packet.data(), sensor_bytes, target)) {
-          ++out.corrections_dropped;
-          continue;
-        }
-        CorrectionMessage m;
-        m.reference_s = t;
-        m.arrival_s = t + c.online.compute_delay_s + c.controller.egm_delay_s;
-        m.offset_rad = target.planned_joints_deg * (kPi / 180.0) - planned_sent[target.seqno % planned_sent.size()];
-        if (!channel.push(m)) ++out.corrections_dropped;
+        // One exchange over the link; a packet that fails to encode or decode is dropped, as a lost
+        // datagram would be, and the servo carries on with the last correction.
+        [&] {
+          // Controller -> sensor: EgmRobot with the feedback (motor-side command) and planned joints,
+          // through the same codec a real UDP link uses.
+          ++seqno;
+          EgmRobotMessage robot_msg;
+          robot_msg.seqno = seqno;
+          robot_msg.tm_ms = static_cast<std::uint32_t>(t * 1e3);
+          robot_msg.feedback_joints_deg = q_cmd * (180.0 / kPi);
+          robot_msg.planned_joints_deg = q_plan * (180.0 / kPi);
+          robot_msg.motor_state = 1;
+          robot_msg.mci_state = 3;
+          robot_msg.rapid_exec_state = 2;
+          planned_sent[seqno % planned_sent.size()] = q_plan;
+          const std::size_t robot_bytes = codec.encode_robot(robot_msg, packet.data(), packet.size());
+          EgmRobotMessage received;
+          if (robot_bytes == 0 || codec.decode_robot(packet.data(), robot_bytes, received) != EgmDecodeStatus::kOk) {
+            ++out.corrections_dropped;
+            return;
+          }
+          // Sensor side: the compensation cycle. The latency-compensated strategy evaluates the
+          // deflection where the arm will be when the correction takes effect.
+          CycleInput in;
+          in.t_s = t;
+          in.q_feedback = received.feedback_joints_deg * (kPi / 180.0);
+          if (lead_s > 0.0) {
+            program.at(schedule.angle(t + lead_s), in.q_planned);
+          } else {
+            in.q_planned = received.planned_joints_deg * (kPi / 180.0);
+          }
+          const CycleOutput o = compensator->step(in);
+          ++out.online_cycles;
+          out.max_tcp_correction_m = std::max(out.max_tcp_correction_m, o.tcp_correction_m);
+          if (static_cast<int>(o.status) < 0) return;
+          EgmSensorMessage reply;
+          reply.seqno = received.seqno;
+          reply.tm_ms = received.tm_ms;
+          reply.planned_joints_deg = received.planned_joints_deg - o.dtheta * (180.0 / kPi);
+          const std::size_t sensor_bytes = codec.encode_sensor(reply, packet.data(), packet.size());
+          // Controller: decodes the target and turns it into an offset from the planned joints it
+          // reported under that sequence number.
+          EgmSensorMessage target;
+          if (sensor_bytes == 0 || !codec.decode_sensor(packet.data(), sensor_bytes, target)) {
+            ++out.corrections_dropped;
+            return;
+          }
+          CorrectionMessage m;
+          m.reference_s = t;
+          m.arrival_s = t + c.online.compute_delay_s + c.controller.egm_delay_s;
+          m.offset_rad = target.planned_joints_deg * (kPi / 180.0) - planned_sent[target.seqno % planned_sent.size()];
+          if (!channel.push(m)) ++out.corrections_dropped;
+        }();
       }
     }
 

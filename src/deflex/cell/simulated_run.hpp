@@ -39,7 +39,7 @@ struct RunSpec {
 };
 
 struct RunOutput {
-  TrackerTrace trace;                ///< tracker samples during the laps (t from the start of motion)
+  TrackerTrace trace;                  ///< tracker samples during the laps (t from the start of motion)
   std::vector<std::size_t> lap_start;  ///< index of each lap's first sample in `trace`
   double simulated_s = 0.0;
   int online_cycles = 0;

@@ -82,7 +82,8 @@ TrueRobotState TrueRobot::initial_state(const JointVector& q_cmd) const {
   for (int i = 0; i < true_->dof(); ++i) {
     const auto k = static_cast<std::size_t>(i);
     s.lost_motion[k].half_width_rad = k < lm.size() ? lm[k] : 0.0;
-    s.lost_motion[k].torque_nm = k < config_.robot.lost_motion_torque_nm.size() ? config_.robot.lost_motion_torque_nm[k] : 1.0;
+    s.lost_motion[k].torque_nm =
+        k < config_.robot.lost_motion_torque_nm.size() ? config_.robot.lost_motion_torque_nm[k] : 1.0;
     s.lost_motion[k].state = 0.0;
   }
   s.gravity_torque_nm = JointVector::Zero(true_->dof());

@@ -26,8 +26,8 @@ struct LostMotion {
 
 /// Per-run mutable state of the true robot (one per simulated run).
 struct TrueRobotState {
-  JointVector q_actual;      ///< last solved configuration (warm start of the next solve)
-  JointVector q_cmd_last;    ///< command of the last solve
+  JointVector q_actual;    ///< last solved configuration (warm start of the next solve)
+  JointVector q_cmd_last;  ///< command of the last solve
   std::array<LostMotion, kMaxJoints> lost_motion{};
   JointVector gravity_torque_nm;  ///< preload of the lost motion (constant)
 };
