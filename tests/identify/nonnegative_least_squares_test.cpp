@@ -83,5 +83,14 @@ TEST(NonnegativeLeastSquares, NegativeUnconstrainedComponentIsClampedWithTheOthe
   EXPECT_TRUE(r.at_bound[1]);
 }
 
+
+TEST(NonnegativeLeastSquares, NoColumnsGiveAnEmptyConvergedSolution) {
+  const NnlsResult r = nonnegative_least_squares(Eigen::MatrixXd(3, 0), Eigen::Vector3d(1.0, 2.0, 3.0));
+  EXPECT_TRUE(r.converged);
+  EXPECT_EQ(r.x.size(), 0);
+  EXPECT_EQ(r.at_bound.size(), 0);
+  EXPECT_EQ(r.iterations, 0);
+}
+
 }  // namespace
 }  // namespace deflex

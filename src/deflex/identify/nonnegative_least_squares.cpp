@@ -39,8 +39,9 @@ NnlsResult nonnegative_least_squares(const Eigen::MatrixXd& A, const Eigen::Vect
     max_iterations = 3 * static_cast<int>(n) + 10;
   }
   Eigen::Array<bool, Eigen::Dynamic, 1> passive = Eigen::Array<bool, Eigen::Dynamic, 1>::Constant(n, false);
-  const double scale = (A.transpose() * y).cwiseAbs().maxCoeff();
-  if (n == 0 || scale == 0.0) {
+  // No columns: nothing to solve (and maxCoeff of an empty vector is undefined).
+  const double scale = n == 0 ? 0.0 : (A.transpose() * y).cwiseAbs().maxCoeff();
+  if (scale == 0.0) {
     r.converged = true;
     return r;
   }
