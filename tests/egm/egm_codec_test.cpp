@@ -1,5 +1,6 @@
 // The EGM schema against the wire format written by hand from the protocol facts (field numbers and
 // types), packed and unpacked joints, and the truncated/malformed distinction.
+#include <cmath>
 #include <cstring>
 #include <vector>
 
@@ -147,6 +148,19 @@ TEST(EgmCodec, RejectsBadPacketsWithTheRightReason) {
   varint(h, 3);
   len_field(only_header, 1, h);
   EXPECT_EQ(codec.decode_robot(only_header.data(), only_header.size(), m), EgmDecodeStatus::kMissingJoints);
+}
+
+
+TEST(EgmCodec, TimeStampWrapsLikeTheUint32Field) {
+  EXPECT_EQ(egm_time_stamp_ms(0.0), 0u);
+  EXPECT_EQ(egm_time_stamp_ms(1.2345), 1234u);  // whole milliseconds, truncated
+  EXPECT_EQ(egm_time_stamp_ms(4294967.295), 4294967295u);  // the largest value before the wrap
+  // 2^32 ms = 4294967.296 s: the field wraps to 0 and counts on (49.7 days of uptime).
+  EXPECT_EQ(egm_time_stamp_ms(4294967.296 + 10.0), 10000u);
+  EXPECT_EQ(egm_time_stamp_ms(3.0 * 4294967.296 + 0.5), 500u);
+  EXPECT_EQ(egm_time_stamp_ms(-1.0), 0u);
+  EXPECT_EQ(egm_time_stamp_ms(std::nan("")), 0u);
+  EXPECT_EQ(egm_time_stamp_ms(1e12), 2764472320u);  // 1e15 ms mod 2^32
 }
 
 }  // namespace

@@ -70,6 +70,14 @@ void set_joints(const JointVector& q, Joints* j) {
 
 }  // namespace
 
+std::uint32_t egm_time_stamp_ms(double t_s) noexcept {
+  if (!std::isfinite(t_s) || !(t_s > 0.0)) {
+    return 0;
+  }
+  const double ms = std::fmod(std::floor(t_s * 1000.0), 4294967296.0);  // exact: doubles hold 2^53
+  return static_cast<std::uint32_t>(ms);
+}
+
 EgmDecodeStatus scan_wire_format(const unsigned char* data, std::size_t size) noexcept {
   const unsigned char* p = data;
   const unsigned char* end = data + size;

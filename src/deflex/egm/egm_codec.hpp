@@ -67,6 +67,11 @@ class EgmCodec {
   int expected_joints_;
 };
 
+/// EgmHeader.tm for a clock reading t_s (s): whole milliseconds modulo 2^32, as the uint32 field
+/// wraps (after 49.7 days); 0 for a negative or non-finite time. A plain cast of t_s * 1000 to
+/// uint32 would be undefined behaviour past the wrap.
+[[nodiscard]] std::uint32_t egm_time_stamp_ms(double t_s) noexcept;
+
 /// Walks the top level of a protobuf buffer: kTruncated when a field runs past the end, kMalformed on
 /// an impossible tag or wire type, kOk otherwise. Independent of protobuf's parser, so a truncated
 /// packet is told apart from a garbled one.

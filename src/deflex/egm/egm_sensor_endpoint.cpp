@@ -124,7 +124,7 @@ EgmPollResult EgmSensorEndpoint::poll(double timeout_s) noexcept {
   EgmPollResult result = EgmPollResult::kNotAnswered;
   if (static_cast<int>(out.status) >= 0 && out.q_command.allFinite()) {
     reply_.seqno = ++reply_seq_;
-    reply_.tm_ms = static_cast<std::uint32_t>(input_.t_s * 1000.0);
+    reply_.tm_ms = egm_time_stamp_ms(input_.t_s);
     for (int i = 0; i < out.q_command.size(); ++i) {
       reply_.planned_joints_deg[i] = rad_to_deg(out.q_command[i]);
     }
