@@ -53,22 +53,25 @@ OnlineCompensator::OnlineCompensator(const RobotModel& model, const SensorConfig
   config_.validate();
   (void)model_.stiffness();  // throws ModelError when the robot file gives no stiffness
   correction_ = JointVector::Zero(model_.dof());
+  const double per_cycle = std::ceil(std::max(0.0, sensor.sample_rate_hz) * config_.period_s);
+  queue_capacity_ = std::max(64, 2 * static_cast<int>(std::min(per_cycle, 1e6)) + 8);
+  queue_.resize(static_cast<std::size_t>(queue_capacity_));
 }
 
 void OnlineCompensator::push_force(const ForceSample& sample) noexcept {
-  if (queue_count_ == kQueueSize) {
-    queue_head_ = (queue_head_ + 1) % kQueueSize;  // drop the oldest
+  if (queue_count_ == queue_capacity_) {
+    queue_head_ = (queue_head_ + 1) % queue_capacity_;  // drop the oldest
     --queue_count_;
     ++counters_.samples_dropped;
   }
-  queue_[static_cast<std::size_t>((queue_head_ + queue_count_) % kQueueSize)] = sample;
+  queue_[static_cast<std::size_t>((queue_head_ + queue_count_) % queue_capacity_)] = sample;
   ++queue_count_;
 }
 
 void OnlineCompensator::drain(ForceSource& source) noexcept {
   ForceSample s;
   // Bounded so that a source flooding faster than we read cannot stall the cycle.
-  for (int i = 0; i < 4 * kQueueSize && source.latest(s); ++i) {
+  for (int i = 0; i < 4 * queue_capacity_ && source.latest(s); ++i) {
     push_force(s);
   }
 }
@@ -117,7 +120,7 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
   // Condition every queued sample with this cycle's orientation.
   while (queue_count_ > 0) {
     const ForceSample& s = queue_[static_cast<std::size_t>(queue_head_)];
-    queue_head_ = (queue_head_ + 1) % kQueueSize;
+    queue_head_ = (queue_head_ + 1) % queue_capacity_;
     --queue_count_;
     const ConditionedWrench c = pipeline_.step(s, base_R_sensor);
     ++out.samples_used;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <vector>
 #include <cstdint>
 
 #include "deflex/model/kinematics.hpp"
@@ -70,7 +71,8 @@ class OnlineCompensator {
   /// Throws ModelError when the model has no stiffness, InputError on a bad configuration.
   OnlineCompensator(const RobotModel& model, const SensorConfig& sensor, const OnlineConfig& config);
 
-  /// Queues one raw sample (conditioned at the next step() with that cycle's orientation). A full
+  /// Queues one raw sample (conditioned at the next step() with that cycle's orientation). The queue
+  /// holds two cycles of samples at the sensor's rate (at least 64), sized at construction; a full
   /// queue drops the oldest sample and counts it. Never allocates.
   void push_force(const ForceSample& sample) noexcept;
   /// Pulls every new sample of `source` into the queue.
@@ -90,8 +92,6 @@ class OnlineCompensator {
   [[nodiscard]] const ForcePipeline& pipeline() const { return pipeline_; }
 
  private:
-  static constexpr int kQueueSize = 64;
-
   RobotModel model_;  // a copy: the compensator may outlive the caller's model
   OnlineConfig config_;
   Pose flange_T_sensor_;
@@ -99,7 +99,10 @@ class OnlineCompensator {
   Workspace ws_;
   Jacobian jac_;
 
-  std::array<ForceSample, kQueueSize> queue_{};
+  // Sized once from the sample rate and the cycle period: at the paper's 100 ms cycle a 1 kHz DAQ
+  // delivers 100 samples a cycle, and every one must reach the filter.
+  std::vector<ForceSample> queue_;
+  int queue_capacity_ = 0;
   int queue_head_ = 0, queue_count_ = 0;
 
   JointVector correction_;
