@@ -148,5 +148,27 @@ TEST(StudyTables, MarkdownAndCsv) {
   std::filesystem::remove(path);
 }
 
+
+TEST(StudyTables, SpeedColumnsValueLookupAndPercentText) {
+  // The given columns win, in the given order; without them every speed any load reports, ascending
+  // and once each (the report module lays out its tables and charts by the same function).
+  StudyResult s = example_study();
+  s.speeds_mm_s = {50, 10};
+  EXPECT_EQ(study_speeds_mm_s(s), (std::vector<int>{50, 10}));
+  s.speeds_mm_s.clear();
+  s.setups[1].loads[0].c_mm[200] = 0.3;
+  s.setups[0].loads[0].c_mm[5] = 0.05;
+  EXPECT_EQ(study_speeds_mm_s(s), (std::vector<int>{5, 10, 30, 50, 200}));
+
+  EXPECT_DOUBLE_EQ(value_at_speed({{10, 0.5}, {30, 0.25}}, 30), 0.25);
+  EXPECT_TRUE(std::isnan(value_at_speed({{10, 0.5}}, 30)));
+
+  EXPECT_EQ(percent_text(0.67), "67%");
+  EXPECT_EQ(percent_text(1.0 - 0.4 / 1.1), "64%");  // 63.6% rounds up
+  EXPECT_EQ(percent_text(-0.004), "0%");            // rounds to zero: no "-0%"
+  EXPECT_EQ(percent_text(-0.25), "-25%");
+  EXPECT_EQ(percent_text(std::nan("")), "n/a");
+}
+
 }  // namespace
 }  // namespace deflex

@@ -15,11 +15,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-double get(const std::map<int, double>& m, int speed) {
-  const auto it = m.find(speed);
-  return it == m.end() ? kNaN : it->second;
-}
-
 nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 nlohmann::json speed_map(const std::map<int, double>& m) {
@@ -50,7 +45,7 @@ double mean_over(const std::map<int, double>& m, const std::vector<int>& speeds)
   double sum = 0.0;
   int n = 0;
   for (const int v : speeds) {
-    const double x = get(m, v);
+    const double x = value_at_speed(m, v);
     if (std::isfinite(x)) {
       sum += x;
       ++n;
@@ -69,14 +64,6 @@ double paper_compensation(const PaperRow& r) {
 }
 
 std::string mm(double v) { return std::isfinite(v) ? fmt::format("{:.3f}", v) : "n/a"; }
-// Whole percent; a value that rounds to zero prints "0%", not "-0%".
-std::string pct(double v) {
-  if (!std::isfinite(v)) {
-    return "n/a";
-  }
-  const double p = std::round(v * 100.0);
-  return fmt::format("{:.0f}%", p == 0.0 ? 0.0 : p);
-}
 std::string paper_mm(double v) { return std::isfinite(v) ? fmt::format("{:.2f}", v) : ""; }
 
 std::string cell_with_paper(const std::string& ours, const std::string& paper) {
@@ -107,33 +94,14 @@ Grid setup_grid(const SetupResult& s, const std::vector<int>& speeds, const Pape
     r.cells.push_back(fmt::format("{:g} N", l.load_N));
     r.cells.push_back(cell_with_paper(mm(l.uc_mean_mm()), pr != nullptr ? paper_mm(pr->uc_mm) : ""));
     for (const int v : speeds) {
-      const double pc = pr != nullptr ? get(pr->c_mm, v) : kNaN;
-      r.cells.push_back(cell_with_paper(mm(get(l.c_mm, v)), paper_mm(pc)));
+      const double pc = pr != nullptr ? value_at_speed(pr->c_mm, v) : kNaN;
+      r.cells.push_back(cell_with_paper(mm(value_at_speed(l.c_mm, v)), paper_mm(pc)));
     }
-    r.cells.push_back(cell_with_paper(pct(mean_over(l.compensation, speeds)),
-                                      pr != nullptr ? pct(paper_compensation(*pr)) : ""));
+    r.cells.push_back(cell_with_paper(percent_text(mean_over(l.compensation, speeds)),
+                                      pr != nullptr ? percent_text(paper_compensation(*pr)) : ""));
     g.rows.push_back(r);
   }
   return g;
-}
-
-std::vector<int> speeds_of(const StudyResult& study) {
-  if (!study.speeds_mm_s.empty()) {
-    return study.speeds_mm_s;
-  }
-  std::map<int, bool> seen;
-  for (const auto& s : study.setups) {
-    for (const auto& l : s.loads) {
-      for (const auto& [v, c] : l.c_mm) {
-        seen[v] = true;
-      }
-    }
-  }
-  std::vector<int> out;
-  for (const auto& [v, b] : seen) {
-    out.push_back(v);
-  }
-  return out;
 }
 
 std::map<int, double> read_speed_map(const nlohmann::json& j, const std::string& where) {
@@ -177,6 +145,38 @@ double read_number(const nlohmann::json& j, const char* key, const std::string& 
 }
 
 }  // namespace
+
+std::vector<int> study_speeds_mm_s(const StudyResult& study) {
+  if (!study.speeds_mm_s.empty()) {
+    return study.speeds_mm_s;
+  }
+  std::map<int, bool> seen;
+  for (const auto& s : study.setups) {
+    for (const auto& l : s.loads) {
+      for (const auto& [v, c] : l.c_mm) {
+        seen[v] = true;
+      }
+    }
+  }
+  std::vector<int> out;
+  for (const auto& [v, b] : seen) {
+    out.push_back(v);
+  }
+  return out;
+}
+
+double value_at_speed(const std::map<int, double>& m, int speed_mm_s) {
+  const auto it = m.find(speed_mm_s);
+  return it == m.end() ? kNaN : it->second;
+}
+
+std::string percent_text(double fraction) {
+  if (!std::isfinite(fraction)) {
+    return "n/a";
+  }
+  const double p = std::round(fraction * 100.0);
+  return fmt::format("{:.0f}%", p == 0.0 ? 0.0 : p);
+}
 
 double LoadResult::uc_mean_mm() const {
   if (uc_mm.empty()) {
@@ -228,7 +228,7 @@ nlohmann::json study_to_json(const StudyResult& study) {
     }
     setups.push_back(js);
   }
-  nlohmann::json doc{{"setups", setups}, {"speeds_mm_s", speeds_of(study)}};
+  nlohmann::json doc{{"setups", setups}, {"speeds_mm_s", study_speeds_mm_s(study)}};
   if (!study.speed_sweep.empty()) {
     nlohmann::json sweep = nlohmann::json::array();
     for (const auto& p : study.speed_sweep) {
@@ -345,7 +345,7 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
 
 std::string study_tables_text(const StudyResult& study) {
   const PaperFigures paper = paper_reference();
-  const std::vector<int> speeds = speeds_of(study);
+  const std::vector<int> speeds = study_speeds_mm_s(study);
   const auto titles = table_titles(study);
   std::string out;
   for (std::size_t si = 0; si < study.setups.size(); ++si) {
@@ -403,7 +403,7 @@ std::string study_tables_text(const StudyResult& study) {
 
 std::string study_tables_markdown(const StudyResult& study) {
   const PaperFigures paper = paper_reference();
-  const std::vector<int> speeds = speeds_of(study);
+  const std::vector<int> speeds = study_speeds_mm_s(study);
   const auto titles = table_titles(study);
   std::string out;
   for (std::size_t si = 0; si < study.setups.size(); ++si) {
@@ -450,13 +450,12 @@ void write_study_csv(const StudyResult& study, const std::string& path) {
     const PaperTable* pt = paper.table_for(s.setup);
     for (const auto& l : s.loads) {
       const PaperRow* pr = pt != nullptr ? pt->row_for(l.load_N) : nullptr;
-      for (const int v : speeds_of(study)) {
-        f << fmt::format("{},{:g},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", s.setup, l.load_N, v, cell(get(l.uc_mm, v)),
-                         cell(get(l.c_mm, v)), cell(get(l.compensation, v)), cell(get(l.uc_std_mm, v)),
-                         cell(get(l.c_std_mm, v)), cell(get(l.uc_max_mm, v)), cell(get(l.c_max_mm, v)),
-                         cell(get(l.iso_accuracy_uc_mm, v)), cell(get(l.iso_accuracy_c_mm, v)),
-                         cell(get(l.iso_repeatability_mm, v)), cell(pr != nullptr ? pr->uc_mm : kNaN),
-                         cell(pr != nullptr ? get(pr->c_mm, v) : kNaN));
+      for (const int v : study_speeds_mm_s(study)) {
+        const auto at = [&](const std::map<int, double>& m) { return cell(value_at_speed(m, v)); };
+        f << fmt::format("{},{:g},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", s.setup, l.load_N, v, at(l.uc_mm),
+                         at(l.c_mm), at(l.compensation), at(l.uc_std_mm), at(l.c_std_mm), at(l.uc_max_mm),
+                         at(l.c_max_mm), at(l.iso_accuracy_uc_mm), at(l.iso_accuracy_c_mm), at(l.iso_repeatability_mm),
+                         cell(pr != nullptr ? pr->uc_mm : kNaN), pr != nullptr ? at(pr->c_mm) : std::string());
       }
     }
   }

@@ -65,6 +65,14 @@ nlohmann::json study_to_json(const StudyResult& study);
 /// field on a malformed document.
 StudyResult study_from_json(const nlohmann::json& doc, const std::string& source = "JSON");
 
+/// The speed columns of the tables (mm/s): study.speeds_mm_s when given, else every speed any load
+/// reports, ascending. The report module lays its tables and charts out by the same columns.
+[[nodiscard]] std::vector<int> study_speeds_mm_s(const StudyResult& study);
+/// m[speed_mm_s], NaN when the map has no value at that speed.
+[[nodiscard]] double value_at_speed(const std::map<int, double>& m, int speed_mm_s);
+/// A fraction as whole percent ("67%"); one that rounds to zero prints "0%", not "-0%"; "n/a" if not finite.
+[[nodiscard]] std::string percent_text(double fraction);
+
 /// Terminal text: for each setup a table in the paper's layout (rows loads; columns UC, C1, C2, C3
 /// in mm, then compensation %), each cell "ours (paper)" where the paper has the figure.
 std::string study_tables_text(const StudyResult& study);

@@ -40,39 +40,7 @@ pre { background: #f6f6f6; padding: 10px; overflow-x: auto; font-size: 12px; }
 
 std::string esc(const std::string& s) { return xml_escape(s); }
 
-double get(const std::map<int, double>& m, int key) {
-  const auto it = m.find(key);
-  return it == m.end() ? kNaN : it->second;
-}
-
 std::string mm(double v) { return std::isfinite(v) ? fmt::format("{:.3f}", v) : "n/a"; }
-// Whole percent; a value that rounds to zero prints "0%", not "-0%".
-std::string pct(double v) {
-  if (!std::isfinite(v)) {
-    return "n/a";
-  }
-  const double p = std::round(v * 100.0);
-  return fmt::format("{:.0f}%", p == 0.0 ? 0.0 : p);
-}
-
-std::vector<int> speeds_of(const StudyResult& study) {
-  if (!study.speeds_mm_s.empty()) {
-    return study.speeds_mm_s;
-  }
-  std::map<int, bool> seen;
-  for (const auto& s : study.setups) {
-    for (const auto& l : s.loads) {
-      for (const auto& [v, c] : l.c_mm) {
-        seen[v] = true;
-      }
-    }
-  }
-  std::vector<int> out;
-  for (const auto& [v, b] : seen) {
-    out.push_back(v);
-  }
-  return out;
-}
 
 std::string with_paper(const std::string& ours, double paper_value, int decimals = 2) {
   if (!std::isfinite(paper_value)) {
@@ -83,7 +51,7 @@ std::string with_paper(const std::string& ours, double paper_value, int decimals
 
 std::string results_tables(const StudyResult& study) {
   const PaperFigures paper = paper_reference();
-  const std::vector<int> speeds = speeds_of(study);
+  const std::vector<int> speeds = study_speeds_mm_s(study);
   std::string h;
   int next = 3;
   for (const auto& s : study.setups) {
@@ -113,12 +81,13 @@ std::string results_tables(const StudyResult& study) {
       h += fmt::format("<tr><td class=\"l\">{:g} N</td><td>{}</td>", l.load_N,
                        with_paper(mm(l.uc_mean_mm()), pr != nullptr ? pr->uc_mm : kNaN));
       for (const int v : speeds) {
-        h += fmt::format("<td>{}</td>", with_paper(mm(get(l.c_mm, v)), pr != nullptr ? get(pr->c_mm, v) : kNaN));
+        h += fmt::format("<td>{}</td>", with_paper(mm(value_at_speed(l.c_mm, v)),
+                                                   pr != nullptr ? value_at_speed(pr->c_mm, v) : kNaN));
       }
       for (const int v : speeds) {
         const double paper_comp =
-            pr != nullptr ? 1.0 - get(pr->c_mm, v) / pr->uc_mm : kNaN;  // the paper's UC is the speeds' mean
-        const std::string ours = pct(get(l.compensation, v));
+            pr != nullptr ? 1.0 - value_at_speed(pr->c_mm, v) / pr->uc_mm : kNaN;  // the paper's UC is the speeds' mean
+        const std::string ours = percent_text(value_at_speed(l.compensation, v));
         h += fmt::format("<td>{}</td>", std::isfinite(paper_comp)
                                             ? fmt::format("{} <span class=\"paper\">({:.0f}%)</span>", ours,
                                                           paper_comp * 100.0)
@@ -144,21 +113,22 @@ std::string results_tables(const StudyResult& study) {
 }
 
 std::string iso_table(const StudyResult& study) {
-  const std::vector<int> speeds = speeds_of(study);
+  const std::vector<int> speeds = study_speeds_mm_s(study);
   std::string rows;
   for (const auto& s : study.setups) {
     for (const auto& l : s.loads) {
       for (const int v : speeds) {
-        const double a_uc = get(l.iso_accuracy_uc_mm, v);
-        const double a_c = get(l.iso_accuracy_c_mm, v);
-        const double rt = get(l.iso_repeatability_mm, v);
+        const double a_uc = value_at_speed(l.iso_accuracy_uc_mm, v);
+        const double a_c = value_at_speed(l.iso_accuracy_c_mm, v);
+        const double rt = value_at_speed(l.iso_repeatability_mm, v);
         if (!std::isfinite(a_uc) && !std::isfinite(a_c) && !std::isfinite(rt)) {
           continue;
         }
         rows += fmt::format(
             "<tr><td class=\"l\">{}</td><td>{:g} N</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>"
             "<td>{}</td></tr>\n",
-            esc(s.setup), l.load_N, v, mm(get(l.uc_mm, v)), mm(a_uc), mm(get(l.c_mm, v)), mm(a_c), mm(rt));
+            esc(s.setup), l.load_N, v, mm(value_at_speed(l.uc_mm, v)), mm(a_uc), mm(value_at_speed(l.c_mm, v)), mm(a_c),
+            mm(rt));
       }
     }
   }
@@ -197,7 +167,7 @@ std::string budget_tables(const std::vector<ErrorBudget>& budgets) {
       h += fmt::format(
           "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td>"
           "<td class=\"l\"><span class=\"bar\" style=\"width:{:.0f}px\"></span></td></tr>\n",
-          esc(e.effect), esc(e.size), mm(e.residual_mm_without_it), pct(share), w);
+          esc(e.effect), esc(e.size), mm(e.residual_mm_without_it), percent_text(share), w);
     }
     h += "</table>\n";
   }

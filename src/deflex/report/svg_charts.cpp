@@ -27,30 +27,6 @@ const char* const kCColour = "#1F77B4";
 
 std::string colour(std::size_t i) { return kPalette[i % kPaletteSize]; }
 
-double value_or_nan(const std::map<int, double>& m, int key) {
-  const auto it = m.find(key);
-  return it == m.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
-}
-
-std::vector<int> study_speeds(const StudyResult& study) {
-  if (!study.speeds_mm_s.empty()) {
-    return study.speeds_mm_s;
-  }
-  std::map<int, bool> seen;
-  for (const auto& s : study.setups) {
-    for (const auto& l : s.loads) {
-      for (const auto& [v, c] : l.c_mm) {
-        seen[v] = true;
-      }
-    }
-  }
-  std::vector<int> out;
-  for (const auto& [v, b] : seen) {
-    out.push_back(v);
-  }
-  return out;
-}
-
 std::string short_setup_name(const std::string& setup) {
   if (setup == "offline") {
     return "offline (OFF)";
@@ -136,7 +112,7 @@ std::string xml_escape(const std::string& text) {
 }
 
 std::string svg_figure5(const StudyResult& study) {
-  const std::vector<int> speeds = study_speeds(study);
+  const std::vector<int> speeds = study_speeds_mm_s(study);
   const PaperFigures paper = paper_reference();
   struct Group {
     std::size_t setup;
@@ -151,12 +127,12 @@ std::string svg_figure5(const StudyResult& study) {
       const PaperRow* pr = pt != nullptr ? pt->row_for(l.load_N) : nullptr;
       groups.push_back({si, &l, pr});
       for (const int v : speeds) {
-        const double c = value_or_nan(l.c_mm, v);
+        const double c = value_at_speed(l.c_mm, v);
         if (std::isfinite(c)) {
           top_value = std::max(top_value, c);
         }
         if (pr != nullptr) {
-          const double pc = value_or_nan(pr->c_mm, v);
+          const double pc = value_at_speed(pr->c_mm, v);
           if (std::isfinite(pc)) {
             top_value = std::max(top_value, pc);
           }
@@ -193,13 +169,13 @@ std::string svg_figure5(const StudyResult& study) {
     const LoadResult& l = *groups[g].load;
     for (std::size_t k = 0; k < speeds.size(); ++k) {
       const double x0 = xc + (static_cast<double>(k) - n_speeds / 2.0) * bar_w;
-      const double v = value_or_nan(l.c_mm, speeds[k]);
+      const double v = value_at_speed(l.c_mm, speeds[k]);
       if (std::isfinite(v)) {
         c.rect(x0 + 1.0, y(v), bar_w - 2.0, y(0.0) - y(v), colour(k),
                fmt::format(R"(data-value="{:.6g}")", v));
       }
       if (groups[g].paper != nullptr) {
-        const double pv = value_or_nan(groups[g].paper->c_mm, speeds[k]);
+        const double pv = value_at_speed(groups[g].paper->c_mm, speeds[k]);
         if (std::isfinite(pv)) {
           c.line(x0 - 1.0, y(pv), x0 + bar_w + 1.0, y(pv), "#111", 2.5);
           c.circle(x0 + bar_w / 2.0, y(pv), 3.0, "white", R"(stroke="#111" stroke-width="1.5")");
