@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -51,7 +52,12 @@ UdpSocket::~UdpSocket() {
 
 bool UdpSocket::wait_readable(double timeout_s) noexcept {
   pollfd p{fd_, POLLIN, 0};
-  const int ms = timeout_s <= 0.0 ? 0 : static_cast<int>(std::ceil(timeout_s * 1000.0));
+  // NaN and negative: no wait. Beyond INT_MAX ms (24.8 days, or infinite): INT_MAX, since the cast
+  // of a larger double to int is undefined (in practice INT_MIN, which poll() takes as "forever").
+  constexpr double kMaxMs = std::numeric_limits<int>::max();
+  const double ms_wanted = std::ceil(timeout_s * 1000.0);
+  const int ms = !(ms_wanted > 0.0) ? 0 : ms_wanted >= kMaxMs ? std::numeric_limits<int>::max()
+                                                               : static_cast<int>(ms_wanted);
   return ::poll(&p, 1, ms) > 0 && (p.revents & POLLIN) != 0;
 }
 
