@@ -1,5 +1,7 @@
 // ISO 9283 path accuracy and repeatability on runs whose crossing points are known by construction.
 #include <cmath>
+#include <limits>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -76,6 +78,30 @@ TEST(Iso9283Path, BadInput) {
   EXPECT_THROW(iso9283_path({ref}, TrackerTrace{ref[0]}), InputError);
   EXPECT_THROW(iso9283_path({TrackerTrace{ref[0]}}, ref), InputError);
   EXPECT_THROW(iso9283_path({ref}, ref, 0), InputError);
+}
+
+std::string error_of(const std::vector<TrackerTrace>& runs, const TrackerTrace& ref) {
+  try {
+    (void)iso9283_path(runs, ref);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(Iso9283Path, NonFiniteSamplesAreNamedNotSkipped) {
+  const TrackerTrace ref = test::closed_circle(kR, kCentre, 400);
+  TrackerTrace bad_run = ref;
+  bad_run[123].p_m.y() = std::nan("");
+  // Before: the planes that sample should cross were counted as "not crossed" and the figures came
+  // from the others, with no word about the NaN.
+  EXPECT_NE(error_of({ref, bad_run, ref}, ref).find("run 2 sample 123"), std::string::npos)
+      << error_of({ref, bad_run, ref}, ref);
+  TrackerTrace bad_ref = ref;
+  bad_ref[0].p_m.x() = std::numeric_limits<double>::infinity();
+  // Before: the first sample was not checked, so the length was NaN and the error said "zero length".
+  EXPECT_NE(error_of({ref}, bad_ref).find("reference sample 0 is not finite"), std::string::npos)
+      << error_of({ref}, bad_ref);
 }
 
 }  // namespace

@@ -63,17 +63,27 @@ Iso9283Path iso9283_path(const std::vector<TrackerTrace>& repeated_runs, const T
   if (reference.size() < 2) {
     throw InputError("ISO 9283 path figures: the reference path needs at least 2 samples");
   }
+  // A non-finite sample would silently drop the planes it should cross (or, in the reference, make
+  // the path length NaN and the error "zero length"): name it instead.
   for (std::size_t j = 0; j < repeated_runs.size(); ++j) {
     if (repeated_runs[j].size() < 2) {
       throw InputError(fmt::format("ISO 9283 path figures: run {} has fewer than 2 samples", j + 1));
     }
+    for (std::size_t k = 0; k < repeated_runs[j].size(); ++k) {
+      if (!repeated_runs[j][k].p_m.allFinite()) {
+        throw InputError(fmt::format("ISO 9283 path figures: run {} sample {} (t = {} s) is not finite", j + 1, k,
+                                     repeated_runs[j][k].t_s));
+      }
+    }
   }
   std::vector<double> cum(reference.size(), 0.0);
-  for (std::size_t k = 1; k < reference.size(); ++k) {
+  for (std::size_t k = 0; k < reference.size(); ++k) {
     if (!reference[k].p_m.allFinite()) {
       throw InputError(fmt::format("ISO 9283 path figures: reference sample {} is not finite", k));
     }
-    cum[k] = cum[k - 1] + (reference[k].p_m - reference[k - 1].p_m).norm();
+    if (k > 0) {
+      cum[k] = cum[k - 1] + (reference[k].p_m - reference[k - 1].p_m).norm();
+    }
   }
   const double length = cum.back();
   if (!(length > 0.0)) {
