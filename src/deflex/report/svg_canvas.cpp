@@ -24,8 +24,20 @@ std::vector<double> nice_ticks(double lo, double hi, int target) {
       break;
     }
   }
-  for (double t = std::ceil(lo / step - 1e-9) * step; t <= hi + step * 1e-9; t += step) {
-    ticks.push_back(std::abs(t) < step * 1e-9 ? 0.0 : t);
+  // Each tick as (k * step), not by adding step up: no drift (0.30000000000000004), and a range
+  // narrower than the doubles' resolution at its magnitude (lo = 1000, hi = the next double) ends
+  // instead of adding a step that rounds away, forever.
+  const double first = std::ceil(lo / step - 1e-9);
+  for (int i = 0; i <= 1000; ++i) {
+    const double t = (first + i) * step;
+    if (t > hi + step * 1e-9) {
+      break;
+    }
+    const double tick = std::abs(t) < step * 1e-9 ? 0.0 : t;
+    if (!ticks.empty() && !(tick > ticks.back())) {
+      break;
+    }
+    ticks.push_back(tick);
   }
   return ticks;
 }
