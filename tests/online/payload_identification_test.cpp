@@ -110,6 +110,17 @@ TEST(PayloadIdentification, CsvWithJointsUsesTheRobotAndSensorMount) {
   } catch (const DataError& err) {
     EXPECT_NE(std::string(err.what()).find(":3"), std::string::npos) << err.what();
   }
+
+  // Too few poses: the error names the file (identify_payload alone cannot).
+  std::ofstream two(path);
+  two << "qw,qx,qy,qz,fx_N,fy_N,fz_N\n1,0,0,0,1,2,3\n0,1,0,0,1,2,3\n";
+  two.close();
+  try {
+    (void)read_payload_observations(path, nullptr, Pose::Identity(), Matrix6::Identity(), has_moments);
+    ADD_FAILURE() << "two poses accepted";
+  } catch (const DataError& err) {
+    EXPECT_NE(std::string(err.what()).find(path + ": 2 static poses"), std::string::npos) << err.what();
+  }
 }
 
 }  // namespace

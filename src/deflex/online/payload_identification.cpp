@@ -151,6 +151,11 @@ std::vector<PayloadObservation> read_payload_observations(const std::string& csv
     }
     out.push_back(o);
   }
+  // Checked here as well as in identify_payload(), so that the message names the file.
+  if (out.size() < 3) {
+    throw DataError(fmt::format("{}: {} static pose{}; payload identification needs at least 3", csv_path, out.size(),
+                                out.size() == 1 ? "" : "s"));
+  }
   return out;
 }
 
