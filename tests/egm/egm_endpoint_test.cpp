@@ -323,5 +323,46 @@ TEST_F(EgmEndToEnd, SteadyStateCycleDoesNotAllocateAndHistoryIsWritten) {
   EXPECT_NEAR(t.at(15, "q_command1_rad"), deg_to_rad(reply.planned_joints_deg[0]), 1e-11);
 }
 
+
+TEST_F(EgmEndToEnd, OnlyTheNewestOfABurstIsAnsweredAndSilenceMarksARestart) {
+  OnlineCompensator comp(robot, sensor, cfg);
+  EgmEndpointConfig ec;
+  ec.port = 0;
+  ec.restart_silence_s = 0.3;  // short, so the test waits little
+  EgmSensorEndpoint endpoint(comp, ec);
+  EgmRobotPeer controller("127.0.0.1", endpoint.port());
+  EgmSensorMessage reply;
+
+  // Three packets before one poll: one answer, carrying the newest packet's planned joints (no
+  // force yet, so the command is the planned configuration itself).
+  for (std::uint32_t k = 100; k < 103; ++k) {
+    EgmRobotMessage m = message(k);
+    m.planned_joints_deg[0] += static_cast<double>(k - 100);
+    ASSERT_TRUE(controller.send(m));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));  // all three queued on loopback
+  ASSERT_EQ(endpoint.poll(1.0), EgmPollResult::kReplied);
+  ASSERT_TRUE(controller.receive(reply, 1.0));
+  EXPECT_NEAR(reply.planned_joints_deg[0], q_deg[0] + 2.0, 1e-9);
+  EXPECT_FALSE(controller.receive(reply, 0.02));  // exactly one answer
+  EXPECT_EQ(endpoint.counters().superseded, 2u);
+  EXPECT_EQ(endpoint.last_cycle().seqno, 102u);
+
+  // A step back to 50 right away is a stale packet (not a small number, no silence): ignored.
+  controller.send(message(50));
+  EXPECT_EQ(endpoint.poll(0.2), EgmPollResult::kRejected);
+  EXPECT_FALSE(controller.receive(reply, 0.02));
+  EXPECT_EQ(endpoint.counters().out_of_order, 1u);
+  EXPECT_EQ(endpoint.counters().restarts, 0u);
+
+  // The same step back after more than restart_silence_s without a packet: a restarted controller.
+  std::this_thread::sleep_for(std::chrono::milliseconds(400));
+  controller.send(message(50));
+  EXPECT_EQ(endpoint.poll(1.0), EgmPollResult::kReplied);
+  EXPECT_TRUE(controller.receive(reply, 1.0));
+  EXPECT_EQ(endpoint.counters().restarts, 1u);
+  EXPECT_EQ(endpoint.counters().out_of_order, 1u);
+}
+
 }  // namespace
 }  // namespace deflex
