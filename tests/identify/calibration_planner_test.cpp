@@ -2,15 +2,20 @@
 // design beats random ones, and running it (simulated) identifies the stiffness as predicted.
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <iterator>
+#include <string>
 #include <random>
 
 #include <Eigen/SVD>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "deflex/identify/calibration_planner.hpp"
 #include "deflex/identify/calibration_simulation.hpp"
 #include "deflex/identify/stiffness_identification.hpp"
 #include "deflex/model/compliance.hpp"
+#include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
 #include "deflex/model/robot_io.hpp"
@@ -88,6 +93,40 @@ TEST(CalibrationPlanner, PosesAreReachableInTheRegionAndLoadsAreWhatTheRowsSay) 
     EXPECT_LT(r, 0.1);
   }
   EXPECT_TRUE(plan.warnings.empty());
+}
+
+TEST(CalibrationPlanner, WrittenPlanReadsBackInMillimetresDegreesAndNewtons) {
+  const RobotModel model = kr210();
+  CalibrationPlanOptions o = kr210_options();
+  o.poses = 3;
+  const CalibrationPlan plan = plan_calibration(model, o);
+  const std::string path = ::testing::TempDir() + "/calibration_plan.csv";
+  write_calibration_plan(path, plan, {"made by the planner test"});
+  const CsvTable t = CsvTable::read_file(path);
+  ASSERT_EQ(t.rows(), plan.points.size());
+  for (std::size_t r = 0; r < t.rows(); ++r) {
+    const CalibrationPoint& p = plan.points[r];
+    EXPECT_EQ(t.at(r, "pose"), static_cast<double>(p.pose));
+    for (int j = 0; j < 6; ++j) {
+      EXPECT_NEAR(t.at(r, fmt::format("q{}_deg", j + 1)), p.q[j] * 180.0 / kPi, 1e-7);
+    }
+    const char* const xyz[3] = {"x", "y", "z"};
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(t.at(r, fmt::format("{}_mm", xyz[k])), p.base_T_tcp.translation()[k] * 1000.0, 1e-6);
+      EXPECT_NEAR(t.at(r, fmt::format("load_{}_mm", xyz[k])), p.load_point_base[k] * 1000.0, 1e-6);
+      EXPECT_NEAR(t.at(r, fmt::format("expected_d{}_mm", xyz[k])), p.expected_dp_m[k] * 1000.0, 1e-9);
+    }
+    const char* const wrench[6] = {"fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm"};
+    for (int k = 0; k < 6; ++k) {
+      EXPECT_NEAR(t.at(r, wrench[k]), p.wrench_base[k], 1e-6) << wrench[k];
+    }
+    // The quaternion is the pose's rotation (either sign).
+    const Eigen::Quaterniond q(t.at(r, "qw"), t.at(r, "qx"), t.at(r, "qy"), t.at(r, "qz"));
+    EXPECT_TRUE(q.normalized().toRotationMatrix().isApprox(p.base_T_tcp.linear(), 1e-8));
+  }
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("# made by the planner test\n"), std::string::npos) << text;
 }
 
 TEST(CalibrationPlanner, GreedyDesignBeatsRandomDesignsOfTheSameSize) {
