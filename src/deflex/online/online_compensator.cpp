@@ -176,13 +176,18 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
   }
   out.wrench_base = wrench_base_;
 
-  // Rate bound; also the ramp to zero when the target dropped to zero.
+  // Rate bound; also the ramp to zero when the target dropped to zero. The change is scaled as a
+  // whole, not clamped joint by joint: the new correction then lies on the segment from the old one
+  // to the target, and as both meet the size bounds (a box and a TCP ball, convex sets) so does
+  // every cycle of the ramp. Clamping each joint bent the path and could pass the TCP bound.
   const double max_step = config_.max_correction_rate_rad_s * dt;
-  for (int i = 0; i < n; ++i) {
-    const double change = target[i] - correction_[i];
-    const double limited = std::clamp(change, -max_step, max_step);
-    out.rate_limited = out.rate_limited || limited != change;
-    correction_[i] += limited;
+  const JointVector change = target - correction_;
+  const double largest = change.cwiseAbs().maxCoeff();
+  if (largest > max_step) {
+    correction_ += (max_step / largest) * change;
+    out.rate_limited = true;
+  } else {
+    correction_ += change;
   }
   out.dtheta = correction_;
   out.q_command = in.q_planned - correction_;
