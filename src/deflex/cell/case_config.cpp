@@ -76,7 +76,7 @@ Vector3 CaseConfig::pivot_m() const {
 CaseConfig load_case_text(const std::string& text, const std::string& source) {
   const yaml::Field root = yaml::Field::load_string(text, source);
   root.only_keys({"deflex_case", "name", "robot", "seed", "circle", "protocol", "setups", "true_robot", "tool",
-                  "sensor", "ldbb", "tracker", "controller", "online", "calibration", "error_budget"});
+                  "sensor", "ldbb", "tracker", "controller", "online", "calibration", "drift", "error_budget"});
   if (root.at("deflex_case").as_int() != 1) root.at("deflex_case").fail("unsupported version (expected 1)");
   CaseConfig c;
   c.source = source;
@@ -134,7 +134,7 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   const auto r = root.at("true_robot");
   r.only_keys({"stiffness_scale", "stiffness_spread_pct", "coupling_23", "forearm_EI_Nm2", "forearm_length_mm",
                "lost_motion_urad", "lost_motion_torque_Nm", "gravity_torque_Nm", "dh_length_sigma_mm",
-               "dh_angle_sigma_deg"});
+               "dh_angle_sigma_deg", "hardening_softening", "hardening_torque_Nm"});
   c.robot.stiffness_scale = positive(r.at("stiffness_scale"));
   c.robot.stiffness_spread = non_negative(r.at("stiffness_spread_pct")) / 100.0;
   c.robot.coupling_23 = r.at("coupling_23").as_double();
@@ -155,6 +155,16 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   }
   c.robot.dh_length_sigma_m = non_negative(r.at("dh_length_sigma_mm")) * kMm;
   c.robot.dh_angle_sigma_rad = deg_to_rad(non_negative(r.at("dh_angle_sigma_deg")));
+  if (r.has("hardening_softening") || r.has("hardening_torque_Nm")) {
+    c.robot.hardening_softening = r.at("hardening_softening").as_doubles();
+    for (double v : c.robot.hardening_softening) {
+      if (!(v >= 0.0 && v <= 5.0)) r.at("hardening_softening").fail("must be within 0..5");
+    }
+    c.robot.hardening_torque_nm = r.at("hardening_torque_Nm").as_doubles(c.robot.hardening_softening.size());
+    for (double v : c.robot.hardening_torque_nm) {
+      if (!(v > 0)) r.at("hardening_torque_Nm").fail("must be positive");
+    }
+  }
 
   const auto t = root.at("tool");
   t.only_keys({"ee_length_mm", "ee_mass_kg", "ee_cog_mm"});
@@ -165,7 +175,7 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   const auto s = root.at("sensor");
   s.only_keys({"height_mm", "lateral_compliance_um_per_N", "axial_compliance_um_per_N",
                "rotational_compliance_urad_per_Nm", "crosstalk_pct", "crosstalk_calibration_residual_pct", "noise_N",
-               "bias_N", "rate_Hz", "gravity_mass_error_pct"});
+               "bias_N", "rate_Hz", "gravity_mass_error_pct", "sensitivity_error_pct", "misalignment_deg"});
   c.sensor.height_m = non_negative(s.at("height_mm")) * kMm;
   c.sensor.lateral_compliance_m_per_n = non_negative(s.at("lateral_compliance_um_per_N")) * kUm;
   c.sensor.axial_compliance_m_per_n = non_negative(s.at("axial_compliance_um_per_N")) * kUm;
@@ -176,6 +186,12 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   c.sensor.bias_n = s.at("bias_N").as_vector3();
   c.sensor.rate_hz = positive(s.at("rate_Hz"));
   c.sensor.gravity_mass_error = s.at("gravity_mass_error_pct").as_double() / 100.0;
+  c.sensor.sensitivity_error = s.get("sensitivity_error_pct", 0.0) / 100.0;
+  if (!(c.sensor.sensitivity_error >= 0.0 && c.sensor.sensitivity_error < 0.2))
+    s.at("sensitivity_error_pct").fail("must be within 0..20 %");
+  c.sensor.misalignment_rad = deg_to_rad(s.get("misalignment_deg", 0.0));
+  if (!(std::abs(c.sensor.misalignment_rad) < deg_to_rad(10.0)))
+    s.at("misalignment_deg").fail("must be within +-10 deg");
 
   const auto l = root.at("ldbb");
   l.only_keys({"bar_length_mm", "inclination_deg", "push", "time_constant_s", "ripple_pct", "ripple_Hz", "noise_pct",
@@ -226,6 +242,15 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   c.calibration.load_error = non_negative(cal.at("load_error_pct")) / 100.0;
   c.calibration.samples = cal.at("samples").as_int();
   if (c.calibration.samples < 1) cal.at("samples").fail("must be at least 1");
+
+  if (root.has("drift")) {
+    const auto d = root.at("drift");
+    d.only_keys({"offset_um", "rotation_urad", "wander_um", "wander_time_s"});
+    c.drift.offset_m = non_negative(d.at("offset_um")) * kUm;
+    c.drift.rotation_rad = non_negative(d.at("rotation_urad")) * kUm;
+    c.drift.wander_m = non_negative(d.at("wander_um")) * kUm;
+    c.drift.wander_time_s = positive(d.at("wander_time_s"));
+  }
 
   if (root.has("error_budget")) {
     const auto b = root.at("error_budget");
@@ -291,6 +316,12 @@ const char* to_string(Effect e) {
       return "calibration load error";
     case Effect::kLatency:
       return "online cycle and delays";
+    case Effect::kPathDrift:
+      return "run-to-run drift, path repeatability";
+    case Effect::kGearHardening:
+      return "torque-dependent gear stiffness";
+    case Effect::kSensorCalibration:
+      return "sensor sensitivity error, misalignment";
   }
   return "?";
 }
@@ -328,6 +359,17 @@ std::string effect_size(const CaseConfig& c, Effect e) {
     case Effect::kLatency:
       return fmt::format("cycle {:.0f} ms + {:.0f} ms", c.online.cycle_s * 1e3,
                          (c.online.compute_delay_s + c.controller.egm_delay_s) * 1e3);
+    case Effect::kPathDrift:
+      return fmt::format("{:.0f} um, {:.0f} urad per run, wander {:.0f} um", c.drift.offset_m * 1e6,
+                         c.drift.rotation_rad * 1e6, c.drift.wander_m * 1e6);
+    case Effect::kGearHardening: {
+      double m = 0;
+      for (double v : c.robot.hardening_softening) m = std::max(m, v);
+      return fmt::format("up to {:.1f}x softer near zero torque", 1.0 + m);
+    }
+    case Effect::kSensorCalibration:
+      return fmt::format("{:.1f} % sensitivity, {:.2f} deg", c.sensor.sensitivity_error * 100,
+                         rad_to_deg(c.sensor.misalignment_rad));
   }
   return "";
 }
@@ -385,6 +427,18 @@ CaseConfig without_effect(const CaseConfig& config, Effect e) {
       c.online.compute_delay_s = 0.0;
       c.controller.egm_delay_s = 0.0;
       c.controller.egm_filter_s = 0.0;
+      break;
+    case Effect::kPathDrift:
+      c.drift.offset_m = 0.0;
+      c.drift.rotation_rad = 0.0;
+      c.drift.wander_m = 0.0;
+      break;
+    case Effect::kGearHardening:
+      for (double& v : c.robot.hardening_softening) v = 0.0;
+      break;
+    case Effect::kSensorCalibration:
+      c.sensor.sensitivity_error = 0.0;
+      c.sensor.misalignment_rad = 0.0;
       break;
   }
   return c;

@@ -44,6 +44,21 @@ struct TrueRobotConfig {
   std::vector<double> gravity_torque_nm;
   double dh_length_sigma_m = 0.0;   ///< kinematic errors: 1-sigma of a, d
   double dh_angle_sigma_rad = 0.0;  ///< 1-sigma of alpha, offset
+  /// Torque-dependent gear stiffness (hardening of the reducers), per joint: the tangent compliance
+  /// at total joint torque x is C (1 + s exp(-|x|/tau_h)), i.e. (1+s) times softer near zero torque
+  /// than at large torque (C: the true compliance above). Empty or zero s: linear gears.
+  std::vector<double> hardening_softening;  ///< s per joint
+  std::vector<double> hardening_torque_nm;  ///< tau_h per joint
+};
+
+/// Run-to-run drift and path repeatability of the true robot: every run (the unloaded reference and
+/// each loaded run are different runs at different times) is displaced by its own small rigid
+/// motion plus a slow random wander within the run. Unknown to every strategy.
+struct DriftConfig {
+  double offset_m = 0.0;       ///< 1-sigma per axis of the run's rigid offset (thermal drift)
+  double rotation_rad = 0.0;   ///< 1-sigma per axis of the run's small rotation about the base origin
+  double wander_m = 0.0;       ///< stationary 1-sigma per axis of the wander within a run
+  double wander_time_s = 1.0;  ///< correlation time of the wander (Ornstein-Uhlenbeck process)
 };
 
 struct ToolConfig {
@@ -63,6 +78,11 @@ struct SensorConfig {
   Vector3 bias_n = Vector3::Zero();
   double rate_hz = 1000.0;
   double gravity_mass_error = 0.0;  ///< relative error of the identified EE mass
+  /// Calibration-sheet errors the user never learns: the true sensitivity of each channel differs
+  /// from the sheet's by a seeded relative error (1-sigma), and the sensor is mounted turned by this
+  /// angle about the tool axis (flange z) from the frame the user assumes.
+  double sensitivity_error = 0.0;
+  double misalignment_rad = 0.0;
 };
 
 struct LdbbConfig {
@@ -139,6 +159,7 @@ struct CaseConfig {
   ControllerConfig controller;
   OnlineConfig online;
   CalibrationConfig calibration;
+  DriftConfig drift;
   BudgetConfig budget;
   /// Give the compensators the true joint stiffness instead of an identified one (tests only:
   /// the model-consistent cell).
@@ -169,13 +190,17 @@ enum class Effect {
   kLdbbRipple,      ///< ripple and noise of the pneumatic force
   kSensorErrors,    ///< crosstalk, noise, bias, gravity-compensation error
   kTrackerNoise,
-  kCalibrationNoise,  ///< load error of the calibration experiment
-  kLatency,           ///< online cycle, compute delay, EGM delay and filter
+  kCalibrationNoise,   ///< load error of the calibration experiment
+  kLatency,            ///< online cycle, compute delay, EGM delay and filter
+  kPathDrift,          ///< run-to-run drift and path repeatability
+  kGearHardening,      ///< torque-dependent gear stiffness
+  kSensorCalibration,  ///< sensitivity error and mounting misalignment unknown to the user
 };
-inline constexpr std::array<Effect, 12> kAllEffects = {
+inline constexpr std::array<Effect, 15> kAllEffects = {
     Effect::kStiffnessMismatch, Effect::kJointCoupling,   Effect::kLinkBending,      Effect::kSensorCompliance,
     Effect::kLostMotion,        Effect::kKinematicErrors, Effect::kLdbbForceError,   Effect::kLdbbRipple,
-    Effect::kSensorErrors,      Effect::kTrackerNoise,    Effect::kCalibrationNoise, Effect::kLatency};
+    Effect::kSensorErrors,      Effect::kTrackerNoise,    Effect::kCalibrationNoise, Effect::kLatency,
+    Effect::kPathDrift,         Effect::kGearHardening,   Effect::kSensorCalibration};
 [[nodiscard]] const char* to_string(Effect e);
 /// Short description of the effect's size in `config` (for the error budget table).
 [[nodiscard]] std::string effect_size(const CaseConfig& config, Effect e);

@@ -196,7 +196,9 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
         budget_jobs.push_back(BudgetJob{static_cast<int>(i), std::nullopt});
         for (Effect e : kAllEffects) {
           if (e == Effect::kSensorCompliance && !config.setups[i].sensor_mounted) continue;
-          if ((e == Effect::kSensorErrors || e == Effect::kLatency) && st == Strategy::kOffline) continue;
+          if ((e == Effect::kSensorErrors || e == Effect::kSensorCalibration || e == Effect::kLatency) &&
+              st == Strategy::kOffline)
+            continue;
           budget_jobs.push_back(BudgetJob{static_cast<int>(i), e});
         }
       }

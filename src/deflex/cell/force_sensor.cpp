@@ -3,8 +3,9 @@
 
 namespace deflex::cell {
 
-ForceSensorDaq::ForceSensorDaq(const SensorConfig& sensor, const ToolConfig& tool, std::uint64_t seed)
-    : config_(sensor), tool_(tool), rng_(seed) {
+ForceSensorDaq::ForceSensorDaq(const SensorConfig& sensor, const ToolConfig& tool, std::uint64_t seed,
+                               std::uint64_t unit_seed)
+    : config_(sensor), tool_(tool), rng_(unit_seed) {
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   crosstalk_ = Matrix3::Identity();
   Matrix3 residual = Matrix3::Zero();
@@ -16,7 +17,13 @@ ForceSensorDaq::ForceSensorDaq(const SensorConfig& sensor, const ToolConfig& too
       residual(i, j) = sensor.crosstalk_calibration_residual * uniform(rng_);
     }
   }
+  // The sheet's sensitivities are off by the calibration's uncertainty; the user decouples with the
+  // sheet, so the reading keeps this error (drawn whatever its size: the other draws stay the same).
+  for (int i = 0; i < 3; ++i) sensitivity_[i] = 1.0 + sensor.sensitivity_error * normal_(rng_);
+  flange_R_sensor_ = Eigen::AngleAxisd(sensor.misalignment_rad, Vector3::UnitZ()).toRotationMatrix();
   calibration_.decoupling = crosstalk_.inverse() * (Matrix3::Identity() + residual);
+  rng_.seed(seed);  // noise: this run's own
+  normal_.reset();
   calibration_.bias_n = sensor.bias_n;  // tared at a static pose: the bias itself is known
   calibration_.ee_mass_kg = tool.ee_mass_kg * (1.0 + sensor.gravity_mass_error);
   calibration_.ee_cog_m = tool.ee_cog_m;
@@ -24,9 +31,9 @@ ForceSensorDaq::ForceSensorDaq(const SensorConfig& sensor, const ToolConfig& too
 
 Vector3 ForceSensorDaq::sample(const Vector3& process_force_base_n, const Matrix3& base_R_flange) {
   const Vector3 weight_base(0.0, 0.0, -tool_.ee_mass_kg * kGravity);
-  const Vector3 f_sensor = base_R_flange.transpose() * (process_force_base_n + weight_base);
+  const Vector3 f_sensor = (base_R_flange * flange_R_sensor_).transpose() * (process_force_base_n + weight_base);
   Vector3 noise(normal_(rng_), normal_(rng_), normal_(rng_));
-  return crosstalk_ * f_sensor + config_.bias_n + config_.noise_n * noise;
+  return crosstalk_ * sensitivity_.asDiagonal() * f_sensor + config_.bias_n + config_.noise_n * noise;
 }
 
 }  // namespace deflex::cell

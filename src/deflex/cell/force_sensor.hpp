@@ -22,18 +22,28 @@ struct SensorCalibration {
 
 class ForceSensorDaq {
  public:
-  ForceSensorDaq(const SensorConfig& sensor, const ToolConfig& tool, std::uint64_t seed);
+  /// `seed` draws the noise of this run; `unit_seed` draws what belongs to the physical sensor (its
+  /// crosstalk, the calibration's residual and the true sensitivities), the same in every run.
+  ForceSensorDaq(const SensorConfig& sensor, const ToolConfig& tool, std::uint64_t seed, std::uint64_t unit_seed);
+  ForceSensorDaq(const SensorConfig& sensor, const ToolConfig& tool, std::uint64_t seed)
+      : ForceSensorDaq(sensor, tool, seed, seed) {}
 
   /// One DAQ sample (N, sensor frame = flange frame) for the process force on the TCP (base frame)
   /// at the flange orientation base_R_flange.
   [[nodiscard]] Vector3 sample(const Vector3& process_force_base_n, const Matrix3& base_R_flange);
   [[nodiscard]] const SensorCalibration& calibration() const { return calibration_; }
   [[nodiscard]] const Matrix3& crosstalk() const { return crosstalk_; }
+  /// True sensitivity of each channel relative to the calibration sheet's (1 + error).
+  [[nodiscard]] const Vector3& sensitivity() const { return sensitivity_; }
+  /// True sensor frame in the flange frame: a turn of misalignment_rad about the tool axis.
+  [[nodiscard]] const Matrix3& flange_R_sensor() const { return flange_R_sensor_; }
 
  private:
   SensorConfig config_;
   ToolConfig tool_;
   Matrix3 crosstalk_;
+  Vector3 sensitivity_ = Vector3::Ones();
+  Matrix3 flange_R_sensor_ = Matrix3::Identity();
   SensorCalibration calibration_;
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};

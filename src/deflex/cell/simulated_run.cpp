@@ -9,6 +9,7 @@
 
 #include "deflex/cell/force_sensor.hpp"
 #include "deflex/cell/ldbb_device.hpp"
+#include "deflex/cell/path_drift.hpp"
 #include "deflex/egm/egm_codec.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/model/errors.hpp"
@@ -27,7 +28,7 @@ std::uint64_t splitmix(std::uint64_t x) {
 }
 
 // Seeds of the run's components, each from the run's own seed.
-enum class Component : std::uint64_t { kLdbb = 1, kSensor = 2, kTracker = 3 };
+enum class Component : std::uint64_t { kLdbb = 1, kSensor = 2, kTracker = 3, kDrift = 4 };
 std::uint64_t component_seed(std::uint64_t run, Component c) {
   return splitmix(run ^ (static_cast<std::uint64_t>(c) * 0x632be59bd9b4e019ULL));
 }
@@ -126,7 +127,11 @@ RunOutput simulate_run(const SetupCell& setup, const RunSpec& spec) {
   const double dt = c.controller.servo_period_s;
   const auto ticks = static_cast<long>(std::ceil(schedule.duration_s() / dt));
   LdbbDevice ldbb(c.ldbb, c.pivot_m(), spec.load_n, component_seed(spec.seed, Component::kLdbb));
-  ForceSensorDaq sensor(c.sensor, c.tool, component_seed(spec.seed, Component::kSensor));
+  // One physical sensor for the whole case: its crosstalk and true sensitivities come from the case
+  // seed; its noise from the run's.
+  ForceSensorDaq sensor(c.sensor, c.tool, component_seed(spec.seed, Component::kSensor),
+                        splitmix(c.seed ^ 0x5e5503ULL));
+  PathDrift drift(c.drift, component_seed(spec.seed, Component::kDrift));
   std::mt19937_64 tracker_rng(component_seed(spec.seed, Component::kTracker));
   std::normal_distribution<double> normal(0.0, 1.0);
   const LdbbForceModel force_model(c.pivot_m(), std::max(spec.load_n, 1.0), c.ldbb.push);
@@ -169,7 +174,7 @@ RunOutput simulate_run(const SetupCell& setup, const RunSpec& spec) {
   JointVector q_plan(n), q_cmd(n), offset = JointVector::Zero(n), offset_target = JointVector::Zero(n);
   program.at(0.0, q_plan);
   TrueRobotState state = robot.initial_state(q_plan);
-  Vector3 p_prev = robot.solve(ws, q_plan, Wrench::Zero(), state);
+  Vector3 p_prev = drift.apply(robot.solve(ws, q_plan, Wrench::Zero(), state));
   Vector3 v_prev = Vector3::Zero();
   Matrix3 base_R_flange = ws.base_T_flange.linear();
   CorrectionChannel channel(256);
@@ -210,7 +215,9 @@ RunOutput simulate_run(const SetupCell& setup, const RunSpec& spec) {
       ldbb.advance(dt);
       w = ldbb.wrench(p_prev, v_prev);
     }
-    const Vector3 p = robot.solve(ws, q_cmd, w, state);
+    drift.advance(dt);
+    // Drift moves the whole arm (thermal growth, repeatability), so the LDBB sees it too.
+    const Vector3 p = drift.apply(robot.solve(ws, q_cmd, w, state));
     base_R_flange = ws.base_T_flange.linear();
 
     if (online) {

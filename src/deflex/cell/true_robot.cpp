@@ -17,6 +17,12 @@ double LostMotion::update(double joint_torque_nm) {
 
 double LostMotion::offset_rad() const { return half_width_rad * std::clamp(state, -1.0, 1.0); }
 
+double GearHardening::equivalent_torque(double x) const {
+  if (softening == 0.0) return x;
+  const double a = std::abs(x);
+  return x + std::copysign(softening * torque_nm * (1.0 - std::exp(-a / torque_nm)), x);
+}
+
 Pose setup_flange_T_tcp(const CaseConfig& config, bool sensor_mounted) {
   Pose t = Pose::Identity();
   t.translation() = Vector3(0, 0, config.tool.ee_length_m + (sensor_mounted ? config.sensor.height_m : 0.0));
@@ -72,6 +78,14 @@ TrueRobot::TrueRobot(const CaseConfig& config, bool sensor_mounted, std::uint64_
     K(1, 2) = K(2, 1) = config.robot.coupling_23 * std::sqrt(K(1, 1) * K(2, 2));
   }
   joint_compliance_ = K.inverse();
+  const auto& hs = config.robot.hardening_softening;
+  const auto& ht = config.robot.hardening_torque_nm;
+  for (int i = 0; i < n && static_cast<std::size_t>(i) < hs.size(); ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    hardening_[k].softening = hs[k];
+    hardening_[k].torque_nm = k < ht.size() ? ht[k] : 1.0;
+    hardening_on_ = hardening_on_ || hs[k] > 0.0;
+  }
 }
 
 TrueRobotState TrueRobot::initial_state(const JointVector& q_cmd) const {
@@ -137,11 +151,23 @@ Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd, const Wrench& 
   jacobian(m, ws, q, EndPoint::kTcp, J);
   JointVector tau = J.transpose() * wrench_base;
   JointVector lost(n);
+  JointVector tau_eff(n);
+  // The gears deflect along their hardening curves from the gravity preload (linear when off).
+  const auto equivalent = [&](const JointVector& t) {
+    if (!hardening_on_) {
+      tau_eff = t;
+      return;
+    }
+    for (int i = 0; i < n; ++i) {
+      tau_eff[i] = hardening_[static_cast<std::size_t>(i)].increment(state.gravity_torque_nm[i], t[i]);
+    }
+  };
   for (int i = 0; i < n; ++i) {
     lost[i] = state.lost_motion[static_cast<std::size_t>(i)].update(tau[i] + state.gravity_torque_nm[i]);
   }
   for (int it = 0; it < 30; ++it) {
-    const JointVector q_new = q_cmd + joint_compliance_ * tau + lost;
+    equivalent(tau);
+    const JointVector q_new = q_cmd + joint_compliance_ * tau_eff + lost;
     const double step = (q_new - q).cwiseAbs().maxCoeff();
     q = q_new;
     if (step < 1e-12) {

@@ -24,6 +24,21 @@ struct LostMotion {
   [[nodiscard]] double offset_rad() const;
 };
 
+/// Torque-dependent stiffness of one gear (hardening reducer): the tangent compliance at the total
+/// joint torque x is c (1 + softening exp(-|x|/torque_nm)), so the gear is (1 + softening) times
+/// softer near zero torque than at large torque. equivalent_torque(x) is the torque a linear gear of
+/// compliance c would need for the same deflection from zero torque:
+///   H(x) = x + softening torque_nm sign(x) (1 - exp(-|x|/torque_nm)).
+struct GearHardening {
+  double softening = 0.0;
+  double torque_nm = 1.0;
+  [[nodiscard]] double equivalent_torque(double total_torque_nm) const;
+  /// Equivalent torque of a process torque `tau_nm` on top of the static preload (gravity).
+  [[nodiscard]] double increment(double preload_nm, double tau_nm) const {
+    return equivalent_torque(preload_nm + tau_nm) - equivalent_torque(preload_nm);
+  }
+};
+
 /// Per-run mutable state of the true robot (one per simulated run).
 struct TrueRobotState {
   JointVector q_actual;    ///< last solved configuration (warm start of the next solve)
@@ -65,6 +80,8 @@ class TrueRobot {
   std::shared_ptr<const RobotModel> nominal_;
   std::shared_ptr<const RobotModel> true_;
   JointMatrix joint_compliance_;
+  std::array<GearHardening, kMaxJoints> hardening_{};
+  bool hardening_on_ = false;
   double last_d_m_ = 0.0;  ///< wrist centre to flange along the flange z axis
 };
 
