@@ -97,6 +97,14 @@ void run(const Opts& o, int& exit_code) {
   IkRequest first;
   if (!o.config.empty()) {
     const auto c = parse_numbers(o.config, "--config", 4);
+    for (const double v : c) {
+      // Whole numbers only (2.5 was cut to 2), and small enough that the cast to int is defined.
+      if (v != std::floor(v) || std::abs(v) > 1000.0) {
+        throw InputError(fmt::format(
+            "option --config: '{}' is not four whole numbers cf1,cf4,cf6,cfx (quadrant numbers, at most 1000 in size)",
+            o.config));
+      }
+    }
     if (c[3] < 0 || c[3] > 7) {
       throw InputError("option --config: cfx must be 0..7");
     }
