@@ -364,5 +364,45 @@ TEST_F(EgmEndToEnd, OnlyTheNewestOfABurstIsAnsweredAndSilenceMarksARestart) {
   EXPECT_EQ(endpoint.counters().out_of_order, 1u);
 }
 
+TEST_F(EgmEndToEnd, AStrayRestartPacketDoesNotMakeTheControllersCommandJump) {
+  OnlineConfig slow = cfg;
+  slow.max_correction_rate_rad_s = 5e-4;  // 2e-6 rad in a 4 ms cycle: the correction builds up slowly
+  OnlineCompensator comp(robot, sensor, slow);
+  EgmEndpointConfig ec;
+  ec.port = 0;
+  EgmSensorEndpoint endpoint(comp, ec);
+  SwitchableForce force(reading(Vector3(0, 300, -800)));
+  endpoint.set_force_source(&force);
+  EgmRobotPeer controller("127.0.0.1", endpoint.port());
+  EgmRobotPeer stray("127.0.0.1", endpoint.port());
+  EgmSensorMessage reply;
+  std::uint32_t seq = 500;
+  for (int k = 0; k < 40; ++k, ++seq) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(4));
+    controller.send(message(seq));
+    ASSERT_EQ(endpoint.poll(1.0), EgmPollResult::kReplied);
+    ASSERT_TRUE(controller.receive(reply, 1.0));
+  }
+  const JointVector before_deg = reply.planned_joints_deg;
+  const double built_up_rad = deg_to_rad((before_deg - q_deg).cwiseAbs().maxCoeff());
+  ASSERT_GT(built_up_rad, 2e-5);  // well above what one cycle may change
+  const auto t0 = std::chrono::steady_clock::now();
+
+  // Another sender's packet with a small sequence number: taken as a controller restart.
+  stray.send(message(1));
+  ASSERT_EQ(endpoint.poll(1.0), EgmPollResult::kReplied);
+  EXPECT_TRUE(stray.receive(reply, 1.0));
+  EXPECT_EQ(endpoint.counters().restarts, 1u);
+  // The real controller's next answer differs from its last by no more than the rate bound allows
+  // for the time that passed (with a reset, the whole correction vanished in one cycle).
+  controller.send(message(seq));
+  ASSERT_EQ(endpoint.poll(1.0), EgmPollResult::kReplied);
+  ASSERT_TRUE(controller.receive(reply, 1.0));
+  const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double change_rad = deg_to_rad((reply.planned_joints_deg - before_deg).cwiseAbs().maxCoeff());
+  EXPECT_LE(change_rad, slow.max_correction_rate_rad_s * (elapsed_s + 0.004) + 1e-12)
+      << "built up " << built_up_rad << " rad";
+}
+
 }  // namespace
 }  // namespace deflex

@@ -42,9 +42,12 @@ bool EgmSensorEndpoint::accept_sequence(std::uint32_t seqno, double now) noexcep
     const bool silent = now - last_accept_s_ > config_.restart_silence_s;
     const bool restart_jump = diff < 0 && seqno <= config_.restart_seqno_max && last_seq_ > seqno + config_.restart_seqno_max;
     if (diff <= 0 && (silent || restart_jump)) {
-      // The controller started again: the old session's correction state must not carry over.
+      // The controller started again: accept its numbering. The compensator is not reset: that
+      // would drop the correction to zero at once, past the rate bound, and a single stray packet
+      // with a small sequence number (another sender on the port) would make the real controller's
+      // next command jump by the whole correction. The correction follows its new target at the
+      // rate bound instead.
       ++counters_.restarts;
-      comp_.reset();
     } else if (diff == 0) {
       ++counters_.duplicate;
       return false;
