@@ -104,8 +104,8 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
     out.dtheta = JointVector::Zero(n);
     return out;
   }
-  // Time since the last cycle; a first cycle or a jump (pause, debugger) counts as one period so the
-  // rate bound never lets a large step through.
+  // Time since the last cycle; a first cycle counts as one period and a long gap (pause, debugger)
+  // as at most ten, so the rate bound never lets a large step through after a pause.
   double dt = config_.period_s;
   if (have_cycle_) {
     dt = std::min(in.t_s - last_cycle_t_s_, 10.0 * config_.period_s);
