@@ -13,29 +13,11 @@
 #include "deflex/model/csv_table.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/online/udp_force_source.hpp"
+#include "online/fd_jacobian.hpp"
 #include "support/allocation_guard.hpp"
 
 namespace deflex {
 namespace {
-
-Jacobian fd_jacobian(const RobotModel& m, const JointVector& q) {
-  Workspace ws(m);
-  Jacobian J(6, m.dof());
-  const double h = 1e-6;
-  for (int i = 0; i < m.dof(); ++i) {
-    JointVector qp = q, qm = q;
-    qp[i] += h;
-    qm[i] -= h;
-    forward_kinematics(m, ws, qp);
-    const Pose a = ws.base_T_wap;
-    forward_kinematics(m, ws, qm);
-    const Pose b = ws.base_T_wap;
-    J.block<3, 1>(0, i) = (a.translation() - b.translation()) / (2 * h);
-    const Eigen::AngleAxisd d(a.linear() * b.linear().transpose());
-    J.block<3, 1>(3, i) = d.axis() * d.angle() / (2 * h);
-  }
-  return J;
-}
 
 // A force source the test can switch on and off; one sample a call when on (atomic: the endpoint
 // may run in another thread).
@@ -99,7 +81,7 @@ class EgmEndToEnd : public ::testing::Test {
   JointVector expected_command_deg(const Vector3& f_base) const {
     Wrench W;
     W << f_base, Vector3::Zero();
-    JointVector d = fd_jacobian(robot, q_rad()).transpose() * W;
+    JointVector d = test::fd_wap_jacobian(robot, q_rad()).transpose() * W;
     for (int i = 0; i < 6; ++i) {
       d[i] /= robot.stiffness()[i];
     }

@@ -8,34 +8,14 @@
 #include "deflex/model/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/online/online_compensator.hpp"
+#include "online/fd_jacobian.hpp"
 #include "support/allocation_guard.hpp"
 
 namespace deflex {
 namespace {
 
-// Geometric Jacobian of the WAP by central differences of forward kinematics (position and
-// rotation vector), independent of the analytic Jacobian under the compensator.
-Jacobian fd_jacobian(const RobotModel& m, const JointVector& q) {
-  Workspace ws(m);
-  Jacobian J(6, m.dof());
-  const double h = 1e-6;
-  for (int i = 0; i < m.dof(); ++i) {
-    JointVector qp = q, qm = q;
-    qp[i] += h;
-    qm[i] -= h;
-    forward_kinematics(m, ws, qp);
-    const Pose a = ws.base_T_wap;
-    forward_kinematics(m, ws, qm);
-    const Pose b = ws.base_T_wap;
-    J.block<3, 1>(0, i) = (a.translation() - b.translation()) / (2 * h);
-    const Eigen::AngleAxisd d(a.linear() * b.linear().transpose());
-    J.block<3, 1>(3, i) = d.axis() * d.angle() / (2 * h);
-  }
-  return J;
-}
-
 JointVector model_dtheta(const RobotModel& m, const JointVector& q, const Wrench& w) {
-  const Jacobian J = fd_jacobian(m, q);
+  const Jacobian J = test::fd_wap_jacobian(m, q);
   JointVector d = J.transpose() * w;
   for (int i = 0; i < m.dof(); ++i) {
     d[i] /= m.stiffness()[i];
