@@ -247,7 +247,7 @@ RunOutput simulate_run(const SetupCell& setup, const RunSpec& spec) {
           ++seqno;
           EgmRobotMessage robot_msg;
           robot_msg.seqno = seqno;
-          robot_msg.tm_ms = static_cast<std::uint32_t>(t * 1e3);
+          robot_msg.tm_ms = egm_time_stamp_ms(t);  // wraps like the controller clock
           robot_msg.feedback_joints_deg = q_cmd * (180.0 / kPi);
           robot_msg.planned_joints_deg = q_plan * (180.0 / kPi);
           robot_msg.motor_state = 1;
