@@ -149,6 +149,33 @@ TEST_F(EgmEndToEnd, ThreadedEndpointAnswersWithTheModelsCorrection) {
   EXPECT_EQ(forces.counters().accepted, 40u);
 }
 
+TEST_F(EgmEndToEnd, JointsBeyondTheRobotsLimitsAreNeverAnswered) {
+  OnlineCompensator comp(robot, sensor, cfg);
+  EgmEndpointConfig ec;
+  ec.port = 0;
+  EgmSensorEndpoint endpoint(comp, ec);
+  SwitchableForce force(reading(Vector3(0, 0, -500)));
+  endpoint.set_force_source(&force);
+  EgmRobotPeer controller("127.0.0.1", endpoint.port());
+  EgmSensorMessage reply;
+  // Finite but impossible joints: planned joint 2 at 1e6 deg; feedback joint 1 at 200 deg (limit 170).
+  EgmRobotMessage absurd = message(20);
+  absurd.planned_joints_deg[1] = 1e6;
+  ASSERT_TRUE(controller.send(absurd));
+  EXPECT_NE(endpoint.poll(0.5), EgmPollResult::kReplied);
+  EXPECT_FALSE(controller.receive(reply, 0.02));
+  EgmRobotMessage beyond = message(21);
+  beyond.feedback_joints_deg[0] = 200.0;
+  ASSERT_TRUE(controller.send(beyond));
+  EXPECT_NE(endpoint.poll(0.5), EgmPollResult::kReplied);
+  EXPECT_FALSE(controller.receive(reply, 0.02));
+  EXPECT_EQ(endpoint.counters().out_of_limits, 2u);
+  // A packet within the limits is answered as usual.
+  ASSERT_TRUE(controller.send(message(22)));
+  EXPECT_EQ(endpoint.poll(1.0), EgmPollResult::kReplied);
+  EXPECT_TRUE(controller.receive(reply, 1.0));
+}
+
 TEST_F(EgmEndToEnd, BadPacketsAreCountedAndNeverAnswered) {
   OnlineCompensator comp(robot, sensor, cfg);
   EgmEndpointConfig ec;

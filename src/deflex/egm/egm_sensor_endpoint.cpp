@@ -62,6 +62,21 @@ bool EgmSensorEndpoint::accept_sequence(std::uint32_t seqno, double now) noexcep
   return true;
 }
 
+bool EgmSensorEndpoint::joints_plausible(const EgmRobotMessage& m) const noexcept {
+  constexpr double kToleranceRad = kPi / 180.0;
+  const RobotModel& model = comp_.model();
+  for (int i = 0; i < model.dof(); ++i) {
+    const double lo = model.lower_limits()[i] - kToleranceRad;
+    const double hi = model.upper_limits()[i] + kToleranceRad;
+    const double planned = deg_to_rad(m.planned_joints_deg[i]);
+    const double feedback = deg_to_rad(m.feedback_joints_deg[i]);
+    if (!(planned >= lo && planned <= hi && feedback >= lo && feedback <= hi)) {
+      return false;
+    }
+  }
+  return true;
+}
+
 EgmPollResult EgmSensorEndpoint::poll(double timeout_s) noexcept {
   if (!socket_.wait_readable(timeout_s)) {
     return EgmPollResult::kTimeout;
@@ -88,6 +103,13 @@ EgmPollResult EgmSensorEndpoint::poll(double timeout_s) noexcept {
       case EgmDecodeStatus::kMissingJoints: ++counters_.missing_joints; continue;
       case EgmDecodeStatus::kNonFinite: ++counters_.non_finite; continue;
       case EgmDecodeStatus::kEmpty: ++counters_.empty; continue;
+    }
+    // A packet that decodes but whose joints no robot of this model can have (a corrupted or foreign
+    // sender) must not be answered: its correction would be computed at a configuration that is not
+    // the arm's. The tolerance allows for the controller's own rounding beyond its soft limits.
+    if (!joints_plausible(msg_)) {
+      ++counters_.out_of_limits;
+      continue;
     }
     if (!accept_sequence(msg_.seqno, now_s())) {
       continue;

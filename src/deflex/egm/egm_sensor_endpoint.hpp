@@ -38,13 +38,14 @@ struct EgmCounters {
   std::uint64_t malformed = 0, truncated = 0, oversized = 0, empty = 0;
   std::uint64_t missing_header = 0, missing_joints = 0, non_finite = 0;
   std::uint64_t duplicate = 0, out_of_order = 0;
+  std::uint64_t out_of_limits = 0;  ///< finite joints beyond the robot's limits (plus 1 deg): never answered
   std::uint64_t superseded = 0;   ///< valid but a newer one arrived in the same drain: not answered
   std::uint64_t restarts = 0;     ///< controller restarts recognised
   std::uint64_t invalid_cycles = 0;  ///< the compensator refused the input: not answered
   std::uint64_t send_errors = 0;
   [[nodiscard]] std::uint64_t rejected() const {
     return malformed + truncated + oversized + empty + missing_header + missing_joints + non_finite + duplicate +
-           out_of_order;
+           out_of_order + out_of_limits;
   }
 };
 
@@ -99,6 +100,7 @@ class EgmSensorEndpoint {
 
  private:
   bool accept_sequence(std::uint32_t seqno, double now_s) noexcept;
+  [[nodiscard]] bool joints_plausible(const EgmRobotMessage& m) const noexcept;
   void record(const EgmCycleRecord& r) noexcept;
   [[nodiscard]] double now_s() const noexcept;
 
