@@ -104,6 +104,10 @@ void setup_online(CLI::App& sub, int& exit_code) {
     positive(o->max_tcp_mm, "--max-tcp-correction-mm");
     positive(o->max_rate_deg_s, "--max-rate-deg-s");
     positive(o->watchdog_ms, "--watchdog-ms");
+    positive(o->status_s, "--status-interval-s");
+    if (!std::isfinite(o->duration_s) || o->duration_s < 0.0) {
+      throw InputError(fmt::format("option --duration-s: must be a number >= 0 (got {})", o->duration_s));
+    }
     OnlineConfig cfg;
     cfg.period_s = o->period_ms * 1e-3;
     cfg.max_joint_correction_rad = deg_to_rad(o->max_joint_deg);
