@@ -312,18 +312,12 @@ double jacobian_min_singular_value(const RobotModel& model, Workspace& ws, const
   return svd.singularValues().minCoeff();
 }
 
-std::vector<IkResult> all_ik_solutions(const RobotModel& model, Workspace& ws, const Pose& base_T_tcp,
-                                       const IkRequest& request) {
+namespace {
+
+/// Every 2*pi turn of every branch that fits the joint limits, each checked by FK.
+std::vector<IkResult> solutions_of_branches(const RobotModel& model, Workspace& ws, const Pose& base_T_tcp,
+                                            const std::vector<Branch>& branches) {
   std::vector<IkResult> out;
-  if (!has_analytic_ik(model)) {
-    return out;
-  }
-  std::vector<Branch> branches;
-  std::string message;
-  const JointVector* seed = request.seed ? &*request.seed : nullptr;
-  if (!analytic_branches(model, base_T_tcp, seed, request.near_singular_threshold, branches, message)) {
-    return out;
-  }
   const JointVector& lo = model.lower_limits();
   const JointVector& hi = model.upper_limits();
   for (const Branch& b : branches) {
@@ -378,6 +372,20 @@ std::vector<IkResult> all_ik_solutions(const RobotModel& model, Workspace& ws, c
   return out;
 }
 
+}  // namespace
+
+std::vector<IkResult> all_ik_solutions(const RobotModel& model, Workspace& ws, const Pose& base_T_tcp,
+                                       const IkRequest& request) {
+  std::vector<Branch> branches;
+  std::string message;
+  const JointVector* seed = request.seed ? &*request.seed : nullptr;
+  if (!has_analytic_ik(model) ||
+      !analytic_branches(model, base_T_tcp, seed, request.near_singular_threshold, branches, message)) {
+    return {};
+  }
+  return solutions_of_branches(model, ws, base_T_tcp, branches);
+}
+
 IkResult inverse_kinematics(const RobotModel& model, Workspace& ws, const Pose& base_T_tcp, const IkRequest& request) {
   IkResult fail;
   if (!base_T_tcp.matrix().allFinite() ||
@@ -402,7 +410,7 @@ IkResult inverse_kinematics(const RobotModel& model, Workspace& ws, const Pose& 
     fail.message = message;
     return fail;
   }
-  const std::vector<IkResult> all = all_ik_solutions(model, ws, base_T_tcp, request);
+  const std::vector<IkResult> all = solutions_of_branches(model, ws, base_T_tcp, branches);
   if (all.empty()) {
     fail.status = IkStatus::kOutsideJointLimits;
     fail.message = "the pose is reachable, but every solution violates a joint limit";
