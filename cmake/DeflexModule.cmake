@@ -26,3 +26,17 @@ function(deflex_module name)
   endif()
   set(DEFLEX_MODULE_TARGETS ${DEFLEX_MODULE_TARGETS} ${target} CACHE INTERNAL "")
 endfunction()
+
+# deflex_embed_text(TARGET FILE SYMBOL)
+# Compiles the text of FILE (relative to the source tree) into TARGET as
+# `extern const char* const deflex::SYMBOL`. The generated source is rewritten only when the text
+# changes, so a re-configure does not force a recompile; editing FILE re-runs the configure.
+function(deflex_embed_text target file symbol)
+  set(src ${PROJECT_SOURCE_DIR}/${file})
+  set_property(DIRECTORY ${PROJECT_SOURCE_DIR} APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${src})
+  file(READ ${src} text)
+  set(out ${PROJECT_BINARY_DIR}/generated/${symbol}.cpp)
+  file(CONFIGURE OUTPUT ${out} @ONLY CONTENT
+    "// Generated from ${file} by deflex_embed_text (cmake/DeflexModule.cmake).\nnamespace deflex { extern const char* const ${symbol}; const char* const ${symbol} = R\"deflexembed(@text@)deflexembed\"; }\n")
+  target_sources(${target} PRIVATE ${out})
+endfunction()
