@@ -112,6 +112,30 @@ TEST(RobotFile, BuiltinIrb6700HasItsDocumentedNumbers) {
   EXPECT_DOUBLE_EQ(m.stiffness()[5], 3.0e5);
   EXPECT_NEAR(rad_to_deg(m.lower_limits()[1]), -65.0, 1e-12);
   EXPECT_NEAR(rad_to_deg(m.upper_limits()[2]), 70.0, 1e-12);
+  // Joint speed limits, deg/s, as the file's comment cites them.
+  const double speeds_deg_s[6] = {100, 90, 90, 170, 120, 190};
+  ASSERT_TRUE(m.has_max_speed());
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_NEAR(m.max_speed()[i], speeds_deg_s[i] * kPi / 180.0, 1e-12) << "joint " << i + 1;
+  }
+}
+
+TEST(RobotFile, JointSpeedLimitsInTheFileUnitAndUnknownWhenAbsent) {
+  const RobotModel none = load_robot_yaml_text(kGood, "robot.yaml");
+  EXPECT_FALSE(none.has_max_speed());
+  EXPECT_TRUE(std::isinf(none.max_speed()[0]));
+  const RobotModel deg =
+      load_robot_yaml_text(replace(kGood, "min: -170, max: 170}\n    - {a: 600", "min: -170, max: 170, max_speed: 45}\n    - {a: 600"),
+                           "robot.yaml");
+  EXPECT_NEAR(deg.max_speed()[0], kPi / 4.0, 1e-12);  // 45 deg/s
+  EXPECT_TRUE(std::isinf(deg.max_speed()[1]));
+  expect_error(replace(kGood, "min: -170, max: 170}\n    - {a: 600", "min: -170, max: 170, max_speed: -3}\n    - {a: 600"),
+               {"robot.yaml:7", "kinematics.joints[1].max_speed", "positive"});
+  // Written and read back: the limit survives (robot_to_yaml writes degrees per second).
+  const std::string path = write_temp("speed_roundtrip.yaml", robot_to_yaml(builtin_irb6700()));
+  const RobotModel back = load_robot(path);
+  EXPECT_LT((back.max_speed() - builtin_irb6700().max_speed()).norm(), 1e-9);
+  fs::remove(path);
 }
 
 // The IRB6700 written as a URDF by hand from the published axis positions (not from the DH table):
@@ -141,6 +165,7 @@ TEST(RobotFile, UrdfChainMatchesTheDhModel) {
   const std::string path = write_temp("irb.urdf", kIrbUrdf);
   const RobotModel urdf = load_robot(path);
   EXPECT_FALSE(urdf.has_stiffness());
+  EXPECT_DOUBLE_EQ(urdf.max_speed()[0], 1.0);  // <limit velocity="1"/>, rad/s
   EXPECT_THROW((void)urdf.stiffness(), ModelError);
   const RobotModel dh = builtin_irb6700();
   Workspace wu(urdf);

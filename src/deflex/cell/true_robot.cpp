@@ -49,12 +49,13 @@ TrueRobot::TrueRobot(const CaseConfig& config, bool sensor_mounted, std::uint64_
     r.theta_offset_rad += config.robot.dh_angle_sigma_rad * normal(rng);
   }
   if (desc.dh_convention && (config.robot.dh_length_sigma_m > 0 || config.robot.dh_angle_sigma_rad > 0)) {
-    std::vector<double> lower, upper;
+    std::vector<double> lower, upper, speed;
     for (const auto& j : desc.joints) {
       lower.push_back(j.lower_rad);
       upper.push_back(j.upper_rad);
+      speed.push_back(j.max_speed_rad_s);
     }
-    set_dh_chain(desc, *desc.dh_convention, rows, lower, upper);
+    set_dh_chain(desc, *desc.dh_convention, rows, lower, upper, speed);
   }
   std::vector<double> k_true(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {

@@ -122,6 +122,10 @@ RobotDescription load_urdf_chain(const std::string& path, const std::string& bas
           throw ModelError(fmt::format("{}: joint '{}': axis has zero length", path, j->name));
         }
         s.axis.normalize();
+        // URDF gives the speed limit in rad/s; 0 (or none) means the file does not say.
+        if (j->limits && j->limits->velocity > 0.0) {
+          s.max_speed_rad_s = j->limits->velocity;
+        }
         if (j->type == urdf::Joint::REVOLUTE && j->limits) {
           s.lower_rad = j->limits->lower;
           s.upper_rad = j->limits->upper;
@@ -166,9 +170,10 @@ RobotModel load_robot_yaml_text(const std::string& text, const std::string& sour
     std::vector<DhRow> rows;
     std::vector<double> lo;
     std::vector<double> hi;
+    std::vector<double> speed;
     for (std::size_t i = 0; i < joints.size(); ++i) {
       const yaml::Field j = joints.at(i);
-      j.only_keys({"a", "alpha", "d", "offset", "min", "max"});
+      j.only_keys({"a", "alpha", "d", "offset", "min", "max", "max_speed"});
       DhRow r;
       r.a_m = j.at("a").as_double() * u.length;
       r.alpha_rad = j.at("alpha").as_double() * u.angle;
@@ -180,8 +185,17 @@ RobotModel load_robot_yaml_text(const std::string& text, const std::string& sour
       if (!(lo.back() < hi.back())) {
         j.fail("'min' must be below 'max'");
       }
+      // The file's angle unit per second (deg/s with angle: deg).
+      speed.push_back(HUGE_VAL);
+      if (j.has("max_speed")) {
+        speed.back() = j.at("max_speed").as_double() * u.angle;
+        if (!(speed.back() > 0.0)) {
+          j.at("max_speed").fail("joint speed limit must be positive (angle unit per second)");
+        }
+      }
     }
-    set_dh_chain(d, convention == "standard_dh" ? DhConvention::kStandard : DhConvention::kModified, rows, lo, hi);
+    set_dh_chain(d, convention == "standard_dh" ? DhConvention::kStandard : DhConvention::kModified, rows, lo, hi,
+                 speed);
   } else if (convention == "urdf") {
     kin.only_keys({"convention", "file", "base_link", "tip_link"});
     fs::path file = kin.at("file").as_string();
@@ -260,9 +274,11 @@ std::string robot_to_yaml(const RobotModel& model) {
                        *d.dh_convention == DhConvention::kStandard ? "standard_dh" : "modified_dh");
     for (std::size_t i = 0; i < d.dh.size(); ++i) {
       const DhRow& r = d.dh[i];
-      out += fmt::format("    - {{a: {:.9g}, alpha: {:.9g}, d: {:.9g}, offset: {:.9g}, min: {:.9g}, max: {:.9g}}}\n", r.a_m,
+      const double speed = d.joints[i].max_speed_rad_s;
+      out += fmt::format("    - {{a: {:.9g}, alpha: {:.9g}, d: {:.9g}, offset: {:.9g}, min: {:.9g}, max: {:.9g}{}}}\n", r.a_m,
                          rad_to_deg(r.alpha_rad), r.d_m, rad_to_deg(r.theta_offset_rad),
-                         rad_to_deg(d.joints[i].lower_rad), rad_to_deg(d.joints[i].upper_rad));
+                         rad_to_deg(d.joints[i].lower_rad), rad_to_deg(d.joints[i].upper_rad),
+                         std::isfinite(speed) ? fmt::format(", max_speed: {:.9g}", rad_to_deg(speed)) : "");
     }
   } else if (!d.urdf_file.empty()) {
     out += fmt::format("  convention: urdf\n  file: \"{}\"\n  base_link: \"{}\"\n  tip_link: \"{}\"\n", d.urdf_file,

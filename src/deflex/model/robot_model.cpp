@@ -26,7 +26,8 @@ bool is_rotation(const Matrix3& r) {
 }  // namespace
 
 void set_dh_chain(RobotDescription& desc, DhConvention convention, const std::vector<DhRow>& rows,
-                  const std::vector<double>& lower_rad, const std::vector<double>& upper_rad) {
+                  const std::vector<double>& lower_rad, const std::vector<double>& upper_rad,
+                  const std::vector<double>& max_speed_rad_s) {
   desc.dh_convention = convention;
   desc.dh = rows;
   desc.joints.clear();
@@ -41,6 +42,7 @@ void set_dh_chain(RobotDescription& desc, DhConvention convention, const std::ve
     j.offset_rad = r.theta_offset_rad;
     j.lower_rad = i < lower_rad.size() ? lower_rad[i] : -kPi;
     j.upper_rad = i < upper_rad.size() ? upper_rad[i] : kPi;
+    j.max_speed_rad_s = i < max_speed_rad_s.size() ? max_speed_rad_s[i] : HUGE_VAL;
     if (convention == DhConvention::kStandard) {
       j.parent_T_joint = pending;
       pending = trans(0, 0, r.d_m) * trans(r.a_m, 0, 0) * rot_x(r.alpha_rad);
@@ -65,6 +67,7 @@ RobotModel::RobotModel(RobotDescription desc) : desc_(std::move(desc)) {
   dof_ = static_cast<int>(n);
   lower_.resize(dof_);
   upper_.resize(dof_);
+  max_speed_.resize(dof_);
   for (std::size_t i = 0; i < n; ++i) {
     const JointSpec& j = d.joints[i];
     const std::string where = fmt::format("joints[{}]", i + 1);
@@ -81,6 +84,10 @@ RobotModel::RobotModel(RobotDescription desc) : desc_(std::move(desc)) {
       fail(d, where + ".limits", fmt::format("lower limit ({} rad) must be below upper limit ({} rad)",
                                              j.lower_rad, j.upper_rad));
     }
+    if (std::isnan(j.max_speed_rad_s) || !(j.max_speed_rad_s > 0.0)) {
+      fail(d, where + ".max_speed", fmt::format("joint speed limit must be positive (got {} rad/s)", j.max_speed_rad_s));
+    }
+    max_speed_[static_cast<int>(i)] = j.max_speed_rad_s;
     lower_[static_cast<int>(i)] = j.lower_rad;
     upper_[static_cast<int>(i)] = j.upper_rad;
     if ((j.axis - Vector3::UnitZ()).norm() > 1e-12) {

@@ -3,6 +3,7 @@
 // (kinematics.hpp): the model never changes once built, so one model serves many threads.
 #pragma once
 
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -35,6 +36,8 @@ struct JointSpec {
   double offset_rad = 0.0;
   double lower_rad = -kPi;
   double upper_rad = kPi;
+  /// Largest joint speed the controller allows, rad/s; infinity when the file does not say.
+  double max_speed_rad_s = HUGE_VAL;
 };
 
 /// Everything a robot file says. Plain data: fill it, then build a RobotModel (which validates it).
@@ -61,8 +64,10 @@ struct RobotDescription {
 };
 
 /// Builds the joints and the flange transform of a DH chain. Lengths in m, angles in rad.
+/// `max_speed_rad_s` may be empty (speeds unknown: infinity).
 void set_dh_chain(RobotDescription& desc, DhConvention convention, const std::vector<DhRow>& rows,
-                  const std::vector<double>& lower_rad, const std::vector<double>& upper_rad);
+                  const std::vector<double>& lower_rad, const std::vector<double>& upper_rad,
+                  const std::vector<double>& max_speed_rad_s = {});
 
 /// A validated robot description with quantities derived once. Immutable.
 class RobotModel {
@@ -84,6 +89,9 @@ class RobotModel {
 
   [[nodiscard]] const JointVector& lower_limits() const { return lower_; }
   [[nodiscard]] const JointVector& upper_limits() const { return upper_; }
+  /// Largest joint speeds, rad/s (infinity where the robot file gives none).
+  [[nodiscard]] const JointVector& max_speed() const { return max_speed_; }
+  [[nodiscard]] bool has_max_speed() const { return max_speed_.allFinite(); }
   /// True when every joint of q is inside its limits, within `tolerance_rad`.
   [[nodiscard]] bool within_limits(const JointVector& q, double tolerance_rad = 1e-9) const;
 
@@ -107,6 +115,7 @@ class RobotModel {
   JointVector compliance_;
   JointVector lower_;
   JointVector upper_;
+  JointVector max_speed_;
   Pose flange_T_wap_ = Pose::Identity();
   bool z_axes_only_ = true;
 };
