@@ -1,21 +1,24 @@
-// Loopback EGM round trip: a controller-side peer sends an EgmRobot message, the sensor endpoint (its
-// own thread, callback style) drains, decodes, runs the compensator on a fresh force sample and
-// replies; the peer receives the EgmSensor reply. Reports p50/p99/max over 100,000 cycles and the
-// heap allocations counted in steady state (both threads).
+// Loopback round trips of deflex's ABB EGM links: a controller-side sender encodes an EgmRobot
+// message, the link (its own thread) drains, decodes, runs the strategy and the compensator on a
+// fresh force sample and answers; the sender receives the answer. Beside them, the floor: the same
+// exchange with a plain UDP echo (no decode, no compute), so the link's own cost is the difference.
+// Reports p50/p99/max over 100,000 cycles and the heap allocations counted in steady state.
 //   build-*/bench/egm_bench
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
+#include <memory>
 #include <new>
 #include <thread>
 #include <vector>
 
 #include <benchmark/benchmark.h>
 
-#include "deflex/egm/egm_robot_peer.hpp"
-#include "deflex/egm/egm_sensor_endpoint.hpp"
+#include "deflex/egm/egm_joint_link.hpp"
+#include "deflex/egm/egm_path_link.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/transport/udp_transport.hpp"
 
 // GCC sees the replacement operator new (malloc) and delete (free) of this file inlined into the same
 // translation unit and calls them mismatched; they are the standard replacement pair.
@@ -57,64 +60,125 @@ class ConstantForce final : public ForceSource {
   bool served_ = false;
 };
 
-void BM_EgmLoopbackRoundTrip(benchmark::State& state) {
+struct RoundTrips {
+  std::vector<double> us;
+  std::size_t lost = 0;
+};
+
+// Sends `cycles` EgmRobot messages from a fresh socket to `to` and times each answer.
+RoundTrips exchange(const DatagramAddress& to, std::size_t cycles, const JointVector& q_deg) {
+  UdpTransport controller("127.0.0.1", 0);
+  EgmCodec codec(6);
+  EgmRobotMessage msg;
+  msg.feedback_joints_deg = msg.planned_joints_deg = q_deg;
+  msg.has_planned = true;
+  std::vector<unsigned char> out(1024), in(2048);
+  RoundTrips r;
+  r.us.resize(cycles);
+  std::uint32_t seq = 0;
+  const auto one = [&](double& us) {
+    msg.seqno = ++seq;
+    msg.tm_ms = seq * 4;
+    const std::size_t n = codec.encode_robot(msg, out.data(), out.size());
+    const auto t0 = std::chrono::steady_clock::now();
+    controller.send_to(out.data(), n, to);
+    DatagramAddress from;
+    if (!controller.wait_readable(1.0) || controller.receive(in.data(), in.size(), from) < 0) ++r.lost;
+    us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
+  };
+  double warm = 0.0;
+  for (int i = 0; i < 200; ++i) one(warm);  // sockets, caches, protobuf messages
+  g_allocations = 0;
+  g_counting = true;
+  for (std::size_t i = 0; i < cycles; ++i) one(r.us[i]);
+  g_counting = false;
+  return r;
+}
+
+void report(benchmark::State& state, RoundTrips& r) {
+  std::sort(r.us.begin(), r.us.end());
+  const auto pct = [&](double p) { return r.us[static_cast<std::size_t>(p * static_cast<double>(r.us.size() - 1))]; };
+  state.counters["cycles"] = static_cast<double>(r.us.size());
+  state.counters["p50_us"] = pct(0.50);
+  state.counters["p99_us"] = pct(0.99);
+  state.counters["max_us"] = r.us.back();
+  state.counters["lost"] = static_cast<double>(r.lost);
+  state.counters["allocations"] = static_cast<double>(g_allocations.load());
+}
+
+JointVector start_deg() {
+  JointVector q(6);
+  q << 0, 20, 10, 0, 60, 0;
+  return q;
+}
+
+// The floor: the same datagrams bounced by a plain UDP echo.
+void BM_UdpLoopbackFloor(benchmark::State& state) {
+  UdpTransport echo("127.0.0.1", 0);
+  std::atomic<bool> stop{false};
+  std::thread server([&] {
+    std::vector<unsigned char> buf(2048);
+    while (!stop.load()) {
+      if (!echo.wait_readable(0.05)) continue;
+      DatagramAddress from;
+      const long n = echo.receive(buf.data(), buf.size(), from);
+      if (n > 0) echo.send_to(buf.data(), static_cast<std::size_t>(n), from);
+    }
+  });
+  for (auto _ : state) {
+    RoundTrips r = exchange(echo.local_address(), static_cast<std::size_t>(state.range(0)), start_deg());
+    report(state, r);
+  }
+  stop = true;
+  server.join();
+}
+BENCHMARK(BM_UdpLoopbackFloor)->Arg(100000)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+template <class Link>
+void run_link(benchmark::State& state, Link& link, UdpTransport& transport) {
+  std::atomic<bool> stop{false};
+  std::thread server([&] {
+    while (!stop.load()) (void)link.poll(0.05);
+  });
+  for (auto _ : state) {
+    RoundTrips r = exchange(transport.local_address(), static_cast<std::size_t>(state.range(0)), start_deg());
+    report(state, r);
+    state.counters["replies"] = static_cast<double>(link.counters().replies);
+  }
+  stop = true;
+  server.join();
+}
+
+void BM_EgmJointLinkRoundTrip(benchmark::State& state) {
   const RobotModel robot = builtin_irb6700();
   SensorConfig sensor;
   sensor.components = 6;
   OnlineCompensator comp(robot, sensor, OnlineConfig{});
-  EgmEndpointConfig ec;
-  ec.port = 0;
-  EgmSensorEndpoint endpoint(comp, ec);
+  OnlineStrategy strategy(robot, StrategyKind::kOnline, nullptr);
+  const JointVector q = start_deg() * (kPi / 180.0);
+  auto program = std::make_shared<const JointTrajectory>(std::vector<double>{0.0, 1e6}, std::vector<JointVector>{q, q},
+                                                         robot, "hold");
   ConstantForce force;
-  endpoint.set_force_source(&force);
-  std::atomic<bool> stop{false};
-  std::thread server([&] { endpoint.run(stop, nullptr, 0.05); });
-
-  EgmRobotPeer controller("127.0.0.1", endpoint.port());
-  EgmRobotMessage msg;
-  msg.feedback_joints_deg = JointVector::Zero(6);
-  msg.feedback_joints_deg << 0, 20, 10, 0, 60, 0;
-  msg.planned_joints_deg = msg.feedback_joints_deg;
-  EgmSensorMessage reply;
-  reply.planned_joints_deg = JointVector::Zero(6);
-  const std::size_t cycles = static_cast<std::size_t>(state.range(0));
-  std::vector<double> rtt_us(cycles);
-  std::uint32_t seq = 0;
-  // Warm-up (sockets, caches, protobuf messages).
-  for (int i = 0; i < 200; ++i) {
-    msg.seqno = ++seq;
-    controller.send(msg);
-    controller.receive(reply, 1.0);
-  }
-  std::size_t lost = 0;
-  for (auto _ : state) {
-    g_allocations = 0;
-    g_counting = true;
-    for (std::size_t i = 0; i < cycles; ++i) {
-      msg.seqno = ++seq;
-      msg.tm_ms = seq * 4;
-      const auto t0 = std::chrono::steady_clock::now();
-      controller.send(msg);
-      if (!controller.receive(reply, 1.0)) {
-        ++lost;
-      }
-      rtt_us[i] = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
-    }
-    g_counting = false;
-  }
-  stop = true;
-  server.join();
-  std::sort(rtt_us.begin(), rtt_us.end());
-  const auto pct = [&](double p) { return rtt_us[static_cast<std::size_t>(p * static_cast<double>(cycles - 1))]; };
-  state.counters["cycles"] = static_cast<double>(cycles);
-  state.counters["p50_us"] = pct(0.50);
-  state.counters["p99_us"] = pct(0.99);
-  state.counters["max_us"] = rtt_us.back();
-  state.counters["lost"] = static_cast<double>(lost);
-  state.counters["allocations"] = static_cast<double>(g_allocations.load());
-  state.counters["replies"] = static_cast<double>(endpoint.counters().replies);
+  UdpTransport transport("127.0.0.1", 0);
+  SteadyClock clock;
+  EgmJointLink link(comp, strategy, program, transport, clock, &force);
+  run_link(state, link, transport);
 }
-BENCHMARK(BM_EgmLoopbackRoundTrip)->Arg(100000)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EgmJointLinkRoundTrip)->Arg(100000)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+void BM_EgmPathLinkRoundTrip(benchmark::State& state) {
+  const RobotModel robot = builtin_irb6700();
+  SensorConfig sensor;
+  sensor.components = 6;
+  OnlineCompensator comp(robot, sensor, OnlineConfig{});
+  OnlineStrategy strategy(robot, StrategyKind::kOnline, nullptr);
+  ConstantForce force;
+  UdpTransport transport("127.0.0.1", 0);
+  SteadyClock clock;
+  EgmPathLink link(comp, strategy, transport, clock, &force);
+  run_link(state, link, transport);
+}
+BENCHMARK(BM_EgmPathLinkRoundTrip)->Arg(100000)->Iterations(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace deflex

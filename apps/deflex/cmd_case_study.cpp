@@ -9,7 +9,7 @@
 
 #include "cli_util.hpp"
 #include "command.hpp"
-#include "deflex/cell/case_study.hpp"
+#include "deflex/study/case_study.hpp"
 #include "deflex/evaluate/study_tables.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/report/html_report.hpp"
@@ -34,7 +34,7 @@ void draw_progress(double fraction, const std::string& label) {
   std::fflush(stderr);
 }
 
-std::vector<std::string> honest_notes(const cell::CaseConfig& config, const StudyResult& study) {
+std::vector<std::string> honest_notes(const study::CaseConfig& config, const StudyResult& study) {
   std::vector<std::string> notes;
   notes.push_back(
       "These figures come from deflex's simulated cell, not from a robot. The cell's sizes are in the case file and "
@@ -82,8 +82,8 @@ std::vector<std::string> honest_notes(const cell::CaseConfig& config, const Stud
       const auto& top = s.loads.back().compensation;
       double mean = 0;
       for (const auto& [speed, comp] : top) mean += comp / static_cast<double>(top.size());
-      if (sc.strategy == cell::Strategy::kOffline) offline_high = mean;
-      if (sc.strategy == cell::Strategy::kOnline) online_high = mean;
+      if (sc.strategy == study::Strategy::kOffline) offline_high = mean;
+      if (sc.strategy == study::Strategy::kOnline && sc.link == study::LinkKind::kEgmJoint) online_high = mean;
     }
   }
   if (std::isfinite(offline_high) && std::isfinite(online_high)) {
@@ -97,16 +97,16 @@ std::vector<std::string> honest_notes(const cell::CaseConfig& config, const Stud
 }
 
 void run(const Opts& o, int& exit_code) {
-  cell::CaseConfig config = o.case_file.empty() ? cell::paper_case() : cell::load_case(o.case_file);
+  study::CaseConfig config = o.case_file.empty() ? study::paper_case() : study::load_case(o.case_file);
   if (o.seed >= 0) config.seed = static_cast<std::uint64_t>(o.seed);
-  cell::CaseStudyOptions options;
+  study::CaseStudyOptions options;
   options.quick = o.quick;
   options.speed_sweep = !o.no_sweep;
   options.error_budget = !o.no_budget;
   options.threads = o.threads;
   if (!o.no_progress) options.progress = draw_progress;
   std::cerr << fmt::format("deflex case-study: {} (seed {}{})\n", config.name, config.seed, o.quick ? ", quick" : "");
-  const cell::CaseStudyOutput result = cell::run_case_study(config, options);
+  const study::CaseStudyOutput result = study::run_case_study(config, options);
   if (!o.no_progress) std::cerr << "\n";
 
   ReportContent report;
@@ -130,7 +130,7 @@ void run(const Opts& o, int& exit_code) {
     report.error_budgets.push_back(eb);
   }
   report.notes = honest_notes(config, result.study);
-  report.case_text = o.case_file.empty() ? cell::paper_case_yaml() : std::string();
+  report.case_text = o.case_file.empty() ? study::paper_case_yaml() : std::string();
   write_report(report, o.out_dir);
 
   if (o.json) {
@@ -153,6 +153,16 @@ void run(const Opts& o, int& exit_code) {
         std::cout << fmt::format("  {:<48} {:<34} C without it {:.3f} mm ({:+.0f}% of C)\n", r.name, r.size,
                                  r.residual_mm_without,
                                  100.0 * residual_share(b.residual_mm_all, r.residual_mm_without));
+      }
+    }
+    if (!result.links.empty()) {
+      std::cout << "\nThe online setups' controller links (deflex's deployable link code, over the cell's network):\n";
+      for (const auto& l : result.links) {
+        std::cout << fmt::format(
+            "  {:<16} {:>8} cycles answered, {} datagrams rejected, {} commands stopped by the guard; "
+            "largest correction {:.3f} mrad of the {:.1f} mrad bound ({:.3f} mm at the TCP); measured delay {:.0f} ms\n",
+            l.setup, l.cycles, l.rejected, l.guard_trips, l.max_command_deviation_rad * 1e3, l.bound_rad * 1e3,
+            l.max_tcp_correction_m * 1e3, l.measured_delay_s * 1e3);
       }
     }
     std::cout << fmt::format(

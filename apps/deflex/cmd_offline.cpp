@@ -18,6 +18,7 @@
 #include "deflex/offline/offline_csv.hpp"
 #include "deflex/offline/offline_summary.hpp"
 #include "deflex/offline/rapid_module.hpp"
+#include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/path_spec.hpp"
 #include "deflex/paths/pose_path_csv.hpp"
@@ -27,6 +28,8 @@ namespace {
 
 struct Opts {
   std::string robot, circle, line, path_csv, orientation = "0,0,1,0", config, seed, csv_out, rapid_out;
+  std::string trajectory_out, nominal_trajectory_out;
+  double hold_start_s = 0.0;
   std::vector<std::string> forces;
   std::string motion = "absj", zone = "fine", tool = "tool0", wobj = "wobj0", module = "DeflexOffline";
   double speed_mm_s = 10.0;
@@ -144,6 +147,30 @@ void run(const Opts& o, int& exit_code) {
                            joints.configuration.cf1, joints.configuration.cf4, joints.configuration.cf6,
                            joints.configuration.cfx);
 
+  // Timed joint programs for the streaming links (deflex online --program): the path at the TCP
+  // speed, compensated (per load) or nominal.
+  if (!std::isfinite(o.hold_start_s) || o.hold_start_s < 0.0 || o.hold_start_s > 3600.0) {
+    throw InputError(fmt::format("option --hold-start-s: must be 0..3600 s (got {})", o.hold_start_s));
+  }
+  if ((!o.trajectory_out.empty() || !o.nominal_trajectory_out.empty()) &&
+      (!std::isfinite(o.speed_mm_s) || !(o.speed_mm_s > 0.0) || o.speed_mm_s > 10000.0)) {
+    throw InputError(fmt::format("option --speed-mm-s: must be a positive TCP speed up to 10000 mm/s (got {})",
+                                 o.speed_mm_s));
+  }
+  const auto write_trajectory = [&](const std::vector<JointVector>& q, const std::string& file,
+                                    const std::string& what) {
+    const JointTrajectory t = trajectory_at_tcp_speed(poses, q, o.speed_mm_s * 1e-3, model, o.hold_start_s);
+    t.write_csv(file, fmt::format("deflex offline: {} joint trajectory of {} at {:g} mm/s ({} points, {:.3f} s); "
+                                  "stream it with deflex online --link egm-joint --program {}",
+                                  what, path_text, o.speed_mm_s, t.size(), t.duration_s(), file));
+    return t;
+  };
+  if (!o.nominal_trajectory_out.empty()) {
+    const JointTrajectory t = write_trajectory(joints.q, o.nominal_trajectory_out, "nominal (uncompensated)");
+    (o.json ? std::cerr : std::cout) << fmt::format("wrote {} (nominal joint trajectory, {:.3f} s)\n",
+                                                    o.nominal_trajectory_out, t.duration_s());
+  }
+
   nlohmann::json runs = nlohmann::json::array();
   const bool several = forces.size() > 1;
   std::vector<std::string> labels;  // file-name labels, made unique so no run overwrites another
@@ -184,6 +211,16 @@ void run(const Opts& o, int& exit_code) {
       write_offline_csv(result, file);
       run["csv"] = file;
       extra += fmt::format("wrote {}\n", file);
+    }
+    if (!o.trajectory_out.empty()) {
+      const std::string file = several ? suffixed(o.trajectory_out, label) : o.trajectory_out;
+      std::vector<JointVector> q;
+      q.reserve(result.points.size());
+      for (const auto& p : result.points) q.push_back(p.q_command);
+      const JointTrajectory t = write_trajectory(q, file, "compensated");
+      run["joint_trajectory"] = file;
+      extra += fmt::format("wrote {} (compensated joint trajectory, {:.3f} s at {:g} mm/s)\n", file, t.duration_s(),
+                           o.speed_mm_s);
     }
     if (!o.rapid_out.empty()) {
       const std::string file = several ? suffixed(o.rapid_out, label) : o.rapid_out;
@@ -233,7 +270,16 @@ void setup_offline(CLI::App& sub, int& exit_code) {
                  "\"ldbb:phi_deg=A,force_N=...\" (circle only: pivot on the circle's axis, bar inclined by A), "
                  "\"constant:fx_N=..,fy_N=..,fz_N=..,mx_Nm=..,my_Nm=..,mz_Nm=..\", \"table:FILE.csv\"")
       ->required();
-  sub.add_option("--speed-mm-s", o->speed_mm_s, "TCP speed for the RAPID speeddata, mm/s (default 10)");
+  sub.add_option("--speed-mm-s", o->speed_mm_s,
+                 "TCP speed, mm/s (default 10): the RAPID speeddata and the timing of the joint trajectories");
+  sub.add_option("--joint-trajectory", o->trajectory_out,
+                 "Write the compensated path as a timed joint trajectory CSV (t_s,q1_deg..) at --speed-mm-s, for deflex "
+                 "online --program (hybrid strategy); one file per load when several");
+  sub.add_option("--nominal-trajectory", o->nominal_trajectory_out,
+                 "Write the uncompensated path as a timed joint trajectory CSV at --speed-mm-s, for deflex online "
+                 "--program (online and predictive strategies)");
+  sub.add_option("--hold-start-s", o->hold_start_s,
+                 "Joint trajectories: hold the first point this long before moving, s (default 0)");
   sub.add_option("--zone", o->zone, "RAPID zonedata: fine (default) or z0, z1, z5, z10, ...");
   sub.add_option("--motion", o->motion, "RAPID motion: absj (MoveAbsJ over jointtargets, default) or movel "
                                         "(MoveL over robtargets with confdata)");

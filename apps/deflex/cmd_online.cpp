@@ -1,6 +1,6 @@
-// Subcommands of the online strategy: `online` (the EGM sensor-side compensator, runs until SIGINT or
-// SIGTERM) and `identify-payload` (end-effector mass, centre of gravity and sensor bias from static
-// poses).
+// Subcommands of the online strategies: `online` (deflex on a controller link: ABB EGM position
+// guidance or path correction; runs until the session ends, SIGINT or SIGTERM) and `identify-payload`
+// (end-effector mass, centre of gravity and sensor bias from static poses).
 #include <atomic>
 #include <cmath>
 #include <chrono>
@@ -14,7 +14,10 @@
 
 #include "cli_util.hpp"
 #include "command.hpp"
-#include "deflex/egm/egm_sensor_endpoint.hpp"
+#include "deflex/egm/egm_joint_link.hpp"
+#include "deflex/egm/egm_path_link.hpp"
+#include "deflex/force/force_spec.hpp"
+#include "deflex/transport/udp_transport.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/online/csv_force_replay.hpp"
@@ -60,35 +63,137 @@ std::unique_ptr<ForceSource> make_force_source(const std::string& spec, bool loo
   throw InputError(fmt::format("option --force-source: '{}' is not udp:PORT or csv:FILE", spec));
 }
 
+// The per-cycle CSV log (degrees, mm, N, microseconds), written outside the link's cycle.
+class CycleLog {
+ public:
+  CycleLog(const std::string& path, int joints) : joints_(joints) {
+    if (path.empty()) return;
+    file_ = std::fopen(path.c_str(), "w");
+    if (file_ == nullptr) {
+      throw Error(fmt::format("{}: cannot write the cycle log", path));
+    }
+    buffer_.resize(1 << 20);
+    std::setvbuf(file_, buffer_.data(), _IOFBF, buffer_.size());
+    std::string header = "t_s,program_t_s,sequence,status";
+    for (const char* name : {"q_nominal", "q_feedback", "q_command", "dtheta"}) {
+      for (int j = 1; j <= joints; ++j) header += fmt::format(",{}{}_deg", name, j);
+    }
+    header += ",corr_x_mm,corr_y_mm,corr_z_mm,fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,delay_ms,compute_us\n";
+    std::fputs(header.c_str(), file_);
+  }
+  ~CycleLog() {
+    if (file_ != nullptr) std::fclose(file_);
+  }
+  CycleLog(const CycleLog&) = delete;
+  CycleLog& operator=(const CycleLog&) = delete;
+  void write(const LinkCycleRecord& r) {
+    if (file_ == nullptr) return;
+    std::fprintf(file_, "%.6f,%.9f,%u,%d", r.t_s, r.program_time_s, r.sequence, static_cast<int>(r.status));
+    for (const JointVector* q : {&r.q_nominal, &r.q_feedback, &r.q_command, &r.dtheta}) {
+      for (int j = 0; j < joints_ && j < q->size(); ++j) std::fprintf(file_, ",%.10g", rad_to_deg((*q)[j]));
+    }
+    std::fprintf(file_, ",%.6f,%.6f,%.6f", r.tcp_correction_m.x() * 1e3, r.tcp_correction_m.y() * 1e3,
+                 r.tcp_correction_m.z() * 1e3);
+    for (int j = 0; j < 6; ++j) std::fprintf(file_, ",%.6g", r.wrench_base[j]);
+    std::fprintf(file_, ",%.2f,%.2f\n", r.delay_s * 1e3, r.compute_s * 1e6);
+  }
+
+ private:
+  std::FILE* file_ = nullptr;
+  std::vector<char> buffer_;
+  int joints_;
+};
+
+std::string refusal_text(const ControllerLink& link, const JointTrajectory& program, double tolerance_deg) {
+  std::string joints;
+  const JointVector& d = link.start_distance();
+  for (int j = 0; j < d.size(); ++j) {
+    if (rad_to_deg(d[j]) > tolerance_deg) {
+      joints += fmt::format("{}joint {} is {:.3f} deg away", joints.empty() ? "" : ", ", j + 1, rad_to_deg(d[j]));
+    }
+  }
+  return fmt::format(
+      "deflex online: refusing to start: the controller reports the arm more than {:g} deg from where the program "
+      "{} is ({}). Move the robot to the program's start first; nothing was sent to the controller.",
+      tolerance_deg, program.source(), joints);
+}
+
 void setup_online(CLI::App& sub, int& exit_code) {
   struct Opts {
-    std::string robot, sensor, force, log, bind = "127.0.0.1", fault_dump, jacobian_at = "planned";
+    std::string link, robot, sensor, force_source, program, strategy = "online", force_model, log, bind = "127.0.0.1",
+        fault_dump, jacobian_at = "nominal", path_frame = "tool";
     int egm_port = -1;
     double period_ms = 4.0, max_joint_deg = 0.5, max_tcp_mm = 5.0, max_rate_deg_s = 3.0, watchdog_ms = 50.0;
+    double ramp_in_s = 1.0, correction_latency_ms = 0.0, rotation_warning_mrad = 0.1, end_silence_s = 2.0;
     double duration_s = 0.0, status_s = 1.0;
-    bool loop = false;
+    bool loop = false, no_speed_ref = false;
   };
   auto o = std::make_shared<Opts>();
+  sub.add_option("--link", o->link,
+                 "Controller link: egm-joint (ABB EGM position guidance: deflex streams --program) or egm-path (ABB "
+                 "EGM path correction: the controller runs its own program)")
+      ->required();
   sub.add_option("--robot", o->robot, kRobotHelp);
   sub.add_option("--sensor-config", o->sensor,
                  "Force-sensor YAML (docs/online.md); default: identity crosstalk, no payload, no bias, at the flange");
   sub.add_option("--egm-port", o->egm_port, "UDP port the controller's EGM messages arrive on (ABB examples: 6510)")
       ->required();
-  sub.add_option("--bind", o->bind, "Address to bind the EGM and UDP force ports to (0.0.0.0 for a real cell)")->capture_default_str();
-  sub.add_option("--force-source", o->force, "udp:PORT (docs/online.md, UDP force-sample format) or csv:FILE")
+  sub.add_option("--bind", o->bind, "Address to bind the EGM and UDP force ports to (0.0.0.0 for a real cell)")
+      ->capture_default_str();
+  sub.add_option("--force-source", o->force_source, "udp:PORT (docs/online.md, UDP force-sample format) or csv:FILE")
       ->required();
   sub.add_flag("--loop", o->loop, "With csv:FILE, replay the file again and again");
-  sub.add_option("--period-ms", o->period_ms, "Nominal cycle in ms (4 for EGM, 100 like the paper)")->capture_default_str();
-  sub.add_option("--max-joint-correction-deg", o->max_joint_deg, "Bound on each joint's correction, degrees")->capture_default_str();
-  sub.add_option("--max-tcp-correction-mm", o->max_tcp_mm, "Bound on the TCP displacement of the correction, mm")->capture_default_str();
-  sub.add_option("--max-rate-deg-s", o->max_rate_deg_s, "Bound on each joint's correction rate, deg/s")->capture_default_str();
-  sub.add_option("--watchdog-ms", o->watchdog_ms, "No valid force sample for this long: ramp the correction to zero")->capture_default_str();
-  sub.add_option("--jacobian-at", o->jacobian_at, "planned (exact compensation form) or feedback")->capture_default_str();
+  sub.add_option("--program", o->program,
+                 "egm-joint: the nominal joint trajectory to stream, CSV t_s,q1_deg..qN_deg (deflex offline "
+                 "--joint-trajectory writes one)");
+  sub.add_option("--strategy", o->strategy,
+                 "online (the paper's), hybrid (--program is the offline-compensated one; corrects measured minus "
+                 "--force), predictive (wrench predicted where the command is executed), none (stream only)")
+      ->capture_default_str();
+  sub.add_option("--force", o->force_model,
+                 "Force model of the process, a pose model: ldbb:pivot_mm=X;Y;Z,force_N=F,mode=push|pull or "
+                 "constant:fx_N=.. (hybrid: required; predictive: optional)");
+  sub.add_option("--period-ms", o->period_ms,
+                 "The controller's cycle in ms (egm-joint: 4; egm-path: the EGMActMove SampleRate)")
+      ->capture_default_str();
+  sub.add_option("--max-joint-correction-deg", o->max_joint_deg,
+                 "Bound on each joint's correction, degrees: no command leaves the nominal by more")
+      ->capture_default_str();
+  sub.add_option("--max-tcp-correction-mm", o->max_tcp_mm, "Bound on the TCP displacement of the correction, mm")
+      ->capture_default_str();
+  sub.add_option("--max-rate-deg-s", o->max_rate_deg_s, "Bound on each joint's correction rate, deg/s")
+      ->capture_default_str();
+  sub.add_option("--watchdog-ms", o->watchdog_ms, "No valid force sample for this long: ramp the correction to zero")
+      ->capture_default_str();
+  sub.add_option("--jacobian-at", o->jacobian_at, "nominal (the configuration the command is for) or feedback")
+      ->capture_default_str();
+  sub.add_option("--ramp-in-s", o->ramp_in_s, "egm-joint: blend from where the arm is to the program over this time, s")
+      ->capture_default_str();
+  sub.add_flag("--no-speed-reference", o->no_speed_ref, "egm-joint: do not send the nominal's joint speeds");
+  sub.add_option("--end-silence-s", o->end_silence_s,
+                 "egm-joint: after the program's end, a controller silence this long ends the session, s")
+      ->capture_default_str();
+  sub.add_option("--path-corr-frame", o->path_frame,
+                 "egm-path: the frame EGMActMove was given: tool (tool.tframe), flange (tool0) or path (path "
+                 "coordinates)")
+      ->capture_default_str();
+  sub.add_option("--correction-latency-ms", o->correction_latency_ms,
+                 "egm-path, predictive: the controller's correction latency beyond the measured servo delay, ms")
+      ->capture_default_str();
+  sub.add_option("--rotation-warning-mrad", o->rotation_warning_mrad,
+                 "egm-path: report when the model predicts a TCP rotation above this (it cannot be corrected), mrad")
+      ->capture_default_str();
   sub.add_option("--log", o->log, "CSV log of every cycle");
   sub.add_option("--fault-dump", o->fault_dump, "CSV the last cycles are written to when a fault occurs");
-  sub.add_option("--duration-s", o->duration_s, "Stop after this many seconds (0: run until SIGINT/SIGTERM)")->capture_default_str();
-  sub.add_option("--status-interval-s", o->status_s, "Live status on stderr every this many seconds")->capture_default_str();
+  sub.add_option("--duration-s", o->duration_s, "Stop after this many seconds (0: run until SIGINT/SIGTERM)")
+      ->capture_default_str();
+  sub.add_option("--status-interval-s", o->status_s, "Live status on stderr every this many seconds")
+      ->capture_default_str();
   sub.callback([o, &exit_code] {
+    const bool joint_link = o->link == "egm-joint";
+    if (!joint_link && o->link != "egm-path") {
+      throw InputError(fmt::format("option --link: '{}' is not egm-joint or egm-path", o->link));
+    }
     const RobotModel model = load_robot_or_builtin(o->robot);
     const SensorConfig sensor = sensor_or_default(o->sensor);
     if (o->egm_port < 0 || o->egm_port > 65535) {
@@ -99,14 +204,33 @@ void setup_online(CLI::App& sub, int& exit_code) {
         throw InputError(fmt::format("option {}: must be a number > 0 (got {})", option, v));
       }
     };
+    const auto non_negative = [](double v, const char* option) {
+      if (!std::isfinite(v) || v < 0.0) {
+        throw InputError(fmt::format("option {}: must be a number >= 0 (got {})", option, v));
+      }
+    };
     positive(o->period_ms, "--period-ms");
     positive(o->max_joint_deg, "--max-joint-correction-deg");
     positive(o->max_tcp_mm, "--max-tcp-correction-mm");
     positive(o->max_rate_deg_s, "--max-rate-deg-s");
     positive(o->watchdog_ms, "--watchdog-ms");
     positive(o->status_s, "--status-interval-s");
-    if (!std::isfinite(o->duration_s) || o->duration_s < 0.0) {
-      throw InputError(fmt::format("option --duration-s: must be a number >= 0 (got {})", o->duration_s));
+    positive(o->end_silence_s, "--end-silence-s");
+    non_negative(o->duration_s, "--duration-s");
+    non_negative(o->ramp_in_s, "--ramp-in-s");
+    non_negative(o->correction_latency_ms, "--correction-latency-ms");
+    non_negative(o->rotation_warning_mrad, "--rotation-warning-mrad");
+    if (o->period_ms > 1000.0) throw InputError("option --period-ms: at most 1000 ms");
+    if (o->max_joint_deg > 10.0) {
+      throw InputError("option --max-joint-correction-deg: at most 10 deg (a compliance correction is a fraction of one)");
+    }
+    const StrategyKind kind = parse_strategy(o->strategy);
+    if (joint_link && o->program.empty()) {
+      throw InputError("option --program: egm-joint streams a nominal program: give --program P.csv (deflex offline "
+                       "--joint-trajectory writes one)");
+    }
+    if (!joint_link && !o->program.empty()) {
+      throw InputError("option --program: egm-path corrects the controller's own program; deflex streams none");
     }
     OnlineConfig cfg;
     cfg.period_s = o->period_ms * 1e-3;
@@ -114,48 +238,63 @@ void setup_online(CLI::App& sub, int& exit_code) {
     cfg.max_tcp_correction_m = o->max_tcp_mm * 1e-3;
     cfg.max_correction_rate_rad_s = deg_to_rad(o->max_rate_deg_s);
     cfg.watchdog_s = o->watchdog_ms * 1e-3;
-    if (o->jacobian_at == "planned") {
+    if (o->jacobian_at == "nominal" || o->jacobian_at == "planned") {
       cfg.jacobian_at = JacobianAt::kPlanned;
     } else if (o->jacobian_at == "feedback") {
       cfg.jacobian_at = JacobianAt::kFeedback;
     } else {
-      throw InputError("option --jacobian-at: must be planned or feedback");
+      throw InputError("option --jacobian-at: must be nominal or feedback");
     }
     cfg.validate();
+    std::unique_ptr<ForceModel> force_model;
+    if (!o->force_model.empty()) {
+      force_model = parse_force_spec(o->force_model);
+    }
     OnlineCompensator comp(model, sensor, cfg);
+    OnlineStrategy strategy(model, kind, force_model.get());
+    std::shared_ptr<const JointTrajectory> program;
+    if (joint_link) {
+      program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o->program, model));
+      if (!model.has_max_speed()) {
+        std::cerr << "deflex online: warning: the robot file gives no joint speed limits, so the program's speeds "
+                     "were not checked (add max_speed to the robot file)\n";
+      }
+    }
     std::string source_text;
-    const std::unique_ptr<ForceSource> source = make_force_source(o->force, o->loop, o->bind, source_text);
-    EgmEndpointConfig ec;
-    ec.bind_address = o->bind;
-    ec.port = static_cast<std::uint16_t>(o->egm_port);
-    EgmSensorEndpoint endpoint(comp, ec);
-    endpoint.set_force_source(source.get());
-
-    std::FILE* log = nullptr;
-    std::vector<char> log_buffer;
-    const int n = model.dof();
-    if (!o->log.empty()) {
-      log = std::fopen(o->log.c_str(), "w");
-      if (log == nullptr) {
-        throw Error(fmt::format("{}: cannot write the cycle log", o->log));
-      }
-      log_buffer.resize(1 << 20);
-      std::setvbuf(log, log_buffer.data(), _IOFBF, log_buffer.size());
-      std::string header = "t_s,seqno,status";
-      for (const char* name : {"q_planned", "q_feedback", "q_command", "dtheta"}) {
-        for (int j = 1; j <= n; ++j) {
-          header += fmt::format(",{}{}_deg", name, j);
-        }
-      }
-      header += ",fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,compute_us\n";
-      std::fputs(header.c_str(), log);
+    const std::unique_ptr<ForceSource> source = make_force_source(o->force_source, o->loop, o->bind, source_text);
+    UdpTransport transport(o->bind, static_cast<std::uint16_t>(o->egm_port));
+    SteadyClock clock;
+    std::unique_ptr<ControllerLink> link;
+    const EgmPathLink* path_link = nullptr;
+    if (joint_link) {
+      EgmJointLinkConfig lc;
+      lc.stream.ramp_in_s = o->ramp_in_s;
+      lc.send_speed_reference = !o->no_speed_ref;
+      link = std::make_unique<EgmJointLink>(comp, strategy, program, transport, clock, source.get(), lc);
+    } else {
+      EgmPathLinkConfig lc;
+      lc.frame = parse_path_corr_frame(o->path_frame);
+      lc.correction_latency_s = o->correction_latency_ms * 1e-3;
+      lc.rotation_warning_rad = o->rotation_warning_mrad * 1e-3;
+      auto p = std::make_unique<EgmPathLink>(comp, strategy, transport, clock, source.get(), lc);
+      path_link = p.get();
+      link = std::move(p);
+    }
+    CycleLog log(o->log, model.dof());
+    // The fault dump's path is checked now, not at the first fault in the middle of a run.
+    if (!o->fault_dump.empty()) {
+      std::FILE* probe = std::fopen(o->fault_dump.c_str(), "a");
+      if (probe == nullptr) throw Error(fmt::format("{}: cannot write the fault dump", o->fault_dump));
+      std::fclose(probe);
     }
 
     std::cerr << fmt::format(
-        "deflex online: robot {}; sensor {}; force from {}; EGM on {}:{}; period {} ms; bounds {} deg/joint, "
+        "deflex online: {} link, strategy {}; robot {}; sensor {}; force from {}; EGM on {}:{}; {}bounds {} deg/joint, "
         "{} mm TCP, {} deg/s; watchdog {} ms. Stop with Ctrl-C.\n",
-        model.name(), sensor.source, source_text, o->bind, endpoint.port(), o->period_ms, o->max_joint_deg,
-        o->max_tcp_mm, o->max_rate_deg_s, o->watchdog_ms);
+        link->name(), to_string(kind), model.name(), sensor.source, source_text, o->bind, transport.port(),
+        joint_link ? fmt::format("program {} ({} points, {:.1f} s); ", o->program, program->size(), program->duration_s())
+                   : fmt::format("correction frame {}; ", o->path_frame),
+        o->max_joint_deg, o->max_tcp_mm, o->max_rate_deg_s, o->watchdog_ms);
 
     g_stop = false;
     struct sigaction sa {};
@@ -164,90 +303,92 @@ void setup_online(CLI::App& sub, int& exit_code) {
     sigaction(SIGINT, &sa, nullptr);
     sigaction(SIGTERM, &sa, nullptr);
 
-    const auto start = std::chrono::steady_clock::now();
-    auto next_status = start + std::chrono::duration<double>(o->status_s);
-    double max_compute_s = 0.0, last_t = -1.0, max_gap_s = 0.0;
-    std::uint64_t window_cycles = 0;
-    const auto print_status = [&](const EgmCycleRecord& r) {
-      const EgmCounters& c = endpoint.counters();
+    const double start = clock.now_s();
+    double next_status = start + o->status_s;
+    // Interval figures (reset at every status line; the line says so).
+    double max_compute_s = 0.0, max_gap_s = 0.0, max_dev_rad = 0.0, last_t = -1.0, last_message = -1.0;
+    std::uint64_t window_cycles = 0, cycles = 0;
+    bool refused = false;
+    const auto print_status = [&](double now) {
+      const LinkCounters& c = link->counters();
+      const LinkCycleRecord& r = link->last_cycle();
+      std::string extra;
+      if (joint_link) {
+        const auto* j = dynamic_cast<const EgmJointLink*>(link.get());
+        extra = fmt::format("program {:.1f}/{:.1f} s | ", j->stream().program_time_s() - program->start_time_s(),
+                            program->duration_s());
+      } else if (path_link != nullptr && path_link->max_rotation_rad() > o->rotation_warning_mrad * 1e-3) {
+        extra = fmt::format("uncorrected TCP rotation up to {:.3f} mrad (path correction cannot rotate) | ",
+                            path_link->max_rotation_rad() * 1e3);
+      }
       std::cerr << fmt::format(
-          "[{:8.1f} s] cycles {} replies {} rejected {} restarts {} | status {} | |F| {:.1f} N | max dtheta {:.4f} deg "
-          "| compute max {:.1f} us | gap max {:.1f} ms | force samples ok {} fault {}\n",
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), window_cycles, c.replies,
-          c.rejected(), c.restarts, to_string(r.status), r.wrench_base.head<3>().norm(),
-          rad_to_deg(r.dtheta.size() > 0 ? r.dtheta.cwiseAbs().maxCoeff() : 0.0), max_compute_s * 1e6,
-          max_gap_s * 1e3, comp.counters().samples_ok, comp.counters().samples_fault);
-      max_compute_s = 0.0;
-      max_gap_s = 0.0;
+          "[{:8.1f} s] {} | {}cycles {} (total {}) | status {} | |F| {:.1f} N | max |command-nominal| {:.4f} deg | TCP "
+          "correction {:.3f} mm | delay {:.0f} ms | in the last interval: compute max {:.1f} us, gap max {:.1f} ms | "
+          "rejected {} restarts {}\n",
+          now - start, to_string(link->state()), extra, window_cycles, cycles, to_string(r.status),
+          r.wrench_measured_base.head<3>().norm(), rad_to_deg(max_dev_rad), r.tcp_correction_m.norm() * 1e3,
+          r.delay_s * 1e3, max_compute_s * 1e6, max_gap_s * 1e3, c.rejected(), c.restarts);
+      max_compute_s = max_gap_s = max_dev_rad = 0.0;
+      window_cycles = 0;
     };
-    const auto on_cycle = [&](const EgmCycleRecord& r) {
-      ++window_cycles;
-      max_compute_s = std::max(max_compute_s, r.compute_s);
-      if (last_t >= 0.0) {
-        max_gap_s = std::max(max_gap_s, r.t_s - last_t);
-      }
-      last_t = r.t_s;
-      if (log != nullptr) {
-        std::fprintf(log, "%.6f,%u,%d", r.t_s, r.seqno, static_cast<int>(r.status));
-        for (const JointVector* q : {&r.q_planned, &r.q_feedback, &r.q_command, &r.dtheta}) {
-          for (int j = 0; j < q->size(); ++j) {
-            std::fprintf(log, ",%.10g", rad_to_deg((*q)[j]));
-          }
-        }
-        for (int j = 0; j < 6; ++j) {
-          std::fprintf(log, ",%.6g", r.wrench_base[j]);
-        }
-        std::fprintf(log, ",%.2f\n", r.compute_s * 1e6);
-      }
-      const auto now = std::chrono::steady_clock::now();
-      if (now >= next_status) {
-        print_status(r);
-        next_status = now + std::chrono::duration<double>(o->status_s);
-      }
-      if (o->duration_s > 0.0 && std::chrono::duration<double>(now - start).count() >= o->duration_s) {
-        return false;
-      }
-      return true;
-    };
-    // Our own loop over poll() (not endpoint.run()) so that status and the duration limit keep going
-    // while no controller is talking to us.
-    std::uint64_t cycles = 0;
+    // Our own loop over poll(), so that status and the duration limit keep going while no controller
+    // is talking to us.
     while (!g_stop.load()) {
-      const EgmPollResult r = endpoint.poll(0.05);
-      const auto now = std::chrono::steady_clock::now();
-      if (r == EgmPollResult::kReplied || r == EgmPollResult::kNotAnswered) {
-        ++cycles;
-        if (endpoint.fault_pending() && !o->fault_dump.empty()) {
-          endpoint.write_history_csv(o->fault_dump);
-          std::cerr << fmt::format("deflex online: fault ({}); last {} cycles written to {}\n",
-                                   to_string(endpoint.last_cycle().status), endpoint.history_size(), o->fault_dump);
-          endpoint.clear_fault();
-        }
-        if (!on_cycle(endpoint.last_cycle())) {
-          break;
-        }
-      } else if (now >= next_status) {
-        std::cerr << fmt::format("[{:8.1f} s] waiting for EGM messages on port {} (received {}, rejected {})\n",
-                                 std::chrono::duration<double>(now - start).count(), endpoint.port(),
-                                 endpoint.counters().datagrams, endpoint.counters().rejected());
-        next_status = now + std::chrono::duration<double>(o->status_s);
+      const LinkPollResult r = link->poll(0.05);
+      const double now = clock.now_s();
+      if (r == LinkPollResult::kRefused) {
+        refused = true;
+        break;
       }
-      if (o->duration_s > 0.0 && std::chrono::duration<double>(now - start).count() >= o->duration_s) {
+      if (r == LinkPollResult::kAnswered || r == LinkPollResult::kNotAnswered) {
+        ++cycles;
+        ++window_cycles;
+        last_message = now;
+        const LinkCycleRecord& rec = link->last_cycle();
+        max_compute_s = std::max(max_compute_s, rec.compute_s);
+        if (last_t >= 0.0) max_gap_s = std::max(max_gap_s, rec.t_s - last_t);
+        last_t = rec.t_s;
+        if (rec.replied) max_dev_rad = std::max(max_dev_rad, (rec.q_command - rec.q_nominal).cwiseAbs().maxCoeff());
+        log.write(rec);
+        if (link->fault_pending() && !o->fault_dump.empty()) {
+          link->write_history_csv(o->fault_dump);
+          std::cerr << fmt::format("deflex online: fault ({}); last cycles written to {}\n", to_string(rec.status),
+                                   o->fault_dump);
+          link->clear_fault();
+        }
+      }
+      if (now >= next_status) {
+        if (link->state() == LinkState::kWaiting) {
+          std::cerr << fmt::format("[{:8.1f} s] waiting for EGM messages on port {} (received {}, rejected {})\n",
+                                   now - start, transport.port(), link->counters().datagrams,
+                                   link->counters().rejected());
+        } else {
+          print_status(now);
+        }
+        next_status = now + o->status_s;
+      }
+      if (link->state() == LinkState::kFinished && last_message >= 0.0 && now - last_message > o->end_silence_s) {
+        std::cerr << "deflex online: the program has ended and the controller went quiet: session over\n";
+        break;
+      }
+      if (o->duration_s > 0.0 && now - start >= o->duration_s) {
         break;
       }
     }
-    if (log != nullptr) {
-      std::fflush(log);
-      std::fclose(log);
+    const LinkCounters& c = link->counters();
+    if (refused) {
+      std::cerr << refusal_text(*link, *program, 1.0) << "\n";
+      exit_code = 2;
+      return;
     }
-    const EgmCounters& c = endpoint.counters();
     std::cerr << fmt::format(
-        "deflex online: stopped after {} cycles: {} replies; rejected packets {} (malformed {}, truncated {}, "
-        "oversized {}, missing joints {}, non-finite {}, duplicate {}, out of order {}); restarts {}; force "
-        "samples ok {}, fault {}, invalid {}{}\n",
+        "deflex online: stopped after {} cycles: {} answers; rejected datagrams {} (malformed {}, truncated {}, "
+        "oversized {}, missing joints {}, non-finite {}, duplicate {}, out of order {}, beyond limits {}, other "
+        "sender {}); restarts {}; guard stops {}; force samples ok {}, fault {}, invalid {}{}\n",
         cycles, c.replies, c.rejected(), c.malformed, c.truncated, c.oversized, c.missing_joints, c.non_finite,
-        c.duplicate, c.out_of_order, c.restarts, comp.counters().samples_ok, comp.counters().samples_fault,
-        comp.counters().samples_invalid, o->log.empty() ? "" : fmt::format("; log {}", o->log));
+        c.duplicate, c.out_of_order, c.out_of_limits, c.foreign_sender, c.restarts, c.guard_trips,
+        comp.counters().samples_ok, comp.counters().samples_fault, comp.counters().samples_invalid,
+        o->log.empty() ? "" : fmt::format("; log {}", o->log));
     exit_code = 0;
   });
 }
@@ -320,8 +461,8 @@ void setup_identify_payload(CLI::App& sub, int& exit_code) {
 }  // namespace
 
 DEFLEX_COMMAND("online",
-               "Online compensation: condition force samples and answer ABB EGM messages with compensated joints "
-               "(runs until SIGINT/SIGTERM)",
+               "Online compensation on a controller link (--link egm-joint|egm-path): condition force samples and "
+               "answer the controller, never beyond the bound of the nominal",
                setup_online, 40);
 DEFLEX_COMMAND("identify-payload",
                "Identify the end effector's mass, centre of gravity and the force-sensor bias from static poses (CSV)",

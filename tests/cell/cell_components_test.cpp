@@ -1,12 +1,11 @@
 // Components of the simulated cell against closed forms: LDBB force direction, first-order response
 // and ball friction; lost motion's sign and history; the sensor's compliance; the true robot's fixed
-// point against the core's deflected configuration; the controller's program and schedule.
+// point against the core's deflected configuration; the force sensor's reading.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "deflex/cell/case_config.hpp"
-#include "deflex/cell/controller.hpp"
+#include "deflex/cell/cell_config.hpp"
 #include "deflex/cell/force_sensor.hpp"
 #include "deflex/cell/ldbb_device.hpp"
 #include "deflex/cell/true_robot.hpp"
@@ -93,12 +92,10 @@ TEST(LostMotion, GravityPreloadKeepsAJointOnOneSide) {
   }
 }
 
-CaseConfig bare_case() {
-  CaseConfig c = paper_case();
-  c = model_consistent(c, false);
-  c.exact_model = false;
-  c.robot.stiffness_spread = 0.0;
-  c.robot.stiffness_scale = 1.0;
+// The built-in robot with nothing but its lumped joint stiffness (scale 1, no spread, no extra effect).
+CellConfig bare_cell() {
+  CellConfig c;
+  c.robot.gravity_torque_nm = {0, 9000, 3500, 0, 60, 0};
   return c;
 }
 
@@ -109,7 +106,7 @@ JointVector test_pose() {
 }
 
 TEST(TrueRobot, LumpedOnlyMatchesTheCoresDeflectedConfiguration) {
-  const CaseConfig c = bare_case();
+  const CellConfig c = bare_cell();
   const TrueRobot robot(c, false, 7);
   Workspace ws(robot.true_model());
   const JointVector q = test_pose();
@@ -127,7 +124,7 @@ TEST(TrueRobot, LumpedOnlyMatchesTheCoresDeflectedConfiguration) {
 }
 
 TEST(TrueRobot, SensorComplianceAddsTheCantileverDeflection) {
-  CaseConfig c = bare_case();
+  CellConfig c = bare_cell();
   c.sensor.lateral_compliance_m_per_n = 0.5e-6;
   c.sensor.rotational_compliance_rad_per_nm = 4e-6;
   c.sensor.axial_compliance_m_per_n = 0.0;
@@ -174,65 +171,6 @@ TEST(ForceSensorDaq, DecouplingUndoesTheCrosstalkUpToTheCalibrationResidual) {
   EXPECT_GT((daq.crosstalk() - Matrix3::Identity()).norm(), 1e-3);
   const Vector3 raw = daq.sample(Vector3(100.0, -50.0, 20.0), Matrix3::Identity());
   EXPECT_NEAR((daq.calibration().decoupling * raw - Vector3(100.0, -50.0, 20.0)).norm(), 0.0, 1e-9);
-}
-
-TEST(JointProgram, PassesThroughItsPointsAndInterpolatesSmoothly) {
-  std::vector<JointVector> pts;
-  const int n = 80;
-  for (int k = 0; k < n; ++k) {
-    JointVector q(2);
-    const double a = 2.0 * kPi * k / n;
-    q << std::sin(a), 0.3 * std::cos(2.0 * a);
-    pts.push_back(q);
-  }
-  const JointProgram program(pts);
-  JointVector q;
-  program.at(2.0 * kPi * 5 / n, q);
-  EXPECT_NEAR((q - pts[5]).norm(), 0.0, 1e-12);
-  program.at(-2.0 * kPi * 3 / n, q);  // periodic: negative angles wrap
-  EXPECT_NEAR((q - pts[n - 3]).norm(), 0.0, 1e-12);
-  double worst = 0.0;
-  for (int i = 0; i < 1000; ++i) {
-    const double a = 2.0 * kPi * i / 1000.0;
-    program.at(a, q);
-    worst = std::max(worst, std::abs(q[0] - std::sin(a)));
-  }
-  EXPECT_LT(worst, 1e-4);  // cubic accuracy with 4.5 deg steps
-  EXPECT_THROW(JointProgram(std::vector<JointVector>(3, JointVector::Zero(2))), InputError);
-}
-
-TEST(LapSchedule, ClockwiseThenAnticlockwiseAfterSettling) {
-  LapSchedule s;
-  s.omega_rad_s = 0.5;
-  s.settle_s = 2.0;
-  s.laps_cw = 3;
-  s.laps_ccw = 3;
-  const double lap = 2.0 * kPi / 0.5;
-  EXPECT_DOUBLE_EQ(s.angle(1.0), 0.0);
-  EXPECT_EQ(s.direction(1.0), 0);
-  EXPECT_NEAR(s.angle(2.0 + lap), -2.0 * kPi, 1e-12);
-  EXPECT_EQ(s.direction(2.0 + lap), -1);
-  EXPECT_NEAR(s.angle(2.0 + 3 * lap), -6.0 * kPi, 1e-12);
-  EXPECT_EQ(s.direction(2.0 + 4 * lap), 1);
-  EXPECT_NEAR(s.angle(s.duration_s()), 0.0, 1e-9);
-  EXPECT_NEAR(s.duration_s(), 2.0 + 6 * lap, 1e-9);
-}
-
-TEST(CorrectionChannel, KeepsTheNewestArrivedMessage) {
-  CorrectionChannel ch(4);
-  for (int i = 0; i < 3; ++i) {
-    CorrectionMessage m;
-    m.arrival_s = 0.1 * i;
-    m.reference_s = i;
-    m.offset_rad = JointVector::Constant(1, i);
-    EXPECT_TRUE(ch.push(m));
-  }
-  CorrectionMessage out;
-  EXPECT_TRUE(ch.pop_arrived(0.15, out));
-  EXPECT_DOUBLE_EQ(out.reference_s, 1.0);
-  EXPECT_FALSE(ch.pop_arrived(0.15, out));
-  EXPECT_TRUE(ch.pop_arrived(1.0, out));
-  EXPECT_DOUBLE_EQ(out.reference_s, 2.0);
 }
 
 }  // namespace

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <vector>
 
-#include "deflex/cell/case_config.hpp"
+#include "deflex/cell/cell_config.hpp"
 #include "deflex/cell/force_sensor.hpp"
 #include "deflex/cell/path_drift.hpp"
 #include "deflex/cell/true_robot.hpp"
@@ -46,15 +46,16 @@ TEST(GearHardening, DeflectionIsTheIntegralOfTheTangentCompliance) {
   EXPECT_EQ(GearHardening{}.equivalent_torque(123.0), 123.0);
 }
 
-CaseConfig hardening_case() {
-  CaseConfig c = model_consistent(paper_case(), false);
+CellConfig hardening_case() {
+  CellConfig c;
+  c.robot.gravity_torque_nm = {0, 9000, 3500, 0, 60, 0};  // the paper case's preload
   c.robot.hardening_softening = {0.6, 0.6, 0.6, 0.6, 0.6, 0.6};
   c.robot.hardening_torque_nm = {800, 1500, 1000, 120, 120, 60};
   return c;
 }
 
 TEST(TrueRobot, HardeningGearsDeflectAlongTheirCurveFromTheGravityPreload) {
-  const CaseConfig c = hardening_case();
+  const CellConfig c = hardening_case();
   ASSERT_EQ(c.robot.gravity_torque_nm.size(), 6u);
   const TrueRobot robot(c, false, 7);
   Workspace ws(robot.true_model());
@@ -152,28 +153,6 @@ TEST(ForceSensorDaq, UnknownSensitivityAndMisalignmentGiveTheExpectedReading) {
     sum2 += (u.sensitivity() - Vector3::Ones()).squaredNorm();
   }
   EXPECT_NEAR(std::sqrt(sum2 / (3.0 * units)), 0.01, 0.0005);
-}
-
-TEST(CaseConfig, NewEffectsAreSizedInThePaperCaseAndSwitchOff) {
-  const CaseConfig c = paper_case();
-  EXPECT_GT(c.drift.offset_m, 0.0);
-  EXPECT_GT(c.drift.wander_m, 0.0);
-  EXPECT_GT(c.sensor.sensitivity_error, 0.0);
-  EXPECT_GT(std::abs(c.sensor.misalignment_rad), 0.0);
-  ASSERT_EQ(c.robot.hardening_softening.size(), 6u);
-  const CaseConfig d = without_effect(c, Effect::kPathDrift);
-  EXPECT_EQ(d.drift.offset_m + d.drift.rotation_rad + d.drift.wander_m, 0.0);
-  const CaseConfig h = without_effect(c, Effect::kGearHardening);
-  for (double v : h.robot.hardening_softening) EXPECT_EQ(v, 0.0);
-  const CaseConfig s = without_effect(c, Effect::kSensorCalibration);
-  EXPECT_EQ(s.sensor.sensitivity_error, 0.0);
-  EXPECT_EQ(s.sensor.misalignment_rad, 0.0);
-  // The model-consistent cell has none of them.
-  const CaseConfig m = model_consistent(c, true);
-  EXPECT_EQ(m.drift.offset_m + m.drift.rotation_rad + m.drift.wander_m, 0.0);
-  for (double v : m.robot.hardening_softening) EXPECT_EQ(v, 0.0);
-  EXPECT_EQ(m.sensor.sensitivity_error, 0.0);
-  EXPECT_EQ(m.sensor.misalignment_rad, 0.0);
 }
 
 }  // namespace

@@ -93,20 +93,3 @@ TEST(CliModel, BadRobotFileNamesFileLineAndField) {
 
 }  // namespace
 }  // namespace deflex
-
-namespace deflex {
-namespace {
-
-TEST(CliOnline, NonsenseTimingOptionsAreRefusedBeforeAnythingRuns) {
-  auto r = test::run_cli("online --egm-port 0 --force-source csv:" + std::string(DEFLEX_SOURCE_DIR) +
-                         "/examples/online/force_replay.csv --status-interval-s nan");
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("--status-interval-s"), std::string::npos) << r.err;
-  r = test::run_cli("online --egm-port 0 --force-source csv:" + std::string(DEFLEX_SOURCE_DIR) +
-                    "/examples/online/force_replay.csv --duration-s -1");
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("--duration-s"), std::string::npos) << r.err;
-}
-
-}  // namespace
-}  // namespace deflex

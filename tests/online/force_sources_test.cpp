@@ -64,10 +64,11 @@ TEST(UdpForceSource, DecodesTheDocumentedFormatAndDropsBadDatagrams) {
   tx.send(wrong_magic, 64);
   tx.send(hand, 64);  // duplicate sequence 5
   std::array<unsigned char, kForceDatagramBytes> enc{};
-  ForceSample s;
+  ForceDatagram s;
+  s.sequence = 6;
   s.t_s = 1.5;
   s.wrench_sensor << 1, 2, 3, 4, 5, 6;
-  encode_force_datagram(s, 6, enc);
+  encode_force_datagram(s, enc);
   tx.send(enc.data(), enc.size());
   unsigned char big[200] = {'D', 'F', 'X', 'F'};
   tx.send(big, sizeof(big));  // oversized
@@ -93,9 +94,10 @@ TEST(UdpForceSource, NonFiniteValuesArriveFlaggedInvalidAndPollingDoesNotAllocat
   UdpForceSource src(0);
   Sender tx(src.port());
   std::array<unsigned char, kForceDatagramBytes> enc{};
-  ForceSample s;
+  ForceDatagram s;
+  s.sequence = 1;
   s.wrench_sensor[2] = std::nan("");
-  encode_force_datagram(s, 1, enc);
+  encode_force_datagram(s, enc);
   tx.send(enc.data(), enc.size());
   std::vector<ForceSample> got;
   got.reserve(4);
@@ -113,10 +115,11 @@ TEST(UdpForceSource, ARestartedSenderIsAcceptedAgain) {
   UdpForceSource src(0);
   Sender tx(src.port());
   std::array<unsigned char, kForceDatagramBytes> enc{};
-  ForceSample s;
+  ForceDatagram s;
   for (std::uint32_t seq : {500u, 501u, 1u, 2u}) {
     s.t_s = seq;
-    encode_force_datagram(s, seq, enc);
+    s.sequence = seq;
+    encode_force_datagram(s, enc);
     tx.send(enc.data(), enc.size());
   }
   std::vector<ForceSample> got;

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <random>
 
-#include "deflex/cell/case_config.hpp"
+#include "deflex/cell/cell_config.hpp"
 
 namespace deflex::cell {
 

@@ -23,13 +23,13 @@ double GearHardening::equivalent_torque(double x) const {
   return x + std::copysign(softening * torque_nm * (1.0 - std::exp(-a / torque_nm)), x);
 }
 
-Pose setup_flange_T_tcp(const CaseConfig& config, bool sensor_mounted) {
+Pose setup_flange_T_tcp(const CellConfig& config, bool sensor_mounted) {
   Pose t = Pose::Identity();
   t.translation() = Vector3(0, 0, config.tool.ee_length_m + (sensor_mounted ? config.sensor.height_m : 0.0));
   return t;
 }
 
-TrueRobot::TrueRobot(const CaseConfig& config, bool sensor_mounted, std::uint64_t seed)
+TrueRobot::TrueRobot(const CellConfig& config, bool sensor_mounted, std::uint64_t seed)
     : config_(config), sensor_mounted_(sensor_mounted) {
   const RobotModel base = load_robot_or_builtin(config.robot_file);
   const Pose flange_T_tcp = setup_flange_T_tcp(config, sensor_mounted);

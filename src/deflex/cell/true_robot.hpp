@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <memory>
 
-#include "deflex/cell/case_config.hpp"
+#include "deflex/cell/cell_config.hpp"
 #include "deflex/model/kinematics.hpp"
 
 namespace deflex::cell {
@@ -51,7 +51,7 @@ class TrueRobot {
  public:
   /// `sensor_mounted` puts the sensor's height and compliance between flange and end effector.
   /// `seed` draws the per-joint stiffness factors and the DH errors.
-  TrueRobot(const CaseConfig& config, bool sensor_mounted, std::uint64_t seed);
+  TrueRobot(const CellConfig& config, bool sensor_mounted, std::uint64_t seed);
 
   /// The nominal model the compensators start from: built-in kinematics, the setup's tool, the
   /// built-in (assumed) stiffness. Nothing of the true robot leaks into it.
@@ -67,7 +67,7 @@ class TrueRobot {
   /// sensor displacements. Updates the lost motion once per call (one call per servo cycle).
   Vector3 solve(Workspace& ws, const JointVector& q_cmd, const Wrench& wrench_base, TrueRobotState& state) const;
 
-  [[nodiscard]] const CaseConfig& config() const { return config_; }
+  [[nodiscard]] const CellConfig& config() const { return config_; }
   [[nodiscard]] bool sensor_mounted() const { return sensor_mounted_; }
 
   /// Cartesian displacement (m) of the TCP from the link and sensor compliances at the current
@@ -75,7 +75,7 @@ class TrueRobot {
   [[nodiscard]] Vector3 structural_displacement(const Workspace& ws, const Wrench& wrench_base) const;
 
  private:
-  CaseConfig config_;
+  CellConfig config_;
   bool sensor_mounted_;
   std::shared_ptr<const RobotModel> nominal_;
   std::shared_ptr<const RobotModel> true_;
@@ -86,6 +86,6 @@ class TrueRobot {
 };
 
 /// Flange to TCP of a setup: end effector, plus the sensor's height when it is mounted.
-[[nodiscard]] Pose setup_flange_T_tcp(const CaseConfig& config, bool sensor_mounted);
+[[nodiscard]] Pose setup_flange_T_tcp(const CellConfig& config, bool sensor_mounted);
 
 }  // namespace deflex::cell

@@ -11,6 +11,10 @@ class ConstantWrenchModel final : public ForceModel {
   explicit ConstantWrenchModel(const Wrench& wrench_base);
 
   [[nodiscard]] Wrench wrench_at(std::size_t index, const Pose& base_T_tcp) const override;
+  [[nodiscard]] bool wrench_at_pose(const Pose& /*base_T_tcp*/, Wrench& out) const noexcept override {
+    out = wrench_;
+    return true;
+  }
   [[nodiscard]] std::string describe() const override;
   [[nodiscard]] std::string label() const override { return "constant"; }
 

@@ -28,6 +28,12 @@ class ForceModel {
   [[nodiscard]] virtual std::string label() const { return "force"; }
   /// Number of path points the model has data for, when it is limited (tables); none otherwise.
   [[nodiscard]] virtual std::optional<std::size_t> points() const { return std::nullopt; }
+  /// The wrench at a pose alone, for the online strategies' real-time cycle (hybrid, predictive):
+  /// never throws or allocates. False when the model cannot say: it needs a path index (tables), or
+  /// the pose is degenerate for it. Models of the pose override it.
+  [[nodiscard]] virtual bool wrench_at_pose(const Pose& /*base_T_tcp*/, Wrench& /*out*/) const noexcept {
+    return false;
+  }
 
  protected:
   ForceModel() = default;

@@ -32,6 +32,17 @@ Wrench LdbbForceModel::wrench_at(std::size_t index, const Pose& base_T_tcp) cons
   return w;
 }
 
+bool LdbbForceModel::wrench_at_pose(const Pose& base_T_tcp, Wrench& out) const noexcept {
+  const Vector3 bar = base_T_tcp.translation() - pivot_base_m_;
+  const double length = bar.norm();
+  if (!(length > 1e-3)) {
+    return false;
+  }
+  out.setZero();
+  out.head<3>() = (push_ ? force_N_ : -force_N_) / length * bar;
+  return true;
+}
+
 double LdbbForceModel::bar_length_m(const Pose& base_T_tcp) const {
   return (base_T_tcp.translation() - pivot_base_m_).norm();
 }

@@ -22,6 +22,7 @@ class LdbbForceModel final : public ForceModel {
 
   /// Throws InputError when the TCP is at the pivot (no bar direction).
   [[nodiscard]] Wrench wrench_at(std::size_t index, const Pose& base_T_tcp) const override;
+  [[nodiscard]] bool wrench_at_pose(const Pose& base_T_tcp, Wrench& out) const noexcept override;
   [[nodiscard]] std::string describe() const override;
   [[nodiscard]] std::string label() const override;
 

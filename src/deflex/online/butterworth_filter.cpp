@@ -51,6 +51,17 @@ ButterworthDesign design_butterworth_lowpass(int order, double cutoff_hz, double
   return d;
 }
 
+double dc_group_delay_s(const ButterworthDesign& design) {
+  // For H(z) = B(z)/A(z) with B = sum b_k z^-k, the group delay at w = 0 is
+  // sum k b_k / sum b_k - sum k a_k / sum a_k samples (a_0 = 1); sections add.
+  double samples = 0.0;
+  for (int i = 0; i < design.sections; ++i) {
+    const BiquadCoefficients& c = design.section[static_cast<std::size_t>(i)];
+    samples += (c.b1 + 2.0 * c.b2) / (c.b0 + c.b1 + c.b2) - (c.a1 + 2.0 * c.a2) / (1.0 + c.a1 + c.a2);
+  }
+  return samples / design.sample_rate_hz;
+}
+
 Vector6 ButterworthLowPass::step(const Vector6& x) noexcept {
   if (!primed_) {
     reset(x);

@@ -29,6 +29,10 @@ struct ButterworthDesign {
 /// Designs the filter. Throws InputError unless 1 <= order <= 8 and 0 < cutoff < sample_rate/2.
 [[nodiscard]] ButterworthDesign design_butterworth_lowpass(int order, double cutoff_hz, double sample_rate_hz);
 
+/// Group delay of the designed filter at zero frequency, s: how far a slowly changing signal lags
+/// behind its filtered value (the latency-compensated strategy adds it to its lead).
+[[nodiscard]] double dc_group_delay_s(const ButterworthDesign& design);
+
 /// The Butterworth low-pass run on 6 channels at once (a wrench), Direct Form II transposed.
 class ButterworthLowPass {
  public:

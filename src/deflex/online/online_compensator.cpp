@@ -32,6 +32,7 @@ const char* to_string(CycleStatus s) {
     case CycleStatus::kNoForceYet: return "no_force_yet";
     case CycleStatus::kStaleForce: return "stale_force";
     case CycleStatus::kForceFault: return "force_fault";
+    case CycleStatus::kHeld: return "held";
     case CycleStatus::kInvalidInput: return "invalid_input";
   }
   return "unknown";
@@ -53,6 +54,7 @@ OnlineCompensator::OnlineCompensator(const RobotModel& model, const SensorConfig
   config_.validate();
   (void)model_.stiffness();  // throws ModelError when the robot file gives no stiffness
   correction_ = JointVector::Zero(model_.dof());
+  filter_delay_s_ = dc_group_delay_s(pipeline_.lowpass.design());
   const double per_cycle = std::ceil(std::max(0.0, sensor.sample_rate_hz) * config_.period_s);
   queue_capacity_ = std::max(64, 2 * static_cast<int>(std::min(per_cycle, 1e6)) + 8);
   queue_.resize(static_cast<std::size_t>(queue_capacity_));
@@ -89,7 +91,40 @@ void OnlineCompensator::reset() noexcept {
   wrench_base_.setZero();
   last_fault_t_s_ = -1e300;
   have_cycle_ = false;
+  slope_head_ = slope_count_ = 0;
+  slope_.setZero();
   pipeline_.reset();
+}
+
+void OnlineCompensator::update_slope(double t_s) noexcept {
+  // Least-squares slope of the conditioned wrench over the cycles of the last kSlopeWindowS (at
+  // least two). Fitted at the cycle rate: the samples inside a cycle are already low-passed.
+  slope_t_[static_cast<std::size_t>(slope_head_)] = t_s;
+  slope_w_[static_cast<std::size_t>(slope_head_)] = wrench_base_;
+  slope_head_ = (slope_head_ + 1) % kSlopeRing;
+  slope_count_ = std::min(slope_count_ + 1, kSlopeRing);
+  int used = 0;
+  double st = 0.0;
+  Wrench sw = Wrench::Zero();
+  for (int k = 0; k < slope_count_; ++k) {
+    const auto i = static_cast<std::size_t>((slope_head_ - 1 - k + kSlopeRing) % kSlopeRing);
+    if (k >= 2 && t_s - slope_t_[i] > kSlopeWindowS) break;
+    st += slope_t_[i];
+    sw += slope_w_[i];
+    ++used;
+  }
+  slope_.setZero();
+  if (used < 2) return;
+  const double tm = st / used;
+  const Wrench wm = sw / used;
+  double stt = 0.0;
+  Wrench stw = Wrench::Zero();
+  for (int k = 0; k < used; ++k) {
+    const auto i = static_cast<std::size_t>((slope_head_ - 1 - k + kSlopeRing) % kSlopeRing);
+    stt += (slope_t_[i] - tm) * (slope_t_[i] - tm);
+    stw += (slope_t_[i] - tm) * (slope_w_[i] - wm);
+  }
+  if (stt > 0.0) slope_ = stw / stt;
 }
 
 CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
@@ -97,7 +132,8 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
   const int n = model_.dof();
   ++counters_.cycles;
   if (in.q_planned.size() != n || in.q_feedback.size() != n || !in.q_planned.allFinite() ||
-      !in.q_feedback.allFinite() || !std::isfinite(in.t_s) || (have_cycle_ && in.t_s < last_cycle_t_s_)) {
+      !in.q_feedback.allFinite() || !std::isfinite(in.t_s) || (have_cycle_ && in.t_s < last_cycle_t_s_) ||
+      !in.wrench_offset_base.allFinite() || std::isnan(in.wrench_lead_s)) {
     ++counters_.invalid_inputs;
     out.status = CycleStatus::kInvalidInput;
     out.q_command = JointVector::Zero(n);
@@ -137,6 +173,15 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
     }
   }
 
+  if (have_force_) {
+    update_slope(in.t_s);
+  }
+  out.wrench_measured_base = wrench_base_;
+  Wrench used = wrench_base_ + in.wrench_offset_base;
+  if (in.wrench_lead_s > 0.0 && std::isfinite(in.wrench_lead_s)) {
+    used += in.wrench_lead_s * slope_;
+  }
+
   // Target correction: the model's deflection, or zero when the force cannot be trusted.
   JointVector target = JointVector::Zero(n);
   out.force_age_s = have_force_ ? in.t_s - last_force_t_s_ : 0.0;
@@ -146,6 +191,8 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
     out.status = CycleStatus::kForceFault;
   } else if (out.force_age_s > config_.watchdog_s) {
     out.status = CycleStatus::kStaleForce;
+  } else if (in.hold_to_zero) {
+    out.status = CycleStatus::kHeld;
   } else {
     out.status = CycleStatus::kOk;
     // dtheta = K^-1 J_wap(q)^T W. FK is already at q_feedback; a second FK only when the Jacobian is
@@ -154,7 +201,7 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
       forward_kinematics(model_, ws_, in.q_planned);
     }
     point_jacobian(ws_, ws_.base_T_wap.translation(), jac_);
-    target = model_.compliance().cwiseProduct(jac_.transpose() * wrench_base_);
+    target = model_.compliance().cwiseProduct(jac_.transpose() * used);
     if (!target.allFinite()) {
       target.setZero();
     }
@@ -174,7 +221,7 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
       out.size_limited = true;
     }
   }
-  out.wrench_base = wrench_base_;
+  out.wrench_base = out.status == CycleStatus::kOk && used.allFinite() ? used : wrench_base_;
 
   // Rate bound; also the ramp to zero when the target dropped to zero. The change is scaled as a
   // whole, not clamped joint by joint: the new correction then lies on the segment from the old one

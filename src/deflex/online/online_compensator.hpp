@@ -1,7 +1,9 @@
-// The online compensation cycle (paper, Figure 3): every cycle the latest conditioned wrench and the
-// current configuration give dtheta = K^-1 J^T W by the lumped model, and theta_c = theta_planned -
-// dtheta goes to the controller. Bounded in size and rate; stale or faulty force data ramp the
-// correction to zero. step() never allocates, locks or throws (tests prove it with AllocationGuard).
+// The online compensation cycle (paper, Figure 3): every cycle the latest conditioned wrench and a
+// configuration give dtheta = K^-1 J^T W by the lumped model, bounded in size and rate; stale or
+// faulty force data ramp the correction to zero. What the correction is added to is the caller's
+// business: a controller link subtracts it from the nominal it holds itself (never from what the
+// controller echoes back). step() never allocates, locks or throws (tests prove it with
+// AllocationGuard).
 #pragma once
 
 #include <array>
@@ -15,7 +17,8 @@ namespace deflex {
 
 /// Where the Jacobian of dtheta = K^-1 J(q)^T W is evaluated.
 enum class JacobianAt {
-  kPlanned,   ///< q_planned: the exact compensation form (compliance.hpp, compensated_configuration)
+  kPlanned,   ///< q_planned: the configuration the command is for (the exact compensation form of
+              ///< compliance.hpp, compensated_configuration)
   kFeedback,  ///< q_feedback: the configuration the arm has now (the paper's "current pose")
 };
 
@@ -38,6 +41,7 @@ enum class CycleStatus : int {
   kNoForceYet = 1,    ///< no valid force sample since start: correction zero
   kStaleForce = 2,    ///< watchdog expired: correction ramping to zero
   kForceFault = 3,    ///< a fault sample was seen within fault_hold_s: correction ramping to zero
+  kHeld = 4,          ///< the caller asked to hold (hold_to_zero): correction ramping to zero
   kInvalidInput = -1, ///< wrong joint count or non-finite joints/time: q_command must not be sent
 };
 
@@ -45,14 +49,24 @@ enum class CycleStatus : int {
 
 struct CycleInput {
   double t_s = 0.0;         ///< cycle time (s), monotonic (the caller's clock)
-  JointVector q_planned;    ///< rad
-  JointVector q_feedback;   ///< rad; the sensor orientation comes from it
+  JointVector q_planned;    ///< rad: the configuration the command is for (a nominal the caller holds)
+  JointVector q_feedback;   ///< rad: where the arm is; the sensor orientation comes from it
+  /// Added to the conditioned wrench before the model (base frame, at the WAP): the hybrid strategy
+  /// subtracts its force model's wrench here, the predictive one adds the model's change.
+  Wrench wrench_offset_base = Wrench::Zero();
+  /// > 0: the conditioned wrench is extrapolated this far ahead (s) along its recent slope (the
+  /// predictive strategy without a force model).
+  double wrench_lead_s = 0.0;
+  /// The caller cannot trust this cycle's wrench (its strategy could not evaluate its model): the
+  /// correction ramps to zero as on a stale force.
+  bool hold_to_zero = false;
 };
 
 struct CycleOutput {
   JointVector q_command;                ///< q_planned - dtheta, rad
   JointVector dtheta;                   ///< applied correction (after bounds), rad
-  Wrench wrench_base = Wrench::Zero();  ///< conditioned wrench used (base frame, at the WAP)
+  Wrench wrench_base = Wrench::Zero();  ///< wrench the model used (base frame, at the WAP)
+  Wrench wrench_measured_base = Wrench::Zero();  ///< conditioned measurement, before offset and lead
   CycleStatus status = CycleStatus::kNoForceYet;
   bool size_limited = false;            ///< the joint or TCP bound cut the correction
   bool rate_limited = false;            ///< the rate bound cut the change of correction
@@ -86,6 +100,11 @@ class OnlineCompensator {
   /// Back to the start state: zero correction, empty queue, filter unprimed (controller restart).
   void reset() noexcept;
 
+  /// DC group delay of the force low-pass, s (the conditioned wrench lags the sensor by this much).
+  [[nodiscard]] double filter_delay_s() const { return filter_delay_s_; }
+  /// Slope of the conditioned wrench over the last `slope_window_s` (per s, base frame at the WAP).
+  [[nodiscard]] const Wrench& wrench_slope() const { return slope_; }
+
   [[nodiscard]] const CompensatorCounters& counters() const { return counters_; }
   [[nodiscard]] const RobotModel& model() const { return model_; }
   [[nodiscard]] const OnlineConfig& config() const { return config_; }
@@ -108,6 +127,16 @@ class OnlineCompensator {
   JointVector correction_;
   bool have_force_ = false;
   Wrench wrench_base_ = Wrench::Zero();
+  double filter_delay_s_ = 0.0;
+
+  // Conditioned wrench at recent cycles, for its slope (fixed ring, no allocation).
+  static constexpr int kSlopeRing = 32;
+  static constexpr double kSlopeWindowS = 0.05;
+  std::array<double, kSlopeRing> slope_t_{};
+  std::array<Wrench, kSlopeRing> slope_w_{};
+  int slope_head_ = 0, slope_count_ = 0;
+  Wrench slope_ = Wrench::Zero();
+  void update_slope(double t_s) noexcept;
   double last_force_t_s_ = 0.0;
   double last_fault_t_s_ = -1e300;
   double last_cycle_t_s_ = 0.0;

@@ -1,0 +1,61 @@
+// The controller side of ABB EGM position guidance in joint mode (EGMActJoint + EGMRunJoint), as the
+// real controller behaves, never more kindly:
+//   - every egm_period_s it sends an EgmRobot with the motor-side joints as feedback and, as
+//     "planned", the reference it is following: the sensor's own last target;
+//   - it takes each EgmSensor's joints as the absolute target (and its speed reference, when sent),
+//     filters them (\LpFilter), and its servo follows them after a dead time with
+//       speed = k (target - position) + speed reference
+//     (k the position gain: PosCorrGain x the configured proportional position gain);
+//   - with no answer for egm_comm_timeout_s EGM stops and the arm holds where it is.
+// It knows nothing of deflex: only the wire format, over a datagram transport.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "deflex/cell/cell_config.hpp"
+#include "deflex/cell/robot_controller.hpp"
+#include "deflex/transport/datagram_transport.hpp"
+#include "deflex/wire/egm_codec.hpp"
+
+namespace deflex::cell {
+
+struct EgmControllerCounters {
+  std::uint64_t sent = 0;          ///< EgmRobot messages
+  std::uint64_t targets = 0;       ///< EgmSensor messages taken
+  std::uint64_t ignored = 0;       ///< datagrams that were not a usable answer
+  bool timed_out = false;          ///< EGM stopped for lack of answers
+};
+
+class EgmPositionGuidanceController final : public RobotController {
+ public:
+  /// The arm starts at rest at `q_start` (rad). `transport` must outlive the controller; the sensor
+  /// (deflex) listens at `sensor`.
+  EgmPositionGuidanceController(const ControllerConfig& config, const JointVector& q_start,
+                                DatagramTransport& transport, const DatagramAddress& sensor);
+
+  const JointVector& tick(double t_s) override;
+  [[nodiscard]] const char* name() const override { return "EGM position guidance"; }
+  [[nodiscard]] const EgmControllerCounters& counters() const { return counters_; }
+  /// The target the controller follows now (rad): the sensor's last one.
+  [[nodiscard]] const JointVector& target() const { return target_; }
+
+ private:
+  ControllerConfig config_;
+  DatagramTransport& transport_;
+  DatagramAddress sensor_;
+  EgmCodec codec_;
+  std::vector<unsigned char> buffer_;
+  EgmRobotMessage robot_;
+  EgmSensorMessage answer_;
+  JointVector target_, speed_ref_, filtered_target_, filtered_speed_, position_;
+  // Delay line of the filtered references, one entry a servo tick.
+  std::vector<JointVector> delay_target_, delay_speed_;
+  std::size_t delay_head_ = 0;
+  double last_t_s_ = 0.0, next_send_s_ = 0.0, last_answer_s_ = 0.0;
+  std::uint32_t seqno_ = 0;
+  bool stopped_ = false;
+  EgmControllerCounters counters_;
+};
+
+}  // namespace deflex::cell

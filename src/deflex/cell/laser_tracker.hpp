@@ -1,0 +1,31 @@
+// The laser tracker (Leica AT901-class with a 0.5" reflector on the TCP): samples the true TCP at
+// its own rate with its noise, between the servo ticks of the simulation (the TCP interpolated
+// linearly within a tick). Time stamps count from a chosen origin (the start of the laps).
+#pragma once
+
+#include <cstdint>
+#include <random>
+
+#include "deflex/cell/cell_config.hpp"
+#include "deflex/evaluate/tracker_trace.hpp"
+
+namespace deflex::cell {
+
+class LaserTracker {
+ public:
+  /// Samples from `first_sample_s` on (simulation time), stamped relative to `time_origin_s`, until
+  /// `last_sample_s`.
+  LaserTracker(const TrackerConfig& config, std::uint64_t seed, double first_sample_s, double last_sample_s,
+               double time_origin_s);
+
+  /// The TCP moved from p0 at t0 to p1 at t1 (a servo tick): records every sample due in (t0, t1].
+  void observe(double t0_s, const Vector3& p0_m, double t1_s, const Vector3& p1_m, TrackerTrace& out);
+
+ private:
+  TrackerConfig config_;
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+  double next_s_, last_s_, origin_s_, period_s_;
+};
+
+}  // namespace deflex::cell

@@ -1,0 +1,97 @@
+// ABB EGM path correction (RAPID: EGMActMove + EGMMoveL/EGMMoveC): the controller runs its own
+// programmed path and, at its path-correction rate, asks for a correction; deflex answers each
+// EgmRobot with an EgmSensorPathCorr carrying the whole current TCP position correction (an absolute
+// offset, never an increment, so nothing accumulates), expressed in the correction frame the RAPID
+// program declared, with its age. The nominal deflex holds is "no offset": what it sends is bounded
+// by the TCP bound. Orientation cannot be corrected in this mode; the link reports the rotation the
+// model predicts so the user sees when it matters.
+#pragma once
+
+#include "deflex/egm/egm_receiver.hpp"
+#include "deflex/link/controller_link.hpp"
+#include "deflex/link/link_history.hpp"
+#include "deflex/online/delay_estimator.hpp"
+#include "deflex/online/online_strategy.hpp"
+
+namespace deflex {
+
+/// The frame the correction is expressed in (the frame EGMActMove is given).
+enum class PathCorrFrame {
+  kTool,    ///< the robot model's tool frame (EGMActMove egmID, tool.tframe: ABB's examples)
+  kFlange,  ///< tool0
+  kPath,    ///< path coordinates: x along the direction of travel, y = z_tool x x, z = x x y
+};
+[[nodiscard]] const char* to_string(PathCorrFrame f);
+/// "tool", "flange" or "path"; throws InputError otherwise.
+[[nodiscard]] PathCorrFrame parse_path_corr_frame(const std::string& name);
+
+struct EgmPathLinkConfig {
+  EgmReceiverConfig receiver;
+  PathCorrFrame frame = PathCorrFrame::kTool;
+  /// Rotation of the TCP the model predicts above which the status says it is left uncorrected.
+  double rotation_warning_rad = 1e-4;
+  /// Predictive strategy: latency of the controller's correction channel beyond the servo delay the
+  /// link measures (deflex cannot observe it; take it from the RobotWare in use). s.
+  double correction_latency_s = 0.0;
+  std::size_t history_cycles = 1000;
+  double initial_delay_s = 0.05;
+  void validate() const;
+};
+
+class EgmPathLink final : public ControllerLink {
+ public:
+  /// Every reference must outlive the link. `force` may be null. Throws InputError.
+  EgmPathLink(OnlineCompensator& compensator, OnlineStrategy& strategy, DatagramTransport& transport,
+              const Clock& clock, ForceSource* force, const EgmPathLinkConfig& config = {});
+
+  LinkPollResult poll(double timeout_s) noexcept override;
+  [[nodiscard]] const char* name() const override { return "egm-path"; }
+  [[nodiscard]] LinkState state() const override { return state_; }
+  [[nodiscard]] const LinkCounters& counters() const override { return counters_; }
+  [[nodiscard]] const LinkCycleRecord& last_cycle() const override { return last_; }
+  [[nodiscard]] const JointVector& start_distance() const override { return no_distance_; }
+  [[nodiscard]] bool fault_pending() const override { return fault_pending_; }
+  void clear_fault() override { fault_pending_ = false; }
+  void write_history_csv(const std::string& path) const override { history_.write_csv(path); }
+
+  [[nodiscard]] const DelayEstimator& delay() const { return delay_; }
+  /// Cycles whose predicted rotation exceeded the warning threshold, and the largest one (rad).
+  [[nodiscard]] std::uint64_t rotation_warnings() const { return rotation_warnings_; }
+  [[nodiscard]] double max_rotation_rad() const { return max_rotation_rad_; }
+  /// The correction period the controller asks at (s, measured; 0 before two messages).
+  [[nodiscard]] double period_s() const { return period_s_; }
+
+ private:
+  bool correction_frame(const JointVector& q_feedback, Matrix3& base_R_frame) noexcept;
+
+  OnlineCompensator& comp_;
+  OnlineStrategy& strategy_;
+  const Clock& clock_;
+  ForceSource* force_;
+  EgmPathLinkConfig config_;
+  LinkCounters counters_;
+  EgmReceiver receiver_;
+  DelayEstimator delay_;
+  LinkHistory history_;
+  LinkState state_ = LinkState::kWaiting;
+  bool fault_pending_ = false;
+
+  CycleInput input_;
+  JointVector feedback_, planned_, previous_feedback_, velocity_, target_, no_distance_;
+  double previous_t_s_ = 0.0;
+  bool have_previous_ = false;
+  double period_s_ = 0.0;
+  Vector3 previous_tcp_m_ = Vector3::Zero();
+  Vector3 travel_direction_ = Vector3::Zero();
+  bool have_direction_ = false;
+  std::uint64_t rotation_warnings_ = 0;
+  double max_rotation_rad_ = 0.0;
+  EgmPathCorrMessage reply_;
+  std::vector<unsigned char> tx_;
+  std::uint32_t reply_seq_ = 0;
+  LinkCycleRecord last_;
+  Workspace ws_;
+  Jacobian jac_;
+};
+
+}  // namespace deflex

@@ -1,0 +1,65 @@
+// Link delay measurement (see delay_estimator.hpp).
+#include "deflex/online/delay_estimator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace deflex {
+
+DelayEstimator::DelayEstimator(double initial_delay_s, double window_s)
+    : window_s_(window_s), delay_s_(initial_delay_s), last_s_(std::numeric_limits<double>::quiet_NaN()) {}
+
+void DelayEstimator::record_reference(double t_s, const JointVector& q_ref) noexcept {
+  if (!std::isfinite(t_s) || !q_ref.allFinite() || (count_ > 0 && !(t_s > t_[static_cast<std::size_t>((head_ + kRing - 1) % kRing)]))) {
+    return;
+  }
+  t_[static_cast<std::size_t>(head_)] = t_s;
+  q_[static_cast<std::size_t>(head_)] = q_ref;
+  head_ = (head_ + 1) % kRing;
+  count_ = std::min(count_ + 1, kRing);
+}
+
+void DelayEstimator::observe_feedback(double t_s, const JointVector& q_feedback) noexcept {
+  if (count_ < 3 || !q_feedback.allFinite()) {
+    return;
+  }
+  const auto at = [&](int k) { return static_cast<std::size_t>((head_ - 1 - k + kRing) % kRing); };
+  // The reference must be moving now (at rest, or after it stopped, every recent reference matches
+  // the feedback equally), and the matched piece of it must be moving too.
+  constexpr double kMinStepRad = 1e-6;
+  if ((q_[at(0)] - q_[at(1)]).norm() < kMinStepRad) return;
+  double best = std::numeric_limits<double>::infinity();
+  double best_t = 0.0;
+  double best_step = 0.0;
+  double travel = 0.0;
+  for (int k = 1; k < count_; ++k) {
+    const std::size_t i1 = at(k - 1), i0 = at(k);  // segment from the older i0 to the newer i1
+    if (t_s - t_[i0] > window_s_) break;
+    if (q_[i0].size() != q_feedback.size() || q_[i1].size() != q_feedback.size()) return;
+    const JointVector d = q_[i1] - q_[i0];
+    const double len2 = d.squaredNorm();
+    const double len = std::sqrt(len2);
+    travel += len;
+    double s = 0.0;
+    if (len2 > 0.0) s = std::clamp((q_feedback - q_[i0]).dot(d) / len2, 0.0, 1.0);
+    const double dist = (q_[i0] + s * d - q_feedback).norm();
+    if (dist < best) {
+      best = dist;
+      best_t = t_[i0] + s * (t_[i1] - t_[i0]);
+      best_step = len;
+    }
+  }
+  // Ambiguous (the feedback is not on the reference's recent path, or matched where it rested).
+  if (!(best_step > kMinStepRad) || !(best < 0.1 * travel)) {
+    return;
+  }
+  const double sample = t_s - best_t;
+  if (!(sample >= 0.0) || !(sample < window_s_)) return;
+  last_s_ = sample;
+  ++measurements_;
+  // Running mean that forgets slowly (about the last 50 measurements).
+  delay_s_ = measurements_ == 1 ? sample : delay_s_ + 0.02 * (sample - delay_s_);
+}
+
+}  // namespace deflex

@@ -1,0 +1,43 @@
+// Measures a controller link's delay: how long after a joint reference is given the robot's feedback
+// shows it. Each feedback sample is matched against the recent references (the nearest point on the
+// reference's polyline, by joint distance), and the time between them is one measurement; the
+// estimate is their running average. Only samples taken while the reference moves are used (at rest
+// every reference matches). The predictive strategy leads by this delay. Fixed ring: no allocation.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "deflex/model/types.hpp"
+
+namespace deflex {
+
+class DelayEstimator {
+ public:
+  /// `initial_delay_s`: the estimate until the first measurement. `window_s`: how far back a
+  /// reference is looked for (longer than any delay expected).
+  explicit DelayEstimator(double initial_delay_s = 0.05, double window_s = 0.5);
+
+  /// The reference the controller was given (or reports following) at time t_s.
+  void record_reference(double t_s, const JointVector& q_ref) noexcept;
+  /// A feedback sample at time t_s; updates the estimate when it can be matched.
+  void observe_feedback(double t_s, const JointVector& q_feedback) noexcept;
+
+  [[nodiscard]] double delay_s() const { return delay_s_; }
+  [[nodiscard]] bool measured() const { return measurements_ > 0; }
+  [[nodiscard]] std::uint64_t measurements() const { return measurements_; }
+  /// The last single measurement, s (NaN before the first).
+  [[nodiscard]] double last_measurement_s() const { return last_s_; }
+
+ private:
+  static constexpr int kRing = 256;
+  std::array<double, kRing> t_{};
+  std::array<JointVector, kRing> q_{};
+  int head_ = 0, count_ = 0;
+  double window_s_;
+  double delay_s_;
+  double last_s_;
+  std::uint64_t measurements_ = 0;
+};
+
+}  // namespace deflex

@@ -1,0 +1,141 @@
+// The case-study file: the paper's protocol (circle, laps, speeds, setups and loads), deflex's own
+// settings for its online setups, the calibration procedure, the error budget, and the simulated
+// cell's hardware (cell/cell_config.hpp), in one place (data/cases/paper.yaml is the paper's case;
+// docs/error-budget.md explains each size). SI units inside; the YAML file uses mm, deg, um, N, s as
+// its keys say.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "deflex/cell/cell_config.hpp"
+#include "deflex/model/types.hpp"
+
+namespace deflex::study {
+
+/// The compensation strategy of a setup.
+enum class Strategy {
+  kOffline,     ///< paper Fig. 2: compensated program from the LDBB force model
+  kOnline,      ///< paper Fig. 3: force sensor, compensation every controller cycle
+  kHybrid,      ///< offline program + online correction of measured minus modelled force
+  kPredictive,  ///< online, with the wrench predicted where the command will be executed
+};
+[[nodiscard]] const char* to_string(Strategy s);
+
+/// How deflex reaches the controller in a setup.
+enum class LinkKind {
+  kProgram,   ///< the controller runs a (compensated) robot program of its own: no link
+  kEgmJoint,  ///< ABB EGM position guidance: deflex streams the program (egm_joint_link.hpp)
+  kEgmPath,   ///< ABB EGM path correction: the controller runs its program, deflex sends offsets
+};
+[[nodiscard]] const char* to_string(LinkKind k);
+
+/// One strategy setup of the protocol (a row group of the paper's tables).
+struct SetupConfig {
+  std::string name;  ///< "offline", "online", ... (JSON "setup")
+  Strategy strategy = Strategy::kOffline;
+  LinkKind link = LinkKind::kProgram;
+  bool sensor_mounted = false;
+  std::vector<double> loads_n;
+  std::vector<double> paper_uc_mm;                ///< paper's UC per load (empty: none)
+  std::vector<std::array<double, 3>> paper_c_mm;  ///< paper's C1..C3 per load
+};
+
+/// What a user would give `deflex online` for the online setups (the same settings, the same code).
+struct OnlineSettings {
+  double lowpass_hz = 25.0;           ///< the paper's 25 Hz
+  double dead_band_n = 0.0;           ///< the paper's lower threshold
+  double fault_threshold_n = 5000.0;  ///< the paper's upper threshold
+  double max_joint_correction_rad = 0.01;
+  double max_tcp_correction_m = 0.005;
+  double max_rate_rad_s = 0.05;
+  double watchdog_s = 0.05;
+  double ramp_in_s = 1.0;
+};
+
+struct CalibrationConfig {
+  int poses = 12;           ///< around the circle
+  double load_n = 500.0;    ///< in +-x, +-y, +-z of the base
+  double load_error = 0.0;  ///< relative 1-sigma of the applied calibration load
+  int samples = 1000;       ///< tracker samples averaged per measurement
+};
+
+struct CircleConfig {
+  Vector3 center_m = Vector3::Zero();
+  Pose tcp_orientation = Pose::Identity();  ///< rotation part used for every point
+  int points = 81;                          ///< configurations of the programmed circle (paper: 81)
+};
+
+struct BudgetConfig {
+  double speed_m_s = 0.05;
+  int load_index = 2;
+  int laps_each_way = 1;
+};
+
+struct CaseConfig {
+  std::string name;
+  std::string source = "<memory>";
+  std::uint64_t seed = 1;
+  CircleConfig circle;
+  int laps_cw = 3;
+  int laps_ccw = 3;
+  std::vector<double> speeds_m_s;
+  std::vector<double> sweep_speeds_m_s;
+  double sweep_load_n = 650.0;
+  std::vector<SetupConfig> setups;
+  cell::CellConfig cell;  ///< the hardware
+  OnlineSettings online;
+  CalibrationConfig calibration;
+  BudgetConfig budget;
+  /// Give the compensators the true joint stiffness instead of an identified one (tests only:
+  /// the model-consistent cell).
+  bool exact_model = false;
+
+  /// Circle radius, from the LDBB geometry: r = L cos(phi).
+  [[nodiscard]] double radius_m() const;
+  /// The nominal pivot (the force model's), below the circle centre by L sin(phi).
+  [[nodiscard]] Vector3 pivot_m() const;
+};
+
+/// Loads a case file; every error names the file, line and field. Throws ModelError.
+CaseConfig load_case(const std::string& path);
+CaseConfig load_case_text(const std::string& text, const std::string& source);
+/// The paper's case (data/cases/paper.yaml, compiled in).
+CaseConfig paper_case();
+const std::string& paper_case_yaml();
+
+/// Every effect of the cell that the error budget switches off one at a time.
+enum class Effect {
+  kStiffnessMismatch,  ///< per-joint spread of the true stiffness around the scaled built-in one
+  kJointCoupling,
+  kLinkBending,
+  kSensorCompliance,
+  kLostMotion,
+  kKinematicErrors,
+  kLdbbForceError,  ///< magnitude bias, pivot error, ball friction
+  kLdbbRipple,      ///< ripple and noise of the pneumatic force
+  kSensorErrors,    ///< crosstalk, noise, bias, gravity-compensation error
+  kTrackerNoise,
+  kCalibrationNoise,   ///< load error of the calibration experiment
+  kLatency,            ///< the controller's EGM dead time and filter, network and DAQ latency
+  kPathDrift,          ///< run-to-run drift and path repeatability
+  kGearHardening,      ///< torque-dependent gear stiffness
+  kSensorCalibration,  ///< sensitivity error and mounting misalignment unknown to the user
+};
+inline constexpr std::array<Effect, 15> kAllEffects = {
+    Effect::kStiffnessMismatch, Effect::kJointCoupling,   Effect::kLinkBending,      Effect::kSensorCompliance,
+    Effect::kLostMotion,        Effect::kKinematicErrors, Effect::kLdbbForceError,   Effect::kLdbbRipple,
+    Effect::kSensorErrors,      Effect::kTrackerNoise,    Effect::kCalibrationNoise, Effect::kLatency,
+    Effect::kPathDrift,         Effect::kGearHardening,   Effect::kSensorCalibration};
+[[nodiscard]] const char* to_string(Effect e);
+/// Short description of the effect's size in `config` (for the error budget table).
+[[nodiscard]] std::string effect_size(const CaseConfig& config, Effect e);
+/// A copy of `config` with the effect switched off.
+[[nodiscard]] CaseConfig without_effect(const CaseConfig& config, Effect e);
+/// A copy with every extra effect off, the exact stiffness given to the compensators and no noise,
+/// except the tracker noise when `keep_tracker_noise`.
+[[nodiscard]] CaseConfig model_consistent(const CaseConfig& config, bool keep_tracker_noise = true);
+
+}  // namespace deflex::study

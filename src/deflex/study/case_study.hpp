@@ -1,0 +1,79 @@
+// The paper's protocol on the simulated cell, end to end (paper, section 3): per setup, load and
+// speed an unloaded, a loaded uncompensated (UC) and a loaded compensated (C) run, evaluated by the
+// paper's mean distance from the unloaded path and ISO 9283; the speed sweep; the error budget.
+// Runs are independent and seeded by their identity, so they run on every core and the figures do
+// not depend on the scheduling.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "deflex/study/case_config.hpp"
+#include "deflex/evaluate/study_tables.hpp"
+#include "deflex/evaluate/tracker_trace.hpp"
+
+namespace deflex::study {
+
+struct CaseStudyOptions {
+  bool quick = false;  ///< one clockwise and one anticlockwise lap per run
+  bool speed_sweep = true;
+  bool error_budget = true;
+  int threads = 0;  ///< 0: one per hardware thread
+  /// Progress in [0, 1] with a short label; called from worker threads, one call at a time.
+  std::function<void(double fraction, const std::string& label)> progress;
+};
+
+/// One row of the error budget: the compensated residual with one effect switched off.
+struct BudgetRow {
+  Effect effect = Effect::kLostMotion;
+  std::string name;
+  std::string size;
+  double residual_mm_without = 0.0;
+};
+
+struct BudgetResult {
+  std::string setup;
+  double load_n = 0.0;
+  double speed_mm_s = 0.0;
+  double residual_mm_all = 0.0;
+  double uc_mm = 0.0;
+  std::vector<BudgetRow> rows;
+};
+
+/// Traces for a path plot (one lap each, thinned for drawing).
+struct PlotTraces {
+  std::string title;
+  TrackerTrace unloaded, uc, c;
+};
+
+/// What deflex's links did in the online runs (every run of the study, summed or maximised).
+struct LinkSummary {
+  std::string setup;
+  std::uint64_t cycles = 0;               ///< controller messages answered
+  std::uint64_t rejected = 0;             ///< datagrams counted and not answered
+  std::uint64_t guard_trips = 0;          ///< commands the final check stopped (must be 0)
+  double max_command_deviation_rad = 0.0; ///< largest |command - nominal|, any joint, any cycle
+  double bound_rad = 0.0;                 ///< the bound it must stay within
+  double max_tcp_correction_m = 0.0;
+  double measured_delay_s = 0.0;          ///< the link's measured delay (mean over the runs)
+};
+
+struct CaseStudyOutput {
+  StudyResult study;
+  std::vector<LinkSummary> links;
+  std::vector<BudgetResult> budgets;
+  std::vector<PlotTraces> plots;
+  std::vector<std::string> setup_paragraphs;  ///< the cell and calibration in words
+  double simulated_s = 0.0;                   ///< total simulated robot time
+  int runs = 0;
+};
+
+/// Runs the whole study. Throws deflex::Error on a case the cell cannot run (unreachable circle ...).
+[[nodiscard]] CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions& options);
+
+/// Runs `jobs` on `threads` threads (0: hardware), largest first as given; rethrows the first
+/// exception after every thread has stopped.
+void run_parallel(std::vector<std::function<void()>>& jobs, int threads);
+
+}  // namespace deflex::study

@@ -1,0 +1,304 @@
+// One protocol run on the simulated cell (see simulated_run.hpp).
+#include "deflex/study/simulated_run.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <memory>
+
+#include "deflex/cell/daq_stream.hpp"
+#include "deflex/cell/egm_path_controller.hpp"
+#include "deflex/cell/egm_position_controller.hpp"
+#include "deflex/cell/force_sensor.hpp"
+#include "deflex/cell/laser_tracker.hpp"
+#include "deflex/cell/ldbb_device.hpp"
+#include "deflex/cell/path_drift.hpp"
+#include "deflex/cell/robot_controller.hpp"
+#include "deflex/egm/egm_joint_link.hpp"
+#include "deflex/egm/egm_path_link.hpp"
+#include "deflex/force/ldbb_force_model.hpp"
+#include "deflex/model/errors.hpp"
+#include "deflex/offline/compensate_path.hpp"
+#include "deflex/online/datagram_force_source.hpp"
+#include "deflex/online/online_strategy.hpp"
+#include "deflex/paths/circle_path.hpp"
+#include "deflex/transport/memory_network.hpp"
+
+namespace deflex::study {
+namespace {
+
+std::uint64_t splitmix(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+// Seeds of the run's components, each from the run's own seed.
+enum class Component : std::uint64_t { kLdbb = 1, kSensor = 2, kTracker = 3, kDrift = 4 };
+std::uint64_t component_seed(std::uint64_t run, Component c) {
+  return splitmix(run ^ (static_cast<std::uint64_t>(c) * 0x632be59bd9b4e019ULL));
+}
+
+// The cell's network: the controller, the cell PC running deflex, and the DAQ.
+const DatagramAddress kDeflexEgm{0x0a000001, 6510};    // 10.0.0.1:6510
+const DatagramAddress kDeflexForce{0x0a000001, 6600};  // 10.0.0.1:6600
+const DatagramAddress kController{0x0a000002, 6511};   // 10.0.0.2:6511
+const DatagramAddress kDaq{0x0a000003, 5000};          // 10.0.0.3:5000
+
+}  // namespace
+
+std::uint64_t run_seed(std::uint64_t case_seed, bool sensor_mounted, RunKind kind, Strategy strategy, double load_n,
+                       double speed_m_s, std::uint64_t extra) {
+  std::uint64_t h = splitmix(case_seed);
+  h = splitmix(h ^ (sensor_mounted ? 0x51ULL : 0x17ULL));
+  h = splitmix(h ^ static_cast<std::uint64_t>(kind));
+  // The uncompensated and unloaded runs of a setup do not depend on the strategy that follows.
+  h = splitmix(h ^ (kind == RunKind::kCompensated ? static_cast<std::uint64_t>(strategy) + 11 : 0));
+  h = splitmix(h ^ static_cast<std::uint64_t>(std::llround(load_n * 1000.0)));
+  h = splitmix(h ^ static_cast<std::uint64_t>(std::llround(speed_m_s * 1e6)));
+  return splitmix(h ^ extra);
+}
+
+SetupCell build_setup_cell(const CaseConfig& config, bool sensor_mounted) {
+  // The same physical robot in every setup: its draws depend on the case seed only.
+  auto robot = std::make_shared<const cell::TrueRobot>(config.cell, sensor_mounted, splitmix(config.seed ^ 0xabcdefULL));
+  CellCalibration calibration =
+      calibrate_setup(config, *robot, splitmix(config.seed ^ (sensor_mounted ? 0x1111ULL : 0x2222ULL)));
+  CirclePath circle;
+  circle.centre_m = config.circle.center_m;
+  circle.radius_m = config.radius_m();
+  circle.points = config.circle.points;
+  std::vector<Pose> poses = sample_circle(circle, Eigen::Quaterniond(config.circle.tcp_orientation.linear()));
+  IkRequest first;
+  if (calibration.identified.dof() == 6) {
+    JointVector seed(6);
+    seed << 0.0, deg_to_rad(20.0), deg_to_rad(10.0), 0.0, deg_to_rad(60.0), 0.0;
+    first.seed = seed;
+  }
+  JointPath path = solve_path_ik(calibration.identified, poses, first);
+  return SetupCell{std::move(robot), std::move(calibration), std::move(poses), std::move(path)};
+}
+
+JointTrajectory protocol_program(const std::vector<Pose>& circle_poses, const std::vector<JointVector>& q,
+                                 double speed_m_s, double settle_s, int laps_cw, int laps_ccw,
+                                 const RobotModel& model) {
+  if (circle_poses.size() != q.size() || q.size() < 4) {
+    throw InputError("protocol program: a closed circle of at least 4 points is needed");
+  }
+  const std::size_t n = q.size() - 1;  // distinct points; index n repeats index 0
+  std::vector<Pose> poses;
+  std::vector<JointVector> joints;
+  poses.push_back(circle_poses[0]);
+  joints.push_back(q[0]);
+  // The circle's points run anticlockwise (seen from above); clockwise laps walk them backwards.
+  for (int lap = 0; lap < laps_cw; ++lap) {
+    for (std::size_t k = 1; k <= n; ++k) {
+      poses.push_back(circle_poses[n - k]);
+      joints.push_back(q[n - k]);
+    }
+  }
+  for (int lap = 0; lap < laps_ccw; ++lap) {
+    for (std::size_t k = 1; k <= n; ++k) {
+      poses.push_back(circle_poses[k]);
+      joints.push_back(q[k]);
+    }
+  }
+  return trajectory_at_tcp_speed(poses, joints, speed_m_s, model, settle_s);
+}
+
+std::vector<JointVector> offline_configurations(const CaseConfig& config, const SetupCell& setup, double load_n) {
+  const LdbbForceModel force(config.pivot_m(), load_n, config.cell.ldbb.push);
+  OfflineOptions options;
+  options.predict = false;
+  const OfflineResult r =
+      compensate_path(setup.calibration.identified, setup.nominal_path, setup.circle_poses, force, options);
+  std::vector<JointVector> q;
+  q.reserve(r.points.size());
+  for (const auto& p : r.points) {
+    q.push_back(p.q_command);
+  }
+  return q;
+}
+
+RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const RunSpec& spec) {
+  const cell::TrueRobot& robot = *setup.robot;
+  const cell::CellConfig& c = config.cell;
+  const bool loaded = spec.kind != RunKind::kUnloaded;
+  const bool compensated = spec.kind == RunKind::kCompensated;
+  const bool linked = spec.link != LinkKind::kProgram;
+  if (linked && !robot.sensor_mounted()) {
+    throw InputError(fmt::format("run: the {} link's online strategies need the force sensor mounted",
+                                 to_string(spec.link)));
+  }
+  const RobotModel& identified = setup.calibration.identified;
+  const bool offline_program =
+      compensated && (spec.strategy == Strategy::kOffline || spec.strategy == Strategy::kHybrid);
+  const std::vector<JointVector> configurations =
+      offline_program ? offline_configurations(config, setup, spec.load_n) : setup.nominal_path.q;
+  auto program = std::make_shared<const JointTrajectory>(protocol_program(
+      setup.circle_poses, configurations, spec.speed_m_s, c.ldbb.settle_s, spec.laps_cw, spec.laps_ccw, identified));
+
+  // The cell's network and its three hosts, on a clock this simulation advances.
+  ManualClock clock;
+  MemoryNetwork network(clock);
+  MemoryTransport& controller_port = network.add_endpoint(kController, c.controller.network_latency_s);
+  MemoryTransport& deflex_egm_port = network.add_endpoint(kDeflexEgm, c.controller.network_latency_s);
+  MemoryTransport& daq_port = network.add_endpoint(kDaq, c.sensor.daq_latency_s);
+  MemoryTransport& deflex_force_port = network.add_endpoint(kDeflexForce, 0.0);
+
+  // The controller.
+  std::unique_ptr<cell::RobotController> controller;
+  switch (spec.link) {
+    case LinkKind::kProgram:
+      controller = std::make_unique<cell::ProgramController>(program);
+      break;
+    case LinkKind::kEgmJoint:
+      controller = std::make_unique<cell::EgmPositionGuidanceController>(c.controller, program->points().front(),
+                                                                          controller_port, kDeflexEgm);
+      break;
+    case LinkKind::kEgmPath:
+      controller = std::make_unique<cell::EgmPathCorrectionController>(c.controller, robot.nominal_model(), program,
+                                                                        controller_port, kDeflexEgm);
+      break;
+  }
+
+  // One physical sensor for the whole case: its crosstalk and true sensitivities come from the case
+  // seed; its noise from the run's.
+  cell::ForceSensorDaq sensor(c.sensor, c.tool, component_seed(spec.seed, Component::kSensor),
+                              splitmix(config.seed ^ 0x5e5503ULL));
+  cell::DaqStream daq(daq_port, kDeflexForce);
+
+  // deflex's side, built as `deflex online` builds it: the sensor's calibration sheet and identified
+  // payload, the identified robot model, the user's settings, the strategy, the link.
+  std::unique_ptr<OnlineCompensator> compensator;
+  std::unique_ptr<LdbbForceModel> force_model;
+  std::unique_ptr<OnlineStrategy> strategy;
+  std::unique_ptr<DatagramForceSource> force_source;
+  std::unique_ptr<ControllerLink> link;
+  if (linked) {
+    deflex::SensorConfig sc;
+    sc.name = "MSC10-class 3-component sensor (calibration sheet)";
+    sc.components = 3;
+    sc.crosstalk.topLeftCorner<3, 3>() = sensor.calibration().decoupling;
+    sc.flange_T_sensor = Pose::Identity();
+    sc.flange_T_sensor.translation() = Vector3(0, 0, c.sensor.height_m);
+    sc.payload_mass_kg = sensor.calibration().ee_mass_kg;
+    sc.payload_cog_sensor_m = sensor.calibration().ee_cog_m;
+    sc.bias_sensor.head<3>() = sensor.calibration().bias_n;
+    sc.gravity_base_m_s2 = Vector3(0, 0, -cell::kGravity);
+    sc.lowpass_cutoff_hz = config.online.lowpass_hz;
+    sc.sample_rate_hz = c.sensor.rate_hz;
+    sc.dead_band_N = config.online.dead_band_n;
+    sc.fault_threshold_N = config.online.fault_threshold_n;
+    deflex::OnlineConfig oc;
+    oc.period_s = spec.link == LinkKind::kEgmPath ? c.controller.path_corr_period_s : c.controller.egm_period_s;
+    oc.max_joint_correction_rad = config.online.max_joint_correction_rad;
+    oc.max_tcp_correction_m = config.online.max_tcp_correction_m;
+    oc.max_correction_rate_rad_s = config.online.max_rate_rad_s;
+    oc.watchdog_s = std::max(config.online.watchdog_s, 2.0 * oc.period_s);
+    compensator = std::make_unique<OnlineCompensator>(identified, sc, oc);
+    StrategyKind kind = StrategyKind::kNone;  // the reference runs stream the program uncorrected
+    if (compensated) {
+      kind = spec.strategy == Strategy::kHybrid       ? StrategyKind::kHybrid
+             : spec.strategy == Strategy::kPredictive ? StrategyKind::kPredictive
+                                                      : StrategyKind::kOnline;
+    }
+    if (kind == StrategyKind::kHybrid || kind == StrategyKind::kPredictive) {
+      // The user's force model: the LDBB with its nominal pivot and set-point force.
+      force_model = std::make_unique<LdbbForceModel>(config.pivot_m(), std::max(spec.load_n, 1.0), c.ldbb.push);
+    }
+    strategy = std::make_unique<OnlineStrategy>(identified, kind, force_model.get());
+    force_source = std::make_unique<DatagramForceSource>(deflex_force_port);
+    if (spec.link == LinkKind::kEgmJoint) {
+      EgmJointLinkConfig lc;
+      lc.stream.ramp_in_s = config.online.ramp_in_s;
+      lc.history_cycles = 16;
+      link = std::make_unique<EgmJointLink>(*compensator, *strategy, program, deflex_egm_port, clock,
+                                            force_source.get(), lc);
+    } else {
+      EgmPathLinkConfig lc;
+      lc.frame = parse_path_corr_frame(c.controller.path_corr_frame);
+      lc.history_cycles = 16;
+      link = std::make_unique<EgmPathLink>(*compensator, *strategy, deflex_egm_port, clock, force_source.get(), lc);
+    }
+  }
+
+  const double settle_s = c.ldbb.settle_s;
+  const double motion_end_s = program->end_time_s();
+  // The arm follows a streamed program a little late: let the tracker see the motion to its end.
+  const double run_end_s = motion_end_s + (linked ? 0.5 : 0.0);
+  const double dt = c.controller.servo_period_s;
+  const auto ticks = static_cast<long>(std::ceil(run_end_s / dt));
+  cell::LdbbDevice ldbb(c.ldbb, config.pivot_m(), spec.load_n, component_seed(spec.seed, Component::kLdbb));
+  cell::PathDrift drift(c.drift, component_seed(spec.seed, Component::kDrift));
+  cell::LaserTracker tracker(c.tracker, component_seed(spec.seed, Component::kTracker), settle_s, run_end_s, settle_s);
+
+  RunOutput out;
+  out.simulated_s = run_end_s;
+  out.trace.reserve(static_cast<std::size_t>((run_end_s - settle_s) * c.tracker.rate_hz) + 2);
+  Workspace ws(robot.true_model());
+  JointVector q_motor = program->points().front();
+  cell::TrueRobotState state = robot.initial_state(q_motor);
+  Vector3 p_prev = drift.apply(robot.solve(ws, q_motor, Wrench::Zero(), state));
+  Vector3 v_prev = Vector3::Zero();
+  const double daq_period = 1.0 / c.sensor.rate_hz;
+  double next_daq = daq_period;
+
+  for (long k = 1; k <= ticks; ++k) {
+    const double t = static_cast<double>(k) * dt;
+    clock.set(t);
+    q_motor = controller->tick(t);
+    Wrench w = Wrench::Zero();
+    if (loaded) {
+      ldbb.advance(dt);
+      w = ldbb.wrench(p_prev, v_prev);
+    }
+    drift.advance(dt);
+    // Drift moves the whole arm (thermal growth, repeatability), so the LDBB sees it too.
+    const Vector3 p = drift.apply(robot.solve(ws, q_motor, w, state));
+    if (linked) {
+      // The DAQ streams this tick's samples; the EGM message sent this tick reaches deflex after the
+      // network's latency, and deflex answers at once (its reply reaches the controller's next tick).
+      const Matrix3 base_R_flange = ws.base_T_flange.linear();
+      for (; next_daq <= t + 1e-12; next_daq += daq_period) {
+        daq.send(next_daq, sensor.sample(w.head<3>(), base_R_flange));
+      }
+      clock.set(t + c.controller.network_latency_s);
+      for (;;) {
+        const LinkPollResult r = link->poll(0.0);
+        if (r == LinkPollResult::kIdle) break;
+        if (r == LinkPollResult::kRefused) {
+          throw Error(fmt::format("run: deflex's {} link refused the start (the arm was not at the program's start)",
+                                  link->name()));
+        }
+        if (r != LinkPollResult::kAnswered) continue;
+        ++out.link_cycles;
+        const LinkCycleRecord& rec = link->last_cycle();
+        if (spec.link == LinkKind::kEgmJoint) {
+          out.max_command_deviation_rad =
+              std::max(out.max_command_deviation_rad, (rec.q_command - rec.q_nominal).cwiseAbs().maxCoeff());
+        }
+        out.max_tcp_correction_m = std::max(out.max_tcp_correction_m, rec.tcp_correction_m.norm());
+      }
+    }
+    tracker.observe(t - dt, p_prev, t, p, out.trace);
+    v_prev = (p - p_prev) / dt;
+    p_prev = p;
+  }
+  if (linked) {
+    out.link_counters = link->counters();
+    if (const auto* joint = dynamic_cast<const EgmJointLink*>(link.get())) {
+      out.measured_delay_s = joint->delay().delay_s();
+    } else if (const auto* path = dynamic_cast<const EgmPathLink*>(link.get())) {
+      out.measured_delay_s = path->delay().delay_s();
+    }
+    const auto* egm = dynamic_cast<const cell::EgmPositionGuidanceController*>(controller.get());
+    if (egm != nullptr && egm->counters().timed_out) {
+      throw Error("run: the simulated controller stopped EGM for lack of answers (a broken setup, not a result)");
+    }
+  }
+  return out;
+}
+
+}  // namespace deflex::study

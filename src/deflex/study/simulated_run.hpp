@@ -1,0 +1,80 @@
+// One run of the protocol on the simulated cell: the controller drives the programmed circle at a TCP
+// speed for the laps of the protocol, the LDBB loads the TCP (or not), the laser tracker records it.
+// A compensated run gets its correction the way a real cell would: the offline strategy as a
+// compensated robot program the controller runs, the online strategies from deflex's own controller
+// link (egm-joint or egm-path) over the cell's network, fed by the cell's force-sensor DAQ. The
+// study builds deflex's side exactly as `deflex online` would; the cell never sees it.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "deflex/cell/true_robot.hpp"
+#include "deflex/evaluate/tracker_trace.hpp"
+#include "deflex/link/controller_link.hpp"
+#include "deflex/paths/joint_trajectory.hpp"
+#include "deflex/paths/path_ik.hpp"
+#include "deflex/study/cell_calibration.hpp"
+#include "deflex/study/case_config.hpp"
+
+namespace deflex::study {
+
+/// Everything one physical setup's runs share, built once (read-only while runs execute in parallel).
+struct SetupCell {
+  std::shared_ptr<const cell::TrueRobot> robot;
+  CellCalibration calibration;
+  std::vector<Pose> circle_poses;  ///< the programmed circle, closed (last = first)
+  JointPath nominal_path;          ///< IK of circle_poses with the nominal kinematics
+};
+
+/// Builds the setup: the true robot from the case seed (the same robot for every setup), its
+/// calibration, the programmed circle.
+[[nodiscard]] SetupCell build_setup_cell(const CaseConfig& config, bool sensor_mounted);
+
+enum class RunKind { kUnloaded, kUncompensated, kCompensated };
+
+struct RunSpec {
+  RunKind kind = RunKind::kUnloaded;
+  Strategy strategy = Strategy::kOffline;  ///< the compensated run's strategy
+  LinkKind link = LinkKind::kProgram;      ///< how every run of the setup reaches the controller
+  double load_n = 0.0;
+  double speed_m_s = 0.01;
+  int laps_cw = 3;
+  int laps_ccw = 3;
+  std::uint64_t seed = 1;  ///< this run's own seed (see run_seed)
+};
+
+struct RunOutput {
+  TrackerTrace trace;  ///< tracker samples from the start of the laps (t = 0) to the end of the motion
+  double simulated_s = 0.0;
+  // What deflex's link did (online setups).
+  std::uint64_t link_cycles = 0;       ///< controller messages answered
+  LinkCounters link_counters;
+  double max_command_deviation_rad = 0.0;  ///< largest |command - nominal| of any joint, any cycle
+  double max_tcp_correction_m = 0.0;
+  double measured_delay_s = 0.0;       ///< the link's measured delay at the end of the run
+};
+
+/// A run's seed from the case seed and the run's identity, so results do not depend on the order
+/// or the thread that runs them.
+[[nodiscard]] std::uint64_t run_seed(std::uint64_t case_seed, bool sensor_mounted, RunKind kind, Strategy strategy,
+                                     double load_n, double speed_m_s, std::uint64_t extra = 0);
+
+/// The protocol's program for a closed list of configurations around the circle (last = first):
+/// hold at the start for `settle_s`, `laps_cw` clockwise laps, then `laps_ccw` anticlockwise ones,
+/// at the TCP speed. The circle poses give the distances.
+[[nodiscard]] JointTrajectory protocol_program(const std::vector<Pose>& circle_poses, const std::vector<JointVector>& q,
+                                               double speed_m_s, double settle_s, int laps_cw, int laps_ccw,
+                                               const RobotModel& model);
+
+/// The compensated configurations of the offline strategy (paper, Figure 2) for a load, closed, from
+/// the identified model and the LDBB force model (nominal pivot, set-point force).
+[[nodiscard]] std::vector<JointVector> offline_configurations(const CaseConfig& config, const SetupCell& setup,
+                                                              double load_n);
+
+/// Runs one protocol run. Throws Error when the run cannot be done (an online strategy without the
+/// sensor, a refused start or a controller that timed out: a broken setup, never a result).
+[[nodiscard]] RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const RunSpec& spec);
+
+}  // namespace deflex::study

@@ -1,0 +1,85 @@
+// An in-memory datagram network for deterministic simulation: the simulated cell's controller, its
+// force-sensor DAQ and deflex's links each get an endpoint with an address, and datagrams reach
+// their destination a fixed latency after they were sent, by a shared Clock that the simulation
+// advances. Nothing waits and nothing depends on the machine's speed, so a run gives the same
+// figures on any number of threads. Preallocated: sending and receiving never allocate.
+// Single-threaded: one network belongs to one simulation.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <vector>
+
+#include "deflex/transport/clock.hpp"
+#include "deflex/transport/datagram_transport.hpp"
+
+namespace deflex {
+
+class MemoryNetwork;
+
+struct MemoryNetworkCounters {
+  std::uint64_t delivered = 0;       ///< datagrams handed to a receiver
+  std::uint64_t dropped_full = 0;    ///< the destination's queue was full (a lost datagram)
+  std::uint64_t dropped_no_route = 0;  ///< no endpoint has the destination address
+  std::uint64_t dropped_oversized = 0;  ///< larger than the network's datagram size (send_to fails)
+};
+
+/// One endpoint of a MemoryNetwork. Datagrams come out in the order they were sent to it, each once
+/// its delivery time has come.
+class MemoryTransport final : public DatagramTransport {
+ public:
+  /// True when the oldest waiting datagram has arrived by the clock's time (never waits).
+  bool wait_readable(double timeout_s) noexcept override;
+  long receive(unsigned char* buffer, std::size_t capacity, DatagramAddress& from) noexcept override;
+  bool send_to(const unsigned char* data, std::size_t size, const DatagramAddress& to) noexcept override;
+  [[nodiscard]] DatagramAddress local_address() const noexcept override { return address_; }
+  /// Datagrams queued here, arrived or not.
+  [[nodiscard]] std::size_t queued() const { return count_; }
+
+ private:
+  friend class MemoryNetwork;
+  struct Slot {
+    double deliver_at_s = 0.0;
+    DatagramAddress from;
+    std::size_t size = 0;
+    std::vector<unsigned char> bytes;
+  };
+  MemoryTransport(MemoryNetwork& network, const DatagramAddress& address, double latency_s, std::size_t depth,
+                  std::size_t max_bytes);
+  bool enqueue(const unsigned char* data, std::size_t size, const DatagramAddress& from, double deliver_at_s) noexcept;
+
+  MemoryNetwork& network_;
+  DatagramAddress address_;
+  double latency_s_;
+  std::vector<Slot> slots_;
+  std::size_t head_ = 0, count_ = 0;
+};
+
+class MemoryNetwork {
+ public:
+  explicit MemoryNetwork(const Clock& clock, std::size_t max_datagram_bytes = 2048, std::size_t queue_depth = 512);
+  MemoryNetwork(const MemoryNetwork&) = delete;
+  MemoryNetwork& operator=(const MemoryNetwork&) = delete;
+
+  /// A new endpoint at `address`; what it sends arrives `latency_s` (>= 0) later. The endpoint lives
+  /// as long as the network. Throws InputError when the address is taken or the latency is bad.
+  MemoryTransport& add_endpoint(const DatagramAddress& address, double latency_s = 0.0);
+
+  [[nodiscard]] const Clock& clock() const { return clock_; }
+  [[nodiscard]] const MemoryNetworkCounters& counters() const { return counters_; }
+
+ private:
+  friend class MemoryTransport;
+  bool route(const unsigned char* data, std::size_t size, const DatagramAddress& from, const DatagramAddress& to,
+             double latency_s) noexcept;
+
+  const Clock& clock_;
+  std::size_t max_bytes_;
+  std::size_t depth_;
+  std::deque<std::unique_ptr<MemoryTransport>> endpoints_;
+  MemoryNetworkCounters counters_;
+};
+
+}  // namespace deflex

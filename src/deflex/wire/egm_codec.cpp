@@ -1,0 +1,295 @@
+// EGM codec over the protoc-generated classes (egm.proto).
+#include "deflex/wire/egm_codec.hpp"
+
+#include <cmath>
+
+#include "egm.pb.h"
+
+namespace deflex {
+
+const char* to_string(EgmDecodeStatus s) {
+  switch (s) {
+    case EgmDecodeStatus::kOk: return "ok";
+    case EgmDecodeStatus::kMalformed: return "malformed";
+    case EgmDecodeStatus::kTruncated: return "truncated";
+    case EgmDecodeStatus::kMissingHeader: return "missing_header";
+    case EgmDecodeStatus::kMissingJoints: return "missing_joints";
+    case EgmDecodeStatus::kNonFinite: return "non_finite";
+    case EgmDecodeStatus::kEmpty: return "empty";
+  }
+  return "unknown";
+}
+
+struct EgmCodec::Impl {
+  abb::egm::EgmRobot robot_in, robot_out;
+  abb::egm::EgmSensor sensor_in, sensor_out;
+  abb::egm::EgmSensorPathCorr path_in, path_out;
+};
+
+namespace {
+
+// Reads a varint; false when it runs past `end` (truncated) and sets `bad` when longer than 10 bytes.
+bool read_varint(const unsigned char*& p, const unsigned char* end, std::uint64_t& v, bool& bad) {
+  v = 0;
+  for (int shift = 0; shift < 70; shift += 7) {
+    if (p >= end) {
+      return false;
+    }
+    const unsigned char b = *p++;
+    if (shift == 63 && b > 1) {
+      bad = true;
+      return true;
+    }
+    v |= static_cast<std::uint64_t>(b & 0x7f) << shift;
+    if ((b & 0x80) == 0) {
+      return true;
+    }
+  }
+  bad = true;
+  return true;
+}
+
+template <class Joints>
+bool copy_joints(const Joints& j, int expected, JointVector& out) {
+  if (j.joints_size() != expected) {
+    return false;
+  }
+  out.resize(expected);
+  for (int i = 0; i < expected; ++i) {
+    out[i] = j.joints(i);
+  }
+  return true;
+}
+
+template <class Joints>
+void set_joints(const JointVector& q, Joints* j) {
+  j->clear_joints();  // keeps capacity: no allocation once warm
+  for (int i = 0; i < q.size(); ++i) {
+    j->add_joints(q[i]);
+  }
+}
+
+}  // namespace
+
+std::uint32_t egm_time_stamp_ms(double t_s) noexcept {
+  if (!std::isfinite(t_s) || !(t_s > 0.0)) {
+    return 0;
+  }
+  const double ms = std::fmod(std::floor(t_s * 1000.0), 4294967296.0);  // exact: doubles hold 2^53
+  return static_cast<std::uint32_t>(ms);
+}
+
+EgmDecodeStatus scan_wire_format(const unsigned char* data, std::size_t size) noexcept {
+  const unsigned char* p = data;
+  const unsigned char* end = data + size;
+  while (p < end) {
+    std::uint64_t tag = 0;
+    bool bad = false;
+    if (!read_varint(p, end, tag, bad)) {
+      return EgmDecodeStatus::kTruncated;
+    }
+    if (bad || (tag >> 3) == 0) {
+      return EgmDecodeStatus::kMalformed;
+    }
+    std::uint64_t len = 0;
+    switch (tag & 7) {
+      case 0:
+        if (!read_varint(p, end, len, bad)) {
+          return EgmDecodeStatus::kTruncated;
+        }
+        if (bad) {
+          return EgmDecodeStatus::kMalformed;
+        }
+        break;
+      case 1:
+        if (end - p < 8) {
+          return EgmDecodeStatus::kTruncated;
+        }
+        p += 8;
+        break;
+      case 2:
+        if (!read_varint(p, end, len, bad)) {
+          return EgmDecodeStatus::kTruncated;
+        }
+        if (bad) {
+          return EgmDecodeStatus::kMalformed;
+        }
+        if (len > static_cast<std::uint64_t>(end - p)) {
+          return EgmDecodeStatus::kTruncated;
+        }
+        p += len;
+        break;
+      case 5:
+        if (end - p < 4) {
+          return EgmDecodeStatus::kTruncated;
+        }
+        p += 4;
+        break;
+      default:
+        return EgmDecodeStatus::kMalformed;  // groups (3, 4) are not in EGM; 6 and 7 do not exist
+    }
+  }
+  return EgmDecodeStatus::kOk;
+}
+
+EgmCodec::EgmCodec(int expected_joints) : impl_(std::make_unique<Impl>()), expected_joints_(expected_joints) {
+  // Warm the messages once so their sub-messages and repeated fields exist before the first cycle.
+  EgmRobotMessage r;
+  r.feedback_joints_deg = JointVector::Zero(expected_joints);
+  r.planned_joints_deg = JointVector::Zero(expected_joints);
+  unsigned char buf[1024];
+  const std::size_t n = encode_robot(r, buf, sizeof(buf));
+  EgmRobotMessage back;
+  (void)decode_robot(buf, n, back);
+  EgmSensorMessage s;
+  s.planned_joints_deg = JointVector::Zero(expected_joints);
+  s.speed_ref_joints_deg_s = JointVector::Zero(expected_joints);
+  const std::size_t m = encode_sensor(s, buf, sizeof(buf));
+  EgmSensorMessage sback;
+  (void)decode_sensor(buf, m, sback);
+  const std::size_t k = encode_path_corr(EgmPathCorrMessage{}, buf, sizeof(buf));
+  EgmPathCorrMessage pback;
+  (void)decode_path_corr(buf, k, pback);
+}
+
+EgmCodec::~EgmCodec() = default;
+
+EgmDecodeStatus EgmCodec::decode_robot(const unsigned char* data, std::size_t size, EgmRobotMessage& out) noexcept {
+  if (size == 0) {
+    return EgmDecodeStatus::kEmpty;
+  }
+  const EgmDecodeStatus wire = scan_wire_format(data, size);
+  if (wire != EgmDecodeStatus::kOk) {
+    return wire;
+  }
+  abb::egm::EgmRobot& m = impl_->robot_in;
+  if (!m.ParseFromArray(data, static_cast<int>(size))) {
+    return EgmDecodeStatus::kMalformed;  // includes missing required fields inside sub-messages
+  }
+  if (!m.has_header() || !m.header().has_seqno()) {
+    return EgmDecodeStatus::kMissingHeader;
+  }
+  if (!m.has_feedback() || !m.feedback().has_joints() ||
+      !copy_joints(m.feedback().joints(), expected_joints_, out.feedback_joints_deg)) {
+    return EgmDecodeStatus::kMissingJoints;
+  }
+  out.has_planned = m.has_planned() && m.planned().has_joints();
+  if (out.has_planned) {
+    if (!copy_joints(m.planned().joints(), expected_joints_, out.planned_joints_deg)) {
+      return EgmDecodeStatus::kMissingJoints;
+    }
+  } else {
+    out.planned_joints_deg.setZero(expected_joints_);
+  }
+  if (!out.feedback_joints_deg.allFinite() || !out.planned_joints_deg.allFinite()) {
+    return EgmDecodeStatus::kNonFinite;
+  }
+  out.seqno = m.header().seqno();
+  out.tm_ms = m.header().tm();
+  out.motor_state = m.has_motorstate() ? static_cast<int>(m.motorstate().state()) : 0;
+  out.mci_state = m.has_mcistate() ? static_cast<int>(m.mcistate().state()) : 0;
+  out.rapid_exec_state = m.has_rapidexecstate() ? static_cast<int>(m.rapidexecstate().state()) : 0;
+  out.mci_convergence_met = m.mciconvergencemet();
+  return EgmDecodeStatus::kOk;
+}
+
+std::size_t EgmCodec::encode_sensor(const EgmSensorMessage& msg, unsigned char* out, std::size_t capacity) noexcept {
+  if (!msg.planned_joints_deg.allFinite() || !msg.speed_ref_joints_deg_s.allFinite()) {
+    return 0;
+  }
+  abb::egm::EgmSensor& m = impl_->sensor_out;
+  m.mutable_header()->set_seqno(msg.seqno);
+  m.mutable_header()->set_tm(msg.tm_ms);
+  m.mutable_header()->set_mtype(abb::egm::EgmHeader::MSGTYPE_CORRECTION);
+  set_joints(msg.planned_joints_deg, m.mutable_planned()->mutable_joints());
+  if (msg.speed_ref_joints_deg_s.size() > 0) {
+    set_joints(msg.speed_ref_joints_deg_s, m.mutable_speedref()->mutable_joints());
+  } else if (m.has_speedref()) {
+    m.mutable_speedref()->mutable_joints()->clear_joints();  // keeps the sub-message: no allocation later
+  }
+  const std::size_t n = m.ByteSizeLong();
+  if (n > capacity || !m.SerializeToArray(out, static_cast<int>(capacity))) {
+    return 0;
+  }
+  return n;
+}
+
+std::size_t EgmCodec::encode_robot(const EgmRobotMessage& msg, unsigned char* out, std::size_t capacity) noexcept {
+  abb::egm::EgmRobot& m = impl_->robot_out;
+  m.mutable_header()->set_seqno(msg.seqno);
+  m.mutable_header()->set_tm(msg.tm_ms);
+  m.mutable_header()->set_mtype(abb::egm::EgmHeader::MSGTYPE_DATA);
+  set_joints(msg.feedback_joints_deg, m.mutable_feedback()->mutable_joints());
+  if (msg.has_planned) {
+    set_joints(msg.planned_joints_deg, m.mutable_planned()->mutable_joints());
+  } else {
+    m.clear_planned();
+  }
+  m.mutable_motorstate()->set_state(msg.motor_state == 2 ? abb::egm::EgmMotorState::MOTORS_OFF
+                                                         : abb::egm::EgmMotorState::MOTORS_ON);
+  m.mutable_mcistate()->set_state(abb::egm::EgmMCIState::MCI_RUNNING);
+  m.set_mciconvergencemet(msg.mci_convergence_met);
+  const std::size_t n = m.ByteSizeLong();
+  if (n > capacity || !m.SerializeToArray(out, static_cast<int>(capacity))) {
+    return 0;
+  }
+  return n;
+}
+
+bool EgmCodec::decode_sensor(const unsigned char* data, std::size_t size, EgmSensorMessage& out) noexcept {
+  if (size == 0 || scan_wire_format(data, size) != EgmDecodeStatus::kOk) {
+    return false;
+  }
+  abb::egm::EgmSensor& m = impl_->sensor_in;
+  if (!m.ParseFromArray(data, static_cast<int>(size)) || !m.has_planned() || !m.planned().has_joints()) {
+    return false;
+  }
+  if (!copy_joints(m.planned().joints(), expected_joints_, out.planned_joints_deg)) {
+    return false;
+  }
+  out.speed_ref_joints_deg_s.resize(0);
+  if (m.has_speedref() && m.speedref().has_joints() && m.speedref().joints().joints_size() > 0 &&
+      !copy_joints(m.speedref().joints(), expected_joints_, out.speed_ref_joints_deg_s)) {
+    return false;
+  }
+  out.seqno = m.has_header() ? m.header().seqno() : 0;
+  out.tm_ms = m.has_header() ? m.header().tm() : 0;
+  return out.planned_joints_deg.allFinite() && out.speed_ref_joints_deg_s.allFinite();
+}
+
+std::size_t EgmCodec::encode_path_corr(const EgmPathCorrMessage& msg, unsigned char* out,
+                                       std::size_t capacity) noexcept {
+  if (!msg.pos_mm.allFinite()) {
+    return 0;
+  }
+  abb::egm::EgmSensorPathCorr& m = impl_->path_out;
+  m.mutable_header()->set_seqno(msg.seqno);
+  m.mutable_header()->set_tm(msg.tm_ms);
+  m.mutable_header()->set_mtype(abb::egm::EgmHeader::MSGTYPE_PATH_CORRECTION);
+  m.mutable_pathcorr()->mutable_pos()->set_x(msg.pos_mm.x());
+  m.mutable_pathcorr()->mutable_pos()->set_y(msg.pos_mm.y());
+  m.mutable_pathcorr()->mutable_pos()->set_z(msg.pos_mm.z());
+  m.mutable_pathcorr()->set_age(msg.age_ms);
+  const std::size_t n = m.ByteSizeLong();
+  if (n > capacity || !m.SerializeToArray(out, static_cast<int>(capacity))) {
+    return 0;
+  }
+  return n;
+}
+
+bool EgmCodec::decode_path_corr(const unsigned char* data, std::size_t size, EgmPathCorrMessage& out) noexcept {
+  if (size == 0 || scan_wire_format(data, size) != EgmDecodeStatus::kOk) {
+    return false;
+  }
+  abb::egm::EgmSensorPathCorr& m = impl_->path_in;
+  if (!m.ParseFromArray(data, static_cast<int>(size)) || !m.has_pathcorr()) {
+    return false;  // pathCorr's pos and age are required: protobuf refuses a message without them
+  }
+  out.pos_mm = Vector3(m.pathcorr().pos().x(), m.pathcorr().pos().y(), m.pathcorr().pos().z());
+  out.age_ms = m.pathcorr().age();
+  out.seqno = m.has_header() ? m.header().seqno() : 0;
+  out.tm_ms = m.has_header() ? m.header().tm() : 0;
+  return out.pos_mm.allFinite();
+}
+
+}  // namespace deflex

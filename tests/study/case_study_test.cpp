@@ -1,0 +1,201 @@
+// Short cases of the protocol on the simulated cell (one speed, one lap): the tracker's noise
+// statistics, the uncompensated deviation growing with the load, the model-consistent cell
+// compensated down to the tracker's noise floor through every kind of link, the online strategies'
+// lag at speed and the predictive strategy removing it, reproducibility from the seed, and the
+// cell's independence from the strategies (it includes none of their code).
+#include "deflex/study/case_study.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "deflex/study/simulated_run.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include "deflex/evaluate/path_metrics.hpp"
+
+namespace deflex::study {
+namespace {
+
+CaseConfig short_case(CaseConfig c) {
+  c.laps_cw = 1;
+  c.laps_ccw = 0;
+  c.speeds_m_s = {0.05};
+  c.sweep_speeds_m_s.clear();
+  c.cell.ldbb.settle_s = 1.0;
+  c.setups.resize(2);  // offline and online
+  c.setups[0].loads_n = {150.0, 650.0};
+  c.setups[1].loads_n = {150.0, 650.0};
+  c.setups[0].paper_uc_mm.clear();
+  c.setups[0].paper_c_mm.clear();
+  c.setups[1].paper_uc_mm.clear();
+  c.setups[1].paper_c_mm.clear();
+  c.budget.load_index = 0;
+  return c;
+}
+
+RunSpec spec(RunKind kind, Strategy s, double load, std::uint64_t seed, LinkKind link = LinkKind::kProgram) {
+  RunSpec r;
+  r.kind = kind;
+  r.strategy = s;
+  r.link = link;
+  r.load_n = load;
+  r.speed_m_s = 0.05;
+  r.laps_cw = 1;
+  r.laps_ccw = 0;
+  r.seed = seed;
+  return r;
+}
+
+TEST(SimulatedRun, TrackerNoiseHasTheConfiguredSigma) {
+  CaseConfig c = short_case(paper_case());
+  c.cell.tracker.noise_m = 8e-6;
+  CaseConfig quiet = c;
+  quiet.cell.tracker.noise_m = 0.0;
+  const SetupCell noisy_cell = build_setup_cell(c, false);
+  const SetupCell quiet_cell = build_setup_cell(quiet, false);
+  const RunOutput a = simulate_run(c, noisy_cell, spec(RunKind::kUnloaded, Strategy::kOffline, 0.0, 3));
+  const RunOutput b = simulate_run(quiet, quiet_cell, spec(RunKind::kUnloaded, Strategy::kOffline, 0.0, 3));
+  ASSERT_EQ(a.trace.size(), b.trace.size());
+  // 1 kHz for one lap at 50 mm/s: the program runs along the chords between the 81 points.
+  const double lap_m = 80.0 * 2.0 * c.radius_m() * std::sin(kPi / 80.0);
+  EXPECT_NEAR(static_cast<double>(a.trace.size()), lap_m / 0.05 * 1000.0, 2.0);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero(), sq = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < a.trace.size(); ++i) {
+    const Vector3 d = a.trace[i].p_m - b.trace[i].p_m;
+    sum += d;
+    sq += d.cwiseProduct(d);
+  }
+  const double n = static_cast<double>(a.trace.size());
+  for (int k = 0; k < 3; ++k) {
+    const double mean = sum[k] / n;
+    const double sigma = std::sqrt(sq[k] / n - mean * mean);
+    EXPECT_NEAR(mean, 0.0, 4.0 * 8e-6 / std::sqrt(n));
+    EXPECT_NEAR(sigma, 8e-6, 0.05 * 8e-6);  // 1600+ samples: the estimate is within a few %
+  }
+}
+
+TEST(SimulatedRun, UncompensatedDeviationGrowsWithLoad) {
+  const CaseConfig c = short_case(paper_case());
+  for (bool sensor : {false, true}) {
+    const SetupCell cell = build_setup_cell(c, sensor);
+    const LinkKind link = sensor ? LinkKind::kEgmJoint : LinkKind::kProgram;
+    const RunOutput unloaded = simulate_run(c, cell, spec(RunKind::kUnloaded, Strategy::kOffline, 0.0, 1, link));
+    const double low = mean_distance_to_path_m(
+        simulate_run(c, cell, spec(RunKind::kUncompensated, Strategy::kOffline, 150.0, 2, link)).trace, unloaded.trace);
+    const double high = mean_distance_to_path_m(
+        simulate_run(c, cell, spec(RunKind::kUncompensated, Strategy::kOffline, 650.0, 2, link)).trace, unloaded.trace);
+    EXPECT_GT(high, 2.5 * low) << "sensor " << sensor;  // roughly proportional to the load
+    EXPECT_GT(low, 5e-5);
+  }
+}
+
+TEST(SimulatedRun, ModelConsistentCellIsCompensatedDownToTheTrackerNoise) {
+  // Every extra effect off, the exact stiffness given to the compensators, no force error: what is
+  // left after compensation must be the noise floor, i.e. what one unloaded run measures against
+  // another, whichever way the correction reaches the controller.
+  CaseConfig c = model_consistent(short_case(paper_case()), true);
+  c.speeds_m_s = {0.02};
+  struct Way {
+    bool sensor;
+    LinkKind link;
+    Strategy strategy;
+    double allowed;  // of the floor
+  };
+  for (const Way& w : {Way{false, LinkKind::kProgram, Strategy::kOffline, 1.15},
+                       Way{true, LinkKind::kEgmJoint, Strategy::kOnline, 1.3},
+                       Way{true, LinkKind::kEgmPath, Strategy::kOnline, 1.3}}) {
+    const SetupCell cell = build_setup_cell(c, w.sensor);
+    RunSpec r = spec(RunKind::kUnloaded, w.strategy, 0.0, 1, w.link);
+    r.speed_m_s = 0.02;
+    const RunOutput unloaded = simulate_run(c, cell, r);
+    r.seed = 99;
+    const RunOutput unloaded2 = simulate_run(c, cell, r);
+    const double floor = mean_distance_to_path_m(unloaded2.trace, unloaded.trace);
+    r.kind = RunKind::kUncompensated;
+    r.load_n = 650.0;
+    r.seed = 2;
+    const double uc = mean_distance_to_path_m(simulate_run(c, cell, r).trace, unloaded.trace);
+    r.kind = RunKind::kCompensated;
+    const RunOutput compensated = simulate_run(c, cell, r);
+    const double comp = mean_distance_to_path_m(compensated.trace, unloaded.trace);
+    EXPECT_GT(uc, 20.0 * floor) << to_string(w.link);
+    EXPECT_LT(comp, floor * w.allowed) << to_string(w.link) << " floor " << floor << " C " << comp;
+    if (w.link != LinkKind::kProgram) {
+      EXPECT_GT(compensated.link_cycles, 100u);
+      EXPECT_EQ(compensated.link_counters.rejected(), 0u);
+      EXPECT_EQ(compensated.link_counters.guard_trips, 0u);
+    }
+  }
+}
+
+TEST(SimulatedRun, OnlineLagGrowsWithSpeedAndThePredictiveStrategyRemovesIt) {
+  // Noise-free, model-consistent cell: what is left of the online residual is the force measured
+  // where the arm was one link delay (and the filter's lag) before the pose the command is for; it
+  // grows with the TCP speed; predicting the wrench there removes most of it.
+  CaseConfig c = model_consistent(short_case(paper_case()), false);
+  const SetupCell cell = build_setup_cell(c, true);
+  auto residual = [&](Strategy s, double speed) {
+    RunSpec r = spec(RunKind::kUnloaded, s, 0.0, 5, LinkKind::kEgmJoint);
+    r.speed_m_s = speed;
+    const RunOutput unloaded = simulate_run(c, cell, r);
+    r.kind = RunKind::kCompensated;
+    r.load_n = 650.0;
+    return mean_distance_to_path_m(simulate_run(c, cell, r).trace, unloaded.trace);
+  };
+  const double slow = residual(Strategy::kOnline, 0.02);
+  const double fast = residual(Strategy::kOnline, 0.2);
+  const double fast_predicted = residual(Strategy::kPredictive, 0.2);
+  EXPECT_GT(fast, 3.0 * slow) << slow << " " << fast;
+  EXPECT_LT(fast_predicted, 0.5 * fast) << fast_predicted << " " << fast;
+}
+
+TEST(CaseStudy, SameSeedGivesTheSameFiguresOnAnyNumberOfThreads) {
+  CaseConfig c = short_case(paper_case());
+  c.setups[0].loads_n = {650.0};
+  c.setups[1].loads_n = {650.0};
+  CaseStudyOptions o;
+  o.speed_sweep = false;
+  o.error_budget = false;
+  o.threads = 2;
+  const CaseStudyOutput a = run_case_study(c, o);
+  o.threads = 1;
+  const CaseStudyOutput b = run_case_study(c, o);
+  ASSERT_EQ(a.study.setups.size(), 2u);
+  for (std::size_t s = 0; s < 2; ++s) {
+    EXPECT_EQ(a.study.setups[s].loads[0].uc_mm.at(50), b.study.setups[s].loads[0].uc_mm.at(50));
+    EXPECT_EQ(a.study.setups[s].loads[0].c_mm.at(50), b.study.setups[s].loads[0].c_mm.at(50));
+    EXPECT_GT(a.study.setups[s].loads[0].compensation.at(50), 0.5);
+  }
+  c.seed = 2;
+  const CaseStudyOutput d = run_case_study(c, o);
+  EXPECT_NE(a.study.setups[1].loads[0].c_mm.at(50), d.study.setups[1].loads[0].c_mm.at(50));
+  // The online setup went through deflex's link, never beyond its bound.
+  ASSERT_EQ(a.links.size(), 1u);
+  EXPECT_GT(a.links[0].cycles, 1000u);
+  EXPECT_EQ(a.links[0].guard_trips, 0u);
+  EXPECT_LE(a.links[0].max_command_deviation_rad, a.links[0].bound_rad);
+  EXPECT_GT(a.links[0].max_command_deviation_rad, 0.0);
+}
+
+TEST(CellModule, IncludesNothingOfTheStrategiesOrTheirLinks) {
+  // The simulated cell is hardware: it may speak the links' wire formats, never run their code.
+  namespace fs = std::filesystem;
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(DEFLEX_SOURCE_DIR) / "src/deflex/cell")) {
+    std::ifstream in(entry.path());
+    std::stringstream text;
+    text << in.rdbuf();
+    for (const char* forbidden : {"deflex/online/", "deflex/offline/", "deflex/link/", "deflex/egm/",
+                                  "deflex/study/", "deflex/identify/"}) {
+      EXPECT_EQ(text.str().find(forbidden), std::string::npos) << entry.path() << " includes " << forbidden;
+    }
+    ++files;
+  }
+  EXPECT_GT(files, 10);
+}
+
+}  // namespace
+}  // namespace deflex::study
