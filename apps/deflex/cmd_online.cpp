@@ -14,10 +14,8 @@
 
 #include "cli_util.hpp"
 #include "command.hpp"
-#include "deflex/egm/egm_joint_link.hpp"
-#include "deflex/egm/egm_path_link.hpp"
+#include "online_links.hpp"
 #include "deflex/force/force_spec.hpp"
-#include "deflex/transport/udp_transport.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/online/csv_force_replay.hpp"
@@ -25,6 +23,14 @@
 #include "deflex/online/udp_force_source.hpp"
 
 namespace deflex::cli {
+
+std::vector<LinkKindInfo>& link_kind_registry() {
+  static std::vector<LinkKindInfo> registry;
+  return registry;
+}
+
+LinkKindRegistrar::LinkKindRegistrar(LinkKindInfo info) { link_kind_registry().push_back(std::move(info)); }
+
 namespace {
 
 const char* const kRobotHelp = "Robot file (.yaml deflex format or .urdf); default: the built-in ABB IRB 6700-300/2.70";
@@ -104,6 +110,7 @@ class CycleLog {
   int joints_;
 };
 
+
 std::string refusal_text(const ControllerLink& link, const JointTrajectory& program, double tolerance_deg) {
   std::string joints;
   const JointVector& d = link.start_distance();
@@ -118,34 +125,35 @@ std::string refusal_text(const ControllerLink& link, const JointTrajectory& prog
       tolerance_deg, program.source(), joints);
 }
 
+std::string link_names() {
+  std::string names;
+  for (const auto& k : link_kind_registry()) names += (names.empty() ? "" : ", ") + k.name;
+  return names;
+}
+
 void setup_online(CLI::App& sub, int& exit_code) {
   struct Opts {
     std::string link, robot, sensor, force_source, program, strategy = "online", force_model, log, bind = "127.0.0.1",
-        fault_dump, jacobian_at = "nominal", path_frame = "tool";
-    int egm_port = -1;
+        fault_dump, jacobian_at = "nominal";
     double period_ms = 4.0, max_joint_deg = 0.5, max_tcp_mm = 5.0, max_rate_deg_s = 3.0, watchdog_ms = 50.0;
-    double ramp_in_s = 1.0, correction_latency_ms = 0.0, rotation_warning_mrad = 0.1, end_silence_s = 2.0;
-    double duration_s = 0.0, status_s = 1.0;
-    bool loop = false, no_speed_ref = false;
+    double end_silence_s = 2.0, duration_s = 0.0, status_s = 1.0;
+    bool loop = false;
   };
   auto o = std::make_shared<Opts>();
-  sub.add_option("--link", o->link,
-                 "Controller link: egm-joint (ABB EGM position guidance: deflex streams --program) or egm-path (ABB "
-                 "EGM path correction: the controller runs its own program)")
-      ->required();
+  std::string link_help = "Controller link:";
+  for (const auto& k : link_kind_registry()) link_help += fmt::format(" {} ({});", k.name, k.help);
+  sub.add_option("--link", o->link, link_help)->required();
   sub.add_option("--robot", o->robot, kRobotHelp);
   sub.add_option("--sensor-config", o->sensor,
                  "Force-sensor YAML (docs/online.md); default: identity crosstalk, no payload, no bias, at the flange");
-  sub.add_option("--egm-port", o->egm_port, "UDP port the controller's EGM messages arrive on (ABB examples: 6510)")
-      ->required();
-  sub.add_option("--bind", o->bind, "Address to bind the EGM and UDP force ports to (0.0.0.0 for a real cell)")
+  sub.add_option("--bind", o->bind, "Address to bind the link's and the UDP force port to (0.0.0.0 for a real cell)")
       ->capture_default_str();
   sub.add_option("--force-source", o->force_source, "udp:PORT (docs/online.md, UDP force-sample format) or csv:FILE")
       ->required();
   sub.add_flag("--loop", o->loop, "With csv:FILE, replay the file again and again");
   sub.add_option("--program", o->program,
-                 "egm-joint: the nominal joint trajectory to stream, CSV t_s,q1_deg..qN_deg (deflex offline "
-                 "--joint-trajectory writes one)");
+                 "Streaming links: the nominal joint trajectory deflex streams, CSV t_s,q1_deg..qN_deg (deflex offline "
+                 "--nominal-trajectory / --joint-trajectory write one)");
   sub.add_option("--strategy", o->strategy,
                  "online (the paper's), hybrid (--program is the offline-compensated one; corrects measured minus "
                  "--force), predictive (wrench predicted where the command is executed), none (stream only)")
@@ -167,21 +175,8 @@ void setup_online(CLI::App& sub, int& exit_code) {
       ->capture_default_str();
   sub.add_option("--jacobian-at", o->jacobian_at, "nominal (the configuration the command is for) or feedback")
       ->capture_default_str();
-  sub.add_option("--ramp-in-s", o->ramp_in_s, "egm-joint: blend from where the arm is to the program over this time, s")
-      ->capture_default_str();
-  sub.add_flag("--no-speed-reference", o->no_speed_ref, "egm-joint: do not send the nominal's joint speeds");
   sub.add_option("--end-silence-s", o->end_silence_s,
-                 "egm-joint: after the program's end, a controller silence this long ends the session, s")
-      ->capture_default_str();
-  sub.add_option("--path-corr-frame", o->path_frame,
-                 "egm-path: the frame EGMActMove was given: tool (tool.tframe), flange (tool0) or path (path "
-                 "coordinates)")
-      ->capture_default_str();
-  sub.add_option("--correction-latency-ms", o->correction_latency_ms,
-                 "egm-path, predictive: the controller's correction latency beyond the measured servo delay, ms")
-      ->capture_default_str();
-  sub.add_option("--rotation-warning-mrad", o->rotation_warning_mrad,
-                 "egm-path: report when the model predicts a TCP rotation above this (it cannot be corrected), mrad")
+                 "Streaming links: after the program's end, a controller silence this long ends the session, s")
       ->capture_default_str();
   sub.add_option("--log", o->log, "CSV log of every cycle");
   sub.add_option("--fault-dump", o->fault_dump, "CSV the last cycles are written to when a fault occurs");
@@ -189,24 +184,20 @@ void setup_online(CLI::App& sub, int& exit_code) {
       ->capture_default_str();
   sub.add_option("--status-interval-s", o->status_s, "Live status on stderr every this many seconds")
       ->capture_default_str();
+  for (const auto& k : link_kind_registry()) k.add_options(sub);
   sub.callback([o, &exit_code] {
-    const bool joint_link = o->link == "egm-joint";
-    if (!joint_link && o->link != "egm-path") {
-      throw InputError(fmt::format("option --link: '{}' is not egm-joint or egm-path", o->link));
+    const LinkKindInfo* kind_info = nullptr;
+    for (const auto& k : link_kind_registry()) {
+      if (k.name == o->link) kind_info = &k;
+    }
+    if (kind_info == nullptr) {
+      throw InputError(fmt::format("option --link: '{}' is not one of {}", o->link, link_names()));
     }
     const RobotModel model = load_robot_or_builtin(o->robot);
     const SensorConfig sensor = sensor_or_default(o->sensor);
-    if (o->egm_port < 0 || o->egm_port > 65535) {
-      throw InputError("option --egm-port: must be 0..65535");
-    }
     const auto positive = [](double v, const char* option) {
       if (!std::isfinite(v) || !(v > 0.0)) {
         throw InputError(fmt::format("option {}: must be a number > 0 (got {})", option, v));
-      }
-    };
-    const auto non_negative = [](double v, const char* option) {
-      if (!std::isfinite(v) || v < 0.0) {
-        throw InputError(fmt::format("option {}: must be a number >= 0 (got {})", option, v));
       }
     };
     positive(o->period_ms, "--period-ms");
@@ -216,21 +207,22 @@ void setup_online(CLI::App& sub, int& exit_code) {
     positive(o->watchdog_ms, "--watchdog-ms");
     positive(o->status_s, "--status-interval-s");
     positive(o->end_silence_s, "--end-silence-s");
-    non_negative(o->duration_s, "--duration-s");
-    non_negative(o->ramp_in_s, "--ramp-in-s");
-    non_negative(o->correction_latency_ms, "--correction-latency-ms");
-    non_negative(o->rotation_warning_mrad, "--rotation-warning-mrad");
+    if (!std::isfinite(o->duration_s) || o->duration_s < 0.0) {
+      throw InputError(fmt::format("option --duration-s: must be a number >= 0 (got {})", o->duration_s));
+    }
     if (o->period_ms > 1000.0) throw InputError("option --period-ms: at most 1000 ms");
     if (o->max_joint_deg > 10.0) {
       throw InputError("option --max-joint-correction-deg: at most 10 deg (a compliance correction is a fraction of one)");
     }
     const StrategyKind kind = parse_strategy(o->strategy);
-    if (joint_link && o->program.empty()) {
-      throw InputError("option --program: egm-joint streams a nominal program: give --program P.csv (deflex offline "
-                       "--joint-trajectory writes one)");
+    if (kind_info->streams_program && o->program.empty()) {
+      throw InputError(fmt::format("option --program: {} streams a nominal program: give --program P.csv (deflex "
+                                   "offline --nominal-trajectory writes one)",
+                                   kind_info->name));
     }
-    if (!joint_link && !o->program.empty()) {
-      throw InputError("option --program: egm-path corrects the controller's own program; deflex streams none");
+    if (!kind_info->streams_program && !o->program.empty()) {
+      throw InputError(fmt::format("option --program: {} corrects the controller's own program; deflex streams none",
+                                   kind_info->name));
     }
     OnlineConfig cfg;
     cfg.period_s = o->period_ms * 1e-3;
@@ -253,47 +245,33 @@ void setup_online(CLI::App& sub, int& exit_code) {
     OnlineCompensator comp(model, sensor, cfg);
     OnlineStrategy strategy(model, kind, force_model.get());
     std::shared_ptr<const JointTrajectory> program;
-    if (joint_link) {
+    if (kind_info->streams_program) {
       program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o->program, model));
       if (!model.has_max_speed()) {
         std::cerr << "deflex online: warning: the robot file gives no joint speed limits, so the program's speeds "
                      "were not checked (add max_speed to the robot file)\n";
       }
     }
-    std::string source_text;
-    const std::unique_ptr<ForceSource> source = make_force_source(o->force_source, o->loop, o->bind, source_text);
-    UdpTransport transport(o->bind, static_cast<std::uint16_t>(o->egm_port));
-    SteadyClock clock;
-    std::unique_ptr<ControllerLink> link;
-    const EgmPathLink* path_link = nullptr;
-    if (joint_link) {
-      EgmJointLinkConfig lc;
-      lc.stream.ramp_in_s = o->ramp_in_s;
-      lc.send_speed_reference = !o->no_speed_ref;
-      link = std::make_unique<EgmJointLink>(comp, strategy, program, transport, clock, source.get(), lc);
-    } else {
-      EgmPathLinkConfig lc;
-      lc.frame = parse_path_corr_frame(o->path_frame);
-      lc.correction_latency_s = o->correction_latency_ms * 1e-3;
-      lc.rotation_warning_rad = o->rotation_warning_mrad * 1e-3;
-      auto p = std::make_unique<EgmPathLink>(comp, strategy, transport, clock, source.get(), lc);
-      path_link = p.get();
-      link = std::move(p);
-    }
-    CycleLog log(o->log, model.dof());
     // The fault dump's path is checked now, not at the first fault in the middle of a run.
     if (!o->fault_dump.empty()) {
       std::FILE* probe = std::fopen(o->fault_dump.c_str(), "a");
       if (probe == nullptr) throw Error(fmt::format("{}: cannot write the fault dump", o->fault_dump));
       std::fclose(probe);
     }
+    std::string source_text;
+    const std::unique_ptr<ForceSource> source = make_force_source(o->force_source, o->loop, o->bind, source_text);
+    SteadyClock clock;
+    const OnlineContext context{model, comp, strategy, source.get(), clock, o->bind, program, cfg.period_s};
+    const std::unique_ptr<LinkSession> session = kind_info->make(context);
+    ControllerLink& link = session->link();
+    CycleLog log(o->log, model.dof());
 
     std::cerr << fmt::format(
-        "deflex online: {} link, strategy {}; robot {}; sensor {}; force from {}; EGM on {}:{}; {}bounds {} deg/joint, "
+        "deflex online: {} link, strategy {}; robot {}; sensor {}; force from {}; {}; {}bounds {} deg/joint, "
         "{} mm TCP, {} deg/s; watchdog {} ms. Stop with Ctrl-C.\n",
-        link->name(), to_string(kind), model.name(), sensor.source, source_text, o->bind, transport.port(),
-        joint_link ? fmt::format("program {} ({} points, {:.1f} s); ", o->program, program->size(), program->duration_s())
-                   : fmt::format("correction frame {}; ", o->path_frame),
+        link.name(), to_string(kind), model.name(), sensor.source, source_text, session->where(),
+        program ? fmt::format("program {} ({} points, {:.1f} s); ", o->program, program->size(), program->duration_s())
+                : "",
         o->max_joint_deg, o->max_tcp_mm, o->max_rate_deg_s, o->watchdog_ms);
 
     g_stop = false;
@@ -310,31 +288,23 @@ void setup_online(CLI::App& sub, int& exit_code) {
     std::uint64_t window_cycles = 0, cycles = 0;
     bool refused = false;
     const auto print_status = [&](double now) {
-      const LinkCounters& c = link->counters();
-      const LinkCycleRecord& r = link->last_cycle();
-      std::string extra;
-      if (joint_link) {
-        const auto* j = dynamic_cast<const EgmJointLink*>(link.get());
-        extra = fmt::format("program {:.1f}/{:.1f} s | ", j->stream().program_time_s() - program->start_time_s(),
-                            program->duration_s());
-      } else if (path_link != nullptr && path_link->max_rotation_rad() > o->rotation_warning_mrad * 1e-3) {
-        extra = fmt::format("uncorrected TCP rotation up to {:.3f} mrad (path correction cannot rotate) | ",
-                            path_link->max_rotation_rad() * 1e3);
-      }
+      const LinkCounters& c = link.counters();
+      const LinkCycleRecord& r = link.last_cycle();
+      const std::string extra = session->status();
       std::cerr << fmt::format(
-          "[{:8.1f} s] {} | {}cycles {} (total {}) | status {} | |F| {:.1f} N | max |command-nominal| {:.4f} deg | TCP "
-          "correction {:.3f} mm | delay {:.0f} ms | in the last interval: compute max {:.1f} us, gap max {:.1f} ms | "
-          "rejected {} restarts {}\n",
-          now - start, to_string(link->state()), extra, window_cycles, cycles, to_string(r.status),
-          r.wrench_measured_base.head<3>().norm(), rad_to_deg(max_dev_rad), r.tcp_correction_m.norm() * 1e3,
-          r.delay_s * 1e3, max_compute_s * 1e6, max_gap_s * 1e3, c.rejected(), c.restarts);
+          "[{:8.1f} s] {} | {}{}cycles {} (total {}) | status {} | |F| {:.1f} N | TCP correction {:.3f} mm | delay "
+          "{:.0f} ms | in the last interval: max |command-nominal| {:.4f} deg, compute max {:.1f} us, gap max {:.1f} "
+          "ms | rejected {} restarts {}\n",
+          now - start, to_string(link.state()), extra, extra.empty() ? "" : " | ", window_cycles, cycles,
+          to_string(r.status), r.wrench_measured_base.head<3>().norm(), r.tcp_correction_m.norm() * 1e3,
+          r.delay_s * 1e3, rad_to_deg(max_dev_rad), max_compute_s * 1e6, max_gap_s * 1e3, c.rejected(), c.restarts);
       max_compute_s = max_gap_s = max_dev_rad = 0.0;
       window_cycles = 0;
     };
     // Our own loop over poll(), so that status and the duration limit keep going while no controller
     // is talking to us.
     while (!g_stop.load()) {
-      const LinkPollResult r = link->poll(0.05);
+      const LinkPollResult r = link.poll(0.05);
       const double now = clock.now_s();
       if (r == LinkPollResult::kRefused) {
         refused = true;
@@ -344,30 +314,29 @@ void setup_online(CLI::App& sub, int& exit_code) {
         ++cycles;
         ++window_cycles;
         last_message = now;
-        const LinkCycleRecord& rec = link->last_cycle();
+        const LinkCycleRecord& rec = link.last_cycle();
         max_compute_s = std::max(max_compute_s, rec.compute_s);
         if (last_t >= 0.0) max_gap_s = std::max(max_gap_s, rec.t_s - last_t);
         last_t = rec.t_s;
         if (rec.replied) max_dev_rad = std::max(max_dev_rad, (rec.q_command - rec.q_nominal).cwiseAbs().maxCoeff());
         log.write(rec);
-        if (link->fault_pending() && !o->fault_dump.empty()) {
-          link->write_history_csv(o->fault_dump);
+        if (link.fault_pending() && !o->fault_dump.empty()) {
+          link.write_history_csv(o->fault_dump);
           std::cerr << fmt::format("deflex online: fault ({}); last cycles written to {}\n", to_string(rec.status),
                                    o->fault_dump);
-          link->clear_fault();
+          link.clear_fault();
         }
       }
       if (now >= next_status) {
-        if (link->state() == LinkState::kWaiting) {
-          std::cerr << fmt::format("[{:8.1f} s] waiting for EGM messages on port {} (received {}, rejected {})\n",
-                                   now - start, transport.port(), link->counters().datagrams,
-                                   link->counters().rejected());
+        if (link.state() == LinkState::kWaiting) {
+          std::cerr << fmt::format("[{:8.1f} s] waiting for the controller ({}; received {}, rejected {})\n",
+                                   now - start, session->where(), link.counters().datagrams, link.counters().rejected());
         } else {
           print_status(now);
         }
         next_status = now + o->status_s;
       }
-      if (link->state() == LinkState::kFinished && last_message >= 0.0 && now - last_message > o->end_silence_s) {
+      if (link.state() == LinkState::kFinished && last_message >= 0.0 && now - last_message > o->end_silence_s) {
         std::cerr << "deflex online: the program has ended and the controller went quiet: session over\n";
         break;
       }
@@ -375,20 +344,21 @@ void setup_online(CLI::App& sub, int& exit_code) {
         break;
       }
     }
-    const LinkCounters& c = link->counters();
     if (refused) {
-      std::cerr << refusal_text(*link, *program, 1.0) << "\n";
+      std::cerr << refusal_text(link, *program, 1.0) << "\n";
       exit_code = 2;
       return;
     }
+    const LinkCounters& c = link.counters();
+    const std::string extra = session->summary();
     std::cerr << fmt::format(
         "deflex online: stopped after {} cycles: {} answers; rejected datagrams {} (malformed {}, truncated {}, "
         "oversized {}, missing joints {}, non-finite {}, duplicate {}, out of order {}, beyond limits {}, other "
-        "sender {}); restarts {}; guard stops {}; force samples ok {}, fault {}, invalid {}{}\n",
+        "sender {}); restarts {}; guard stops {}; force samples ok {}, fault {}, invalid {}{}{}{}\n",
         cycles, c.replies, c.rejected(), c.malformed, c.truncated, c.oversized, c.missing_joints, c.non_finite,
         c.duplicate, c.out_of_order, c.out_of_limits, c.foreign_sender, c.restarts, c.guard_trips,
         comp.counters().samples_ok, comp.counters().samples_fault, comp.counters().samples_invalid,
-        o->log.empty() ? "" : fmt::format("; log {}", o->log));
+        extra.empty() ? "" : "; ", extra, o->log.empty() ? "" : fmt::format("; log {}", o->log));
     exit_code = 0;
   });
 }
@@ -461,7 +431,7 @@ void setup_identify_payload(CLI::App& sub, int& exit_code) {
 }  // namespace
 
 DEFLEX_COMMAND("online",
-               "Online compensation on a controller link (--link egm-joint|egm-path): condition force samples and "
+               "Online compensation on a controller link (--link egm-joint|egm-path|...): condition force samples and "
                "answer the controller, never beyond the bound of the nominal",
                setup_online, 40);
 DEFLEX_COMMAND("identify-payload",

@@ -224,6 +224,11 @@ TEST(CliOnline, BadOptionsAndProgramsAreRefusedBeforeAnythingRuns) {
     EXPECT_NE(r.err.find(fragment), std::string::npos) << args << "\n" << r.err;
   };
   expect("--link rsi", "--link");
+  {
+    const auto r = test::run_cli("online --link egm-path --force-source csv:" + kReplay);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find("--egm-port"), std::string::npos) << r.err;
+  }
   expect("--link egm-joint", "--program");
   expect("--link egm-path --program " + program_path, "--program");
   expect("--link egm-joint --program " + program_path + " --status-interval-s nan", "--status-interval-s");
