@@ -56,8 +56,19 @@ void DelayEstimator::observe_feedback(double t_s, const JointVector& q_feedback)
   }
   const double sample = t_s - best_t;
   if (!(sample >= 0.0) || !(sample < window_s_)) return;
+  // Once the estimate has settled, a measurement far from it is a mismatch (a reversal, the arm
+  // coming to rest), not a change of the link: it is counted and left out.
+  if (measurements_ >= 20 && std::abs(sample - delay_s_) > std::max(0.02, 0.5 * delay_s_)) {
+    ++outliers_;
+    // Many in a row are no mismatch: the first estimate was wrong or the link changed. Start again.
+    if (++consecutive_outliers_ < 25) return;
+    measurements_ = 0;
+    sum_s_ = 0.0;
+  }
+  consecutive_outliers_ = 0;
   last_s_ = sample;
   ++measurements_;
+  sum_s_ += sample;
   // Running mean that forgets slowly (about the last 50 measurements).
   delay_s_ = measurements_ == 1 ? sample : delay_s_ + 0.02 * (sample - delay_s_);
 }

@@ -2,7 +2,9 @@
 // shows it. Each feedback sample is matched against the recent references (the nearest point on the
 // reference's polyline, by joint distance), and the time between them is one measurement; the
 // estimate is their running average. Only samples taken while the reference moves are used (at rest
-// every reference matches). The predictive strategy leads by this delay. Fixed ring: no allocation.
+// every reference matches), and once settled a measurement far from the estimate is left out (a run of
+// them starts the estimate afresh). The predictive strategy leads by this delay. Fixed ring: no
+// allocation.
 #pragma once
 
 #include <array>
@@ -28,6 +30,10 @@ class DelayEstimator {
   [[nodiscard]] std::uint64_t measurements() const { return measurements_; }
   /// The last single measurement, s (NaN before the first).
   [[nodiscard]] double last_measurement_s() const { return last_s_; }
+  /// The mean of every measurement taken, s (NaN before the first).
+  [[nodiscard]] double mean_s() const { return measurements_ > 0 ? sum_s_ / static_cast<double>(measurements_) : last_s_; }
+  /// Measurements left out as mismatches.
+  [[nodiscard]] std::uint64_t outliers() const { return outliers_; }
 
  private:
   static constexpr int kRing = 256;
@@ -38,6 +44,9 @@ class DelayEstimator {
   double delay_s_;
   double last_s_;
   std::uint64_t measurements_ = 0;
+  std::uint64_t outliers_ = 0;
+  int consecutive_outliers_ = 0;
+  double sum_s_ = 0.0;
 };
 
 }  // namespace deflex

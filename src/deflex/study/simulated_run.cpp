@@ -289,9 +289,9 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
   if (linked) {
     out.link_counters = link->counters();
     if (const auto* joint = dynamic_cast<const EgmJointLink*>(link.get())) {
-      out.measured_delay_s = joint->delay().delay_s();
+      out.measured_delay_s = joint->delay().mean_s();
     } else if (const auto* path = dynamic_cast<const EgmPathLink*>(link.get())) {
-      out.measured_delay_s = path->delay().delay_s();
+      out.measured_delay_s = path->delay().mean_s();
     }
     const auto* egm = dynamic_cast<const cell::EgmPositionGuidanceController*>(controller.get());
     if (egm != nullptr && egm->counters().timed_out) {

@@ -53,7 +53,7 @@ struct RunOutput {
   LinkCounters link_counters;
   double max_command_deviation_rad = 0.0;  ///< largest |command - nominal| of any joint, any cycle
   double max_tcp_correction_m = 0.0;
-  double measured_delay_s = 0.0;       ///< the link's measured delay at the end of the run
+  double measured_delay_s = 0.0;       ///< the mean of the link's delay measurements over the run
 };
 
 /// A run's seed from the case seed and the run's identity, so results do not depend on the order
