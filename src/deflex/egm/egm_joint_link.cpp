@@ -21,9 +21,7 @@ EgmJointLink::EgmJointLink(OnlineCompensator& compensator, OnlineStrategy& strat
       receiver_(transport, clock, compensator.model(), config.receiver, counters_),
       stream_(nominal, config.stream),
       delay_(config.initial_delay_s),
-      history_(config.history_cycles, compensator.model().dof()),
-      ws_(compensator.model()),
-      jac_(6, compensator.model().dof()) {
+      history_(config.history_cycles, compensator.model().dof()) {
   const int n = compensator.model().dof();
   if (nominal->dof() != n) {
     throw InputError(fmt::format("EGM joint link: the program has {} joints, the robot {}", nominal->dof(), n));
@@ -96,8 +94,7 @@ LinkPollResult EgmJointLink::poll(double timeout_s) noexcept {
   } else {
     command_ = nominal_ - out.dtheta;
     r.q_command = command_;
-    jacobian(comp_.model(), ws_, nominal_, EndPoint::kTcp, jac_);
-    r.tcp_correction_m = -(jac_.topRows<3>() * out.dtheta);  // what the correction moves the TCP by
+    r.tcp_correction_m = -out.tcp_deflection_base_m;  // what the correction moves the TCP by
     // The last check before anything leaves deflex: every joint within the bound of the nominal.
     const double bound = comp_.config().max_joint_correction_rad * (1.0 + 1e-9) + 1e-12;
     if (!command_.allFinite() || (command_ - nominal_).cwiseAbs().maxCoeff() > bound) {

@@ -73,8 +73,6 @@ class EgmJointLink final : public ControllerLink {
   std::vector<unsigned char> tx_;
   std::uint32_t reply_seq_ = 0;
   LinkCycleRecord last_;
-  Workspace ws_;
-  Jacobian jac_;
 };
 
 }  // namespace deflex

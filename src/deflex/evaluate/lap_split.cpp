@@ -1,7 +1,11 @@
 // Laps of a closed path from the angle turned about its centre.
 #include "deflex/evaluate/lap_split.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include <Eigen/Eigenvalues>
 
@@ -88,6 +92,39 @@ LapSplit split_laps(const TrackerTrace& trace, double min_turn_rad, double rever
   if (start + 1 < trace.size()) {
     close_lap(start, trace.size() - 1);
   }
+  return out;
+}
+
+TrackerTrace mean_closed_path(const TrackerTrace& trace, int bins) {
+  if (bins < 8 || bins > 1'000'000) {
+    throw InputError(fmt::format("mean path: {} bins (use 8..1000000)", bins));
+  }
+  const PathPlane pl = best_fit_plane(trace);
+  std::vector<Vector3> sum(static_cast<std::size_t>(bins), Vector3::Zero());
+  std::vector<int> count(static_cast<std::size_t>(bins), 0);
+  for (const auto& s : trace) {
+    const Vector3 r = s.p_m - pl.centroid_m;
+    const double a = std::atan2(r.dot(pl.v), r.dot(pl.u));  // [-pi, pi]
+    auto b = static_cast<int>(std::floor((a + kPi) / (2.0 * kPi) * bins));
+    b = std::clamp(b, 0, bins - 1);
+    sum[static_cast<std::size_t>(b)] += s.p_m;
+    ++count[static_cast<std::size_t>(b)];
+  }
+  TrackerTrace out;
+  for (int b = 0; b < bins; ++b) {
+    const auto k = static_cast<std::size_t>(b);
+    if (count[k] == 0) continue;
+    TrackerSample m;
+    m.t_s = (b + 0.5) / bins * 2.0 * kPi - kPi;  // the bin's angle, rad (no time: a mean of laps)
+    m.p_m = sum[k] / count[k];
+    out.push_back(m);
+  }
+  if (out.size() < static_cast<std::size_t>(0.9 * bins)) {
+    throw InputError(fmt::format("mean path: only {} of {} angle bins hold a sample: not a closed path around its "
+                                 "centre",
+                                 out.size(), bins));
+  }
+  out.push_back(out.front());
   return out;
 }
 

@@ -33,4 +33,12 @@ struct LapSplit {
 LapSplit split_laps(const TrackerTrace& trace, double min_turn_rad = 0.9 * 2.0 * kPi,
                     double reversal_rad = deg_to_rad(5.0));
 
+/// The mean of a closed path's laps, as one closed polyline: the samples binned by their angle about
+/// the centroid in the plane of best fit (`bins` equal sectors), each bin's positions averaged, the
+/// bins in angle order and the first repeated at the end. A nearest-point distance to a dense, noisy
+/// reference is biased low (the reference's noise fills a band the loaded point finds its nearest
+/// neighbour in); to the laps' mean it is not. Needs a path around its centroid: throws InputError
+/// for fewer than 2 samples or when fewer than 90 % of the bins hold a sample.
+TrackerTrace mean_closed_path(const TrackerTrace& trace, int bins = 3600);
+
 }  // namespace deflex

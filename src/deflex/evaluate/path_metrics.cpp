@@ -202,10 +202,26 @@ PolylineIndex::Nearest PolylineIndex::nearest(const Vector3& p_m, const Nearest*
 
 namespace {
 
-PathDeviationStats stats_of(const std::vector<const TrackerTrace*>& loaded, const PolylineIndex& index) {
+// Mean, max, RMS and sample standard deviation of a set of distances (m).
+PathDeviationStats stats_of_distances(const std::vector<double>& d) {
   PathDeviationStats st;
-  double sum = 0.0;
-  double sum2 = 0.0;
+  const auto n = static_cast<double>(d.size());
+  double sum = 0.0, sum2 = 0.0;
+  for (const double di : d) {
+    sum += di;
+    sum2 += di * di;
+    st.max_m = std::max(st.max_m, di);
+  }
+  st.samples = d.size();
+  st.mean_m = sum / n;
+  st.rms_m = std::sqrt(sum2 / n);
+  double var = 0.0;
+  for (const double di : d) var += (di - st.mean_m) * (di - st.mean_m);
+  st.std_m = d.size() > 1 ? std::sqrt(var / (n - 1.0)) : 0.0;
+  return st;
+}
+
+PathDeviationStats stats_of(const std::vector<const TrackerTrace*>& loaded, const PolylineIndex& index) {
   std::vector<double> d;
   PolylineIndex::Nearest hint;
   for (const auto* trace_ptr : loaded) {
@@ -216,26 +232,13 @@ PathDeviationStats stats_of(const std::vector<const TrackerTrace*>& loaded, cons
                                      trace[i].t_s));
       }
       hint = index.nearest(trace[i].p_m, i > 0 ? &hint : nullptr);
-      const double di = hint.distance_m;
-      d.push_back(di);
-      sum += di;
-      sum2 += di * di;
-      st.max_m = std::max(st.max_m, di);
+      d.push_back(hint.distance_m);
     }
   }
   if (d.empty()) {
     throw InputError("loaded path: no samples");
   }
-  const auto n = static_cast<double>(d.size());
-  st.samples = d.size();
-  st.mean_m = sum / n;
-  st.rms_m = std::sqrt(sum2 / n);
-  double var = 0.0;
-  for (const double di : d) {
-    var += (di - st.mean_m) * (di - st.mean_m);
-  }
-  st.std_m = d.size() > 1 ? std::sqrt(var / (n - 1.0)) : 0.0;
-  return st;
+  return stats_of_distances(d);
 }
 
 }  // namespace
@@ -252,6 +255,36 @@ PathDeviationStats path_deviation(const std::vector<TrackerTrace>& loaded, const
 PathDeviationStats path_deviation(const TrackerTrace& loaded, const TrackerTrace& reference) {
   const PolylineIndex index(reference);
   return stats_of({&loaded}, index);
+}
+
+PathDeviationStats path_deviation(const TrackerTrace& loaded, const PolylineIndex& reference) {
+  return stats_of({&loaded}, reference);
+}
+
+PathDeviationStats time_synchronous_deviation(const TrackerTrace& loaded, const TrackerTrace& reference) {
+  if (reference.size() < 2) {
+    throw InputError("time-synchronous deviation: the reference has fewer than 2 samples");
+  }
+  std::size_t j = 0;
+  std::vector<double> d;
+  d.reserve(loaded.size());
+  for (const auto& s : loaded) {
+    if (s.t_s < reference.front().t_s || s.t_s > reference.back().t_s) continue;
+    while (j + 2 < reference.size() && reference[j + 1].t_s < s.t_s) ++j;
+    while (j > 0 && reference[j].t_s > s.t_s) --j;
+    const TrackerSample& a = reference[j];
+    const TrackerSample& b = reference[j + 1];
+    const double u = b.t_s > a.t_s ? std::clamp((s.t_s - a.t_s) / (b.t_s - a.t_s), 0.0, 1.0) : 0.0;
+    const double di = (s.p_m - (a.p_m + u * (b.p_m - a.p_m))).norm();
+    if (!std::isfinite(di)) {
+      throw InputError(fmt::format("time-synchronous deviation: the sample at t = {} s is not finite", s.t_s));
+    }
+    d.push_back(di);
+  }
+  if (d.empty()) {
+    throw InputError("time-synchronous deviation: no loaded sample lies in the reference's time span");
+  }
+  return stats_of_distances(d);
 }
 
 double mean_distance_to_path_m(const TrackerTrace& loaded, const TrackerTrace& reference) {

@@ -58,6 +58,15 @@ struct PathDeviationStats {
 PathDeviationStats path_deviation(const TrackerTrace& loaded, const TrackerTrace& reference);
 /// Several loaded laps against a reference made of several laps (each its own polyline).
 PathDeviationStats path_deviation(const std::vector<TrackerTrace>& loaded, const std::vector<TrackerTrace>& reference);
+/// Against a reference indexed once (a study compares many runs with one unloaded reference).
+PathDeviationStats path_deviation(const TrackerTrace& loaded, const PolylineIndex& reference);
+
+/// The time-synchronous (along-path) error: the mean distance between the loaded and the reference
+/// positions at the same time (both traces stamped from the same start of motion; each loaded sample
+/// against the reference interpolated linearly at its time). Unlike the nearest-point distance it
+/// sees lag along the path. Samples outside the reference's time span are left out; throws
+/// InputError when no sample overlaps.
+PathDeviationStats time_synchronous_deviation(const TrackerTrace& loaded, const TrackerTrace& reference);
 
 /// Compensation achieved: 1 - C/UC (0.67 means 67% of the uncompensated deviation removed). NaN when
 /// UC is not a positive finite number (compensation is then undefined; tables print "n/a").

@@ -214,7 +214,9 @@ nlohmann::json study_to_json(const StudyResult& study) {
           {"c_max_mm", &l.c_max_mm},
           {"iso_accuracy_uc_mm", &l.iso_accuracy_uc_mm},
           {"iso_accuracy_c_mm", &l.iso_accuracy_c_mm},
-          {"iso_repeatability_mm", &l.iso_repeatability_mm}};
+          {"iso_repeatability_mm", &l.iso_repeatability_mm},
+          {"uc_sync_mm", &l.uc_sync_mm},
+          {"c_sync_mm", &l.c_sync_mm}};
       for (const auto& [key, m] : optional) {
         if (!m->empty()) {
           jl[key] = speed_map(*m);
@@ -294,7 +296,9 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
           {"c_max_mm", &l.c_max_mm},
           {"iso_accuracy_uc_mm", &l.iso_accuracy_uc_mm},
           {"iso_accuracy_c_mm", &l.iso_accuracy_c_mm},
-          {"iso_repeatability_mm", &l.iso_repeatability_mm}};
+          {"iso_repeatability_mm", &l.iso_repeatability_mm},
+          {"uc_sync_mm", &l.uc_sync_mm},
+          {"c_sync_mm", &l.c_sync_mm}};
       for (const auto& [key, m] : maps) {
         if (jl.contains(key)) {
           *m = read_speed_map(jl.at(key), lw + "." + key);
@@ -445,17 +449,18 @@ void write_study_csv(const StudyResult& study, const std::string& path) {
   const PaperFigures paper = paper_reference();
   auto cell = [](double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : std::string(); };
   f << "setup,load_N,speed_mm_s,uc_mm,c_mm,compensation,uc_std_mm,c_std_mm,uc_max_mm,c_max_mm,"
-       "iso_accuracy_uc_mm,iso_accuracy_c_mm,iso_repeatability_mm,paper_uc_mm,paper_c_mm\n";
+       "iso_accuracy_uc_mm,iso_accuracy_c_mm,iso_repeatability_mm,uc_sync_mm,c_sync_mm,paper_uc_mm,paper_c_mm\n";
   for (const auto& s : study.setups) {
     const PaperTable* pt = paper.table_for(s.setup);
     for (const auto& l : s.loads) {
       const PaperRow* pr = pt != nullptr ? pt->row_for(l.load_N) : nullptr;
       for (const int v : study_speeds_mm_s(study)) {
         const auto at = [&](const std::map<int, double>& m) { return cell(value_at_speed(m, v)); };
-        f << fmt::format("{},{:g},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", s.setup, l.load_N, v, at(l.uc_mm),
+        f << fmt::format("{},{:g},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", s.setup, l.load_N, v, at(l.uc_mm),
                          at(l.c_mm), at(l.compensation), at(l.uc_std_mm), at(l.c_std_mm), at(l.uc_max_mm),
                          at(l.c_max_mm), at(l.iso_accuracy_uc_mm), at(l.iso_accuracy_c_mm), at(l.iso_repeatability_mm),
-                         cell(pr != nullptr ? pr->uc_mm : kNaN), pr != nullptr ? at(pr->c_mm) : std::string());
+                         at(l.uc_sync_mm), at(l.c_sync_mm), cell(pr != nullptr ? pr->uc_mm : kNaN),
+                         pr != nullptr ? at(pr->c_mm) : std::string());
       }
     }
   }

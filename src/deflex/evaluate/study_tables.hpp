@@ -23,6 +23,9 @@ struct LoadResult {
   std::map<int, double> uc_max_mm, c_max_mm;    ///< largest distance (optional)
   std::map<int, double> iso_accuracy_uc_mm, iso_accuracy_c_mm;  ///< ISO 9283 AT_p vs the unloaded path (optional)
   std::map<int, double> iso_repeatability_mm;                   ///< ISO 9283 RT_p of the compensated runs (optional)
+  /// The time-synchronous (along-path) error against the unloaded run at the same time (optional): it
+  /// sees lag that the nearest-point distance does not.
+  std::map<int, double> uc_sync_mm, c_sync_mm;
 
   /// Mean of uc_mm over the speeds: the paper's UC column. NaN when uc_mm is empty.
   [[nodiscard]] double uc_mean_mm() const;

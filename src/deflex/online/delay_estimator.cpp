@@ -14,8 +14,11 @@ void DelayEstimator::record_reference(double t_s, const JointVector& q_ref) noex
   if (!std::isfinite(t_s) || !q_ref.allFinite() || (count_ > 0 && !(t_s > t_[static_cast<std::size_t>((head_ + kRing - 1) % kRing)]))) {
     return;
   }
-  t_[static_cast<std::size_t>(head_)] = t_s;
-  q_[static_cast<std::size_t>(head_)] = q_ref;
+  const auto h = static_cast<std::size_t>(head_);
+  const auto prev = static_cast<std::size_t>((head_ + kRing - 1) % kRing);
+  travel_[h] = count_ > 0 && q_[prev].size() == q_ref.size() ? travel_[prev] + (q_ref - q_[prev]).norm() : 0.0;
+  t_[h] = t_s;
+  q_[h] = q_ref;
   head_ = (head_ + 1) % kRing;
   count_ = std::min(count_ + 1, kRing);
 }
@@ -32,25 +35,44 @@ void DelayEstimator::observe_feedback(double t_s, const JointVector& q_feedback)
   double best = std::numeric_limits<double>::infinity();
   double best_t = 0.0;
   double best_step = 0.0;
-  double travel = 0.0;
-  for (int k = 1; k < count_; ++k) {
-    const std::size_t i1 = at(k - 1), i0 = at(k);  // segment from the older i0 to the newer i1
-    if (t_s - t_[i0] > window_s_) break;
-    if (q_[i0].size() != q_feedback.size() || q_[i1].size() != q_feedback.size()) return;
-    const JointVector d = q_[i1] - q_[i0];
-    const double len2 = d.squaredNorm();
-    const double len = std::sqrt(len2);
-    travel += len;
-    double s = 0.0;
-    if (len2 > 0.0) s = std::clamp((q_feedback - q_[i0]).dot(d) / len2, 0.0, 1.0);
-    const double dist = (q_[i0] + s * d - q_feedback).norm();
-    if (dist < best) {
-      best = dist;
-      best_t = t_[i0] + s * (t_[i1] - t_[i0]);
-      best_step = len;
+  int best_k = -1;
+  const auto scan = [&](int k_from, int k_to) {  // segments k in [k_from, k_to], k back from the newest
+    for (int k = std::max(1, k_from); k <= k_to && k < count_; ++k) {
+      const std::size_t i1 = at(k - 1), i0 = at(k);  // segment from the older i0 to the newer i1
+      if (t_s - t_[i0] > window_s_) break;
+      if (q_[i0].size() != q_feedback.size() || q_[i1].size() != q_feedback.size()) return;
+      const JointVector d = q_[i1] - q_[i0];
+      const double len2 = d.squaredNorm();
+      double s = 0.0;
+      if (len2 > 0.0) s = std::clamp((q_feedback - q_[i0]).dot(d) / len2, 0.0, 1.0);
+      const double dist = (q_[i0] + s * d - q_feedback).norm();
+      if (dist < best) {
+        best = dist;
+        best_t = t_[i0] + s * (t_[i1] - t_[i0]);
+        best_step = std::sqrt(len2);
+        best_k = k;
+      }
     }
+  };
+  // Where the last match was, give or take a few segments (the delay changes slowly); the whole
+  // window when that finds the best at its edge, and every 64th sample anyway.
+  constexpr int kNear = 6;
+  const bool full = last_k_ < 1 || ++since_full_ >= 64;
+  if (!full) {
+    scan(last_k_ - kNear, last_k_ + kNear);
   }
-  // Ambiguous (the feedback is not on the reference's recent path, or matched where it rested).
+  if (full || best_k <= std::max(1, last_k_ - kNear) || best_k >= last_k_ + kNear) {
+    best = std::numeric_limits<double>::infinity();
+    best_k = -1;
+    scan(1, count_ - 1);
+    since_full_ = 0;
+  }
+  if (best_k < 0) return;
+  last_k_ = best_k;
+  // How far the reference went from the match to now (cumulative path length).
+  const double travel = travel_[at(0)] - travel_[at(best_k)];
+  // Ambiguous: the feedback is not on the reference's recent path, or the reference has hardly moved
+  // since the match (it rested there).
   if (!(best_step > kMinStepRad) || !(best < 0.1 * travel)) {
     return;
   }

@@ -39,6 +39,7 @@ class DelayEstimator {
   static constexpr int kRing = 256;
   std::array<double, kRing> t_{};
   std::array<JointVector, kRing> q_{};
+  std::array<double, kRing> travel_{};  // cumulative path length of the references, rad
   int head_ = 0, count_ = 0;
   double window_s_;
   double delay_s_;
@@ -46,6 +47,8 @@ class DelayEstimator {
   std::uint64_t measurements_ = 0;
   std::uint64_t outliers_ = 0;
   int consecutive_outliers_ = 0;
+  int last_k_ = 0;       // segments back from the newest reference at the last match
+  int since_full_ = 0;   // samples since the last search of the whole window
   double sum_s_ = 0.0;
 };
 

@@ -241,7 +241,8 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
   if (out.status != CycleStatus::kOk) {
     point_jacobian(ws_, ws_.base_T_tcp.translation(), jac_);  // FK is at q_feedback here
   }
-  out.tcp_correction_m = (jac_.topRows<3>() * correction_).norm();
+  out.tcp_deflection_base_m = jac_.topRows<3>() * correction_;
+  out.tcp_correction_m = out.tcp_deflection_base_m.norm();
   return out;
 }
 

@@ -71,6 +71,7 @@ struct CycleOutput {
   bool size_limited = false;            ///< the joint or TCP bound cut the correction
   bool rate_limited = false;            ///< the rate bound cut the change of correction
   double tcp_correction_m = 0.0;        ///< |J_p dtheta|, m
+  Vector3 tcp_deflection_base_m = Vector3::Zero();  ///< J_p dtheta (base frame, m): the TCP offset the correction cancels
   double force_age_s = 0.0;             ///< time since the last valid force sample
   int samples_used = 0;                 ///< force samples conditioned during this cycle
 };

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <exception>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -25,24 +26,41 @@ namespace {
 int mm_s(double speed_m_s) { return static_cast<int>(std::lround(speed_m_s * 1e3)); }
 
 struct Figures {
-  double mean_mm = 0, std_mm = 0, max_mm = 0, iso_accuracy_mm = NAN, iso_repeatability_mm = NAN;
+  double mean_mm = 0, std_mm = 0, max_mm = 0, sync_mm = NAN, iso_accuracy_mm = NAN, iso_repeatability_mm = NAN;
 };
 
 // The laps of a run, found in its tracker trace the way `deflex evaluate --split-laps` finds them
 // (by the angle turned about the path's centre), not from the simulator's schedule.
 std::vector<TrackerTrace> laps_of(const TrackerTrace& trace) { return split_laps(trace).laps; }
 
-Figures evaluate_run(const RunOutput& loaded, const RunOutput& unloaded) {
+// An unloaded run prepared once for every loaded run compared with it: its raw trace (for the
+// time-synchronous metric) and the mean of its laps, indexed (for the nearest-point metric: a dense,
+// noisy reference would bias that distance low by its own noise).
+struct Reference {
+  RunOutput run;
+  TrackerTrace mean;
+  std::shared_ptr<const PolylineIndex> index;
+};
+
+Reference make_reference(RunOutput run) {
+  Reference r;
+  r.mean = mean_closed_path(run.trace);
+  r.index = std::make_shared<const PolylineIndex>(r.mean);
+  r.run = std::move(run);
+  return r;
+}
+
+Figures evaluate_run(const RunOutput& loaded, const Reference& reference) {
   Figures f;
-  const PathDeviationStats s = path_deviation(loaded.trace, unloaded.trace);
+  const PathDeviationStats s = path_deviation(loaded.trace, *reference.index);
   f.mean_mm = s.mean_m * 1e3;
   f.std_mm = s.std_m * 1e3;
   f.max_mm = s.max_m * 1e3;
+  f.sync_mm = time_synchronous_deviation(loaded.trace, reference.run.trace).mean_m * 1e3;
   const auto laps = laps_of(loaded.trace);
-  const auto ref_laps = laps_of(unloaded.trace);
-  if (!laps.empty() && !ref_laps.empty()) {
+  if (!laps.empty()) {
     try {
-      const Iso9283Path iso = iso9283_path(laps, ref_laps.front());
+      const Iso9283Path iso = iso9283_path(laps, reference.mean);
       f.iso_accuracy_mm = iso.accuracy_m * 1e3;
       f.iso_repeatability_mm = iso.repeatability_m * 1e3;
     } catch (const InputError&) {
@@ -68,7 +86,7 @@ TrackerTrace thin_lap(const RunOutput& run, std::size_t max_points) {
 struct Family {
   bool sensor = false;
   LinkKind link = LinkKind::kProgram;
-  std::map<int, RunOutput> unloaded;  // by speed mm/s
+  std::map<int, Reference> unloaded;  // by speed mm/s
 };
 
 struct Progress {
@@ -286,7 +304,7 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
           spec.laps_ccw = laps_ccw;
           spec.seed = run_seed(config.seed, fam.sensor, RunKind::kUnloaded, Strategy::kOffline, 0.0, v,
                                static_cast<std::uint64_t>(fam.link));
-          fam.unloaded[mm_s(v)] = simulate_run(config, *cells[fam.sensor ? 1 : 0], spec);
+          fam.unloaded[mm_s(v)] = make_reference(simulate_run(config, *cells[fam.sensor ? 1 : 0], spec));
           progress.add(run_cost(config, v, laps), fmt::format("unloaded {} mm/s", mm_s(v)));
         });
       }
@@ -347,7 +365,7 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
         const std::uint64_t extra = 0xb0d6e7ULL;
         spec.kind = RunKind::kUnloaded;
         spec.seed = run_seed(config.seed, sc.sensor_mounted, spec.kind, sc.strategy, 0.0, v, extra);
-        const RunOutput unloaded = simulate_run(cfg, cell, spec);
+        const Reference unloaded = make_reference(simulate_run(cfg, cell, spec));
         spec.kind = RunKind::kCompensated;
         spec.strategy = sc.strategy;
         spec.load_n = load;
@@ -419,6 +437,8 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
         lr.c_max_mm[key] = c->figures.max_mm;
         lr.iso_accuracy_c_mm[key] = c->figures.iso_accuracy_mm;
         lr.iso_repeatability_mm[key] = c->figures.iso_repeatability_mm;
+        lr.uc_sync_mm[key] = uc->figures.sync_mm;
+        lr.c_sync_mm[key] = c->figures.sync_mm;
       }
       lr.fill_compensation();
       sr.loads.push_back(lr);
@@ -446,7 +466,8 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
       PlotTraces pt;
       pt.title =
           fmt::format("{}: {:.0f} N at {} mm/s (last lap)", s.name, s.loads_n.back(), mm_s(config.speeds_m_s.front()));
-      pt.unloaded = thin_lap(families[static_cast<std::size_t>(fam)].unloaded.at(mm_s(config.speeds_m_s.front())), 1500);
+      pt.unloaded =
+          thin_lap(families[static_cast<std::size_t>(fam)].unloaded.at(mm_s(config.speeds_m_s.front())).run, 1500);
       pt.uc = thin_lap(uc->keep, 1500);
       pt.c = thin_lap(c->keep, 1500);
       out.plots.push_back(std::move(pt));
