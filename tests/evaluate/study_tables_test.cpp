@@ -33,7 +33,14 @@ StudyResult example_study() {
   h.fill_compensation();
   hyb.loads.push_back(h);
   s.setups = {off, hyb};
-  s.speed_sweep.push_back({"online", 650, 200, 1.1, 0.4, 1.0 - 0.4 / 1.1});
+  SweepPoint p;
+  p.setup = "online";
+  p.load_N = 650;
+  p.speed_mm_s = 200;
+  p.uc_mm = 1.1;
+  p.c_mm = 0.4;
+  p.compensation = 1.0 - 0.4 / 1.1;
+  s.speed_sweep.push_back(p);
   return s;
 }
 
@@ -168,6 +175,66 @@ TEST(StudyTables, SpeedColumnsValueLookupAndPercentText) {
   EXPECT_EQ(percent_text(-0.004), "0%");            // rounds to zero: no "-0%"
   EXPECT_EQ(percent_text(-0.25), "-25%");
   EXPECT_EQ(percent_text(std::nan("")), "n/a");
+}
+
+}  // namespace
+}  // namespace deflex
+
+namespace deflex {
+namespace {
+
+TEST(StudyTables, MeansAndSpreadOverSeedsAndTheirJsonAndCsv) {
+  LoadResult l;
+  l.load_N = 650;
+  l.uc_mm_by_seed = {{10, {1.0, 1.2, 1.1}}, {30, {1.0, 1.0, 1.3}}};
+  l.c_mm_by_seed = {{10, {0.1, 0.2, 0.3}}, {30, {0.2, 0.2, 0.2}}};
+  l.fill_means();
+  EXPECT_DOUBLE_EQ(l.c_mm.at(10), 0.2);
+  EXPECT_DOUBLE_EQ(l.uc_mm.at(30), 1.1);
+  const Spread c10 = l.c_spread(10);
+  EXPECT_EQ(c10.n, 3);
+  EXPECT_NEAR(c10.sd, 0.1, 1e-12);  // sample standard deviation of 0.1, 0.2, 0.3
+  EXPECT_DOUBLE_EQ(c10.min, 0.1);
+  EXPECT_DOUBLE_EQ(c10.max, 0.3);
+  // UC per seed is averaged over the speeds first: 1.0, 1.1, 1.2 -> mean 1.1, sd 0.1.
+  EXPECT_NEAR(l.uc_mean_spread().mean, 1.1, 1e-12);
+  EXPECT_NEAR(l.uc_mean_spread().sd, 0.1, 1e-12);
+  // Compensation per seed: mean over the speeds of 1 - C/UC, written out here.
+  const double s0 = ((1 - 0.1 / 1.0) + (1 - 0.2 / 1.0)) / 2, s1 = ((1 - 0.2 / 1.2) + (1 - 0.2 / 1.0)) / 2,
+               s2 = ((1 - 0.3 / 1.1) + (1 - 0.2 / 1.3)) / 2;
+  EXPECT_NEAR(l.compensation_spread().mean, (s0 + s1 + s2) / 3, 1e-12);
+  EXPECT_EQ(l.seeds(), 3);
+
+  StudyResult study;
+  study.seeds = {1, 2, 3};
+  SetupResult on{"online", "", {l}};
+  study.setups = {on};
+  study.speeds_mm_s = {10, 30};
+  ErrorBudget b;
+  b.setup = "online";
+  b.load_N = 650;
+  b.speed_mm_s = 50;
+  b.residual_mm_all = 0.2;
+  b.uc_mm = 1.1;
+  b.entries = {{"lost motion", "40 urad", 0.15, residual_share(0.2, 0.15)}};
+  study.error_budgets = {b};
+  const StudyResult back = study_from_json(study_to_json(study), "test");
+  EXPECT_EQ(back.seeds, study.seeds);
+  EXPECT_EQ(back.setups[0].loads[0].c_mm_by_seed, l.c_mm_by_seed);
+  ASSERT_EQ(back.error_budgets.size(), 1u);
+  EXPECT_EQ(back.error_budgets[0].entries[0].effect, "lost motion");
+  EXPECT_NEAR(back.error_budgets[0].entries[0].share_of_residual, 0.25, 1e-12);
+  // The text table carries the spread: "0.200 ±0.100 (0.25)" for C at 10 mm/s.
+  const std::string text = study_tables_text(study);
+  EXPECT_NE(text.find("0.200 ±0.100 (0.25)"), std::string::npos) << text;
+  EXPECT_NE(text.find("1.100 ±0.100 (1.10)"), std::string::npos) << text;
+  const std::string dir = ::testing::TempDir();
+  write_error_budget_csv(study, dir + "/budget.csv");
+  std::ifstream in(dir + "/budget.csv");
+  std::string header, row;
+  std::getline(in, header);
+  std::getline(in, row);
+  EXPECT_EQ(row, "online,650,50,0.2,1.1,lost motion,40 urad,0.15,0.25");
 }
 
 }  // namespace

@@ -41,8 +41,16 @@ inline StudyResult synthetic_study() {
     const double uc = 1.12;
     const double c_on = 0.24 + 0.0025 * v;
     const double c_lat = 0.22 + 0.0004 * v;
-    s.speed_sweep.push_back({"online", 650, v, uc, c_on, 1.0 - c_on / uc});
-    s.speed_sweep.push_back({"online-latency-comp", 650, v, uc, c_lat, 1.0 - c_lat / uc});
+    for (const auto& [name, c] : {std::pair<const char*, double>{"online", c_on}, {"online-latency-comp", c_lat}}) {
+      SweepPoint p;
+      p.setup = name;
+      p.load_N = 650;
+      p.speed_mm_s = v;
+      p.uc_mm = uc;
+      p.c_mm = c;
+      p.compensation = 1.0 - c / uc;
+      s.speed_sweep.push_back(p);
+    }
   }
   return s;
 }

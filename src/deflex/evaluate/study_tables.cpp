@@ -25,6 +25,35 @@ nlohmann::json speed_map(const std::map<int, double>& m) {
   return j;
 }
 
+nlohmann::json numbers(const std::vector<double>& v) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const double x : v) j.push_back(number(x));
+  return j;
+}
+
+nlohmann::json speed_lists(const std::map<int, std::vector<double>>& m) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [speed, v] : m) j[std::to_string(speed)] = numbers(v);
+  return j;
+}
+
+nlohmann::json spread_json(const Spread& s) {
+  return {{"mean", number(s.mean)}, {"sd", number(s.sd)}, {"min", number(s.min)}, {"max", number(s.max)}, {"n", s.n}};
+}
+
+double mean_of(const std::vector<double>& v) { return spread_of(v).mean; }
+
+// A text cell of a CSV file: quoted (quotes doubled) when it holds a comma, a quote or a line break.
+std::string csv_text(const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+  std::string out = "\"";
+  for (const char c : text) {
+    out += c;
+    if (c == '"') out += '"';
+  }
+  return out + "\"";
+}
+
 // The table number a setup gets: the paper's own numbers for its two, then 3, 4, ... in order.
 std::vector<std::string> table_titles(const StudyResult& study) {
   std::vector<std::string> titles;
@@ -64,6 +93,16 @@ double paper_compensation(const PaperRow& r) {
 }
 
 std::string mm(double v) { return std::isfinite(v) ? fmt::format("{:.3f}", v) : "n/a"; }
+
+// "0.152" for one seed, "0.152 ±0.012" (the sample standard deviation over the seeds) for several.
+std::string mm_spread(const Spread& s) {
+  if (s.n <= 1) return mm(s.mean);
+  return fmt::format("{} ±{:.3f}", mm(s.mean), s.sd);
+}
+std::string percent_spread(const Spread& s) {
+  if (s.n <= 1) return percent_text(s.mean);
+  return fmt::format("{} ±{:.0f}", percent_text(s.mean), 100.0 * s.sd);
+}
 std::string paper_mm(double v) { return std::isfinite(v) ? fmt::format("{:.2f}", v) : ""; }
 
 std::string cell_with_paper(const std::string& ours, const std::string& paper) {
@@ -92,13 +131,14 @@ Grid setup_grid(const SetupResult& s, const std::vector<int>& speeds, const Pape
     const PaperRow* pr = paper != nullptr ? paper->row_for(l.load_N) : nullptr;
     Row r;
     r.cells.push_back(fmt::format("{:g} N", l.load_N));
-    r.cells.push_back(cell_with_paper(mm(l.uc_mean_mm()), pr != nullptr ? paper_mm(pr->uc_mm) : ""));
+    r.cells.push_back(cell_with_paper(mm_spread(l.uc_mean_spread()), pr != nullptr ? paper_mm(pr->uc_mm) : ""));
     for (const int v : speeds) {
       const double pc = pr != nullptr ? value_at_speed(pr->c_mm, v) : kNaN;
-      r.cells.push_back(cell_with_paper(mm(value_at_speed(l.c_mm, v)), paper_mm(pc)));
+      r.cells.push_back(cell_with_paper(mm_spread(l.c_spread(v)), paper_mm(pc)));
     }
-    r.cells.push_back(cell_with_paper(percent_text(mean_over(l.compensation, speeds)),
-                                      pr != nullptr ? percent_text(paper_compensation(*pr)) : ""));
+    Spread comp = l.compensation_spread();
+    if (comp.n <= 1) comp.mean = mean_over(l.compensation, speeds);
+    r.cells.push_back(cell_with_paper(percent_spread(comp), pr != nullptr ? percent_text(paper_compensation(*pr)) : ""));
     g.rows.push_back(r);
   }
   return g;
@@ -127,6 +167,40 @@ std::map<int, double> read_speed_map(const nlohmann::json& j, const std::string&
     } else {
       throw DataError(fmt::format("{}.\"{}\": not a number", where, key));
     }
+  }
+  return m;
+}
+
+std::vector<double> read_numbers(const nlohmann::json& j, const std::string& where) {
+  if (!j.is_array()) throw DataError(fmt::format("{}: must be an array of numbers", where));
+  std::vector<double> out;
+  for (const auto& v : j) {
+    if (v.is_null()) {
+      out.push_back(kNaN);
+    } else if (v.is_number()) {
+      out.push_back(v.get<double>());
+    } else {
+      throw DataError(fmt::format("{}: not a number", where));
+    }
+  }
+  return out;
+}
+
+std::map<int, std::vector<double>> read_speed_lists(const nlohmann::json& j, const std::string& where) {
+  std::map<int, std::vector<double>> m;
+  if (!j.is_object()) throw DataError(fmt::format("{}: must be an object keyed by speed in mm/s", where));
+  for (const auto& [key, value] : j.items()) {
+    std::size_t used = 0;
+    int speed = 0;
+    try {
+      speed = std::stoi(key, &used);
+    } catch (const std::logic_error&) {
+      used = 0;
+    }
+    if (used != key.size() || key.empty()) {
+      throw DataError(fmt::format("{}: key '{}' is not a speed in mm/s", where, key));
+    }
+    m[speed] = read_numbers(value, fmt::format("{}.\"{}\"", where, key));
   }
   return m;
 }
@@ -189,6 +263,96 @@ double LoadResult::uc_mean_mm() const {
   return sum / static_cast<double>(uc_mm.size());
 }
 
+Spread spread_of(const std::vector<double>& values) {
+  Spread s;
+  double sum = 0.0;
+  for (const double v : values) {
+    if (!std::isfinite(v)) continue;
+    sum += v;
+    s.min = s.n == 0 ? v : std::min(s.min, v);
+    s.max = s.n == 0 ? v : std::max(s.max, v);
+    ++s.n;
+  }
+  if (s.n == 0) return s;
+  s.mean = sum / s.n;
+  if (s.n > 1) {
+    double var = 0.0;
+    for (const double v : values) {
+      if (std::isfinite(v)) var += (v - s.mean) * (v - s.mean);
+    }
+    s.sd = std::sqrt(var / (s.n - 1));
+  }
+  return s;
+}
+
+int LoadResult::seeds() const {
+  std::size_t n = 0;
+  for (const auto& [v, list] : c_mm_by_seed) n = std::max(n, list.size());
+  return static_cast<int>(std::max<std::size_t>(n, 1));
+}
+
+void LoadResult::fill_means() {
+  const std::pair<std::map<int, std::vector<double>>*, std::map<int, double>*> pairs[] = {
+      {&uc_mm_by_seed, &uc_mm}, {&c_mm_by_seed, &c_mm}, {&uc_sync_mm_by_seed, &uc_sync_mm}, {&c_sync_mm_by_seed, &c_sync_mm}};
+  for (const auto& [by_seed, mean] : pairs) {
+    for (const auto& [v, list] : *by_seed) (*mean)[v] = mean_of(list);
+  }
+  fill_compensation();
+}
+
+Spread LoadResult::c_spread(int speed_mm_s) const {
+  const auto it = c_mm_by_seed.find(speed_mm_s);
+  if (it != c_mm_by_seed.end() && !it->second.empty()) return spread_of(it->second);
+  return spread_of({value_at_speed(c_mm, speed_mm_s)});
+}
+
+Spread LoadResult::uc_mean_spread() const {
+  // Per seed: UC averaged over the speeds (the paper's UC column), then spread over the seeds.
+  const int n = seeds();
+  if (n <= 1 || uc_mm_by_seed.empty()) return spread_of({uc_mean_mm()});
+  std::vector<double> per_seed;
+  for (int k = 0; k < n; ++k) {
+    double sum = 0.0;
+    int count = 0;
+    for (const auto& [v, list] : uc_mm_by_seed) {
+      if (static_cast<std::size_t>(k) < list.size() && std::isfinite(list[static_cast<std::size_t>(k)])) {
+        sum += list[static_cast<std::size_t>(k)];
+        ++count;
+      }
+    }
+    per_seed.push_back(count > 0 ? sum / count : kNaN);
+  }
+  return spread_of(per_seed);
+}
+
+Spread LoadResult::compensation_spread() const {
+  const int n = seeds();
+  if (n <= 1 || uc_mm_by_seed.empty() || c_mm_by_seed.empty()) {
+    std::vector<double> all;
+    for (const auto& [v, c] : compensation) all.push_back(c);
+    return spread_of({spread_of(all).mean});
+  }
+  std::vector<double> per_seed;
+  for (int k = 0; k < n; ++k) {
+    double sum = 0.0;
+    int count = 0;
+    for (const auto& [v, list] : c_mm_by_seed) {
+      const auto uc = uc_mm_by_seed.find(v);
+      if (uc == uc_mm_by_seed.end() || static_cast<std::size_t>(k) >= list.size() ||
+          static_cast<std::size_t>(k) >= uc->second.size()) {
+        continue;
+      }
+      const double r = compensation_ratio(uc->second[static_cast<std::size_t>(k)], list[static_cast<std::size_t>(k)]);
+      if (std::isfinite(r)) {
+        sum += r;
+        ++count;
+      }
+    }
+    per_seed.push_back(count > 0 ? sum / count : kNaN);
+  }
+  return spread_of(per_seed);
+}
+
 void LoadResult::fill_compensation() {
   for (const auto& [v, c] : c_mm) {
     const auto it = uc_mm.find(v);
@@ -222,6 +386,19 @@ nlohmann::json study_to_json(const StudyResult& study) {
           jl[key] = speed_map(*m);
         }
       }
+      const std::pair<const char*, const std::map<int, std::vector<double>>*> by_seed[] = {
+          {"uc_mm_by_seed", &l.uc_mm_by_seed},
+          {"c_mm_by_seed", &l.c_mm_by_seed},
+          {"uc_sync_mm_by_seed", &l.uc_sync_mm_by_seed},
+          {"c_sync_mm_by_seed", &l.c_sync_mm_by_seed}};
+      for (const auto& [key, m] : by_seed) {
+        if (!m->empty()) jl[key] = speed_lists(*m);
+      }
+      nlohmann::json c_spread = nlohmann::json::object();
+      for (const auto& [v, c] : l.c_mm) c_spread[std::to_string(v)] = spread_json(l.c_spread(v));
+      jl["spread"] = {{"uc_mm", spread_json(l.uc_mean_spread())},
+                      {"c_mm", c_spread},
+                      {"compensation", spread_json(l.compensation_spread())}};
       loads.push_back(jl);
     }
     nlohmann::json js{{"setup", s.setup}, {"loads", loads}};
@@ -234,14 +411,43 @@ nlohmann::json study_to_json(const StudyResult& study) {
   if (!study.speed_sweep.empty()) {
     nlohmann::json sweep = nlohmann::json::array();
     for (const auto& p : study.speed_sweep) {
-      sweep.push_back({{"setup", p.setup},
-                       {"load_N", p.load_N},
-                       {"speed_mm_s", p.speed_mm_s},
-                       {"uc_mm", number(p.uc_mm)},
-                       {"c_mm", number(p.c_mm)},
-                       {"compensation", number(p.compensation)}});
+      nlohmann::json jp{{"setup", p.setup},
+                        {"load_N", p.load_N},
+                        {"speed_mm_s", p.speed_mm_s},
+                        {"uc_mm", number(p.uc_mm)},
+                        {"c_mm", number(p.c_mm)},
+                        {"compensation", number(p.compensation)},
+                        {"c_sync_mm", number(p.c_sync_mm)}};
+      if (!p.c_mm_by_seed.empty()) {
+        jp["uc_mm_by_seed"] = numbers(p.uc_mm_by_seed);
+        jp["c_mm_by_seed"] = numbers(p.c_mm_by_seed);
+        jp["c_sync_mm_by_seed"] = numbers(p.c_sync_mm_by_seed);
+      }
+      sweep.push_back(jp);
     }
     doc["speed_sweep"] = sweep;
+  }
+  if (!study.error_budgets.empty()) {
+    nlohmann::json budgets = nlohmann::json::array();
+    for (const auto& b : study.error_budgets) {
+      nlohmann::json entries = nlohmann::json::array();
+      for (const auto& e : b.entries) {
+        entries.push_back({{"effect", e.effect},
+                           {"size", e.size},
+                           {"residual_mm_without_it", number(e.residual_mm_without_it)},
+                           {"share_of_residual", number(e.share_of_residual)}});
+      }
+      budgets.push_back({{"setup", b.setup},
+                         {"load_N", b.load_N},
+                         {"speed_mm_s", b.speed_mm_s},
+                         {"residual_mm_all", number(b.residual_mm_all)},
+                         {"uc_mm", number(b.uc_mm)},
+                         {"entries", entries}});
+    }
+    doc["error_budget"] = budgets;
+  }
+  if (!study.seeds.empty()) {
+    doc["seeds"] = study.seeds;
   }
   if (!study.case_name.empty()) {
     doc["case"] = study.case_name;
@@ -306,6 +512,14 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
           throw DataError(fmt::format("{}: missing field '{}'", lw, key));
         }
       }
+      const std::pair<const char*, std::map<int, std::vector<double>>*> by_seed[] = {
+          {"uc_mm_by_seed", &l.uc_mm_by_seed},
+          {"c_mm_by_seed", &l.c_mm_by_seed},
+          {"uc_sync_mm_by_seed", &l.uc_sync_mm_by_seed},
+          {"c_sync_mm_by_seed", &l.c_sync_mm_by_seed}};
+      for (const auto& [key, m] : by_seed) {
+        if (jl.contains(key)) *m = read_speed_lists(jl.at(key), lw + "." + key);
+      }
       s.loads.push_back(l);
     }
     study.setups.push_back(s);
@@ -332,6 +546,14 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
       p.uc_mm = jp.contains("uc_mm") && jp.at("uc_mm").is_null() ? kNaN : read_number(jp, "uc_mm", pw);
       p.c_mm = jp.contains("c_mm") && jp.at("c_mm").is_null() ? kNaN : read_number(jp, "c_mm", pw);
       p.compensation = compensation_ratio(p.uc_mm, p.c_mm);
+      if (jp.contains("c_sync_mm")) {
+        p.c_sync_mm = jp.at("c_sync_mm").is_null() ? kNaN : read_number(jp, "c_sync_mm", pw);
+      }
+      if (jp.contains("c_mm_by_seed")) p.c_mm_by_seed = read_numbers(jp.at("c_mm_by_seed"), pw + ".c_mm_by_seed");
+      if (jp.contains("uc_mm_by_seed")) p.uc_mm_by_seed = read_numbers(jp.at("uc_mm_by_seed"), pw + ".uc_mm_by_seed");
+      if (jp.contains("c_sync_mm_by_seed")) {
+        p.c_sync_mm_by_seed = read_numbers(jp.at("c_sync_mm_by_seed"), pw + ".c_sync_mm_by_seed");
+      }
       study.speed_sweep.push_back(p);
     }
   }
@@ -343,6 +565,47 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
   }
   if (doc.contains("wall_time_s") && doc.at("wall_time_s").is_number()) {
     study.wall_time_s = doc.at("wall_time_s").get<double>();
+  }
+  if (doc.contains("seeds")) {
+    for (const auto& v : doc.at("seeds")) {
+      if (!v.is_number_unsigned()) throw DataError(fmt::format("{}: seeds: not a seed", source));
+      study.seeds.push_back(v.get<std::uint64_t>());
+    }
+  }
+  if (doc.contains("error_budget")) {
+    std::size_t bi = 0;
+    for (const auto& jb : doc.at("error_budget")) {
+      const std::string bw = fmt::format("{}: error_budget[{}]", source, bi++);
+      ErrorBudget b;
+      if (!jb.contains("setup") || !jb.at("setup").is_string()) {
+        throw DataError(fmt::format("{}: missing string field 'setup'", bw));
+      }
+      b.setup = jb.at("setup").get<std::string>();
+      b.load_N = read_number(jb, "load_N", bw);
+      b.speed_mm_s = read_number(jb, "speed_mm_s", bw);
+      b.residual_mm_all = jb.contains("residual_mm_all") && jb.at("residual_mm_all").is_null()
+                              ? kNaN
+                              : read_number(jb, "residual_mm_all", bw);
+      b.uc_mm = jb.contains("uc_mm") && jb.at("uc_mm").is_null() ? kNaN : read_number(jb, "uc_mm", bw, false);
+      if (jb.contains("entries")) {
+        std::size_t ei = 0;
+        for (const auto& je : jb.at("entries")) {
+          const std::string ew = fmt::format("{}.entries[{}]", bw, ei++);
+          ErrorBudgetEntry e;
+          if (!je.contains("effect") || !je.at("effect").is_string()) {
+            throw DataError(fmt::format("{}: missing string field 'effect'", ew));
+          }
+          e.effect = je.at("effect").get<std::string>();
+          e.size = je.contains("size") && je.at("size").is_string() ? je.at("size").get<std::string>() : "";
+          e.residual_mm_without_it = je.contains("residual_mm_without_it") && je.at("residual_mm_without_it").is_null()
+                                         ? kNaN
+                                         : read_number(je, "residual_mm_without_it", ew);
+          e.share_of_residual = residual_share(b.residual_mm_all, e.residual_mm_without_it);
+          b.entries.push_back(e);
+        }
+      }
+      study.error_budgets.push_back(b);
+    }
   }
   return study;
 }
@@ -449,19 +712,59 @@ void write_study_csv(const StudyResult& study, const std::string& path) {
   const PaperFigures paper = paper_reference();
   auto cell = [](double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : std::string(); };
   f << "setup,load_N,speed_mm_s,uc_mm,c_mm,compensation,uc_std_mm,c_std_mm,uc_max_mm,c_max_mm,"
-       "iso_accuracy_uc_mm,iso_accuracy_c_mm,iso_repeatability_mm,uc_sync_mm,c_sync_mm,paper_uc_mm,paper_c_mm\n";
+       "iso_accuracy_uc_mm,iso_accuracy_c_mm,iso_repeatability_mm,uc_sync_mm,c_sync_mm,seeds,c_mm_seed_sd,"
+       "c_mm_seed_min,c_mm_seed_max,paper_uc_mm,paper_c_mm\n";
   for (const auto& s : study.setups) {
     const PaperTable* pt = paper.table_for(s.setup);
     for (const auto& l : s.loads) {
       const PaperRow* pr = pt != nullptr ? pt->row_for(l.load_N) : nullptr;
       for (const int v : study_speeds_mm_s(study)) {
         const auto at = [&](const std::map<int, double>& m) { return cell(value_at_speed(m, v)); };
-        f << fmt::format("{},{:g},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", s.setup, l.load_N, v, at(l.uc_mm),
-                         at(l.c_mm), at(l.compensation), at(l.uc_std_mm), at(l.c_std_mm), at(l.uc_max_mm),
-                         at(l.c_max_mm), at(l.iso_accuracy_uc_mm), at(l.iso_accuracy_c_mm), at(l.iso_repeatability_mm),
-                         at(l.uc_sync_mm), at(l.c_sync_mm), cell(pr != nullptr ? pr->uc_mm : kNaN),
+        const Spread cs = l.c_spread(v);
+        f << fmt::format("{},{:g},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", csv_text(s.setup),
+                         l.load_N, v, at(l.uc_mm), at(l.c_mm), at(l.compensation), at(l.uc_std_mm), at(l.c_std_mm),
+                         at(l.uc_max_mm), at(l.c_max_mm), at(l.iso_accuracy_uc_mm), at(l.iso_accuracy_c_mm),
+                         at(l.iso_repeatability_mm), at(l.uc_sync_mm), at(l.c_sync_mm), cs.n, cell(cs.sd),
+                         cell(cs.min), cell(cs.max), cell(pr != nullptr ? pr->uc_mm : kNaN),
                          pr != nullptr ? at(pr->c_mm) : std::string());
       }
+    }
+  }
+  if (!f) {
+    throw Error(fmt::format("{}: write failed", path));
+  }
+}
+
+void write_sweep_csv(const StudyResult& study, const std::string& path) {
+  std::ofstream f(path);
+  if (!f) {
+    throw Error(fmt::format("{}: cannot write the file", path));
+  }
+  auto cell = [](double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : std::string(); };
+  f << "setup,load_N,speed_mm_s,uc_mm,c_mm,compensation,c_sync_mm,seeds,c_mm_seed_sd,c_mm_seed_min,c_mm_seed_max\n";
+  for (const auto& p : study.speed_sweep) {
+    const Spread cs = p.c_mm_by_seed.empty() ? spread_of({p.c_mm}) : spread_of(p.c_mm_by_seed);
+    f << fmt::format("{},{:g},{:g},{},{},{},{},{},{},{},{}\n", csv_text(p.setup), p.load_N, p.speed_mm_s, cell(p.uc_mm),
+                     cell(p.c_mm), cell(p.compensation), cell(p.c_sync_mm), cs.n, cell(cs.sd), cell(cs.min),
+                     cell(cs.max));
+  }
+  if (!f) {
+    throw Error(fmt::format("{}: write failed", path));
+  }
+}
+
+void write_error_budget_csv(const StudyResult& study, const std::string& path) {
+  std::ofstream f(path);
+  if (!f) {
+    throw Error(fmt::format("{}: cannot write the file", path));
+  }
+  auto cell = [](double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : std::string(); };
+  f << "setup,load_N,speed_mm_s,residual_mm_all,uc_mm,effect,size,residual_mm_without_it,share_of_residual\n";
+  for (const auto& b : study.error_budgets) {
+    for (const auto& e : b.entries) {
+      f << fmt::format("{},{:g},{:g},{},{},{},{},{},{}\n", csv_text(b.setup), b.load_N, b.speed_mm_s,
+                       cell(b.residual_mm_all), cell(b.uc_mm), csv_text(e.effect), csv_text(e.size),
+                       cell(e.residual_mm_without_it), cell(e.share_of_residual));
     }
   }
   if (!f) {

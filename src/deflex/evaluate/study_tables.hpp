@@ -1,19 +1,35 @@
-// Results of a case study (per setup, load and speed) and their forms: JSON, terminal tables in the
-// paper's layout beside the paper's figures, Markdown and CSV.
+// Results of a case study (per setup, load and speed, over one or several seeds) and their forms:
+// JSON, terminal tables in the paper's layout beside the paper's figures (mean and spread over the
+// seeds), Markdown and CSV.
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "deflex/evaluate/error_budget.hpp"
 #include "deflex/evaluate/paper_figures.hpp"
 
 namespace deflex {
 
+/// Several seeds' values of one figure: the mean, the sample standard deviation over the seeds (0 for
+/// one) and the range. NaN values are left out; n counts the rest.
+struct Spread {
+  double mean = std::numeric_limits<double>::quiet_NaN();
+  double sd = 0.0;
+  double min = std::numeric_limits<double>::quiet_NaN();
+  double max = std::numeric_limits<double>::quiet_NaN();
+  int n = 0;
+};
+[[nodiscard]] Spread spread_of(const std::vector<double>& values);
+
 /// Figures of one load of one setup. Every map is keyed by the TCP speed in mm/s; lengths in mm.
+/// With several seeds the plain maps hold the mean over the seeds and the *_by_seed maps the values
+/// they are the mean of, in the study's seed order.
 struct LoadResult {
   double load_N = 0.0;
   std::map<int, double> uc_mm;         ///< mean distance of the loaded uncompensated path from the unloaded one
@@ -26,11 +42,22 @@ struct LoadResult {
   /// The time-synchronous (along-path) error against the unloaded run at the same time (optional): it
   /// sees lag that the nearest-point distance does not.
   std::map<int, double> uc_sync_mm, c_sync_mm;
+  /// Per seed (optional; one value each for a single seed).
+  std::map<int, std::vector<double>> uc_mm_by_seed, c_mm_by_seed, uc_sync_mm_by_seed, c_sync_mm_by_seed;
 
   /// Mean of uc_mm over the speeds: the paper's UC column. NaN when uc_mm is empty.
   [[nodiscard]] double uc_mean_mm() const;
   /// Sets compensation[v] = compensation_ratio(uc_mm[v], c_mm[v]) for every speed with both.
   void fill_compensation();
+  /// Sets the plain maps to the means of the *_by_seed maps, then fill_compensation().
+  void fill_means();
+  /// Spread over the seeds of C at a speed, of UC (mean over the speeds, per seed), and of the
+  /// compensation (mean over the speeds of 1 - C/UC, per seed). A study without per-seed values
+  /// gives its single value with sd 0.
+  [[nodiscard]] Spread c_spread(int speed_mm_s) const;
+  [[nodiscard]] Spread uc_mean_spread() const;
+  [[nodiscard]] Spread compensation_spread() const;
+  [[nodiscard]] int seeds() const;
 };
 
 /// One strategy setup: "offline", "online" (the paper's two), "hybrid", "online-latency-comp", ...
@@ -45,23 +72,31 @@ struct SweepPoint {
   std::string setup;
   double load_N = 0.0;
   double speed_mm_s = 0.0;
-  double uc_mm = 0.0;
-  double c_mm = 0.0;
+  double uc_mm = 0.0;  ///< mean over the seeds
+  double c_mm = 0.0;   ///< mean over the seeds
   double compensation = 0.0;
+  double c_sync_mm = std::numeric_limits<double>::quiet_NaN();  ///< time-synchronous error, mean over the seeds
+  std::vector<double> uc_mm_by_seed, c_mm_by_seed, c_sync_mm_by_seed;  ///< optional
 };
 
 struct StudyResult {
   std::vector<SetupResult> setups;
   std::vector<int> speeds_mm_s;          ///< the table columns C1, C2, C3 ... (mm/s)
   std::vector<SweepPoint> speed_sweep;   ///< optional
+  std::vector<ErrorBudget> error_budgets;  ///< optional
   std::string case_name;                 ///< optional, shown in headings
-  std::uint64_t seed = 0;
+  std::uint64_t seed = 0;                ///< the first seed
+  std::vector<std::uint64_t> seeds;      ///< every seed the figures are over (empty: just `seed`)
   double wall_time_s = 0.0;              ///< optional, 0 = not reported
 };
 
 /// {"setups":[{"setup":"offline","description":..,"loads":[{"load_N":125,"uc_mm":{"10":..,"30":..,"50":..},
-///  "c_mm":{..},"compensation":{..}, (optional maps when filled)}, ...]}, ...], "speeds_mm_s":[..],
-///  "speed_sweep":[{"setup","load_N","speed_mm_s","uc_mm","c_mm","compensation"}], "paper":{...}}.
+///  "c_mm":{..},"compensation":{..}, (optional maps when filled; per-seed values as
+///  "c_mm_by_seed":{"10":[..],..}), "spread":{"uc_mm":{mean,sd,min,max,n},"c_mm":{"10":{..}},
+///  "compensation":{..}}}, ...]}, ...], "speeds_mm_s":[..], "seeds":[..],
+///  "speed_sweep":[{"setup","load_N","speed_mm_s","uc_mm","c_mm","compensation","c_sync_mm",
+///  "c_mm_by_seed":[..]}], "error_budget":[{"setup","load_N","speed_mm_s","residual_mm_all","uc_mm",
+///  "entries":[{"effect","size","residual_mm_without_it","share_of_residual"}]}], "paper":{...}}.
 /// NaN values are written as null.
 nlohmann::json study_to_json(const StudyResult& study);
 /// The inverse of study_to_json (for `deflex report` from a saved JSON). Throws DataError naming the
@@ -82,7 +117,12 @@ std::string study_tables_text(const StudyResult& study);
 /// The same tables in GitHub Markdown.
 std::string study_tables_markdown(const StudyResult& study);
 /// Long format, one row per setup, load and speed: setup,load_N,speed_mm_s,uc_mm,c_mm,compensation,
-/// ... ,paper_uc_mm,paper_c_mm (empty cell where there is no figure). Throws Error on a write failure.
+/// ... ,seeds,c_mm_seed_sd,c_mm_seed_min,c_mm_seed_max,paper_uc_mm,paper_c_mm (empty cell where there
+/// is no figure). Throws Error on a write failure.
 void write_study_csv(const StudyResult& study, const std::string& path);
+/// The speed sweep, one row per setup and speed (means and spread over the seeds).
+void write_sweep_csv(const StudyResult& study, const std::string& path);
+/// The error budget, one row per setup and effect.
+void write_error_budget_csv(const StudyResult& study, const std::string& path);
 
 }  // namespace deflex

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "deflex/evaluate/study_tables.hpp"
-#include "deflex/report/error_budget.hpp"
+#include "deflex/evaluate/error_budget.hpp"
 #include "deflex/report/svg_charts.hpp"
 
 namespace deflex {

@@ -1,5 +1,6 @@
 // The error budget of a simulated case: each effect of the cell, its size, and how much of the
-// compensated residual it explains (found by switching effects off one at a time).
+// compensated residual it explains (found by switching effects off one at a time). Part of a study's
+// results (study_tables.hpp), so its JSON and CSV carry it.
 #pragma once
 
 #include <string>
