@@ -112,5 +112,63 @@ TEST(CaseConfig, NewEffectsAreSizedInThePaperCaseAndSwitchOff) {
 
 
 
+TEST(CaseConfig, TheTwinsFurtherEffectsAreSizedCheckedAndSwitchOff) {
+  const CaseConfig c = paper_case();
+  const auto& r = c.cell.robot;
+  EXPECT_GT(r.upper_arm_ei_nm2, 0.0);
+  EXPECT_GT(r.base_tilt_compliance_rad_per_nm, 0.0);
+  EXPECT_GT(r.speed_stiffening, 0.0);
+  EXPECT_GT(r.direction_asymmetry, 0.0);
+  EXPECT_GT(r.servo_following_s, 0.0);
+  EXPECT_GT(r.servo_compliance_fraction, 0.0);
+  EXPECT_GT(c.cell.sensor.zero_drift_n, 0.0);
+  EXPECT_GT(c.cell.drift.load_offset_m, 0.0);
+  EXPECT_GT(c.cell.ldbb.stick_slip, 0.0);
+  EXPECT_GE(c.seeds, 2);
+  // The units at the edge: mm, ms, %, nrad/Nm in the file; SI inside.
+  EXPECT_NEAR(r.servo_following_s, 0.008, 1e-12);
+  EXPECT_NEAR(r.base_tilt_compliance_rad_per_nm, 0.3e-9, 1e-18);
+  EXPECT_NEAR(c.cell.ldbb.stick_slip_travel_m, 0.0005, 1e-12);
+  EXPECT_NEAR(c.cell.drift.load_offset_m, 15e-6, 1e-12);
+  // Each switch turns its own effect off and leaves the rest.
+  EXPECT_EQ(without_effect(c, Effect::kLinkBending).cell.robot.upper_arm_ei_nm2, 0.0);
+  EXPECT_EQ(without_effect(c, Effect::kBaseCompliance).cell.robot.base_tilt_compliance_rad_per_nm, 0.0);
+  const CaseConfig m = without_effect(c, Effect::kMotionStiffness);
+  EXPECT_EQ(m.cell.robot.speed_stiffening + m.cell.robot.direction_asymmetry, 0.0);
+  EXPECT_GT(m.cell.robot.servo_following_s, 0.0);
+  const CaseConfig sv = without_effect(c, Effect::kServo);
+  EXPECT_EQ(sv.cell.robot.servo_following_s + sv.cell.robot.servo_compliance_fraction, 0.0);
+  EXPECT_EQ(without_effect(c, Effect::kSensorDrift).cell.sensor.zero_drift_n, 0.0);
+  EXPECT_EQ(without_effect(c, Effect::kThermalLoadDrift).cell.drift.load_offset_m, 0.0);
+  EXPECT_GT(without_effect(c, Effect::kThermalLoadDrift).cell.drift.offset_m, 0.0);
+  EXPECT_EQ(without_effect(c, Effect::kLdbbStickSlip).cell.ldbb.stick_slip, 0.0);
+  for (Effect e : kAllEffects) {
+    EXPECT_STRNE(to_string(e), "?");
+    EXPECT_FALSE(effect_size(c, e).empty()) << to_string(e);
+  }
+  const CaseConfig mc = model_consistent(c, true);
+  EXPECT_EQ(mc.cell.robot.upper_arm_ei_nm2 + mc.cell.robot.base_tilt_compliance_rad_per_nm, 0.0);
+  EXPECT_EQ(mc.cell.robot.servo_compliance_fraction + mc.cell.robot.speed_stiffening, 0.0);
+  EXPECT_EQ(mc.cell.sensor.zero_drift_n + mc.cell.drift.load_offset_m + mc.cell.ldbb.stick_slip, 0.0);
+}
+
+TEST(CaseConfig, OutOfRangeEffectSizesAndSeedsAreRefusedByName) {
+  const std::string stiff = error_of(paper_with("speed_stiffening_pct: 5", "speed_stiffening_pct: 80"));
+  EXPECT_NE(stiff.find("true_robot.speed_stiffening_pct"), std::string::npos) << stiff;
+  EXPECT_NE(stiff.find("0..50 %"), std::string::npos) << stiff;
+  const std::string follow = error_of(paper_with("servo_following_ms: 8", "servo_following_ms: 500"));
+  EXPECT_NE(follow.find("servo_following_ms"), std::string::npos) << follow;
+  const std::string tilt = error_of(paper_with("base_tilt_compliance_nrad_per_Nm: 0.3", "base_tilt_compliance_nrad_per_Nm: -1"));
+  EXPECT_NE(tilt.find("base_tilt_compliance_nrad_per_Nm"), std::string::npos) << tilt;
+  const std::string drift = error_of(paper_with("zero_drift_N_per_10min: 0.4", "zero_drift_N_per_10min: .nan"));
+  EXPECT_NE(drift.find("zero_drift_N_per_10min"), std::string::npos) << drift;
+  const std::string slip = error_of(paper_with("stick_slip_travel_mm: 0.5", "stick_slip_travel_mm: 0"));
+  EXPECT_NE(slip.find("stick_slip_travel_mm"), std::string::npos) << slip;
+  const std::string seeds = error_of(paper_with("seeds: 4", "seeds: 0"));
+  EXPECT_NE(seeds.find("protocol.seeds"), std::string::npos) << seeds;
+  const std::string old_budget = error_of(paper_with("  load_index: 2", "  load_index: 2\n  laps_each_way: 1"));
+  EXPECT_NE(old_budget.find("laps_each_way"), std::string::npos) << old_budget;
+}
+
 }  // namespace
 }  // namespace deflex::study

@@ -32,6 +32,21 @@ struct TrueRobotConfig {
   /// than at large torque (C: the true compliance above). Empty or zero s: linear gears.
   std::vector<double> hardening_softening;  ///< s per joint
   std::vector<double> hardening_torque_nm;  ///< tau_h per joint
+  double upper_arm_ei_nm2 = 0.0;            ///< upper arm bending stiffness EI, joint 2 to joint 3 (0: rigid)
+  double base_tilt_compliance_rad_per_nm = 0.0;  ///< foundation and base: tilt per Nm of moment about the base
+  /// Stiffness that depends on the joint's motion: the process deflection of a joint is scaled by
+  ///   (1 - speed_stiffening tanh(|v|/v_ref)) (1 + direction_asymmetry tanh(v/v_ref) sign(tau)),
+  /// v the joint's speed: moving joints appear stiffer (the paper's hypothesis), and a joint yields
+  /// more when it moves with its process torque than against it.
+  double speed_stiffening = 0.0;
+  double direction_asymmetry = 0.0;
+  double speed_ref_rad_s = 0.01;
+  /// The drives' position loops: the motor lags its command by servo_following_s times its speed,
+  /// and yields to a changing process torque by servo_compliance_fraction of the joint's compliance
+  /// until the integral action (time constant servo_integral_s) has taken the torque over.
+  double servo_following_s = 0.0;
+  double servo_compliance_fraction = 0.0;
+  double servo_integral_s = 0.1;
 };
 
 /// Run-to-run drift and path repeatability of the true robot: every run (the unloaded reference and
@@ -39,9 +54,14 @@ struct TrueRobotConfig {
 /// motion plus a slow random wander within the run.
 struct DriftConfig {
   double offset_m = 0.0;       ///< 1-sigma per axis of the run's rigid offset (thermal drift)
+  double offset_time_s = 1200.0;  ///< its correlation time: runs this far apart drift nearly independently
   double rotation_rad = 0.0;   ///< 1-sigma per axis of the run's small rotation about the base origin
   double wander_m = 0.0;       ///< stationary 1-sigma per axis of the wander within a run
   double wander_time_s = 1.0;  ///< correlation time of the wander (Ornstein-Uhlenbeck process)
+  /// The motors warm more under load: a loaded run's own extra rigid offset, 1-sigma per axis at the
+  /// reference load, growing with the square of the load (heat goes with the current squared).
+  double load_offset_m = 0.0;
+  double load_reference_n = 650.0;
 };
 
 struct ToolConfig {
@@ -69,6 +89,9 @@ struct SensorConfig {
   double sensitivity_error = 0.0;
   double misalignment_rad = 0.0;
   double daq_latency_s = 0.0005;  ///< from the sample to deflex's force port (DAQ program + network)
+  /// The zero drifts after it was tared at the start of a run (temperature, creep): a linear drift
+  /// whose change over 10 minutes is zero_drift_n (1-sigma per channel, drawn per run).
+  double zero_drift_n = 0.0;
 };
 
 struct LdbbConfig {
@@ -80,6 +103,13 @@ struct LdbbConfig {
   double ripple_hz = 2.0;
   double noise = 0.0;                       ///< relative 1-sigma per servo cycle
   double force_bias = 0.0;                  ///< true force = set-point * (1 + bias): unknown to the force model
+  /// The same after the bar's maintenance and recalibration (the paper's online tests came after it):
+  /// the runs with the force sensor mounted use this one.
+  double force_bias_recalibrated = 0.0;
+  /// The cylinder's seal friction sticks and slips: a sawtooth of this relative amplitude, one tooth
+  /// per stick_slip_travel_m of the TCP's travel.
+  double stick_slip = 0.0;
+  double stick_slip_travel_m = 0.0005;
   Vector3 pivot_error_m = Vector3::Zero();  ///< true pivot minus the force model's pivot
   double ball_friction = 0.0;               ///< friction coefficient of the ball joints
   double ball_radius_m = 0.0127;

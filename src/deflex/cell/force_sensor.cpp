@@ -22,18 +22,20 @@ ForceSensorDaq::ForceSensorDaq(const SensorConfig& sensor, const ToolConfig& too
   for (int i = 0; i < 3; ++i) sensitivity_[i] = 1.0 + sensor.sensitivity_error * normal_(rng_);
   flange_R_sensor_ = Eigen::AngleAxisd(sensor.misalignment_rad, Vector3::UnitZ()).toRotationMatrix();
   calibration_.decoupling = crosstalk_.inverse() * (Matrix3::Identity() + residual);
-  rng_.seed(seed);  // noise: this run's own
+  rng_.seed(seed);  // noise and zero drift: this run's own
   normal_.reset();
+  for (int i = 0; i < 3; ++i) zero_drift_n_per_s_[i] = sensor.zero_drift_n / 600.0 * normal_(rng_);
   calibration_.bias_n = sensor.bias_n;  // tared at a static pose: the bias itself is known
   calibration_.ee_mass_kg = tool.ee_mass_kg * (1.0 + sensor.gravity_mass_error);
   calibration_.ee_cog_m = tool.ee_cog_m;
 }
 
-Vector3 ForceSensorDaq::sample(const Vector3& process_force_base_n, const Matrix3& base_R_flange) {
+Vector3 ForceSensorDaq::sample(const Vector3& process_force_base_n, const Matrix3& base_R_flange, double t_s) {
   const Vector3 weight_base(0.0, 0.0, -tool_.ee_mass_kg * kGravity);
   const Vector3 f_sensor = (base_R_flange * flange_R_sensor_).transpose() * (process_force_base_n + weight_base);
   Vector3 noise(normal_(rng_), normal_(rng_), normal_(rng_));
-  return crosstalk_ * sensitivity_.asDiagonal() * f_sensor + config_.bias_n + config_.noise_n * noise;
+  return crosstalk_ * sensitivity_.asDiagonal() * f_sensor + config_.bias_n + zero_drift_n_per_s_ * t_s +
+         config_.noise_n * noise;
 }
 
 }  // namespace deflex::cell

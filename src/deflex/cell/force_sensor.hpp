@@ -29,8 +29,8 @@ class ForceSensorDaq {
       : ForceSensorDaq(sensor, tool, seed, seed) {}
 
   /// One DAQ sample (N, sensor frame = flange frame) for the process force on the TCP (base frame)
-  /// at the flange orientation base_R_flange.
-  [[nodiscard]] Vector3 sample(const Vector3& process_force_base_n, const Matrix3& base_R_flange);
+  /// at the flange orientation base_R_flange, taken t_s after the sensor was tared (its zero drifts).
+  [[nodiscard]] Vector3 sample(const Vector3& process_force_base_n, const Matrix3& base_R_flange, double t_s = 0.0);
   [[nodiscard]] const SensorCalibration& calibration() const { return calibration_; }
   [[nodiscard]] const Matrix3& crosstalk() const { return crosstalk_; }
   /// True sensitivity of each channel relative to the calibration sheet's (1 + error).
@@ -44,6 +44,7 @@ class ForceSensorDaq {
   Matrix3 crosstalk_;
   Vector3 sensitivity_ = Vector3::Ones();
   Matrix3 flange_R_sensor_ = Matrix3::Identity();
+  Vector3 zero_drift_n_per_s_ = Vector3::Zero();
   SensorCalibration calibration_;
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};

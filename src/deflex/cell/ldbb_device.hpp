@@ -34,6 +34,8 @@ class LdbbDevice {
   double setpoint_n_;
   double state_n_ = 0.0;
   double t_ = 0.0;
+  double travel_m_ = 0.0;  // the TCP's path travel, for the stick-slip
+  double last_dt_s_ = 0.0;
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};
 };

@@ -70,6 +70,9 @@ TrueRobot::TrueRobot(const CellConfig& config, bool sensor_mounted, std::uint64_
   if (!desc.dh.empty()) {
     last_d_m_ = desc.dh.back().d_m;
   }
+  if (desc.dh.size() >= 2) {
+    upper_arm_length_m_ = std::hypot(desc.dh[1].a_m, desc.dh[1].d_m);
+  }
 
   JointMatrix K = JointMatrix::Zero(n, n);
   for (int i = 0; i < n; ++i) {
@@ -93,6 +96,7 @@ TrueRobotState TrueRobot::initial_state(const JointVector& q_cmd) const {
   TrueRobotState s;
   s.q_actual = q_cmd;
   s.q_cmd_last = q_cmd;
+  s.q_motor = q_cmd;
   const auto& lm = config_.robot.lost_motion_rad;
   for (int i = 0; i < true_->dof(); ++i) {
     const auto k = static_cast<std::size_t>(i);
@@ -102,6 +106,7 @@ TrueRobotState TrueRobot::initial_state(const JointVector& q_cmd) const {
     s.lost_motion[k].state = 0.0;
   }
   s.gravity_torque_nm = JointVector::Zero(true_->dof());
+  s.torque_lowpass_nm = JointVector::Zero(true_->dof());
   for (int i = 0; i < true_->dof(); ++i) {
     const auto k = static_cast<std::size_t>(i);
     if (k < config_.robot.gravity_torque_nm.size()) s.gravity_torque_nm[i] = config_.robot.gravity_torque_nm[k];
@@ -129,6 +134,33 @@ Vector3 TrueRobot::structural_displacement(const Workspace& ws, const Wrench& w)
     const Vector3 theta = a.cross(F_perp) * (L * L / (2 * ei)) + M_perp * (L / ei);
     d += delta + theta.cross(p_tcp - p_wc);
   }
+  if (config_.robot.upper_arm_ei_nm2 > 0.0 && ws.dof >= 3 && upper_arm_length_m_ > 0.0) {
+    // Cantilever from joint 2 to the elbow (joint 3's axis): the elbow moves and turns, and carries
+    // everything beyond it.
+    const Vector3 p2 = ws.origin_base[1];
+    const Vector3 p3 = ws.origin_base[2];
+    Vector3 a = p3 - p2;
+    a = a - ws.axis_base[1] * ws.axis_base[1].dot(a);  // along the arm, across joint 2's axis
+    if (a.norm() > 1e-6) {
+      a.normalize();
+      const Vector3 M_el = M + (p_tcp - p3).cross(F);
+      const Vector3 F_perp = F - a * a.dot(F);
+      const Vector3 M_perp = M_el - a * a.dot(M_el);
+      const double L = upper_arm_length_m_;
+      const double ei = config_.robot.upper_arm_ei_nm2;
+      const Vector3 delta = F_perp * (L * L * L / (3 * ei)) + M_perp.cross(a) * (L * L / (2 * ei));
+      const Vector3 theta = a.cross(F_perp) * (L * L / (2 * ei)) + M_perp * (L / ei);
+      d += delta + theta.cross(p_tcp - p3);
+    }
+  }
+  if (config_.robot.base_tilt_compliance_rad_per_nm > 0.0) {
+    // The foundation tilts about the horizontal axes under the moment the process puts on the base
+    // (its turn about z is joint 1's compliance).
+    const Vector3 M_base = M + p_tcp.cross(F);
+    const Vector3 tilt(M_base.x() * config_.robot.base_tilt_compliance_rad_per_nm,
+                       M_base.y() * config_.robot.base_tilt_compliance_rad_per_nm, 0.0);
+    d += tilt.cross(p_tcp);
+  }
   if (sensor_mounted_) {
     const auto& s = config_.sensor;
     const Matrix3& R = ws.base_T_flange.linear();
@@ -143,14 +175,25 @@ Vector3 TrueRobot::structural_displacement(const Workspace& ws, const Wrench& w)
   return d;
 }
 
-Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd, const Wrench& wrench_base,
-                         TrueRobotState& state) const {
+Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd_in, const Wrench& wrench_base,
+                         TrueRobotState& state, double dt_s) const {
   const RobotModel& m = *true_;
   const int n = m.dof();
+  const auto& rc = config_.robot;
   Jacobian J(6, n);
-  JointVector q = state.q_actual + (q_cmd - state.q_cmd_last);
-  jacobian(m, ws, q, EndPoint::kTcp, J);
-  JointVector tau = J.transpose() * wrench_base;
+  // The joints' speed (from the commands) drives the motion effects; the servo's following error
+  // makes the motor lag its command by servo_following_s of that speed.
+  JointVector speed = JointVector::Zero(n);
+  if (dt_s > 0.0) speed = (q_cmd_in - state.q_cmd_last) / dt_s;
+  const JointVector q_cmd = q_cmd_in - rc.servo_following_s * speed;
+  JointVector q = state.q_actual + (q_cmd_in - state.q_cmd_last);
+  // No process wrench (the unloaded runs): no process torque, so no Jacobian to find it with.
+  const bool loaded = !wrench_base.isZero(0.0);
+  JointVector tau = JointVector::Zero(n);
+  if (loaded) {
+    jacobian(m, ws, q, EndPoint::kTcp, J);
+    tau = J.transpose() * wrench_base;
+  }
   JointVector lost(n);
   JointVector tau_eff(n);
   // The gears deflect along their hardening curves from the gravity preload (linear when off).
@@ -166,20 +209,50 @@ Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd, const Wrench& 
   for (int i = 0; i < n; ++i) {
     lost[i] = state.lost_motion[static_cast<std::size_t>(i)].update(tau[i] + state.gravity_torque_nm[i]);
   }
+  // The process deflection's scale per joint: stiffer when moving, and more yielding with the torque
+  // than against it.
+  JointVector scale = JointVector::Ones(n);
+  if (dt_s > 0.0 && (rc.speed_stiffening != 0.0 || rc.direction_asymmetry != 0.0)) {
+    for (int i = 0; i < n; ++i) {
+      const double u = std::tanh(speed[i] / rc.speed_ref_rad_s);
+      scale[i] = (1.0 - rc.speed_stiffening * std::abs(u)) *
+                 (1.0 + rc.direction_asymmetry * u * (tau[i] > 0.0 ? 1.0 : (tau[i] < 0.0 ? -1.0 : 0.0)));
+    }
+  }
+  // The servo yields to the part of the process torque its integral action has not yet taken over.
+  JointVector servo = JointVector::Zero(n);
+  if (rc.servo_compliance_fraction > 0.0) {
+    if (!state.have_torque_lowpass) {
+      state.torque_lowpass_nm = tau;  // a static start: the integrator holds the present torque
+      state.have_torque_lowpass = true;
+    } else if (dt_s > 0.0) {
+      state.torque_lowpass_nm += (1.0 - std::exp(-dt_s / rc.servo_integral_s)) * (tau - state.torque_lowpass_nm);
+    }
+    for (int i = 0; i < n; ++i) {
+      servo[i] = rc.servo_compliance_fraction * joint_compliance_(i, i) * (tau[i] - state.torque_lowpass_nm[i]);
+    }
+  }
+  // Fixed point q = q_cmd + C tau(q): converged when a step moves no joint by more than 1e-11 rad
+  // (0.03 nm at 3 m). The workspace then holds the kinematics of the last Jacobian's configuration,
+  // which differs from q by less than that, so it is not recomputed.
+  bool ws_current = false;
   for (int it = 0; it < 30; ++it) {
     equivalent(tau);
-    const JointVector q_new = q_cmd + joint_compliance_ * tau_eff + lost;
+    const JointVector q_new = q_cmd + scale.cwiseProduct(joint_compliance_ * tau_eff) + lost + servo;
     const double step = (q_new - q).cwiseAbs().maxCoeff();
     q = q_new;
-    if (step < 1e-12) {
+    if (!loaded) break;  // tau does not depend on q
+    if (step < 1e-11) {
+      ws_current = true;  // the Jacobian before this step was taken at a q within the tolerance
       break;
     }
     jacobian(m, ws, q, EndPoint::kTcp, J);
     tau = J.transpose() * wrench_base;
   }
-  forward_kinematics(m, ws, q);
+  if (!ws_current) forward_kinematics(m, ws, q);
   state.q_actual = q;
-  state.q_cmd_last = q_cmd;
+  state.q_cmd_last = q_cmd_in;
+  state.q_motor = q_cmd;
   return ws.base_T_tcp.translation() + structural_displacement(ws, wrench_base);
 }
 

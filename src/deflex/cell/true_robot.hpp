@@ -1,7 +1,9 @@
 // The simulated cell's true robot: what the compensators never see. IRB6700 kinematics with small
-// seeded DH errors, a true joint stiffness (coupled between joints 2 and 3), forearm bending, the
-// force sensor as an elastic element between flange and end effector, and direction-dependent lost
-// motion. The deflection is solved at the deflected configuration (fixed point).
+// seeded DH errors, a true joint stiffness (coupled between joints 2 and 3) on gears that harden with
+// torque, stiffness that depends on the joints' motion, the servos' following and yielding, forearm
+// and upper-arm bending, the base's tilt, the force sensor as an elastic element between flange and
+// end effector, and direction-dependent lost motion. The deflection is solved at the deflected
+// configuration (fixed point).
 #pragma once
 
 #include <cstdint>
@@ -43,8 +45,11 @@ struct GearHardening {
 struct TrueRobotState {
   JointVector q_actual;    ///< last solved configuration (warm start of the next solve)
   JointVector q_cmd_last;  ///< command of the last solve
+  JointVector q_motor;     ///< the motors' position at the last solve: the command less the following error
   std::array<LostMotion, kMaxJoints> lost_motion{};
   JointVector gravity_torque_nm;  ///< preload of the lost motion (constant)
+  JointVector torque_lowpass_nm;  ///< the servo's integral action: the process torque it has taken over
+  bool have_torque_lowpass = false;
 };
 
 class TrueRobot {
@@ -63,9 +68,11 @@ class TrueRobot {
   [[nodiscard]] TrueRobotState initial_state(const JointVector& q_cmd) const;
 
   /// Solves the configuration the arm takes when commanded to q_cmd under `wrench_base` (N, Nm at the
-  /// TCP, base frame) and returns the TCP position (m, base frame) including the link-bending and
-  /// sensor displacements. Updates the lost motion once per call (one call per servo cycle).
-  Vector3 solve(Workspace& ws, const JointVector& q_cmd, const Wrench& wrench_base, TrueRobotState& state) const;
+  /// TCP, base frame) and returns the TCP position (m, base frame) including the link-bending, base
+  /// and sensor displacements. Updates the lost motion and the servos once per call: one call per servo
+  /// cycle of `dt_s` (0: a static pose, no motion effects).
+  Vector3 solve(Workspace& ws, const JointVector& q_cmd, const Wrench& wrench_base, TrueRobotState& state,
+                double dt_s = 0.0) const;
 
   [[nodiscard]] const CellConfig& config() const { return config_; }
   [[nodiscard]] bool sensor_mounted() const { return sensor_mounted_; }
@@ -83,6 +90,7 @@ class TrueRobot {
   std::array<GearHardening, kMaxJoints> hardening_{};
   bool hardening_on_ = false;
   double last_d_m_ = 0.0;  ///< wrist centre to flange along the flange z axis
+  double upper_arm_length_m_ = 0.0;  ///< joint 2 axis to joint 3 axis
 };
 
 /// Flange to TCP of a setup: end effector, plus the sensor's height when it is mounted.

@@ -50,6 +50,10 @@ double non_negative(const yaml::Field& f) {
   return v;
 }
 
+double non_negative_or(const yaml::Field& parent, const std::string& key, double fallback) {
+  return parent.has(key) ? non_negative(parent.at(key)) : fallback;
+}
+
 std::vector<double> speeds(const yaml::Field& f) {
   std::vector<double> out;
   for (std::size_t i = 0; i < f.size(); ++i) {
@@ -115,7 +119,9 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   c.circle.tcp_orientation.linear() = quat.normalized().toRotationMatrix();
 
   const auto proto = root.at("protocol");
-  proto.only_keys({"laps_cw", "laps_ccw", "speeds_mm_s", "sweep_speeds_mm_s", "sweep_load_N"});
+  proto.only_keys({"laps_cw", "laps_ccw", "speeds_mm_s", "sweep_speeds_mm_s", "sweep_load_N", "seeds"});
+  c.seeds = proto.get("seeds", 1);
+  if (c.seeds < 1 || c.seeds > 1000) proto.at("seeds").fail("must be 1..1000");
   c.laps_cw = proto.get("laps_cw", 3);
   c.laps_ccw = proto.get("laps_ccw", 3);
   if (c.laps_cw < 0 || c.laps_ccw < 0 || c.laps_cw + c.laps_ccw == 0) proto.fail("needs at least one lap");
@@ -164,7 +170,26 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   const auto r = root.at("true_robot");
   r.only_keys({"stiffness_scale", "stiffness_spread_pct", "coupling_23", "forearm_EI_Nm2", "forearm_length_mm",
                "lost_motion_urad", "lost_motion_torque_Nm", "gravity_torque_Nm", "dh_length_sigma_mm",
-               "dh_angle_sigma_deg", "hardening_softening", "hardening_torque_Nm"});
+               "dh_angle_sigma_deg", "hardening_softening", "hardening_torque_Nm", "upper_arm_EI_Nm2",
+               "base_tilt_compliance_nrad_per_Nm", "speed_stiffening_pct", "direction_asymmetry_pct",
+               "speed_ref_mrad_s", "servo_following_ms", "servo_compliance_pct", "servo_integral_s"});
+  {
+    auto& t = c.cell.robot;
+    t.upper_arm_ei_nm2 = non_negative_or(r, "upper_arm_EI_Nm2", 0.0);
+    t.base_tilt_compliance_rad_per_nm = non_negative_or(r, "base_tilt_compliance_nrad_per_Nm", 0.0) * 1e-9;
+    t.speed_stiffening = non_negative_or(r, "speed_stiffening_pct", 0.0) / 100.0;
+    if (t.speed_stiffening > 0.5) r.at("speed_stiffening_pct").fail("must be within 0..50 %");
+    t.direction_asymmetry = non_negative_or(r, "direction_asymmetry_pct", 0.0) / 100.0;
+    if (t.direction_asymmetry > 0.5) r.at("direction_asymmetry_pct").fail("must be within 0..50 %");
+    t.speed_ref_rad_s = non_negative_or(r, "speed_ref_mrad_s", 10.0) * kMm;
+    if (!(t.speed_ref_rad_s > 0.0)) r.at("speed_ref_mrad_s").fail("must be positive");
+    t.servo_following_s = non_negative_or(r, "servo_following_ms", 0.0) * kMm;
+    if (t.servo_following_s > 0.1) r.at("servo_following_ms").fail("must be within 0..100 ms");
+    t.servo_compliance_fraction = non_negative_or(r, "servo_compliance_pct", 0.0) / 100.0;
+    if (t.servo_compliance_fraction > 1.0) r.at("servo_compliance_pct").fail("must be within 0..100 %");
+    t.servo_integral_s = non_negative_or(r, "servo_integral_s", 0.1);
+    if (!(t.servo_integral_s > 0.0)) r.at("servo_integral_s").fail("must be positive");
+  }
   c.cell.robot.stiffness_scale = positive(r.at("stiffness_scale"));
   c.cell.robot.stiffness_spread = non_negative(r.at("stiffness_spread_pct")) / 100.0;
   c.cell.robot.coupling_23 = r.at("coupling_23").as_double();
@@ -206,7 +231,9 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   s.only_keys({"height_mm", "lateral_compliance_um_per_N", "axial_compliance_um_per_N",
                "rotational_compliance_urad_per_Nm", "crosstalk_pct", "crosstalk_calibration_residual_pct", "noise_N",
                "bias_N", "rate_Hz", "gravity_mass_error_pct", "sensitivity_error_pct", "misalignment_deg",
-               "daq_latency_ms"});
+               "daq_latency_ms", "zero_drift_N_per_10min"});
+  c.cell.sensor.zero_drift_n = non_negative_or(s, "zero_drift_N_per_10min", 0.0);
+  if (c.cell.sensor.zero_drift_n > 50.0) s.at("zero_drift_N_per_10min").fail("must be within 0..50 N");
   c.cell.sensor.height_m = non_negative(s.at("height_mm")) * kMm;
   c.cell.sensor.lateral_compliance_m_per_n = non_negative(s.at("lateral_compliance_um_per_N")) * kUm;
   c.cell.sensor.axial_compliance_m_per_n = non_negative(s.at("axial_compliance_um_per_N")) * kUm;
@@ -229,7 +256,14 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
 
   const auto l = root.at("ldbb");
   l.only_keys({"bar_length_mm", "inclination_deg", "push", "time_constant_s", "ripple_pct", "ripple_Hz", "noise_pct",
-               "force_bias_pct", "pivot_error_mm", "ball_friction", "ball_radius_mm", "settle_s"});
+               "force_bias_pct", "force_bias_recalibrated_pct", "pivot_error_mm", "ball_friction", "ball_radius_mm",
+               "settle_s", "stick_slip_pct", "stick_slip_travel_mm"});
+  c.cell.ldbb.force_bias_recalibrated = l.get("force_bias_recalibrated_pct", 0.0) / 100.0;
+  if (std::abs(c.cell.ldbb.force_bias_recalibrated) >= 0.5) l.at("force_bias_recalibrated_pct").fail("must be within +-50 %");
+  c.cell.ldbb.stick_slip = non_negative_or(l, "stick_slip_pct", 0.0) / 100.0;
+  if (c.cell.ldbb.stick_slip > 0.2) l.at("stick_slip_pct").fail("must be within 0..20 %");
+  c.cell.ldbb.stick_slip_travel_m = non_negative_or(l, "stick_slip_travel_mm", 0.5) * kMm;
+  if (!(c.cell.ldbb.stick_slip_travel_m > 0.0)) l.at("stick_slip_travel_mm").fail("must be positive");
   c.cell.ldbb.bar_length_m = positive(l.at("bar_length_mm")) * kMm;
   c.cell.ldbb.inclination_rad = deg_to_rad(l.at("inclination_deg").as_double());
   if (std::abs(c.cell.ldbb.inclination_rad) >= deg_to_rad(89.0)) l.at("inclination_deg").fail("must be within +-89 deg");
@@ -288,17 +322,31 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   c.online.ramp_in_s = non_negative(on.at("ramp_in_s"));
 
   const auto cal = root.at("calibration");
-  cal.only_keys({"poses", "load_N", "load_error_pct", "samples"});
-  c.calibration.poses = cal.at("poses").as_int();
-  if (c.calibration.poses < 2) cal.at("poses").fail("needs at least 2 poses");
+  cal.only_keys({"arcs", "arc_deg", "speed_mm_s", "load_N", "points_per_arc", "window_ms", "ldbb_force_error_pct"});
+  c.calibration.arcs = cal.at("arcs").as_int();
+  if (c.calibration.arcs < 3 || c.calibration.arcs > 60) cal.at("arcs").fail("must be 3..60");
+  c.calibration.arc_rad = deg_to_rad(positive(cal.at("arc_deg")));
+  if (c.calibration.arc_rad > 2.0 * kPi) cal.at("arc_deg").fail("must be at most 360 deg");
+  c.calibration.speed_m_s = positive(cal.at("speed_mm_s")) * kMm;
+  if (c.calibration.speed_m_s > 0.5) cal.at("speed_mm_s").fail("must be at most 500 mm/s (quasi-static)");
   c.calibration.load_n = positive(cal.at("load_N"));
-  c.calibration.load_error = non_negative(cal.at("load_error_pct")) / 100.0;
-  c.calibration.samples = cal.at("samples").as_int();
-  if (c.calibration.samples < 1) cal.at("samples").fail("must be at least 1");
+  if (c.calibration.load_n > 5000.0) cal.at("load_N").fail("must be at most 5000 N");
+  c.calibration.points_per_arc = cal.at("points_per_arc").as_int();
+  if (c.calibration.points_per_arc < 2 || c.calibration.points_per_arc > 1000)
+    cal.at("points_per_arc").fail("must be 2..1000");
+  c.calibration.window_s = positive(cal.at("window_ms")) * kMm;
+  c.calibration.ldbb_force_error = non_negative(cal.at("ldbb_force_error_pct")) / 100.0;
+  if (c.calibration.ldbb_force_error > 0.5) cal.at("ldbb_force_error_pct").fail("must be within 0..50 %");
 
   if (root.has("drift")) {
     const auto d = root.at("drift");
-    d.only_keys({"offset_um", "rotation_urad", "wander_um", "wander_time_s"});
+    d.only_keys({"offset_um", "offset_time_s", "rotation_urad", "wander_um", "wander_time_s", "load_offset_um",
+                 "load_reference_N"});
+    c.cell.drift.load_offset_m = non_negative_or(d, "load_offset_um", 0.0) * kUm;
+    c.cell.drift.load_reference_n = non_negative_or(d, "load_reference_N", 650.0);
+    if (!(c.cell.drift.load_reference_n > 0.0)) d.at("load_reference_N").fail("must be positive");
+    c.cell.drift.offset_time_s = d.get("offset_time_s", 1200.0);
+    if (!(c.cell.drift.offset_time_s > 0.0)) d.at("offset_time_s").fail("must be positive");
     c.cell.drift.offset_m = non_negative(d.at("offset_um")) * kUm;
     c.cell.drift.rotation_rad = non_negative(d.at("rotation_urad")) * kUm;
     c.cell.drift.wander_m = non_negative(d.at("wander_um")) * kUm;
@@ -307,11 +355,9 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
 
   if (root.has("error_budget")) {
     const auto b = root.at("error_budget");
-    b.only_keys({"speed_mm_s", "load_index", "laps_each_way"});
+    b.only_keys({"speed_mm_s", "load_index"});
     c.budget.speed_m_s = positive(b.at("speed_mm_s")) * kMm;
     c.budget.load_index = b.at("load_index").as_int();
-    c.budget.laps_each_way = b.at("laps_each_way").as_int();
-    if (c.budget.laps_each_way < 1) b.at("laps_each_way").fail("must be at least 1");
     for (const auto& sc : c.setups) {
       if (c.budget.load_index < 0 || c.budget.load_index >= static_cast<int>(sc.loads_n.size())) {
         b.at("load_index").fail(fmt::format("out of range for setup '{}'", sc.name));
@@ -350,7 +396,7 @@ const char* to_string(Effect e) {
     case Effect::kJointCoupling:
       return "coupled stiffness of joints 2-3";
     case Effect::kLinkBending:
-      return "forearm bending (link compliance)";
+      return "forearm and upper arm bending (link compliance)";
     case Effect::kSensorCompliance:
       return "force sensor compliance";
     case Effect::kLostMotion:
@@ -375,6 +421,18 @@ const char* to_string(Effect e) {
       return "torque-dependent gear stiffness";
     case Effect::kSensorCalibration:
       return "sensor sensitivity error, misalignment";
+    case Effect::kBaseCompliance:
+      return "foundation and base tilt";
+    case Effect::kMotionStiffness:
+      return "speed- and direction-dependent stiffness";
+    case Effect::kServo:
+      return "servo following error and yield";
+    case Effect::kSensorDrift:
+      return "force sensor zero drift";
+    case Effect::kThermalLoadDrift:
+      return "thermal drift of a loaded run";
+    case Effect::kLdbbStickSlip:
+      return "LDBB seal stick-slip";
   }
   return "?";
 }
@@ -386,7 +444,8 @@ std::string effect_size(const CaseConfig& c, Effect e) {
     case Effect::kJointCoupling:
       return fmt::format("k23 coupling {:.2f}", c.cell.robot.coupling_23);
     case Effect::kLinkBending:
-      return fmt::format("EI {:.2g} Nm^2", c.cell.robot.forearm_ei_nm2);
+      return fmt::format("EI forearm {:.2g}, upper arm {:.2g} Nm^2", c.cell.robot.forearm_ei_nm2,
+                         c.cell.robot.upper_arm_ei_nm2);
     case Effect::kSensorCompliance:
       return fmt::format("{:.2f} um/N lateral, {:.2f} urad/Nm", c.cell.sensor.lateral_compliance_m_per_n * 1e6,
                          c.cell.sensor.rotational_compliance_rad_per_nm * 1e6);
@@ -399,7 +458,8 @@ std::string effect_size(const CaseConfig& c, Effect e) {
       return fmt::format("{:.2f} mm, {:.3f} deg (1 sigma)", c.cell.robot.dh_length_sigma_m * 1e3,
                          rad_to_deg(c.cell.robot.dh_angle_sigma_rad));
     case Effect::kLdbbForceError:
-      return fmt::format("{:+.0f} %, pivot {:.1f} mm, friction {:.2f}", c.cell.ldbb.force_bias * 100,
+      return fmt::format("{:+.0f} % ({:+.0f} % recalibrated), pivot {:.1f} mm, friction {:.2f}",
+                         c.cell.ldbb.force_bias * 100, c.cell.ldbb.force_bias_recalibrated * 100,
                          c.cell.ldbb.pivot_error_m.norm() * 1e3, c.cell.ldbb.ball_friction);
     case Effect::kLdbbRipple:
       return fmt::format("{:.1f} % at {:.1f} Hz", c.cell.ldbb.ripple * 100, c.cell.ldbb.ripple_hz);
@@ -408,7 +468,7 @@ std::string effect_size(const CaseConfig& c, Effect e) {
     case Effect::kTrackerNoise:
       return fmt::format("{:.1f} um (1 sigma)", c.cell.tracker.noise_m * 1e6);
     case Effect::kCalibrationNoise:
-      return fmt::format("{:.1f} % load error", c.calibration.load_error * 100);
+      return fmt::format("LDBB force {:.1f} % at calibration", c.calibration.ldbb_force_error * 100);
     case Effect::kLatency:
       return fmt::format("dead time {:.0f} ms, filter {:.0f} Hz", c.cell.controller.egm_dead_time_s * 1e3,
                          c.cell.controller.egm_lowpass_hz);
@@ -423,6 +483,22 @@ std::string effect_size(const CaseConfig& c, Effect e) {
     case Effect::kSensorCalibration:
       return fmt::format("{:.1f} % sensitivity, {:.2f} deg", c.cell.sensor.sensitivity_error * 100,
                          rad_to_deg(c.cell.sensor.misalignment_rad));
+    case Effect::kBaseCompliance:
+      return fmt::format("{:.2f} nrad/Nm", c.cell.robot.base_tilt_compliance_rad_per_nm * 1e9);
+    case Effect::kMotionStiffness:
+      return fmt::format("{:.0f} % stiffer moving, {:.0f} % direction asymmetry", c.cell.robot.speed_stiffening * 100,
+                         c.cell.robot.direction_asymmetry * 100);
+    case Effect::kServo:
+      return fmt::format("following {:.0f} ms, yield {:.0f} % for {:.2f} s", c.cell.robot.servo_following_s * 1e3,
+                         c.cell.robot.servo_compliance_fraction * 100, c.cell.robot.servo_integral_s);
+    case Effect::kSensorDrift:
+      return fmt::format("{:.2f} N per 10 min (1 sigma)", c.cell.sensor.zero_drift_n);
+    case Effect::kThermalLoadDrift:
+      return fmt::format("{:.0f} um at {:.0f} N (1 sigma)", c.cell.drift.load_offset_m * 1e6,
+                         c.cell.drift.load_reference_n);
+    case Effect::kLdbbStickSlip:
+      return fmt::format("{:.1f} % per {:.1f} mm of travel", c.cell.ldbb.stick_slip * 100,
+                         c.cell.ldbb.stick_slip_travel_m * 1e3);
   }
   return "";
 }
@@ -440,6 +516,7 @@ CaseConfig without_effect(const CaseConfig& config, Effect e) {
       break;
     case Effect::kLinkBending:
       c.cell.robot.forearm_ei_nm2 = 0.0;
+      c.cell.robot.upper_arm_ei_nm2 = 0.0;
       break;
     case Effect::kSensorCompliance:
       c.cell.sensor.lateral_compliance_m_per_n = 0.0;
@@ -455,6 +532,7 @@ CaseConfig without_effect(const CaseConfig& config, Effect e) {
       break;
     case Effect::kLdbbForceError:
       c.cell.ldbb.force_bias = 0.0;
+      c.cell.ldbb.force_bias_recalibrated = 0.0;
       c.cell.ldbb.pivot_error_m.setZero();
       c.cell.ldbb.ball_friction = 0.0;
       break;
@@ -473,7 +551,7 @@ CaseConfig without_effect(const CaseConfig& config, Effect e) {
       c.cell.tracker.noise_m = 0.0;
       break;
     case Effect::kCalibrationNoise:
-      c.calibration.load_error = 0.0;
+      c.calibration.ldbb_force_error = 0.0;
       break;
     case Effect::kLatency:
       c.cell.controller.network_latency_s = 0.0;
@@ -494,6 +572,26 @@ CaseConfig without_effect(const CaseConfig& config, Effect e) {
     case Effect::kSensorCalibration:
       c.cell.sensor.sensitivity_error = 0.0;
       c.cell.sensor.misalignment_rad = 0.0;
+      break;
+    case Effect::kBaseCompliance:
+      c.cell.robot.base_tilt_compliance_rad_per_nm = 0.0;
+      break;
+    case Effect::kMotionStiffness:
+      c.cell.robot.speed_stiffening = 0.0;
+      c.cell.robot.direction_asymmetry = 0.0;
+      break;
+    case Effect::kServo:
+      c.cell.robot.servo_following_s = 0.0;
+      c.cell.robot.servo_compliance_fraction = 0.0;
+      break;
+    case Effect::kSensorDrift:
+      c.cell.sensor.zero_drift_n = 0.0;
+      break;
+    case Effect::kThermalLoadDrift:
+      c.cell.drift.load_offset_m = 0.0;
+      break;
+    case Effect::kLdbbStickSlip:
+      c.cell.ldbb.stick_slip = 0.0;
       break;
   }
   return c;

@@ -55,11 +55,19 @@ struct OnlineSettings {
   double ramp_in_s = 1.0;
 };
 
+/// The quasi-static calibration while moving (the paper's, after Theissen et al.): arcs in the
+/// operating space (not the test circle), each run unloaded and then loaded by the LDBB, the deflection
+/// measured by the tracker time-synchronously between the two passes.
 struct CalibrationConfig {
-  int poses = 12;           ///< around the circle
-  double load_n = 500.0;    ///< in +-x, +-y, +-z of the base
-  double load_error = 0.0;  ///< relative 1-sigma of the applied calibration load
-  int samples = 1000;       ///< tracker samples averaged per measurement
+  int arcs = 6;                   ///< calibration arcs (each at its own height, radius and bar direction)
+  double arc_rad = 2.6;           ///< the angle each arc sweeps (150 deg)
+  double speed_m_s = 0.02;        ///< TCP speed along the arcs (quasi-static)
+  double load_n = 500.0;          ///< LDBB set-point during the loaded passes
+  int points_per_arc = 15;        ///< measurements along each arc
+  double window_s = 0.2;          ///< tracker samples averaged per measurement (time-synchronous)
+  /// The LDBB's force against its set-point at calibration time, relative 1-sigma, drawn per seed: a
+  /// setup without the force sensor knows only the set-point (a setup with it measures the force).
+  double ldbb_force_error = 0.0;
 };
 
 struct CircleConfig {
@@ -68,16 +76,20 @@ struct CircleConfig {
   int points = 81;                          ///< configurations of the programmed circle (paper: 81)
 };
 
+/// The error budget runs at one speed and load of the tables, on the study's first seed, with the
+/// protocol's laps: its "every effect" figure is the table's own run.
 struct BudgetConfig {
   double speed_m_s = 0.05;
   int load_index = 2;
-  int laps_each_way = 1;
 };
 
 struct CaseConfig {
   std::string name;
   std::string source = "<memory>";
   std::uint64_t seed = 1;
+  /// Seeds the study runs (seed, seed + 1, ...): each its own cell (true robot, sensor, calibration)
+  /// and its own runs; the tables give the mean and spread over them.
+  int seeds = 1;
   CircleConfig circle;
   int laps_cw = 3;
   int laps_ccw = 3;
@@ -123,12 +135,20 @@ enum class Effect {
   kPathDrift,          ///< run-to-run drift and path repeatability
   kGearHardening,      ///< torque-dependent gear stiffness
   kSensorCalibration,  ///< sensitivity error and mounting misalignment unknown to the user
+  kBaseCompliance,     ///< foundation and base tilt under the process moment
+  kMotionStiffness,    ///< stiffness that depends on the joints' speed and direction of motion
+  kServo,              ///< the drives' following error and their yielding to a changing torque
+  kSensorDrift,        ///< the force sensor's zero drifting after the tare
+  kThermalLoadDrift,   ///< the extra warming of a loaded run
+  kLdbbStickSlip,      ///< the cylinder seal's stick-slip
 };
-inline constexpr std::array<Effect, 15> kAllEffects = {
+inline constexpr std::array<Effect, 21> kAllEffects = {
     Effect::kStiffnessMismatch, Effect::kJointCoupling,   Effect::kLinkBending,      Effect::kSensorCompliance,
     Effect::kLostMotion,        Effect::kKinematicErrors, Effect::kLdbbForceError,   Effect::kLdbbRipple,
     Effect::kSensorErrors,      Effect::kTrackerNoise,    Effect::kCalibrationNoise, Effect::kLatency,
-    Effect::kPathDrift,         Effect::kGearHardening,   Effect::kSensorCalibration};
+    Effect::kPathDrift,         Effect::kGearHardening,   Effect::kSensorCalibration, Effect::kBaseCompliance,
+    Effect::kMotionStiffness,   Effect::kServo,           Effect::kSensorDrift,      Effect::kThermalLoadDrift,
+    Effect::kLdbbStickSlip};
 [[nodiscard]] const char* to_string(Effect e);
 /// Short description of the effect's size in `config` (for the error budget table).
 [[nodiscard]] std::string effect_size(const CaseConfig& config, Effect e);

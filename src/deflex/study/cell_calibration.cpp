@@ -1,15 +1,61 @@
-// Compliance calibration on the simulated cell (see cell_calibration.hpp).
+// The compliance calibration experiment on the simulated cell (see cell_calibration.hpp).
 #include "deflex/study/cell_calibration.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 
-#include "deflex/identify/calibration_planner.hpp"
+#include "deflex/cell/force_sensor.hpp"
+#include "deflex/cell/laser_tracker.hpp"
+#include "deflex/cell/ldbb_device.hpp"
+#include "deflex/cell/path_drift.hpp"
+#include "deflex/model/errors.hpp"
+#include "deflex/online/force_pipeline.hpp"
+#include "deflex/paths/circle_path.hpp"
+#include "deflex/paths/joint_trajectory.hpp"
+#include "deflex/paths/path_ik.hpp"
+#include "deflex/study/simulated_run.hpp"
 
 namespace deflex::study {
+namespace {
+
+std::uint64_t mix(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+// One calibration arc: the LDBB's bar inclination (which sets the arc's radius, r = L cos phi, and
+// the force's vertical part), the arc's height above the test circle, push or pull, and where it
+// starts. Six of them span the operating space and the force directions; more repeat the pattern
+// with turned starts.
+struct Arc {
+  double phi_rad;
+  double dz_m;
+  bool push;
+  double start_rad;
+};
+
+Arc arc_of(int k) {
+  static const Arc kArcs[6] = {{deg_to_rad(15), 0.05, true, 0.0},           {deg_to_rad(15), -0.05, false, 2.1},
+                               {deg_to_rad(50), 0.05, false, 4.2},          {deg_to_rad(50), -0.05, true, 1.0},
+                               {deg_to_rad(-30), 0.0, true, 3.1},           {deg_to_rad(-30), 0.03, false, 5.2}};
+  Arc a = kArcs[k % 6];
+  a.start_rad += 0.37 * (k / 6);
+  return a;
+}
+
+struct Pass {
+  TrackerTrace trace;
+  std::vector<double> force_t;      // times of the conditioned force samples (sensor mounted)
+  std::vector<Vector3> force_base;  // the conditioned process force, base frame at the WAP
+};
+
+}  // namespace
 
 CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robot, std::uint64_t seed) {
   const RobotModel& nominal = robot.nominal_model();
@@ -21,36 +67,152 @@ CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robo
                            0,
                            {"exact stiffness given: model-consistent cell"}};
   }
-  CalibrationPlanOptions plan_options;
-  const double r = c.radius_m();
-  plan_options.region_min_m = c.circle.center_m - Vector3(r, r, 0.1);
-  plan_options.region_max_m = c.circle.center_m + Vector3(r, r, 0.1);
-  plan_options.load_n = c.calibration.load_n;
-  plan_options.poses = c.calibration.poses;
-  plan_options.orientation = Eigen::Quaterniond(c.circle.tcp_orientation.linear());
-  // The planner predicts standard errors from the noise; a noiseless cell still needs a positive one.
-  plan_options.noise_m = std::max(1e-9, c.cell.tracker.noise_m / std::sqrt(static_cast<double>(c.calibration.samples)));
-  const CalibrationPlan plan = plan_calibration(nominal, plan_options);
-
+  const cell::CellConfig& cc = c.cell;
+  const CalibrationConfig& cal = c.calibration;
+  const bool sensor_mounted = robot.sensor_mounted();
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
+  // The LDBB's force against its set-point today (the setup without the sensor knows only the
+  // set-point; with the sensor the force is measured and this does not enter the estimate).
+  cell::LdbbConfig ldbb_config = cc.ldbb;
+  ldbb_config.force_bias = cal.ldbb_force_error * normal(rng);
+  // The sensor and what its sheet says (the same physical sensor as in the runs).
+  cell::ForceSensorDaq sensor(cc.sensor, cc.tool, mix(seed ^ 0x5e5ULL), mix(c.seed ^ 0x5e5503ULL));
+  const deflex::SensorConfig sheet = sensor_config_from_sheet(c, sensor.calibration());
+  const Pose sensor_T_wap = sheet.flange_T_sensor.inverse() * nominal.flange_T_wap();
+
   Workspace ws(robot.true_model());
-  const double tracker_sigma = c.cell.tracker.noise_m / std::sqrt(static_cast<double>(c.calibration.samples));
+  Workspace ws_nominal(nominal);
+  cell::TrueRobotState state;
+  bool have_state = false;
   std::vector<StiffnessMeasurement> data;
-  for (const CalibrationPoint& pt : plan.points) {
-    // Unloaded, then loaded, from the same lost-motion state: what a tracker sees as the load goes on.
-    cell::TrueRobotState state = robot.initial_state(pt.q);
-    const Vector3 p0 = robot.solve(ws, pt.q, Wrench::Zero(), state);
-    const Vector3 p1 = robot.solve(ws, pt.q, pt.wrench_base, state);
-    StiffnessMeasurement m;
-    m.q = pt.q;
-    // The load cell reading of the calibration rig carries its own error.
-    m.wrench_base = pt.wrench_base * (1.0 + c.calibration.load_error * normal(rng));
-    m.dp_m = p1 - p0 + tracker_sigma * Vector3(normal(rng), normal(rng), normal(rng)) * std::sqrt(2.0);
-    data.push_back(m);
+  const double dt = cc.controller.servo_period_s;
+  const double hold_s = std::max(1.5, 5.0 * cc.ldbb.time_constant_s);
+  JointVector seed_q(6);
+  seed_q << 0.0, deg_to_rad(20.0), deg_to_rad(10.0), 0.0, deg_to_rad(60.0), 0.0;
+
+  for (int k = 0; k < cal.arcs; ++k) {
+    const Arc arc = arc_of(k);
+    const double radius = cc.ldbb.bar_length_m * std::cos(arc.phi_rad);
+    const Vector3 centre = c.circle.center_m + Vector3(0, 0, arc.dz_m);
+    const Vector3 pivot = centre - Vector3::UnitZ() * (cc.ldbb.bar_length_m * std::sin(arc.phi_rad));
+    // The arc's program: poses every ~2 deg at the calibration speed, after a hold for the force.
+    const int n = std::max(8, static_cast<int>(std::ceil(cal.arc_rad / deg_to_rad(2.0)))) + 1;
+    std::vector<Pose> poses;
+    for (int i = 0; i < n; ++i) {
+      const double a = arc.start_rad + cal.arc_rad * i / (n - 1);
+      Pose p = c.circle.tcp_orientation;
+      p.translation() = centre + radius * Vector3(std::cos(a), std::sin(a), 0.0);
+      poses.push_back(p);
+    }
+    IkRequest first;
+    if (nominal.dof() == 6) first.seed = have_state ? state.q_actual : seed_q;
+    const JointPath path = solve_path_ik(nominal, poses, first);
+    const JointTrajectory program = trajectory_at_tcp_speed(poses, path.q, cal.speed_m_s, nominal, hold_s);
+
+    // Two passes over the same program: unloaded, then loaded. Each is its own run (its own drift),
+    // and the joints' lost motion carries on from whatever came before (nothing resets it).
+    Pass passes[2];
+    std::optional<cell::PathDrift> unloaded_drift;
+    for (int loaded = 0; loaded < 2; ++loaded) {
+      const std::uint64_t pass_seed = mix(seed ^ (static_cast<std::uint64_t>(k) * 2 + loaded + 1) * 0x9e37ULL);
+      cell::LdbbConfig bar = ldbb_config;
+      bar.push = arc.push;
+      cell::LdbbDevice device(bar, pivot, loaded ? cal.load_n : 0.0, mix(pass_seed ^ 1));
+      // The loaded pass follows the unloaded one a pass later: its thermal drift has hardly moved.
+      cell::PathDrift drift = loaded ? cell::PathDrift(cc.drift, mix(pass_seed ^ 2), *unloaded_drift,
+                                                       program.end_time_s(), cal.load_n)
+                                     : cell::PathDrift(cc.drift, mix(pass_seed ^ 2));
+      if (!loaded) unloaded_drift.emplace(drift);
+      cell::LaserTracker tracker(cc.tracker, mix(pass_seed ^ 3), hold_s, program.end_time_s(), 0.0);
+      ForcePipeline pipeline(sheet, sensor_T_wap);
+      JointVector q = program.points().front();
+      if (!have_state) {
+        state = robot.initial_state(q);
+        have_state = true;
+      } else {
+        state.q_actual = q;  // the arm moved here unloaded: only the lost motion remembers
+        state.q_cmd_last = q;
+      }
+      Vector3 p_prev = drift.apply(robot.solve(ws, q, Wrench::Zero(), state));
+      Vector3 v_prev = Vector3::Zero();
+      const auto ticks = static_cast<long>(std::ceil(program.end_time_s() / dt));
+      double next_sample = 1.0 / cc.sensor.rate_hz;
+      for (long i = 1; i <= ticks; ++i) {
+        const double t = static_cast<double>(i) * dt;
+        program.sample(t, q);
+        Wrench w = Wrench::Zero();
+        if (loaded) {
+          device.advance(dt);
+          w = device.wrench(p_prev, v_prev);
+        }
+        drift.advance(dt);
+        const Vector3 p = drift.apply(robot.solve(ws, q, w, state, dt));
+        if (sensor_mounted && loaded) {
+          const Matrix3 base_R_flange = ws.base_T_flange.linear();
+          forward_kinematics(nominal, ws_nominal, q);  // the orientation deflex knows (nominal, encoders)
+          const Matrix3 base_R_sensor = ws_nominal.base_T_flange.linear() * sheet.flange_T_sensor.linear();
+          for (; next_sample <= t + 1e-12; next_sample += 1.0 / cc.sensor.rate_hz) {
+            ForceSample fs;
+            fs.t_s = next_sample;
+            fs.wrench_sensor.head<3>() = sensor.sample(w.head<3>(), base_R_flange, next_sample);
+            const ConditionedWrench cw = pipeline.step(fs, base_R_sensor);
+            if (static_cast<int>(cw.status) >= 0) {
+              passes[loaded].force_t.push_back(next_sample);
+              passes[loaded].force_base.push_back(cw.wrench_base.head<3>());
+            }
+          }
+        }
+        tracker.observe(t - dt, p_prev, t, p, passes[loaded].trace);
+        v_prev = (p - p_prev) / dt;
+        p_prev = p;
+      }
+    }
+
+    // Measurements: at points along the arc, the mean of the tracker samples in a window, loaded
+    // minus unloaded at the same times (both passes ran the same program).
+    const double motion_s = program.end_time_s() - hold_s;
+    for (int j = 0; j < cal.points_per_arc; ++j) {
+      const double tj = hold_s + motion_s * (j + 0.5) / cal.points_per_arc;
+      Vector3 sum[2] = {Vector3::Zero(), Vector3::Zero()};
+      int count[2] = {0, 0};
+      for (int pass = 0; pass < 2; ++pass) {
+        for (const auto& s : passes[pass].trace) {
+          if (std::abs(s.t_s - tj) <= 0.5 * cal.window_s) {
+            sum[pass] += s.p_m;
+            ++count[pass];
+          }
+        }
+      }
+      if (count[0] == 0 || count[1] == 0) continue;
+      StiffnessMeasurement m;
+      program.sample(tj, m.q);  // the encoders' reading: the commanded joints
+      m.dp_m = sum[1] / count[1] - sum[0] / count[0];
+      m.wrench_base = Wrench::Zero();
+      if (sensor_mounted) {
+        Vector3 f = Vector3::Zero();
+        int nf = 0;
+        for (std::size_t i = 0; i < passes[1].force_t.size(); ++i) {
+          if (std::abs(passes[1].force_t[i] - tj) <= 0.5 * cal.window_s) {
+            f += passes[1].force_base[i];
+            ++nf;
+          }
+        }
+        if (nf == 0) continue;
+        m.wrench_base.head<3>() = f / nf;
+      } else {
+        // The set-point along the bar as the user places it: nominal pivot, nominal TCP.
+        const Vector3 tcp = tcp_pose(nominal, ws_nominal, m.q).translation();
+        m.wrench_base.head<3>() = (arc.push ? cal.load_n : -cal.load_n) * (tcp - pivot).normalized();
+      }
+      data.push_back(m);
+    }
   }
-  // Plain least squares: the cell's misfit is systematic (sensor compliance, lost motion), not
-  // gross outliers, and a robust re-weighting would throw good measurements away for it.
+  if (data.size() < 6) {
+    throw InputError("calibration: fewer than 6 measurements (check the calibration section of the case)");
+  }
+  // Plain least squares: the misfit is systematic (sensor compliance, lost motion, drift), not gross
+  // outliers, and a robust re-weighting would throw good measurements away for it.
   IdentificationOptions id_options;
   id_options.robust = false;
   CellCalibration out{nominal, identify_stiffness(nominal, data, id_options), static_cast<int>(data.size()), {}};
@@ -68,8 +230,8 @@ CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robo
     out.notes.push_back(w);
   }
   out.identified = nominal.with_stiffness(
-      k, fmt::format("identified on the simulated cell ({} measurements, residual {:.1f} um RMS)", data.size(),
-                     out.estimate.residual_rms_m * 1e6));
+      k, fmt::format("identified on the simulated cell while moving ({} measurements on {} arcs, residual {:.1f} um RMS)",
+                     data.size(), cal.arcs, out.estimate.residual_rms_m * 1e6));
   return out;
 }
 

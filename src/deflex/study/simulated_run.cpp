@@ -121,6 +121,24 @@ std::vector<JointVector> offline_configurations(const CaseConfig& config, const 
   return q;
 }
 
+deflex::SensorConfig sensor_config_from_sheet(const CaseConfig& config, const cell::SensorCalibration& sheet) {
+  deflex::SensorConfig sc;
+  sc.name = "MSC10-class 3-component sensor (calibration sheet)";
+  sc.components = 3;
+  sc.crosstalk.topLeftCorner<3, 3>() = sheet.decoupling;
+  sc.flange_T_sensor = Pose::Identity();
+  sc.flange_T_sensor.translation() = Vector3(0, 0, config.cell.sensor.height_m);
+  sc.payload_mass_kg = sheet.ee_mass_kg;
+  sc.payload_cog_sensor_m = sheet.ee_cog_m;
+  sc.bias_sensor.head<3>() = sheet.bias_n;
+  sc.gravity_base_m_s2 = Vector3(0, 0, -cell::kGravity);
+  sc.lowpass_cutoff_hz = config.online.lowpass_hz;
+  sc.sample_rate_hz = config.cell.sensor.rate_hz;
+  sc.dead_band_N = config.online.dead_band_n;
+  sc.fault_threshold_N = config.online.fault_threshold_n;
+  return sc;
+}
+
 RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const RunSpec& spec) {
   const cell::TrueRobot& robot = *setup.robot;
   const cell::CellConfig& c = config.cell;
@@ -177,20 +195,7 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
   std::unique_ptr<DatagramForceSource> force_source;
   std::unique_ptr<ControllerLink> link;
   if (linked) {
-    deflex::SensorConfig sc;
-    sc.name = "MSC10-class 3-component sensor (calibration sheet)";
-    sc.components = 3;
-    sc.crosstalk.topLeftCorner<3, 3>() = sensor.calibration().decoupling;
-    sc.flange_T_sensor = Pose::Identity();
-    sc.flange_T_sensor.translation() = Vector3(0, 0, c.sensor.height_m);
-    sc.payload_mass_kg = sensor.calibration().ee_mass_kg;
-    sc.payload_cog_sensor_m = sensor.calibration().ee_cog_m;
-    sc.bias_sensor.head<3>() = sensor.calibration().bias_n;
-    sc.gravity_base_m_s2 = Vector3(0, 0, -cell::kGravity);
-    sc.lowpass_cutoff_hz = config.online.lowpass_hz;
-    sc.sample_rate_hz = c.sensor.rate_hz;
-    sc.dead_band_N = config.online.dead_band_n;
-    sc.fault_threshold_N = config.online.fault_threshold_n;
+    const deflex::SensorConfig sc = sensor_config_from_sheet(config, sensor.calibration());
     deflex::OnlineConfig oc;
     oc.period_s = spec.link == LinkKind::kEgmPath ? c.controller.path_corr_period_s : c.controller.egm_period_s;
     oc.max_joint_correction_rad = config.online.max_joint_correction_rad;
@@ -230,8 +235,12 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
   const double run_end_s = motion_end_s + (linked ? 0.5 : 0.0);
   const double dt = c.controller.servo_period_s;
   const auto ticks = static_cast<long>(std::ceil(run_end_s / dt));
-  cell::LdbbDevice ldbb(c.ldbb, config.pivot_m(), spec.load_n, component_seed(spec.seed, Component::kLdbb));
-  cell::PathDrift drift(c.drift, component_seed(spec.seed, Component::kDrift));
+  // The bar was serviced and recalibrated before the online tests (paper, section 3): the runs with
+  // the sensor mounted see its recalibrated force error, the offline runs its earlier one.
+  cell::LdbbConfig bar = c.ldbb;
+  if (robot.sensor_mounted()) bar.force_bias = c.ldbb.force_bias_recalibrated;
+  cell::LdbbDevice ldbb(bar, config.pivot_m(), spec.load_n, component_seed(spec.seed, Component::kLdbb));
+  cell::PathDrift drift(c.drift, component_seed(spec.seed, Component::kDrift), loaded ? spec.load_n : 0.0);
   cell::LaserTracker tracker(c.tracker, component_seed(spec.seed, Component::kTracker), settle_s, run_end_s, settle_s);
 
   RunOutput out;
@@ -256,13 +265,14 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
     }
     drift.advance(dt);
     // Drift moves the whole arm (thermal growth, repeatability), so the LDBB sees it too.
-    const Vector3 p = drift.apply(robot.solve(ws, q_motor, w, state));
+    const Vector3 p = drift.apply(robot.solve(ws, q_motor, w, state, dt));
+    controller->encoders(state.q_motor);
     if (linked) {
       // The DAQ streams this tick's samples; the EGM message sent this tick reaches deflex after the
       // network's latency, and deflex answers at once (its reply reaches the controller's next tick).
       const Matrix3 base_R_flange = ws.base_T_flange.linear();
       for (; next_daq <= t + 1e-12; next_daq += daq_period) {
-        daq.send(next_daq, sensor.sample(w.head<3>(), base_R_flange));
+        daq.send(next_daq, sensor.sample(w.head<3>(), base_R_flange, next_daq));
       }
       clock.set(t + c.controller.network_latency_s);
       for (;;) {

@@ -10,9 +10,11 @@
 #include <memory>
 #include <vector>
 
+#include "deflex/cell/force_sensor.hpp"
 #include "deflex/cell/true_robot.hpp"
 #include "deflex/evaluate/tracker_trace.hpp"
 #include "deflex/link/controller_link.hpp"
+#include "deflex/online/sensor_config.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/study/cell_calibration.hpp"
@@ -72,6 +74,11 @@ struct RunOutput {
 /// the identified model and the LDBB force model (nominal pivot, set-point force).
 [[nodiscard]] std::vector<JointVector> offline_configurations(const CaseConfig& config, const SetupCell& setup,
                                                               double load_n);
+
+/// What a user's sensor file would hold for the cell's sensor: its calibration sheet (decoupling,
+/// bias, payload), the mount, and deflex's conditioning settings from the case.
+[[nodiscard]] deflex::SensorConfig sensor_config_from_sheet(const CaseConfig& config,
+                                                            const cell::SensorCalibration& sheet);
 
 /// Runs one protocol run. Throws Error when the run cannot be done (an online strategy without the
 /// sensor, a refused start or a controller that timed out: a broken setup, never a result).
