@@ -101,13 +101,18 @@ const JointVector& EgmPathCorrectionController::tick(double t_s) {
     robot_.seqno = ++seqno_;
     robot_.tm_ms = egm_time_stamp_ms(t_s);
     for (int i = 0; i < position_.size(); ++i) {
-      robot_.feedback_joints_deg[i] = rad_to_deg(position_[i]);
+      robot_.feedback_joints_deg[i] = rad_to_deg(have_encoders_ ? encoders_[i] : position_[i]);
       robot_.planned_joints_deg[i] = rad_to_deg(planned_[i]);
     }
     const std::size_t n = codec_.encode_robot(robot_, buffer_.data(), buffer_.size());
     if (n > 0 && transport_.send_to(buffer_.data(), n, sensor_)) ++counters_.sent;
   }
   return position_;
+}
+
+void EgmPathCorrectionController::encoders(const JointVector& q_motor_rad) {
+  encoders_ = q_motor_rad;
+  have_encoders_ = true;
 }
 
 }  // namespace deflex::cell

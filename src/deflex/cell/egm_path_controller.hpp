@@ -26,6 +26,7 @@ class EgmPathCorrectionController final : public RobotController {
                               const DatagramAddress& sensor);
 
   const JointVector& tick(double t_s) override;
+  void encoders(const JointVector& q_motor_rad) override;
   [[nodiscard]] const char* name() const override { return "EGM path correction"; }
   [[nodiscard]] const EgmControllerCounters& counters() const { return counters_; }
   /// The TCP offset applied now (m, base frame).
@@ -55,6 +56,8 @@ class EgmPathCorrectionController final : public RobotController {
   Vector3 active_frame_m_ = Vector3::Zero();
   Vector3 applied_m_ = Vector3::Zero();
   Vector3 direction_ = Vector3::UnitX();
+  JointVector encoders_;  ///< the last encoder reading: the feedback it reports
+  bool have_encoders_ = false;
   JointVector planned_, planned_velocity_, position_;
   double last_t_s_ = 0.0, next_send_s_ = 0.0;
   std::uint32_t seqno_ = 0;

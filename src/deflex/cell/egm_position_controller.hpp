@@ -35,6 +35,7 @@ class EgmPositionGuidanceController final : public RobotController {
                                 DatagramTransport& transport, const DatagramAddress& sensor);
 
   const JointVector& tick(double t_s) override;
+  void encoders(const JointVector& q_motor_rad) override;
   [[nodiscard]] const char* name() const override { return "EGM position guidance"; }
   [[nodiscard]] const EgmControllerCounters& counters() const { return counters_; }
   /// The target the controller follows now (rad): the sensor's last one.
@@ -48,6 +49,8 @@ class EgmPositionGuidanceController final : public RobotController {
   std::vector<unsigned char> buffer_;
   EgmRobotMessage robot_;
   EgmSensorMessage answer_;
+  JointVector encoders_;  ///< the last encoder reading: the feedback it reports
+  bool have_encoders_ = false;
   JointVector target_, speed_ref_, filtered_target_, filtered_speed_, position_;
   // Delay line of the filtered references, one entry a servo tick.
   std::vector<JointVector> delay_target_, delay_speed_;

@@ -15,8 +15,12 @@ namespace deflex::cell {
 class RobotController {
  public:
   virtual ~RobotController() = default;
-  /// Advances to t_s (once per servo tick, increasing) and returns the motor-side joints (rad).
+  /// Advances to t_s (once per servo tick, increasing) and returns the motor-side joints (rad) the
+  /// drives are commanded to.
   virtual const JointVector& tick(double t_s) = 0;
+  /// The motors' encoders after the tick (rad): where the drives got to, behind their command by the
+  /// servo's following error. What the controller reports as the robot's position from then on.
+  virtual void encoders(const JointVector& q_motor_rad) { (void)q_motor_rad; }
   [[nodiscard]] virtual const char* name() const = 0;
 
  protected:

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include <Eigen/LU>
+
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
@@ -51,7 +53,7 @@ EgmPathLink::EgmPathLink(OnlineCompensator& compensator, OnlineStrategy& strateg
   config_.validate();
   const int n = compensator.model().dof();
   for (JointVector* q : {&input_.q_planned, &input_.q_feedback, &feedback_, &planned_, &previous_feedback_, &velocity_,
-                         &target_, &no_distance_}) {
+                         &target_, &no_distance_, &sent_offset_joints_, &reference_}) {
     *q = JointVector::Zero(n);
   }
   tx_.assign(512, 0);
@@ -123,7 +125,10 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
   previous_tcp_m_ = tcp;
   have_previous_ = true;
 
-  if (m.has_planned) delay_.record_reference(now, planned_);
+  if (m.has_planned) {
+    reference_ = planned_ + sent_offset_joints_;
+    delay_.record_reference(now, reference_);
+  }
   delay_.observe_feedback(now, feedback_);
   // The correction sent now is applied after the servo delay, the channel's latency and on average
   // half a correction period: the predictive strategy evaluates it where the arm will be by then.
@@ -182,6 +187,18 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
       if (n > 0 && receiver_.reply(tx_.data(), n)) {
         r.replied = true;
         result = LinkPollResult::kAnswered;
+        // The joints' share of this offset, orientation held (6-axis arms; a fixed-size solve, no
+        // allocation). A singular Jacobian leaves the previous value: the delay measurement only.
+        if (comp_.model().dof() == 6 && frame_ok) {
+          const Eigen::Matrix<double, 6, 6> j6 = jac_;
+          Eigen::Matrix<double, 6, 1> twist;
+          twist << correction, Vector3::Zero();
+          const Eigen::PartialPivLU<Eigen::Matrix<double, 6, 6>> lu(j6);
+          if (std::abs(lu.determinant()) > 1e-9) {
+            const Eigen::Matrix<double, 6, 1> dq = lu.solve(twist);
+            if (dq.allFinite()) sent_offset_joints_ = dq;
+          }
+        }
       } else if (n == 0) {
         ++counters_.send_errors;
       }

@@ -78,6 +78,11 @@ class EgmPathLink final : public ControllerLink {
 
   CycleInput input_;
   JointVector feedback_, planned_, previous_feedback_, velocity_, target_, no_distance_;
+  /// The joint motion the last offset sent asks of the controller (the arm's joints move by it,
+  /// orientation held): the delay is measured between planned + this and the feedback, which carries
+  /// the applied offset.
+  JointVector sent_offset_joints_;
+  JointVector reference_;
   double previous_t_s_ = 0.0;
   bool have_previous_ = false;
   double period_s_ = 0.0;
