@@ -2,7 +2,9 @@
 // the paper's, Figure 5, path plots, the error budget and the HTML report.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -11,6 +13,7 @@
 #include "command.hpp"
 #include "deflex/study/case_study.hpp"
 #include "deflex/evaluate/study_tables.hpp"
+#include "deflex/evaluate/tracker_trace.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/report/html_report.hpp"
 
@@ -18,11 +21,21 @@ namespace deflex::cli {
 namespace {
 
 struct Opts {
-  std::string case_file, out_dir = "case-study-out";
+  std::string case_file, out_dir = "case-study-out", traces_dir;
   long long seed = -1;
+  int seeds = 0;
   int threads = 0;
   bool json = false, quick = false, no_sweep = false, no_budget = false, no_progress = false;
 };
+
+// The first path containing `part` (sorted, so the pick does not depend on the threads' order).
+std::string first_matching(std::vector<std::string> paths, const std::string& part) {
+  std::sort(paths.begin(), paths.end());
+  for (const auto& p : paths) {
+    if (p.find(part) != std::string::npos) return p;
+  }
+  return paths.empty() ? std::string() : paths.front();
+}
 
 // A one-line progress bar on stderr, redrawn in place.
 void draw_progress(double fraction, const std::string& label) {
@@ -104,8 +117,22 @@ void run(const Opts& o, int& exit_code) {
   options.speed_sweep = !o.no_sweep;
   options.error_budget = !o.no_budget;
   options.threads = o.threads;
+  options.seeds = o.seeds;
   if (!o.no_progress) options.progress = draw_progress;
-  std::cerr << fmt::format("deflex case-study: {} (seed {}{})\n", config.name, config.seed, o.quick ? ", quick" : "");
+  std::vector<std::string> traces_written;
+  if (!o.traces_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(o.traces_dir, ec);
+    if (ec) throw Error(fmt::format("{}: cannot create the directory: {}", o.traces_dir, ec.message()));
+    options.trace_sink = [&](const std::string& name, const TrackerTrace& trace) {
+      const std::string path = (std::filesystem::path(o.traces_dir) / (name + ".csv")).string();
+      write_tracker_csv(trace, path);
+      traces_written.push_back(path);
+    };
+  }
+  const int seeds = o.seeds > 0 ? o.seeds : config.seeds;
+  std::cerr << fmt::format("deflex case-study: {} ({} seed{} from {}{})\n", config.name, seeds, seeds == 1 ? "" : "s",
+                           config.seed, o.quick ? ", quick" : "");
   const study::CaseStudyOutput result = study::run_case_study(config, options);
   if (!o.no_progress) std::cerr << "\n";
 
@@ -114,20 +141,15 @@ void run(const Opts& o, int& exit_code) {
   report.setup_paragraphs = result.setup_paragraphs;
   report.study = result.study;
   for (const auto& p : result.plots) {
-    report.path_plots.push_back(PathPlot{p.title, p.unloaded, p.uc, p.c, 0.0});
-  }
-  for (const auto& b : result.budgets) {
-    ErrorBudget eb;
-    eb.setup = b.setup;
-    eb.load_N = b.load_n;
-    eb.speed_mm_s = b.speed_mm_s;
-    eb.residual_mm_all = b.residual_mm_all;
-    eb.uc_mm = b.uc_mm;
-    for (const auto& r : b.rows) {
-      eb.entries.push_back(ErrorBudgetEntry{r.name, r.size, r.residual_mm_without,
-                                            residual_share(b.residual_mm_all, r.residual_mm_without)});
-    }
-    report.error_budgets.push_back(eb);
+    PathPlot plot;
+    plot.title = p.title;
+    plot.unloaded = p.unloaded;
+    plot.uc = p.uc;
+    plot.c = p.c;
+    plot.unloaded_mean = p.unloaded_mean;
+    plot.uc_laps = p.uc_laps;
+    plot.c_laps = p.c_laps;
+    report.path_plots.push_back(std::move(plot));
   }
   report.notes = honest_notes(config, result.study);
   report.case_text = o.case_file.empty() ? study::paper_case_yaml() : std::string();
@@ -145,29 +167,40 @@ void run(const Opts& o, int& exit_code) {
                                  p.speed_mm_s, p.uc_mm, p.c_mm, 100.0 * p.compensation);
       }
     }
-    for (const auto& b : result.budgets) {
+    for (const auto& b : result.study.error_budgets) {
       std::cout << fmt::format(
-          "\nError budget, {} {:.0f} N at {:.0f} mm/s: C = {:.3f} mm with every effect (UC {:.3f} mm)\n", b.setup,
-          b.load_n, b.speed_mm_s, b.residual_mm_all, b.uc_mm);
-      for (const auto& r : b.rows) {
-        std::cout << fmt::format("  {:<48} {:<34} C without it {:.3f} mm ({:+.0f}% of C)\n", r.name, r.size,
-                                 r.residual_mm_without,
-                                 100.0 * residual_share(b.residual_mm_all, r.residual_mm_without));
+          "\nError budget, {} {:.0f} N at {:.0f} mm/s (seed {}, the table's runs, {} laps each): C = {:.3f} mm with "
+          "every effect (UC {:.3f} mm)\n",
+          b.setup, b.load_N, b.speed_mm_s, b.seed, b.laps, b.residual_mm_all, b.uc_mm);
+      for (const auto& e : b.entries) {
+        std::cout << fmt::format("  {:<48} {:<44} C without it {:.3f} mm ({:+.0f}% of C)\n", e.effect, e.size,
+                                 e.residual_mm_without_it, 100.0 * e.share_of_residual);
       }
     }
     if (!result.links.empty()) {
       std::cout << "\nThe online setups' controller links (deflex's deployable link code, over the cell's network):\n";
       for (const auto& l : result.links) {
+        const std::string correction =
+            l.joint_commands
+                ? fmt::format("largest correction {:.3f} mrad of the {:.1f} mrad bound ({:.3f} mm at the TCP)",
+                              l.max_command_deviation_rad * 1e3, l.bound_rad * 1e3, l.max_tcp_correction_m * 1e3)
+                : fmt::format("largest offset {:.3f} mm at the TCP", l.max_tcp_correction_m * 1e3);
         std::cout << fmt::format(
-            "  {:<16} {:>8} cycles answered, {} datagrams rejected, {} commands stopped by the guard; "
-            "largest correction {:.3f} mrad of the {:.1f} mrad bound ({:.3f} mm at the TCP); measured delay {:.0f} ms\n",
-            l.setup, l.cycles, l.rejected, l.guard_trips, l.max_command_deviation_rad * 1e3, l.bound_rad * 1e3,
-            l.max_tcp_correction_m * 1e3, l.measured_delay_s * 1e3);
+            "  {:<16} {:<10} {:>8} cycles answered, {} datagrams rejected, {} commands stopped by the guard; {}; "
+            "measured delay {:.0f} ms\n",
+            l.setup, l.link, l.cycles, l.rejected, l.guard_trips, correction, l.measured_delay_s * 1e3);
       }
     }
     std::cout << fmt::format(
-        "\n{} runs, {:.0f} s of robot time simulated in {:.1f} s wall time; report in {}/report.html\n", result.runs,
-        result.simulated_s, result.study.wall_time_s, o.out_dir);
+        "\n{} runs and {} calibrations, {:.0f} s of robot time simulated in {:.1f} s wall time; report in "
+        "{}/report.html\n",
+        result.runs, result.calibrations, result.simulated_s, result.study.wall_time_s, o.out_dir);
+    if (!traces_written.empty()) {
+      std::cout << fmt::format(
+          "{} tracker traces (t_s,x_mm,y_mm,z_mm) in {}; try: deflex evaluate --split-laps --unloaded {} --loaded {}\n",
+          traces_written.size(), o.traces_dir, first_matching(traces_written, "_unloaded_"),
+          first_matching(traces_written, "_uc_"));
+    }
   }
   exit_code = 0;
 }
@@ -179,6 +212,13 @@ void setup(CLI::App& sub, int& exit_code) {
       ->check(CLI::NonNegativeNumber);
   sub.add_option("--out", o->out_dir,
                  "Directory for report.html, the SVG figures and the tables (default ./case-study-out)");
+  sub.add_option("--seeds", o->seeds,
+                 "Seeds to run, from --seed up: each its own cell and runs; the tables give mean and spread "
+                 "(default: the case file's protocol.seeds)")
+      ->check(CLI::Range(1, 1000));
+  sub.add_option("--write-traces", o->traces_dir,
+                 "Directory for the simulated tracker CSVs of the first seed at the error budget's speed and each "
+                 "setup's highest load (unloaded, UC and C), to try `deflex evaluate` on");
   sub.add_option("--threads", o->threads, "Worker threads (default: one per hardware thread)")
       ->check(CLI::NonNegativeNumber);
   sub.add_flag("--json", o->json, "Print only the JSON document of the results on stdout");

@@ -57,6 +57,7 @@ class CaseStudyCli : public ::testing::Test {
     text = replaced(text, "speeds_mm_s: [10, 30, 50]", "speeds_mm_s: [40, 50]");
     text = replaced(text, "laps_ccw: 3", "laps_ccw: 0");
     text = replaced(text, "settle_s: 2.0", "settle_s: 0.5");
+    text = replaced(text, "seeds: 4", "seeds: 1");
     short_case_ = text;
     std::ofstream(dir_ / "short.yaml") << text;
   }
@@ -114,6 +115,35 @@ TEST_F(CaseStudyCli, TextPrintsThePapersFiguresBesideOurs) {
   EXPECT_NE(r.out.find("Table 2"), std::string::npos);
   EXPECT_NE(r.out.find("(0.12)"), std::string::npos);  // Table 1, 125 N, UC of the paper
   EXPECT_NE(r.out.find("(1.10)"), std::string::npos);  // Table 2, 650 N
+}
+
+TEST_F(CaseStudyCli, SeedsSpreadAndTracesThatDeflexEvaluateReads) {
+  const fs::path out = dir_ / "out3";
+  const fs::path traces = dir_ / "traces";
+  const Result r = run("case-study --case " + (dir_ / "short.yaml").string() + " --quick --no-sweep --no-budget " +
+                           "--no-progress --seeds 2 --write-traces " + traces.string() + " --out " + out.string(),
+                       dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("2 seeds"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find(" ±"), std::string::npos) << r.out;  // the spread beside each mean
+  const nlohmann::json doc = nlohmann::json::parse(slurp(out / "results.json"));
+  EXPECT_EQ(doc["seeds"].size(), 2u);
+  EXPECT_EQ(doc["setups"][1]["loads"][2]["c_mm_by_seed"]["50"].size(), 2u);
+  // The traces: deflex evaluate, on the unloaded and uncompensated runs of the online setup at
+  // 650 N and 50 mm/s, gives the table's first-seed UC (the same nearest-point metric, to the
+  // mean of the unloaded laps).
+  const fs::path unloaded = traces / "sensor-egm-joint_unloaded_50mm_s.csv";
+  const fs::path uc = traces / "sensor-egm-joint_uc_650N_50mm_s.csv";
+  ASSERT_TRUE(fs::exists(unloaded)) << r.out;
+  ASSERT_TRUE(fs::exists(uc)) << r.out;
+  EXPECT_TRUE(fs::exists(traces / "sensor-egm-joint_online_650N_50mm_s.csv"));
+  EXPECT_TRUE(fs::exists(traces / "offline-program_offline_625N_50mm_s.csv"));
+  const Result e = run("evaluate --split-laps --mean-reference --json --unloaded " + unloaded.string() + " --loaded " + uc.string(), dir_);
+  ASSERT_EQ(e.exit_code, 0) << e.err;
+  const nlohmann::json ev = nlohmann::json::parse(e.out);
+  const double table_uc = doc["setups"][1]["loads"][2]["uc_mm_by_seed"]["50"][0];
+  ASSERT_TRUE(ev.contains("mean_deformation_mm")) << ev.dump(2);
+  EXPECT_NEAR(ev["mean_deformation_mm"].get<double>(), table_uc, 0.05 * table_uc) << ev.dump(2);
 }
 
 TEST_F(CaseStudyCli, BadCaseFileIsAnErrorNamingTheField) {

@@ -216,6 +216,8 @@ TEST(StudyTables, MeansAndSpreadOverSeedsAndTheirJsonAndCsv) {
   b.speed_mm_s = 50;
   b.residual_mm_all = 0.2;
   b.uc_mm = 1.1;
+  b.seed = 7;
+  b.laps = 6;
   b.entries = {{"lost motion", "40 urad", 0.15, residual_share(0.2, 0.15)}};
   study.error_budgets = {b};
   const StudyResult back = study_from_json(study_to_json(study), "test");
@@ -223,6 +225,8 @@ TEST(StudyTables, MeansAndSpreadOverSeedsAndTheirJsonAndCsv) {
   EXPECT_EQ(back.setups[0].loads[0].c_mm_by_seed, l.c_mm_by_seed);
   ASSERT_EQ(back.error_budgets.size(), 1u);
   EXPECT_EQ(back.error_budgets[0].entries[0].effect, "lost motion");
+  EXPECT_EQ(back.error_budgets[0].seed, 7u);
+  EXPECT_EQ(back.error_budgets[0].laps, 6);
   EXPECT_NEAR(back.error_budgets[0].entries[0].share_of_residual, 0.25, 1e-12);
   // The text table carries the spread: "0.200 ±0.100 (0.25)" for C at 10 mm/s.
   const std::string text = study_tables_text(study);
@@ -234,7 +238,9 @@ TEST(StudyTables, MeansAndSpreadOverSeedsAndTheirJsonAndCsv) {
   std::string header, row;
   std::getline(in, header);
   std::getline(in, row);
-  EXPECT_EQ(row, "online,650,50,0.2,1.1,lost motion,40 urad,0.15,0.25");
+  EXPECT_EQ(header, "setup,load_N,speed_mm_s,seed,laps,residual_mm_all,uc_mm,effect,size,residual_mm_without_it,"
+                    "share_of_residual");
+  EXPECT_EQ(row, "online,650,50,7,6,0.2,1.1,lost motion,40 urad,0.15,0.25");
 }
 
 }  // namespace

@@ -127,7 +127,7 @@ TEST(PathPlot, DeviationsAreMagnifiedByTheStatedFactor) {
     }
     return t;
   };
-  PathPlot p{"test", circle(0.1), circle(0.1005), circle(0.1001), 40.0};
+  PathPlot p{"test", circle(0.1), circle(0.1005), circle(0.1001), 40.0, {}, {}, {}};
   const std::string svg = svg_path_plot(p);
   EXPECT_EQ(test::xml_problem(svg), "");
   EXPECT_NE(svg.find("magnified x40"), std::string::npos);
@@ -164,7 +164,7 @@ TEST(PathPlot, AutomaticMagnificationAndBadInput) {
   const std::string svg = svg_path_plot(p);
   EXPECT_EQ(test::xml_problem(svg), "");
   EXPECT_NE(svg.find("magnified x20"), std::string::npos);
-  PathPlot only_unloaded{"no loaded runs", p.unloaded, {}, {}, 0.0};
+  PathPlot only_unloaded{"no loaded runs", p.unloaded, {}, {}, 0.0, {}, {}, {}};
   const std::string empty = svg_path_plot(only_unloaded);
   EXPECT_EQ(test::xml_problem(empty), "");
   EXPECT_NE(empty.find("UC (no data)"), std::string::npos);

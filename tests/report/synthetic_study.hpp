@@ -94,7 +94,7 @@ inline ReportContent synthetic_report() {
                {"lost motion", "0.02 mrad per joint", 0.17, residual_share(0.20, 0.17)},
                {"tracker noise", "5 um 1-sigma", 0.195, residual_share(0.20, 0.195)},
                {"LDBB ripple", "1 % at 2 Hz", 0.2004, residual_share(0.20, 0.2004)}};
-  r.error_budgets.push_back(b);
+  r.study.error_budgets.push_back(b);
   r.notes = {"Our online UC at 150 N is 14% above the paper's: the sensor compliance is a guess."};
   r.case_text = "case: synthetic\nseed: 11\n";
   return r;

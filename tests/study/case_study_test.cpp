@@ -33,6 +33,7 @@ CaseConfig short_case(CaseConfig c) {
   c.setups[1].paper_uc_mm.clear();
   c.setups[1].paper_c_mm.clear();
   c.budget.load_index = 0;
+  c.seeds = 1;
   return c;
 }
 
@@ -178,6 +179,94 @@ TEST(CaseStudy, SameSeedGivesTheSameFiguresOnAnyNumberOfThreads) {
   EXPECT_EQ(a.links[0].guard_trips, 0u);
   EXPECT_LE(a.links[0].max_command_deviation_rad, a.links[0].bound_rad);
   EXPECT_GT(a.links[0].max_command_deviation_rad, 0.0);
+}
+
+TEST(CaseStudy, SeveralSeedsGiveEachSeedsOwnFiguresTheirMeanAndSpread) {
+  CaseConfig c = short_case(paper_case());
+  c.setups[0].loads_n = {650.0};
+  c.setups[1].loads_n = {650.0};
+  CaseStudyOptions o;
+  o.speed_sweep = false;
+  o.error_budget = false;
+  o.seeds = 2;
+  const CaseStudyOutput both = run_case_study(c, o);
+  EXPECT_EQ(both.study.seeds, (std::vector<std::uint64_t>{c.seed, c.seed + 1}));
+  // Each seed's figure is the one a study of that seed alone gives.
+  o.seeds = 1;
+  const CaseStudyOutput first = run_case_study(c, o);
+  CaseConfig second_case = c;
+  second_case.seed = c.seed + 1;
+  const CaseStudyOutput second = run_case_study(second_case, o);
+  for (std::size_t s = 0; s < 2; ++s) {
+    const LoadResult& l = both.study.setups[s].loads[0];
+    ASSERT_EQ(l.c_mm_by_seed.at(50).size(), 2u);
+    EXPECT_EQ(l.c_mm_by_seed.at(50)[0], first.study.setups[s].loads[0].c_mm.at(50));
+    EXPECT_EQ(l.c_mm_by_seed.at(50)[1], second.study.setups[s].loads[0].c_mm.at(50));
+    EXPECT_EQ(l.uc_mm_by_seed.at(50)[1], second.study.setups[s].loads[0].uc_mm.at(50));
+    EXPECT_NEAR(l.c_mm.at(50), 0.5 * (l.c_mm_by_seed.at(50)[0] + l.c_mm_by_seed.at(50)[1]), 1e-15);
+    const Spread sp = l.c_spread(50);
+    EXPECT_EQ(sp.n, 2);
+    EXPECT_NEAR(sp.sd, std::abs(l.c_mm_by_seed.at(50)[0] - l.c_mm_by_seed.at(50)[1]) / std::sqrt(2.0), 1e-12);
+    EXPECT_NE(l.c_mm_by_seed.at(50)[0], l.c_mm_by_seed.at(50)[1]);  // two cells, two results
+  }
+}
+
+TEST(CaseStudy, TheErrorBudgetsEveryEffectFigureIsTheTablesOwnRun) {
+  CaseConfig c = short_case(paper_case());
+  c.setups[0].loads_n = {650.0};
+  c.setups[1].loads_n = {650.0};
+  c.calibration.arcs = 3;  // a quicker calibration for each budget cell
+  CaseStudyOptions o;
+  o.speed_sweep = false;
+  o.seeds = 1;
+  const CaseStudyOutput out = run_case_study(c, o);
+  ASSERT_EQ(out.study.error_budgets.size(), 2u);
+  for (const auto& b : out.study.error_budgets) {
+    const SetupResult* table = nullptr;
+    for (const auto& s : out.study.setups) {
+      if (s.setup == b.setup) table = &s;
+    }
+    ASSERT_NE(table, nullptr) << b.setup;
+    EXPECT_EQ(b.residual_mm_all, table->loads[0].c_mm.at(50)) << b.setup;
+    EXPECT_EQ(b.uc_mm, table->loads[0].uc_mm.at(50)) << b.setup;
+    EXPECT_EQ(b.seed, c.seed);
+    EXPECT_EQ(b.laps, 1);
+    EXPECT_GT(b.entries.size(), 10u);
+    bool tracker = false;
+    for (const auto& e : b.entries) {
+      EXPECT_TRUE(std::isfinite(e.residual_mm_without_it)) << e.effect;
+      tracker = tracker || e.effect == to_string(Effect::kTrackerNoise);
+    }
+    EXPECT_TRUE(tracker);
+  }
+}
+
+TEST(CellCalibration, WhileMovingItFindsTheTrueStiffnessOfAModelConsistentCell) {
+  // No effect the lumped model lacks, no noise, the LDBB exact: what the moving calibration
+  // identifies must be the true stiffness of the joints the arcs load (1, 2, 3 and 5).
+  CaseConfig c = model_consistent(paper_case(), false);
+  c.exact_model = false;
+  c.calibration.ldbb_force_error = 0.0;
+  c.cell.ldbb.ripple = 0.0;
+  c.cell.ldbb.noise = 0.0;
+  const SetupCell cell = build_setup_cell(c, false);
+  const auto& k_true = cell.robot->true_model().stiffness();
+  const auto& k_id = cell.calibration.identified.stiffness();
+  for (int j : {0, 1, 2, 4}) {
+    EXPECT_NEAR(k_id[j] / k_true[j], 1.0, 0.03) << "joint " << j + 1;
+  }
+  EXPECT_GT(cell.calibration.measurements, 6 * 10);
+  EXPECT_LT(cell.calibration.estimate.residual_rms_m, 5e-6);
+  // The same calibration on the full cell (drift, lost motion, link bending ...) leaves a residual
+  // the model cannot explain, and still finds the stiffness within a plausible band.
+  const CaseConfig full = paper_case();
+  const SetupCell real = build_setup_cell(full, false);
+  EXPECT_GT(real.calibration.estimate.residual_rms_m, 3.0 * cell.calibration.estimate.residual_rms_m);
+  for (int j : {1, 2}) {
+    const double ratio = real.calibration.identified.stiffness()[j] / real.robot->true_model().stiffness()[j];
+    EXPECT_GT(ratio, 0.5) << "joint " << j + 1;
+    EXPECT_LT(ratio, 2.0) << "joint " << j + 1;
+  }
 }
 
 TEST(CellModule, IncludesNothingOfTheStrategiesOrTheirLinks) {

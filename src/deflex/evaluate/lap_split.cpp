@@ -95,6 +95,19 @@ LapSplit split_laps(const TrackerTrace& trace, double min_turn_rad, double rever
   return out;
 }
 
+std::vector<DirectedLap> directed_laps(const TrackerTrace& trace) {
+  const PathPlane plane = best_fit_plane(trace);
+  std::vector<DirectedLap> out;
+  for (auto& lap : split_laps(trace).laps) {
+    double area = 0.0;
+    for (std::size_t k = 0; k + 1 < lap.size(); ++k) {
+      area += (lap[k].p_m - plane.centroid_m).cross(lap[k + 1].p_m - plane.centroid_m).dot(plane.normal);
+    }
+    out.push_back(DirectedLap{std::move(lap), area < 0.0});
+  }
+  return out;
+}
+
 TrackerTrace mean_closed_path(const TrackerTrace& trace, int bins) {
   if (bins < 8 || bins > 1'000'000) {
     throw InputError(fmt::format("mean path: {} bins (use 8..1000000)", bins));

@@ -33,6 +33,16 @@ struct LapSplit {
 LapSplit split_laps(const TrackerTrace& trace, double min_turn_rad = 0.9 * 2.0 * kPi,
                     double reversal_rad = deg_to_rad(5.0));
 
+/// A lap and its direction of travel: clockwise when, seen from the side the plane's normal points
+/// to (n.z >= 0: from above), it turns clockwise about the trace's centroid.
+struct DirectedLap {
+  TrackerTrace trace;
+  bool clockwise = false;
+};
+/// split_laps(trace).laps, each with its direction (the sign of the area it sweeps about the
+/// centroid of the whole trace in its plane of best fit).
+std::vector<DirectedLap> directed_laps(const TrackerTrace& trace);
+
 /// The mean of a closed path's laps, as one closed polyline: the samples binned by their angle about
 /// the centroid in the plane of best fit (`bins` equal sectors), each bin's positions averaged, the
 /// bins in angle order and the first repeated at the end. A nearest-point distance to a dense, noisy

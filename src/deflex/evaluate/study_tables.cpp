@@ -442,6 +442,8 @@ nlohmann::json study_to_json(const StudyResult& study) {
                          {"speed_mm_s", b.speed_mm_s},
                          {"residual_mm_all", number(b.residual_mm_all)},
                          {"uc_mm", number(b.uc_mm)},
+                         {"seed", b.seed},
+                         {"laps", b.laps},
                          {"entries", entries}});
     }
     doc["error_budget"] = budgets;
@@ -587,6 +589,15 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
                               ? kNaN
                               : read_number(jb, "residual_mm_all", bw);
       b.uc_mm = jb.contains("uc_mm") && jb.at("uc_mm").is_null() ? kNaN : read_number(jb, "uc_mm", bw, false);
+      if (jb.contains("seed")) {
+        if (!jb.at("seed").is_number_unsigned()) throw DataError(fmt::format("{}: seed: not a seed", bw));
+        b.seed = jb.at("seed").get<std::uint64_t>();
+      }
+      if (jb.contains("laps")) {
+        const double laps = read_number(jb, "laps", bw);
+        if (laps < 0 || laps > 1e6 || laps != std::floor(laps)) throw DataError(fmt::format("{}: laps: not a lap count", bw));
+        b.laps = static_cast<int>(laps);
+      }
       if (jb.contains("entries")) {
         std::size_t ei = 0;
         for (const auto& je : jb.at("entries")) {
@@ -759,11 +770,11 @@ void write_error_budget_csv(const StudyResult& study, const std::string& path) {
     throw Error(fmt::format("{}: cannot write the file", path));
   }
   auto cell = [](double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : std::string(); };
-  f << "setup,load_N,speed_mm_s,residual_mm_all,uc_mm,effect,size,residual_mm_without_it,share_of_residual\n";
+  f << "setup,load_N,speed_mm_s,seed,laps,residual_mm_all,uc_mm,effect,size,residual_mm_without_it,share_of_residual\n";
   for (const auto& b : study.error_budgets) {
     for (const auto& e : b.entries) {
-      f << fmt::format("{},{:g},{:g},{},{},{},{},{},{}\n", csv_text(b.setup), b.load_N, b.speed_mm_s,
-                       cell(b.residual_mm_all), cell(b.uc_mm), csv_text(e.effect), csv_text(e.size),
+      f << fmt::format("{},{:g},{:g},{},{},{},{},{},{},{},{}\n", csv_text(b.setup), b.load_N, b.speed_mm_s, b.seed,
+                       b.laps, cell(b.residual_mm_all), cell(b.uc_mm), csv_text(e.effect), csv_text(e.size),
                        cell(e.residual_mm_without_it), cell(e.share_of_residual));
     }
   }

@@ -229,7 +229,7 @@ std::string html_report(const ReportContent& content) {
          "drawn at its nearest unloaded point plus the magnified deviation. Right: the distance of each loaded "
          "point from the unloaded path at true scale.</p>\n";
   }
-  h += budget_tables(content.error_budgets);
+  h += budget_tables(study.error_budgets);
   if (!study.speed_sweep.empty()) {
     h += "<h2 id=\"sweep\">Speed sweep</h2>\n<div class=\"fig\">\n" + svg_speed_sweep(study) + "</div>\n";
     h += "<p class=\"caption\">Beyond the paper's 10-50 mm/s (shaded): how each strategy's compensation holds up "
@@ -268,6 +268,9 @@ void write_report(const ReportContent& content, const std::string& out_dir) {
   }
   write_text((dir / "tables.md").string(), study_tables_markdown(content.study));
   write_study_csv(content.study, (dir / "tables.csv").string());
+  if (!content.study.speed_sweep.empty()) write_sweep_csv(content.study, (dir / "sweep.csv").string());
+  if (!content.study.error_budgets.empty()) write_error_budget_csv(content.study, (dir / "error_budget.csv").string());
+  write_text((dir / "results.json").string(), study_to_json(content.study).dump(2) + "\n");
 }
 
 }  // namespace deflex

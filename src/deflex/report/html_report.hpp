@@ -17,7 +17,6 @@ struct ReportContent {
   std::vector<std::string> setup_paragraphs;
   StudyResult study;
   std::vector<PathPlot> path_plots;
-  std::vector<ErrorBudget> error_budgets;
   /// Honest notes: where our figures differ from the paper's and why; one paragraph an entry.
   std::vector<std::string> notes;
   /// Optional: the case file as given (shown verbatim in a <pre> block).
@@ -26,9 +25,10 @@ struct ReportContent {
 
 std::string html_report(const ReportContent& content);
 
-/// Writes out_dir/report.html, figure5.svg, speed_sweep.svg (when there is a sweep),
-/// path_<n>.svg, tables.md and tables.csv; creates out_dir if needed. Throws Error when a file
-/// cannot be written.
+/// Writes out_dir/report.html, figure5.svg, speed_sweep.svg and sweep.csv (when there is a sweep),
+/// path_<n>.svg, tables.md, tables.csv, error_budget.csv (when there is a budget) and results.json
+/// (the study's JSON, study_to_json); creates out_dir if needed. Throws Error when a file cannot be
+/// written.
 void write_report(const ReportContent& content, const std::string& out_dir);
 
 }  // namespace deflex

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "deflex/evaluate/study_tables.hpp"
+#include "deflex/evaluate/lap_split.hpp"
 #include "deflex/evaluate/tracker_trace.hpp"
 
 namespace deflex {
@@ -20,8 +21,12 @@ std::string svg_figure5(const StudyResult& study);
 /// to 12% of the path's size.
 struct PathPlot {
   std::string title;
-  TrackerTrace unloaded, uc, c;
+  TrackerTrace unloaded, uc, c;  ///< one lap each (the last)
   double magnification = 0.0;
+  // Optional, for the per-lap and polar figures: the reference the distances are taken to (the
+  // unloaded laps' mean) and every lap of the loaded runs with its direction.
+  TrackerTrace unloaded_mean;
+  std::vector<DirectedLap> uc_laps, c_laps;
 };
 std::string svg_path_plot(const PathPlot& plot);
 

@@ -12,10 +12,13 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <tuple>
+#include <array>
 #include <thread>
 
 #include "deflex/evaluate/iso9283_path.hpp"
 #include "deflex/evaluate/lap_split.hpp"
+#include "deflex/evaluate/tracker_trace.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/study/simulated_run.hpp"
@@ -70,14 +73,25 @@ Figures evaluate_run(const RunOutput& loaded, const Reference& reference) {
   return f;
 }
 
-TrackerTrace thin_lap(const RunOutput& run, std::size_t max_points) {
-  const auto laps = laps_of(run.trace);
-  if (laps.empty()) return {};
-  const TrackerTrace& lap = laps.back();
+TrackerTrace thin(const TrackerTrace& lap, std::size_t max_points) {
   const std::size_t step = std::max<std::size_t>(1, lap.size() / max_points);
   TrackerTrace out;
   for (std::size_t i = 0; i < lap.size(); i += step) out.push_back(lap[i]);
   return out;
+}
+
+TrackerTrace thin_lap(const RunOutput& run, std::size_t max_points) {
+  const auto laps = laps_of(run.trace);
+  if (laps.empty()) return {};
+  return thin(laps.back(), max_points);
+}
+
+// Every lap of a run, thinned, with its direction of travel.
+std::vector<DirectedLap> plot_laps(const RunOutput& run, std::size_t max_points) {
+  if (run.trace.size() < 2) return {};
+  std::vector<DirectedLap> laps = directed_laps(run.trace);
+  for (auto& lap : laps) lap.trace = thin(lap.trace, max_points);
+  return laps;
 }
 
 // Runs that share a physical configuration and a way of driving the arm share their unloaded
@@ -86,7 +100,6 @@ TrackerTrace thin_lap(const RunOutput& run, std::size_t max_points) {
 struct Family {
   bool sensor = false;
   LinkKind link = LinkKind::kProgram;
-  std::map<int, Reference> unloaded;  // by speed mm/s
 };
 
 struct Progress {
@@ -103,6 +116,14 @@ struct Progress {
 
 double run_cost(const CaseConfig& c, double speed_m_s, int laps) {
   return c.cell.ldbb.settle_s + 2.0 * kPi * c.radius_m() * laps / speed_m_s;
+}
+
+// Simulated seconds of a calibration: an unloaded and a loaded pass over every arc, each after a
+// hold (the arcs' radii are at most the bar's length).
+double calibration_cost(const CaseConfig& c) {
+  if (c.exact_model) return 0.0;
+  const double hold_s = std::max(1.5, 5.0 * c.cell.ldbb.time_constant_s);
+  return 2.0 * c.calibration.arcs * (hold_s + c.calibration.arc_rad * c.cell.ldbb.bar_length_m / c.calibration.speed_m_s);
 }
 
 const char* describe(Strategy s, LinkKind link) {
@@ -156,27 +177,35 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
   Progress progress;
   progress.options = &options;
 
+  // The seeds: each one its own cell (true robot, sensor, calibrations) and runs.
+  const int n_seeds = options.seeds > 0 ? options.seeds : std::max(1, config.seeds);
+  std::vector<CaseConfig> seed_config(static_cast<std::size_t>(n_seeds), config);
+  for (int si = 0; si < n_seeds; ++si) seed_config[static_cast<std::size_t>(si)].seed = config.seed + static_cast<std::uint64_t>(si);
+  auto cfg_of = [&](int si) -> const CaseConfig& { return seed_config[static_cast<std::size_t>(si)]; };
+
   // The physical setups (with and without the sensor) and the families of runs.
-  std::optional<SetupCell> cells[2];
   bool need_cell[2] = {false, false};
   std::vector<Family> families;
   auto family_of = [&](const SetupConfig& s) {
     for (std::size_t i = 0; i < families.size(); ++i) {
       if (families[i].sensor == s.sensor_mounted && families[i].link == s.link) return static_cast<int>(i);
     }
-    families.push_back(Family{s.sensor_mounted, s.link, {}});
+    families.push_back(Family{s.sensor_mounted, s.link});
     return static_cast<int>(families.size()) - 1;
   };
   for (const auto& s : config.setups) {
     need_cell[s.sensor_mounted ? 1 : 0] = true;
     (void)family_of(s);
   }
+  std::vector<std::array<std::optional<SetupCell>, 2>> cells(static_cast<std::size_t>(n_seeds));
   std::vector<double> speeds = config.speeds_m_s;
+  auto add_speed = [&](double v) {
+    if (std::none_of(speeds.begin(), speeds.end(), [&](double u) { return mm_s(u) == mm_s(v); })) speeds.push_back(v);
+  };
   if (options.speed_sweep) {
-    for (double v : config.sweep_speeds_m_s) {
-      if (std::none_of(speeds.begin(), speeds.end(), [&](double u) { return mm_s(u) == mm_s(v); })) speeds.push_back(v);
-    }
+    for (double v : config.sweep_speeds_m_s) add_speed(v);
   }
+  if (options.error_budget) add_speed(config.budget.speed_m_s);
   // The sweep runs each setup at its load nearest to sweep_load_n.
   auto sweep_load = [&](const SetupConfig& s) {
     return *std::min_element(s.loads_n.begin(), s.loads_n.end(), [&](double a, double b) {
@@ -184,8 +213,10 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
     });
   };
 
-  // Loaded jobs: uncompensated per family, load and speed; compensated per setup, load and speed.
+  // Loaded jobs per seed: uncompensated per family, load and speed; compensated per setup, load and
+  // speed.
   struct LoadedJob {
+    int seed;
     int family;
     RunKind kind;
     Strategy strategy;
@@ -194,51 +225,69 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
     RunOutput keep;  // only for the plotted runs
     Figures figures;
     bool plot = false;
+    bool write_trace = false;
     std::uint64_t link_cycles = 0, rejected = 0, guard_trips = 0;
     double max_deviation_rad = 0.0, max_tcp_m = 0.0, delay_s = 0.0;
   };
   std::vector<LoadedJob> loaded;
-  auto add_loaded = [&](int fam, RunKind kind, Strategy strategy, double load, double speed) {
-    for (const auto& j : loaded) {
-      if (j.family == fam && j.kind == kind && (kind != RunKind::kCompensated || j.strategy == strategy) &&
-          j.load_n == load && mm_s(j.speed) == mm_s(speed)) {
-        return;
+  auto find = [&](int si, int fam, RunKind kind, Strategy st, double load, double v) -> LoadedJob* {
+    for (auto& j : loaded) {
+      if (j.seed == si && j.family == fam && j.kind == kind && (kind != RunKind::kCompensated || j.strategy == st) &&
+          j.load_n == load && mm_s(j.speed) == mm_s(v)) {
+        return &j;
       }
     }
-    loaded.push_back(LoadedJob{fam, kind, strategy, load, speed, {}, {}, false});
+    return nullptr;
   };
-  for (const auto& s : config.setups) {
-    const int fam = family_of(s);
-    for (double load : s.loads_n) {
-      for (double v : config.speeds_m_s) {
-        add_loaded(fam, RunKind::kUncompensated, s.strategy, load, v);
-        add_loaded(fam, RunKind::kCompensated, s.strategy, load, v);
+  auto add_loaded = [&](int si, int fam, RunKind kind, Strategy strategy, double load, double speed) {
+    if (find(si, fam, kind, strategy, load, speed) != nullptr) return;
+    LoadedJob j{si, fam, kind, strategy, load, speed, {}, {}};
+    loaded.push_back(std::move(j));
+  };
+  for (int si = 0; si < n_seeds; ++si) {
+    for (const auto& s : config.setups) {
+      const int fam = family_of(s);
+      for (double load : s.loads_n) {
+        for (double v : config.speeds_m_s) {
+          add_loaded(si, fam, RunKind::kUncompensated, s.strategy, load, v);
+          add_loaded(si, fam, RunKind::kCompensated, s.strategy, load, v);
+        }
       }
-    }
-    if (options.speed_sweep) {
-      for (double v : config.sweep_speeds_m_s) {
-        add_loaded(fam, RunKind::kUncompensated, s.strategy, sweep_load(s), v);
-        add_loaded(fam, RunKind::kCompensated, s.strategy, sweep_load(s), v);
+      if (options.speed_sweep) {
+        for (double v : config.sweep_speeds_m_s) {
+          add_loaded(si, fam, RunKind::kUncompensated, s.strategy, sweep_load(s), v);
+          add_loaded(si, fam, RunKind::kCompensated, s.strategy, sweep_load(s), v);
+        }
       }
     }
   }
-  // Plot: each setup's highest load at the first speed.
-  for (auto& j : loaded) {
+  if (options.error_budget) {
     for (const auto& s : config.setups) {
-      if (family_of(s) == j.family && j.load_n == s.loads_n.back() &&
-          mm_s(j.speed) == mm_s(config.speeds_m_s.front()) &&
-          (j.kind == RunKind::kUncompensated || j.strategy == s.strategy)) {
-        j.plot = true;
+      const double load = s.loads_n[static_cast<std::size_t>(config.budget.load_index)];
+      add_loaded(0, family_of(s), RunKind::kUncompensated, s.strategy, load, config.budget.speed_m_s);
+      add_loaded(0, family_of(s), RunKind::kCompensated, s.strategy, load, config.budget.speed_m_s);
+    }
+  }
+  // Plot: each setup's highest load at the first speed, first seed. Traces written: the first
+  // seed's runs at the highest load and the budget's speed.
+  for (auto& j : loaded) {
+    if (j.seed != 0) continue;
+    for (const auto& s : config.setups) {
+      if (family_of(s) != j.family || j.load_n != s.loads_n.back()) continue;
+      if (j.kind == RunKind::kUncompensated || j.strategy == s.strategy) {
+        if (mm_s(j.speed) == mm_s(config.speeds_m_s.front())) j.plot = true;
+        if (mm_s(j.speed) == mm_s(config.budget.speed_m_s) && options.trace_sink) j.write_trace = true;
       }
     }
   }
 
-  // Error budget cells: the offline setup and the paper's online one (position guidance), all
-  // effects on plus each effect off.
+  // Error budget, first seed: the offline setup and the paper's online one (position guidance).
+  // "Every effect" is the table's own run; each effect off is a cell built without it (its own
+  // calibration) running the same runs with the same seeds.
   struct BudgetJob {
     int setup;
-    std::optional<Effect> off;
-    double residual_mm = NAN, uc_mm = NAN;
+    Effect off;
+    double residual_mm = NAN;
   };
   std::vector<BudgetJob> budget_jobs;
   std::vector<int> budget_setups;
@@ -252,66 +301,107 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
       have_offline = have_offline || offline;
       have_online = have_online || online;
       budget_setups.push_back(static_cast<int>(i));
-      budget_jobs.push_back(BudgetJob{static_cast<int>(i), std::nullopt});
       for (Effect e : kAllEffects) {
-        if (e == Effect::kSensorCompliance && !sc.sensor_mounted) continue;
+        if ((e == Effect::kSensorCompliance || e == Effect::kSensorDrift) && !sc.sensor_mounted) continue;
         if ((e == Effect::kSensorErrors || e == Effect::kSensorCalibration || e == Effect::kLatency) && offline) continue;
         budget_jobs.push_back(BudgetJob{static_cast<int>(i), e});
       }
     }
   }
-  const int budget_laps = 2 * config.budget.laps_each_way;
 
   // Progress weights: simulated seconds.
-  for (int f = 0; f < 2; ++f) {
-    if (need_cell[f]) progress.total += 5.0;  // calibration
-  }
-  for (std::size_t f = 0; f < families.size(); ++f) {
-    for (double v : speeds) progress.total += run_cost(config, v, laps);
+  const double cal_cost = calibration_cost(config);
+  for (int si = 0; si < n_seeds; ++si) {
+    for (int f = 0; f < 2; ++f) {
+      if (need_cell[f]) progress.total += cal_cost;
+    }
+    for (std::size_t f = 0; f < families.size(); ++f) {
+      for (double v : speeds) progress.total += run_cost(config, v, laps);
+    }
   }
   for (const auto& j : loaded) progress.total += run_cost(config, j.speed, laps);
-  for (const auto& bj : budget_jobs) {
-    progress.total += 5.0 + (bj.off ? 2.0 : 3.0) * run_cost(config, config.budget.speed_m_s, budget_laps);
+  for (std::size_t i = 0; i < budget_jobs.size(); ++i) {
+    progress.total += cal_cost + 2.0 * run_cost(config, config.budget.speed_m_s, laps);
   }
 
   // Phase 1: calibrations.
   {
     std::vector<std::function<void()>> jobs;
-    for (int f = 0; f < 2; ++f) {
-      if (!need_cell[f]) continue;
-      jobs.emplace_back([&, f] {
-        cells[f].emplace(build_setup_cell(config, f == 1));
-        progress.add(5.0, f == 1 ? "calibration, sensor mounted" : "calibration, no sensor");
-      });
-    }
-    run_parallel(jobs, options.threads);
-  }
-  // Phase 2: unloaded runs.
-  {
-    for (auto& fam : families) {
-      for (double v : speeds) fam.unloaded[mm_s(v)];  // create slots before the threads start
-    }
-    std::vector<std::function<void()>> jobs;
-    for (std::size_t f = 0; f < families.size(); ++f) {
-      for (double v : speeds) {
-        jobs.emplace_back([&, f, v] {
-          Family& fam = families[f];
-          RunSpec spec;
-          spec.kind = RunKind::kUnloaded;
-          spec.link = fam.link;
-          spec.speed_m_s = v;
-          spec.laps_cw = laps_cw;
-          spec.laps_ccw = laps_ccw;
-          spec.seed = run_seed(config.seed, fam.sensor, RunKind::kUnloaded, Strategy::kOffline, 0.0, v,
-                               static_cast<std::uint64_t>(fam.link));
-          fam.unloaded[mm_s(v)] = make_reference(simulate_run(config, *cells[fam.sensor ? 1 : 0], spec));
-          progress.add(run_cost(config, v, laps), fmt::format("unloaded {} mm/s", mm_s(v)));
+    for (int si = 0; si < n_seeds; ++si) {
+      for (int f = 0; f < 2; ++f) {
+        if (!need_cell[f]) continue;
+        jobs.emplace_back([&, si, f] {
+          cells[static_cast<std::size_t>(si)][static_cast<std::size_t>(f)].emplace(build_setup_cell(cfg_of(si), f == 1));
+          progress.add(cal_cost, fmt::format("seed {}: calibration, {}", cfg_of(si).seed, f == 1 ? "sensor mounted" : "no sensor"));
         });
+        ++out.calibrations;
       }
     }
     run_parallel(jobs, options.threads);
   }
-  // Phase 3: loaded runs (slowest first so both cores finish together).
+  auto cell_of = [&](int si, bool sensor) -> const SetupCell& {
+    return *cells[static_cast<std::size_t>(si)][sensor ? 1 : 0];
+  };
+  auto unloaded_seed = [&](int si, const Family& fam, double v) {
+    return run_seed(cfg_of(si).seed, fam.sensor, RunKind::kUnloaded, Strategy::kOffline, 0.0, v,
+                    static_cast<std::uint64_t>(fam.link));
+  };
+  auto loaded_spec = [&](int si, const Family& fam, RunKind kind, Strategy strategy, double load, double v) {
+    RunSpec spec;
+    spec.kind = kind;
+    spec.strategy = strategy;
+    spec.link = fam.link;
+    spec.load_n = load;
+    spec.speed_m_s = v;
+    spec.laps_cw = laps_cw;
+    spec.laps_ccw = laps_ccw;
+    spec.seed = run_seed(cfg_of(si).seed, fam.sensor, kind, strategy, load, v, static_cast<std::uint64_t>(fam.link));
+    return spec;
+  };
+  std::mutex sink_mutex;
+  auto sink = [&](const std::string& name, const TrackerTrace& trace) {
+    std::lock_guard<std::mutex> lock(sink_mutex);
+    options.trace_sink(name, trace);
+  };
+  const char* kFamilyName[] = {"offline", "sensor"};
+  auto family_label = [&](const Family& fam) {
+    return fmt::format("{}-{}", kFamilyName[fam.sensor ? 1 : 0], to_string(fam.link));
+  };
+
+  // Phase 2: unloaded runs, the references (seed, family, speed).
+  std::map<std::tuple<int, int, int>, Reference> unloaded;
+  {
+    for (int si = 0; si < n_seeds; ++si) {
+      for (std::size_t f = 0; f < families.size(); ++f) {
+        for (double v : speeds) unloaded[{si, static_cast<int>(f), mm_s(v)}];  // slots before the threads start
+      }
+    }
+    std::vector<std::function<void()>> jobs;
+    for (int si = 0; si < n_seeds; ++si) {
+      for (std::size_t f = 0; f < families.size(); ++f) {
+        for (double v : speeds) {
+          jobs.emplace_back([&, si, f, v] {
+            const Family& fam = families[f];
+            RunSpec spec;
+            spec.kind = RunKind::kUnloaded;
+            spec.link = fam.link;
+            spec.speed_m_s = v;
+            spec.laps_cw = laps_cw;
+            spec.laps_ccw = laps_ccw;
+            spec.seed = unloaded_seed(si, fam, v);
+            RunOutput run = simulate_run(cfg_of(si), cell_of(si, fam.sensor), spec);
+            if (si == 0 && options.trace_sink && mm_s(v) == mm_s(config.budget.speed_m_s)) {
+              sink(fmt::format("{}_unloaded_{}mm_s", family_label(fam), mm_s(v)), run.trace);
+            }
+            unloaded.at({si, static_cast<int>(f), mm_s(v)}) = make_reference(std::move(run));
+            progress.add(run_cost(config, v, laps), fmt::format("seed {}: unloaded {} mm/s", cfg_of(si).seed, mm_s(v)));
+          });
+        }
+      }
+    }
+    run_parallel(jobs, options.threads);
+  }
+  // Phase 3: loaded runs (slowest first so both cores finish together) and the error budget's runs.
   {
     std::vector<std::size_t> order(loaded.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -321,81 +411,68 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
     for (std::size_t i : order) {
       jobs.emplace_back([&, i] {
         LoadedJob& j = loaded[i];
-        Family& fam = families[static_cast<std::size_t>(j.family)];
-        RunSpec spec;
-        spec.kind = j.kind;
-        spec.strategy = j.strategy;
-        spec.link = fam.link;
-        spec.load_n = j.load_n;
-        spec.speed_m_s = j.speed;
-        spec.laps_cw = laps_cw;
-        spec.laps_ccw = laps_ccw;
-        spec.seed = run_seed(config.seed, fam.sensor, j.kind, j.strategy, j.load_n, j.speed,
-                             static_cast<std::uint64_t>(fam.link));
-        RunOutput run = simulate_run(config, *cells[fam.sensor ? 1 : 0], spec);
-        j.figures = evaluate_run(run, fam.unloaded.at(mm_s(j.speed)));
+        const Family& fam = families[static_cast<std::size_t>(j.family)];
+        const RunSpec spec = loaded_spec(j.seed, fam, j.kind, j.strategy, j.load_n, j.speed);
+        RunOutput run = simulate_run(cfg_of(j.seed), cell_of(j.seed, fam.sensor), spec);
+        j.figures = evaluate_run(run, unloaded.at({j.seed, j.family, mm_s(j.speed)}));
         j.link_cycles = run.link_cycles;
         j.rejected = run.link_counters.rejected();
         j.guard_trips = run.link_counters.guard_trips;
         j.max_deviation_rad = run.max_command_deviation_rad;
         j.max_tcp_m = run.max_tcp_correction_m;
         j.delay_s = run.measured_delay_s;
+        if (j.write_trace) {
+          sink(fmt::format("{}_{}_{:.0f}N_{}mm_s", family_label(fam),
+                           j.kind == RunKind::kUncompensated ? "uc" : to_string(j.strategy), j.load_n, mm_s(j.speed)),
+               run.trace);
+        }
         if (j.plot) j.keep = std::move(run);
         progress.add(run_cost(config, j.speed, laps),
-                     fmt::format("{} {} N {} mm/s", j.kind == RunKind::kUncompensated ? "UC" : to_string(j.strategy),
-                                 j.load_n, mm_s(j.speed)));
+                     fmt::format("seed {}: {} {} N {} mm/s", cfg_of(j.seed).seed,
+                                 j.kind == RunKind::kUncompensated ? "UC" : to_string(j.strategy), j.load_n,
+                                 mm_s(j.speed)));
       });
     }
-    run_parallel(jobs, options.threads);
-  }
-  // Phase 4: error budget (its own cells: switching an effect off changes the calibration too).
-  {
-    std::vector<std::function<void()>> jobs;
     for (auto& bj : budget_jobs) {
       jobs.emplace_back([&] {
         const SetupConfig& sc = config.setups[static_cast<std::size_t>(bj.setup)];
-        const CaseConfig cfg = bj.off ? without_effect(config, *bj.off) : config;
+        const Family& fam = families[static_cast<std::size_t>(family_of(sc))];
+        const CaseConfig cfg = without_effect(cfg_of(0), bj.off);
         const SetupCell cell = build_setup_cell(cfg, sc.sensor_mounted);
         const double load = sc.loads_n[static_cast<std::size_t>(config.budget.load_index)];
         const double v = config.budget.speed_m_s;
         RunSpec spec;
-        spec.link = sc.link;
-        spec.speed_m_s = v;
-        spec.laps_cw = spec.laps_ccw = config.budget.laps_each_way;
-        const std::uint64_t extra = 0xb0d6e7ULL;
         spec.kind = RunKind::kUnloaded;
-        spec.seed = run_seed(config.seed, sc.sensor_mounted, spec.kind, sc.strategy, 0.0, v, extra);
-        const Reference unloaded = make_reference(simulate_run(cfg, cell, spec));
-        spec.kind = RunKind::kCompensated;
-        spec.strategy = sc.strategy;
-        spec.load_n = load;
-        spec.seed = run_seed(config.seed, sc.sensor_mounted, spec.kind, sc.strategy, load, v, extra);
-        bj.residual_mm = evaluate_run(simulate_run(cfg, cell, spec), unloaded).mean_mm;
-        if (!bj.off) {
-          spec.kind = RunKind::kUncompensated;
-          spec.seed = run_seed(config.seed, sc.sensor_mounted, spec.kind, sc.strategy, load, v, extra);
-          bj.uc_mm = evaluate_run(simulate_run(cfg, cell, spec), unloaded).mean_mm;
-        }
-        progress.add(5.0 + (bj.off ? 2.0 : 3.0) * run_cost(config, v, budget_laps),
-                     bj.off ? fmt::format("budget: {}", to_string(*bj.off)) : std::string("budget"));
+        spec.link = fam.link;
+        spec.speed_m_s = v;
+        spec.laps_cw = laps_cw;
+        spec.laps_ccw = laps_ccw;
+        spec.seed = unloaded_seed(0, fam, v);
+        const Reference reference = make_reference(simulate_run(cfg, cell, spec));
+        const RunSpec c_spec = loaded_spec(0, fam, RunKind::kCompensated, sc.strategy, load, v);
+        bj.residual_mm = evaluate_run(simulate_run(cfg, cell, c_spec), reference).mean_mm;
+        progress.add(cal_cost + 2.0 * run_cost(config, v, laps), fmt::format("budget: {}", to_string(bj.off)));
       });
     }
     run_parallel(jobs, options.threads);
   }
 
-  // Assemble the study.
+  // Assemble the study: per setup, load and speed the seeds' figures, their means and spread.
   StudyResult& study = out.study;
   study.case_name = config.name;
   study.seed = config.seed;
+  for (int si = 0; si < n_seeds; ++si) study.seeds.push_back(cfg_of(si).seed);
   for (double v : config.speeds_m_s) study.speeds_mm_s.push_back(mm_s(v));
-  auto find = [&](int fam, RunKind kind, Strategy st, double load, double v) -> const LoadedJob* {
-    for (const auto& j : loaded) {
-      if (j.family == fam && j.kind == kind && (kind != RunKind::kCompensated || j.strategy == st) &&
-          j.load_n == load && mm_s(j.speed) == mm_s(v)) {
-        return &j;
+  auto mean_over_seeds = [&](const std::vector<double>& values) {
+    double sum = 0.0;
+    int n = 0;
+    for (double x : values) {
+      if (std::isfinite(x)) {
+        sum += x;
+        ++n;
       }
     }
-    return nullptr;
+    return n > 0 ? sum / n : NAN;
   };
   for (const auto& s : config.setups) {
     const int fam = family_of(s);
@@ -404,6 +481,8 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
     sr.description = describe(s.strategy, s.link);
     LinkSummary ls;
     ls.setup = s.name;
+    ls.link = to_string(s.link);
+    ls.joint_commands = s.link != LinkKind::kEgmPath;
     ls.bound_rad = config.online.max_joint_correction_rad;
     int delay_runs = 0;
     for (const auto& j : loaded) {
@@ -414,87 +493,112 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
       ls.guard_trips += j.guard_trips;
       ls.max_command_deviation_rad = std::max(ls.max_command_deviation_rad, j.max_deviation_rad);
       ls.max_tcp_correction_m = std::max(ls.max_tcp_correction_m, j.max_tcp_m);
-      ls.measured_delay_s += j.delay_s;
-      ++delay_runs;
+      if (std::isfinite(j.delay_s)) {
+        ls.measured_delay_s += j.delay_s;
+        ++delay_runs;
+      }
     }
-    if (delay_runs > 0) {
-      ls.measured_delay_s /= delay_runs;
+    if (s.link != LinkKind::kProgram) {
+      ls.measured_delay_s = delay_runs > 0 ? ls.measured_delay_s / delay_runs : NAN;
       out.links.push_back(ls);
     }
     for (double load : s.loads_n) {
       LoadResult lr;
       lr.load_N = load;
       for (double v : config.speeds_m_s) {
-        const LoadedJob* uc = find(fam, RunKind::kUncompensated, s.strategy, load, v);
-        const LoadedJob* c = find(fam, RunKind::kCompensated, s.strategy, load, v);
         const int key = mm_s(v);
-        lr.uc_mm[key] = uc->figures.mean_mm;
-        lr.uc_std_mm[key] = uc->figures.std_mm;
-        lr.uc_max_mm[key] = uc->figures.max_mm;
-        lr.iso_accuracy_uc_mm[key] = uc->figures.iso_accuracy_mm;
-        lr.c_mm[key] = c->figures.mean_mm;
-        lr.c_std_mm[key] = c->figures.std_mm;
-        lr.c_max_mm[key] = c->figures.max_mm;
-        lr.iso_accuracy_c_mm[key] = c->figures.iso_accuracy_mm;
-        lr.iso_repeatability_mm[key] = c->figures.iso_repeatability_mm;
-        lr.uc_sync_mm[key] = uc->figures.sync_mm;
-        lr.c_sync_mm[key] = c->figures.sync_mm;
+        std::vector<double> uc_std, uc_max, iso_uc, c_std, c_max, iso_c, iso_rep;
+        for (int si = 0; si < n_seeds; ++si) {
+          const LoadedJob* uc = find(si, fam, RunKind::kUncompensated, s.strategy, load, v);
+          const LoadedJob* c = find(si, fam, RunKind::kCompensated, s.strategy, load, v);
+          lr.uc_mm_by_seed[key].push_back(uc->figures.mean_mm);
+          lr.c_mm_by_seed[key].push_back(c->figures.mean_mm);
+          lr.uc_sync_mm_by_seed[key].push_back(uc->figures.sync_mm);
+          lr.c_sync_mm_by_seed[key].push_back(c->figures.sync_mm);
+          uc_std.push_back(uc->figures.std_mm);
+          uc_max.push_back(uc->figures.max_mm);
+          iso_uc.push_back(uc->figures.iso_accuracy_mm);
+          c_std.push_back(c->figures.std_mm);
+          c_max.push_back(c->figures.max_mm);
+          iso_c.push_back(c->figures.iso_accuracy_mm);
+          iso_rep.push_back(c->figures.iso_repeatability_mm);
+        }
+        lr.uc_std_mm[key] = mean_over_seeds(uc_std);
+        lr.uc_max_mm[key] = mean_over_seeds(uc_max);
+        lr.iso_accuracy_uc_mm[key] = mean_over_seeds(iso_uc);
+        lr.c_std_mm[key] = mean_over_seeds(c_std);
+        lr.c_max_mm[key] = mean_over_seeds(c_max);
+        lr.iso_accuracy_c_mm[key] = mean_over_seeds(iso_c);
+        lr.iso_repeatability_mm[key] = mean_over_seeds(iso_rep);
       }
-      lr.fill_compensation();
+      lr.fill_means();
       sr.loads.push_back(lr);
     }
     study.setups.push_back(sr);
     if (options.speed_sweep) {
       const double load = sweep_load(s);
       for (double v : config.sweep_speeds_m_s) {
-        const LoadedJob* uc = find(fam, RunKind::kUncompensated, s.strategy, load, v);
-        const LoadedJob* c = find(fam, RunKind::kCompensated, s.strategy, load, v);
         SweepPoint p;
         p.setup = s.name;
         p.load_N = load;
         p.speed_mm_s = v * 1e3;
-        p.uc_mm = uc->figures.mean_mm;
-        p.c_mm = c->figures.mean_mm;
+        for (int si = 0; si < n_seeds; ++si) {
+          const LoadedJob* uc = find(si, fam, RunKind::kUncompensated, s.strategy, load, v);
+          const LoadedJob* c = find(si, fam, RunKind::kCompensated, s.strategy, load, v);
+          p.uc_mm_by_seed.push_back(uc->figures.mean_mm);
+          p.c_mm_by_seed.push_back(c->figures.mean_mm);
+          p.c_sync_mm_by_seed.push_back(c->figures.sync_mm);
+        }
+        p.uc_mm = mean_over_seeds(p.uc_mm_by_seed);
+        p.c_mm = mean_over_seeds(p.c_mm_by_seed);
+        p.c_sync_mm = mean_over_seeds(p.c_sync_mm_by_seed);
         p.compensation = compensation_ratio(p.uc_mm, p.c_mm);
         study.speed_sweep.push_back(p);
       }
     }
-    // Path plot traces.
-    const LoadedJob* uc = find(fam, RunKind::kUncompensated, s.strategy, s.loads_n.back(), config.speeds_m_s.front());
-    const LoadedJob* c = find(fam, RunKind::kCompensated, s.strategy, s.loads_n.back(), config.speeds_m_s.front());
+    // Path plot traces (first seed).
+    const double v0 = config.speeds_m_s.front();
+    const LoadedJob* uc = find(0, fam, RunKind::kUncompensated, s.strategy, s.loads_n.back(), v0);
+    const LoadedJob* c = find(0, fam, RunKind::kCompensated, s.strategy, s.loads_n.back(), v0);
     if (uc && c && !uc->keep.trace.empty() && !c->keep.trace.empty()) {
+      const Reference& ref = unloaded.at({0, fam, mm_s(v0)});
       PlotTraces pt;
-      pt.title =
-          fmt::format("{}: {:.0f} N at {} mm/s (last lap)", s.name, s.loads_n.back(), mm_s(config.speeds_m_s.front()));
-      pt.unloaded =
-          thin_lap(families[static_cast<std::size_t>(fam)].unloaded.at(mm_s(config.speeds_m_s.front())).run, 1500);
+      pt.setup = s.name;
+      pt.load_n = s.loads_n.back();
+      pt.speed_mm_s = mm_s(v0);
+      pt.title = fmt::format("{}: {:.0f} N at {} mm/s (seed {})", s.name, s.loads_n.back(), mm_s(v0), config.seed);
+      pt.unloaded = thin_lap(ref.run, 1500);
+      pt.unloaded_mean = thin(ref.mean, 1500);
       pt.uc = thin_lap(uc->keep, 1500);
       pt.c = thin_lap(c->keep, 1500);
+      pt.uc_laps = plot_laps(uc->keep, 720);
+      pt.c_laps = plot_laps(c->keep, 720);
       out.plots.push_back(std::move(pt));
     }
   }
   for (int si : budget_setups) {
     const SetupConfig& sc = config.setups[static_cast<std::size_t>(si)];
-    BudgetResult b;
+    const int fam = family_of(sc);
+    ErrorBudget b;
     b.setup = sc.name;
-    b.load_n = sc.loads_n[static_cast<std::size_t>(config.budget.load_index)];
-    b.speed_mm_s = config.budget.speed_m_s * 1e3;
+    b.load_N = sc.loads_n[static_cast<std::size_t>(config.budget.load_index)];
+    b.speed_mm_s = mm_s(config.budget.speed_m_s);
+    b.seed = config.seed;
+    b.laps = laps;
+    b.residual_mm_all = find(0, fam, RunKind::kCompensated, sc.strategy, b.load_N, config.budget.speed_m_s)->figures.mean_mm;
+    b.uc_mm = find(0, fam, RunKind::kUncompensated, sc.strategy, b.load_N, config.budget.speed_m_s)->figures.mean_mm;
     for (const auto& bj : budget_jobs) {
       if (bj.setup != si) continue;
-      if (!bj.off) {
-        b.residual_mm_all = bj.residual_mm;
-        b.uc_mm = bj.uc_mm;
-      } else {
-        b.rows.push_back(BudgetRow{*bj.off, to_string(*bj.off), effect_size(config, *bj.off), bj.residual_mm});
-      }
+      b.entries.push_back(ErrorBudgetEntry{to_string(bj.off), effect_size(config, bj.off), bj.residual_mm,
+                                           residual_share(b.residual_mm_all, bj.residual_mm)});
     }
-    out.budgets.push_back(std::move(b));
+    study.error_budgets.push_back(std::move(b));
   }
 
-  // The cell in words.
+  // The cell in words (the first seed's).
   for (int f = 0; f < 2; ++f) {
     if (!need_cell[f]) continue;
-    const SetupCell& cell = *cells[f];
+    const SetupCell& cell = cell_of(0, f == 1);
     std::string k_true, k_id;
     const auto& kt = cell.robot->true_model().stiffness();
     const auto& ki = cell.calibration.identified.stiffness();
@@ -503,13 +607,13 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
       k_id += fmt::format("{}{:.3g}", j ? ", " : "", ki[j]);
     }
     out.setup_paragraphs.push_back(fmt::format(
-        "Setup {} the force sensor: true joint stiffness (diagonal, Nm/rad) [{}]; identified from {} calibration "
-        "measurements in the operating space [{}] (residual {:.1f} um RMS). The identified values absorb what the "
-        "lumped model lacks ({}).",
-        f == 1 ? "with" : "without", k_true, cell.calibration.measurements, k_id,
+        "Setup {} the force sensor (seed {}): true joint stiffness (diagonal, Nm/rad) [{}]; identified from {} "
+        "calibration measurements taken while moving along {} arcs in the operating space [{}] (residual {:.1f} um "
+        "RMS). The identified values absorb what the lumped model lacks ({}).",
+        f == 1 ? "with" : "without", config.seed, k_true, cell.calibration.measurements, config.calibration.arcs, k_id,
         cell.calibration.estimate.residual_rms_m * 1e6,
-        f == 1 ? "sensor compliance, joint coupling, forearm bending, lost motion"
-               : "joint coupling, forearm bending, lost motion"));
+        f == 1 ? "sensor compliance, joint coupling, link bending, base tilt, lost motion"
+               : "joint coupling, link bending, base tilt, lost motion"));
     for (const auto& note : cell.calibration.notes) {
       if (note.find("kept the assumed") != std::string::npos || note.find("poorly") != std::string::npos) {
         out.setup_paragraphs.back() += " Calibration: " + note + ".";
@@ -524,15 +628,17 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
       "reach the controller through deflex's own links over the cell's network: EGM position guidance (deflex streams "
       "the program every {:.0f} ms; the controller follows after {:.0f} ms of dead time through a {:.0f} Hz filter, "
       "gain {:.0f}/s plus deflex's speed reference) or EGM path correction (the controller asks every {:.0f} ms and "
-      "applies an offset {:.0f} ms later). Seed {}.",
+      "applies an offset {:.0f} ms later). {} seed{} ({}{}): each its own true robot, sensor and calibration; the "
+      "tables give the mean over them and their spread.",
       config.radius_m() * 1e3, config.circle.center_m.x() * 1e3, config.circle.center_m.y() * 1e3,
       config.circle.center_m.z() * 1e3, config.circle.points, config.cell.ldbb.bar_length_m * 1e3,
       rad_to_deg(config.cell.ldbb.inclination_rad), laps_cw, laps_ccw, config.cell.tracker.rate_hz,
       config.cell.tracker.noise_m * 1e6, k.servo_period_s * 1e3, k.egm_period_s * 1e3, k.egm_dead_time_s * 1e3,
-      k.egm_lowpass_hz, k.egm_position_gain_per_s, k.path_corr_period_s * 1e3, k.path_corr_dead_time_s * 1e3,
-      config.seed));
-  out.runs = static_cast<int>(loaded.size()) + static_cast<int>(budget_jobs.size()) * 2 + static_cast<int>(budget_setups.size());
-  out.runs += static_cast<int>(families.size() * speeds.size());
+      k.egm_lowpass_hz, k.egm_position_gain_per_s, k.path_corr_period_s * 1e3, k.path_corr_dead_time_s * 1e3, n_seeds,
+      n_seeds == 1 ? "" : "s", config.seed, n_seeds == 1 ? std::string() : fmt::format(" to {}", cfg_of(n_seeds - 1).seed)));
+  out.runs = static_cast<int>(loaded.size()) + static_cast<int>(budget_jobs.size()) * 2;
+  out.runs += n_seeds * static_cast<int>(families.size() * speeds.size());
+  out.calibrations += static_cast<int>(budget_jobs.size());
   out.simulated_s = progress.total;
   study.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;

@@ -1,8 +1,9 @@
-// The paper's protocol on the simulated cell, end to end (paper, section 3): per setup, load and
-// speed an unloaded, a loaded uncompensated (UC) and a loaded compensated (C) run, evaluated by the
-// paper's mean distance from the unloaded path and ISO 9283; the speed sweep; the error budget.
-// Runs are independent and seeded by their identity, so they run on every core and the figures do
-// not depend on the scheduling.
+// The paper's protocol on the simulated cell, end to end (paper, section 3): per seed, setup, load
+// and speed an unloaded, a loaded uncompensated (UC) and a loaded compensated (C) run, evaluated by
+// the paper's mean distance from the unloaded path, a time-synchronous error and ISO 9283; the speed
+// sweep; the error budget. Each seed is its own cell (true robot, sensor, calibration); the figures
+// are the mean and spread over the seeds. Runs are independent and seeded by their identity, so they
+// run on every core and the figures do not depend on the scheduling.
 #pragma once
 
 #include <functional>
@@ -11,45 +12,43 @@
 
 #include "deflex/study/case_config.hpp"
 #include "deflex/evaluate/study_tables.hpp"
+#include "deflex/evaluate/lap_split.hpp"
 #include "deflex/evaluate/tracker_trace.hpp"
 
 namespace deflex::study {
 
 struct CaseStudyOptions {
   bool quick = false;  ///< one clockwise and one anticlockwise lap per run
+  int seeds = 0;       ///< seeds to run (0: the case's protocol.seeds)
   bool speed_sweep = true;
   bool error_budget = true;
   int threads = 0;  ///< 0: one per hardware thread
   /// Progress in [0, 1] with a short label; called from worker threads, one call at a time.
   std::function<void(double fraction, const std::string& label)> progress;
+  /// Called with every run of the first seed at the error budget's speed and the highest load
+  /// (and the unloaded runs at that speed), for --write-traces: a name and the tracker trace.
+  /// Called from worker threads, one call at a time.
+  std::function<void(const std::string& name, const TrackerTrace& trace)> trace_sink;
 };
 
-/// One row of the error budget: the compensated residual with one effect switched off.
-struct BudgetRow {
-  Effect effect = Effect::kLostMotion;
-  std::string name;
-  std::string size;
-  double residual_mm_without = 0.0;
-};
-
-struct BudgetResult {
+/// Traces for the path plots of one setup at one load and speed (the study's first seed).
+struct PlotTraces {
+  std::string title;
   std::string setup;
   double load_n = 0.0;
   double speed_mm_s = 0.0;
-  double residual_mm_all = 0.0;
-  double uc_mm = 0.0;
-  std::vector<BudgetRow> rows;
-};
-
-/// Traces for a path plot (one lap each, thinned for drawing).
-struct PlotTraces {
-  std::string title;
-  TrackerTrace unloaded, uc, c;
+  TrackerTrace unloaded, uc, c;  ///< the last lap of each run, thinned
+  TrackerTrace unloaded_mean;    ///< the mean of the unloaded laps: the reference the distances are taken to
+  /// Every lap of the loaded runs, in order, thinned, each with its direction of travel as the
+  /// trace shows it (not as the protocol says).
+  std::vector<DirectedLap> uc_laps, c_laps;
 };
 
 /// What deflex's links did in the online runs (every run of the study, summed or maximised).
 struct LinkSummary {
   std::string setup;
+  std::string link;                       ///< the link kind (egm-joint, egm-path, ...)
+  bool joint_commands = true;             ///< the link sends joints (else Cartesian offsets)
   std::uint64_t cycles = 0;               ///< controller messages answered
   std::uint64_t rejected = 0;             ///< datagrams counted and not answered
   std::uint64_t guard_trips = 0;          ///< commands the final check stopped (must be 0)
@@ -62,11 +61,11 @@ struct LinkSummary {
 struct CaseStudyOutput {
   StudyResult study;
   std::vector<LinkSummary> links;
-  std::vector<BudgetResult> budgets;
   std::vector<PlotTraces> plots;
   std::vector<std::string> setup_paragraphs;  ///< the cell and calibration in words
-  double simulated_s = 0.0;                   ///< total simulated robot time
+  double simulated_s = 0.0;                   ///< total simulated robot time (runs and calibrations)
   int runs = 0;
+  int calibrations = 0;
 };
 
 /// Runs the whole study. Throws deflex::Error on a case the cell cannot run (unreachable circle ...).
