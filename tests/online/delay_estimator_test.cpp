@@ -59,5 +59,25 @@ TEST(DelayEstimator, MeasuresNothingAtRestAndIgnoresMismatchesOnceSettled) {
   EXPECT_EQ(guard.allocations(), 0u);
 }
 
+TEST(DelayEstimator, AnArmThatHasNotStartedYetGivesNoMeasurement) {
+  // The reference starts moving at t = 1 s; the arm, 80 ms behind, stands at the start until then.
+  // Matched against the reference's start, the standing arm would "measure" the time since the
+  // reference left it (80 ms, then more); only the moving arm measures the delay.
+  const double delay = 0.08;
+  const auto ref = [](double t) { return path_at(std::max(0.0, t - 1.0)); };
+  DelayEstimator e(0.05);
+  double first = NAN;
+  for (int k = 0; k < 750; ++k) {
+    const double t = 0.004 * k;
+    e.record_reference(t, ref(t));
+    e.observe_feedback(t, ref(t - delay));
+    if (e.measured() && std::isnan(first)) first = e.last_measurement_s();
+  }
+  ASSERT_TRUE(e.measured());
+  EXPECT_NEAR(first, delay, 2e-3);           // the first measurement is already the delay
+  EXPECT_NEAR(e.mean_s(), delay, 1e-3);      // and no early wrong one weighs on the mean
+  EXPECT_EQ(e.outliers(), 0u);
+}
+
 }  // namespace
 }  // namespace deflex

@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <random>
 
+#include <boost/random/normal_distribution.hpp>
+
 #include "deflex/cell/cell_config.hpp"
 
 namespace deflex::cell {
@@ -47,7 +49,7 @@ class ForceSensorDaq {
   Vector3 zero_drift_n_per_s_ = Vector3::Zero();
   SensorCalibration calibration_;
   std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  boost::random::normal_distribution<double> normal_{0.0, 1.0};
 };
 
 /// Standard gravity, m/s^2.

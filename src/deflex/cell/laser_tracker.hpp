@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <random>
 
+#include <boost/random/normal_distribution.hpp>
+
 #include "deflex/cell/cell_config.hpp"
 #include "deflex/evaluate/tracker_trace.hpp"
 
@@ -24,7 +26,7 @@ class LaserTracker {
  private:
   TrackerConfig config_;
   std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  boost::random::normal_distribution<double> normal_{0.0, 1.0};
   double next_s_, last_s_, origin_s_, period_s_;
 };
 

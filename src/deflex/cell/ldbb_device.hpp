@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <random>
 
+#include <boost/random/normal_distribution.hpp>
+
 #include "deflex/cell/cell_config.hpp"
 
 namespace deflex::cell {
@@ -37,7 +39,7 @@ class LdbbDevice {
   double travel_m_ = 0.0;  // the TCP's path travel, for the stick-slip
   double last_dt_s_ = 0.0;
   std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  boost::random::normal_distribution<double> normal_{0.0, 1.0};
 };
 
 }  // namespace deflex::cell

@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <random>
 
+#include <boost/random/normal_distribution.hpp>
+
 #include "deflex/cell/cell_config.hpp"
 
 namespace deflex::cell {
@@ -38,7 +40,7 @@ class PathDrift {
  private:
   DriftConfig config_;
   std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  boost::random::normal_distribution<double> normal_{0.0, 1.0};
   Vector3 offset_m_ = Vector3::Zero();
   Vector3 rotation_rad_ = Vector3::Zero();
   Vector3 wander_m_ = Vector3::Zero();

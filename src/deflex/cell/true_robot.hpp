@@ -46,6 +46,9 @@ struct TrueRobotState {
   JointVector q_actual;    ///< last solved configuration (warm start of the next solve)
   JointVector q_cmd_last;  ///< command of the last solve
   JointVector q_motor;     ///< the motors' position at the last solve: the command less the following error
+  /// The deflection q_actual - q_motor of the last solve and its change from the one before (the next
+  /// solve's starting guess extrapolates it).
+  JointVector deflection, deflection_step;
   std::array<LostMotion, kMaxJoints> lost_motion{};
   JointVector gravity_torque_nm;  ///< preload of the lost motion (constant)
   JointVector torque_lowpass_nm;  ///< the servo's integral action: the process torque it has taken over

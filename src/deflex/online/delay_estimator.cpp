@@ -24,13 +24,22 @@ void DelayEstimator::record_reference(double t_s, const JointVector& q_ref) noex
 }
 
 void DelayEstimator::observe_feedback(double t_s, const JointVector& q_feedback) noexcept {
-  if (count_ < 3 || !q_feedback.allFinite()) {
+  if (!q_feedback.allFinite()) {
+    return;
+  }
+  // The arm must be moving: standing (before it starts, or stopped) it matches any reference that
+  // passed its place, at any delay.
+  constexpr double kMinStepRad = 1e-6;
+  const bool moving = have_feedback_ && last_feedback_.size() == q_feedback.size() &&
+                      (q_feedback - last_feedback_).norm() >= kMinStepRad;
+  last_feedback_ = q_feedback;
+  have_feedback_ = true;
+  if (count_ < 3 || !moving) {
     return;
   }
   const auto at = [&](int k) { return static_cast<std::size_t>((head_ - 1 - k + kRing) % kRing); };
   // The reference must be moving now (at rest, or after it stopped, every recent reference matches
   // the feedback equally), and the matched piece of it must be moving too.
-  constexpr double kMinStepRad = 1e-6;
   if ((q_[at(0)] - q_[at(1)]).norm() < kMinStepRad) return;
   double best = std::numeric_limits<double>::infinity();
   double best_t = 0.0;

@@ -1,8 +1,9 @@
 // Measures a controller link's delay: how long after a joint reference is given the robot's feedback
 // shows it. Each feedback sample is matched against the recent references (the nearest point on the
 // reference's polyline, by joint distance), and the time between them is one measurement; the
-// estimate is their running average. Only samples taken while the reference moves are used (at rest
-// every reference matches), and once settled a measurement far from the estimate is left out (a run of
+// estimate is their running average. Only samples taken while both the reference and the feedback
+// move are used (at rest every reference matches; an arm that has not started yet matches the
+// reference's start at any delay), and once settled a measurement far from the estimate is left out (a run of
 // them starts the estimate afresh). The predictive strategy leads by this delay. Fixed ring: no
 // allocation.
 #pragma once
@@ -47,6 +48,8 @@ class DelayEstimator {
   std::uint64_t measurements_ = 0;
   std::uint64_t outliers_ = 0;
   int consecutive_outliers_ = 0;
+  JointVector last_feedback_;  // the previous feedback sample: the arm must be moving too
+  bool have_feedback_ = false;
   int last_k_ = 0;       // segments back from the newest reference at the last match
   int since_full_ = 0;   // samples since the last search of the whole window
   double sum_s_ = 0.0;

@@ -131,8 +131,11 @@ CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robo
         state = robot.initial_state(q);
         have_state = true;
       } else {
-        state.q_actual = q;  // the arm moved here unloaded: only the lost motion remembers
-        state.q_cmd_last = q;
+        // The arm moved here unloaded and stood: only the lost motion remembers.
+        const cell::TrueRobotState fresh = robot.initial_state(q);
+        const auto lost_motion = state.lost_motion;
+        state = fresh;
+        state.lost_motion = lost_motion;
       }
       Vector3 p_prev = drift.apply(robot.solve(ws, q, Wrench::Zero(), state));
       Vector3 v_prev = Vector3::Zero();

@@ -17,6 +17,7 @@
 #include "deflex/egm/egm_joint_link.hpp"
 #include "deflex/egm/egm_path_link.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
+#include "deflex/model/compliance.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/online/datagram_force_source.hpp"
@@ -119,6 +120,30 @@ std::vector<JointVector> offline_configurations(const CaseConfig& config, const 
     q.push_back(p.q_command);
   }
   return q;
+}
+
+double identified_model_error(const CaseConfig& config, const SetupCell& setup, double load_n, double* scale) {
+  const LdbbForceModel force(config.pivot_m(), load_n, config.cell.ldbb.push);
+  const RobotModel& model = setup.calibration.identified;
+  const cell::TrueRobot& robot = *setup.robot;
+  Workspace ws(model);
+  Workspace ws_true(robot.true_model());
+  double error_sum = 0.0, scale_sum = 0.0;
+  int n = 0;
+  for (std::size_t i = 0; i + 1 < setup.nominal_path.q.size(); ++i) {
+    const JointVector& q = setup.nominal_path.q[i];
+    const Wrench w = force.wrench_at(i, tcp_pose(model, ws, q));
+    const Vector3 d_model = tcp_deflection(model, ws, q, w).head<3>();
+    cell::TrueRobotState state = robot.initial_state(q);
+    const Vector3 unloaded = robot.solve(ws_true, q, Wrench::Zero(), state);
+    const Vector3 d_true = robot.solve(ws_true, q, w, state) - unloaded;
+    if (!(d_true.norm() > 0.0)) continue;
+    error_sum += (d_model - d_true).norm() / d_true.norm();
+    scale_sum += d_model.norm() / d_true.norm();
+    ++n;
+  }
+  if (scale != nullptr) *scale = n > 0 ? scale_sum / n : NAN;
+  return n > 0 ? error_sum / n : NAN;
 }
 
 deflex::SensorConfig sensor_config_from_sheet(const CaseConfig& config, const cell::SensorCalibration& sheet) {

@@ -75,6 +75,15 @@ struct RunOutput {
 [[nodiscard]] std::vector<JointVector> offline_configurations(const CaseConfig& config, const SetupCell& setup,
                                                               double load_n);
 
+/// How well a setup's identified model predicts the true arm on the circle (a diagnostic of the
+/// calibration, for the report; no strategy sees it): at every programmed point, the static TCP
+/// deflection under the LDBB's nominal force (set-point along the nominal bar) from the identified
+/// lumped model against the true robot's (all its elastic effects, from the unloaded pose, lost
+/// motion included). Returns the mean over the points of |model - true| / |true|, and the mean of
+/// |model| / |true| in `scale`.
+[[nodiscard]] double identified_model_error(const CaseConfig& config, const SetupCell& setup, double load_n,
+                                            double* scale = nullptr);
+
 /// What a user's sensor file would hold for the cell's sensor: its calibration sheet (decoupling,
 /// bias, payload), the mount, and deflex's conditioning settings from the case.
 [[nodiscard]] deflex::SensorConfig sensor_config_from_sheet(const CaseConfig& config,
