@@ -30,9 +30,13 @@ void DelayEstimator::observe_feedback(double t_s, const JointVector& q_feedback)
   // The arm must be moving: standing (before it starts, or stopped) it matches any reference that
   // passed its place, at any delay.
   constexpr double kMinStepRad = 1e-6;
-  const bool moving = have_feedback_ && last_feedback_.size() == q_feedback.size() &&
-                      (q_feedback - last_feedback_).norm() >= kMinStepRad;
+  const double feedback_step = have_feedback_ && last_feedback_.size() == q_feedback.size()
+                                   ? (q_feedback - last_feedback_).norm()
+                                   : 0.0;
+  const double feedback_dt = t_s - last_feedback_t_;
+  const bool moving = have_feedback_ && feedback_step >= kMinStepRad && feedback_dt > 0.0;
   last_feedback_ = q_feedback;
+  last_feedback_t_ = t_s;
   have_feedback_ = true;
   if (count_ < 3 || !moving) {
     return;
@@ -44,6 +48,7 @@ void DelayEstimator::observe_feedback(double t_s, const JointVector& q_feedback)
   double best = std::numeric_limits<double>::infinity();
   double best_t = 0.0;
   double best_step = 0.0;
+  double best_dt = 0.0;
   int best_k = -1;
   const auto scan = [&](int k_from, int k_to) {  // segments k in [k_from, k_to], k back from the newest
     for (int k = std::max(1, k_from); k <= k_to && k < count_; ++k) {
@@ -59,6 +64,7 @@ void DelayEstimator::observe_feedback(double t_s, const JointVector& q_feedback)
         best = dist;
         best_t = t_[i0] + s * (t_[i1] - t_[i0]);
         best_step = std::sqrt(len2);
+        best_dt = t_[i1] - t_[i0];
         best_k = k;
       }
     }
@@ -85,18 +91,35 @@ void DelayEstimator::observe_feedback(double t_s, const JointVector& q_feedback)
   if (!(best_step > kMinStepRad) || !(best < 0.1 * travel)) {
     return;
   }
+  // A delay line keeps the speed: the arm moves now as fast as the reference did where it matched.
+  // An arm settling at the end of a motion creeps far slower than the reference it matches.
+  const double speed_ratio = best_dt > 0.0 ? (feedback_step / feedback_dt) / (best_step / best_dt) : 0.0;
+  if (!(speed_ratio > 0.5 && speed_ratio < 2.0)) {
+    return;
+  }
   const double sample = t_s - best_t;
   if (!(sample >= 0.0) || !(sample < window_s_)) return;
   // Once the estimate has settled, a measurement far from it is a mismatch (a reversal, the arm
   // coming to rest), not a change of the link: it is counted and left out.
-  if (measurements_ >= 20 && std::abs(sample - delay_s_) > std::max(0.02, 0.5 * delay_s_)) {
+  const auto far = [](double a, double b) { return std::abs(a - b) > std::max(0.02, 0.5 * b); };
+  if (measurements_ >= 20 && far(sample, delay_s_)) {
     ++outliers_;
-    // Many in a row are no mismatch: the first estimate was wrong or the link changed. Start again.
+    // Many in a row that agree with each other are no mismatch: the first estimate was wrong or the
+    // link changed. Start again from them. Mismatches that scatter start the count afresh.
+    const double run_mean = consecutive_outliers_ > 0 ? outlier_sum_s_ / consecutive_outliers_ : sample;
+    if (std::abs(sample - run_mean) > std::max(0.01, 0.25 * run_mean)) {
+      consecutive_outliers_ = 0;
+      outlier_sum_s_ = 0.0;
+    }
+    outlier_sum_s_ += sample;
     if (++consecutive_outliers_ < 25) return;
-    measurements_ = 0;
-    sum_s_ = 0.0;
+    // The estimate restarts as the mean of the run of them (this sample is added below).
+    delay_s_ = outlier_sum_s_ / consecutive_outliers_;
+    measurements_ = static_cast<std::uint64_t>(consecutive_outliers_ - 1);
+    sum_s_ = outlier_sum_s_ - sample;
   }
   consecutive_outliers_ = 0;
+  outlier_sum_s_ = 0.0;
   last_s_ = sample;
   ++measurements_;
   sum_s_ += sample;

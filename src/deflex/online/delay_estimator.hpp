@@ -2,9 +2,11 @@
 // shows it. Each feedback sample is matched against the recent references (the nearest point on the
 // reference's polyline, by joint distance), and the time between them is one measurement; the
 // estimate is their running average. Only samples taken while both the reference and the feedback
-// move are used (at rest every reference matches; an arm that has not started yet matches the
+// move, the feedback as fast as the reference did where it matched (a delay line keeps the speed),
+// are used (at rest every reference matches; an arm that has not started yet matches the
 // reference's start at any delay), and once settled a measurement far from the estimate is left out (a run of
-// them starts the estimate afresh). The predictive strategy leads by this delay. Fixed ring: no
+// them that agree with each other, a link whose delay changed, starts the estimate afresh from them;
+// scattered mismatches, as when the arm comes to rest, never do). The predictive strategy leads by this delay. Fixed ring: no
 // allocation.
 #pragma once
 
@@ -47,8 +49,10 @@ class DelayEstimator {
   double last_s_;
   std::uint64_t measurements_ = 0;
   std::uint64_t outliers_ = 0;
-  int consecutive_outliers_ = 0;
+  int consecutive_outliers_ = 0;  // in a row, and agreeing with each other (a changed link)
+  double outlier_sum_s_ = 0.0;     // their sum
   JointVector last_feedback_;  // the previous feedback sample: the arm must be moving too
+  double last_feedback_t_ = 0.0;
   bool have_feedback_ = false;
   int last_k_ = 0;       // segments back from the newest reference at the last match
   int since_full_ = 0;   // samples since the last search of the whole window
