@@ -621,6 +621,37 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
   return study;
 }
 
+namespace {
+
+// The time-synchronous (along-path) error of each load: UC (mean over the speeds) and C per speed,
+// as rows of text cells; empty when no load carries it.
+std::vector<std::vector<std::string>> sync_rows(const SetupResult& s, const std::vector<int>& speeds) {
+  std::vector<std::vector<std::string>> rows;
+  bool any = false;
+  for (const auto& l : s.loads) {
+    std::vector<std::string> r{fmt::format("{:g} N", l.load_N)};
+    double uc = 0.0;
+    int n = 0;
+    for (const auto& [v, x] : l.uc_sync_mm) {
+      if (std::isfinite(x)) {
+        uc += x;
+        ++n;
+      }
+    }
+    r.push_back(n > 0 ? fmt::format("{:.3f}", uc / n) : "-");
+    for (int v : speeds) {
+      const double c = value_at_speed(l.c_sync_mm, v);
+      any = any || std::isfinite(c);
+      r.push_back(std::isfinite(c) ? fmt::format("{:.3f}", c) : "-");
+    }
+    rows.push_back(std::move(r));
+  }
+  if (!any) rows.clear();
+  return rows;
+}
+
+}  // namespace
+
 std::string study_tables_text(const StudyResult& study) {
   const PaperFigures paper = paper_reference();
   const std::vector<int> speeds = study_speeds_mm_s(study);
@@ -674,6 +705,18 @@ std::string study_tables_text(const StudyResult& study) {
         out += fmt::format("  UC against the paper's: {}\n", diffs);
       }
     }
+    const auto sync = sync_rows(s, speeds);
+    if (!sync.empty()) {
+      out += "  Time-synchronous error (against the unloaded run at the same time: sees lag along the path), mm:\n";
+      std::string head = fmt::format("  {:<7} {:>6}", "load", "UC");
+      for (int v : speeds) head += fmt::format(" {:>10}", fmt::format("C {} mm/s", v));
+      out += head + "\n";
+      for (const auto& r : sync) {
+        std::string l = fmt::format("  {:<7} {:>6}", r[0], r[1]);
+        for (std::size_t c = 2; c < r.size(); ++c) l += fmt::format(" {:>10}", r[c]);
+        out += l + "\n";
+      }
+    }
     out += "\n";
   }
   return out;
@@ -708,6 +751,20 @@ std::string study_tables_markdown(const StudyResult& study) {
         out.append(" ").append(c).append(" |");
       }
       out += "\n";
+    }
+    const auto sync = sync_rows(s, speeds);
+    if (!sync.empty()) {
+      out += "\nTime-synchronous error in mm (against the unloaded run at the same time: it sees lag along the path, "
+             "which the nearest-point distance does not).\n\n| load | UC |";
+      for (int v : speeds) out += fmt::format(" C {} mm/s |", v);
+      out += "\n| --- | ---: |";
+      for (std::size_t c = 0; c < speeds.size(); ++c) out += " ---: |";
+      out += "\n";
+      for (const auto& r : sync) {
+        out += "|";
+        for (const auto& c : r) out.append(" ").append(c).append(" |");
+        out += "\n";
+      }
     }
     out += "\n";
   }
