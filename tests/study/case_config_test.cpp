@@ -164,6 +164,11 @@ TEST(CaseConfig, OutOfRangeEffectSizesAndSeedsAreRefusedByName) {
   EXPECT_NE(drift.find("zero_drift_N_per_10min"), std::string::npos) << drift;
   const std::string slip = error_of(paper_with("stick_slip_travel_mm: 0.5", "stick_slip_travel_mm: 0"));
   EXPECT_NE(slip.find("stick_slip_travel_mm"), std::string::npos) << slip;
+  const std::string from = error_of(paper_with("  ldbb_force_error_pct: 5", "  force_from: tracker\n  ldbb_force_error_pct: 5"));
+  EXPECT_NE(from.find("calibration.force_from"), std::string::npos) << from;
+  EXPECT_NE(from.find("sensor or ldbb"), std::string::npos) << from;
+  const std::string bias = error_of(paper_with("  ldbb_force_error_pct: 5", "  ldbb_force_bias_pct: -60\n  ldbb_force_error_pct: 5"));
+  EXPECT_NE(bias.find("calibration.ldbb_force_bias_pct"), std::string::npos) << bias;
   const std::string seeds = error_of(paper_with("seeds: 4", "seeds: 0"));
   EXPECT_NE(seeds.find("protocol.seeds"), std::string::npos) << seeds;
   const std::string old_budget = error_of(paper_with("  load_index: 2", "  load_index: 2\n  laps_each_way: 1"));

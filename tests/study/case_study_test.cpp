@@ -269,6 +269,33 @@ TEST(CellCalibration, WhileMovingItFindsTheTrueStiffnessOfAModelConsistentCell) 
   }
 }
 
+TEST(CellCalibration, TheForceItTakesDecidesWhatAnLdbbBiasDoesToTheModel) {
+  // A model-consistent cell with the sensor mounted and an LDBB whose force is 10 % under its
+  // set-point at calibration time. Taking the sensor's force, the bias does not matter; taking the
+  // set-point, every deflection is put down to a force 1/0.9 of the true one, so the identified
+  // stiffness comes out 1/0.9 of the true.
+  CaseConfig c = model_consistent(paper_case(), false);
+  c.exact_model = false;
+  c.calibration.ldbb_force_error = 0.0;
+  c.calibration.ldbb_force_bias = -0.10;
+  c.cell.ldbb.ripple = 0.0;
+  c.cell.ldbb.noise = 0.0;
+  c.cell.sensor.noise_n = 0.0;
+  c.cell.sensor.lateral_compliance_m_per_n = 0.0;
+  c.cell.sensor.axial_compliance_m_per_n = 0.0;
+  c.cell.sensor.rotational_compliance_rad_per_nm = 0.0;
+  for (const bool from_sensor : {true, false}) {
+    c.calibration.force_from_sensor = from_sensor;
+    const SetupCell cell = build_setup_cell(c, true);
+    const double expected = from_sensor ? 1.0 : 1.0 / 0.9;
+    for (int j : {0, 1, 2, 4}) {
+      EXPECT_NEAR(cell.calibration.identified.stiffness()[j] / cell.robot->true_model().stiffness()[j], expected,
+                  0.03 * expected)
+          << "joint " << j + 1 << (from_sensor ? " (sensor)" : " (set-point)");
+    }
+  }
+}
+
 TEST(CellModule, IncludesNothingOfTheStrategiesOrTheirLinks) {
   // The simulated cell is hardware: it may speak the links' wire formats, never run their code.
   namespace fs = std::filesystem;

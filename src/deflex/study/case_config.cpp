@@ -322,7 +322,14 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   c.online.ramp_in_s = non_negative(on.at("ramp_in_s"));
 
   const auto cal = root.at("calibration");
-  cal.only_keys({"arcs", "arc_deg", "speed_mm_s", "load_N", "points_per_arc", "window_ms", "ldbb_force_error_pct"});
+  cal.only_keys({"arcs", "arc_deg", "speed_mm_s", "load_N", "points_per_arc", "window_ms", "ldbb_force_error_pct",
+                 "ldbb_force_bias_pct", "force_from"});
+  c.calibration.ldbb_force_bias = cal.get("ldbb_force_bias_pct", 0.0) / 100.0;
+  if (!std::isfinite(c.calibration.ldbb_force_bias) || std::abs(c.calibration.ldbb_force_bias) >= 0.5)
+    cal.at("ldbb_force_bias_pct").fail("must be within +-50 %");
+  const std::string force_from = cal.get("force_from", std::string("sensor"));
+  if (force_from != "sensor" && force_from != "ldbb") cal.at("force_from").fail("must be sensor or ldbb");
+  c.calibration.force_from_sensor = force_from == "sensor";
   c.calibration.arcs = cal.at("arcs").as_int();
   if (c.calibration.arcs < 3 || c.calibration.arcs > 60) cal.at("arcs").fail("must be 3..60");
   c.calibration.arc_rad = deg_to_rad(positive(cal.at("arc_deg")));
@@ -468,7 +475,12 @@ std::string effect_size(const CaseConfig& c, Effect e) {
     case Effect::kTrackerNoise:
       return fmt::format("{:.1f} um (1 sigma)", c.cell.tracker.noise_m * 1e6);
     case Effect::kCalibrationNoise:
-      return fmt::format("LDBB force {:.1f} % at calibration", c.calibration.ldbb_force_error * 100);
+      return fmt::format("LDBB force {:.1f} % (1 sigma){} at calibration, force from the {}",
+                         c.calibration.ldbb_force_error * 100,
+                         c.calibration.ldbb_force_bias != 0.0
+                             ? fmt::format(" {:+.0f} % bias", c.calibration.ldbb_force_bias * 100)
+                             : std::string(),
+                         c.calibration.force_from_sensor ? "sensor when mounted" : "LDBB set-point");
     case Effect::kLatency:
       return fmt::format("dead time {:.0f} ms, filter {:.0f} Hz", c.cell.controller.egm_dead_time_s * 1e3,
                          c.cell.controller.egm_lowpass_hz);
@@ -552,6 +564,7 @@ CaseConfig without_effect(const CaseConfig& config, Effect e) {
       break;
     case Effect::kCalibrationNoise:
       c.calibration.ldbb_force_error = 0.0;
+      c.calibration.ldbb_force_bias = 0.0;
       break;
     case Effect::kLatency:
       c.cell.controller.network_latency_s = 0.0;

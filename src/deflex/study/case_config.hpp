@@ -68,6 +68,12 @@ struct CalibrationConfig {
   /// The LDBB's force against its set-point at calibration time, relative 1-sigma, drawn per seed: a
   /// setup without the force sensor knows only the set-point (a setup with it measures the force).
   double ldbb_force_error = 0.0;
+  /// The LDBB's systematic force error at calibration time (true force = set-point x (1 + bias)),
+  /// on top of the random one.
+  double ldbb_force_bias = 0.0;
+  /// With the sensor mounted, take the calibration's force from the sensor (true) or, as a setup
+  /// without it must, from the LDBB's set-point (false).
+  bool force_from_sensor = true;
 };
 
 struct CircleConfig {

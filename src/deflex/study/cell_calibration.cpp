@@ -75,7 +75,10 @@ CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robo
   // The LDBB's force against its set-point today (the setup without the sensor knows only the
   // set-point; with the sensor the force is measured and this does not enter the estimate).
   cell::LdbbConfig ldbb_config = cc.ldbb;
-  ldbb_config.force_bias = cal.ldbb_force_error * normal(rng);
+  ldbb_config.force_bias = cal.ldbb_force_bias + cal.ldbb_force_error * normal(rng);
+  // Where the calibration's force comes from: the sensor when it is mounted (unless the user
+  // chose the LDBB's set-point), else the set-point.
+  const bool force_from_sensor = sensor_mounted && cal.force_from_sensor;
   // The sensor and what its sheet says (the same physical sensor as in the runs).
   cell::ForceSensorDaq sensor(cc.sensor, cc.tool, mix(seed ^ 0x5e5ULL), mix(c.seed ^ 0x5e5503ULL));
   const deflex::SensorConfig sheet = sensor_config_from_sheet(c, sensor.calibration());
@@ -151,7 +154,7 @@ CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robo
         }
         drift.advance(dt);
         const Vector3 p = drift.apply(robot.solve(ws, q, w, state, dt));
-        if (sensor_mounted && loaded) {
+        if (force_from_sensor && loaded) {
           const Matrix3 base_R_flange = ws.base_T_flange.linear();
           forward_kinematics(nominal, ws_nominal, q);  // the orientation deflex knows (nominal, encoders)
           const Matrix3 base_R_sensor = ws_nominal.base_T_flange.linear() * sheet.flange_T_sensor.linear();
@@ -192,7 +195,7 @@ CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robo
       program.sample(tj, m.q);  // the encoders' reading: the commanded joints
       m.dp_m = sum[1] / count[1] - sum[0] / count[0];
       m.wrench_base = Wrench::Zero();
-      if (sensor_mounted) {
+      if (force_from_sensor) {
         Vector3 f = Vector3::Zero();
         int nf = 0;
         for (std::size_t i = 0; i < passes[1].force_t.size(); ++i) {
