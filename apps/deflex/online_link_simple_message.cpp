@@ -44,7 +44,8 @@ void add_simple_message_options(CLI::App& sub) {
                  "simple-message: points kept queued on the controller; each adds one cycle of lag (reported; the "
                  "predictive strategy leads by the measured delay)")
       ->capture_default_str();
-  sub.add_option("--connect-timeout-s", g_sm->connect_timeout_s, "simple-message: wait this long for each connection, s")
+  sub.add_option("--connect-timeout-s", g_sm->connect_timeout_s,
+                 "simple-message: wait this long for each connection, s")
       ->capture_default_str();
   sub.add_option("--reply-timeout-s", g_sm->reply_timeout_s,
                  "simple-message: a point unanswered this long stops the motion, s")
@@ -61,7 +62,9 @@ void add_simple_message_options(CLI::App& sub) {
 }
 
 std::uint16_t port_option(int port, const char* option) {
-  if (port < 1 || port > 65535) throw InputError(fmt::format("option {}: must be a TCP port 1..65535 (got {})", option, port));
+  if (port < 1 || port > 65535) {
+    throw InputError(fmt::format("option {}: must be a TCP port 1..65535 (got {})", option, port));
+  }
   return static_cast<std::uint16_t>(port);
 }
 
@@ -77,7 +80,9 @@ SimpleMessageLinkConfig link_config(const OnlineContext& c) {
         kMinPeriodS * 1e3, c.period_s * 1e3));
   }
   const auto positive = [](double v, const char* option) {
-    if (!std::isfinite(v) || !(v > 0.0)) throw InputError(fmt::format("option {}: must be a number > 0 (got {})", option, v));
+    if (!std::isfinite(v) || !(v > 0.0)) {
+      throw InputError(fmt::format("option {}: must be a number > 0 (got {})", option, v));
+    }
   };
   positive(o.connect_timeout_s, "--connect-timeout-s");
   positive(o.reply_timeout_s, "--reply-timeout-s");

@@ -162,7 +162,9 @@ TEST(SimpleMessageServer, PublishesJointPositionAndStatusEveryTenthOfASecond) {
         ++joints;
         ASSERT_EQ(f.data.size(), 44u);
         EXPECT_EQ(f.i32(big, 0), 0);  // ROS_stateServer's sequence is 0
-        for (std::size_t j = 0; j < 6; ++j) EXPECT_EQ(f.f32(big, 1 + j), static_cast<float>(start()[static_cast<int>(j)]));
+        for (std::size_t j = 0; j < 6; ++j) {
+          EXPECT_EQ(f.f32(big, 1 + j), static_cast<float>(start()[static_cast<int>(j)]));
+        }
         for (std::size_t j = 6; j < 10; ++j) EXPECT_EQ(f.f32(big, 1 + j), 0.0f);
       } else if (f.type == 13) {
         ++statuses;

@@ -246,7 +246,8 @@ TEST(CliSimpleMessage, BadOptionsAreRefusedBeforeAnythingConnects) {
   };
   expect(base + " --period-ms 100", "--robot-host");
   expect(base + " --robot-host 127.0.0.1", "option --period-ms: simple-message sends one point a cycle");
-  expect(base + " --robot-host 127.0.0.1 --period-ms 100 --byte-order middle", "option --byte-order: byte order 'middle'");
+  expect(base + " --robot-host 127.0.0.1 --period-ms 100 --byte-order middle",
+         "option --byte-order: byte order 'middle'");
   expect(base + " --robot-host 127.0.0.1 --period-ms 100 --buffer-depth 0", "option --buffer-depth");
   expect(base + " --robot-host 127.0.0.1 --period-ms 100 --motion-port 70000", "option --motion-port");
   expect(base + " --robot-host 127.0.0.1 --period-ms 100 --reply-timeout-s 0", "option --reply-timeout-s");

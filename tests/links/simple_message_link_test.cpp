@@ -538,11 +538,12 @@ TEST(SimpleMessageLink, PartialWritesNeverCutAPoint) {
 // A sensor that measures the LDBB-like force at the arm's true pose, at 250 Hz.
 class PoseForce final : public ForceSource {
  public:
-  PoseForce(const RobotModel& robot, const ForceModel& field, const ManualClock& clock, const cell::SimpleMessageServer* const* server)
+  PoseForce(const RobotModel& robot, const ForceModel& field, const ManualClock& clock,
+            const cell::SimpleMessageServer& server)
       : robot_(robot), field_(field), clock_(clock), server_(server), ws_(robot) {}
   bool latest(ForceSample& out) noexcept override {
-    if (*server_ == nullptr || next_s_ > clock_.now_s()) return false;
-    const JointVector& q = (*server_)->motion().position();
+    if (next_s_ > clock_.now_s()) return false;
+    const JointVector& q = server_.motion().position();
     forward_kinematics(robot_, ws_, q);
     Wrench w;
     if (!field_.wrench_at_pose(ws_.base_T_tcp, w)) return false;
@@ -557,7 +558,7 @@ class PoseForce final : public ForceSource {
   const RobotModel& robot_;
   const ForceModel& field_;
   const ManualClock& clock_;
-  const cell::SimpleMessageServer* const* server_;
+  const cell::SimpleMessageServer& server_;
   Workspace ws_;
   double next_s_ = 0.0;
 };
@@ -565,8 +566,8 @@ class PoseForce final : public ForceSource {
 TEST(SimpleMessageLink, ThePredictiveStrategyCompensatesTheBuffersLag) {
   // A force that turns with the pose (the LDBB's bar from a pivot to the TCP), measured where the arm
   // is; the ideal point is the nominal minus the model's correction for the force at the nominal's own
-  // pose. The online strategy corrects with the force the arm felt some 250 ms earlier; the
-  // predictive one leads by the buffer: it must come much closer to the ideal.
+  // pose. The online strategy corrects with the force the arm felt some 0.3 s earlier (the
+  // buffer and the planner); the predictive one leads by it: it must come much closer to the ideal.
   const JointVector q0 = pose_deg(0, 25, 5, 0, 60, 0);
   const auto program = test::sweep_program(test::bench_robot(), q0, pose_deg(25, 0, 0, 0, 0, 0), 6.0, 81);
   const RobotModel robot = test::bench_robot();
@@ -583,8 +584,7 @@ TEST(SimpleMessageLink, ThePredictiveStrategyCompensatesTheBuffersLag) {
       bool latest(ForceSample& out) noexcept override { return inner != nullptr && inner->latest(out); }
     } forward;
     SimpleMessageBench bench(program, q0, kind, &ldbb, {}, {}, 65536, &forward);
-    const cell::SimpleMessageServer* server = bench.server.get();
-    PoseForce source(bench.robot, ldbb, bench.clock, &server);
+    PoseForce source(bench.robot, ldbb, bench.clock, *bench.server);
     forward.inner = &source;
     int counted = 0;
     while (bench.link.state() != LinkState::kFinished) {

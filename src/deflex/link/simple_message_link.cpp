@@ -38,7 +38,8 @@ void SimpleMessageLinkConfig::validate() const {
     throw InputError(fmt::format("simple message link: state timeout must be > 0 s (got {})", state_timeout_s));
   }
   if (max_failures < 1) {
-    throw InputError(fmt::format("simple message link: max FAILURE replies in a row must be >= 1 (got {})", max_failures));
+    throw InputError(
+        fmt::format("simple message link: max FAILURE replies in a row must be >= 1 (got {})", max_failures));
   }
   if (max_frame_bytes < sm::kHeaderBytes + sm::kJointTrajPtBytes || max_frame_bytes > (std::size_t{1} << 20)) {
     throw InputError(fmt::format("simple message link: the largest frame must be 64 bytes..1 MiB (got {})",
@@ -133,7 +134,9 @@ void SimpleMessageLink::send_stop() noexcept {
   // would hold the arm where it was going anyway.
   sm::JointTrajPt stop{};
   stop.sequence = sm::kStopTrajectory;
-  for (int j = 0; j < last_sent_.size(); ++j) stop.joints_rad[static_cast<std::size_t>(j)] = static_cast<float>(last_sent_[j]);
+  for (int j = 0; j < last_sent_.size(); ++j) {
+    stop.joints_rad[static_cast<std::size_t>(j)] = static_cast<float>(last_sent_[j]);
+  }
   unsigned char* at = outbox_.reserve(kPointFrameBytes);
   if (at == nullptr) return;  // cannot happen: a point is queued only with room for a STOP behind it
   const std::size_t n = sm::encode(config_.byte_order, {sm::kJointTrajPt, sm::kServiceRequest, sm::kReplyInvalid},

@@ -40,7 +40,8 @@ class MemoryStreamPair {
  public:
   /// `latency_s` >= 0 one way; `window_bytes` >= 1 unread bytes per direction; `max_writes` >= 1
   /// writes in flight per direction (writes at the same instant count once). Throws InputError.
-  MemoryStreamPair(const Clock& clock, double latency_s, std::size_t window_bytes = 65536, std::size_t max_writes = 4096);
+  MemoryStreamPair(const Clock& clock, double latency_s, std::size_t window_bytes = 65536,
+                   std::size_t max_writes = 4096);
   MemoryStreamPair(const MemoryStreamPair&) = delete;
   MemoryStreamPair& operator=(const MemoryStreamPair&) = delete;
 

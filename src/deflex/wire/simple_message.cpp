@@ -82,7 +82,8 @@ void write_float32(ByteOrder order, float value, unsigned char* out) noexcept {
 std::size_t encode_frame(ByteOrder order, const Header& header, const unsigned char* data, std::size_t data_bytes,
                          unsigned char* out, std::size_t capacity) noexcept {
   const std::size_t total = kLengthBytes + kHeaderBytes + data_bytes;
-  if (total > capacity || data_bytes > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()) - kHeaderBytes) {
+  constexpr auto kMaxData = static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()) - kHeaderBytes;
+  if (total > capacity || data_bytes > kMaxData) {
     return 0;
   }
   write_header(order, header, data_bytes, out);

@@ -45,7 +45,8 @@ inline constexpr std::int32_t kStopTrajectory = -4;
 inline constexpr std::size_t kLengthBytes = 4;   ///< the LENGTH prefix
 inline constexpr std::size_t kHeaderBytes = 12;  ///< MSG_TYPE, COMM_TYPE, REPLY_CODE
 inline constexpr std::size_t kWireJoints = 10;   ///< joint slots in every joint message (unused ones 0)
-inline constexpr std::size_t kJointTrajPtBytes = 4 + 4 * kWireJoints + 4 + 4;  ///< 52: sequence, joints, velocity, duration
+/// 52: sequence, joints, velocity, duration.
+inline constexpr std::size_t kJointTrajPtBytes = 4 + 4 * kWireJoints + 4 + 4;
 inline constexpr std::size_t kJointPositionBytes = 4 + 4 * kWireJoints;         ///< 44: sequence, joints
 inline constexpr std::size_t kRobotStatusBytes = 7 * 4;                         ///< 28: seven int32
 /// industrial_core reads frames into 1024-byte buffers: a longer LENGTH is no simple message deflex

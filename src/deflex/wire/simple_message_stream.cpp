@@ -12,7 +12,8 @@ namespace deflex::simple_message {
 
 FrameReader::FrameReader(ByteOrder order, std::size_t max_frame_bytes) : order_(order), max_frame_(max_frame_bytes) {
   if (max_frame_bytes < kHeaderBytes || max_frame_bytes > (std::size_t{1} << 20)) {
-    throw InputError(fmt::format("simple message: the largest frame must be 12 bytes..1 MiB (got {})", max_frame_bytes));
+    throw InputError(
+        fmt::format("simple message: the largest frame must be 12 bytes..1 MiB (got {})", max_frame_bytes));
   }
   // Two whole frames and their prefixes: a frame that straddles the end always fits after compaction.
   buffer_.assign(2 * (max_frame_bytes + kLengthBytes), 0);
