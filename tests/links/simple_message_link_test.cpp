@@ -424,7 +424,16 @@ TEST(SimpleMessageLink, EveryKindOfBadFrameStopsTheMotionAndSaysWhy) {
       } else {
         s.to_state(c.frame(big));
       }
-      EXPECT_EQ(s.step(), LinkPollResult::kStopped);
+      // The poll that meets the bad frame: it stops the motion, formats the reason, queues the STOP, all
+      // without allocating.
+      s.t_s += 0.004;
+      s.clock.set(s.t_s);
+      {
+        test::AllocationGuard guard;
+        EXPECT_EQ(s.link.poll(0.0), LinkPollResult::kStopped);
+        EXPECT_EQ(guard.allocations(), 0u);
+      }
+      s.step();
       EXPECT_EQ(s.link.state(), LinkState::kStopped);
       EXPECT_EQ(s.link.stop_cause(), LinkStopCause::kProtocol);
       EXPECT_NE(std::string(s.link.stop_reason()).find(c.reason), std::string::npos) << s.link.stop_reason();
