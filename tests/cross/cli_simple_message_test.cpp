@@ -57,9 +57,19 @@ struct Deflex {
   }
   Deflex(const Deflex&) = delete;
   Deflex& operator=(const Deflex&) = delete;
-  int wait() {
+  // The exit code, or -1 when it did not exit within `timeout_s` (then it is killed: a test never hangs).
+  int wait(double timeout_s = 30.0) {
     int status = 0;
-    ::waitpid(pid, &status, 0);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (::waitpid(pid, &status, WNOHANG) == 0) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        ::kill(pid, SIGKILL);
+        ::waitpid(pid, &status, 0);
+        pid = -1;
+        return -1;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
     pid = -1;
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   }
@@ -103,6 +113,13 @@ struct RealTime {
 };
 const auto kNever = [] { return false; };
 
+// A directory of this test process's own (other checkouts' tests may run on this machine at once).
+std::string temp_dir(const std::string& name) {
+  const std::string dir = ::testing::TempDir() + "/" + name + "_" + std::to_string(::getpid());
+  fs::create_directories(dir);
+  return dir;
+}
+
 std::string nominal_program(const std::string& dir) {
   const std::string path = dir + "/nominal.csv";
   const auto r = test::run_cli("offline --circle \"centre_mm=1800;0;900,radius_mm=129.9,points=81\" --force "
@@ -118,8 +135,7 @@ std::vector<std::string> join(std::vector<std::string> a, const std::vector<std:
 }
 
 TEST(CliSimpleMessage, StreamsTheProgramWithinTheBoundAndCtrlCStopsTheArm) {
-  const std::string dir = ::testing::TempDir() + "/cli_sm_stream";
-  fs::create_directories(dir);
+  const std::string dir = temp_dir("cli_sm_stream");
   const std::string program_path = nominal_program(dir);
   const RobotModel robot = builtin_irb6700();
   const JointTrajectory program = JointTrajectory::read_csv(program_path, robot);
@@ -167,8 +183,7 @@ TEST(CliSimpleMessage, StreamsTheProgramWithinTheBoundAndCtrlCStopsTheArm) {
 }
 
 TEST(CliSimpleMessage, RefusesAStartAwayFromTheProgramAndSendsNothing) {
-  const std::string dir = ::testing::TempDir() + "/cli_sm_refuse";
-  fs::create_directories(dir);
+  const std::string dir = temp_dir("cli_sm_refuse");
   const std::string program_path = nominal_program(dir);
   const RobotModel robot = builtin_irb6700();
   const JointTrajectory program = JointTrajectory::read_csv(program_path, robot);
@@ -190,8 +205,7 @@ TEST(CliSimpleMessage, RefusesAStartAwayFromTheProgramAndSendsNothing) {
 }
 
 TEST(CliSimpleMessage, ALostConnectionStopsWithExitCodeOneAndSaysWhich) {
-  const std::string dir = ::testing::TempDir() + "/cli_sm_lost";
-  fs::create_directories(dir);
+  const std::string dir = temp_dir("cli_sm_lost");
   const std::string program_path = nominal_program(dir);
   const RobotModel robot = builtin_irb6700();
   const JointTrajectory program = JointTrajectory::read_csv(program_path, robot);
@@ -216,8 +230,7 @@ TEST(CliSimpleMessage, ALostConnectionStopsWithExitCodeOneAndSaysWhich) {
 }
 
 TEST(CliSimpleMessage, AFrameThatCannotBeOneIsBadInputAndNamed) {
-  const std::string dir = ::testing::TempDir() + "/cli_sm_bad";
-  fs::create_directories(dir);
+  const std::string dir = temp_dir("cli_sm_bad");
   const std::string program_path = nominal_program(dir);
   Controller c;
   Deflex deflex(join({"online", "--link", "simple-message", "--program", program_path, "--period-ms", "100",
@@ -235,8 +248,7 @@ TEST(CliSimpleMessage, AFrameThatCannotBeOneIsBadInputAndNamed) {
 }
 
 TEST(CliSimpleMessage, BadOptionsAreRefusedBeforeAnythingConnects) {
-  const std::string dir = ::testing::TempDir() + "/cli_sm_options";
-  fs::create_directories(dir);
+  const std::string dir = temp_dir("cli_sm_options");
   const std::string program_path = nominal_program(dir);
   const std::string base = "online --link simple-message --force-source csv:" + kReplay + " --program " + program_path;
   const auto expect = [](const std::string& args, const std::string& fragment) {
