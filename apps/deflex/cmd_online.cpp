@@ -162,7 +162,8 @@ void setup_online(CLI::App& sub, int& exit_code) {
                  "Force model of the process, a pose model: ldbb:pivot_mm=X;Y;Z,force_N=F,mode=push|pull or "
                  "constant:fx_N=.. (hybrid: required; predictive: optional)");
   sub.add_option("--period-ms", o->period_ms,
-                 "The controller's cycle in ms (egm-joint: 4; egm-path: the EGMActMove SampleRate)")
+                 "The controller's cycle in ms (egm-joint: 4; egm-path: the EGMActMove SampleRate; simple-message: "
+                 "the point cycle, the paper's 100)")
       ->capture_default_str();
   sub.add_option("--max-joint-correction-deg", o->max_joint_deg,
                  "Bound on each joint's correction, degrees: no command leaves the nominal by more")
@@ -286,7 +287,7 @@ void setup_online(CLI::App& sub, int& exit_code) {
     // Interval figures (reset at every status line; the line says so).
     double max_compute_s = 0.0, max_gap_s = 0.0, max_dev_rad = 0.0, last_t = -1.0, last_message = -1.0;
     std::uint64_t window_cycles = 0, cycles = 0;
-    bool refused = false;
+    bool refused = false, stopped = false;
     const auto print_status = [&](double now) {
       const LinkCounters& c = link.counters();
       const LinkCycleRecord& r = link.last_cycle();
@@ -308,6 +309,10 @@ void setup_online(CLI::App& sub, int& exit_code) {
       const double now = clock.now_s();
       if (r == LinkPollResult::kRefused) {
         refused = true;
+        break;
+      }
+      if (r == LinkPollResult::kStopped) {  // a streaming link stopped the motion for a fault
+        stopped = true;
         break;
       }
       if (r == LinkPollResult::kAnswered || r == LinkPollResult::kNotAnswered) {
@@ -344,10 +349,19 @@ void setup_online(CLI::App& sub, int& exit_code) {
         break;
       }
     }
+    // A streaming link stops the controller's motion now (simple message: STOP_TRAJECTORY on Ctrl-C,
+    // SIGTERM, --duration-s or the end of the session); the others have nothing to stop.
+    link.stop();
     if (refused) {
       std::cerr << refusal_text(link, *program, 1.0) << "\n";
       exit_code = 2;
       return;
+    }
+    if (stopped) {
+      if (!o->fault_dump.empty()) link.write_history_csv(o->fault_dump);
+      std::cerr << fmt::format("deflex online: the {} link stopped the robot's motion ({}): {}{}\n", link.name(),
+                               to_string(link.stop_cause()), link.stop_reason(),
+                               o->fault_dump.empty() ? "" : fmt::format("; last cycles written to {}", o->fault_dump));
     }
     const LinkCounters& c = link.counters();
     const std::string extra = session->summary();
@@ -359,7 +373,9 @@ void setup_online(CLI::App& sub, int& exit_code) {
         c.duplicate, c.out_of_order, c.out_of_limits, c.foreign_sender, c.restarts, c.guard_trips,
         comp.counters().samples_ok, comp.counters().samples_fault, comp.counters().samples_invalid,
         extra.empty() ? "" : "; ", extra, o->log.empty() ? "" : fmt::format("; log {}", o->log));
-    exit_code = 0;
+    // What the controller sent that the protocol does not allow is bad input (2); a lost connection, a
+    // refusing or faulted controller, a safety stop: the job failed (1).
+    exit_code = !stopped ? 0 : link.stop_cause() == LinkStopCause::kProtocol ? 2 : 1;
   });
 }
 

@@ -25,7 +25,8 @@ auto g_egm = std::make_shared<EgmOptions>();
 void add_egm_options(CLI::App& sub) {
   if (sub.get_option_no_throw("--egm-port") != nullptr) return;  // shared by both EGM kinds
   sub.add_option("--egm-port", g_egm->port, "EGM: UDP port the controller's EGM messages arrive on (ABB examples: 6510)");
-  sub.add_option("--ramp-in-s", g_egm->ramp_in_s, "egm-joint: blend from where the arm is to the program over this time, s")
+  sub.add_option("--ramp-in-s", g_egm->ramp_in_s,
+                 "egm-joint, simple-message: blend from where the arm is to the program over this time, s")
       ->capture_default_str();
   sub.add_flag("--no-speed-reference", g_egm->no_speed_ref, "egm-joint: do not send the target's joint speeds");
   sub.add_option("--path-corr-frame", g_egm->path_frame,

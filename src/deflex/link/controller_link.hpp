@@ -18,6 +18,7 @@ enum class LinkState : int {
   kRunning = 1,   ///< answering every controller message
   kFinished = 2,  ///< the program has ended; the last point is held (streaming links)
   kRefused = 3,   ///< the start was refused (the robot was not at the program's start): never answers
+  kStopped = 4,   ///< a streaming link stopped the controller's motion (fault or stop()): sends nothing more
 };
 [[nodiscard]] const char* to_string(LinkState s);
 
@@ -29,7 +30,19 @@ enum class LinkPollResult : int {
   kRejected = 2,     ///< datagrams arrived but none was usable (counted)
   kNotAnswered = -1, ///< a usable message was not answered (invalid cycle, guard): counted
   kRefused = -2,     ///< the start was refused: see start_distance()
+  kStopped = -3,     ///< the link stopped the controller's motion for a fault: see stop_reason()
 };
+
+/// Why a streaming link stopped the controller's motion (LinkState::kStopped).
+enum class LinkStopCause : int {
+  kNone = 0,
+  kRequested = 1,   ///< the caller's stop() (Ctrl-C, the end of a session)
+  kProtocol = 2,    ///< the controller sent what the protocol does not allow (bad input: malformed, unknown ...)
+  kConnection = 3,  ///< the connection was lost, or the controller went silent
+  kController = 4,  ///< the controller refused points, or reports an emergency stop or an error
+  kSafety = 5,      ///< deflex's own checks: the final bound check, an invalid cycle
+};
+[[nodiscard]] const char* to_string(LinkStopCause c);
 
 /// What a link counts. Every datagram lands in exactly one of the reasons or is handled.
 struct LinkCounters {
@@ -90,6 +103,15 @@ class ControllerLink {
   virtual void clear_fault() = 0;
   /// The last cycles, oldest first, as CSV (set-up time I/O: allocates; throws Error).
   virtual void write_history_csv(const std::string& path) const = 0;
+
+  /// Stops the controller's motion as soon as possible (streaming links over a connection: the
+  /// simple message link sends STOP_TRAJECTORY) and sends nothing more. Links whose controller stops on
+  /// its own when answers stop (EGM) have nothing to do. Never allocates or throws.
+  virtual void stop() noexcept {}
+  /// Why the link stopped (kNone while it has not).
+  [[nodiscard]] virtual LinkStopCause stop_cause() const { return LinkStopCause::kNone; }
+  /// A sentence saying why, naming the frame or field at fault ("" while the link has not stopped).
+  [[nodiscard]] virtual const char* stop_reason() const { return ""; }
 
  protected:
   ControllerLink() = default;

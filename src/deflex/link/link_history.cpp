@@ -16,6 +16,19 @@ const char* to_string(LinkState s) {
     case LinkState::kRunning: return "running";
     case LinkState::kFinished: return "finished";
     case LinkState::kRefused: return "refused";
+    case LinkState::kStopped: return "stopped";
+  }
+  return "unknown";
+}
+
+const char* to_string(LinkStopCause c) {
+  switch (c) {
+    case LinkStopCause::kNone: return "not stopped";
+    case LinkStopCause::kRequested: return "stop requested";
+    case LinkStopCause::kProtocol: return "protocol error";
+    case LinkStopCause::kConnection: return "connection lost";
+    case LinkStopCause::kController: return "controller refused or faulted";
+    case LinkStopCause::kSafety: return "safety check";
   }
   return "unknown";
 }
