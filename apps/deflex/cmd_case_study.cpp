@@ -186,7 +186,7 @@ void run(const Opts& o, int& exit_code) {
                               l.max_command_deviation_rad * 1e3, l.bound_rad * 1e3, l.max_tcp_correction_m * 1e3)
                 : fmt::format("largest offset {:.3f} mm at the TCP", l.max_tcp_correction_m * 1e3);
         std::cout << fmt::format(
-            "  {:<16} {:<10} {:>8} cycles answered, {} datagrams rejected, {} commands stopped by the guard; {}; "
+            "  {:<16} {:<14} {:>8} cycles answered, {} datagrams rejected, {} commands stopped by the guard; {}; "
             "measured delay {:.0f} ms\n",
             l.setup, l.link, l.cycles, l.rejected, l.guard_trips, correction, l.measured_delay_s * 1e3);
       }

@@ -35,7 +35,8 @@ LinkKind parse_link(const yaml::Field& f) {
   if (s == "program") return LinkKind::kProgram;
   if (s == "egm-joint") return LinkKind::kEgmJoint;
   if (s == "egm-path") return LinkKind::kEgmPath;
-  f.fail("unknown link '" + s + "' (program, egm-joint, egm-path)");
+  if (s == "simple-message") return LinkKind::kSimpleMessage;
+  f.fail("unknown link '" + s + "' (program, egm-joint, egm-path, simple-message)");
 }
 
 double positive(const yaml::Field& f) {
@@ -84,6 +85,7 @@ const char* to_string(LinkKind k) {
     case LinkKind::kProgram: return "program";
     case LinkKind::kEgmJoint: return "egm-joint";
     case LinkKind::kEgmPath: return "egm-path";
+    case LinkKind::kSimpleMessage: return "simple-message";
   }
   return "?";
 }
@@ -142,9 +144,9 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
     if (sc.strategy == Strategy::kOffline && sc.link != LinkKind::kProgram)
       s.at("link").fail("the offline strategy runs a program: its link is 'program'");
     if (sc.strategy != Strategy::kOffline && sc.link == LinkKind::kProgram)
-      s.at("link").fail("an online strategy needs a controller link (egm-joint or egm-path)");
+      s.at("link").fail("an online strategy needs a controller link (egm-joint, egm-path or simple-message)");
     if (sc.strategy == Strategy::kHybrid && sc.link == LinkKind::kEgmPath)
-      s.at("link").fail("the hybrid strategy streams the offline program: its link is egm-joint");
+      s.at("link").fail("the hybrid strategy streams the offline program: its link is egm-joint or simple-message");
     sc.sensor_mounted = s.at("sensor").as_bool();
     if (sc.strategy != Strategy::kOffline && !sc.sensor_mounted)
       s.at("sensor").fail("online strategies need the sensor");
@@ -311,7 +313,13 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
 
   const auto on = root.at("online");
   on.only_keys({"lowpass_Hz", "dead_band_N", "fault_threshold_N", "max_joint_correction_mrad", "max_tcp_correction_mm",
-                "max_rate_mrad_s", "watchdog_ms", "ramp_in_s"});
+                "max_rate_mrad_s", "watchdog_ms", "ramp_in_s", "stream_period_ms", "stream_buffer_depth"});
+  c.online.stream_period_s = on.get("stream_period_ms", 100.0) * 1e-3;
+  if (!(c.online.stream_period_s >= 0.02 && c.online.stream_period_s <= 1.0))
+    on.at("stream_period_ms").fail("must be 20..1000 ms");
+  c.online.stream_buffer_depth = on.get("stream_buffer_depth", 2);
+  if (c.online.stream_buffer_depth < 1 || c.online.stream_buffer_depth > 3)
+    on.at("stream_buffer_depth").fail("must be 1..3 (the streaming server holds 4 points)");
   c.online.lowpass_hz = positive(on.at("lowpass_Hz"));
   c.online.dead_band_n = non_negative(on.at("dead_band_N"));
   c.online.fault_threshold_n = positive(on.at("fault_threshold_N"));

@@ -29,6 +29,9 @@ enum class LinkKind {
   kProgram,   ///< the controller runs a (compensated) robot program of its own: no link
   kEgmJoint,  ///< ABB EGM position guidance: deflex streams the program (egm_joint_link.hpp)
   kEgmPath,   ///< ABB EGM path correction: the controller runs its program, deflex sends offsets
+  /// ROS-Industrial simple message over TCP: deflex streams joint points to the robot program's
+  /// streaming server (the paper's own kind of link, ~100 ms; simple_message_link.hpp)
+  kSimpleMessage,
 };
 [[nodiscard]] const char* to_string(LinkKind k);
 
@@ -53,6 +56,8 @@ struct OnlineSettings {
   double max_rate_rad_s = 0.05;
   double watchdog_s = 0.05;
   double ramp_in_s = 1.0;
+  double stream_period_s = 0.1;  ///< simple message: a point every this long (the paper's ~100 ms)
+  int stream_buffer_depth = 2;   ///< simple message: points kept queued on the controller
 };
 
 /// The quasi-static calibration while moving (the paper's, after Theissen et al.): arcs in the

@@ -132,9 +132,15 @@ const char* describe(Strategy s, LinkKind link) {
       return "offline compensation from the LDBB force model (paper, Figure 2): the controller runs the compensated "
              "program";
     case Strategy::kOnline:
-      return link == LinkKind::kEgmPath
-                 ? "online compensation from the force sensor (paper, Figure 3) over ABB EGM path correction"
-                 : "online compensation from the force sensor (paper, Figure 3) over ABB EGM position guidance";
+      switch (link) {
+        case LinkKind::kEgmPath:
+          return "online compensation from the force sensor (paper, Figure 3) over ABB EGM path correction";
+        case LinkKind::kSimpleMessage:
+          return "online compensation from the force sensor (paper, Figure 3) streamed every 100 ms over TCP to the "
+                 "robot program (simple message): the paper's own kind of link";
+        default:
+          return "online compensation from the force sensor (paper, Figure 3) over ABB EGM position guidance";
+      }
     case Strategy::kHybrid:
       return "hybrid: the offline program streamed, plus an online correction of measured minus modelled force";
     case Strategy::kPredictive:

@@ -14,8 +14,10 @@
 #include "deflex/cell/ldbb_device.hpp"
 #include "deflex/cell/path_drift.hpp"
 #include "deflex/cell/robot_controller.hpp"
+#include "deflex/cell/simple_message_server.hpp"
 #include "deflex/egm/egm_joint_link.hpp"
 #include "deflex/egm/egm_path_link.hpp"
+#include "deflex/link/simple_message_link.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/model/compliance.hpp"
 #include "deflex/model/errors.hpp"
@@ -24,6 +26,7 @@
 #include "deflex/online/online_strategy.hpp"
 #include "deflex/paths/circle_path.hpp"
 #include "deflex/transport/memory_network.hpp"
+#include "deflex/transport/memory_stream.hpp"
 
 namespace deflex::study {
 namespace {
@@ -190,6 +193,10 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
   MemoryTransport& daq_port = network.add_endpoint(kDaq, c.sensor.daq_latency_s);
   MemoryTransport& deflex_force_port = network.add_endpoint(kDeflexForce, 0.0);
 
+  // The robot program's motion and state connections (simple message), on the same clock.
+  MemoryStreamPair motion_stream(clock, c.controller.network_latency_s);
+  MemoryStreamPair state_stream(clock, c.controller.network_latency_s);
+
   // The controller.
   std::unique_ptr<cell::RobotController> controller;
   switch (spec.link) {
@@ -203,6 +210,11 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
     case LinkKind::kEgmPath:
       controller = std::make_unique<cell::EgmPathCorrectionController>(c.controller, robot.nominal_model(), program,
                                                                         controller_port, kDeflexEgm);
+      break;
+    case LinkKind::kSimpleMessage:
+      controller = std::make_unique<cell::SimpleMessageServer>(cell::SimpleMessageServerConfig{}, robot.nominal_model(),
+                                                               program->points().front(), motion_stream.server(),
+                                                               state_stream.server());
       break;
   }
 
@@ -222,7 +234,9 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
   if (linked) {
     const deflex::SensorConfig sc = sensor_config_from_sheet(config, sensor.calibration());
     deflex::OnlineConfig oc;
-    oc.period_s = spec.link == LinkKind::kEgmPath ? c.controller.path_corr_period_s : c.controller.egm_period_s;
+    oc.period_s = spec.link == LinkKind::kEgmPath         ? c.controller.path_corr_period_s
+                  : spec.link == LinkKind::kSimpleMessage ? config.online.stream_period_s
+                                                          : c.controller.egm_period_s;
     oc.max_joint_correction_rad = config.online.max_joint_correction_rad;
     oc.max_tcp_correction_m = config.online.max_tcp_correction_m;
     oc.max_correction_rate_rad_s = config.online.max_rate_rad_s;
@@ -246,6 +260,13 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
       lc.history_cycles = 16;
       link = std::make_unique<EgmJointLink>(*compensator, *strategy, program, deflex_egm_port, clock,
                                             force_source.get(), lc);
+    } else if (spec.link == LinkKind::kSimpleMessage) {
+      SimpleMessageLinkConfig lc;
+      lc.buffer_depth = config.online.stream_buffer_depth;
+      lc.stream.ramp_in_s = config.online.ramp_in_s;
+      lc.history_cycles = 16;
+      link = std::make_unique<SimpleMessageLink>(*compensator, *strategy, program, motion_stream.client(),
+                                                 state_stream.client(), clock, force_source.get(), lc);
     } else {
       EgmPathLinkConfig lc;
       lc.frame = parse_path_corr_frame(c.controller.path_corr_frame);
@@ -257,7 +278,9 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
   const double settle_s = c.ldbb.settle_s;
   const double motion_end_s = program->end_time_s();
   // The arm follows a streamed program a little late: let the tracker see the motion to its end.
-  const double run_end_s = motion_end_s + (linked ? 0.5 : 0.0);
+  // (The streaming server runs a buffer of points behind: a second.)
+  const double run_end_s =
+      motion_end_s + (spec.link == LinkKind::kSimpleMessage ? 1.0 : linked ? 0.5 : 0.0);
   const double dt = c.controller.servo_period_s;
   const auto ticks = static_cast<long>(std::ceil(run_end_s / dt));
   // The bar was serviced and recalibrated before the online tests (paper, section 3): the runs with
@@ -303,6 +326,9 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
       for (;;) {
         const LinkPollResult r = link->poll(0.0);
         if (r == LinkPollResult::kIdle) break;
+        if (r == LinkPollResult::kStopped) {
+          throw Error(fmt::format("run: deflex's {} link stopped the motion: {}", link->name(), link->stop_reason()));
+        }
         if (r == LinkPollResult::kRefused) {
           throw Error(fmt::format("run: deflex's {} link refused the start (the arm was not at the program's start)",
                                   link->name()));
@@ -310,7 +336,7 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
         if (r != LinkPollResult::kAnswered) continue;
         ++out.link_cycles;
         const LinkCycleRecord& rec = link->last_cycle();
-        if (spec.link == LinkKind::kEgmJoint) {
+        if (spec.link == LinkKind::kEgmJoint || spec.link == LinkKind::kSimpleMessage) {
           out.max_command_deviation_rad =
               std::max(out.max_command_deviation_rad, (rec.q_command - rec.q_nominal).cwiseAbs().maxCoeff());
         }
@@ -327,6 +353,8 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
       out.measured_delay_s = joint->delay().mean_s();
     } else if (const auto* path = dynamic_cast<const EgmPathLink*>(link.get())) {
       out.measured_delay_s = path->delay().mean_s();
+    } else if (const auto* stream = dynamic_cast<const SimpleMessageLink*>(link.get())) {
+      out.measured_delay_s = stream->delay().mean_s();
     }
     const auto* egm = dynamic_cast<const cell::EgmPositionGuidanceController*>(controller.get());
     if (egm != nullptr && egm->counters().timed_out) {
