@@ -348,9 +348,17 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
   auto cell_of = [&](int si, bool sensor) -> const SetupCell& {
     return *cells[static_cast<std::size_t>(si)][sensor ? 1 : 0];
   };
-  auto unloaded_seed = [&](int si, const Family& fam, double v) {
-    return run_seed(cfg_of(si).seed, fam.sensor, RunKind::kUnloaded, Strategy::kOffline, 0.0, v,
-                    static_cast<std::uint64_t>(fam.link));
+  // The unloaded reference run of a seed, family and speed (the tables' and the budget's alike).
+  auto unloaded_spec = [&](int si, const Family& fam, double v) {
+    RunSpec spec;
+    spec.kind = RunKind::kUnloaded;
+    spec.link = fam.link;
+    spec.speed_m_s = v;
+    spec.laps_cw = laps_cw;
+    spec.laps_ccw = laps_ccw;
+    spec.seed = run_seed(cfg_of(si).seed, fam.sensor, RunKind::kUnloaded, Strategy::kOffline, 0.0, v,
+                         static_cast<std::uint64_t>(fam.link));
+    return spec;
   };
   auto loaded_spec = [&](int si, const Family& fam, RunKind kind, Strategy strategy, double load, double v) {
     RunSpec spec;
@@ -388,14 +396,7 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
         for (double v : speeds) {
           jobs.emplace_back([&, si, f, v] {
             const Family& fam = families[f];
-            RunSpec spec;
-            spec.kind = RunKind::kUnloaded;
-            spec.link = fam.link;
-            spec.speed_m_s = v;
-            spec.laps_cw = laps_cw;
-            spec.laps_ccw = laps_ccw;
-            spec.seed = unloaded_seed(si, fam, v);
-            RunOutput run = simulate_run(cfg_of(si), cell_of(si, fam.sensor), spec);
+            RunOutput run = simulate_run(cfg_of(si), cell_of(si, fam.sensor), unloaded_spec(si, fam, v));
             if (si == 0 && options.trace_sink && mm_s(v) == mm_s(config.budget.speed_m_s)) {
               sink(fmt::format("{}_unloaded_{}mm_s", family_label(fam), mm_s(v)), run.trace);
             }
@@ -447,14 +448,7 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
         const SetupCell cell = build_setup_cell(cfg, sc.sensor_mounted);
         const double load = sc.loads_n[static_cast<std::size_t>(config.budget.load_index)];
         const double v = config.budget.speed_m_s;
-        RunSpec spec;
-        spec.kind = RunKind::kUnloaded;
-        spec.link = fam.link;
-        spec.speed_m_s = v;
-        spec.laps_cw = laps_cw;
-        spec.laps_ccw = laps_ccw;
-        spec.seed = unloaded_seed(0, fam, v);
-        const Reference reference = make_reference(simulate_run(cfg, cell, spec));
+        const Reference reference = make_reference(simulate_run(cfg, cell, unloaded_spec(0, fam, v)));
         const RunSpec c_spec = loaded_spec(0, fam, RunKind::kCompensated, sc.strategy, load, v);
         bj.residual_mm = evaluate_run(simulate_run(cfg, cell, c_spec), reference).mean_mm;
         progress.add(cal_cost + 2.0 * run_cost(config, v, laps), fmt::format("budget: {}", to_string(bj.off)));

@@ -22,13 +22,6 @@
 namespace deflex::study {
 namespace {
 
-std::uint64_t mix(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
-
 // One calibration arc: the LDBB's bar inclination (which sets the arc's radius, r = L cos phi, and
 // the force's vertical part), the arc's height above the test circle, push or pull, and where it
 // starts. Six of them span the operating space and the force directions; more repeat the pattern
@@ -80,7 +73,7 @@ CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robo
   // chose the LDBB's set-point), else the set-point.
   const bool force_from_sensor = sensor_mounted && cal.force_from_sensor;
   // The sensor and what its sheet says (the same physical sensor as in the runs).
-  cell::ForceSensorDaq sensor(cc.sensor, cc.tool, mix(seed ^ 0x5e5ULL), mix(c.seed ^ 0x5e5503ULL));
+  cell::ForceSensorDaq sensor(cc.sensor, cc.tool, splitmix(seed ^ 0x5e5ULL), splitmix(c.seed ^ 0x5e5503ULL));
   const deflex::SensorConfig sheet = sensor_config_from_sheet(c, sensor.calibration());
   const Pose sensor_T_wap = sheet.flange_T_sensor.inverse() * nominal.flange_T_wap();
 
@@ -118,16 +111,16 @@ CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robo
     Pass passes[2];
     std::optional<cell::PathDrift> unloaded_drift;
     for (int loaded = 0; loaded < 2; ++loaded) {
-      const std::uint64_t pass_seed = mix(seed ^ (static_cast<std::uint64_t>(k) * 2 + loaded + 1) * 0x9e37ULL);
+      const std::uint64_t pass_seed = splitmix(seed ^ (static_cast<std::uint64_t>(k) * 2 + loaded + 1) * 0x9e37ULL);
       cell::LdbbConfig bar = ldbb_config;
       bar.push = arc.push;
-      cell::LdbbDevice device(bar, pivot, loaded ? cal.load_n : 0.0, mix(pass_seed ^ 1));
+      cell::LdbbDevice device(bar, pivot, loaded ? cal.load_n : 0.0, splitmix(pass_seed ^ 1));
       // The loaded pass follows the unloaded one a pass later: its thermal drift has hardly moved.
-      cell::PathDrift drift = loaded ? cell::PathDrift(cc.drift, mix(pass_seed ^ 2), *unloaded_drift,
+      cell::PathDrift drift = loaded ? cell::PathDrift(cc.drift, splitmix(pass_seed ^ 2), *unloaded_drift,
                                                        program.end_time_s(), cal.load_n)
-                                     : cell::PathDrift(cc.drift, mix(pass_seed ^ 2));
+                                     : cell::PathDrift(cc.drift, splitmix(pass_seed ^ 2));
       if (!loaded) unloaded_drift.emplace(drift);
-      cell::LaserTracker tracker(cc.tracker, mix(pass_seed ^ 3), hold_s, program.end_time_s(), 0.0);
+      cell::LaserTracker tracker(cc.tracker, splitmix(pass_seed ^ 3), hold_s, program.end_time_s(), 0.0);
       ForcePipeline pipeline(sheet, sensor_T_wap);
       JointVector q = program.points().front();
       if (!have_state) {

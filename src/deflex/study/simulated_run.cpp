@@ -31,12 +31,6 @@
 namespace deflex::study {
 namespace {
 
-std::uint64_t splitmix(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
 
 // Seeds of the run's components, each from the run's own seed.
 enum class Component : std::uint64_t { kLdbb = 1, kSensor = 2, kTracker = 3, kDrift = 4 };
@@ -51,6 +45,13 @@ const DatagramAddress kController{0x0a000002, 6511};   // 10.0.0.2:6511
 const DatagramAddress kDaq{0x0a000003, 5000};          // 10.0.0.3:5000
 
 }  // namespace
+
+std::uint64_t splitmix(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
 
 std::uint64_t run_seed(std::uint64_t case_seed, bool sensor_mounted, RunKind kind, Strategy strategy, double load_n,
                        double speed_m_s, std::uint64_t extra) {

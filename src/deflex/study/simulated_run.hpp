@@ -58,6 +58,9 @@ struct RunOutput {
   double measured_delay_s = 0.0;       ///< the mean of the link's delay measurements over the run
 };
 
+/// SplitMix64's finaliser: a well-mixed 64-bit value from any seed (the cell's seeds are derived by it).
+[[nodiscard]] std::uint64_t splitmix(std::uint64_t x);
+
 /// A run's seed from the case seed and the run's identity, so results do not depend on the order
 /// or the thread that runs them.
 [[nodiscard]] std::uint64_t run_seed(std::uint64_t case_seed, bool sensor_mounted, RunKind kind, Strategy strategy,
