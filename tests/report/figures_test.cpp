@@ -352,6 +352,22 @@ TEST(LapOverlay, OnePathPerLapColouredByDirectionWithItsTravelMarked) {
   EXPECT_EQ(per["C cw"], 1);
   EXPECT_EQ(per["C ccw"], 1);
   EXPECT_NE(colour_of["cw"], colour_of["ccw"]);
+  // Each direction's mean over its laps, one line per run and direction in 5 deg sectors: C
+  // anticlockwise is 0.06 mm everywhere, so its line is flat.
+  std::map<std::string, std::vector<std::pair<double, double>>> mean_line;
+  for (const auto& t : tags(svg, "path")) {
+    if (attribute(t, "class") == "direction-mean") {
+      const auto pieces = test::path_pieces(attribute(t, "d"));
+      ASSERT_EQ(pieces.size(), 1u);
+      mean_line[attribute(t, "data-run") + " " + attribute(t, "data-direction")] = pieces[0];
+    }
+  }
+  ASSERT_EQ(mean_line.size(), 4u);
+  EXPECT_EQ(mean_line["C ccw"].size(), 72u) << "5 deg sectors";
+  const auto ys = [](const std::vector<std::pair<double, double>>& pts) {
+    return std::minmax_element(pts.begin(), pts.end(), [](auto a, auto b) { return a.second < b.second; });
+  };
+  EXPECT_NEAR(ys(mean_line["C ccw"]).second->second - ys(mean_line["C ccw"]).first->second, 0.0, 0.15);
   // Per direction, the mean distance from the reference (the test's laps are at known distances).
   EXPECT_NE(svg.find("clockwise 1 lap: mean 0.100 mm; anticlockwise 1 lap: mean 0.060 mm"), std::string::npos);
   // The bump of the first clockwise UC lap is where it was put: at 90 deg, read on the labelled axis.

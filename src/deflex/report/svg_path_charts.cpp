@@ -144,6 +144,38 @@ int count_of(const std::vector<LapDeviation>& laps, bool clockwise) {
   return static_cast<int>(std::count_if(laps.begin(), laps.end(), [&](const auto& l) { return l.clockwise == clockwise; }));
 }
 
+constexpr int kSectors = 72;  // 5 deg each
+
+// Mean distance (mm) of one direction's laps in each 5 deg sector of the angle; NaN where no sample
+// fell; empty when the direction has no sample at all.
+std::vector<double> sector_means(const std::vector<LapDeviation>& laps, bool clockwise) {
+  std::vector<double> sum(kSectors, 0.0);
+  std::vector<int> n(kSectors, 0);
+  for (const auto& lap : laps) {
+    if (lap.clockwise != clockwise) {
+      continue;
+    }
+    for (std::size_t i = 0; i < lap.angle_deg.size(); ++i) {
+      const auto s = static_cast<std::size_t>(
+          std::clamp(static_cast<int>(lap.angle_deg[i] / (360.0 / kSectors)), 0, kSectors - 1));
+      sum[s] += lap.distance_mm[i];
+      ++n[s];
+    }
+  }
+  if (std::all_of(n.begin(), n.end(), [](int k) { return k == 0; })) {
+    return {};
+  }
+  std::vector<double> mean(kSectors, kNaN);
+  for (std::size_t s = 0; s < mean.size(); ++s) {
+    if (n[s] > 0) {
+      mean[s] = sum[s] / n[s];
+    }
+  }
+  return mean;
+}
+
+double sector_centre_deg(std::size_t s) { return (static_cast<double>(s) + 0.5) * 360.0 / kSectors; }
+
 // A filled arrowhead at (x, y) pointing along (dx, dy) in pixels.
 void arrowhead(Canvas& c, double x, double y, double dx, double dy, const std::string& col, double size = 9.0) {
   const double n = std::hypot(dx, dy);
@@ -161,6 +193,7 @@ std::string direction_name(bool clockwise) { return clockwise ? "clockwise" : "a
 std::string direction_colour(bool clockwise) {
   return clockwise ? svg::kClockwiseColour : svg::kAnticlockwiseColour;
 }
+std::string direction_mean_colour(bool clockwise) { return clockwise ? "#8F3B00" : "#2E1A4F"; }
 std::string direction_dash(bool clockwise) { return clockwise ? "" : R"(stroke-dasharray="6 3")"; }
 
 // The base direction an angle on a horizontal circle points to (seen from above).
@@ -322,17 +355,19 @@ std::string svg_lap_overlay(const PathPlot& plot) {
   const std::vector<LapDeviation> runs[] = {lap_deviations(plot.uc_laps, plot.uc, *ref),
                                             lap_deviations(plot.c_laps, plot.c, *ref)};
   const char* const names[] = {"UC, uncompensated", "C, compensated"};
-  // Legend: colour and dash by direction, with the direction of travel on the angle axis.
-  double lx = 80.0;
+  // Legend: colour and dash by direction, with the direction of travel on the angle axis; below,
+  // the direction's mean, which the eye cannot find in six noisy laps.
   for (const bool cw : {true, false}) {
+    const double lx = cw ? 80.0 : 590.0;
     const std::string label = fmt::format("{} laps: travel {} (angle {})", direction_name(cw),
                                           cw ? "to the left" : "to the right", cw ? "falls" : "grows");
-    c.line(lx, 68.0, lx + 18.0, 68.0, direction_colour(cw), 2.0, direction_dash(cw));
-    arrowhead(c, lx + (cw ? 2.0 : 16.0), 68.0, cw ? -1.0 : 1.0, 0.0, direction_colour(cw), 11.0);
-    c.text(lx + 24.0, 72.0, label, 12.0);
-    lx += 24.0 + svg::text_width(label, 12.0) + 30.0;
+    c.line(lx, 66.0, lx + 18.0, 66.0, direction_colour(cw), 2.0, direction_dash(cw));
+    arrowhead(c, lx + (cw ? 2.0 : 16.0), 66.0, cw ? -1.0 : 1.0, 0.0, direction_colour(cw), 11.0);
+    c.text(lx + 24.0, 70.0, label, 12.0);
+    c.line(lx, 86.0, lx + 18.0, 86.0, direction_mean_colour(cw), 2.6, direction_dash(cw));
+    c.text(lx + 24.0, 90.0, fmt::format("{} laps' mean in 5 deg sectors", direction_name(cw)), 12.0);
   }
-  const double top = 124.0, panel_h = 280.0, panel_w = 400.0;
+  const double top = 140.0, panel_h = 266.0, panel_w = 400.0;
   const double lefts[] = {80.0, 590.0};
   for (int r = 0; r < 2; ++r) {
     const double left = lefts[r];
@@ -404,6 +439,26 @@ std::string svg_lap_overlay(const PathPlot& plot) {
         }
       }
     }
+    // Each direction's mean over its laps, over the laps.
+    for (const bool cw : {true, false}) {
+      const std::vector<double> means = sector_means(runs[r], cw);
+      std::string d;
+      bool pen = false;
+      for (std::size_t k = 0; k < means.size(); ++k) {
+        if (!std::isfinite(means[k])) {
+          pen = false;
+          continue;
+        }
+        d += fmt::format("{}{:.1f},{:.1f}", pen ? " L" : (d.empty() ? "M" : " M"), x(sector_centre_deg(k)),
+                         y(means[k]));
+        pen = true;
+      }
+      if (!d.empty()) {
+        c.path(d, direction_mean_colour(cw), 2.6,
+               fmt::format(R"({} class="direction-mean" data-run="{}" data-direction="{}")", direction_dash(cw),
+                           r == 0 ? "UC" : "C", cw ? "cw" : "ccw"));
+      }
+    }
     // Over every line, outlined in white, so no later lap hides an earlier one's arrow.
     for (const auto& a : arrows) {
       arrowhead(c, a.x, a.y, a.dx, 0.0, a.colour, 13.0);
@@ -432,7 +487,6 @@ std::string svg_polar_deviation(const PathPlot& plot) {
     return c.str();
   }
   // Each run's laps in one direction averaged in 5 deg sectors.
-  constexpr int kSectors = 72;
   struct Curve {
     const char* run;
     bool clockwise;
@@ -445,30 +499,16 @@ std::string svg_polar_deviation(const PathPlot& plot) {
   double max_mm = 0.0;
   for (int r = 0; r < 2; ++r) {
     for (const bool cw : {true, false}) {
-      std::vector<double> sum(kSectors, 0.0);
-      std::vector<int> n(kSectors, 0);
-      for (const auto& lap : runs[r]) {
-        if (lap.clockwise != cw) {
-          continue;
-        }
-        for (std::size_t i = 0; i < lap.angle_deg.size(); ++i) {
-          const int s = std::clamp(static_cast<int>(lap.angle_deg[i] / (360.0 / kSectors)), 0, kSectors - 1);
-          sum[static_cast<std::size_t>(s)] += lap.distance_mm[i];
-          ++n[static_cast<std::size_t>(s)];
-        }
-      }
-      if (std::all_of(n.begin(), n.end(), [](int k) { return k == 0; })) {
+      std::vector<double> means = sector_means(runs[r], cw);
+      if (means.empty()) {
         continue;
       }
-      Curve cv{r == 0 ? "UC" : "C", cw, r == 0 ? svg::kUcColour : svg::kCColour, {}};
-      for (int s = 0; s < kSectors; ++s) {
-        const double m = n[static_cast<std::size_t>(s)] > 0 ? sum[static_cast<std::size_t>(s)] / n[static_cast<std::size_t>(s)] : kNaN;
-        cv.mean_mm.push_back(m);
+      for (const double m : means) {
         if (std::isfinite(m)) {
           max_mm = std::max(max_mm, m);
         }
       }
-      curves.push_back(std::move(cv));
+      curves.push_back({r == 0 ? "UC" : "C", cw, r == 0 ? svg::kUcColour : svg::kCColour, std::move(means)});
     }
   }
   // Legend: run by colour, direction by dash.
@@ -522,7 +562,7 @@ std::string svg_polar_deviation(const PathPlot& plot) {
         pen = false;
         continue;
       }
-      const auto [x, y] = point((s + 0.5) * 360.0 / kSectors, m);
+      const auto [x, y] = point(sector_centre_deg(static_cast<std::size_t>(s % kSectors)), m);
       d += fmt::format("{}{:.1f},{:.1f}", pen ? " L" : (d.empty() ? "M" : " M"), x, y);
       pen = true;
     }
@@ -543,19 +583,22 @@ std::string svg_polar_deviation(const PathPlot& plot) {
     const std::string label = svg::tick_label(mm, ring_step) + " mm";
     const double half_span_deg = rad_to_deg(0.5 * svg::text_width(label, kMinFont) / radius(mm)) + 2.5;
     double best_deg = 112.5, best_clearance = -1.0;
-    for (int k = 0; k < kSectors; ++k) {
-      const double deg = (k + 0.5) * 360.0 / kSectors;
+    for (std::size_t k = 0; k < kSectors; ++k) {
+      const double deg = sector_centre_deg(k);
+      if (std::abs(std::remainder(deg - 22.5, 45.0)) > 12.5) {
+        continue;  // between the spokes, away from their labels
+      }
       double clearance = INFINITY;
       for (const auto& cv : curves) {
-        for (int j = 0; j < kSectors; ++j) {
-          const double sector_deg = (j + 0.5) * 360.0 / kSectors;
-          const double m = cv.mean_mm[static_cast<std::size_t>(j)];
+        for (std::size_t j = 0; j < kSectors; ++j) {
+          const double sector_deg = sector_centre_deg(j);
+          const double m = cv.mean_mm[j];
           if (std::isfinite(m) && std::abs(std::remainder(sector_deg - deg, 360.0)) <= half_span_deg) {
             clearance = std::min(clearance, std::abs(radius(m) - radius(mm)));
           }
         }
       }
-      // Off the spokes' labels' way (their ends are outside the rings) and, all else equal, nearest 112.5 deg.
+      // All else equal, nearest 112.5 deg.
       const double score = clearance - 1e-3 * std::abs(std::remainder(deg - 112.5, 360.0));
       if (score > best_clearance) {
         best_clearance = score;
