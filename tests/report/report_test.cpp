@@ -201,8 +201,8 @@ TEST(HtmlReport, SelfContainedWellFormedAndComplete) {
   // Budget shares: (0.20 - 0.12) / 0.20 = 40%; a share of -0.2% rounds to 0%, never "-0%".
   EXPECT_NE(html.find("<td>0.120</td><td>40%</td>"), std::string::npos);
   // Tables give the spread over the seeds: 625 N offline, C at 10 mm/s: mean m = 0.6125 * 1.02 *
-  // 0.34 = 0.21242, seeds m * (0.88, 1, 1.12): sample sd 0.12 m = 0.025.
-  EXPECT_NE(html.find("0.212 <span class=\"sd\">&#177;0.025</span> <span class=\"paper\">(0.21)</span>"),
+  // 0.34 = 0.21242, seeds m * (0.88, 1.024, 1.096): sample sd 0.12 m sqrt(0.84) = 0.0234.
+  EXPECT_NE(html.find("0.212 <span class=\"sd\">&#177;0.023</span> <span class=\"paper\">(0.21)</span>"),
             std::string::npos);
   EXPECT_NE(html.find("<td>0.200</td><td>0%</td>"), std::string::npos);
   EXPECT_EQ(html.find("-0%"), std::string::npos);

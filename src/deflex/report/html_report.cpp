@@ -514,9 +514,10 @@ std::string html_report(const ReportContent& content) {
       "<li>Compensation = 1 - C/UC, ours with UC at the same speed, the paper's with its UC column (the mean over "
       "its speeds).</li>\n"
       "<li>Seeds: {}. Each seed is its own cell (true robot, sensor, calibration) and its own runs; tables and "
-      "figures give the mean over the seeds, the tables &#177; the sample standard deviation, the figures whiskers "
-      "from the smallest to the largest seed's value. The path and lap figures show the first seed's runs; the "
-      "error budget uses the first seed's table runs.</li>\n"
+      "figures give the mean over the seeds; the tables add &#177; the sample standard deviation, the figures "
+      "whiskers from the smallest to the largest seed's value. The path, polar and lap figures show the first "
+      "seed's runs at each setup's highest load and lowest speed; the error budget uses the first seed's table "
+      "runs.</li>\n"
       "<li>ISO 9283 path accuracy AT<sub>p</sub> and repeatability RT<sub>p</sub>: section 7.2 of the standard, "
       "positions only, against the same reference (see docs/evaluation.md).</li>\n</ul>\n",
       seeds_text(study));
