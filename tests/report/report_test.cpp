@@ -12,6 +12,7 @@
 #include "deflex/evaluate/tracker_trace.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/report/html_report.hpp"
+#include "svg_scan.hpp"
 #include "synthetic_study.hpp"
 #include "xml_check.hpp"
 
@@ -28,16 +29,7 @@ TEST(XmlCheck, CatchesMalformedDocuments) {
   EXPECT_NE(test::xml_problem("<a>1 > 0</a>"), "");
 }
 
-// Value of the attribute `name` inside one tag's text, or "" when absent.
-std::string attribute(const std::string& tag, const std::string& name) {
-  const std::string key = " " + name + "=\"";
-  const auto b = tag.find(key);
-  if (b == std::string::npos) {
-    return "";
-  }
-  const auto start = b + key.size();
-  return tag.substr(start, tag.find('"', start) - start);
-}
+using test::attribute;
 
 // (value, height) of every bar carrying a data-value. Plain scanning, not std::regex: libstdc++'s
 // regex recurses per character and overflows the stack on a long SVG under AddressSanitizer.
@@ -56,7 +48,7 @@ std::vector<std::pair<double, double>> bars(const std::string& svg) {
 
 TEST(Figure5, OneBarPerSetupLoadAndSpeedScaledToItsValue) {
   const StudyResult s = test::synthetic_study();
-  const std::string svg = svg_figure5(s);
+  const std::string svg = svg_figure5(s, SetupSelection::kAll);
   EXPECT_EQ(test::xml_problem(svg), "");
   const auto b = bars(svg);
   ASSERT_EQ(b.size(), 27u);  // 3 setups x 3 loads x 3 speeds
@@ -67,17 +59,18 @@ TEST(Figure5, OneBarPerSetupLoadAndSpeedScaledToItsValue) {
     EXPECT_NEAR(h, v * px_per_mm, 0.012) << v;  // heights are written with 2 decimals
   }
   EXPECT_NEAR(b[0].first, s.setups[0].loads[0].c_mm.at(10), 1e-4);
-  // The paper's C values are marked on the offline and online bars (18), plus one legend sample.
-  EXPECT_EQ(test::count_of(svg, R"(fill="white" stroke="#111")"), 19u);
+  // The paper's values beside ours, as outlined bars: C of the offline and online setups (18) and
+  // their UC (6); the hybrid setup has none.
+  EXPECT_EQ(test::count_of(svg, "data-paper="), 24u);
   EXPECT_NE(svg.find("offline (OFF)"), std::string::npos);
   EXPECT_NE(svg.find("online (ON)"), std::string::npos);
   EXPECT_NE(svg.find("(mm)"), std::string::npos);  // the axis says its unit
   // 625 N offline: UC = 0.00098 * 625 * (1 + 0.002 v), mean over 10, 30, 50 mm/s = 0.6125 * 1.06 = 0.649.
-  EXPECT_NE(svg.find("UC 0.65 (0.62)"), std::string::npos) << "625 N offline UC beside the paper's";
+  EXPECT_NE(svg.find(R"(data-uc="0.64925")"), std::string::npos) << "625 N offline UC, the mean over the speeds";
 }
 
 TEST(Figure5, EmptyStudyStillDraws) {
-  const std::string svg = svg_figure5(StudyResult{});
+  const std::string svg = svg_figure5(StudyResult{}, SetupSelection::kAll);
   EXPECT_EQ(test::xml_problem(svg), "");
   EXPECT_NE(svg.find("no results"), std::string::npos);
 }
@@ -148,9 +141,10 @@ TEST(PathPlot, DeviationsAreMagnifiedByTheStatedFactor) {
   const double r0 = mean_radius(unloaded, cx, cy);
   EXPECT_NEAR(mean_radius(uc, cx, cy) / r0, 1.20, 0.005);
   EXPECT_NEAR(mean_radius(c, cx, cy) / r0, 1.04, 0.005);
-  // Legend: the mean deviations at true scale.
-  EXPECT_NE(svg.find("UC (mean 0.500 mm)"), std::string::npos);
-  EXPECT_NE(svg.find("C (mean 0.100 mm)"), std::string::npos);
+  // Legend: the mean deviations of the last laps at true scale, and which way they ran (the circle
+  // turns anticlockwise seen from the side its normal points to).
+  EXPECT_NE(svg.find("UC, last lap, anticlockwise: mean 0.500 mm"), std::string::npos);
+  EXPECT_NE(svg.find("C, last lap, anticlockwise: mean 0.100 mm"), std::string::npos);
 }
 
 TEST(PathPlot, AutomaticMagnificationAndBadInput) {
@@ -169,8 +163,11 @@ TEST(PathPlot, AutomaticMagnificationAndBadInput) {
   EXPECT_EQ(test::xml_problem(empty), "");
   EXPECT_NE(empty.find("UC (no data)"), std::string::npos);
   EXPECT_EQ(empty.find("nan"), std::string::npos);
-  p.unloaded.resize(1);
-  EXPECT_THROW(svg_path_plot(p), InputError);
+  // Too little to draw is said in the figure, not thrown: one bad plot must not lose a whole report.
+  PathPlot one_sample{"one sample", {p.unloaded.front()}, p.uc, p.c, 0.0, {}, {}, {}};
+  const std::string none = svg_path_plot(one_sample);
+  EXPECT_EQ(test::xml_problem(none), "");
+  EXPECT_NE(none.find("no unloaded path"), std::string::npos);
 }
 
 TEST(SpeedSweep, OneLinePerSeriesInBothPanels) {
@@ -179,7 +176,9 @@ TEST(SpeedSweep, OneLinePerSeriesInBothPanels) {
   EXPECT_NE(svg.find("online 650 N"), std::string::npos);
   EXPECT_NE(svg.find("online-latency-comp 650 N"), std::string::npos);
   EXPECT_NE(svg.find("TCP speed (mm/s)"), std::string::npos);
-  EXPECT_EQ(test::count_of(svg, "<circle"), 24u);  // 2 series x 6 speeds x 2 panels
+  // 2 series x 6 speeds in each of 4 panels: compensation, C, C time-synchronous, UC.
+  EXPECT_EQ(test::count_of(svg, "<circle "), 48u + 2u) << "points and the 2 legend swatches";
+  EXPECT_EQ(test::count_of(svg, R"(<circle cx)") - 2u, test::count_of(svg, "data-value="));
   EXPECT_EQ(test::xml_problem(svg_speed_sweep(StudyResult{})), "");
 }
 
@@ -189,14 +188,22 @@ TEST(HtmlReport, SelfContainedWellFormedAndComplete) {
   EXPECT_EQ(test::xml_problem(html), "");
   for (const char* needle : {"Table 1: offline compensation", "Table 2: online compensation",
                              "Table 3: hybrid (beyond the paper)", "Figure 5", "ISO 9283", "Error budget",
-                             "Speed sweep", "Path plots", "Notes", "force sensor compliance &lt;unmodelled&gt;",
+                             "Speed sweep", "Paths, laps and directions", "Notes",
+                             "force sensor compliance &lt;unmodelled&gt;", "Compensation per load",
+                             "Parity with the paper", "Time-synchronous error beside",
                              "LDBB loads 125-650 N &amp; speeds", "<span class=\"paper\">(0.12)</span>",
                              "<span class=\"paper\">(1.10)</span>"}) {
     EXPECT_NE(html.find(needle), std::string::npos) << needle;
   }
-  EXPECT_EQ(test::count_of(html, "<svg "), 3u);  // Figure 5, one path plot, the sweep
+  // Figure 5 (the paper's setups), its companion (hybrid), compensation, parity, for the one path
+  // plot its path, polar and per-lap figures, and the sweep.
+  EXPECT_EQ(test::count_of(html, "<svg "), 8u);
   // Budget shares: (0.20 - 0.12) / 0.20 = 40%; a share of -0.2% rounds to 0%, never "-0%".
   EXPECT_NE(html.find("<td>0.120</td><td>40%</td>"), std::string::npos);
+  // Tables give the spread over the seeds: 625 N offline, C at 10 mm/s: mean m = 0.6125 * 1.02 *
+  // 0.34 = 0.21242, seeds m * (0.88, 1.024, 1.096): sample sd 0.12 m sqrt(0.84) = 0.0234.
+  EXPECT_NE(html.find("0.212 <span class=\"sd\">&#177;0.023</span> <span class=\"paper\">(0.21)</span>"),
+            std::string::npos);
   EXPECT_NE(html.find("<td>0.200</td><td>0%</td>"), std::string::npos);
   EXPECT_EQ(html.find("-0%"), std::string::npos);
   // Nothing to fetch: no scripts, no external resources.
@@ -214,7 +221,8 @@ TEST(HtmlReport, WritesTheReportAndFigures) {
       keep != nullptr ? std::filesystem::path(keep) : std::filesystem::temp_directory_path() / "deflex_report_test";
   const ReportContent content = test::synthetic_report();
   write_report(content, dir.string());
-  for (const char* f : {"report.html", "figure5.svg", "speed_sweep.svg", "path_1.svg", "tables.md", "tables.csv"}) {
+  for (const char* f : {"report.html", "figure5.svg", "figure5_beyond.svg", "compensation.svg", "parity.svg",
+                        "speed_sweep.svg", "path_1.svg", "polar_1.svg", "laps_1.svg", "tables.md", "tables.csv"}) {
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
   }
   std::ifstream in(dir / "report.html");

@@ -55,6 +55,27 @@ double nice_ceiling(double v) {
   return 10.0 * mag;
 }
 
+double LogScale::operator()(double d) const {
+  return p0 + (std::log10(d) - std::log10(d0)) / (std::log10(d1) - std::log10(d0)) * (p1 - p0);
+}
+
+std::vector<double> log_ticks(double lo, double hi) {
+  std::vector<double> ticks;
+  if (!(lo > 0.0) || !(hi > lo) || !std::isfinite(hi)) {
+    return ticks;
+  }
+  for (int k = static_cast<int>(std::floor(std::log10(lo))); k <= static_cast<int>(std::ceil(std::log10(hi))); ++k) {
+    for (const double m : {1.0, 2.0, 5.0}) {
+      // m * 10^k written from the decimal text, so 0.2 is the double nearest 0.2, not 2 * 0.1.
+      const double t = std::stod(fmt::format("{:g}e{}", m, k));
+      if (t >= lo * (1.0 - 1e-9) && t <= hi * (1.0 + 1e-9)) {
+        ticks.push_back(t);
+      }
+    }
+  }
+  return ticks;
+}
+
 std::string tick_label(double value, double step) {
   const int decimals = std::max(0, static_cast<int>(std::ceil(-std::log10(step) - 1e-9)));
   return fmt::format("{:.{}f}", value, decimals);
@@ -100,6 +121,31 @@ void Canvas::text(double x, double y, const std::string& t, double size, const s
   body_ += "\n";
 }
 
+void Canvas::path(const std::string& d, const std::string& stroke, double width, const std::string& extra) {
+  body_ += fmt::format(R"(<path d="{}" fill="none" stroke="{}" stroke-width="{:.2f}" stroke-linejoin="round"{}/>)", d,
+                       stroke, width, extra.empty() ? "" : " " + extra);
+  body_ += "\n";
+}
+
+void Canvas::polygon(const std::vector<double>& xy, const std::string& fill, const std::string& extra) {
+  std::string pts;
+  for (std::size_t i = 0; i + 1 < xy.size(); i += 2) {
+    pts += fmt::format("{}{:.1f},{:.1f}", i == 0 ? "" : " ", xy[i], xy[i + 1]);
+  }
+  body_ += fmt::format(R"(<polygon points="{}" fill="{}"{}/>)", pts, fill, extra.empty() ? "" : " " + extra);
+  body_ += "\n";
+}
+
+void Canvas::group_begin(const std::string& tooltip, const std::string& extra) {
+  body_ += extra.empty() ? "<g>" : "<g " + extra + ">";
+  if (!tooltip.empty()) {
+    body_ += "<title>" + xml_escape(tooltip) + "</title>";
+  }
+  body_ += "\n";
+}
+
+void Canvas::group_end() { body_ += "</g>\n"; }
+
 void Canvas::title(const std::string& t) { text(width_ / 2.0, 24.0, t, 16.0, "middle", R"(font-weight="bold")"); }
 
 void Canvas::raw(const std::string& markup) { body_ += markup; }
@@ -113,3 +159,23 @@ std::string Canvas::str() const {
 }
 
 }  // namespace deflex::svg
+
+namespace deflex {
+
+std::string xml_escape(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char ch : text) {
+    switch (ch) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&#39;"; break;
+      default: out += ch;
+    }
+  }
+  return out;
+}
+
+}  // namespace deflex

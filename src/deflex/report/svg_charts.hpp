@@ -1,6 +1,9 @@
-// SVG charts of a case study: the paper's Figure 5 (grouped bars), path plots with magnified
-// deviations, and the speed sweep. Each function returns one standalone <svg> element (no scripts,
-// no external resources) that can be saved as a file or inlined in HTML.
+// SVG charts of a case study: the paper's Figure 5 (grouped bars), compensation per load, a parity
+// plot against the paper's tables, the speed sweep, and per run: path plots with magnified
+// deviations, per-lap deviation against the angle on the circle, and a polar deviation plot. Each
+// function returns one standalone <svg> element (no scripts, no external resources), at most 1020 px
+// wide with no text under 11 px, that can be saved as a file or inlined in HTML. Where a study has
+// several seeds, whiskers show the range (min to max) over the seeds.
 #pragma once
 
 #include <string>
@@ -11,13 +14,30 @@
 
 namespace deflex {
 
-/// Figure 5 of the paper: mean deformation after compensation (and before, lighter) per load, one
-/// group of bars per setup and load, one bar per speed; the paper's values marked beside ours.
-std::string svg_figure5(const StudyResult& study);
+/// Which setups a study figure draws: those the paper has a table for (offline, online), the others
+/// (beyond the paper), or all.
+enum class SetupSelection { kPaper, kBeyondPaper, kAll };
+/// True when the paper has a table for the setup.
+[[nodiscard]] bool paper_has_setup(const std::string& setup);
 
-/// A path in the plane of best fit of the unloaded path: the unloaded path, the loaded uncompensated
-/// (UC) and compensated (C) paths, each drawn at unloaded + magnification * (its deviation from the
-/// unloaded path). magnification <= 0 picks a nice factor (1, 2 or 5 x 10^k) that draws the largest deviation at up
+/// Figure 5 of the paper: mean deformation after compensation per setup, load and speed (upper
+/// panel, one bar per speed), and before it (lower panel, pale bars: UC, mean over the speeds); the
+/// paper's values as outlined bars beside ours; whiskers: min to max over the seeds.
+std::string svg_figure5(const StudyResult& study, SetupSelection which = SetupSelection::kAll);
+
+/// Compensation 1 - C/UC per setup and load (the figure the paper quotes: offline 67%, online
+/// 69-80%): ours, mean over the speeds, whiskers min to max over the seeds; the paper's outlined.
+std::string svg_compensation(const StudyResult& study);
+
+/// Parity plot: ours (y) against the paper's (x) for every figure of Tables 1 and 2 (C per load and
+/// speed, UC per load), log axes, the line y = x, the band +-35% (the fidelity target for C) and the
+/// lines +-25% (the target for UC); whiskers: min to max over the seeds.
+std::string svg_parity(const StudyResult& study);
+
+/// A path in the plane of best fit of the reference (the unloaded laps' mean, else the last
+/// unloaded lap): the reference, the last lap of the loaded uncompensated (UC) and compensated (C)
+/// runs, each drawn at reference + magnification * (its deviation from the reference).
+/// magnification <= 0 picks a nice factor (1, 2 or 5 x 10^k) that draws the largest deviation at up
 /// to 12% of the path's size.
 struct PathPlot {
   std::string title;
@@ -30,7 +50,20 @@ struct PathPlot {
 };
 std::string svg_path_plot(const PathPlot& plot);
 
-/// Compensation (or residual) versus TCP speed, one line per setup and load in the sweep.
+/// Distance from the reference (the unloaded laps' mean) against the angle about the circle's centre
+/// (0 deg: the base's +x direction from the centre, growing anticlockwise seen from above), one line
+/// per lap of the UC runs (left) and the C runs (right), clockwise and anticlockwise laps in their
+/// own colours, each with an arrow in its direction of travel. Laps: plot.uc_laps and plot.c_laps.
+std::string svg_lap_overlay(const PathPlot& plot);
+
+/// Polar deviation plot: around the circle (angle as in svg_lap_overlay), the distance from the
+/// reference drawn outward from a ring that stands for 0 mm, magnified, with rings labelled in mm;
+/// UC and C, clockwise and anticlockwise laps each averaged in 5 deg sectors.
+std::string svg_polar_deviation(const PathPlot& plot);
+
+/// The speed sweep against TCP speed, one line per setup and load: compensation, C (the paper's
+/// nearest-point metric), C time-synchronous (sees lag along the path) and UC; whiskers min to max
+/// over the seeds; the paper's speeds shaded.
 std::string svg_speed_sweep(const StudyResult& study);
 
 /// Escapes &, <, >, " and ' for XML text and attributes.

@@ -1,0 +1,619 @@
+// SVG charts of one setup's runs: the path plot with magnified deviations, the per-lap deviation
+// against the angle on the circle, and the polar deviation plot. Distances are taken, as the
+// study's figures are, to the nearest point of the reference: the unloaded laps' mean path.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "deflex/evaluate/lap_split.hpp"
+#include "deflex/evaluate/path_metrics.hpp"
+#include "deflex/report/svg_canvas.hpp"
+#include "deflex/report/svg_chart_parts.hpp"
+#include "deflex/report/svg_charts.hpp"
+
+namespace deflex {
+namespace {
+
+using svg::Canvas;
+using svg::kMinFont;
+using svg::Scale;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+TrackerTrace finite_only(const TrackerTrace& t) {
+  TrackerTrace out;
+  out.reserve(t.size());
+  for (const auto& s : t) {
+    if (s.p_m.allFinite()) {
+      out.push_back(s);
+    }
+  }
+  return out;
+}
+
+// The reference the distances are taken to and the frame the angle is measured in.
+struct Reference {
+  TrackerTrace path;  // finite samples; a closed path is closed (its first sample repeated)
+  bool is_mean = false;
+  PathPlane plane;
+  bool closed = false;
+  bool horizontal = false;  // the plane's normal within 10 deg of the base z: u, v are +x, +y
+  double size_m = 0.0;
+  std::optional<PolylineIndex> index;
+};
+
+// nullopt when neither the unloaded mean nor the unloaded lap has 2 finite samples.
+std::optional<Reference> reference_of(const PathPlot& plot) {
+  Reference r;
+  r.path = finite_only(plot.unloaded_mean);
+  r.is_mean = r.path.size() >= 2;
+  if (!r.is_mean) {
+    r.path = finite_only(plot.unloaded);
+  }
+  if (r.path.size() < 2) {
+    return std::nullopt;
+  }
+  r.plane = best_fit_plane(r.path);
+  double lo_u = INFINITY, hi_u = -INFINITY, lo_v = INFINITY, hi_v = -INFINITY;
+  for (const auto& s : r.path) {
+    const Vector3 d = s.p_m - r.plane.centroid_m;
+    lo_u = std::min(lo_u, d.dot(r.plane.u));
+    hi_u = std::max(hi_u, d.dot(r.plane.u));
+    lo_v = std::min(lo_v, d.dot(r.plane.v));
+    hi_v = std::max(hi_v, d.dot(r.plane.v));
+  }
+  r.size_m = std::max(hi_u - lo_u, hi_v - lo_v);
+  const double gap = (r.path.front().p_m - r.path.back().p_m).norm();
+  r.closed = gap < 0.1 * r.size_m;
+  // A thinned closed path can lose its repeated first sample; without it a point near the seam
+  // would find its nearest neighbour a whole gap away.
+  if (r.closed && gap > 0.0) {
+    r.path.push_back(r.path.front());
+  }
+  r.horizontal = std::abs(r.plane.normal.z()) > std::cos(deg_to_rad(10.0));
+  r.index.emplace(r.path);
+  return r;
+}
+
+// Angle about the reference's centre in its plane, 0..360 deg, anticlockwise seen from the side
+// the normal points to (from above).
+double angle_deg(const Reference& r, const Vector3& p) {
+  const Vector3 d = p - r.plane.centroid_m;
+  const double a = rad_to_deg(std::atan2(d.dot(r.plane.v), d.dot(r.plane.u)));
+  return a < 0.0 ? a + 360.0 : a;
+}
+
+// Clockwise seen from above: the sign of the area swept about the centre.
+bool turns_clockwise(const TrackerTrace& t, const Reference& r) {
+  double area = 0.0;
+  for (std::size_t k = 0; k + 1 < t.size(); ++k) {
+    area += (t[k].p_m - r.plane.centroid_m).cross(t[k + 1].p_m - r.plane.centroid_m).dot(r.plane.normal);
+  }
+  return area < 0.0;
+}
+
+struct LapDeviation {
+  bool clockwise = false;
+  std::vector<double> angle_deg, distance_mm;
+  Vector3 first = Vector3::Zero();
+};
+
+std::vector<LapDeviation> lap_deviations(const std::vector<DirectedLap>& laps, const TrackerTrace& last_lap,
+                                         const Reference& ref) {
+  std::vector<DirectedLap> use = laps;
+  if (use.empty() && last_lap.size() >= 2) {  // no per-lap data: the last lap, its direction from the trace
+    use.push_back({last_lap, turns_clockwise(finite_only(last_lap), ref)});
+  }
+  std::vector<LapDeviation> out;
+  for (const auto& lap : use) {
+    LapDeviation d;
+    d.clockwise = lap.clockwise;
+    for (const auto& s : lap.trace) {
+      if (!s.p_m.allFinite()) {
+        continue;
+      }
+      d.angle_deg.push_back(angle_deg(ref, s.p_m));
+      d.distance_mm.push_back(ref.index->nearest(s.p_m).distance_m * 1e3);
+    }
+    if (!d.distance_mm.empty()) {
+      out.push_back(std::move(d));
+    }
+  }
+  return out;
+}
+
+double mean_of(const std::vector<LapDeviation>& laps, int clockwise /* -1: any */) {
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (const auto& l : laps) {
+    if (clockwise >= 0 && l.clockwise != (clockwise == 1)) {
+      continue;
+    }
+    for (const double d : l.distance_mm) {
+      sum += d;
+      ++n;
+    }
+  }
+  return n > 0 ? sum / static_cast<double>(n) : kNaN;
+}
+
+int count_of(const std::vector<LapDeviation>& laps, bool clockwise) {
+  return static_cast<int>(std::count_if(laps.begin(), laps.end(), [&](const auto& l) { return l.clockwise == clockwise; }));
+}
+
+constexpr int kSectors = 72;  // 5 deg each
+
+// Mean distance (mm) of one direction's laps in each 5 deg sector of the angle; NaN where no sample
+// fell; empty when the direction has no sample at all.
+std::vector<double> sector_means(const std::vector<LapDeviation>& laps, bool clockwise) {
+  std::vector<double> sum(kSectors, 0.0);
+  std::vector<int> n(kSectors, 0);
+  for (const auto& lap : laps) {
+    if (lap.clockwise != clockwise) {
+      continue;
+    }
+    for (std::size_t i = 0; i < lap.angle_deg.size(); ++i) {
+      const auto s = static_cast<std::size_t>(
+          std::clamp(static_cast<int>(lap.angle_deg[i] / (360.0 / kSectors)), 0, kSectors - 1));
+      sum[s] += lap.distance_mm[i];
+      ++n[s];
+    }
+  }
+  if (std::all_of(n.begin(), n.end(), [](int k) { return k == 0; })) {
+    return {};
+  }
+  std::vector<double> mean(kSectors, kNaN);
+  for (std::size_t s = 0; s < mean.size(); ++s) {
+    if (n[s] > 0) {
+      mean[s] = sum[s] / n[s];
+    }
+  }
+  return mean;
+}
+
+double sector_centre_deg(std::size_t s) { return (static_cast<double>(s) + 0.5) * 360.0 / kSectors; }
+
+// A filled arrowhead at (x, y) pointing along (dx, dy) in pixels.
+void arrowhead(Canvas& c, double x, double y, double dx, double dy, const std::string& col, double size = 9.0) {
+  const double n = std::hypot(dx, dy);
+  if (!(n > 0.0)) {
+    return;
+  }
+  const double ux = dx / n, uy = dy / n;
+  c.polygon({x + ux * size * 0.6, y + uy * size * 0.6, x - ux * size * 0.4 - uy * size * 0.45,
+             y - uy * size * 0.4 + ux * size * 0.45, x - ux * size * 0.4 + uy * size * 0.45,
+             y - uy * size * 0.4 - ux * size * 0.45},
+            col, R"(class="travel-arrow" stroke="white" stroke-width="1" stroke-linejoin="round")");
+}
+
+std::string direction_name(bool clockwise) { return clockwise ? "clockwise" : "anticlockwise"; }
+std::string direction_colour(bool clockwise) {
+  return clockwise ? svg::kClockwiseColour : svg::kAnticlockwiseColour;
+}
+std::string direction_mean_colour(bool clockwise) { return clockwise ? "#8F3B00" : "#2E1A4F"; }
+std::string direction_dash(bool clockwise) { return clockwise ? "" : R"(stroke-dasharray="6 3")"; }
+
+// The base direction an angle on a horizontal circle points to (seen from above).
+std::string compass(int deg) {
+  switch (deg) {
+    case 0: return "+x";
+    case 90: return "+y";
+    case 180: return "-x";
+    case 270: return "-y";
+    default: return "";
+  }
+}
+
+// A title and, under it, what the figure is of (the plot's own title: setup, load, speed, seed).
+void titles(Canvas& c, const std::string& title, const std::string& of) {
+  c.title(title);
+  if (!of.empty()) {
+    c.text(c.width() / 2.0, 44.0, of, 13.0, "middle", R"(fill="#444")");
+  }
+}
+
+void no_data(Canvas& c, const std::string& why) {
+  c.text(c.width() / 2.0, c.height() / 2.0, why, 14.0, "middle");
+}
+
+}  // namespace
+
+std::string svg_path_plot(const PathPlot& plot) {
+  const double width = 500.0, height = 640.0;
+  Canvas c(width, height);
+  titles(c, "The last laps, deviations magnified", plot.title);
+  const std::optional<Reference> ref = reference_of(plot);
+  if (!ref) {
+    no_data(c, "no unloaded path to plot (fewer than 2 samples)");
+    return c.str();
+  }
+  const Vector3& centroid = ref->plane.centroid_m;
+  const Vector3& u = ref->plane.u;
+  const Vector3& v = ref->plane.v;
+  struct Dev {
+    Vector3 on_path, d;
+  };
+  auto deviations = [&](const TrackerTrace& t) {
+    std::vector<Dev> out;
+    const std::size_t stride = std::max<std::size_t>(1, (t.size() + 1499) / 1500);
+    for (std::size_t i = 0; i < t.size(); i += stride) {
+      if (t[i].p_m.allFinite()) {
+        const auto near = ref->index->nearest(t[i].p_m);
+        out.push_back({near.point_m, t[i].p_m - near.point_m});
+      }
+    }
+    return out;
+  };
+  const std::vector<Dev> uc = deviations(plot.uc);
+  const std::vector<Dev> cc = deviations(plot.c);
+  double max_dev = 0.0;
+  for (const auto* set : {&uc, &cc}) {
+    for (const auto& d : *set) {
+      max_dev = std::max(max_dev, d.d.norm());
+    }
+  }
+  const double mag = plot.magnification > 0.0 ? plot.magnification
+                     : max_dev > 0.0             ? svg::nice_floor(0.12 * ref->size_m / max_dev)
+                                                 : 1.0;
+  auto mean_text = [&](const char* name, const std::vector<Dev>& ds, const TrackerTrace& lap) {
+    if (ds.empty()) {
+      return fmt::format("{} (no data)", name);
+    }
+    double s = 0.0;
+    for (const auto& d : ds) {
+      s += d.d.norm();
+    }
+    const std::string dir = ref->closed ? ", " + direction_name(turns_clockwise(finite_only(lap), *ref)) : "";
+    return fmt::format("{}, last lap{}: mean {:.3f} mm", name, dir, s / static_cast<double>(ds.size()) * 1e3);
+  };
+  svg::legend_entry(c, 40.0, 72.0, "line", svg::kUnloadedColour,
+                    ref->is_mean ? "unloaded, mean of the laps (the reference)" : "unloaded, last lap (the reference)");
+  svg::legend_entry(c, 40.0, 92.0, "line", svg::kUcColour, mean_text("UC", uc, plot.uc));
+  svg::legend_entry(c, 40.0, 112.0, "line", svg::kCColour, mean_text("C", cc, plot.c));
+
+  // The path in its plane, equal scales, deviations magnified.
+  const double pl = 76.0, pt = 130.0, pw = 400.0, ph = 400.0;
+  double lo_u = INFINITY, hi_u = -INFINITY, lo_v = INFINITY, hi_v = -INFINITY;
+  for (const auto& s : ref->path) {
+    const Vector3 d = s.p_m - centroid;
+    lo_u = std::min(lo_u, d.dot(u));
+    hi_u = std::max(hi_u, d.dot(u));
+    lo_v = std::min(lo_v, d.dot(v));
+    hi_v = std::max(hi_v, d.dot(v));
+  }
+  const double half = 0.5 * ref->size_m * 1.3 + 1e-9;
+  const double mid_u = 0.5 * (lo_u + hi_u), mid_v = 0.5 * (lo_v + hi_v);
+  const Scale xs{(mid_u - half) * 1e3, (mid_u + half) * 1e3, pl, pl + pw};
+  const Scale ys{(mid_v - half) * 1e3, (mid_v + half) * 1e3, pt + ph, pt};
+  c.rect(pl, pt, pw, ph, "none", R"(stroke="#ccc")");
+  const std::string axis_u = ref->horizontal ? "x" : "u", axis_v = ref->horizontal ? "y" : "v";
+  svg::value_axis(c, ys, pl, pl + pw, fmt::format("{} about the centre (mm)", axis_v), 1.0, 50.0);
+  svg::position_axis(c, xs, pt + ph, fmt::format("{} about the centre (mm)", axis_u));
+  auto to_px = [&](const Vector3& p) {
+    const Vector3 d = p - centroid;
+    return std::pair{xs(d.dot(u) * 1e3), ys(d.dot(v) * 1e3)};
+  };
+  {
+    std::vector<double> xy;
+    const std::size_t stride = std::max<std::size_t>(1, (ref->path.size() + 1499) / 1500);
+    for (std::size_t i = 0; i < ref->path.size(); i += stride) {
+      const auto [x, y] = to_px(ref->path[i].p_m);
+      xy.insert(xy.end(), {x, y});
+    }
+    const auto [x, y] = to_px(ref->path.back().p_m);
+    xy.insert(xy.end(), {x, y});
+    c.polyline(xy, svg::kUnloadedColour, 4.5);  // wide, so it shows beside a C path lying on it
+  }
+  for (const auto& [set, col] : {std::pair{&uc, svg::kUcColour}, std::pair{&cc, svg::kCColour}}) {
+    std::vector<double> xy;
+    for (const auto& d : *set) {
+      const auto [x, y] = to_px(d.on_path + mag * d.d);
+      xy.insert(xy.end(), {x, y});
+    }
+    c.polyline(xy, col, 1.3);
+    // The direction of travel: an arrowhead a third of the way along.
+    if (set->size() >= 8) {
+      const std::size_t k = set->size() / 3;
+      const auto [x0, y0] = to_px((*set)[k].on_path + mag * (*set)[k].d);
+      const auto [x1, y1] = to_px((*set)[k + 3].on_path + mag * (*set)[k + 3].d);
+      arrowhead(c, x0, y0, x1 - x0, y1 - y0, col, 11.0);
+    }
+  }
+  if (ref->closed) {
+    // The centre and the 0 deg ray of the angle the other figures use.
+    const auto [cx, cy] = to_px(centroid);
+    c.line(cx - 5.0, cy, cx + 5.0, cy, "#666", 1.0);
+    c.line(cx, cy - 5.0, cx, cy + 5.0, "#666", 1.0);
+    const double ray = 0.5 * ref->size_m * 0.75 * pw / (2.0 * half);
+    c.line(cx, cy, cx + ray, cy, "#666", 1.0, R"(stroke-dasharray="3 3")");
+    c.text(cx + 8.0, cy - 6.0, ref->horizontal ? "0 deg (+x)" : "0 deg (+u)", kMinFont, "start", R"(fill="#444")");
+  }
+  // Below the axes, clear of every line: how to read the figure.
+  c.text(pl + pw / 2.0, pt + ph + 62.0, fmt::format("Deviations magnified x{:g}", mag), 12.0, "middle",
+         R"(font-weight="bold")");
+  c.text(pl + pw / 2.0, pt + ph + 78.0,
+         fmt::format("each point drawn from its nearest reference point; seen from {},",
+                     ref->horizontal ? "above" : "the plane's normal"),
+         12.0, "middle", R"(fill="#555")");
+  c.text(pl + pw / 2.0, pt + ph + 94.0, "projected on the path's plane (the out-of-plane part is not drawn)", 12.0,
+         "middle", R"(fill="#555")");
+  return c.str();
+}
+
+std::string svg_lap_overlay(const PathPlot& plot) {
+  const double width = svg::kMaxWidth, height = 530.0;
+  Canvas c(width, height);
+  titles(c, "Every lap: distance from the reference against the angle on the circle", plot.title);
+  const std::optional<Reference> ref = reference_of(plot);
+  if (!ref || !ref->closed) {
+    no_data(c, !ref ? "no unloaded path to plot (fewer than 2 samples)" : "the path is not closed: no angle to plot");
+    return c.str();
+  }
+  const std::vector<LapDeviation> runs[] = {lap_deviations(plot.uc_laps, plot.uc, *ref),
+                                            lap_deviations(plot.c_laps, plot.c, *ref)};
+  const char* const names[] = {"UC, uncompensated", "C, compensated"};
+  // Legend: colour and dash by direction, with the direction of travel on the angle axis; below,
+  // the direction's mean, which the eye cannot find in six noisy laps.
+  for (const bool cw : {true, false}) {
+    const double lx = cw ? 80.0 : 590.0;
+    const std::string label = fmt::format("{} laps: travel {} (angle {})", direction_name(cw),
+                                          cw ? "to the left" : "to the right", cw ? "falls" : "grows");
+    c.line(lx, 66.0, lx + 18.0, 66.0, direction_colour(cw), 2.0, direction_dash(cw));
+    arrowhead(c, lx + (cw ? 2.0 : 16.0), 66.0, cw ? -1.0 : 1.0, 0.0, direction_colour(cw), 11.0);
+    c.text(lx + 24.0, 70.0, label, 12.0);
+    c.line(lx, 86.0, lx + 18.0, 86.0, direction_mean_colour(cw), 2.6, direction_dash(cw));
+    c.text(lx + 24.0, 90.0, fmt::format("{} laps' mean in 5 deg sectors", direction_name(cw)), 12.0);
+  }
+  const double top = 140.0, panel_h = 266.0, panel_w = 400.0;
+  const double lefts[] = {80.0, 590.0};
+  for (int r = 0; r < 2; ++r) {
+    const double left = lefts[r];
+    const Scale x{0.0, 360.0, left, left + panel_w};
+    double max_d = 0.0;
+    for (const auto& lap : runs[r]) {
+      for (const double d : lap.distance_mm) {
+        max_d = std::max(max_d, d);
+      }
+    }
+    const Scale y{0.0, svg::nice_ceiling(max_d * 1.05), top + panel_h, top};
+    c.text(left, top - 26.0, names[r], 13.0, "start", R"(font-weight="bold")");
+    std::string summary;
+    for (const bool cw : {true, false}) {
+      const int n = count_of(runs[r], cw);
+      if (n > 0) {
+        summary += fmt::format("{}{} {} lap{}: mean {:.3f} mm", summary.empty() ? "" : "; ", direction_name(cw), n,
+                               n == 1 ? "" : "s", mean_of(runs[r], cw ? 1 : 0));
+      }
+    }
+    c.text(left, top - 9.0, summary.empty() ? "no laps" : summary, 12.0, "start", R"(fill="#444")");
+    svg::value_axis(c, y, left, left + panel_w, "distance from the reference (mm)", 1.0, 46.0);
+    c.line(left, top + panel_h, left + panel_w, top + panel_h, "#444", 1.0);
+    for (int deg = 0; deg <= 360; deg += 45) {
+      c.line(x(deg), top + panel_h, x(deg), top + panel_h + 5.0, "#444", 1.0);
+      c.text(x(deg), top + panel_h + 18.0, fmt::format("{}", deg), kMinFont, "middle");
+      if (ref->horizontal && deg % 90 == 0) {
+        c.text(x(deg), top + panel_h + 32.0, compass(deg % 360), kMinFont, "middle", R"(fill="#666")");
+      }
+      if (deg % 90 == 0) {
+        c.line(x(deg), top, x(deg), top + panel_h, deg % 360 == 0 ? "#777" : "#d8d8d8", 1.0,
+               deg % 360 == 0 ? "" : R"(stroke-dasharray="3 3")");
+      }
+    }
+    c.text(left + panel_w / 2.0, top + panel_h + 50.0, "angle about the circle's centre (deg)", 12.0, "middle");
+    struct Arrow {
+      double x, y, dx;
+      std::string colour;
+    };
+    std::vector<Arrow> arrows;
+    for (std::size_t k = 0; k < runs[r].size(); ++k) {
+      const LapDeviation& lap = runs[r][k];
+      std::string d;
+      for (std::size_t i = 0; i < lap.angle_deg.size(); ++i) {
+        const bool wrap = i > 0 && std::abs(lap.angle_deg[i] - lap.angle_deg[i - 1]) > 180.0;
+        d += fmt::format("{}{:.1f},{:.1f}", i == 0 || wrap ? (i == 0 ? "M" : " M") : " L", x(lap.angle_deg[i]),
+                         y(lap.distance_mm[i]));
+      }
+      const std::string col = direction_colour(lap.clockwise);
+      c.path(d, col, 1.1,
+             fmt::format(R"(stroke-opacity="0.85" {} class="lap" data-run="{}" data-direction="{}")",
+                         direction_dash(lap.clockwise), r == 0 ? "UC" : "C", lap.clockwise ? "cw" : "ccw"));
+      // The direction of travel, from the samples themselves: an arrowhead at this lap's own angle
+      // (the laps' arrows spread evenly along the axis, so they do not stack).
+      const std::size_t n = lap.angle_deg.size();
+      if (n >= 12) {
+        const double target = (static_cast<double>(k) + 0.5) * 360.0 / static_cast<double>(runs[r].size());
+        std::size_t i = 0;
+        for (std::size_t j = 1; j + 3 < n; ++j) {
+          if (std::abs(std::remainder(lap.angle_deg[j] - target, 360.0)) <
+              std::abs(std::remainder(lap.angle_deg[i] - target, 360.0))) {
+            i = j;
+          }
+        }
+        double da = lap.angle_deg[i + 3] - lap.angle_deg[i];
+        da = std::remainder(da, 360.0);
+        if (std::abs(da) < 90.0 && da != 0.0) {
+          arrows.push_back({x(lap.angle_deg[i]), y(lap.distance_mm[i]), da, col});
+        }
+      }
+    }
+    // Each direction's mean over its laps, over the laps.
+    for (const bool cw : {true, false}) {
+      const std::vector<double> means = sector_means(runs[r], cw);
+      std::string d;
+      bool pen = false;
+      for (std::size_t k = 0; k < means.size(); ++k) {
+        if (!std::isfinite(means[k])) {
+          pen = false;
+          continue;
+        }
+        d += fmt::format("{}{:.1f},{:.1f}", pen ? " L" : (d.empty() ? "M" : " M"), x(sector_centre_deg(k)),
+                         y(means[k]));
+        pen = true;
+      }
+      if (!d.empty()) {
+        c.path(d, direction_mean_colour(cw), 2.6,
+               fmt::format(R"({} class="direction-mean" data-run="{}" data-direction="{}")", direction_dash(cw),
+                           r == 0 ? "UC" : "C", cw ? "cw" : "ccw"));
+      }
+    }
+    // Over every line, outlined in white, so no later lap hides an earlier one's arrow.
+    for (const auto& a : arrows) {
+      arrowhead(c, a.x, a.y, a.dx, 0.0, a.colour, 13.0);
+    }
+  }
+  c.text(width / 2.0, height - 36.0,
+         fmt::format("Angle: about the centre of the reference, 0 deg = the base's {} direction from the centre{}, "
+                     "growing anticlockwise seen from {}.",
+                     ref->horizontal ? "+x" : "+x (projected on the circle's plane)", "",
+                     ref->horizontal ? "above" : "the plane's normal (n.z > 0)"),
+         12.0, "middle", R"(fill="#444")");
+  c.text(width / 2.0, height - 18.0,
+         fmt::format("Distance: from each tracker point to the nearest point of the {}; one line per lap.",
+                     ref->is_mean ? "unloaded laps' mean path (the study's reference)" : "last unloaded lap"),
+         12.0, "middle", R"(fill="#444")");
+  return c.str();
+}
+
+std::string svg_polar_deviation(const PathPlot& plot) {
+  const double width = 500.0, height = 640.0;
+  Canvas c(width, height);
+  titles(c, "Distance from the reference around the circle", plot.title);
+  const std::optional<Reference> ref = reference_of(plot);
+  if (!ref || !ref->closed) {
+    no_data(c, !ref ? "no unloaded path to plot (fewer than 2 samples)" : "the path is not closed: no angle to plot");
+    return c.str();
+  }
+  // Each run's laps in one direction averaged in 5 deg sectors.
+  struct Curve {
+    const char* run;
+    bool clockwise;
+    std::string colour;
+    std::vector<double> mean_mm;  // per sector, NaN when empty
+  };
+  std::vector<Curve> curves;
+  const std::vector<LapDeviation> runs[] = {lap_deviations(plot.uc_laps, plot.uc, *ref),
+                                            lap_deviations(plot.c_laps, plot.c, *ref)};
+  double max_mm = 0.0;
+  for (int r = 0; r < 2; ++r) {
+    for (const bool cw : {true, false}) {
+      std::vector<double> means = sector_means(runs[r], cw);
+      if (means.empty()) {
+        continue;
+      }
+      for (const double m : means) {
+        if (std::isfinite(m)) {
+          max_mm = std::max(max_mm, m);
+        }
+      }
+      curves.push_back({r == 0 ? "UC" : "C", cw, r == 0 ? svg::kUcColour : svg::kCColour, std::move(means)});
+    }
+  }
+  // Legend: run by colour, direction by dash.
+  double ly = 72.0;
+  for (const auto& cv : curves) {
+    const std::string label = fmt::format("{}, {} laps (5 deg sector means)", cv.run, direction_name(cv.clockwise));
+    c.line(40.0, ly - 4.0, 58.0, ly - 4.0, cv.colour, 2.0, direction_dash(cv.clockwise));
+    c.text(64.0, ly, label, 12.0);
+    ly += 18.0;
+  }
+  const double cx = 250.0, cy = std::max(ly + 196.0, 340.0), r0 = 70.0, r_out = 165.0;
+  // Rings at a round step, the outermost the first at or beyond the largest sector mean.
+  const auto steps = svg::nice_ticks(0.0, std::max(max_mm, 1e-6) * 1.02, 3);
+  const double ring_step = steps.size() > 1 ? steps[1] - steps[0] : std::max(max_mm, 1e-6);
+  const double ring_max = std::max(1.0, std::ceil(max_mm * 1.02 / ring_step - 1e-9)) * ring_step;
+  const double px_per_mm = (r_out - r0) / ring_max;
+  auto radius = [&](double mm) { return r0 + mm * px_per_mm; };
+  auto point = [&](double deg, double mm) {
+    const double a = deg_to_rad(deg);
+    return std::pair{cx + radius(mm) * std::cos(a), cy - radius(mm) * std::sin(a)};
+  };
+  // Spokes every 45 deg, labelled outside the outer ring.
+  for (int deg = 0; deg < 360; deg += 45) {
+    const auto [x0, y0] = point(deg, 0.0);
+    const auto [x1, y1] = point(deg, ring_max);
+    c.line(x0, y0, x1, y1, "#e0e0e0", 1.0);
+    const double a = deg_to_rad(deg);
+    const double lr = r_out + 12.0;
+    const std::string label =
+        ref->horizontal && deg % 90 == 0 ? fmt::format("{} deg ({})", deg, compass(deg)) : fmt::format("{} deg", deg);
+    const double tx = cx + lr * std::cos(a), ty = cy - lr * std::sin(a) + 4.0;
+    const std::string anchor = std::abs(std::cos(a)) < 0.3 ? "middle" : std::cos(a) > 0.0 ? "start" : "end";
+    c.text(tx, ty, label, kMinFont, anchor, deg == 0 ? R"(font-weight="bold")" : R"(fill="#555")");
+  }
+  // Rings: the reference (0 mm) solid, the others dashed, each labelled in mm.
+  std::vector<double> rings;
+  for (int k = 0; k * ring_step <= ring_max * (1.0 + 1e-9); ++k) {
+    rings.push_back(k * ring_step);
+  }
+  for (const double mm : rings) {
+    c.circle(cx, cy, radius(mm), "none",
+             fmt::format(R"(stroke="{}" stroke-width="{}" {} class="ring" data-mm="{:.6g}")", mm == 0.0 ? "#888" : "#bbb",
+                         mm == 0.0 ? "1.5" : "1", mm == 0.0 ? "" : R"(stroke-dasharray="4 3")", mm));
+  }
+  for (const auto& cv : curves) {
+    std::string d;
+    bool pen = false;
+    for (int s = 0; s <= kSectors; ++s) {
+      const double m = cv.mean_mm[static_cast<std::size_t>(s % kSectors)];
+      if (!std::isfinite(m)) {
+        pen = false;
+        continue;
+      }
+      const auto [x, y] = point(sector_centre_deg(static_cast<std::size_t>(s % kSectors)), m);
+      d += fmt::format("{}{:.1f},{:.1f}", pen ? " L" : (d.empty() ? "M" : " M"), x, y);
+      pen = true;
+    }
+    c.path(d, cv.colour, 1.6,
+           fmt::format(R"({} class="polar" data-run="{}" data-direction="{}")", direction_dash(cv.clockwise), cv.run,
+                       cv.clockwise ? "cw" : "ccw"));
+  }
+  // Ring labels last, on a white halo, each where the curves keep farthest from it: the sector
+  // (over the label's own width) whose nearest curve is the most pixels away from the ring. The
+  // 0 mm ring is named inside, where no distance is drawn.
+  const std::string halo = R"(stroke="white" stroke-width="3" paint-order="stroke" fill="#333")";
+  c.text(cx, cy - 2.0, "0 mm ring:", kMinFont, "middle", R"(class="ring-label" fill="#555")");
+  c.text(cx, cy + 12.0, "the reference", kMinFont, "middle", R"(class="ring-label" fill="#555")");
+  for (const double mm : rings) {
+    if (mm == 0.0) {
+      continue;
+    }
+    const std::string label = svg::tick_label(mm, ring_step) + " mm";
+    const double half_span_deg = rad_to_deg(0.5 * svg::text_width(label, kMinFont) / radius(mm)) + 2.5;
+    double best_deg = 112.5, best_clearance = -1.0;
+    for (std::size_t k = 0; k < kSectors; ++k) {
+      const double deg = sector_centre_deg(k);
+      if (std::abs(std::remainder(deg - 22.5, 45.0)) > 12.5) {
+        continue;  // between the spokes, away from their labels
+      }
+      double clearance = INFINITY;
+      for (const auto& cv : curves) {
+        for (std::size_t j = 0; j < kSectors; ++j) {
+          const double sector_deg = sector_centre_deg(j);
+          const double m = cv.mean_mm[j];
+          if (std::isfinite(m) && std::abs(std::remainder(sector_deg - deg, 360.0)) <= half_span_deg) {
+            clearance = std::min(clearance, std::abs(radius(m) - radius(mm)));
+          }
+        }
+      }
+      // All else equal, nearest 112.5 deg.
+      const double score = clearance - 1e-3 * std::abs(std::remainder(deg - 112.5, 360.0));
+      if (score > best_clearance) {
+        best_clearance = score;
+        best_deg = deg;
+      }
+    }
+    const auto [x, y] = point(best_deg, mm);
+    c.text(x, y + 4.0, label, kMinFont, "middle", R"(class="ring-label" )" + halo);
+  }
+  c.text(cx, cy + r_out + 44.0, "Distance from the reference drawn outward from the 0 mm ring", 12.0, "middle",
+         R"(fill="#444")");
+  c.text(cx, cy + r_out + 60.0,
+         fmt::format("(1 mm = {:.0f} px); angle as in the per-lap figure", px_per_mm), 12.0, "middle",
+         R"(fill="#444")");
+  return c.str();
+}
+
+}  // namespace deflex

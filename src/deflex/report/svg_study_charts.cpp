@@ -1,0 +1,626 @@
+// SVG charts of a whole study: Figure 5, compensation per load, the parity plot and the speed sweep.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "deflex/evaluate/path_metrics.hpp"
+#include "deflex/report/svg_canvas.hpp"
+#include "deflex/report/svg_chart_parts.hpp"
+#include "deflex/report/svg_charts.hpp"
+
+namespace deflex {
+namespace {
+
+using svg::Canvas;
+using svg::kMinFont;
+using svg::Scale;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+bool selected(const std::string& setup, SetupSelection which) {
+  switch (which) {
+    case SetupSelection::kPaper: return paper_has_setup(setup);
+    case SetupSelection::kBeyondPaper: return !paper_has_setup(setup);
+    case SetupSelection::kAll: return true;
+  }
+  return true;
+}
+
+// Number of seeds a study's figures are over (1 when it lists none).
+std::size_t seed_count(const StudyResult& study) { return std::max<std::size_t>(1, study.seeds.size()); }
+
+std::string whisker_note(const StudyResult& study) {
+  const std::size_t n = seed_count(study);
+  return n > 1 ? fmt::format("whiskers: min to max over {} seeds", n) : "one seed: no whiskers";
+}
+
+// Mean over the speeds of 1 - C/UC, with the paper's UC (its mean over the speeds): the paper's
+// own way of quoting compensation.
+double paper_compensation(const PaperRow& r) {
+  double sum = 0.0;
+  int n = 0;
+  for (const auto& [v, c] : r.c_mm) {
+    const double comp = compensation_ratio(r.uc_mm, c);
+    if (std::isfinite(comp)) {
+      sum += comp;
+      ++n;
+    }
+  }
+  return n > 0 ? sum / n : kNaN;
+}
+
+// A bar from the baseline up to `value` (nothing for NaN), with attributes a reader (or a test) can
+// check the drawing against.
+void value_bar(Canvas& c, const Scale& y, double x, double w, double value, const std::string& fill,
+               const std::string& attrs) {
+  if (!std::isfinite(value)) {
+    return;
+  }
+  // From zero (or the axis end nearest it), up or down to the value.
+  const double base = y(std::clamp(0.0, y.d0, y.d1)), end = y(std::clamp(value, y.d0, y.d1));
+  c.rect(x, std::min(base, end), w, std::abs(base - end), fill, attrs);
+}
+
+// The paper's value as an outlined bar.
+void paper_bar(Canvas& c, const Scale& y, double x, double w, double value) {
+  if (!std::isfinite(value)) {
+    return;
+  }
+  const double base = y(std::clamp(0.0, y.d0, y.d1)), end = y(std::clamp(value, y.d0, y.d1));
+  c.rect(x, std::min(base, end), w, std::abs(base - end), "white",
+         fmt::format(R"(stroke="{}" stroke-width="1.3" data-paper="{:.6g}")", svg::kPaperColour, value));
+}
+
+void spread_whisker(Canvas& c, const Scale& y, double x, const Spread& s) {
+  if (s.n > 1 && std::isfinite(s.min) && std::isfinite(s.max)) {
+    svg::whisker(c, x, y(std::max(s.min, y.d0)), y(std::min(s.max, y.d1)), "#333", 6.0);
+  }
+}
+
+std::string spread_text(const Spread& s, double scale, const char* unit, int decimals) {
+  if (!std::isfinite(s.mean)) {
+    return "n/a";
+  }
+  std::string t = fmt::format("{:.{}f}{}", s.mean * scale, decimals, unit);
+  if (s.n > 1) {
+    t += fmt::format(" (seeds {:.{}f} to {:.{}f})", s.min * scale, decimals, s.max * scale, decimals);
+  }
+  return t;
+}
+
+struct Group {
+  std::size_t setup;
+  const LoadResult* load;
+  const PaperRow* paper;
+};
+
+std::vector<Group> groups_of(const StudyResult& study, SetupSelection which, const PaperFigures& paper) {
+  std::vector<Group> groups;
+  for (std::size_t si = 0; si < study.setups.size(); ++si) {
+    if (!selected(study.setups[si].setup, which)) {
+      continue;
+    }
+    const PaperTable* pt = paper.table_for(study.setups[si].setup);
+    for (const auto& l : study.setups[si].loads) {
+      groups.push_back({si, &l, pt != nullptr ? pt->row_for(l.load_N) : nullptr});
+    }
+  }
+  return groups;
+}
+
+// Load labels under the groups, setup names under those and dashed separators between setups.
+void group_labels(Canvas& c, const StudyResult& study, const std::vector<Group>& groups, double left, double group_w,
+                  double sep_top, double labels_y) {
+  std::size_t setup_start = 0;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const double xc = left + group_w * (static_cast<double>(g) + 0.5);
+    c.text(xc, labels_y, fmt::format("{:g} N", groups[g].load->load_N), 12.0, "middle");
+    const bool last_of_setup = g + 1 == groups.size() || groups[g + 1].setup != groups[g].setup;
+    if (last_of_setup) {
+      const double x_first = left + group_w * static_cast<double>(setup_start);
+      const double x_last = left + group_w * static_cast<double>(g + 1);
+      c.text((x_first + x_last) / 2.0, labels_y + 20.0, svg::short_setup_name(study.setups[groups[g].setup].setup),
+             13.0, "middle", R"(font-weight="bold")");
+      if (g + 1 != groups.size()) {
+        c.line(x_last, sep_top, x_last, labels_y + 26.0, "#999", 1.0, R"(stroke-dasharray="4 4")");
+      }
+      setup_start = g + 1;
+    }
+  }
+}
+
+}  // namespace
+
+bool paper_has_setup(const std::string& setup) { return paper_reference().table_for(setup) != nullptr; }
+
+std::string svg_figure5(const StudyResult& study, SetupSelection which) {
+  const std::vector<int> speeds = study_speeds_mm_s(study);
+  const PaperFigures paper = paper_reference();
+  const std::vector<Group> groups = groups_of(study, which, paper);
+  const double width = svg::kMaxWidth, height = 640.0;
+  const double left = 84.0, right = 16.0;
+  Canvas c(width, height);
+  c.title(which == SetupSelection::kBeyondPaper
+              ? "Mean deformation after compensation: the setups beyond the paper"
+              : "Mean deformation after compensation (the paper's Figure 5, ours beside the paper's)");
+  if (groups.empty() || speeds.empty()) {
+    c.text(width / 2.0, height / 2.0, "no results to plot", 14.0, "middle");
+    return c.str();
+  }
+  // The axes span every setup's figures, so the figure of the paper's setups and the one of the
+  // others share their scales and can be compared bar for bar.
+  bool any_paper = false;
+  for (const auto& g : groups) {
+    any_paper = any_paper || g.paper != nullptr;
+  }
+  std::vector<double> c_values, uc_values;
+  for (const auto& g : groups_of(study, SetupSelection::kAll, paper)) {
+    for (const int v : speeds) {
+      const Spread s = g.load->c_spread(v);
+      c_values.insert(c_values.end(), {s.mean, s.max});
+      if (g.paper != nullptr) {
+        c_values.push_back(value_at_speed(g.paper->c_mm, v));
+      }
+    }
+    const Spread u = g.load->uc_mean_spread();
+    uc_values.insert(uc_values.end(), {u.mean, u.max});
+    if (g.paper != nullptr) {
+      uc_values.push_back(g.paper->uc_mm);
+    }
+  }
+  const double c_top = 96.0, c_bottom = 386.0, uc_top = 420.0, uc_bottom = 548.0;
+  const svg::Range cr = svg::fitted_range(c_values, true, 0.05);
+  const svg::Range ur = svg::fitted_range(uc_values, true, 0.05);
+  const Scale yc{cr.lo, cr.hi, c_bottom, c_top};
+  const Scale yu{ur.lo, ur.hi, uc_bottom, uc_top};
+  svg::value_axis(c, yc, left, width - right, "C, after compensation (mm)", 1.0, 56.0);
+  svg::value_axis(c, yu, left, width - right, "UC, before (mm)", 1.0, 56.0);
+
+  // Legend, two rows.
+  double lx = left;
+  for (std::size_t k = 0; k < speeds.size(); ++k) {
+    lx = svg::legend_entry(c, lx, 50.0, "bar", svg::colour(k), fmt::format("C at {} mm/s", speeds[k]));
+  }
+  if (any_paper) {
+    svg::legend_entry(c, lx, 50.0, "hollow", svg::kPaperColour, "the paper's (Tables 1, 2)");
+  }
+  lx = svg::legend_entry(c, left, 72.0, "bar", svg::pale(svg::kUcColour), "UC, uncompensated: mean over the speeds");
+  c.text(lx, 72.0, whisker_note(study), 12.0, "start", R"(fill="#444")");
+
+  const double plot_w = width - left - right;
+  const double group_w = plot_w / static_cast<double>(groups.size());
+  const double n_speeds = static_cast<double>(speeds.size());
+  const double slot_w = std::min(64.0, group_w * 0.86 / n_speeds);
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const double xc = left + group_w * (static_cast<double>(g) + 0.5);
+    const LoadResult& l = *groups[g].load;
+    const std::string& setup = study.setups[groups[g].setup].setup;
+    const bool with_paper = groups[g].paper != nullptr;
+    const double ours_w = with_paper ? slot_w * 0.56 : slot_w * 0.8;
+    const double paper_w = slot_w * 0.3;
+    for (std::size_t k = 0; k < speeds.size(); ++k) {
+      const double x0 = xc + (static_cast<double>(k) - n_speeds / 2.0) * slot_w + slot_w * 0.05;
+      const Spread s = l.c_spread(speeds[k]);
+      const double pv = with_paper ? value_at_speed(groups[g].paper->c_mm, speeds[k]) : kNaN;
+      c.group_begin(fmt::format("{} {:g} N, C at {} mm/s: {}{}", setup, l.load_N, speeds[k],
+                                spread_text(s, 1.0, " mm", 3),
+                                std::isfinite(pv) ? fmt::format("; the paper's {:.2f} mm", pv) : ""));
+      value_bar(c, yc, x0, ours_w, s.mean, svg::colour(k),
+                fmt::format(R"(data-value="{:.6g}" data-min="{:.6g}" data-max="{:.6g}")", s.mean, s.min, s.max));
+      spread_whisker(c, yc, x0 + ours_w / 2.0, s);
+      if (with_paper) {
+        paper_bar(c, yc, x0 + ours_w + 1.5, paper_w, pv);
+      }
+      c.group_end();
+    }
+    // UC: one pale bar a load (the paper's UC is the mean over the speeds), the paper's beside it.
+    const Spread u = l.uc_mean_spread();
+    const double uc_w = std::min(48.0, group_w * 0.34);
+    const double uc_paper_w = uc_w * 0.55;
+    const double x0 = xc - (with_paper ? (uc_w + 1.5 + uc_paper_w) : uc_w) / 2.0;
+    c.group_begin(fmt::format("{} {:g} N, UC (mean over the speeds): {}{}", setup, l.load_N,
+                              spread_text(u, 1.0, " mm", 3),
+                              with_paper ? fmt::format("; the paper's {:.2f} mm", groups[g].paper->uc_mm) : ""));
+    value_bar(c, yu, x0, uc_w, u.mean, svg::pale(svg::kUcColour),
+              fmt::format(R"(data-uc="{:.6g}" data-min="{:.6g}" data-max="{:.6g}")", u.mean, u.min, u.max));
+    spread_whisker(c, yu, x0 + uc_w / 2.0, u);
+    if (with_paper) {
+      paper_bar(c, yu, x0 + uc_w + 1.5, uc_paper_w, groups[g].paper->uc_mm);
+    }
+    c.group_end();
+  }
+  c.line(left, yc(yc.d0), width - right, yc(yc.d0), "#444", 1.0);
+  c.line(left, yu(yu.d0), width - right, yu(yu.d0), "#444", 1.0);
+  group_labels(c, study, groups, left, group_w, c_top, uc_bottom + 20.0);
+  c.text(left + plot_w / 2.0, height - 14.0,
+         "load |F| (N), per strategy setup; mean distance from the unloaded laps' mean path (mm)", 12.0, "middle");
+  return c.str();
+}
+
+std::string svg_compensation(const StudyResult& study) {
+  const PaperFigures paper = paper_reference();
+  const std::vector<Group> groups = groups_of(study, SetupSelection::kAll, paper);
+  const double width = svg::kMaxWidth, height = 430.0;
+  const double left = 84.0, right = 16.0, top = 82.0, bottom = 330.0;
+  Canvas c(width, height);
+  c.title("Compensation 1 - C/UC per load (the figure the paper quotes)");
+  if (groups.empty()) {
+    c.text(width / 2.0, height / 2.0, "no results to plot", 14.0, "middle");
+    return c.str();
+  }
+  std::vector<double> values{0.0, 1.0};
+  bool any_paper = false;
+  for (const auto& g : groups) {
+    const Spread s = g.load->compensation_spread();
+    values.insert(values.end(), {s.mean, s.min});
+    any_paper = any_paper || g.paper != nullptr;
+  }
+  double min_value = 0.0;
+  for (const double v : values) {
+    if (std::isfinite(v)) {
+      min_value = std::min(min_value, v);
+    }
+  }
+  const double lo = std::floor(min_value * 10.0) / 10.0;
+  const Scale y{lo, 1.0, bottom, top};
+  svg::value_axis(c, y, left, width - right, "compensation 1 - C/UC (%)", 100.0, 50.0);
+  double lx = left;
+  lx = svg::legend_entry(c, lx, 52.0, "bar", svg::colour(0), "ours, mean over the speeds (colour: setup)");
+  if (any_paper) {
+    lx = svg::legend_entry(c, lx, 52.0, "hollow", svg::kPaperColour, "the paper's");
+  }
+  c.text(lx, 52.0, whisker_note(study), 12.0, "start", R"(fill="#444")");
+  const double plot_w = width - left - right;
+  const double group_w = plot_w / static_cast<double>(groups.size());
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const double xc = left + group_w * (static_cast<double>(g) + 0.5);
+    const LoadResult& l = *groups[g].load;
+    const bool with_paper = groups[g].paper != nullptr;
+    const double ours_w = std::min(30.0, group_w * (with_paper ? 0.4 : 0.5));
+    const double paper_w = ours_w * 0.6;
+    const double x0 = xc - (with_paper ? ours_w + 1.5 + paper_w : ours_w) / 2.0;
+    Spread s = l.compensation_spread();
+    const double pc = with_paper ? paper_compensation(*groups[g].paper) : kNaN;
+    const std::string& setup = study.setups[groups[g].setup].setup;
+    c.group_begin(fmt::format("{} {:g} N: compensation {}{}", setup, l.load_N, spread_text(s, 100.0, "%", 0),
+                              std::isfinite(pc) ? fmt::format("; the paper's {:.0f}%", pc * 100.0) : ""));
+    value_bar(c, y, x0, ours_w, s.mean, svg::colour(groups[g].setup),
+              fmt::format(R"(data-value="{:.6g}" data-min="{:.6g}" data-max="{:.6g}")", s.mean, s.min, s.max));
+    spread_whisker(c, y, x0 + ours_w / 2.0, s);
+    if (with_paper) {
+      paper_bar(c, y, x0 + ours_w + 1.5, paper_w, pc);
+    }
+    if (std::isfinite(s.mean)) {
+      const double label_at = std::isfinite(s.max) && s.n > 1 ? std::max(s.max, s.mean) : s.mean;
+      c.text(x0 + ours_w / 2.0, y(label_at) - 5.0, fmt::format("{:.0f}%", s.mean * 100.0), kMinFont, "middle");
+    }
+    c.group_end();
+  }
+  c.line(left, y(0.0), width - right, y(0.0), "#444", 1.0);
+  group_labels(c, study, groups, left, group_w, top, bottom + 20.0);
+  c.text(left + plot_w / 2.0, height - 12.0,
+         "load |F| (N), per strategy setup; ours: 1 - C/UC at each speed, averaged over the speeds", 12.0, "middle");
+  return c.str();
+}
+
+std::string svg_parity(const StudyResult& study) {
+  const PaperFigures paper = paper_reference();
+  struct Point {
+    std::string setup;
+    std::size_t setup_index;
+    double load_N;
+    int speed;  // 0 for UC
+    double paper;
+    Spread ours;
+  };
+  std::vector<Point> points;
+  for (std::size_t si = 0; si < study.setups.size(); ++si) {
+    const PaperTable* pt = paper.table_for(study.setups[si].setup);
+    if (pt == nullptr) {
+      continue;
+    }
+    for (const auto& l : study.setups[si].loads) {
+      const PaperRow* pr = pt->row_for(l.load_N);
+      if (pr == nullptr) {
+        continue;
+      }
+      points.push_back({study.setups[si].setup, si, l.load_N, 0, pr->uc_mm, l.uc_mean_spread()});
+      for (const auto& [v, pc] : pr->c_mm) {
+        points.push_back({study.setups[si].setup, si, l.load_N, v, pc, l.c_spread(v)});
+      }
+    }
+  }
+  const double width = svg::kMaxWidth, height = 580.0;
+  const double pl = 96.0, pt = 70.0, ps = 430.0;
+  Canvas c(width, height);
+  c.title("Parity: ours against the paper's Tables 1 and 2");
+  double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+  for (const auto& p : points) {
+    for (const double v : {p.paper, p.ours.mean, p.ours.min, p.ours.max}) {
+      if (std::isfinite(v) && v > 0.0) {
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+      }
+    }
+  }
+  if (!(hi > 0.0)) {
+    c.text(width / 2.0, height / 2.0, "no figure of the paper's to compare with", 14.0, "middle");
+    return c.str();
+  }
+  // Ends on 1, 2 or 5 x 10^k with a margin, so every tick is labelled and no point sits on the frame.
+  const double d0 = svg::nice_floor(lo / 1.2);
+  double d1 = d0;
+  while (d1 < hi * 1.2) {
+    d1 = svg::nice_floor(d1 * 2.6);  // 1 -> 2 -> 5 -> 10
+  }
+  const svg::LogScale xs{d0, d1, pl, pl + ps};
+  const svg::LogScale ys{d0, d1, pt + ps, pt};
+  const auto ticks = svg::log_ticks(d0, d1);
+  for (const double t : ticks) {
+    const std::string label = fmt::format("{:g}", t);
+    c.line(xs(t), pt, xs(t), pt + ps, "#e3e3e3", 1.0);
+    c.line(pl, ys(t), pl + ps, ys(t), "#e3e3e3", 1.0);
+    c.text(xs(t), pt + ps + 18.0, label, kMinFont, "middle", R"(class="x-tick")");
+    c.text(pl - 6.0, ys(t) + 4.0, label, kMinFont, "end", R"(class="y-tick")");
+  }
+  c.rect(pl, pt, ps, ps, "none", R"(stroke="#444")");
+  c.text(pl + ps / 2.0, pt + ps + 38.0, "the paper's mean distance (mm, log scale)", 12.0, "middle");
+  const double ymid = pt + ps / 2.0;
+  c.text(pl - 50.0, ymid, "ours, mean over the seeds (mm, log scale)", 12.0, "middle",
+         fmt::format(R"svg(transform="rotate(-90 {:.2f} {:.2f})")svg", pl - 50.0, ymid));
+  // The bands, clipped to the plot: +-35% (C's target) shaded, +-25% (UC's) dashed, y = x solid.
+  c.raw(fmt::format(R"(<clipPath id="deflex-parity-area"><rect x="{:.2f}" y="{:.2f}" width="{:.2f}" height="{:.2f}"/></clipPath>)"
+                    "\n<g clip-path=\"url(#deflex-parity-area)\">\n",
+                    pl, pt, ps, ps));
+  const double e0 = d0 / 2.0, e1 = d1 * 2.0;  // beyond the plot, clipped
+  c.polygon({xs(e0), ys(e0 * 0.65), xs(e1), ys(e1 * 0.65), xs(e1), ys(e1 * 1.35), xs(e0), ys(e0 * 1.35)}, "#dcefd8");
+  for (const double f : {0.75, 1.25}) {
+    c.line(xs(e0), ys(e0 * f), xs(e1), ys(e1 * f), "#2e7d32", 1.2, R"(stroke-dasharray="5 4")");
+  }
+  c.line(xs(e0), ys(e0), xs(e1), ys(e1), "#444", 1.3);
+  c.raw("</g>\n");
+
+  int c_in = 0, c_n = 0, uc_in = 0, uc_n = 0;
+  for (const auto& p : points) {
+    if (!std::isfinite(p.ours.mean) || !(p.ours.mean > 0.0) || !(p.paper > 0.0)) {
+      continue;
+    }
+    const double ratio = p.ours.mean / p.paper;
+    const std::string col = svg::colour(p.setup_index);
+    const double x = xs(p.paper), yv = ys(p.ours.mean);
+    const std::string what = p.speed == 0 ? "UC" : fmt::format("C at {} mm/s", p.speed);
+    c.group_begin(fmt::format("{} {:g} N, {}: ours {} against the paper's {:.2f} mm ({:+.0f}%)", p.setup, p.load_N,
+                              what, spread_text(p.ours, 1.0, " mm", 3), p.paper, (ratio - 1.0) * 100.0));
+    if (p.ours.n > 1 && std::isfinite(p.ours.min) && p.ours.min > 0.0) {
+      svg::whisker(c, x, ys(p.ours.min), ys(p.ours.max), col, 5.0);
+    }
+    const std::string data = fmt::format(R"(data-paper="{:.6g}" data-ours="{:.6g}")", p.paper, p.ours.mean);
+    if (p.speed == 0) {
+      c.rect(x - 5.0, yv - 5.0, 10.0, 10.0, "white", fmt::format(R"(stroke="{}" stroke-width="2" {})", col, data));
+      ++uc_n;
+      uc_in += std::abs(ratio - 1.0) <= 0.25 ? 1 : 0;
+    } else {
+      c.circle(x, yv, 4.5, col, fmt::format(R"(stroke="white" stroke-width="0.8" {})", data));
+      ++c_n;
+      c_in += std::abs(ratio - 1.0) <= 0.35 ? 1 : 0;
+    }
+    c.group_end();
+  }
+
+  // Legend and a summary at the right.
+  const double rx = pl + ps + 50.0;
+  double ry = pt + 10.0;
+  std::map<std::size_t, std::string> setups;
+  for (const auto& p : points) {
+    setups.emplace(p.setup_index, p.setup);
+  }
+  for (const auto& [si, name] : setups) {
+    svg::legend_entry(c, rx, ry, "dot", svg::colour(si), svg::short_setup_name(name));
+    ry += 20.0;
+  }
+  c.circle(rx + 8.0, ry - 4.0, 4.5, "#666");
+  c.text(rx + 24.0, ry, "C at one load and speed", 12.0);
+  ry += 20.0;
+  c.rect(rx + 3.0, ry - 9.0, 10.0, 10.0, "white", R"(stroke="#666" stroke-width="2")");
+  c.text(rx + 24.0, ry, "UC at one load (mean over the speeds)", 12.0);
+  ry += 20.0;
+  svg::legend_entry(c, rx, ry, "line", "#444", "y = x: ours equal to the paper's");
+  ry += 20.0;
+  svg::legend_entry(c, rx, ry, "band", "#dcefd8", "within 35% of the paper's (the target for C)");
+  ry += 20.0;
+  svg::legend_entry(c, rx, ry, "dash", "#2e7d32", "25% either side (the target for UC)");
+  ry += 20.0;
+  c.text(rx, ry, whisker_note(study), 12.0, "start", R"(fill="#444")");
+  ry += 34.0;
+  c.text(rx, ry, "Against the targets", 13.0, "start", R"(font-weight="bold")");
+  ry += 20.0;
+  c.text(rx, ry, fmt::format("C per load and speed within 35%: {} of {}", c_in, c_n), 12.0);
+  ry += 18.0;
+  c.text(rx, ry, fmt::format("UC per load within 25%: {} of {}", uc_in, uc_n), 12.0);
+  ry += 24.0;
+  // Per setup and load: C as the issue judges it (mean over the speeds), and UC.
+  c.text(rx, ry, "ours / the paper's, per load:", 12.0, "start", R"(fill="#444")");
+  ry += 18.0;
+  for (std::size_t si = 0; si < study.setups.size(); ++si) {
+    const PaperTable* table = paper.table_for(study.setups[si].setup);
+    if (table == nullptr) {
+      continue;
+    }
+    for (const auto& l : study.setups[si].loads) {
+      const PaperRow* pr = table->row_for(l.load_N);
+      if (pr == nullptr || ry > height - 10.0) {
+        continue;
+      }
+      double ours = 0.0, theirs = 0.0;
+      int n = 0;
+      for (const auto& [v, pc] : pr->c_mm) {
+        const double o = value_at_speed(l.c_mm, v);
+        if (std::isfinite(o)) {
+          ours += o;
+          theirs += pc;
+          ++n;
+        }
+      }
+      const double c_ratio = n > 0 ? ours / theirs : kNaN;
+      const double uc_ratio = l.uc_mean_mm() / pr->uc_mm;
+      const bool c_ok = std::abs(c_ratio - 1.0) <= 0.35, uc_ok = std::abs(uc_ratio - 1.0) <= 0.25;
+      c.text(rx, ry,
+             fmt::format("{} {:g} N: C \u00d7{:.2f} {}, UC \u00d7{:.2f} {}", study.setups[si].setup, l.load_N, c_ratio,
+                         c_ok ? "(in)" : "(out)", uc_ratio, uc_ok ? "(in)" : "(out)"),
+             12.0, "start", c_ok && uc_ok ? R"(fill="#2e7d32")" : R"(fill="#c62828")");
+      ry += 18.0;
+    }
+  }
+  return c.str();
+}
+
+std::string svg_speed_sweep(const StudyResult& study) {
+  const double width = svg::kMaxWidth, height = 680.0;
+  Canvas c(width, height);
+  c.title("Speed sweep: compensation, residual and lag against TCP speed");
+  if (study.speed_sweep.empty()) {
+    c.text(width / 2.0, height / 2.0, "no speed sweep in this study", 14.0, "middle");
+    return c.str();
+  }
+  // One series per setup and load, in order of first appearance.
+  struct Series {
+    std::string setup;
+    double load_N;
+    std::vector<const SweepPoint*> points;
+  };
+  std::vector<Series> series;
+  double max_speed = 0.0;
+  for (const auto& p : study.speed_sweep) {
+    auto it = std::find_if(series.begin(), series.end(),
+                           [&](const Series& s) { return s.setup == p.setup && s.load_N == p.load_N; });
+    if (it == series.end()) {
+      series.push_back({p.setup, p.load_N, {}});
+      it = series.end() - 1;
+    }
+    it->points.push_back(&p);
+    if (std::isfinite(p.speed_mm_s)) {
+      max_speed = std::max(max_speed, p.speed_mm_s);
+    }
+  }
+  // The four figures of a point: its mean and its seeds' values.
+  struct Quantity {
+    const char* label;
+    double scale_to_label;
+    bool from_zero;
+  };
+  const Quantity quantities[] = {{"compensation 1 - C/UC (%)", 100.0, false},
+                                 {"C, nearest-point (mm)", 1.0, false},
+                                 {"C, time-synchronous (mm)", 1.0, false},
+                                 {"UC, nearest-point (mm)", 1.0, false}};
+  auto values_of = [](const SweepPoint& p, int q) {
+    std::vector<double> seeds;
+    double mean = kNaN;
+    switch (q) {
+      case 0:
+        mean = p.compensation;
+        for (std::size_t k = 0; k < p.c_mm_by_seed.size() && k < p.uc_mm_by_seed.size(); ++k) {
+          seeds.push_back(compensation_ratio(p.uc_mm_by_seed[k], p.c_mm_by_seed[k]));
+        }
+        break;
+      case 1:
+        mean = p.c_mm;
+        seeds = p.c_mm_by_seed;
+        break;
+      case 2:
+        mean = p.c_sync_mm;
+        seeds = p.c_sync_mm_by_seed;
+        break;
+      default:
+        mean = p.uc_mm;
+        seeds = p.uc_mm_by_seed;
+    }
+    Spread s = spread_of(seeds);
+    s.mean = mean;
+    return s;
+  };
+  std::map<std::string, std::size_t> setup_colour;
+  for (const auto& s : series) {
+    setup_colour.emplace(s.setup, setup_colour.size());
+  }
+  // Legend rows first: the panels start below however many rows it takes.
+  const char* const dashes[] = {"", R"(stroke-dasharray="6 3")", R"(stroke-dasharray="2 3")",
+                                R"(stroke-dasharray="8 3 2 3")"};
+  std::map<std::string, std::size_t> load_rank;
+  std::vector<std::string> series_dash;
+  double lx = 90.0, ly = 52.0;
+  auto next_entry = [&](double w) {
+    if (lx + w > width - 16.0) {
+      lx = 90.0;
+      ly += 20.0;
+    }
+  };
+  for (const auto& s : series) {
+    const std::size_t rank = load_rank[s.setup]++;
+    series_dash.push_back(dashes[rank % 4]);
+    const std::string col = svg::colour(setup_colour[s.setup]);
+    const std::string label = fmt::format("{} {:g} N", s.setup, s.load_N);
+    next_entry(24.0 + svg::text_width(label, 12.0) + 18.0);
+    c.line(lx, ly - 4.0, lx + 18.0, ly - 4.0, col, 2.0, series_dash.back());
+    c.circle(lx + 9.0, ly - 4.0, 3.0, col);
+    c.text(lx + 24.0, ly, label, 12.0);
+    lx += 24.0 + svg::text_width(label, 12.0) + 18.0;
+  }
+  const std::string band_label = "the paper's speeds, 10-50 mm/s";
+  next_entry(24.0 + svg::text_width(band_label, 12.0) + 18.0);
+  lx = svg::legend_entry(c, lx, ly, "band", "#ececec", band_label);
+  next_entry(svg::text_width(whisker_note(study), 12.0));
+  c.text(lx, ly, whisker_note(study), 12.0, "start", R"(fill="#444")");
+
+  const double top0 = ly + 36.0;
+  const double panel_h = (height - top0 - 2.0 * 56.0) / 2.0;
+  const double xs_left[] = {90.0, 600.0};
+  const double panel_w = 400.0;
+  const double x_max = svg::nice_ceiling(max_speed);
+  for (int q = 0; q < 4; ++q) {
+    const double x_left = xs_left[q % 2];
+    const double top = top0 + (q / 2) * (panel_h + 56.0);
+    const Scale x{0.0, x_max, x_left, x_left + panel_w};
+    std::vector<double> all;
+    for (const auto& p : study.speed_sweep) {
+      const Spread s = values_of(p, q);
+      all.insert(all.end(), {s.mean, s.min, s.max});
+    }
+    svg::Range r = svg::fitted_range(all, quantities[q].from_zero, 0.08);
+    if (q == 0) {
+      r.hi = std::min(r.hi, 1.0);  // compensation cannot pass 100%
+    }
+    const Scale y{r.lo, r.hi, top + panel_h, top};
+    const double band_lo = x(std::min(10.0, x_max)), band_hi = x(std::min(50.0, x_max));
+    c.rect(band_lo, top, band_hi - band_lo, panel_h, "#ececec");
+    svg::value_axis(c, y, x.p0, x.p1, quantities[q].label, quantities[q].scale_to_label, 50.0);
+    svg::position_axis(c, x, top + panel_h, "TCP speed (mm/s)");
+    for (std::size_t si = 0; si < series.size(); ++si) {
+      const std::string col = svg::colour(setup_colour[series[si].setup]);
+      // Side by side, so whiskers at the same speed do not hide each other.
+      const double dodge = (static_cast<double>(si) - (static_cast<double>(series.size()) - 1.0) / 2.0) * 3.0;
+      std::vector<double> xy;
+      for (const auto* p : series[si].points) {
+        const Spread s = values_of(*p, q);
+        if (!std::isfinite(s.mean) || !std::isfinite(p->speed_mm_s)) {
+          continue;
+        }
+        const double px = x(p->speed_mm_s) + dodge;
+        if (s.n > 1) {
+          svg::whisker(c, px, y(s.min), y(s.max), col, 5.0);
+        }
+        c.circle(px, y(s.mean), 3.0, col, fmt::format(R"(data-value="{:.6g}")", s.mean));
+        xy.push_back(px);
+        xy.push_back(y(s.mean));
+      }
+      if (xy.size() >= 4) {
+        c.polyline(xy, col, 2.0, series_dash[si]);
+      }
+    }
+  }
+  return c.str();
+}
+
+}  // namespace deflex
