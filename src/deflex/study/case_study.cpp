@@ -647,14 +647,17 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
       "+ {} anticlockwise laps per run; tracker at {:.0f} Hz with {:.1f} um noise; servo {:.0f} ms. The online setups "
       "reach the controller through deflex's own links over the cell's network: EGM position guidance (deflex streams "
       "the program every {:.0f} ms; the controller follows after {:.0f} ms of dead time through a {:.0f} Hz filter, "
-      "gain {:.0f}/s plus deflex's speed reference) or EGM path correction (the controller asks every {:.0f} ms and "
-      "applies an offset {:.0f} ms later). {} seed{} ({}{}): each its own true robot, sensor and calibration; the "
-      "tables give the mean over them and their spread.",
+      "gain {:.0f}/s plus deflex's speed reference), EGM path correction (the controller asks every {:.0f} ms and "
+      "applies an offset {:.0f} ms later) or ROS-Industrial simple message (deflex streams a joint point every {:.0f} "
+      "ms over TCP to the robot program's streaming server, {} queued, each run as a joint move with a zone). {} "
+      "seed{} ({}{}): each its own true robot, sensor and calibration; the tables give the mean over them and their "
+      "spread.",
       config.radius_m() * 1e3, config.circle.center_m.x() * 1e3, config.circle.center_m.y() * 1e3,
       config.circle.center_m.z() * 1e3, config.circle.points, config.cell.ldbb.bar_length_m * 1e3,
       rad_to_deg(config.cell.ldbb.inclination_rad), laps_cw, laps_ccw, config.cell.tracker.rate_hz,
       config.cell.tracker.noise_m * 1e6, k.servo_period_s * 1e3, k.egm_period_s * 1e3, k.egm_dead_time_s * 1e3,
-      k.egm_lowpass_hz, k.egm_position_gain_per_s, k.path_corr_period_s * 1e3, k.path_corr_dead_time_s * 1e3, n_seeds,
+      k.egm_lowpass_hz, k.egm_position_gain_per_s, k.path_corr_period_s * 1e3, k.path_corr_dead_time_s * 1e3,
+      config.online.stream_period_s * 1e3, config.online.stream_buffer_depth, n_seeds,
       n_seeds == 1 ? "" : "s", config.seed, n_seeds == 1 ? std::string() : fmt::format(" to {}", cfg_of(n_seeds - 1).seed)));
   out.runs = static_cast<int>(loaded.size()) + static_cast<int>(budget_jobs.size()) * 2;
   out.runs += n_seeds * static_cast<int>(families.size() * speeds.size());
