@@ -26,7 +26,7 @@ namespace deflex::cli {
 namespace {
 
 struct Opts {
-  std::string robot, circle, line, path_csv, orientation = "0,0,1,0", config, seed, csv_out, rapid_out;
+  std::string robot, stiffness, circle, line, path_csv, orientation = "0,0,1,0", config, seed, csv_out, rapid_out;
   std::vector<std::string> forces;
   std::string motion = "absj", zone = "fine", tool = "tool0", wobj = "wobj0", module = "DeflexOffline";
   double speed_mm_s = 10.0;
@@ -59,7 +59,8 @@ void run(const Opts& o, int& exit_code) {
   if (o.forces.empty()) {
     throw InputError("give a force model: --force ldbb:...|constant:...|table:FILE.csv");
   }
-  const RobotModel model = load_robot_or_builtin(o.robot);
+  const RobotModel model = load_cli_robot("offline", o.robot, o.stiffness);
+  require_stiffness(model);  // before any path is solved
 
   // Path.
   ForceSpecContext context;
@@ -216,6 +217,7 @@ void setup_offline(CLI::App& sub, int& exit_code) {
   auto o = std::make_shared<Opts>();
   sub.add_option("--robot", o->robot,
                  "Robot file (.yaml deflex format or .urdf) with joint stiffness; default: the built-in ABB IRB 6700");
+  sub.add_option("--stiffness-Nm-per-rad", o->stiffness, kStiffnessHelp);
   sub.add_option("--circle", o->circle,
                  "Circle path \"centre_mm=X;Y;Z,radius_mm=R,normal=NX;NY;NZ,start_deg=A,direction=ccw|cw,points=N\"; "
                  "every key optional (default: centre 1500;0;1000 mm, radius 100 mm, normal +z, ccw, 81 points, the "

@@ -53,6 +53,9 @@ struct RobotDescription {
   std::vector<DhRow> dh;
   /// Kept when the chain came from a URDF: the file (absolute) and the chain's end links.
   std::string urdf_file, urdf_base_link, urdf_tip_link;
+  /// How the file was read when that is worth telling the user (which URDF chain was chosen and
+  /// which joints were left out); the command-line program prints them as notes.
+  std::vector<std::string> notes;
 
   /// Diagonal joint stiffness K, Nm/rad, one value a joint. Empty when the file gives none.
   std::vector<double> stiffness_nm_per_rad;
