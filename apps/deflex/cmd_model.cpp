@@ -103,6 +103,8 @@ void setup_ik(CLI::App& sub, int& exit_code) {
         JointVector deg = r.q * (180.0 / kPi);
         doc["joints_deg"] = vector_to_json(deg);
         doc["config"] = {r.configuration.cf1, r.configuration.cf4, r.configuration.cf6, r.configuration.cfx};
+        doc["kuka_status"] = r.kuka.status;
+        doc["kuka_turn"] = r.kuka.turn;
         doc["position_error_m"] = r.position_error_m;
         doc["orientation_error_rad"] = r.orientation_error_rad;
       }
@@ -112,9 +114,11 @@ void setup_ik(CLI::App& sub, int& exit_code) {
       for (int i = 0; i < r.q.size(); ++i) {
         std::cout << fmt::format(" {:.4f}", rad_to_deg(r.q[i]));
       }
-      std::cout << fmt::format("\nconfig [cf1,cf4,cf6,cfx]: [{},{},{},{}]\nsolver: {}, residual {:.2e} m, {:.2e} rad\n",
+      std::cout << fmt::format("\nconfig [cf1,cf4,cf6,cfx]: [{},{},{},{}]  (KUKA S {} T {})\nsolver: {}, residual {:.2e} m, "
+                               "{:.2e} rad\n",
                                r.configuration.cf1, r.configuration.cf4, r.configuration.cf6, r.configuration.cfx,
-                               r.analytic ? "analytic" : "damped least squares", r.position_error_m,
+                               r.kuka.status, r.kuka.turn,
+                               r.analytic ? "analytic (ortho-parallel)" : "damped least squares", r.position_error_m,
                                r.orientation_error_rad);
     }
     if (!r.message.empty()) {

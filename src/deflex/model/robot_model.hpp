@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "deflex/model/opw_geometry.hpp"
 #include "deflex/model/types.hpp"
 
 namespace deflex {
@@ -105,6 +106,12 @@ class RobotModel {
   /// True when every joint axis is its frame's z axis (DH chains), which FK exploits.
   [[nodiscard]] bool z_axes_only() const { return z_axes_only_; }
 
+  /// The ortho-parallel (OPW) geometry the analytic inverse kinematics uses, derived once from the
+  /// chain (DH or URDF) and checked against its FK; null for arms outside that family.
+  [[nodiscard]] const OpwGeometry* opw() const { return opw_ ? &*opw_ : nullptr; }
+  /// Why the chain has no OPW geometry (empty when it has one).
+  [[nodiscard]] const std::string& opw_note() const { return opw_note_; }
+
   /// Returns a copy with a different stiffness (e.g. after identification). Validated again.
   [[nodiscard]] RobotModel with_stiffness(const std::vector<double>& stiffness_nm_per_rad,
                                           const std::string& note) const;
@@ -121,6 +128,8 @@ class RobotModel {
   JointVector max_speed_;
   Pose flange_T_wap_ = Pose::Identity();
   bool z_axes_only_ = true;
+  std::optional<OpwGeometry> opw_;
+  std::string opw_note_;
 };
 
 using RobotModelPtr = std::shared_ptr<const RobotModel>;
