@@ -57,7 +57,7 @@ void run(const Opts& o, int& exit_code) {
     throw InputError("give exactly one path: --circle [SPEC], --line SPEC or --path FILE.csv");
   }
   if (o.forces.empty()) {
-    throw InputError("give a force model: --force ldbb:...|constant:...|table:FILE.csv");
+    throw InputError("give a force model: --force ldbb:...|constant:...|tool:...|table:FILE.csv");
   }
   const RobotModel model = load_cli_robot("offline", o.robot, o.stiffness);
   require_stiffness(model);  // before any path is solved
@@ -233,7 +233,9 @@ void setup_offline(CLI::App& sub, int& exit_code) {
   sub.add_option("--force", o->forces,
                  "Force model (repeatable): \"ldbb:pivot_mm=X;Y;Z,force_N=F[;F2..],mode=push|pull\", "
                  "\"ldbb:phi_deg=A,force_N=...\" (circle only: pivot on the circle's axis, bar inclined by A), "
-                 "\"constant:fx_N=..,fy_N=..,fz_N=..,mx_Nm=..,my_Nm=..,mz_Nm=..\", \"table:FILE.csv\"")
+                 "\"constant:fx_N=..,fy_N=..,fz_N=..,mx_Nm=..,my_Nm=..,mz_Nm=..\" (base frame), \"tool:fz_N=..,...\" "
+                 "(the same keys in the TCP frame: a drilling or milling thrust that turns with the tool), "
+                 "\"table:FILE.csv\"")
       ->required();
   sub.add_option("--speed-mm-s", o->speed_mm_s, "TCP speed for the RAPID speeddata, mm/s (default 10)");
   sub.add_option("--zone", o->zone, "RAPID zonedata: fine (default) or z0, z1, z5, z10, ...");
