@@ -53,7 +53,8 @@ JointVector parse_joints_deg(const std::string& text, const RobotModel& model, c
 const char* const kStiffnessHelp =
     "Joint stiffness \"k1,...,kN\" in Nm/rad, one value a joint; replaces the robot file's (a bare URDF has none)";
 
-RobotModel load_cli_robot(const std::string& command, const std::string& robot_path, const std::string& stiffness_text) {
+RobotModel load_cli_robot(const std::string& command, const std::string& robot_path,
+                          const std::string& stiffness_text) {
   RobotModel model = load_robot_or_builtin(robot_path);
   for (const std::string& note : model.description().notes) {
     std::cerr << fmt::format("deflex {}: note: {}\n", command, note);
@@ -65,7 +66,8 @@ RobotModel load_cli_robot(const std::string& command, const std::string& robot_p
       parse_numbers(stiffness_text, "--stiffness-Nm-per-rad", static_cast<std::size_t>(model.dof()));
   for (std::size_t i = 0; i < k.size(); ++i) {
     if (!(k[i] > 0.0)) {
-      throw InputError(fmt::format("option --stiffness-Nm-per-rad: value {} ({} Nm/rad) must be positive", i + 1, k[i]));
+      throw InputError(
+          fmt::format("option --stiffness-Nm-per-rad: value {} ({} Nm/rad) must be positive", i + 1, k[i]));
     }
   }
   return model.with_stiffness(k, "given on the command line (--stiffness-Nm-per-rad)");

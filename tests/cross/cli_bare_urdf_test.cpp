@@ -48,7 +48,8 @@ TEST(CliBareUrdf, StiffnessOnTheCommandLineGivesTheClosedFormDeflection) {
   EXPECT_NEAR(d["dtheta_rad"][2].get<double>(), 500.0 * lever2 / k[2], 1e-12);
   EXPECT_NEAR(d["dtheta_rad"][4].get<double>(), 500.0 * lever5 / k[4], 1e-12);
   EXPECT_NEAR(d["dtheta_rad"][0].get<double>(), 0.0, 1e-15);
-  const auto bad = run_cli("deflect --robot " + kUrdf + " --joints-deg 0,0,0,0,0,0 --wrench 0,0,-500,0,0,0 "
+  const auto bad = run_cli("deflect --robot " + kUrdf +
+                           " --joints-deg 0,0,0,0,0,0 --wrench 0,0,-500,0,0,0 "
                            "--stiffness-Nm-per-rad 1,2,3");
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("option --stiffness-Nm-per-rad: expected 6"), std::string::npos) << bad.err;

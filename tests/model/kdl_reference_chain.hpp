@@ -12,9 +12,9 @@ namespace deflex::test {
 inline KDL::Chain kdl_chain_from_reference(const std::vector<ReferenceJoint>& joints) {
   KDL::Chain chain;
   for (const ReferenceJoint& j : joints) {
-    chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::None),
-                                  KDL::Frame(KDL::Rotation::RPY(j.rpy.x(), j.rpy.y(), j.rpy.z()),
-                                             KDL::Vector(j.xyz.x(), j.xyz.y(), j.xyz.z()))));
+    chain.addSegment(KDL::Segment(
+        KDL::Joint(KDL::Joint::None),
+        KDL::Frame(KDL::Rotation::RPY(j.rpy.x(), j.rpy.y(), j.rpy.z()), KDL::Vector(j.xyz.x(), j.xyz.y(), j.xyz.z()))));
     if (j.type != "fixed") {
       chain.addSegment(KDL::Segment(
           KDL::Joint(j.name, KDL::Vector::Zero(), KDL::Vector(j.axis.x(), j.axis.y(), j.axis.z()), KDL::Joint::RotAxis),

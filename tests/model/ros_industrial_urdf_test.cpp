@@ -148,8 +148,9 @@ void expect_load_error(const std::string& name, const std::string& body, const s
 
 TEST(RosIndustrialUrdf, BrokenTreesNameTheLineAndTheJoint) {
   // Lines: 1 xml, 2 robot, 3-6 links, 7.. joints.
-  expect_load_error("loop", std::string(kLinks) + revolute("j1", "a", "b") + revolute("j2", "b", "c") + revolute("j3", "c", "b"),
-                    {":9:", "link 'b' has two parents", "'j1' (line 7)", "'j3' (line 9)"});
+  expect_load_error(
+      "loop", std::string(kLinks) + revolute("j1", "a", "b") + revolute("j2", "b", "c") + revolute("j3", "c", "b"),
+      {":9:", "link 'b' has two parents", "'j1' (line 7)", "'j3' (line 9)"});
   expect_load_error("cycle", std::string(kLinks) + revolute("j1", "a", "b") + revolute("j2", "b", "a"),
                     {"closes a loop", "joint 'j"});
   expect_load_error("mimic_on_chain",
@@ -162,8 +163,9 @@ TEST(RosIndustrialUrdf, BrokenTreesNameTheLineAndTheJoint) {
                         "  <joint name=\"g\" type=\"fixed\"><parent link=\"b\"/><child link=\"c\"/></joint>\n"
                         "  <joint name=\"h\" type=\"fixed\"><parent link=\"c\"/><child link=\"d\"/></joint>\n",
                     {"no movable joint"});
-  expect_load_error("branches", std::string(kLinks) + revolute("j1", "a", "b") + revolute("j2", "b", "c") + revolute("j3", "b", "d"),
-                    {"2 leaves", "'c'", "'d'", "tip_link", "branches into several arms"});
+  expect_load_error(
+      "branches", std::string(kLinks) + revolute("j1", "a", "b") + revolute("j2", "b", "c") + revolute("j3", "b", "d"),
+      {"2 leaves", "'c'", "'d'", "tip_link", "branches into several arms"});
   expect_load_error("unknown_link", std::string(kLinks) + revolute("j1", "a", "b") + revolute("j2", "b", "x"),
                     {":8:", "joint 'j2'", "child link 'x' is not defined"});
   expect_load_error("two_roots", std::string(kLinks) + revolute("j1", "a", "b") + revolute("j2", "c", "d"),
@@ -179,11 +181,11 @@ TEST(RosIndustrialUrdf, BrokenTreesNameTheLineAndTheJoint) {
 
 TEST(RosIndustrialUrdf, MimicAndPrismaticJointsOffTheChainAreIgnoredWithANote) {
   // A chain a-b-c with a mimic prismatic slide hanging off b: the slide is not counted as an axis.
-  const std::string path =
-      write_urdf("offchain", std::string(kLinks) + revolute("j1", "a", "b") + revolute("j2", "b", "c") +
-                                 "  <joint name=\"slide\" type=\"prismatic\"><parent link=\"b\"/><child link=\"d\"/>"
-                                 "<axis xyz=\"1 0 0\"/><mimic joint=\"j1\"/><limit lower=\"0\" upper=\"1\" effort=\"1\" "
-                                 "velocity=\"1\"/></joint>\n");
+  const std::string path = write_urdf(
+      "offchain", std::string(kLinks) + revolute("j1", "a", "b") + revolute("j2", "b", "c") +
+                      "  <joint name=\"slide\" type=\"prismatic\"><parent link=\"b\"/><child link=\"d\"/>"
+                      "<axis xyz=\"1 0 0\"/><mimic joint=\"j1\"/><limit lower=\"0\" upper=\"1\" effort=\"1\" "
+                      "velocity=\"1\"/></joint>\n");
   const RobotModel m = load_robot(path);
   EXPECT_EQ(m.dof(), 2);
   EXPECT_EQ(m.description().urdf_tip_link, "c");

@@ -13,7 +13,8 @@ double pose_error(const Pose& a, const Pose& b) {
 }
 
 TEST(PathIkUrdf, APathOnAUrdfArmKeepsItsBranch) {
-  const RobotModel m = load_robot(std::string(DEFLEX_SOURCE_DIR) + "/examples/robots/ros-industrial/kuka_kr120r2500pro.urdf");
+  const RobotModel m =
+      load_robot(std::string(DEFLEX_SOURCE_DIR) + "/examples/robots/ros-industrial/kuka_kr120r2500pro.urdf");
   ASSERT_TRUE(has_analytic_ik(m));
   Workspace ws(m);
   JointVector q(6);

@@ -22,10 +22,10 @@ Wrench ToolWrenchModel::wrench_at(std::size_t /*index*/, const Pose& base_T_tcp)
 }
 
 std::string ToolWrenchModel::describe() const {
-  return fmt::format("wrench constant in the tool frame F = ({:g}, {:g}, {:g}) N, M = ({:g}, {:g}, {:g}) Nm about "
-                     "the TCP (turns with the tool)",
-                     wrench_tool_[0], wrench_tool_[1], wrench_tool_[2], wrench_tool_[3], wrench_tool_[4],
-                     wrench_tool_[5]);
+  return fmt::format(
+      "wrench constant in the tool frame F = ({:g}, {:g}, {:g}) N, M = ({:g}, {:g}, {:g}) Nm about "
+      "the TCP (turns with the tool)",
+      wrench_tool_[0], wrench_tool_[1], wrench_tool_[2], wrench_tool_[3], wrench_tool_[4], wrench_tool_[5]);
 }
 
 }  // namespace deflex

@@ -42,12 +42,16 @@ struct KukaConfiguration {
   return static_cast<int>(std::floor(q_rad / (kPi / 2.0) + 1e-12));
 }
 
+/// A joint value below zero for Turn and confdata bits: -1e-17 is a zero that lost its sign to
+/// rounding, not a negative angle.
+[[nodiscard]] inline bool negative_joint(double q_rad) { return q_rad < -1e-12; }
+
 /// The Turn bits of joint values (bit i set when joint i+1 is negative). Joints beyond the sixth
 /// are ignored (KRL's Turn has six axis bits).
 [[nodiscard]] inline int kuka_turn(const JointVector& q) {
   int t = 0;
   for (int i = 0; i < q.size() && i < 6; ++i) {
-    t |= q[i] < 0.0 ? (1 << i) : 0;
+    t |= negative_joint(q[i]) ? (1 << i) : 0;
   }
   return t;
 }

@@ -172,7 +172,7 @@ void generic_configuration(const RobotModel& model, Workspace& ws, const JointVe
   const Vector3 lower_arm = ws.origin_base[2] - ws.origin_base[1];
   const Vector3 to_wc = wc - ws.origin_base[1];
   const bool behind_lower_arm = ws.axis_base[1].dot(lower_arm.cross(to_wc)) < 0.0;
-  const bool q5_negative = q[4] < 0.0;
+  const bool q5_negative = negative_joint(q[4]);
   abb.cfx = (behind_axis1 ? 4 : 0) + (behind_lower_arm ? 2 : 0) + (q5_negative ? 1 : 0);
   kuka.status = (behind_axis1 ? 1 : 0) + (behind_lower_arm ? 0 : 2) + (q5_negative ? 4 : 0);
 }
@@ -272,14 +272,18 @@ bool choose_turns(const RobotModel& model, const OpwBranch& b, const IkRequest& 
     bool found = false;
     for (int k = 0; k < n; ++k) {
       const double t = turns[static_cast<std::size_t>(k)];
-      if (apply_request && request.configuration && request.match_quadrants) {
+      // A joint within kBoundary of a quadrant boundary or of zero matches either side: a program
+      // taught at A4 = 0 may come back as -1e-16, which must not send the joint a turn away.
+      constexpr double kBoundary = 1e-6;
+      if (apply_request && request.configuration && request.match_quadrants && (i == 0 || i == 3 || i == 5)) {
         const ArmConfiguration& want = *request.configuration;
-        const int wanted = i == 0 ? want.cf1 : i == 3 ? want.cf4 : i == 5 ? want.cf6 : abb_quadrant(t);
-        if (abb_quadrant(t) != wanted) {
+        const int wanted = i == 0 ? want.cf1 : i == 3 ? want.cf4 : want.cf6;
+        if (abb_quadrant(t - kBoundary) != wanted && abb_quadrant(t + kBoundary) != wanted) {
           continue;
         }
       }
-      if (apply_request && request.kuka_configuration && ((request.kuka_configuration->turn >> i) & 1) != (t < 0.0)) {
+      if (apply_request && request.kuka_configuration && std::abs(t) > kBoundary &&
+          ((request.kuka_configuration->turn >> i) & 1) != (t < 0.0)) {
         continue;
       }
       if (std::abs(t - ref) < std::abs(best - ref)) {

@@ -25,8 +25,8 @@ class RobotModel;
 
 struct OpwGeometry {
   double a1 = 0.0, a2 = 0.0, b = 0.0, c1 = 0.0, c2 = 0.0, c3 = 0.0, c4 = 0.0;  ///< m
-  std::array<double, 6> sign{1, 1, 1, 1, 1, 1};    ///< theta_i = sign_i * q_i + offset_i
-  std::array<double, 6> offset{0, 0, 0, 0, 0, 0};  ///< rad
+  std::array<double, 6> sign{1, 1, 1, 1, 1, 1};                                ///< theta_i = sign_i * q_i + offset_i
+  std::array<double, 6> offset{0, 0, 0, 0, 0, 0};                              ///< rad
 
   Pose chain_T_opw = Pose::Identity();   ///< the canonical base frame in the chain's frame
   Pose end_T_flange = Pose::Identity();  ///< canonical end frame to the model's flange (rigid on link 6)

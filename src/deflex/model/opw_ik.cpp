@@ -62,11 +62,11 @@ int quadrant(double q) {
 int kuka_status(const OpwGeometry& g, double wrist_x_a1, double q3, double q5) {
   double d = q3 - g.q3_stretched;
   d -= kTwoPi * round_whole(d * (1.0 / kTwoPi));
-  return (wrist_x_a1 < 0.0 ? 1 : 0) | (d >= 0.0 ? 2 : 0) | (q5 < 0.0 ? 4 : 0);
+  return (wrist_x_a1 < 0.0 ? 1 : 0) | (d >= 0.0 ? 2 : 0) | (negative_joint(q5) ? 4 : 0);
 }
 
 int abb_cfx(const OpwGeometry& g, double wrist_x_a1, double lower_arm_cross, double q5) {
-  return (wrist_x_a1 < 0.0 ? 4 : 0) + (g.sign[1] * lower_arm_cross < 0.0 ? 2 : 0) + (q5 < 0.0 ? 1 : 0);
+  return (wrist_x_a1 < 0.0 ? 4 : 0) + (g.sign[1] * lower_arm_cross < 0.0 ? 2 : 0) + (negative_joint(q5) ? 1 : 0);
 }
 
 }  // namespace
@@ -265,7 +265,7 @@ void opw_solutions(const RobotModel& model, const Pose& base_T_tcp, const JointV
     int turn = 0;
     for (int i = 0; i < 6; ++i) {
       s.q[i] = b.q[static_cast<std::size_t>(i)];
-      turn |= s.q[i] < 0.0 ? (1 << i) : 0;
+      turn |= negative_joint(s.q[i]) ? (1 << i) : 0;
     }
     s.configuration = {quadrant(s.q[0]), quadrant(s.q[3]), quadrant(s.q[5]),
                        abb_cfx(*g, b.wrist_x_a1, b.lower_arm_cross, s.q[4])};

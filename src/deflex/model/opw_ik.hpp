@@ -16,9 +16,9 @@ namespace deflex {
 /// result on the stack costs nothing to create.
 struct OpwBranch {
   std::array<double, 6> theta;
-  double wrist_x_a1;         ///< wrist centre's x in the A1 frame, m (negative: behind axis 1)
-  double lower_arm_cross;    ///< (upper arm direction x (wrist centre - axis 2)) . y, A1 frame
-  std::uint8_t branch;       ///< bit 2 shoulder back, bit 1 second elbow, bit 0 wrist flipped
+  double wrist_x_a1;       ///< wrist centre's x in the A1 frame, m (negative: behind axis 1)
+  double lower_arm_cross;  ///< (upper arm direction x (wrist centre - axis 2)) . y, A1 frame
+  std::uint8_t branch;     ///< bit 2 shoulder back, bit 1 second elbow, bit 0 wrist flipped
   Singularity singularity;
   double position_error_m;   ///< canonical FK against the target, wrist centre
   double orientation_error;  ///< Frobenius norm of the rotation difference (~ rad)
@@ -52,9 +52,9 @@ void opw_branches(const OpwGeometry& g, const Pose& opw_T_end, double theta4_whe
 /// One solution in the model's joints.
 struct OpwSolution {
   Eigen::Matrix<double, 6, 1> q = Eigen::Matrix<double, 6, 1>::Zero();  ///< rad, inside the joint limits
-  ArmConfiguration configuration;                                        ///< ABB confdata
-  KukaConfiguration kuka;                                                ///< KUKA Status and Turn
-  std::uint8_t branch = 0;                                               ///< as OpwBranch::branch
+  ArmConfiguration configuration;                                       ///< ABB confdata
+  KukaConfiguration kuka;                                               ///< KUKA Status and Turn
+  std::uint8_t branch = 0;                                              ///< as OpwBranch::branch
   Singularity singularity = Singularity::kNone;
   double position_error_m = 0.0;
   double orientation_error = 0.0;

@@ -88,7 +88,8 @@ UrdfTree read_urdf_tree(const std::string& file, const std::string& text) {
       fail(file, e->Row(), "<link> without a name");
     }
     if (tree.has_link(name)) {
-      const auto k = static_cast<std::size_t>(std::find(tree.links.begin(), tree.links.end(), name) - tree.links.begin());
+      const auto k =
+          static_cast<std::size_t>(std::find(tree.links.begin(), tree.links.end(), name) - tree.links.begin());
       fail(file, e->Row(), fmt::format("link '{}' is defined twice (also on line {})", name, tree.link_lines[k]));
     }
     tree.links.push_back(name);
@@ -186,7 +187,8 @@ UrdfChain choose_urdf_chain(const UrdfTree& tree, const std::string& base_link, 
       fail(file, 0, fmt::format("{} '{}' not found", what, *name));
     }
   }
-  const bool ros_industrial = tree.has_link("base_link") && tree.has_link("tool0") && tree.is_below("tool0", "base_link");
+  const bool ros_industrial =
+      tree.has_link("base_link") && tree.has_link("tool0") && tree.is_below("tool0", "base_link");
   if (!base_link.empty()) {
     c.base_link = base_link;
   } else if (ros_industrial && (tip_link.empty() || tree.is_below(tip_link, "base_link"))) {
@@ -199,14 +201,15 @@ UrdfChain choose_urdf_chain(const UrdfTree& tree, const std::string& base_link, 
     c.notes.push_back(fmt::format("chain {} -> {} (as named)", c.base_link, c.tip_link));
   } else if (ros_industrial && tree.is_below("tool0", c.base_link)) {
     c.tip_link = "tool0";
-    c.notes.push_back(fmt::format("chain {} -> tool0 (the ROS-Industrial convention; name another with tip_link)",
-                                  c.base_link));
+    c.notes.push_back(
+        fmt::format("chain {} -> tool0 (the ROS-Industrial convention; name another with tip_link)", c.base_link));
   } else {
     // Every leaf below the base, scored by the independent axes on its path; the tip must be unique.
     std::vector<std::pair<std::string, int>> leaves;  // leaf, last axis joint index
     int best = 0;
     for (const std::string& l : tree.links) {
-      const bool leaf = std::none_of(tree.joints.begin(), tree.joints.end(), [&](const auto& j) { return j.parent == l; });
+      const bool leaf =
+          std::none_of(tree.joints.begin(), tree.joints.end(), [&](const auto& j) { return j.parent == l; });
       if (!leaf || !tree.is_below(l, c.base_link)) {
         continue;
       }
@@ -239,7 +242,8 @@ UrdfChain choose_urdf_chain(const UrdfTree& tree, const std::string& base_link, 
       for (const auto& [l, j] : leaves) {
         list += fmt::format("{}'{}'", list.empty() ? "" : ", ", l);
       }
-      const bool same_arm = std::all_of(leaves.begin(), leaves.end(), [&](const auto& p) { return p.second == leaves[0].second; });
+      const bool same_arm =
+          std::all_of(leaves.begin(), leaves.end(), [&](const auto& p) { return p.second == leaves[0].second; });
       fail(file, 0,
            fmt::format("{} leaves end a chain of {} movable joints below '{}' ({}); {}: name the chain's end with "
                        "tip_link (a YAML robot file, docs/robot-file.md)",
@@ -247,8 +251,8 @@ UrdfChain choose_urdf_chain(const UrdfTree& tree, const std::string& base_link, 
                        same_arm ? "they hang off the same last joint" : "the tree branches into several arms"));
     }
     c.tip_link = leaves.front().first;
-    c.notes.push_back(fmt::format("chain {} -> {} (the only leaf at the end of {} movable joints)", c.base_link,
-                                  c.tip_link, best));
+    c.notes.push_back(
+        fmt::format("chain {} -> {} (the only leaf at the end of {} movable joints)", c.base_link, c.tip_link, best));
   }
   if (!tree.is_below(c.tip_link, c.base_link)) {
     fail(file, 0, fmt::format("tip link '{}' is not below base link '{}'", c.tip_link, c.base_link));
@@ -260,7 +264,8 @@ UrdfChain choose_urdf_chain(const UrdfTree& tree, const std::string& base_link, 
   }
   int axes = 0;
   for (const std::string& name : c.joints) {
-    const auto& je = *std::find_if(tree.joints.begin(), tree.joints.end(), [&](const auto& j) { return j.name == name; });
+    const auto& je =
+        *std::find_if(tree.joints.begin(), tree.joints.end(), [&](const auto& j) { return j.name == name; });
     if (!je.mimics.empty()) {
       fail(file, je.line,
            fmt::format("joint '{}' on the chain {} -> {} mimics joint '{}': a mimic joint is not an independent axis "
