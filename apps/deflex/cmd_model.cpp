@@ -114,8 +114,8 @@ void setup_ik(CLI::App& sub, int& exit_code) {
       for (int i = 0; i < r.q.size(); ++i) {
         std::cout << fmt::format(" {:.4f}", rad_to_deg(r.q[i]));
       }
-      std::cout << fmt::format("\nconfig [cf1,cf4,cf6,cfx]: [{},{},{},{}]  (KUKA S {} T {})\nsolver: {}, residual {:.2e} m, "
-                               "{:.2e} rad\n",
+      std::cout << fmt::format("\nconfig [cf1,cf4,cf6,cfx]: [{},{},{},{}]  (KUKA S {} T {})\n"
+                               "solver: {}, residual {:.2e} m, {:.2e} rad\n",
                                r.configuration.cf1, r.configuration.cf4, r.configuration.cf6, r.configuration.cfx,
                                r.kuka.status, r.kuka.turn,
                                r.analytic ? "analytic (ortho-parallel)" : "damped least squares", r.position_error_m,
