@@ -206,6 +206,7 @@ const char* const kDat =
     "DEFDAT dxt\n"
     "DECL E6POS XP1={X 1800.0,Y -300.0,Z 600.0,A 20.0,B 75.0,C 15.0,S 2,T 10,E1 0.0}\n"
     "DECL FDAT FP1={TOOL_NO 1,BASE_NO 0,IPO_FRAME #BASE,POINT2[] \" \",TQ_STATE FALSE}\n"
+    "DECL FRAME TSPINDLE={X 250,Y 0,Z 0,A 0,B 0,C 0}\n"
     "DECL E6POS P[2]\n"
     "P[1]={X 1800.0,Y -200.0,Z 600.0,A 20.0,B 75.0,C 15.0,S 2,T 10}\n"
     "ENDDAT\n";
@@ -237,6 +238,10 @@ TEST(KrlProgram, PointsToolsAndErrors) {
   fails("DEF dxt()\nFDAT_ACT=FP1\nCIRC XP1\nEND\n", o, {"p.src:3", "CIRC", "2 targets"});
   fails("DEF dxt()\n$TOOL=TOOL_DATA[1]\n$BASE=$NULLFRAME\nPTP {X 5000,Y 0,Z 600,A 0,B 90,C 0,S 2,T 2}\nEND\n", o,
         {"p.src:4", "unreachable"});
+  // $TOOL from a FRAME the .dat declares: no command line needed.
+  const ProgramCompensation from_dat = krl("DEF dxt()\n$TOOL=TSPINDLE\n$BASE=$NULLFRAME\nPTP XP1\nEND\n", kDat, {});
+  EXPECT_EQ(from_dat.targets.size(), 1u);
+  EXPECT_NEAR(from_dat.targets[0].correction_m, r.targets[0].correction_m, 1e-12);  // the same tool as TOOL_DATA[1]
   // A point without Status/Turn and nothing before it to continue from: listed.
   const ProgramCompensation nost =
       krl("DEF dxt()\n$TOOL=TOOL_DATA[1]\n$BASE=$NULLFRAME\nLIN {X 1800,Y -300,Z 600,A 20,B 75,C 15}\nEND\n", kDat, o);

@@ -433,6 +433,16 @@ class KrlReader {
       s.frame = frame_of(a);
       return s;
     }
+    // A FRAME the program's .dat declares (and nothing assigns).
+    if (e == b + 1 && src_.is_ident(b)) {
+      std::string why;
+      const KrlDecl* d = find_point(to_upper(src_.str(b)), src_.str(b), why);
+      if (d != nullptr && d->value.numbers({"X", "Y", "Z", "A", "B", "C"})) {
+        s.kind = FrameState::Kind::kLiteral;
+        s.frame = frame_of(d->value);
+        return s;
+      }
+    }
     s.kind = FrameState::Kind::kUnknown;
     s.why = fmt::format("set from an expression on line {} ({})", src_.tok[b].line, src_.span(b, e));
     return s;

@@ -1,7 +1,9 @@
 // Reading an existing KUKA KRL program (.src with its .dat) and writing it back compensated: PTP,
 // LIN and CIRC to E6POS/POS/FRAME and E6AXIS/AXIS points declared in the .dat (arrays included) or
-// written inline, their Status and Turn, $TOOL and $BASE followed through the .src (assignments,
-// FDAT_ACT of the inline forms, BAS(#TOOL/#BASE, n)) with TOOL_DATA/BASE_DATA from the command line.
+// written inline, their Status and Turn, $TOOL and $BASE followed through the .src (assignments of
+// a literal frame, a FRAME of the .dat or TOOL_DATA[n]/BASE_DATA[n], FDAT_ACT of the inline forms,
+// BAS(#TOOL/#BASE, n)), with TOOL_DATA and BASE_DATA (the controller's $config.dat) from the command
+// line.
 // Only the numbers of the points the motions reach change; a point whose uses need different
 // values, or that other code refers to, gets a compensated copy per use declared after it.
 #pragma once
