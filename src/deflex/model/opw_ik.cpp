@@ -182,12 +182,13 @@ void opw_branches(const OpwGeometry& g, const Pose& opw_T_end, double theta4_whe
         c5 = m(2, 2) >= 0.0 ? 1.0 : -1.0;
         s5 = 0.0;
       } else {
+        // (m22, h) and, below, (c6, s6) are unit pairs up to rounding because m is a rotation, so they
+        // need no normalising: atan2 takes any scale and the FK check would see an error.
         const double inv_h = 1.0 / h;
         c4 = m(0, 2) * inv_h;
         s4 = m(1, 2) * inv_h;
-        const double inv5 = 1.0 / std::sqrt(m(2, 2) * m(2, 2) + h * h);
-        c5 = m(2, 2) * inv5;
-        s5 = h * inv5;
+        c5 = m(2, 2);
+        s5 = h;
       }
       // theta6 from what remains once theta4 and theta5 are taken out: exact near the wrist
       // singularity, where theta4 alone is ill-conditioned.
@@ -195,9 +196,6 @@ void opw_branches(const OpwGeometry& g, const Pose& opw_T_end, double theta4_whe
       const double r10 = -s4 * m(0, 0) + c4 * m(1, 0);
       double c6 = c5 * r00 - s5 * m(2, 0);
       double s6 = r10;
-      const double inv6 = 1.0 / std::sqrt(c6 * c6 + s6 * s6);
-      c6 *= inv6;
-      s6 *= inv6;
       double t4 = fast_atan2(s4, c4);
       double t5 = fast_atan2(s5, c5);
       double t6 = fast_atan2(s6, c6);

@@ -590,14 +590,12 @@ class RapidReader {
       if (const auto ext = external.find(key); ext != external.end()) {
         return ext->second.value;
       }
-      if (key == "TOOL0" || key == "WOBJ0") {
-        return std::nullopt;  // predefined: identity, tw keeps it
-      }
       src_.fail(b, fmt::format("{}: {} '{}' is declared neither in this module nor with {} {}=[...]", ins.name, type,
                                name, option, name));
     };
+    // tool0 and wobj0 are predefined (the flange, the base frame) unless the module declares its own.
     const std::string tool_name = to_upper(src_.str(tb));
-    if (!(te == tb + 1 && tool_name == "TOOL0")) {
+    if (!(te == tb + 1 && tool_name == "TOOL0" && by_name_.count("TOOL0") == 0)) {
       const auto v = data(tb, te, "tooldata", "--tooldata", tools_);
       if (!v) {
         return std::nullopt;
@@ -618,7 +616,7 @@ class RapidReader {
     }
     if (const auto it = ins.options.find("WOBJ"); it != ins.options.end()) {
       const auto [wb, we] = it->second;
-      if (!(we == wb + 1 && iequals(src_.str(wb), "wobj0"))) {
+      if (!(we == wb + 1 && iequals(src_.str(wb), "wobj0") && by_name_.count("WOBJ0") == 0)) {
         const auto v = data(wb, we, "wobjdata", "--wobjdata", wobjs_);
         if (!v) {
           return std::nullopt;
