@@ -65,6 +65,15 @@ TEST(RapidProgram, SingleUseTargetsAreEditedInPlaceAndNothingElseChanges) {
   EXPECT_EQ(out.substr(0, 31), in.substr(0, 31));  // "MODULE T\n  CONST robtarget p1:=[["
 }
 
+TEST(RapidProgram, OptionalArgumentsAnywhereTheInstructionAllowsThem) {
+  const std::string in = module(std::string("  CONST robtarget p1:=") + kP1 + ";\n",
+                                "    MoveL \\Conc, p1 \\ID:=10, v100 \\V:=500, fine \\Inpos:=inpos50, tool0 \\WObj:=wobj0;\n");
+  const ProgramCompensation r = rapid(in);
+  ASSERT_EQ(r.targets.size(), 1u);
+  EXPECT_EQ(r.targets[0].target, "p1");
+  EXPECT_EQ(r.targets[0].action, "edited in place");
+}
+
 TEST(RapidProgram, TargetsReferencedElsewhereOrUsedDifferentlyGetCopies) {
   // p1 is also read by an assignment: in place would change p2's run-time value, so a copy.
   const std::string in = module(std::string("  CONST robtarget p1:=") + kP1 + ";\n  VAR robtarget p2;\n",
