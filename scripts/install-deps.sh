@@ -5,7 +5,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libeigen3-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev
-  protobuf-compiler libprotobuf-dev liburdfdom-dev
+  protobuf-compiler libprotobuf-dev liburdfdom-dev libtinyxml-dev
   libgtest-dev libgmock-dev libbenchmark-dev liborocos-kdl-dev libboost-dev
   python3
 )

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/model/robot_io.hpp"
 
 namespace deflex::cli {
 
@@ -47,6 +48,38 @@ JointVector parse_joints_deg(const std::string& text, const RobotModel& model, c
     q[i] = deg_to_rad(v[static_cast<std::size_t>(i)]);
   }
   return q;
+}
+
+const char* const kStiffnessHelp =
+    "Joint stiffness \"k1,...,kN\" in Nm/rad, one value a joint; replaces the robot file's (a bare URDF has none)";
+
+RobotModel load_cli_robot(const std::string& command, const std::string& robot_path,
+                          const std::string& stiffness_text) {
+  RobotModel model = load_robot_or_builtin(robot_path);
+  for (const std::string& note : model.description().notes) {
+    std::cerr << fmt::format("deflex {}: note: {}\n", command, note);
+  }
+  if (stiffness_text.empty()) {
+    return model;
+  }
+  const std::vector<double> k =
+      parse_numbers(stiffness_text, "--stiffness-Nm-per-rad", static_cast<std::size_t>(model.dof()));
+  for (std::size_t i = 0; i < k.size(); ++i) {
+    if (!(k[i] > 0.0)) {
+      throw InputError(
+          fmt::format("option --stiffness-Nm-per-rad: value {} ({} Nm/rad) must be positive", i + 1, k[i]));
+    }
+  }
+  return model.with_stiffness(k, "given on the command line (--stiffness-Nm-per-rad)");
+}
+
+void require_stiffness(const RobotModel& model) {
+  if (!model.has_stiffness()) {
+    throw InputError(fmt::format("robot '{}' ({}) has no joint stiffness: give it with --stiffness-Nm-per-rad "
+                                 "\"k1,...,k{}\" (Nm/rad) or in a robot file (joint_stiffness_Nm_per_rad, "
+                                 "docs/robot-file.md)",
+                                 model.name(), model.description().source, model.dof()));
+  }
 }
 
 nlohmann::json to_json(const Eigen::Ref<const Eigen::MatrixXd>& m) {

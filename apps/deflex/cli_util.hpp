@@ -18,6 +18,19 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& op
 /// Joint values given in degrees on the command line, to rad, checked against the robot's dof.
 JointVector parse_joints_deg(const std::string& text, const RobotModel& model, const std::string& option);
 
+/// The robot of `--robot` (empty: the built-in IRB6700). `stiffness_text` (the option
+/// --stiffness-Nm-per-rad, "k1,...,kN" in Nm/rad) replaces the file's joint stiffness when given.
+/// The loader's notes (e.g. which URDF chain was chosen) go to stderr as "deflex COMMAND: note: ...".
+/// Throws ModelError or InputError naming the file or the option.
+RobotModel load_cli_robot(const std::string& command, const std::string& robot_path,
+                          const std::string& stiffness_text = "");
+
+/// Help text of --stiffness-Nm-per-rad, shared by the subcommands that take it.
+extern const char* const kStiffnessHelp;
+
+/// Throws InputError unless the robot has joint stiffness, saying how to give it.
+void require_stiffness(const RobotModel& model);
+
 /// JSON array of an Eigen vector or matrix (row-major nested arrays for matrices).
 nlohmann::json to_json(const Eigen::Ref<const Eigen::MatrixXd>& m);
 nlohmann::json vector_to_json(const Eigen::Ref<const Eigen::VectorXd>& v);

@@ -71,7 +71,7 @@ void setup_identify(CLI::App& sub, int& exit_code) {
                  "Write the robot file with the identified stiffness (unidentified joints keep the file's value)");
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code] {
-    const RobotModel model = load_robot_or_builtin(o->robot);
+    const RobotModel model = load_cli_robot("identify", o->robot);
     const auto data = read_stiffness_measurements(o->data);
     IdentificationOptions opt;
     opt.robust = !o->no_robust;
@@ -210,7 +210,7 @@ void setup_plan(CLI::App& sub, int& exit_code) {
   sub.add_option("--seed", o->seed, "Seed of the synthetic noise (default 1)");
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code] {
-    const RobotModel model = load_robot_or_builtin(o->robot);
+    const RobotModel model = load_cli_robot("plan-calibration", o->robot);
     const auto r = parse_numbers(o->region, "--region-mm", 6);
     CalibrationPlanOptions opt;
     opt.region_min_m = Vector3(r[0], r[2], r[4]) * 1e-3;

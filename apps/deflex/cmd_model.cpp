@@ -33,7 +33,7 @@ void setup_fk(CLI::App& sub, int& exit_code) {
   sub.add_option("--joints-deg", o->joints, "Joint values in degrees, comma-separated: \"j1,...,j6\"")->required();
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code] {
-    const RobotModel model = load_robot_or_builtin(o->robot);
+    const RobotModel model = load_cli_robot("fk", o->robot);
     const JointVector q = parse_joints_deg(o->joints, model, "--joints-deg");
     Workspace ws(model);
     const Pose tcp = tcp_pose(model, ws, q);
@@ -72,7 +72,7 @@ void setup_ik(CLI::App& sub, int& exit_code) {
   sub.add_option("--seed-deg", o->seed, "Preferred joint values in degrees \"j1,...,j6\"");
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code] {
-    const RobotModel model = load_robot_or_builtin(o->robot);
+    const RobotModel model = load_cli_robot("ik", o->robot);
     const auto p = parse_numbers(o->position, "--position-mm", 3);
     const auto qv = parse_numbers(o->quaternion, "--quaternion-wxyz", 4);
     Eigen::Quaterniond quat(qv[0], qv[1], qv[2], qv[3]);
@@ -103,6 +103,8 @@ void setup_ik(CLI::App& sub, int& exit_code) {
         JointVector deg = r.q * (180.0 / kPi);
         doc["joints_deg"] = vector_to_json(deg);
         doc["config"] = {r.configuration.cf1, r.configuration.cf4, r.configuration.cf6, r.configuration.cfx};
+        doc["kuka_status"] = r.kuka.status;
+        doc["kuka_turn"] = r.kuka.turn;
         doc["position_error_m"] = r.position_error_m;
         doc["orientation_error_rad"] = r.orientation_error_rad;
       }
@@ -112,9 +114,11 @@ void setup_ik(CLI::App& sub, int& exit_code) {
       for (int i = 0; i < r.q.size(); ++i) {
         std::cout << fmt::format(" {:.4f}", rad_to_deg(r.q[i]));
       }
-      std::cout << fmt::format("\nconfig [cf1,cf4,cf6,cfx]: [{},{},{},{}]\nsolver: {}, residual {:.2e} m, {:.2e} rad\n",
+      std::cout << fmt::format("\nconfig [cf1,cf4,cf6,cfx]: [{},{},{},{}]  (KUKA S {} T {})\n"
+                               "solver: {}, residual {:.2e} m, {:.2e} rad\n",
                                r.configuration.cf1, r.configuration.cf4, r.configuration.cf6, r.configuration.cfx,
-                               r.analytic ? "analytic" : "damped least squares", r.position_error_m,
+                               r.kuka.status, r.kuka.turn,
+                               r.analytic ? "analytic (ortho-parallel)" : "damped least squares", r.position_error_m,
                                r.orientation_error_rad);
     }
     if (!r.message.empty()) {
@@ -126,11 +130,12 @@ void setup_ik(CLI::App& sub, int& exit_code) {
 
 void setup_deflect(CLI::App& sub, int& exit_code) {
   struct Opts {
-    std::string robot, joints, wrench;
+    std::string robot, stiffness, joints, wrench;
     bool json = false, complementary = false;
   };
   auto o = std::make_shared<Opts>();
   sub.add_option("--robot", o->robot, kRobotHelp);
+  sub.add_option("--stiffness-Nm-per-rad", o->stiffness, kStiffnessHelp);
   sub.add_option("--joints-deg", o->joints, "Joint values in degrees \"j1,...,j6\"")->required();
   sub.add_option("--wrench", o->wrench,
                  "Wrench at the WAP \"Fx,Fy,Fz,Mx,My,Mz\" in N and Nm, robot base frame, moment about the WAP")
@@ -139,7 +144,9 @@ void setup_deflect(CLI::App& sub, int& exit_code) {
                "Include the complementary stiffness d(J^T W)/dtheta (large loads)");
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code] {
-    const RobotModel model = load_robot_or_builtin(o->robot);
+    const RobotModel model = load_cli_robot("deflect", o->robot, o->stiffness);
+    // Without stiffness the deflection would print as zero: refuse, as offline and online do.
+    require_stiffness(model);
     const JointVector q = parse_joints_deg(o->joints, model, "--joints-deg");
     const auto w = parse_numbers(o->wrench, "--wrench", 6);
     Wrench wrench;
@@ -176,12 +183,13 @@ void setup_deflect(CLI::App& sub, int& exit_code) {
 
 void setup_robot(CLI::App& sub, int& exit_code) {
   struct Opts {
-    std::string robot;
+    std::string robot, stiffness;
   };
   auto o = std::make_shared<Opts>();
   sub.add_option("--robot", o->robot, kRobotHelp);
+  sub.add_option("--stiffness-Nm-per-rad", o->stiffness, kStiffnessHelp);
   sub.callback([o, &exit_code] {
-    std::cout << robot_to_yaml(load_robot_or_builtin(o->robot));
+    std::cout << robot_to_yaml(load_cli_robot("robot", o->robot, o->stiffness));
     exit_code = 0;
   });
 }

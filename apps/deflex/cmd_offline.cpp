@@ -17,6 +17,7 @@
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/offline/offline_csv.hpp"
 #include "deflex/offline/offline_summary.hpp"
+#include "deflex/offline/program_compensation.hpp"
 #include "deflex/offline/rapid_module.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/paths/path_ik.hpp"
@@ -27,10 +28,12 @@ namespace deflex::cli {
 namespace {
 
 struct Opts {
-  std::string robot, circle, line, path_csv, orientation = "0,0,1,0", config, seed, csv_out, rapid_out;
+  std::string robot, stiffness, circle, line, path_csv, orientation = "0,0,1,0", config, seed, csv_out, rapid_out;
   std::string trajectory_out, nominal_trajectory_out;
   double hold_start_s = 0.0;
   std::vector<std::string> forces;
+  std::string program_in, program_out;
+  std::vector<std::string> tooldata, wobjdata;
   std::string motion = "absj", zone = "fine", tool = "tool0", wobj = "wobj0", module = "DeflexOffline";
   double speed_mm_s = 10.0;
   bool circle_given = false, orientation_given = false, json = false;
@@ -54,15 +57,90 @@ std::string identifier_safe(const std::string& s) {
   return out;
 }
 
+/// --program-in: an existing RAPID or KRL program compensated target by target.
+void run_program(const Opts& o, const RobotModel& model, int& exit_code) {
+  if (o.program_out.empty()) {
+    throw InputError("option --program-in needs --program-out FILE (the input is never overwritten)");
+  }
+  if (!o.csv_out.empty() || !o.rapid_out.empty()) {
+    throw InputError("options -o and --rapid write a new path's files; with --program-in the output is --program-out");
+  }
+  std::vector<std::unique_ptr<ForceModel>> forces;
+  for (const std::string& spec : o.forces) {
+    for (auto& m : parse_force_specs(spec, {})) {
+      forces.push_back(std::move(m));
+    }
+  }
+  if (forces.size() != 1) {
+    throw InputError(fmt::format("--program-in compensates for one load: the --force options describe {}",
+                                 forces.size()));
+  }
+  ProgramOptions options;
+  options.tooldata = o.tooldata;
+  options.wobjdata = o.wobjdata;
+  const ProgramCompensation result = compensate_program(model, *forces.front(), o.program_in, o.program_out, options);
+  write_program_outputs(result);  // only once every target has been resolved and compensated
+  if (!o.json) {
+    std::cout << "robot: " << model.name() << "\n" << program_summary(result);
+    exit_code = 0;
+    return;
+  }
+  nlohmann::json targets = nlohmann::json::array();
+  for (const ProgramTargetReport& t : result.targets) {
+    targets.push_back({{"file", t.file},
+                       {"line", t.line},
+                       {"instruction", t.instruction},
+                       {"target", t.target},
+                       {"action", t.action},
+                       {"deflection_mm", t.deflection_m * 1e3},
+                       {"deflection_mrad", t.deflection_rad * 1e3},
+                       {"correction_mm", t.correction_m * 1e3},
+                       {"joint_correction_deg", rad_to_deg(t.joint_correction_rad)},
+                       {"wrench_base_N_Nm", {t.wrench_base[0], t.wrench_base[1], t.wrench_base[2], t.wrench_base[3],
+                                             t.wrench_base[4], t.wrench_base[5]}}});
+  }
+  nlohmann::json unresolved = nlohmann::json::array();
+  for (const UnresolvedConstruct& u : result.unresolved) {
+    unresolved.push_back({{"file", u.file}, {"line", u.line}, {"text", u.text}, {"reason", u.reason}});
+  }
+  nlohmann::json outputs = nlohmann::json::array();
+  for (const ProgramFile& f : result.outputs) {
+    outputs.push_back(f.path);
+  }
+  print_json({{"robot", model.name()},
+              {"language", result.language},
+              {"force", result.force_description},
+              {"targets", targets},
+              {"unresolved", unresolved},
+              {"outputs", outputs}});
+  exit_code = 0;
+}
+
 void run(const Opts& o, int& exit_code) {
+  if (!o.program_in.empty()) {
+    if (o.circle_given || !o.line.empty() || !o.path_csv.empty()) {
+      throw InputError("--program-in takes its targets from the program: give no --circle, --line or --path");
+    }
+    if (o.forces.empty()) {
+      throw InputError("give a force model: --force ldbb:...|constant:...|tool:...|table:FILE.csv");
+    }
+    const RobotModel model = load_cli_robot("offline", o.robot, o.stiffness);
+    require_stiffness(model);
+    run_program(o, model, exit_code);
+    return;
+  }
+  if (!o.program_out.empty() || !o.tooldata.empty() || !o.wobjdata.empty()) {
+    throw InputError("options --program-out, --tooldata and --wobjdata go with --program-in");
+  }
   const int sources = (o.circle_given ? 1 : 0) + (o.line.empty() ? 0 : 1) + (o.path_csv.empty() ? 0 : 1);
   if (sources != 1) {
-    throw InputError("give exactly one path: --circle [SPEC], --line SPEC or --path FILE.csv");
+    throw InputError("give exactly one path: --circle [SPEC], --line SPEC, --path FILE.csv or --program-in FILE");
   }
   if (o.forces.empty()) {
-    throw InputError("give a force model: --force ldbb:...|constant:...|table:FILE.csv");
+    throw InputError("give a force model: --force ldbb:...|constant:...|tool:...|table:FILE.csv");
   }
-  const RobotModel model = load_robot_or_builtin(o.robot);
+  const RobotModel model = load_cli_robot("offline", o.robot, o.stiffness);
+  require_stiffness(model);  // before any path is solved
 
   // Path.
   ForceSpecContext context;
@@ -253,6 +331,7 @@ void setup_offline(CLI::App& sub, int& exit_code) {
   auto o = std::make_shared<Opts>();
   sub.add_option("--robot", o->robot,
                  "Robot file (.yaml deflex format or .urdf) with joint stiffness; default: the built-in ABB IRB 6700");
+  sub.add_option("--stiffness-Nm-per-rad", o->stiffness, kStiffnessHelp);
   sub.add_option("--circle", o->circle,
                  "Circle path \"centre_mm=X;Y;Z,radius_mm=R,normal=NX;NY;NZ,start_deg=A,direction=ccw|cw,points=N\"; "
                  "every key optional (default: centre 1500;0;1000 mm, radius 100 mm, normal +z, ccw, 81 points, the "
@@ -268,7 +347,9 @@ void setup_offline(CLI::App& sub, int& exit_code) {
   sub.add_option("--force", o->forces,
                  "Force model (repeatable): \"ldbb:pivot_mm=X;Y;Z,force_N=F[;F2..],mode=push|pull\", "
                  "\"ldbb:phi_deg=A,force_N=...\" (circle only: pivot on the circle's axis, bar inclined by A), "
-                 "\"constant:fx_N=..,fy_N=..,fz_N=..,mx_Nm=..,my_Nm=..,mz_Nm=..\", \"table:FILE.csv\"")
+                 "\"constant:fx_N=..,fy_N=..,fz_N=..,mx_Nm=..,my_Nm=..,mz_Nm=..\" (base frame), \"tool:fz_N=..,...\" "
+                 "(the same keys in the TCP frame: a drilling or milling thrust that turns with the tool), "
+                 "\"table:FILE.csv\"")
       ->required();
   sub.add_option("--speed-mm-s", o->speed_mm_s,
                  "TCP speed, mm/s (default 10): the RAPID speeddata and the timing of the joint trajectories");
@@ -288,6 +369,19 @@ void setup_offline(CLI::App& sub, int& exit_code) {
   sub.add_option("--module", o->module, "RAPID module name (default DeflexOffline; the load is appended when several)");
   sub.add_option("-o,--output", o->csv_out, "Write the per-point CSV here (one file per load when several)");
   sub.add_option("--rapid", o->rapid_out, "Write the ABB RAPID module here (.mod; one per load when several)");
+  sub.add_option("--program-in", o->program_in,
+                 "An existing robot program to compensate target by target: ABB RAPID module (.mod, .modx, .prg, "
+                 ".sys) or KUKA KRL program (.src, its .dat beside it); every other byte is kept");
+  sub.add_option("--program-out", o->program_out,
+                 "Where the compensated program goes (KRL: the .src; its .dat is written beside it)");
+  sub.add_option("--tooldata", o->tooldata,
+                 "Tool declared outside the program, in its own syntax (repeatable): RAPID "
+                 "\"tGun=[TRUE,[[x,y,z],[q1,q2,q3,q4]],[mass,[cx,cy,cz],[1,0,0,0],0,0,0]]\" (mm), KRL "
+                 "\"TOOL_DATA[1]={X ..,Y ..,Z ..,A ..,B ..,C ..}\" or \"$TOOL={...}\" (mm, deg)");
+  sub.add_option("--wobjdata", o->wobjdata,
+                 "Work object or base declared outside the program (repeatable): RAPID "
+                 "\"wobjTable=[FALSE,TRUE,\"\",[[x,y,z],[q1,q2,q3,q4]],[[0,0,0],[1,0,0,0]]]\", KRL "
+                 "\"BASE_DATA[2]={X ..,Y ..,Z ..,A ..,B ..,C ..}\" or \"$BASE={...}\"");
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code, &sub] {
     o->circle_given = sub.count("--circle") > 0;

@@ -8,6 +8,7 @@
 #include "deflex/force/constant_wrench_model.hpp"
 #include "deflex/force/force_spec.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
+#include "deflex/force/tool_wrench_model.hpp"
 #include "deflex/force/wrench_table_model.hpp"
 #include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
@@ -127,6 +128,26 @@ TEST(ConstantWrench, SameWrenchEverywhere) {
   Wrench bad = expected;
   bad[1] = std::nan("");
   EXPECT_THROW(ConstantWrenchModel{bad}, InputError);
+}
+
+TEST(ToolWrench, TurnsWithTheTool) {
+  // A drill pushed along its own axis feels the thrust back along -z of the tool. Tool pointing
+  // down (rotated by pi about base y): the workpiece pushes the robot up, +z in the base frame.
+  const auto m = parse_force_spec("tool:fz_N=-200,mz_Nm=3");
+  EXPECT_EQ(m->label(), "tool");
+  Pose down = at(Vector3(1.5, 0.2, 0.8));
+  down.linear() = Eigen::AngleAxisd(kPi, Vector3::UnitY()).toRotationMatrix();
+  const Wrench w = m->wrench_at(0, down);
+  EXPECT_NEAR(w[2], 200.0, 1e-12);
+  EXPECT_NEAR(w[5], -3.0, 1e-12);  // the drilling torque about the tool axis, seen from the base
+  EXPECT_NEAR(w.head<2>().norm() + w.segment<2>(3).norm(), 0.0, 1e-12);
+  // Tool along base +x (rotated by +pi/2 about y): the thrust points along -x.
+  Pose forward = at(Vector3(1.5, 0.0, 1.0));
+  forward.linear() = Eigen::AngleAxisd(kPi / 2, Vector3::UnitY()).toRotationMatrix();
+  EXPECT_NEAR(m->wrench_at(7, forward)[0], -200.0, 1e-12);
+  EXPECT_NE(m->describe().find("tool frame"), std::string::npos);
+  EXPECT_NE(error_of([] { (void)parse_force_spec("tool:"); }).find("at least one"), std::string::npos);
+  EXPECT_NE(error_of([] { (void)parse_force_spec("tool:fq_N=3"); }).find("fq_N"), std::string::npos);
 }
 
 TEST(WrenchTable, RowsByOrderOrByIndex) {

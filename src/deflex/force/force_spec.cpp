@@ -7,6 +7,7 @@
 
 #include "deflex/force/constant_wrench_model.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
+#include "deflex/force/tool_wrench_model.hpp"
 #include "deflex/force/wrench_table_model.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/paths/key_value_spec.hpp"
@@ -52,7 +53,8 @@ std::vector<std::unique_ptr<ForceModel>> parse_ldbb(const std::string& spec, con
   return models;
 }
 
-std::vector<std::unique_ptr<ForceModel>> parse_constant(const std::string& spec, const std::string& body) {
+/// The six components of constant:/tool: specs; absent ones are 0, at least one is required.
+Wrench parse_wrench_keys(const std::string& spec, const std::string& body) {
   static const char* const kKeys[6] = {"fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm"};
   const KeyValueSpec keys(spec, body, {kKeys[0], kKeys[1], kKeys[2], kKeys[3], kKeys[4], kKeys[5]});
   Wrench w = Wrench::Zero();
@@ -64,9 +66,7 @@ std::vector<std::unique_ptr<ForceModel>> parse_constant(const std::string& spec,
   if (!any) {
     keys.fail("give at least one of fx_N, fy_N, fz_N, mx_Nm, my_Nm, mz_Nm");
   }
-  std::vector<std::unique_ptr<ForceModel>> models;
-  models.push_back(std::make_unique<ConstantWrenchModel>(w));
-  return models;
+  return w;
 }
 
 }  // namespace
@@ -88,8 +88,15 @@ std::vector<std::unique_ptr<ForceModel>> parse_force_specs(const std::string& sp
   if (kind == "ldbb") {
     return parse_ldbb(spec, body, context);
   }
-  if (kind == "constant") {
-    return parse_constant(spec, body);
+  if (kind == "constant" || kind == "tool") {
+    std::vector<std::unique_ptr<ForceModel>> models;
+    const Wrench w = parse_wrench_keys(spec, body);
+    if (kind == "tool") {
+      models.push_back(std::make_unique<ToolWrenchModel>(w));
+    } else {
+      models.push_back(std::make_unique<ConstantWrenchModel>(w));
+    }
+    return models;
   }
   if (kind == "table") {
     const std::string file = trim_blanks(body);
@@ -100,7 +107,7 @@ std::vector<std::unique_ptr<ForceModel>> parse_force_specs(const std::string& sp
     models.push_back(std::make_unique<WrenchTableModel>(WrenchTableModel::read_file(file)));
     return models;
   }
-  throw InputError(fmt::format("force spec '{}': unknown kind '{}' (use ldbb:..., constant:... or table:FILE.csv)",
+  throw InputError(fmt::format("force spec '{}': unknown kind '{}' (use ldbb:..., constant:..., tool:... or table:FILE.csv)",
                                spec, kind));
 }
 

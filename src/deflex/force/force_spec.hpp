@@ -3,10 +3,12 @@
 //   ldbb:pivot_mm=X;Y;Z,force_N=F[;F2;...],mode=push|pull
 //   ldbb:phi_deg=A,force_N=F[;F2;...],mode=push|pull        (needs a circle path, see below)
 //   constant:fx_N=..,fy_N=..,fz_N=..,mx_Nm=..,my_Nm=..,mz_Nm=..   (absent components are 0)
+//   tool:fx_N=..,fy_N=..,fz_N=..,mx_Nm=..,my_Nm=..,mz_Nm=..       (the same, in the TCP frame)
 //   table:FILE.csv                                          (see wrench_table_model.hpp)
 //
 // Keys are separated by ',' and the components of one value by ';'. Every unit is in the key's
-// name; positions in mm, forces in N, moments in Nm (moment about the TCP), base frame. mode
+// name; positions in mm, forces in N, moments in Nm (moment about the TCP), base frame (tool: the
+// TCP frame, so the wrench turns with the tool, as a drill's thrust does). mode
 // defaults to push. Several force_N values give one model per load (the paper's 125;375;625).
 //
 // phi_deg places the LDBB pivot on the circle's axis so the bar is inclined by phi to the circle's

@@ -1,4 +1,5 @@
-// Analytic IK for ortho-parallel arms with a spherical wrist, and damped least squares otherwise.
+// Inverse kinematics: the ortho-parallel closed form (opw_ik.hpp) with the configuration and turn
+// the caller asks for, and damped least squares for other arms.
 #include "deflex/model/inverse_kinematics.hpp"
 
 #include <algorithm>
@@ -8,124 +9,10 @@
 #include <Eigen/SVD>
 #include <fmt/format.h>
 
+#include "deflex/model/opw_ik.hpp"
+
 namespace deflex {
 namespace {
-
-constexpr double kHalfPi = kPi / 2.0;
-
-bool near(double a, double b, double tol = 1e-9) { return std::abs(a - b) < tol; }
-bool is_quarter_turn(double alpha) { return near(std::abs(alpha), kHalfPi); }
-
-int quadrant(double q) { return static_cast<int>(std::floor(q / kHalfPi + 1e-12)); }
-
-Matrix3 rot_z(double a) { return Eigen::AngleAxisd(a, Vector3::UnitZ()).toRotationMatrix(); }
-Matrix3 rot_x(double a) { return Eigen::AngleAxisd(a, Vector3::UnitX()).toRotationMatrix(); }
-
-double wrap_pi(double a) {
-  a = std::remainder(a, 2.0 * kPi);
-  return a;
-}
-
-/// Target flange pose in the chain's own frame (base frame and tool removed).
-Pose chain_T_flange(const RobotModel& model, const Pose& base_T_tcp) {
-  const RobotDescription& d = model.description();
-  return d.base_T_chain.inverse() * base_T_tcp * d.flange_T_tcp.inverse();
-}
-
-/// One analytic branch before joint limits and 2*pi turns.
-struct Branch {
-  std::array<double, 6> q{};  // joint values (offsets removed), wrapped to (-pi, pi]
-  Singularity singularity = Singularity::kNone;
-};
-
-/// Solves the analytic branches. Returns false when the target is out of reach (message set).
-bool analytic_branches(const RobotModel& model, const Pose& base_T_tcp, const JointVector* seed, double near_tol,
-                       std::vector<Branch>& out, std::string& message) {
-  const auto& dh = model.description().dh;
-  const Pose target = chain_T_flange(model, base_T_tcp);
-  const Matrix3 R06 = target.linear();
-  const double d6 = dh[5].d_m;
-  const double a6 = dh[5].alpha_rad;
-  const Vector3 wc = target.translation() - d6 * (R06 * Vector3(0.0, std::sin(a6), std::cos(a6)));
-
-  const double s1 = std::sin(dh[0].alpha_rad) > 0 ? 1.0 : -1.0;
-  const double lateral = -s1 * (dh[1].d_m + dh[2].d_m);
-  const double rho2 = wc.x() * wc.x() + wc.y() * wc.y();
-  if (rho2 < lateral * lateral - 1e-15) {
-    message = fmt::format("wrist centre ({:.4f}, {:.4f}, {:.4f}) m is inside the shoulder offset cylinder", wc.x(),
-                          wc.y(), wc.z());
-    return false;
-  }
-  const double h_abs = std::sqrt(std::max(0.0, rho2 - lateral * lateral));
-  const double L2 = dh[1].a_m;
-  const Eigen::Vector2d v3(dh[2].a_m, -std::sin(dh[2].alpha_rad) * dh[3].d_m);
-  const double L3 = v3.norm();
-  const double phi3 = std::atan2(v3.y(), v3.x());
-  const double s4 = std::sin(dh[3].alpha_rad) > 0 ? 1.0 : -1.0;
-  const double s5 = std::sin(dh[4].alpha_rad) > 0 ? 1.0 : -1.0;
-  bool any_reach = false;
-  for (const double shoulder : {1.0, -1.0}) {
-    const double h = shoulder * h_abs;
-    const double q1p = std::atan2(wc.y(), wc.x()) - std::atan2(lateral, h);
-    const double X1 = h - dh[0].a_m;
-    const double Y1 = s1 * (wc.z() - dh[0].d_m);
-    const double P2 = X1 * X1 + Y1 * Y1;
-    const double cb = (P2 - L2 * L2 - L3 * L3) / (2.0 * L2 * L3);
-    if (std::abs(cb) > 1.0 + 1e-12) {
-      continue;
-    }
-    any_reach = true;
-    const double cbc = std::clamp(cb, -1.0, 1.0);
-    for (const double elbow : {1.0, -1.0}) {
-      const double beta = elbow * std::acos(cbc);
-      const double q3p = beta - phi3;
-      const double q2p = std::atan2(Y1, X1) - std::atan2(L3 * std::sin(beta), L2 + L3 * std::cos(beta));
-      const Matrix3 R03 = rot_z(q1p) * rot_x(dh[0].alpha_rad) * rot_z(q2p) * rot_x(dh[1].alpha_rad) * rot_z(q3p) *
-                          rot_x(dh[2].alpha_rad);
-      const Matrix3 M = R03.transpose() * R06 * rot_x(-a6);
-      // |sin q5| from the third column (M(0,2), M(1,2) = s5 sin q5 [cos q4, sin q4]) and cos q5 from
-      // M(2,2): atan2 keeps full precision near q5 = 0, where acos(cos q5) would lose half the digits.
-      const double c5 = -s4 * s5 * M(2, 2);
-      const double sin5_abs = std::hypot(M(0, 2), M(1, 2));
-      Singularity sing = Singularity::kNone;
-      if (h_abs < near_tol) {
-        sing = Singularity::kShoulder;
-      } else if (std::abs(std::sin(beta)) < near_tol) {
-        sing = Singularity::kElbow;
-      } else if (sin5_abs < near_tol) {
-        sing = Singularity::kWrist;
-      }
-      const bool wrist_singular = sin5_abs < 1e-12;
-      for (const double wrist : {1.0, -1.0}) {
-        const double q5p = wrist * std::atan2(sin5_abs, c5);
-        // q4 from the third column; at the singularity only q4 + q6 is fixed: keep q4 at the seed
-        // (or zero) and give the rest to q6.
-        const double q4p = wrist_singular ? (seed ? (*seed)[3] + dh[3].theta_offset_rad : 0.0)
-                                          : std::atan2(wrist * s5 * M(1, 2), wrist * s5 * M(0, 2));
-        // q6 from what remains of the rotation once q4 and q5 are taken out: exact whatever the
-        // precision of q4 near the singularity.
-        const Matrix3 A = rot_z(q4p) * rot_x(dh[3].alpha_rad) * rot_z(q5p) * rot_x(dh[4].alpha_rad);
-        const Matrix3 Rz6 = A.transpose() * M;
-        const double q6p = std::atan2(Rz6(1, 0), Rz6(0, 0));
-        Branch b;
-        const std::array<double, 6> qp{q1p, q2p, q3p, q4p, q5p, q6p};
-        for (std::size_t i = 0; i < 6; ++i) {
-          b.q[i] = wrap_pi(qp[i] - dh[i].theta_offset_rad);
-        }
-        b.singularity = sing;
-        out.push_back(b);
-        if (wrist_singular) {
-          break;  // both wrist signs give the same pose family
-        }
-      }
-    }
-  }
-  if (!any_reach) {
-    message = fmt::format("wrist centre ({:.4f}, {:.4f}, {:.4f}) m is out of the arm's reach", wc.x(), wc.y(), wc.z());
-    return false;
-  }
-  return true;
-}
 
 double max_abs_diff(const JointVector& a, const JointVector& b) { return (a - b).cwiseAbs().maxCoeff(); }
 
@@ -134,17 +21,6 @@ void fill_errors(const RobotModel& model, Workspace& ws, const Pose& target, IkR
   const Displacement e = pose_difference(ws.base_T_tcp, target);
   r.position_error_m = e.head<3>().norm();
   r.orientation_error_rad = e.tail<3>().norm();
-}
-
-bool matches(const ArmConfiguration& have, const IkRequest& req) {
-  if (!req.configuration) {
-    return true;
-  }
-  const ArmConfiguration& want = *req.configuration;
-  if (have.cfx != want.cfx) {
-    return false;
-  }
-  return !req.match_quadrants || (have.cf1 == want.cf1 && have.cf4 == want.cf4 && have.cf6 == want.cf6);
 }
 
 IkResult numerical_ik(const RobotModel& model, Workspace& ws, const Pose& target, const IkRequest& req) {
@@ -221,6 +97,7 @@ IkResult numerical_ik(const RobotModel& model, Workspace& ws, const Pose& target
     return best;
   }
   best.configuration = arm_configuration(model, ws, best.q);
+  best.kuka = kuka_configuration(model, ws, best.q);
   const double smin = jacobian_min_singular_value(model, ws, best.q);
   if (smin < req.near_singular_threshold) {
     best.status = IkStatus::kNearSingular;
@@ -268,26 +145,21 @@ const char* to_string(Singularity s) {
   return "unknown";
 }
 
-bool has_analytic_ik(const RobotModel& model) {
-  const RobotDescription& d = model.description();
-  if (model.dof() != 6 || !d.dh_convention || *d.dh_convention != DhConvention::kStandard || d.dh.size() != 6) {
-    return false;
-  }
-  const auto& r = d.dh;
-  return is_quarter_turn(r[0].alpha_rad) && near(r[1].alpha_rad, 0.0) && is_quarter_turn(r[2].alpha_rad) &&
-         is_quarter_turn(r[3].alpha_rad) && is_quarter_turn(r[4].alpha_rad) && near(r[3].a_m, 0.0) &&
-         near(r[4].a_m, 0.0) && near(r[4].d_m, 0.0) && near(r[5].a_m, 0.0) && r[1].a_m > 0.0 &&
-         std::hypot(r[2].a_m, r[3].d_m) > 0.0;
-}
+bool has_analytic_ik(const RobotModel& model) { return model.opw() != nullptr; }
 
-ArmConfiguration arm_configuration(const RobotModel& model, Workspace& ws, const JointVector& q) {
-  ArmConfiguration c;
+namespace {
+
+/// Joints 4 and 5 of the model's first frames give the generic configuration of non-OPW arms.
+void generic_configuration(const RobotModel& model, Workspace& ws, const JointVector& q, ArmConfiguration& abb,
+                           KukaConfiguration& kuka) {
   const int n = model.dof();
-  c.cf1 = quadrant(q[0]);
-  c.cf4 = n > 3 ? quadrant(q[3]) : 0;
-  c.cf6 = n > 5 ? quadrant(q[5]) : 0;
+  abb = ArmConfiguration{};
+  abb.cf1 = abb_quadrant(q[0]);
+  abb.cf4 = n > 3 ? abb_quadrant(q[3]) : 0;
+  abb.cf6 = n > 5 ? abb_quadrant(q[5]) : 0;
+  kuka = KukaConfiguration{0, kuka_turn(q)};
   if (n < 5) {
-    return c;
+    return;
   }
   forward_kinematics(model, ws, q);
   const RobotDescription& d = model.description();
@@ -300,9 +172,55 @@ ArmConfiguration arm_configuration(const RobotModel& model, Workspace& ws, const
   const Vector3 lower_arm = ws.origin_base[2] - ws.origin_base[1];
   const Vector3 to_wc = wc - ws.origin_base[1];
   const bool behind_lower_arm = ws.axis_base[1].dot(lower_arm.cross(to_wc)) < 0.0;
-  const bool q5_negative = q[4] < 0.0;
-  c.cfx = (behind_axis1 ? 4 : 0) + (behind_lower_arm ? 2 : 0) + (q5_negative ? 1 : 0);
-  return c;
+  const bool q5_negative = negative_joint(q[4]);
+  abb.cfx = (behind_axis1 ? 4 : 0) + (behind_lower_arm ? 2 : 0) + (q5_negative ? 1 : 0);
+  kuka.status = (behind_axis1 ? 1 : 0) + (behind_lower_arm ? 0 : 2) + (q5_negative ? 4 : 0);
+}
+
+/// Every 2*pi turn of `q` inside [lo, hi] (at most `capacity`), ascending; only the one nearest
+/// `ref` when a limit is infinite.
+int turns_within(double q, double ref, double lo, double hi, std::array<double, 8>& out) {
+  constexpr double kTwoPi = 2.0 * kPi;
+  constexpr double kSlack = 1e-9;
+  if (!std::isfinite(lo) || !std::isfinite(hi)) {
+    out[0] = q + kTwoPi * std::nearbyint((ref - q) / kTwoPi);
+    return 1;
+  }
+  int n = 0;
+  for (double t = q - kTwoPi * std::floor((q - lo + kSlack) / kTwoPi); t <= hi + kSlack && n < 8; t += kTwoPi) {
+    if (t >= lo - kSlack) {
+      out[static_cast<std::size_t>(n++)] = std::clamp(t, lo, hi);
+    }
+  }
+  return n;
+}
+
+std::string configuration_text(const ArmConfiguration& c, const KukaConfiguration& k) {
+  return fmt::format("[{},{},{},{}] (S {} T {})", c.cf1, c.cf4, c.cf6, c.cfx, k.status, k.turn);
+}
+
+}  // namespace
+
+ArmConfiguration arm_configuration(const RobotModel& model, Workspace& ws, const JointVector& q) {
+  ArmConfiguration abb;
+  KukaConfiguration kuka;
+  if (const OpwGeometry* g = model.opw()) {
+    opw_configuration(*g, q, abb, kuka);
+  } else {
+    generic_configuration(model, ws, q, abb, kuka);
+  }
+  return abb;
+}
+
+KukaConfiguration kuka_configuration(const RobotModel& model, Workspace& ws, const JointVector& q) {
+  ArmConfiguration abb;
+  KukaConfiguration kuka;
+  if (const OpwGeometry* g = model.opw()) {
+    opw_configuration(*g, q, abb, kuka);
+  } else {
+    generic_configuration(model, ws, q, abb, kuka);
+  }
+  return kuka;
 }
 
 double jacobian_min_singular_value(const RobotModel& model, Workspace& ws, const JointVector& q) {
@@ -314,52 +232,119 @@ double jacobian_min_singular_value(const RobotModel& model, Workspace& ws, const
 
 namespace {
 
-/// Every 2*pi turn of every branch that fits the joint limits, each checked by FK.
-std::vector<IkResult> solutions_of_branches(const RobotModel& model, Workspace& ws, const Pose& base_T_tcp,
-                                            const std::vector<Branch>& branches) {
-  std::vector<IkResult> out;
-  const JointVector& lo = model.lower_limits();
-  const JointVector& hi = model.upper_limits();
-  for (const Branch& b : branches) {
-    // Every 2*pi turn of every joint that fits its limits.
-    std::array<std::vector<double>, 6> options;
-    for (int i = 0; i < 6; ++i) {
-      for (int k = -2; k <= 2; ++k) {
-        const double v = b.q[static_cast<std::size_t>(i)] + 2.0 * kPi * k;
-        if (v >= lo[i] - 1e-9 && v <= hi[i] + 1e-9) {
-          options[static_cast<std::size_t>(i)].push_back(std::clamp(v, lo[i], hi[i]));
+/// The analytic branches of a target, with the message when there are none.
+bool branches_of(const RobotModel& model, const Pose& base_T_tcp, const IkRequest& request, OpwBranches& out,
+                 std::string& message) {
+  const OpwGeometry& g = *model.opw();
+  const double theta4 = g.theta(3, request.seed ? (*request.seed)[3] : 0.0);
+  // No early limit check: the caller tells "outside the joint limits" from "no such configuration".
+  opw_branches(g, g.opw_T_base * base_T_tcp * g.tcp_T_end, theta4, request.near_singular_threshold, nullptr, out);
+  if (!out.reachable) {
+    const Pose end = base_T_tcp * g.tcp_T_end;
+    const Vector3 wc = end.translation() - g.c4 * end.linear().col(2);
+    message = fmt::format("wrist centre ({:.4f}, {:.4f}, {:.4f}) m (base frame) is out of the arm's reach", wc.x(),
+                          wc.y(), wc.z());
+    return false;
+  }
+  return true;
+}
+
+/// The model's joint values of a branch with the turn of each joint chosen: among the turns inside
+/// the limits (and, when asked, in the wanted quadrant or of the wanted sign) the one nearest the
+/// seed (or zero). False when some joint has no such turn; `fits_limits` says whether the limits
+/// alone left a turn for every joint.
+bool choose_turns(const RobotModel& model, const OpwBranch& b, const IkRequest& request, bool apply_request,
+                  JointVector& q, bool& fits_limits) {
+  const OpwGeometry& g = *model.opw();
+  q.resize(6);
+  fits_limits = true;
+  bool ok = true;
+  for (int i = 0; i < 6; ++i) {
+    const double ref = request.seed ? (*request.seed)[i] : 0.0;
+    std::array<double, 8> turns{};
+    const int n = turns_within(g.joint(i, b.theta[static_cast<std::size_t>(i)]), ref, model.lower_limits()[i],
+                               model.upper_limits()[i], turns);
+    if (n == 0) {
+      fits_limits = false;
+      return false;
+    }
+    double best = HUGE_VAL;
+    bool found = false;
+    for (int k = 0; k < n; ++k) {
+      const double t = turns[static_cast<std::size_t>(k)];
+      // A joint within kBoundary of a quadrant boundary or of zero matches either side: a program
+      // taught at A4 = 0 may come back as -1e-16, which must not send the joint a turn away.
+      constexpr double kBoundary = 1e-6;
+      if (apply_request && request.configuration && request.match_quadrants && (i == 0 || i == 3 || i == 5)) {
+        const ArmConfiguration& want = *request.configuration;
+        const int wanted = i == 0 ? want.cf1 : i == 3 ? want.cf4 : want.cf6;
+        if (abb_quadrant(t - kBoundary) != wanted && abb_quadrant(t + kBoundary) != wanted) {
+          continue;
         }
       }
+      if (apply_request && request.kuka_configuration && std::abs(t) > kBoundary &&
+          ((request.kuka_configuration->turn >> i) & 1) != (t < 0.0)) {
+        continue;
+      }
+      if (std::abs(t - ref) < std::abs(best - ref)) {
+        best = t;
+        found = true;
+      }
     }
-    std::array<std::size_t, 6> idx{};
+    ok = ok && found;
+    q[i] = found ? best : turns[0];
+  }
+  return ok;
+}
+
+void fill_configuration(const RobotModel& model, IkResult& r) {
+  opw_configuration(*model.opw(), r.q, r.configuration, r.kuka);
+}
+
+}  // namespace
+
+std::vector<IkResult> all_ik_solutions(const RobotModel& model, Workspace& ws, const Pose& base_T_tcp,
+                                       const IkRequest& request) {
+  std::vector<IkResult> out;
+  OpwBranches branches;
+  std::string message;
+  if (!has_analytic_ik(model) || !branches_of(model, base_T_tcp, request, branches, message)) {
+    return out;
+  }
+  const OpwGeometry& g = *model.opw();
+  for (int k = 0; k < branches.count; ++k) {
+    const OpwBranch& b = branches.branch[static_cast<std::size_t>(k)];
+    std::array<std::array<double, 8>, 6> turns{};
+    std::array<int, 6> n{};
+    bool empty = false;
+    for (int i = 0; i < 6; ++i) {
+      n[static_cast<std::size_t>(i)] =
+          turns_within(g.joint(i, b.theta[static_cast<std::size_t>(i)]), 0.0, model.lower_limits()[i],
+                       model.upper_limits()[i], turns[static_cast<std::size_t>(i)]);
+      empty = empty || n[static_cast<std::size_t>(i)] == 0;
+    }
+    if (empty) {
+      continue;
+    }
+    std::array<int, 6> idx{};
     while (true) {
-      bool empty = false;
-      for (const auto& o : options) {
-        empty = empty || o.empty();
-      }
-      if (empty) {
-        break;
-      }
       IkResult r;
       r.q.resize(6);
       for (std::size_t i = 0; i < 6; ++i) {
-        r.q[static_cast<int>(i)] = options[i][idx[i]];
+        r.q[static_cast<int>(i)] = turns[i][static_cast<std::size_t>(idx[i])];
       }
       r.analytic = true;
       r.singularity = b.singularity;
       fill_errors(model, ws, base_T_tcp, r);
-      // FK is the judge: a branch that does not reproduce the target is dropped.
-      if (r.position_error_m < 1e-8 && r.orientation_error_rad < 1e-8) {
-        r.configuration = arm_configuration(model, ws, r.q);
-        r.status = b.singularity == Singularity::kNone ? IkStatus::kOk : IkStatus::kNearSingular;
-        if (b.singularity != Singularity::kNone) {
-          r.message = fmt::format("near a {} singularity", to_string(b.singularity));
-        }
-        out.push_back(r);
+      fill_configuration(model, r);
+      r.status = b.singularity == Singularity::kNone ? IkStatus::kOk : IkStatus::kNearSingular;
+      if (b.singularity != Singularity::kNone) {
+        r.message = fmt::format("near a {} singularity", to_string(b.singularity));
       }
+      out.push_back(r);
       std::size_t i = 0;
       for (; i < 6; ++i) {
-        if (++idx[i] < options[i].size()) {
+        if (++idx[i] < n[i]) {
           break;
         }
         idx[i] = 0;
@@ -370,20 +355,6 @@ std::vector<IkResult> solutions_of_branches(const RobotModel& model, Workspace& 
     }
   }
   return out;
-}
-
-}  // namespace
-
-std::vector<IkResult> all_ik_solutions(const RobotModel& model, Workspace& ws, const Pose& base_T_tcp,
-                                       const IkRequest& request) {
-  std::vector<Branch> branches;
-  std::string message;
-  const JointVector* seed = request.seed ? &*request.seed : nullptr;
-  if (!has_analytic_ik(model) ||
-      !analytic_branches(model, base_T_tcp, seed, request.near_singular_threshold, branches, message)) {
-    return {};
-  }
-  return solutions_of_branches(model, ws, base_T_tcp, branches);
 }
 
 IkResult inverse_kinematics(const RobotModel& model, Workspace& ws, const Pose& base_T_tcp, const IkRequest& request) {
@@ -402,45 +373,65 @@ IkResult inverse_kinematics(const RobotModel& model, Workspace& ws, const Pose& 
   if (!has_analytic_ik(model)) {
     return numerical_ik(model, ws, base_T_tcp, request);
   }
-  std::vector<Branch> branches;
-  std::string message;
-  const JointVector* seed = request.seed ? &*request.seed : nullptr;
-  if (!analytic_branches(model, base_T_tcp, seed, request.near_singular_threshold, branches, message)) {
+  OpwBranches branches;
+  if (!branches_of(model, base_T_tcp, request, branches, fail.message)) {
     fail.status = IkStatus::kUnreachable;
-    fail.message = message;
     return fail;
   }
-  const std::vector<IkResult> all = solutions_of_branches(model, ws, base_T_tcp, branches);
-  if (all.empty()) {
-    fail.status = IkStatus::kOutsideJointLimits;
-    fail.message = "the pose is reachable, but every solution violates a joint limit";
-    return fail;
-  }
-  const IkResult* best = nullptr;
+  IkResult best;
   double best_score = HUGE_VAL;
-  for (const IkResult& r : all) {
-    if (!matches(r.configuration, request)) {
+  bool any_fits = false;
+  std::string available;
+  for (int k = 0; k < branches.count; ++k) {
+    const OpwBranch& b = branches.branch[static_cast<std::size_t>(k)];
+    IkResult r;
+    bool fits = false;
+    if (choose_turns(model, b, request, false, r.q, fits)) {
+      fill_configuration(model, r);
+      available += ' ';
+      available += configuration_text(r.configuration, r.kuka);
+    }
+    any_fits = any_fits || fits;
+    if (!fits || !choose_turns(model, b, request, true, r.q, fits)) {
+      continue;
+    }
+    fill_configuration(model, r);
+    if ((request.configuration && r.configuration.cfx != request.configuration->cfx) ||
+        (request.kuka_configuration && r.kuka.status != request.kuka_configuration->status)) {
       continue;
     }
     const double score = request.seed ? max_abs_diff(r.q, *request.seed) : r.q.norm();
     if (score < best_score) {
       best_score = score;
-      best = &r;
+      best = r;
+      best.singularity = b.singularity;
     }
   }
-  if (best == nullptr) {
-    std::string have;
-    for (const IkResult& r : all) {
-      have += fmt::format(" [{},{},{},{}]", r.configuration.cf1, r.configuration.cf4, r.configuration.cf6,
-                          r.configuration.cfx);
-    }
-    fail.status = IkStatus::kConfigurationUnavailable;
-    const ArmConfiguration& w = *request.configuration;
-    fail.message = fmt::format("no solution with configuration [{},{},{},{}]; available [cf1,cf4,cf6,cfx]:{}", w.cf1,
-                               w.cf4, w.cf6, w.cfx, have);
+  if (!any_fits) {
+    fail.status = IkStatus::kOutsideJointLimits;
+    fail.message = "the pose is reachable, but every solution violates a joint limit";
     return fail;
   }
-  return *best;
+  if (!std::isfinite(best_score)) {
+    fail.status = IkStatus::kConfigurationUnavailable;
+    std::string wanted;
+    if (request.configuration) {
+      const ArmConfiguration& w = *request.configuration;
+      wanted += fmt::format(" configuration [{},{},{},{}]", w.cf1, w.cf4, w.cf6, w.cfx);
+    }
+    if (request.kuka_configuration) {
+      wanted += fmt::format(" Status {} Turn {}", request.kuka_configuration->status, request.kuka_configuration->turn);
+    }
+    fail.message = fmt::format("no solution with{}; available [cf1,cf4,cf6,cfx] (S T):{}", wanted, available);
+    return fail;
+  }
+  best.analytic = true;
+  fill_errors(model, ws, base_T_tcp, best);
+  best.status = best.singularity == Singularity::kNone ? IkStatus::kOk : IkStatus::kNearSingular;
+  if (best.singularity != Singularity::kNone) {
+    best.message = fmt::format("near a {} singularity", to_string(best.singularity));
+  }
+  return best;
 }
 
 }  // namespace deflex

@@ -1,30 +1,18 @@
-// Inverse kinematics of the TCP. Analytic for 6R arms in standard DH with joints 2 and 3 parallel
-// and a spherical wrist (the IRB6700 and most industrial arms): every solution, chosen by an
-// ABB-style configuration (confdata cf1, cf4, cf6, cfx). Damped least squares for other arms.
-// Singular poses are reported (status and kind), never divided through.
+// Inverse kinematics of the TCP. Analytic for every ortho-parallel 6R arm with a spherical wrist
+// (the OPW family: ABB, KUKA, FANUC, Staubli, Yaskawa industrial arms, from a DH table or a URDF;
+// opw_geometry.hpp): every solution, chosen by ABB's confdata or KUKA's Status/Turn and a seed.
+// Damped least squares for other arms. Singular poses are reported (status and kind), never
+// divided through. The allocation-free all-solutions call for hot paths is in opw_ik.hpp.
 #pragma once
 
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "deflex/model/arm_configuration.hpp"
 #include "deflex/model/kinematics.hpp"
 
 namespace deflex {
-
-/// ABB's confdata. cf1, cf4, cf6: quadrant of joints 1, 4, 6 (floor(q / 90 deg): 0 for [0, 90),
-/// -1 for [-90, 0), ...). cfx (0..7) = 4*b1 + 2*b2 + b3 with
-///   b1: wrist centre behind axis 1 (along the x axis of joint 1's moving frame),
-///   b2: wrist centre behind the lower arm (reached from the axis-2-to-axis-3 direction by a
-///       negative rotation about joint 2's axis),
-///   b3: joint 5 negative.
-struct ArmConfiguration {
-  int cf1 = 0;
-  int cf4 = 0;
-  int cf6 = 0;
-  int cfx = 0;
-  bool operator==(const ArmConfiguration&) const = default;
-};
 
 /// KDL's sign convention: positive is usable but degraded, negative is failure.
 enum class IkStatus : int {
@@ -46,6 +34,9 @@ struct IkRequest {
   /// Wanted configuration. cfx always has to match; cf1/cf4/cf6 too when match_quadrants.
   std::optional<ArmConfiguration> configuration;
   bool match_quadrants = true;
+  /// Wanted KUKA Status and Turn (analytic solver only): the status has to match, and each joint
+  /// takes the turn whose sign the Turn bit gives.
+  std::optional<KukaConfiguration> kuka_configuration;
   /// Preferred solution: among those allowed, the closest to the seed (max joint difference).
   /// Also the start of the numerical solver. Typical use: the previous point of a path.
   std::optional<JointVector> seed;
@@ -59,6 +50,7 @@ struct IkResult {
   IkStatus status = IkStatus::kInvalidInput;
   JointVector q;  ///< rad; valid when status >= 0
   ArmConfiguration configuration;
+  KukaConfiguration kuka;  ///< Status and Turn of q
   Singularity singularity = Singularity::kNone;
   double position_error_m = 0.0;
   double orientation_error_rad = 0.0;
@@ -67,18 +59,23 @@ struct IkResult {
   [[nodiscard]] bool ok() const { return static_cast<int>(status) >= 0; }
 };
 
-/// True when the analytic solver applies to this model (see the file comment).
+/// True when the analytic solver applies to this model (model.opw() is set; see the file comment).
 [[nodiscard]] bool has_analytic_ik(const RobotModel& model);
 
 /// The configuration (confdata) of a joint vector.
 [[nodiscard]] ArmConfiguration arm_configuration(const RobotModel& model, Workspace& ws, const JointVector& q);
+
+/// KUKA Status and Turn of a joint vector (the model's joint values taken as A1..A6). For arms
+/// outside the OPW family, status bit 1 is the geometric equivalent: the wrist centre is not behind
+/// the lower arm.
+[[nodiscard]] KukaConfiguration kuka_configuration(const RobotModel& model, Workspace& ws, const JointVector& q);
 
 /// TCP pose (base frame) to joints.
 [[nodiscard]] IkResult inverse_kinematics(const RobotModel& model, Workspace& ws, const Pose& base_T_tcp,
                                           const IkRequest& request = {});
 
 /// Every analytic solution inside the joint limits (all 2*pi turns of each joint), checked by FK.
-/// Empty for arms without an analytic solver.
+/// Empty for arms without an analytic solver. (Allocates; opw_solutions() is the hot-path form.)
 [[nodiscard]] std::vector<IkResult> all_ik_solutions(const RobotModel& model, Workspace& ws, const Pose& base_T_tcp,
                                                      const IkRequest& request = {});
 

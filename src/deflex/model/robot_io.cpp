@@ -10,6 +10,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/model/urdf_tree.hpp"
 #include "deflex/model/yaml_fields.hpp"
 
 namespace deflex {
@@ -68,79 +69,54 @@ RobotDescription load_urdf_chain(const std::string& path, const std::string& bas
   }
   std::stringstream ss;
   ss << in.rdbuf();
-  const urdf::ModelInterfaceSharedPtr urdf_model = urdf::parseURDF(ss.str());
+  const std::string text = ss.str();
+  // The structure first, with line numbers; urdfdom then gives the numbers of a tree known to be valid.
+  const UrdfTree tree = read_urdf_tree(path, text);
+  const UrdfChain chain = choose_urdf_chain(tree, base_link, tip_link);
+  const urdf::ModelInterfaceSharedPtr urdf_model = urdf::parseURDF(text);
   if (!urdf_model) {
     throw ModelError(fmt::format("{}: not a valid URDF document (urdfdom could not parse it)", path));
-  }
-  urdf::LinkConstSharedPtr root = base_link.empty() ? urdf_model->getRoot() : urdf_model->getLink(base_link);
-  if (!root) {
-    throw ModelError(fmt::format("{}: base link '{}' not found", path, base_link));
-  }
-  urdf::LinkConstSharedPtr tip;
-  if (tip_link.empty()) {
-    // Follow the only child down to the only leaf; a branch needs an explicit tip.
-    tip = root;
-    while (!tip->child_links.empty()) {
-      if (tip->child_links.size() > 1) {
-        throw ModelError(fmt::format("{}: link '{}' branches; name the chain's end with tip_link", path, tip->name));
-      }
-      tip = tip->child_links.front();
-    }
-  } else {
-    tip = urdf_model->getLink(tip_link);
-    if (!tip) {
-      throw ModelError(fmt::format("{}: tip link '{}' not found", path, tip_link));
-    }
-  }
-  std::vector<urdf::JointConstSharedPtr> chain;
-  for (urdf::LinkConstSharedPtr l = tip; l != root; l = l->getParent()) {
-    if (!l->parent_joint) {
-      throw ModelError(fmt::format("{}: tip link '{}' is not below base link '{}'", path, tip->name, root->name));
-    }
-    chain.insert(chain.begin(), l->parent_joint);
   }
   RobotDescription d;
   d.name = urdf_model->getName();
   d.source = path;
   d.urdf_file = fs::absolute(path).string();
-  d.urdf_base_link = root->name;
-  d.urdf_tip_link = tip->name;
+  d.urdf_base_link = chain.base_link;
+  d.urdf_tip_link = chain.tip_link;
+  d.notes = chain.notes;
   Pose pending = Pose::Identity();
-  for (const auto& j : chain) {
-    const Pose origin = urdf_pose(j->parent_to_joint_origin_transform);
-    switch (j->type) {
-      case urdf::Joint::FIXED:
-        pending = pending * origin;
-        break;
-      case urdf::Joint::REVOLUTE:
-      case urdf::Joint::CONTINUOUS: {
-        JointSpec s;
-        s.name = j->name;
-        s.parent_T_joint = pending * origin;
-        s.axis = Vector3(j->axis.x, j->axis.y, j->axis.z);
-        if (s.axis.norm() < 1e-9) {
-          throw ModelError(fmt::format("{}: joint '{}': axis has zero length", path, j->name));
-        }
-        s.axis.normalize();
-        // URDF gives the speed limit in rad/s; 0 (or none) means the file does not say.
-        if (j->limits && j->limits->velocity > 0.0) {
-          s.max_speed_rad_s = j->limits->velocity;
-        }
-        if (j->type == urdf::Joint::REVOLUTE && j->limits) {
-          s.lower_rad = j->limits->lower;
-          s.upper_rad = j->limits->upper;
-        } else {
-          s.lower_rad = -HUGE_VAL;
-          s.upper_rad = HUGE_VAL;
-        }
-        d.joints.push_back(s);
-        pending = Pose::Identity();
-        break;
-      }
-      default:
-        throw ModelError(fmt::format("{}: joint '{}': only revolute, continuous and fixed joints are supported",
-                                     path, j->name));
+  for (const std::string& name : chain.joints) {
+    const urdf::JointConstSharedPtr j = urdf_model->getJoint(name);
+    if (!j) {
+      throw ModelError(fmt::format("{}: joint '{}' not found by urdfdom", path, name));
     }
+    const Pose origin = urdf_pose(j->parent_to_joint_origin_transform);
+    if (j->type == urdf::Joint::FIXED) {
+      pending = pending * origin;
+      continue;
+    }
+    // choose_urdf_chain() let only revolute and continuous joints through.
+    JointSpec s;
+    s.name = j->name;
+    s.parent_T_joint = pending * origin;
+    s.axis = Vector3(j->axis.x, j->axis.y, j->axis.z);
+    if (s.axis.norm() < 1e-9) {
+      throw ModelError(fmt::format("{}: joint '{}': axis has zero length", path, j->name));
+    }
+    s.axis.normalize();
+    // URDF gives the speed limit in rad/s; 0 (or none) means the file does not say.
+    if (j->limits && j->limits->velocity > 0.0) {
+      s.max_speed_rad_s = j->limits->velocity;
+    }
+    if (j->type == urdf::Joint::REVOLUTE && j->limits) {
+      s.lower_rad = j->limits->lower;
+      s.upper_rad = j->limits->upper;
+    } else {
+      s.lower_rad = -HUGE_VAL;
+      s.upper_rad = HUGE_VAL;
+    }
+    d.joints.push_back(s);
+    pending = Pose::Identity();
   }
   d.last_T_flange = pending;
   return d;

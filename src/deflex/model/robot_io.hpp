@@ -24,8 +24,12 @@ const std::string& builtin_irb6700_yaml();
 /// `path` if non-empty (load_robot), else the built-in IRB6700.
 RobotModel load_robot_or_builtin(const std::string& path);
 
-/// Serial chain of a URDF from `base_link` to `tip_link` (empty: the root, and the only leaf).
-/// Fixed joints fold into the transforms; revolute and continuous joints become JointSpecs.
+/// Serial chain of a URDF from `base_link` to `tip_link`. Empty names choose it as
+/// choose_urdf_chain() does: base_link -> tool0 when both exist (ROS-Industrial), else the root and
+/// the one leaf ending the longest chain of movable joints; joints off the chain are listed in
+/// RobotDescription::notes. Fixed joints fold into the transforms; revolute and continuous joints
+/// become JointSpecs. Throws ModelError naming the file, line and joint (loops, two parents, a mimic
+/// or prismatic joint on the chain, ...).
 RobotDescription load_urdf_chain(const std::string& path, const std::string& base_link = "",
                                  const std::string& tip_link = "");
 

@@ -128,6 +128,8 @@ RobotModel::RobotModel(RobotDescription desc) : desc_(std::move(desc)) {
       compliance_[static_cast<int>(i)] = 1.0 / k;
     }
   }
+  // Last: the derivation runs FK on this (otherwise complete) model to check itself.
+  opw_ = derive_opw_geometry(*this, opw_note_);
 }
 
 const JointVector& RobotModel::stiffness() const {

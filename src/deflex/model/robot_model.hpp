@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "deflex/model/opw_geometry.hpp"
 #include "deflex/model/types.hpp"
 
 namespace deflex {
@@ -53,6 +54,9 @@ struct RobotDescription {
   std::vector<DhRow> dh;
   /// Kept when the chain came from a URDF: the file (absolute) and the chain's end links.
   std::string urdf_file, urdf_base_link, urdf_tip_link;
+  /// How the file was read when that is worth telling the user (which URDF chain was chosen and
+  /// which joints were left out); the command-line program prints them as notes.
+  std::vector<std::string> notes;
 
   /// Diagonal joint stiffness K, Nm/rad, one value a joint. Empty when the file gives none.
   std::vector<double> stiffness_nm_per_rad;
@@ -102,6 +106,12 @@ class RobotModel {
   /// True when every joint axis is its frame's z axis (DH chains), which FK exploits.
   [[nodiscard]] bool z_axes_only() const { return z_axes_only_; }
 
+  /// The ortho-parallel (OPW) geometry the analytic inverse kinematics uses, derived once from the
+  /// chain (DH or URDF) and checked against its FK; null for arms outside that family.
+  [[nodiscard]] const OpwGeometry* opw() const { return opw_ ? &*opw_ : nullptr; }
+  /// Why the chain has no OPW geometry (empty when it has one).
+  [[nodiscard]] const std::string& opw_note() const { return opw_note_; }
+
   /// Returns a copy with a different stiffness (e.g. after identification). Validated again.
   [[nodiscard]] RobotModel with_stiffness(const std::vector<double>& stiffness_nm_per_rad,
                                           const std::string& note) const;
@@ -118,6 +128,8 @@ class RobotModel {
   JointVector max_speed_;
   Pose flange_T_wap_ = Pose::Identity();
   bool z_axes_only_ = true;
+  std::optional<OpwGeometry> opw_;
+  std::string opw_note_;
 };
 
 using RobotModelPtr = std::shared_ptr<const RobotModel>;

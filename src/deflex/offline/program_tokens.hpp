@@ -1,0 +1,35 @@
+// Tokens of ABB RAPID and KUKA KRL source text, with their byte ranges and lines, so a reader can
+// find numbers and names and the writer can replace exactly those bytes. Comments and blanks are
+// skipped (they are never touched).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace deflex {
+
+enum class TokenKind {
+  kIdentifier,  ///< RAPID: letter [letters digits _]; KRL: also $ and _ anywhere
+  kNumber,      ///< unsigned: 12, 1.5, 9E+09 (a sign is a separate kPunct)
+  kString,      ///< "..." with the quotes
+  kBitLiteral,  ///< KRL 'B0110' or 'H1F' with the quotes
+  kEnum,        ///< KRL #NAME
+  kPunct,       ///< one character, or := == <> <= >=
+};
+
+struct Token {
+  TokenKind kind = TokenKind::kPunct;
+  std::size_t begin = 0;
+  std::size_t end = 0;
+  int line = 0;
+};
+
+/// The tokens of a RAPID module. '!' starts a comment to the end of the line. Throws DataError
+/// "FILE:LINE: ..." for an unterminated string or a character RAPID does not know.
+[[nodiscard]] std::vector<Token> lex_rapid(const std::string& text, const std::string& file);
+
+/// The tokens of a KRL .src or .dat file. ';' starts a comment to the end of the line (fold
+/// markers included). Throws DataError "FILE:LINE: ..." for an unterminated string or literal.
+[[nodiscard]] std::vector<Token> lex_krl(const std::string& text, const std::string& file);
+
+}  // namespace deflex
