@@ -2,6 +2,7 @@
 // guidance or path correction; runs until the session ends, SIGINT or SIGTERM) and `identify-payload`
 // (end-effector mass, centre of gravity and sensor bias from static poses).
 #include <atomic>
+#include <cinttypes>
 #include <cmath>
 #include <chrono>
 #include <csignal>
@@ -94,7 +95,7 @@ class CycleLog {
   CycleLog& operator=(const CycleLog&) = delete;
   void write(const LinkCycleRecord& r) {
     if (file_ == nullptr) return;
-    std::fprintf(file_, "%.6f,%.9f,%u,%d", r.t_s, r.program_time_s, r.sequence, static_cast<int>(r.status));
+    std::fprintf(file_, "%.6f,%.9f,%" PRIu64 ",%d", r.t_s, r.program_time_s, r.sequence, static_cast<int>(r.status));
     for (const JointVector* q : {&r.q_nominal, &r.q_feedback, &r.q_command, &r.dtheta}) {
       for (int j = 0; j < joints_ && j < q->size(); ++j) std::fprintf(file_, ",%.10g", rad_to_deg((*q)[j]));
     }

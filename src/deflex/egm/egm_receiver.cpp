@@ -16,11 +16,34 @@ void EgmReceiverConfig::validate() const {
   if (!std::isfinite(restart_silence_s) || !(restart_silence_s > 0.0)) {
     throw InputError("EGM link: restart silence must be > 0 s");
   }
+  if (max_seqno_ahead < 1 || confirm_jump < 1 || confirm_jump > 1000) {
+    throw InputError("EGM link: max_seqno_ahead must be >= 1 and confirm_jump 1..1000");
+  }
+  if (!std::isfinite(period_s) || !(period_s > 0.0)) {
+    throw InputError("EGM link: the controller's period must be > 0 s");
+  }
 }
+
+namespace {
+SequenceRules egm_sequence_rules(const EgmReceiverConfig& c) {
+  SequenceRules r;
+  r.bits = 32;
+  r.max_ahead = c.max_seqno_ahead;
+  r.restart_max = c.restart_seqno_max;
+  r.confirm = c.confirm_jump;
+  return r;
+}
+}  // namespace
 
 EgmReceiver::EgmReceiver(DatagramTransport& transport, const Clock& clock, const RobotModel& model,
                          const EgmReceiverConfig& config, LinkCounters& counters)
-    : transport_(transport), clock_(clock), config_(config), counters_(counters), codec_(model.dof()) {
+    : transport_(transport),
+      clock_(clock),
+      config_(config),
+      counters_(counters),
+      codec_(model.dof()),
+      seq_(egm_sequence_rules(config)),
+      timing_(config.period_s) {
   config_.validate();
   // The tolerance allows for the controller's own rounding beyond its soft limits.
   lower_ = model.lower_limits().array() - kPi / 180.0;
@@ -59,6 +82,10 @@ EgmReceiver::Result EgmReceiver::drain(double timeout_s, bool& restarted) noexce
       break;
     }
     ++counters_.datagrams;
+    // The silence that ends a session is measured from the controller's last datagram of any kind:
+    // while it keeps sending, even packets the link refuses, it has not gone away.
+    if (have_sender_ && now - last_heard_s_ > config_.restart_silence_s) resync_ = true;
+    if (have_sender_ && from == sender_) last_heard_s_ = now;
     if (static_cast<std::size_t>(n) > config_.max_packet_bytes) {
       ++counters_.oversized;
       continue;
@@ -71,6 +98,8 @@ EgmReceiver::Result EgmReceiver::drain(double timeout_s, bool& restarted) noexce
       case EgmDecodeStatus::kMissingJoints: ++counters_.missing_joints; continue;
       case EgmDecodeStatus::kNonFinite: ++counters_.non_finite; continue;
       case EgmDecodeStatus::kEmpty: ++counters_.empty; continue;
+      case EgmDecodeStatus::kSequenceOutOfRange: ++counters_.sequence_out_of_range; continue;
+      case EgmDecodeStatus::kMissingRequired: ++counters_.missing_required; continue;
     }
     // A packet whose joints no robot of this model can have (a corrupted or foreign sender) must not
     // be answered: its correction would be computed at a configuration that is not the arm's.
@@ -78,40 +107,44 @@ EgmReceiver::Result EgmReceiver::drain(double timeout_s, bool& restarted) noexce
       ++counters_.out_of_limits;
       continue;
     }
-    const bool silent = have_seq_ && now - last_accept_s_ > config_.restart_silence_s;
     // One controller owns the link; another sender may take over only after the controller fell silent.
-    if (have_sender_ && !(from == sender_) && !silent) {
+    if (have_sender_ && !(from == sender_) && !resync_) {
       ++counters_.foreign_sender;
       continue;
     }
-    bool session_start = !have_seq_ || silent || !(from == sender_);
-    if (have_seq_ && !session_start) {
-      const auto diff = static_cast<std::int32_t>(msg_.seqno - last_seq_);
-      const bool restart_jump =
-          diff < 0 && msg_.seqno <= config_.restart_seqno_max && last_seq_ > msg_.seqno + config_.restart_seqno_max;
-      if (restart_jump) {
-        session_start = true;
-      } else if (diff == 0) {
-        ++counters_.duplicate;
-        continue;
-      } else if (diff < 0) {
-        ++counters_.out_of_order;
-        continue;
+    bool session_start = !seq_.started() || resync_ || !(from == sender_);
+    const std::int64_t step = seq_.started() ? seq_.distance(msg_.seqno) : 0;
+    if (session_start) {
+      seq_.reset();
+      (void)seq_.observe(msg_.seqno);
+    } else {
+      switch (seq_.observe(msg_.seqno)) {
+        case SequenceVerdict::kDuplicate: ++counters_.duplicate; continue;
+        case SequenceVerdict::kOutOfOrder: ++counters_.out_of_order; continue;
+        case SequenceVerdict::kFarAhead: ++counters_.far_ahead; continue;
+        case SequenceVerdict::kRestart: session_start = true; break;
+        case SequenceVerdict::kFirst:
+        case SequenceVerdict::kNext: break;
       }
     }
-    if (session_start && have_seq_) {
+    if (session_start && have_sender_) {
       ++counters_.restarts;
     }
     restarted = restarted || session_start;
     if (have) {
       ++counters_.superseded;
     }
-    have_seq_ = true;
-    last_seq_ = msg_.seqno;
+    const std::uint32_t stamp_step_ms = msg_.tm_ms - last_tm_ms_;  // wraps with the field
+    timing_.on_message(stamp_step_ms * 1e-3, now, session_start ? 1 : static_cast<std::uint64_t>(step), session_start,
+                       counters_, msg_arrival_);
+    last_tm_ms_ = msg_.tm_ms;
+    resync_ = false;
     last_accept_s_ = now;
+    last_heard_s_ = now;
     have_sender_ = true;
     sender_ = from;
     newest_ = msg_;
+    arrival_ = msg_arrival_;
     have = true;
   }
   return have ? Result::kMessage : Result::kNoneUsable;
