@@ -4,7 +4,6 @@
 // EGMRunJoint's \CondTime, \RampInTime, \PosCorrGain, EGMActMove's sensor frame and \SampleRate).
 #include "deflex/egm/egm_controller_setup.hpp"
 
-#include <cctype>
 #include <cmath>
 #include <utility>
 
@@ -16,23 +15,6 @@
 namespace deflex {
 
 namespace {
-
-// A RAPID identifier: a letter, then letters, digits or '_', at most 32 characters.
-bool rapid_name(const std::string& s) {
-  if (s.empty() || s.size() > 32 || !std::isalpha(static_cast<unsigned char>(s[0]))) return false;
-  for (const char c : s) {
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') return false;
-  }
-  return true;
-}
-
-// A RAPID num literal in fixed notation, without trailing zeros ("0.1", "20", "1000").
-std::string num(double v) {
-  std::string s = fmt::format("{:.6f}", v);
-  s.erase(s.find_last_not_of('0') + 1);
-  if (s.back() == '.') s.pop_back();
-  return s == "-0" ? "0" : s;
-}
 
 void positive(double v, double at_most, const char* option) {
   if (!std::isfinite(v) || !(v > 0.0) || v > at_most) {
@@ -50,7 +32,7 @@ void EgmSetupOptions::validate() const {
   if (port == 0) throw InputError("option --egm-port: the controller needs deflex's port (1..65535)");
   for (const auto& [value, option] : {std::pair{&device, "--egm-device"}, std::pair{&egm_config, "--egm-config"},
                                       std::pair{&module, "--module"}, std::pair{&tool, "--tool"}}) {
-    if (!rapid_name(*value)) {
+    if (!plain_identifier(*value, 32)) {
       throw InputError(fmt::format("option {}: '{}' is not a RAPID name (a letter, then letters, digits or '_', at "
                                    "most 32)",
                                    option, *value));
@@ -96,10 +78,11 @@ std::vector<ControllerFile> egm_controller_setup(const EgmSetupOptions& o) {
       "--max-tcp-correction-mm {tcp}{more}\n"
       "  LOCAL VAR egmident deflex_egm_id;\n",
       fmt::arg("module", o.module), fmt::arg("link", link), fmt::arg("ip", o.sensor_ip), fmt::arg("port", o.port),
-      fmt::arg("device", o.device), fmt::arg("joint", num(o.max_joint_correction_deg)),
-      fmt::arg("tcp", num(o.max_tcp_correction_mm)), fmt::arg("period", num(o.period_ms)),
+      fmt::arg("device", o.device), fmt::arg("joint", plain_number(o.max_joint_correction_deg)),
+      fmt::arg("tcp", plain_number(o.max_tcp_correction_mm)), fmt::arg("period", plain_number(o.period_ms)),
       fmt::arg("more", o.path_correction ? fmt::format(" --path-corr-frame {}", o.path_frame)
-                                         : fmt::format(" --ramp-in-s {} --program P.csv", num(o.ramp_in_s))));
+                                         : fmt::format(" --ramp-in-s {} --program P.csv",
+                                                       plain_number(o.ramp_in_s))));
   if (!o.path_correction) {
     std::string conditions, joints;
     for (int j = 1; j <= 6; ++j) {
@@ -121,12 +104,13 @@ std::vector<ControllerFile> egm_controller_setup(const EgmSetupOptions& o) {
         "    EGMRunJoint deflex_egm_id,EGM_STOP_HOLD{joints}\\CondTime:={cond}\\RampInTime:={ramp}\\PosCorrGain:=1;\n"
         "    EGMReset deflex_egm_id;\n"
         "  ENDPROC\n",
-        fmt::arg("neg", num(-o.convergence_deg)), fmt::arg("pos", num(o.convergence_deg)),
-        fmt::arg("config", o.egm_config), fmt::arg("device", o.device), fmt::arg("timeout", num(o.comm_timeout_s)),
-        fmt::arg("tool", o.tool), fmt::arg("conditions", conditions), fmt::arg("lp", num(o.lowpass_hz)),
-        fmt::arg("period", num(o.period_ms)), fmt::arg("maxpos", num(o.max_pos_deviation_deg)),
-        fmt::arg("maxspeed", num(o.max_speed_deviation_deg_s)), fmt::arg("joints", joints),
-        fmt::arg("cond", num(o.cond_time_s)), fmt::arg("ramp", num(o.ramp_in_s)));
+        fmt::arg("neg", plain_number(-o.convergence_deg)), fmt::arg("pos", plain_number(o.convergence_deg)),
+        fmt::arg("config", o.egm_config), fmt::arg("device", o.device),
+        fmt::arg("timeout", plain_number(o.comm_timeout_s)),
+        fmt::arg("tool", o.tool), fmt::arg("conditions", conditions), fmt::arg("lp", plain_number(o.lowpass_hz)),
+        fmt::arg("period", plain_number(o.period_ms)), fmt::arg("maxpos", plain_number(o.max_pos_deviation_deg)),
+        fmt::arg("maxspeed", plain_number(o.max_speed_deviation_deg_s)), fmt::arg("joints", joints),
+        fmt::arg("cond", plain_number(o.cond_time_s)), fmt::arg("ramp", plain_number(o.ramp_in_s)));
   } else {
     // The frame EGMActMove is given is the frame deflex expresses its offsets in.
     std::string frame = o.tool + ".tframe";
@@ -160,8 +144,9 @@ std::vector<ControllerFile> egm_controller_setup(const EgmSetupOptions& o) {
         "  !   EGMMoveL deflex_egm_id,p10,v50,z1,{tool}\\WObj:=wobj0;\n"
         "  !   EGMMoveC deflex_egm_id,p20,p30,v50,fine,{tool}\\WObj:=wobj0;\n"
         "  !   deflex_egm_path_end;\n",
-        fmt::arg("period", num(o.period_ms)), fmt::arg("frame_note", frame_note), fmt::arg("config", o.egm_config),
-        fmt::arg("device", o.device), fmt::arg("timeout", num(o.comm_timeout_s)), fmt::arg("frame", frame),
+        fmt::arg("period", plain_number(o.period_ms)), fmt::arg("frame_note", frame_note),
+        fmt::arg("config", o.egm_config),
+        fmt::arg("device", o.device), fmt::arg("timeout", plain_number(o.comm_timeout_s)), fmt::arg("frame", frame),
         fmt::arg("tool", o.tool));
   }
   mod += "ENDMODULE\n";

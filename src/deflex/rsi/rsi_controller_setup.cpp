@@ -4,7 +4,6 @@
 // (AXISCORR type 33, ETHERNET type 64, AXISCORRMON type 82) with their parameter names and IDs.
 #include "deflex/rsi/rsi_controller_setup.hpp"
 
-#include <cctype>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -14,26 +13,6 @@
 #include "deflex/wire/rsi_xml.hpp"
 
 namespace deflex {
-
-namespace {
-
-std::string num(double v) {
-  std::string s = fmt::format("{:.6f}", v);
-  s.erase(s.find_last_not_of('0') + 1);
-  if (s.back() == '.') s.pop_back();
-  return s == "-0" ? "0" : s;
-}
-
-// A KRL name and file base name: a letter, then letters, digits or '_', at most 24 characters.
-bool krl_name(const std::string& s) {
-  if (s.empty() || s.size() > 24 || !std::isalpha(static_cast<unsigned char>(s[0]))) return false;
-  for (const char c : s) {
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') return false;
-  }
-  return true;
-}
-
-}  // namespace
 
 void RsiSetupOptions::validate() const {
   (void)make_datagram_address(sensor_ip, port);  // InputError naming the text when it is not IPv4
@@ -45,7 +24,7 @@ void RsiSetupOptions::validate() const {
     throw InputError(fmt::format(
         "option --rsi-sentype: '{}' must be 1..32 letters, digits, '_' or '-', starting with a letter", sentype));
   }
-  if (!krl_name(context)) {
+  if (!plain_identifier(context, 24)) {
     throw InputError(fmt::format(
         "option --context: '{}' must be a KRL name (a letter, then letters, digits or '_', at most 24)", context));
   }
@@ -65,7 +44,7 @@ void RsiSetupOptions::validate() const {
   if (timeout * period_ms * 1e-3 >= restart_silence_s) {
     throw InputError(fmt::format("option --rsi-timeout: {} late answers of {} ms outlast deflex's {} s restart "
                                  "silence; at most {}",
-                                 timeout, num(period_ms), num(restart_silence_s),
+                                 timeout, plain_number(period_ms), plain_number(restart_silence_s),
                                  static_cast<int>(std::ceil(restart_silence_s / (period_ms * 1e-3))) - 1));
   }
   if (precision < 1 || precision > 12) throw InputError("option --rsi-precision: 1..12 decimals");
@@ -78,7 +57,7 @@ std::vector<ControllerFile> rsi_controller_setup(const RsiSetupOptions& o) {
   const std::string context_file = o.context + ".rsi.xml";
   const std::string command = fmt::format(
       "deflex online --link rsi --rsi-port {} --rsi-sentype {} --period-ms {} --max-joint-correction-deg {}", o.port,
-      o.sentype, num(o.period_ms), num(o.max_joint_correction_deg));
+      o.sentype, plain_number(o.period_ms), plain_number(o.max_joint_correction_deg));
 
   std::string receive;
   for (int a = 1; a <= o.axes; ++a) {
@@ -118,11 +97,11 @@ std::vector<ControllerFile> rsi_controller_setup(const RsiSetupOptions& o) {
   std::string inputs, lower, upper, monitor;
   for (int a = 1; a <= o.axes; ++a) {
     inputs += fmt::format("      <Input InIdx=\"{0}\" OutObjID=\"ETHERNET1\" OutIdx=\"{0}\" />\n", a);
-    lower += fmt::format("      <Parameter Name=\"LowerLimA{}\" ParamID=\"{}\" ParamValue=\"{}\" />\n", a, a, num(-bound));
+    lower += fmt::format("      <Parameter Name=\"LowerLimA{}\" ParamID=\"{}\" ParamValue=\"{}\" />\n", a, a, plain_number(-bound));
     upper += fmt::format("      <Parameter Name=\"UpperLimA{}\" ParamID=\"{}\" ParamValue=\"{}\" />\n", a, 12 + a,
-                         num(bound));
+                         plain_number(bound));
     monitor += fmt::format("      <Parameter Name=\"MaxA{}\" ParamID=\"{}\" ParamValue=\"{}\" />\n", a, a,
-                           num(bound * o.monitor_factor));
+                           plain_number(bound * o.monitor_factor));
   }
   const std::string context = fmt::format(
       "<?xml version=\"1.0\" encoding=\"UTF-8\" standalone=\"yes\"?>\n"
@@ -153,7 +132,7 @@ std::vector<ControllerFile> rsi_controller_setup(const RsiSetupOptions& o) {
       "    </Parameters>\n"
       "  </RSIObject>\n"
       "</RSIObjects>\n",
-      fmt::arg("bound", num(bound)), fmt::arg("max", num(bound * o.monitor_factor)), fmt::arg("timeout", o.timeout),
+      fmt::arg("bound", plain_number(bound)), fmt::arg("max", plain_number(bound * o.monitor_factor)), fmt::arg("timeout", o.timeout),
       fmt::arg("ethernet", ethernet_file), fmt::arg("precision", o.precision), fmt::arg("inputs", inputs),
       fmt::arg("lower", lower), fmt::arg("upper", upper), fmt::arg("monitor", monitor));
 
@@ -182,7 +161,7 @@ std::vector<ControllerFile> rsi_controller_setup(const RsiSetupOptions& o) {
       "  HALT\n"
       "ENDIF\n"
       "END\n",
-      fmt::arg("name", o.context), fmt::arg("bound", num(bound)), fmt::arg("period", num(o.period_ms)),
+      fmt::arg("name", o.context), fmt::arg("bound", plain_number(bound)), fmt::arg("period", plain_number(o.period_ms)),
       fmt::arg("command", command), fmt::arg("mode", std::abs(o.period_ms - 4.0) < 1e-9 ? "#IPO_FAST" : "#IPO"));
 
   return {
