@@ -23,6 +23,7 @@
 #include "deflex/model/csv_table.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/transport/udp_transport.hpp"
+#include "wire/protobuf_bytes.hpp"
 
 namespace deflex {
 namespace {
@@ -165,40 +166,17 @@ TEST(CliRsi, AForceSpikeIsOneFaultEpisodeWithOneDump) {
 
 // EgmRobot with a required field missing inside a sub-message: feedBack { joints {6 doubles},
 // cartesian { pos { x } } } (EgmCartesian's y and z are required), by hand from the field numbers.
-std::vector<unsigned char> egm_missing_required(std::uint32_t seqno) {
-  std::vector<unsigned char> b;
-  const auto varint = [](std::vector<unsigned char>& o, std::uint64_t v) {
-    while (v >= 0x80) {
-      o.push_back(static_cast<unsigned char>(v | 0x80));
-      v >>= 7;
-    }
-    o.push_back(static_cast<unsigned char>(v));
-  };
-  const auto field = [&](std::vector<unsigned char>& o, int number, const std::vector<unsigned char>& body) {
-    varint(o, static_cast<std::uint64_t>(number << 3 | 2));
-    varint(o, body.size());
-    o.insert(o.end(), body.begin(), body.end());
-  };
-  const auto fixed = [](std::vector<unsigned char>& o, double v) {
-    unsigned char raw[8];
-    std::memcpy(raw, &v, 8);
-    o.insert(o.end(), raw, raw + 8);
-  };
-  std::vector<unsigned char> header, joints, pos, cartesian, feedback;
-  varint(header, 1 << 3);
-  varint(header, seqno);
-  for (double q : {0.0, 20.0, 10.0, 0.0, 60.0, 0.0}) {
-    varint(joints, 1 << 3 | 1);
-    fixed(joints, q);
-  }
-  varint(pos, 1 << 3 | 1);
-  fixed(pos, 1500.0);
-  field(cartesian, 1, pos);
-  field(feedback, 1, joints);
-  field(feedback, 2, cartesian);
-  field(b, 1, header);
-  field(b, 2, feedback);
-  return b;
+test::Bytes egm_missing_required(std::uint32_t seqno) {
+  test::Bytes header, joints, pos, cartesian, feedback, out;
+  test::varint_field(header, 1, seqno);
+  for (double q : {0.0, 20.0, 10.0, 0.0, 60.0, 0.0}) test::double_field(joints, 1, q);
+  test::double_field(pos, 1, 1500.0);
+  test::len_field(cartesian, 1, pos);
+  test::len_field(feedback, 1, joints);
+  test::len_field(feedback, 2, cartesian);
+  test::len_field(out, 1, header);
+  test::len_field(out, 2, feedback);
+  return out;
 }
 
 TEST(CliRsi, HundredThousandEgmPacketsMissingARequiredFieldGiveCountersNotLines) {

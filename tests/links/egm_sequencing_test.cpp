@@ -5,45 +5,25 @@
 // from the last one the link took), and a stray from another sender while the controller talks.
 // The packets are written by hand from the field numbers, not by deflex's codec.
 #include <cmath>
-#include <cstring>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "links/link_harness.hpp"
+#include "wire/protobuf_bytes.hpp"
 
 namespace deflex {
 namespace {
 
-using Bytes = std::vector<unsigned char>;
-
-void varint(Bytes& b, std::uint64_t v) {
-  while (v >= 0x80) {
-    b.push_back(static_cast<unsigned char>(v | 0x80));
-    v >>= 7;
-  }
-  b.push_back(static_cast<unsigned char>(v));
-}
-void len_field(Bytes& b, int field, const Bytes& body) {
-  varint(b, static_cast<std::uint64_t>(field << 3 | 2));
-  varint(b, body.size());
-  b.insert(b.end(), body.begin(), body.end());
-}
+using test::Bytes;
+using test::len_field;
 
 // EgmRobot { header 1 { seqno 1, tm 2 }, feedBack 2 { joints 1 }, planned 3 { joints 1 } }, degrees.
 Bytes egm_robot(std::uint64_t seqno, std::uint32_t tm_ms, const JointVector& q_deg) {
   Bytes header, joints, feedback, planned, out;
-  varint(header, 1 << 3);
-  varint(header, seqno);  // a varint: nothing stops a sender from writing more than 32 bits
-  varint(header, 2 << 3);
-  varint(header, tm_ms);
-  for (int i = 0; i < q_deg.size(); ++i) {
-    varint(joints, 1 << 3 | 1);
-    unsigned char raw[8];
-    const double v = q_deg[i];
-    std::memcpy(raw, &v, 8);
-    joints.insert(joints.end(), raw, raw + 8);
-  }
+  test::varint_field(header, 1, seqno);  // a varint: nothing stops a sender from writing more than 32 bits
+  test::varint_field(header, 2, tm_ms);
+  for (int i = 0; i < q_deg.size(); ++i) test::double_field(joints, 1, q_deg[i]);
   len_field(feedback, 1, joints);
   len_field(planned, 1, joints);
   len_field(out, 1, header);

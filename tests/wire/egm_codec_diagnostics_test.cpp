@@ -2,49 +2,24 @@
 // number wider than its uint32 field (protobuf keeps its low 32 bits) is refused, and a packet with a
 // required field missing is refused with its own status and without a line on stderr (protobuf
 // printed one per packet). Packets written by hand from the field numbers.
-#include <cstring>
-#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "deflex/wire/egm_codec.hpp"
+#include "wire/protobuf_bytes.hpp"
 
 namespace deflex {
 namespace {
 
-using Bytes = std::vector<unsigned char>;
-
-void varint(Bytes& b, std::uint64_t v) {
-  while (v >= 0x80) {
-    b.push_back(static_cast<unsigned char>(v | 0x80));
-    v >>= 7;
-  }
-  b.push_back(static_cast<unsigned char>(v));
-}
-void len_field(Bytes& b, int field, const Bytes& body) {
-  varint(b, static_cast<std::uint64_t>(field << 3 | 2));
-  varint(b, body.size());
-  b.insert(b.end(), body.begin(), body.end());
-}
-void fixed64(Bytes& b, double v) {
-  unsigned char raw[8];
-  std::memcpy(raw, &v, 8);
-  b.insert(b.end(), raw, raw + 8);
-}
+using test::Bytes;
+using test::len_field;
 
 // EgmRobot { header { seqno }, feedBack { joints {6}, cartesian { pos { x [, y, z] } } } }.
 Bytes robot(std::uint64_t seqno, bool complete_position) {
   Bytes header, joints, pos, pose, feedback, out;
-  varint(header, 1 << 3);
-  varint(header, seqno);
-  for (int i = 0; i < 6; ++i) {
-    varint(joints, 1 << 3 | 1);
-    fixed64(joints, 10.0 * i);
-  }
-  for (int f = 1; f <= (complete_position ? 3 : 1); ++f) {
-    varint(pos, static_cast<std::uint64_t>(f << 3 | 1));
-    fixed64(pos, 100.0 * f);
-  }
+  test::varint_field(header, 1, seqno);
+  for (int i = 0; i < 6; ++i) test::double_field(joints, 1, 10.0 * i);
+  for (int f = 1; f <= (complete_position ? 3 : 1); ++f) test::double_field(pos, f, 100.0 * f);
   len_field(pose, 1, pos);
   len_field(feedback, 1, joints);
   len_field(feedback, 2, pose);
