@@ -155,6 +155,10 @@ TEST(ControllerSetup, EgmJointModuleIsWellFormedAndAgreesWithDeflex) {
   const RapidModule m = read_rapid(file(files, ".mod").text);
   EXPECT_TRUE(m.problems.empty()) << ::testing::PrintToString(m.problems);
   EXPECT_EQ(m.name, "DeflexEgm");
+  // The command the header names runs deflex bound to the address the controller sends to.
+  EXPECT_NE(file(files, ".mod").text.find("deflex online --link egm-joint --bind 192.168.125.50 --egm-port 6511 "
+                                          "--period-ms 4 --max-joint-correction-deg 0.3"),
+            std::string::npos);
   EXPECT_EQ(m.statements.front(), "EGMReset deflex_egm_id");
   const RapidCall setup = call(m, "EGMSetupUC");
   EXPECT_NE(setup.text.find("ROB_1,deflex_egm_id,\"default\",\"DEFLEX\""), std::string::npos) << setup.text;
@@ -311,7 +315,9 @@ TEST(ControllerSetup, RsiKrlSwitchesRsiOnInAbsoluteModeAroundTheProgram) {
   EXPECT_EQ(rsi_calls[0], "ret = RSI_CREATE(\"deflex_rsi.rsi\", CONTID, TRUE)");
   EXPECT_EQ(rsi_calls[1], "ret = RSI_ON(#ABSOLUTE, #IPO_FAST)");
   EXPECT_EQ(rsi_calls[2], "ret = RSI_OFF()");
-  EXPECT_NE(krl.find("--rsi-port 59152 --rsi-sentype Deflex --period-ms 4 --max-joint-correction-deg 0.35"),
+  // The command it names runs deflex with the same values, bound to the address the controller sends to.
+  EXPECT_NE(krl.find("--bind 192.168.1.20 --rsi-port 59152 --rsi-sentype Deflex --period-ms 4 "
+                     "--max-joint-correction-deg 0.35"),
             std::string::npos);
 }
 
