@@ -306,6 +306,8 @@ TEST(RsiXml, BadDocumentsGetTheStatusThatNamesTheirFault) {
   RsiRobotMessage m;
   ASSERT_EQ(decode(rob(axes + "<IPOC>18446744073709551615</IPOC>"), m), RsiDecodeStatus::kOk);
   EXPECT_EQ(m.ipoc, 18446744073709551615ULL);
+  ASSERT_EQ(decode(rob(axes + "<IPOC>" + std::string(40, '0') + "42</IPOC>"), m), RsiDecodeStatus::kOk);
+  EXPECT_EQ(m.ipoc, 42u);
 }
 
 TEST(RsiXml, TheControllersSideRoundTripsThroughLibxml2) {

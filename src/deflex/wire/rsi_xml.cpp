@@ -48,10 +48,11 @@ Number parse_decimal(std::string_view s, double& v) noexcept {
 }
 
 Number parse_unsigned(std::string_view s, std::uint64_t& v) noexcept {
-  if (s.empty() || s.size() > 40) return s.empty() ? Number::kBad : Number::kOutOfRange;
+  if (s.empty()) return Number::kBad;
   for (const char c : s) {
     if (c < '0' || c > '9') return Number::kBad;
   }
+  while (s.size() > 1 && s[0] == '0') s.remove_prefix(1);  // leading zeros say nothing of the range
   const auto r = std::from_chars(s.data(), s.data() + s.size(), v, 10);
   if (r.ec == std::errc::result_out_of_range) return Number::kOutOfRange;
   if (r.ec != std::errc() || r.ptr != s.data() + s.size()) return Number::kBad;
