@@ -25,13 +25,18 @@ void EgmReceiverConfig::validate() const {
 }
 
 namespace {
-SequenceRules egm_sequence_rules(const EgmReceiverConfig& c) {
-  SequenceRules r;
-  r.bits = 32;
-  r.max_ahead = c.max_seqno_ahead;
-  r.restart_max = c.restart_seqno_max;
-  r.confirm = c.confirm_jump;
-  return r;
+// EGM's seqno counts cycles and wraps at 2^32; header.tm is a 32-bit millisecond stamp.
+ControllerGateConfig egm_gate(const EgmReceiverConfig& c) {
+  ControllerGateConfig g;
+  g.sequence.bits = 32;
+  g.sequence.max_ahead = c.max_seqno_ahead;
+  g.sequence.restart_max = c.restart_seqno_max;
+  g.sequence.confirm = c.confirm_jump;
+  g.restart_silence_s = c.restart_silence_s;
+  g.period_s = c.period_s;
+  g.numbers_per_cycle = 1.0;
+  g.stamp_bits = 32;
+  return g;
 }
 }  // namespace
 
@@ -42,8 +47,7 @@ EgmReceiver::EgmReceiver(DatagramTransport& transport, const Clock& clock, const
       config_(config),
       counters_(counters),
       codec_(model.dof()),
-      seq_(egm_sequence_rules(config)),
-      timing_(config.period_s) {
+      gate_(egm_gate(config)) {
   config_.validate();
   // The tolerance allows for the controller's own rounding beyond its soft limits.
   lower_ = model.lower_limits().array() - kPi / 180.0;
@@ -82,10 +86,7 @@ EgmReceiver::Result EgmReceiver::drain(double timeout_s, bool& restarted) noexce
       break;
     }
     ++counters_.datagrams;
-    // The silence that ends a session is measured from the controller's last datagram of any kind:
-    // while it keeps sending, even packets the link refuses, it has not gone away.
-    if (have_sender_ && now - last_heard_s_ > config_.restart_silence_s) resync_ = true;
-    if (have_sender_ && from == sender_) last_heard_s_ = now;
+    gate_.heard(from, now);  // the silence that ends a session counts from any datagram of the controller
     if (static_cast<std::size_t>(n) > config_.max_packet_bytes) {
       ++counters_.oversized;
       continue;
@@ -107,42 +108,15 @@ EgmReceiver::Result EgmReceiver::drain(double timeout_s, bool& restarted) noexce
       ++counters_.out_of_limits;
       continue;
     }
-    // One controller owns the link; another sender may take over only after the controller fell silent.
-    if (have_sender_ && !(from == sender_) && !resync_) {
-      ++counters_.foreign_sender;
+    bool session_start = false;
+    if (!gate_.take(from, msg_.seqno, msg_.tm_ms, now, counters_, session_start, msg_arrival_)) {
       continue;
-    }
-    bool session_start = !seq_.started() || resync_ || !(from == sender_);
-    const std::int64_t step = seq_.started() ? seq_.distance(msg_.seqno) : 0;
-    if (session_start) {
-      seq_.reset();
-      (void)seq_.observe(msg_.seqno);
-    } else {
-      switch (seq_.observe(msg_.seqno)) {
-        case SequenceVerdict::kDuplicate: ++counters_.duplicate; continue;
-        case SequenceVerdict::kOutOfOrder: ++counters_.out_of_order; continue;
-        case SequenceVerdict::kFarAhead: ++counters_.far_ahead; continue;
-        case SequenceVerdict::kRestart: session_start = true; break;
-        case SequenceVerdict::kFirst:
-        case SequenceVerdict::kNext: break;
-      }
-    }
-    if (session_start && have_sender_) {
-      ++counters_.restarts;
     }
     restarted = restarted || session_start;
     if (have) {
       ++counters_.superseded;
     }
-    const std::uint32_t stamp_step_ms = msg_.tm_ms - last_tm_ms_;  // wraps with the field
-    timing_.on_message(stamp_step_ms * 1e-3, now, session_start ? 1 : static_cast<std::uint64_t>(step), session_start,
-                       counters_, msg_arrival_);
-    last_tm_ms_ = msg_.tm_ms;
-    resync_ = false;
     last_accept_s_ = now;
-    last_heard_s_ = now;
-    have_sender_ = true;
-    sender_ = from;
     newest_ = msg_;
     arrival_ = msg_arrival_;
     have = true;
@@ -151,7 +125,7 @@ EgmReceiver::Result EgmReceiver::drain(double timeout_s, bool& restarted) noexce
 }
 
 bool EgmReceiver::reply(const unsigned char* data, std::size_t size) noexcept {
-  if (!have_sender_ || !transport_.send_to(data, size, sender_)) {
+  if (!gate_.has_controller() || !transport_.send_to(data, size, gate_.controller())) {
     ++counters_.send_errors;
     return false;
   }

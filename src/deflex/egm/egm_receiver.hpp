@@ -11,12 +11,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "deflex/link/controller_gate.hpp"
 #include "deflex/link/controller_link.hpp"
-#include "deflex/link/link_timing.hpp"
 #include "deflex/model/robot_model.hpp"
 #include "deflex/transport/clock.hpp"
 #include "deflex/transport/datagram_transport.hpp"
-#include "deflex/transport/sequence_tracker.hpp"
 #include "deflex/wire/egm_codec.hpp"
 
 namespace deflex {
@@ -60,8 +59,8 @@ class EgmReceiver {
   /// Sends to the controller (the sender of the newest message).
   bool reply(const unsigned char* data, std::size_t size) noexcept;
   [[nodiscard]] EgmCodec& codec() { return codec_; }
-  [[nodiscard]] bool has_controller() const { return have_sender_; }
-  [[nodiscard]] const DatagramAddress& controller() const { return sender_; }
+  [[nodiscard]] bool has_controller() const { return gate_.has_controller(); }
+  [[nodiscard]] const DatagramAddress& controller() const { return gate_.controller(); }
   /// Clock time of the last usable message (s).
   [[nodiscard]] double last_message_s() const { return last_accept_s_; }
   /// How the newest message arrived (diagnostics; also counted in the counters).
@@ -78,15 +77,9 @@ class EgmReceiver {
   JointVector lower_, upper_;
   std::vector<unsigned char> rx_;
   EgmRobotMessage msg_, newest_;
-  bool have_sender_ = false;
-  DatagramAddress sender_;
-  SequenceTracker seq_;
+  ControllerGate gate_;
   double last_accept_s_ = 0.0;
-  double last_heard_s_ = 0.0;   // the last datagram of any kind from the controller's address
-  bool resync_ = false;         // the controller fell silent: the next usable message starts a session
-  LinkTiming timing_;
   LinkArrival arrival_, msg_arrival_;
-  std::uint32_t last_tm_ms_ = 0;
 };
 
 }  // namespace deflex

@@ -1,7 +1,6 @@
 // KUKA RSI axis correction (see rsi_link.hpp).
 #include "deflex/rsi/rsi_link.hpp"
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <utility>
@@ -36,13 +35,19 @@ void RsiLinkConfig::validate() const {
 }
 
 namespace {
-SequenceRules ipoc_rules(const RsiLinkConfig& c) {
-  SequenceRules r;
-  r.bits = 64;
-  r.max_ahead = c.ipoc_max_ahead_ms;
-  r.restart_max = 0;  // an IPOC is a time stamp: it never starts again from a small number
-  r.confirm = c.confirm_jump;
-  return r;
+// The IPOC is both the sequence number and the time stamp: 64 bits of milliseconds, growing by the
+// period every cycle, never starting again from a small number.
+ControllerGateConfig rsi_gate(const RsiLinkConfig& c, double period_s) {
+  ControllerGateConfig g;
+  g.sequence.bits = 64;
+  g.sequence.max_ahead = c.ipoc_max_ahead_ms;
+  g.sequence.restart_max = 0;
+  g.sequence.confirm = c.confirm_jump;
+  g.restart_silence_s = c.restart_silence_s;
+  g.period_s = period_s;
+  g.numbers_per_cycle = period_s * 1e3;
+  g.stamp_bits = 64;
+  return g;
 }
 const RsiLinkConfig& validated(const RsiLinkConfig& c) {
   c.validate();
@@ -60,8 +65,7 @@ RsiLink::RsiLink(OnlineCompensator& compensator, OnlineStrategy& strategy, Datag
       config_(validated(config)),
       delay_(config.initial_delay_s),
       history_(config.history_cycles, compensator.model().dof()),
-      timing_(compensator.config().period_s),
-      ipoc_(ipoc_rules(config)),
+      gate_(rsi_gate(config, compensator.config().period_s)),
       ws_(compensator.model()),
       jac_(6, compensator.model().dof()) {
   const RobotModel& model = compensator.model();
@@ -103,9 +107,7 @@ RsiLink::Drain RsiLink::drain(double timeout_s, bool& restarted) noexcept {
     const long n = transport_.receive(rx_.data(), rx_.size(), from);
     if (n < 0) break;
     ++counters_.datagrams;
-    // A silence is measured from the controller's last datagram of any kind.
-    if (have_sender_ && now - last_heard_s_ > config_.restart_silence_s) resync_ = true;
-    if (have_sender_ && from == sender_) last_heard_s_ = now;
+    gate_.heard(from, now);  // the silence that ends a session counts from any datagram of the controller
     if (static_cast<std::size_t>(n) > config_.max_document_bytes) {
       ++counters_.oversized;
       continue;
@@ -125,36 +127,10 @@ RsiLink::Drain RsiLink::drain(double timeout_s, bool& restarted) noexcept {
       ++counters_.out_of_limits;
       continue;
     }
-    if (have_sender_ && !(from == sender_) && !resync_) {
-      ++counters_.foreign_sender;
-      continue;
-    }
-    bool session_start = !ipoc_.started() || resync_ || !(from == sender_);
-    const std::int64_t step_ms = ipoc_.started() ? ipoc_.distance(msg_.ipoc) : 0;
-    if (session_start) {
-      ipoc_.reset();
-      (void)ipoc_.observe(msg_.ipoc);
-    } else {
-      switch (ipoc_.observe(msg_.ipoc)) {
-        case SequenceVerdict::kDuplicate: ++counters_.duplicate; continue;
-        case SequenceVerdict::kOutOfOrder: ++counters_.out_of_order; continue;
-        case SequenceVerdict::kFarAhead: ++counters_.far_ahead; continue;
-        case SequenceVerdict::kRestart: session_start = true; break;
-        case SequenceVerdict::kFirst:
-        case SequenceVerdict::kNext: break;
-      }
-    }
-    if (session_start && have_sender_) ++counters_.restarts;
+    bool session_start = false;
+    if (!gate_.take(from, msg_.ipoc, msg_.ipoc, now, counters_, session_start, msg_arrival_)) continue;
     restarted = restarted || session_start;
     if (have) ++counters_.superseded;
-    // The IPOC is the controller's clock in ms: its step gives the stamp step and the cycles elapsed.
-    const double period_ms = timing_.period_s() * 1e3;
-    const auto cycles = static_cast<std::uint64_t>(std::max(1.0, std::round(static_cast<double>(step_ms) / period_ms)));
-    timing_.on_message(static_cast<double>(step_ms) * 1e-3, now, cycles, session_start, counters_, msg_arrival_);
-    resync_ = false;
-    last_heard_s_ = now;
-    have_sender_ = true;
-    sender_ = from;
     std::swap(newest_, msg_);
     arrival_ = msg_arrival_;
     have = true;
@@ -247,7 +223,7 @@ LinkPollResult RsiLink::poll(double timeout_s) noexcept {
       reply_.ipoc = m.ipoc;
       for (int i = 0; i < out.dtheta.size(); ++i) reply_.correction_deg[i] = rad_to_deg(-out.dtheta[i]);
       const std::size_t n = encode_rsi_sensor(config_.sentype, reply_, tx_.data(), tx_.size());
-      if (n > 0 && transport_.send_to(tx_.data(), n, sender_)) {
+      if (n > 0 && transport_.send_to(tx_.data(), n, gate_.controller())) {
         ++counters_.replies;
         answered_once_ = true;
         r.replied = true;

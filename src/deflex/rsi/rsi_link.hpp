@@ -17,14 +17,13 @@
 #include <string>
 #include <vector>
 
+#include "deflex/link/controller_gate.hpp"
 #include "deflex/link/controller_link.hpp"
 #include "deflex/link/link_history.hpp"
-#include "deflex/link/link_timing.hpp"
 #include "deflex/online/delay_estimator.hpp"
 #include "deflex/online/online_strategy.hpp"
 #include "deflex/transport/clock.hpp"
 #include "deflex/transport/datagram_transport.hpp"
-#include "deflex/transport/sequence_tracker.hpp"
 #include "deflex/wire/rsi_xml.hpp"
 
 namespace deflex {
@@ -65,7 +64,7 @@ class RsiLink final : public ControllerLink {
   [[nodiscard]] const LinkHistory* history() const override { return &history_; }
 
   [[nodiscard]] const DelayEstimator& delay() const { return delay_; }
-  [[nodiscard]] const DatagramAddress& controller() const { return sender_; }
+  [[nodiscard]] const DatagramAddress& controller() const { return gate_.controller(); }
   /// The controller's cycle as its IPOCs show it (s; 0 before two documents).
   [[nodiscard]] double period_s() const { return period_s_; }
   [[nodiscard]] const RsiLinkConfig& config() const { return config_; }
@@ -84,8 +83,7 @@ class RsiLink final : public ControllerLink {
   LinkCounters counters_;
   DelayEstimator delay_;
   LinkHistory history_;
-  LinkTiming timing_;
-  SequenceTracker ipoc_;
+  ControllerGate gate_;
   LinkState state_ = LinkState::kWaiting;
   bool fault_pending_ = false;
 
@@ -93,9 +91,7 @@ class RsiLink final : public ControllerLink {
   std::vector<unsigned char> rx_, tx_;
   RsiRobotMessage msg_, newest_;
   LinkArrival msg_arrival_, arrival_;
-  bool have_sender_ = false, resync_ = false, answered_once_ = false;
-  DatagramAddress sender_;
-  double last_heard_s_ = 0.0;
+  bool answered_once_ = false;
   JointVector lower_, upper_;
 
   // The cycle (preallocated).
