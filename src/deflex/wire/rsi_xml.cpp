@@ -98,12 +98,18 @@ Values read_values(const XmlScanner& s, const std::string_view* names, int count
   return r;
 }
 
-// Walks the children of the root element (its kStart just read) to the end of the document.
-// on_start(scanner) sees each child's start tag with its attributes and returns kOk or a status that
-// rejects the document; on_text(name, text) gets the character data of a child that holds nothing
-// but one run of text (IPOC), trimmed. White space between children is allowed, other text is not.
-template <class OnStart, class OnText>
-RsiDecodeStatus walk(XmlScanner& s, OnStart&& on_start, OnText&& on_text) {
+// The echoed IPOC, which both documents carry as the text of one <IPOC> child.
+struct Ipoc {
+  bool have = false;
+  bool out_of_range = false;
+};
+
+// Walks the children of the root element (its kStart just read) to the end of the document, reading
+// the <IPOC> child into `ipoc` (once, as nothing but one run of digits, trimmed). on_start(scanner)
+// sees every other child's start tag with its attributes and returns kOk or a status that rejects the
+// document. White space between children is allowed, other text is not.
+template <class OnStart>
+RsiDecodeStatus walk(XmlScanner& s, std::uint64_t& ipoc_value, Ipoc& ipoc, OnStart&& on_start) {
   std::string_view child;
   std::string_view child_text;
   int child_texts = 0;
@@ -129,8 +135,12 @@ RsiDecodeStatus walk(XmlScanner& s, OnStart&& on_start, OnText&& on_text) {
           child_texts = 0;
           child_nested = false;
           child_text = {};
-          const RsiDecodeStatus st = on_start(s);
-          if (st != RsiDecodeStatus::kOk) return st;
+          if (child == "IPOC") {
+            if (ipoc.have) return RsiDecodeStatus::kMalformed;  // twice
+          } else {
+            const RsiDecodeStatus st = on_start(s);
+            if (st != RsiDecodeStatus::kOk) return st;
+          }
         } else {
           child_nested = true;
         }
@@ -142,14 +152,28 @@ RsiDecodeStatus walk(XmlScanner& s, OnStart&& on_start, OnText&& on_text) {
           return after == XmlToken::kDone ? RsiDecodeStatus::kOk : RsiDecodeStatus::kMalformed;
         }
         if (s.depth() == 2) {
-          const bool simple = !child_nested && child_texts <= 1;
-          const RsiDecodeStatus st = on_text(child, simple ? trim(child_text) : std::string_view(), simple);
-          if (st != RsiDecodeStatus::kOk) return st;
+          if (child == "IPOC") {
+            if (child_nested || child_texts > 1) return RsiDecodeStatus::kMalformed;
+            const Number n = parse_unsigned(trim(child_text), ipoc_value);
+            if (n == Number::kBad) return RsiDecodeStatus::kMalformed;
+            ipoc.out_of_range = n == Number::kOutOfRange;
+            ipoc.have = true;
+          }
           child = {};
         }
         break;
     }
   }
+}
+
+// The status of a document whose walk ended with `walked`: the first thing missing or out of range.
+RsiDecodeStatus verdict(RsiDecodeStatus walked, const Ipoc& ipoc, bool axes_complete, bool too_large) {
+  if (walked != RsiDecodeStatus::kOk) return walked;
+  if (ipoc.out_of_range) return RsiDecodeStatus::kIpocOutOfRange;
+  if (!ipoc.have) return RsiDecodeStatus::kMissingIpoc;
+  if (!axes_complete) return RsiDecodeStatus::kMissingAxes;
+  if (too_large) return RsiDecodeStatus::kNonFinite;
+  return RsiDecodeStatus::kOk;
 }
 
 // A bounded writer into the caller's buffer.
@@ -237,61 +261,43 @@ RsiDecodeStatus decode_rsi_robot(const unsigned char* data, std::size_t size, in
   out.actual_deg.resize(axes);
   out.setpoint_deg.resize(axes);
   out.has_setpoint = out.has_delay = out.has_rist = out.has_rsol = false;
-  bool have_actual = false, have_ipoc = false, too_large = false, ipoc_out_of_range = false;
-  bool actual_complete = false;
+  bool have_actual = false, too_large = false, actual_complete = false;
   int seen_delay = 0;
-  const RsiDecodeStatus walked = walk(
-      s,
-      [&](const XmlScanner& c) {
-        const std::string_view name = c.name();
-        if (name == "AIPos" || name == "ASPos") {
-          const bool actual = name == "AIPos";
-          if (actual ? have_actual : out.has_setpoint) return RsiDecodeStatus::kMalformed;  // twice
-          JointVector& q = actual ? out.actual_deg : out.setpoint_deg;
-          const Values v = read_values(c, kAxisNames.data(), axes, q.data());
-          if (v.bad) return RsiDecodeStatus::kMalformed;
-          too_large = too_large || v.too_large;
-          if (actual) {
-            have_actual = true;
-            actual_complete = v.complete;
-          } else {
-            out.has_setpoint = v.complete;  // an incomplete setpoint is not used
-            if (!v.complete) return RsiDecodeStatus::kMissingAxes;
-          }
-        } else if (name == "RIst" || name == "RSol") {
-          const bool ist = name == "RIst";
-          bool& has = ist ? out.has_rist : out.has_rsol;
-          if (has) return RsiDecodeStatus::kMalformed;
-          const Values v = read_values(c, kPoseNames.data(), 6, ist ? out.rist.data() : out.rsol.data());
-          if (v.bad) return RsiDecodeStatus::kMalformed;
-          too_large = too_large || v.too_large;
-          has = v.complete;
-        } else if (name == "Delay") {
-          std::string_view d;
-          if (++seen_delay > 1 || !c.attribute("D", d) || parse_unsigned(d, out.delay) != Number::kOk) {
-            return RsiDecodeStatus::kMalformed;
-          }
-          out.has_delay = true;
-        } else if (name == "IPOC" && have_ipoc) {
-          return RsiDecodeStatus::kMalformed;
-        }
-        return RsiDecodeStatus::kOk;  // elements of other SEND entries are the controller's business
-      },
-      [&](std::string_view name, std::string_view text, bool simple) {
-        if (name != "IPOC") return RsiDecodeStatus::kOk;
-        if (!simple) return RsiDecodeStatus::kMalformed;
-        const Number n = parse_unsigned(text, out.ipoc);
-        if (n == Number::kBad) return RsiDecodeStatus::kMalformed;
-        ipoc_out_of_range = n == Number::kOutOfRange;
-        have_ipoc = true;
-        return RsiDecodeStatus::kOk;
-      });
-  if (walked != RsiDecodeStatus::kOk) return walked;
-  if (ipoc_out_of_range) return RsiDecodeStatus::kIpocOutOfRange;
-  if (!have_ipoc) return RsiDecodeStatus::kMissingIpoc;
-  if (!have_actual || !actual_complete) return RsiDecodeStatus::kMissingAxes;
-  if (too_large) return RsiDecodeStatus::kNonFinite;
-  return RsiDecodeStatus::kOk;
+  Ipoc ipoc;
+  const RsiDecodeStatus walked = walk(s, out.ipoc, ipoc, [&](const XmlScanner& c) {
+    const std::string_view name = c.name();
+    if (name == "AIPos" || name == "ASPos") {
+      const bool actual = name == "AIPos";
+      if (actual ? have_actual : out.has_setpoint) return RsiDecodeStatus::kMalformed;  // twice
+      JointVector& q = actual ? out.actual_deg : out.setpoint_deg;
+      const Values v = read_values(c, kAxisNames.data(), axes, q.data());
+      if (v.bad) return RsiDecodeStatus::kMalformed;
+      too_large = too_large || v.too_large;
+      if (actual) {
+        have_actual = true;
+        actual_complete = v.complete;
+      } else {
+        out.has_setpoint = v.complete;  // an incomplete setpoint is not used
+        if (!v.complete) return RsiDecodeStatus::kMissingAxes;
+      }
+    } else if (name == "RIst" || name == "RSol") {
+      const bool ist = name == "RIst";
+      bool& has = ist ? out.has_rist : out.has_rsol;
+      if (has) return RsiDecodeStatus::kMalformed;
+      const Values v = read_values(c, kPoseNames.data(), 6, ist ? out.rist.data() : out.rsol.data());
+      if (v.bad) return RsiDecodeStatus::kMalformed;
+      too_large = too_large || v.too_large;
+      has = v.complete;
+    } else if (name == "Delay") {
+      std::string_view d;
+      if (++seen_delay > 1 || !c.attribute("D", d) || parse_unsigned(d, out.delay) != Number::kOk) {
+        return RsiDecodeStatus::kMalformed;
+      }
+      out.has_delay = true;
+    }
+    return RsiDecodeStatus::kOk;  // elements of other SEND entries are the controller's business
+  });
+  return verdict(walked, ipoc, have_actual && actual_complete, too_large);
 }
 
 RsiDecodeStatus decode_rsi_sensor(const unsigned char* data, std::size_t size, std::string_view sentype, int axes,
@@ -303,37 +309,20 @@ RsiDecodeStatus decode_rsi_sensor(const unsigned char* data, std::size_t size, s
   std::string_view type;
   if (s.name() != "Sen" || !s.attribute("Type", type) || type != sentype) return RsiDecodeStatus::kForeign;
   out.correction_deg.resize(axes);
-  bool have_ak = false, ak_complete = false, have_ipoc = false, too_large = false, ipoc_out_of_range = false;
-  const RsiDecodeStatus walked = walk(
-      s,
-      [&](const XmlScanner& c) {
-        if (c.name() == "AK") {
-          if (have_ak) return RsiDecodeStatus::kMalformed;
-          const Values v = read_values(c, kAxisNames.data(), axes, out.correction_deg.data());
-          if (v.bad) return RsiDecodeStatus::kMalformed;
-          too_large = too_large || v.too_large;
-          have_ak = true;
-          ak_complete = v.complete;
-        } else if (c.name() == "IPOC" && have_ipoc) {
-          return RsiDecodeStatus::kMalformed;
-        }
-        return RsiDecodeStatus::kOk;
-      },
-      [&](std::string_view name, std::string_view text, bool simple) {
-        if (name != "IPOC") return RsiDecodeStatus::kOk;
-        if (!simple) return RsiDecodeStatus::kMalformed;
-        const Number n = parse_unsigned(text, out.ipoc);
-        if (n == Number::kBad) return RsiDecodeStatus::kMalformed;
-        ipoc_out_of_range = n == Number::kOutOfRange;
-        have_ipoc = true;
-        return RsiDecodeStatus::kOk;
-      });
-  if (walked != RsiDecodeStatus::kOk) return walked;
-  if (ipoc_out_of_range) return RsiDecodeStatus::kIpocOutOfRange;
-  if (!have_ipoc) return RsiDecodeStatus::kMissingIpoc;
-  if (!have_ak || !ak_complete) return RsiDecodeStatus::kMissingAxes;
-  if (too_large) return RsiDecodeStatus::kNonFinite;
-  return RsiDecodeStatus::kOk;
+  bool have_ak = false, ak_complete = false, too_large = false;
+  Ipoc ipoc;
+  const RsiDecodeStatus walked = walk(s, out.ipoc, ipoc, [&](const XmlScanner& c) {
+    if (c.name() == "AK") {
+      if (have_ak) return RsiDecodeStatus::kMalformed;
+      const Values v = read_values(c, kAxisNames.data(), axes, out.correction_deg.data());
+      if (v.bad) return RsiDecodeStatus::kMalformed;
+      too_large = too_large || v.too_large;
+      have_ak = true;
+      ak_complete = v.complete;
+    }
+    return RsiDecodeStatus::kOk;
+  });
+  return verdict(walked, ipoc, have_ak && ak_complete, too_large);
 }
 
 std::size_t encode_rsi_sensor(std::string_view sentype, const RsiSensorMessage& msg, unsigned char* out,
