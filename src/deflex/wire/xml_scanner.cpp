@@ -78,6 +78,32 @@ bool XmlScanner::read_name(std::string_view& out) noexcept {
   return true;
 }
 
+// [41] Attribute: Name Eq AttValue, with [25] Eq ::= S? '=' S?. The value may not hold '<' (not
+// well-formed) nor '&' (a reference: outside the subset). Also reads the declaration's pseudo-attributes.
+bool XmlScanner::read_attribute(Attribute& a) noexcept {
+  if (!read_name(a.name)) return false;
+  skip_space();
+  if (pos_ == end_) return fail(XmlError::kTruncated, pos_), false;
+  if (*pos_ != '=') return fail(XmlError::kSyntax, pos_), false;
+  ++pos_;
+  skip_space();
+  if (pos_ == end_) return fail(XmlError::kTruncated, pos_), false;
+  const char quote = *pos_;
+  if (quote != '"' && quote != '\'') return fail(XmlError::kSyntax, pos_), false;
+  const char* v = ++pos_;
+  while (pos_ < end_ && *pos_ != quote) {
+    const char c = *pos_;
+    if (c == '<') return fail(XmlError::kSyntax, pos_), false;
+    if (c == '&') return fail(XmlError::kUnsupported, pos_), false;
+    if (!is_char(c)) return fail(non_ascii(c) ? XmlError::kUnsupported : XmlError::kSyntax, pos_), false;
+    ++pos_;
+  }
+  if (pos_ == end_) return fail(XmlError::kTruncated, pos_), false;
+  a.value = std::string_view(v, static_cast<std::size_t>(pos_ - v));
+  ++pos_;
+  return true;
+}
+
 // [15] Comment: '<!--' ((Char - '-') | ('-' (Char - '-')))* '-->'. Skipped; kDone on success.
 XmlToken XmlScanner::comment() noexcept {
   pos_ += 4;
@@ -111,24 +137,10 @@ XmlToken XmlScanner::declaration() noexcept {
     }
     if (!space) return fail(XmlError::kSyntax, pos_);
     const char* at = pos_;
-    std::string_view key;
-    if (!read_name(key)) return XmlToken::kError;
-    skip_space();
-    if (pos_ == end_) return fail(XmlError::kTruncated, pos_);
-    if (*pos_ != '=') return fail(XmlError::kSyntax, pos_);
-    ++pos_;
-    skip_space();
-    if (pos_ == end_) return fail(XmlError::kTruncated, pos_);
-    const char quote = *pos_;
-    if (quote != '"' && quote != '\'') return fail(XmlError::kSyntax, pos_);
-    const char* v = ++pos_;
-    while (pos_ < end_ && *pos_ != quote) {
-      if (!is_char(*pos_)) return fail(non_ascii(*pos_) ? XmlError::kUnsupported : XmlError::kSyntax, pos_);
-      ++pos_;
-    }
-    if (pos_ == end_) return fail(XmlError::kTruncated, pos_);
-    const std::string_view value(v, static_cast<std::size_t>(pos_ - v));
-    ++pos_;
+    Attribute pseudo;
+    if (!read_attribute(pseudo)) return XmlToken::kError;
+    const std::string_view key = pseudo.name, value = pseudo.value;
+    const char* v = value.data();
     if (field == 0 && key == "version") {
       if (value != "1.0") return fail(XmlError::kUnsupported, v);
       field = 1;
@@ -147,8 +159,7 @@ XmlToken XmlScanner::declaration() noexcept {
   }
 }
 
-// [40] STag / [44] EmptyElemTag, with [41] Attribute. Attribute values may not hold '<' (not
-// well-formed) nor '&' (a reference: outside the subset).
+// [40] STag / [44] EmptyElemTag, attributes unique within the tag.
 XmlToken XmlScanner::start_tag() noexcept {
   const char* lt = pos_;
   ++pos_;
@@ -176,26 +187,7 @@ XmlToken XmlScanner::start_tag() noexcept {
     if (!space) return fail(XmlError::kSyntax, pos_);  // attributes are separated by white space
     Attribute a;
     const char* at = pos_;
-    if (!read_name(a.name)) return XmlToken::kError;
-    skip_space();
-    if (pos_ == end_) return fail(XmlError::kTruncated, pos_);
-    if (*pos_ != '=') return fail(XmlError::kSyntax, pos_);
-    ++pos_;
-    skip_space();
-    if (pos_ == end_) return fail(XmlError::kTruncated, pos_);
-    const char quote = *pos_;
-    if (quote != '"' && quote != '\'') return fail(XmlError::kSyntax, pos_);
-    const char* v = ++pos_;
-    while (pos_ < end_ && *pos_ != quote) {
-      const char c = *pos_;
-      if (c == '<') return fail(XmlError::kSyntax, pos_);
-      if (c == '&') return fail(XmlError::kUnsupported, pos_);
-      if (!is_char(c)) return fail(non_ascii(c) ? XmlError::kUnsupported : XmlError::kSyntax, pos_);
-      ++pos_;
-    }
-    if (pos_ == end_) return fail(XmlError::kTruncated, pos_);
-    a.value = std::string_view(v, static_cast<std::size_t>(pos_ - v));
-    ++pos_;
+    if (!read_attribute(a)) return XmlToken::kError;
     for (int i = 0; i < attribute_count_; ++i) {
       if (attributes_[static_cast<std::size_t>(i)].name == a.name) return fail(XmlError::kSyntax, at);  // [WFC: Unique Att Spec]
     }

@@ -66,6 +66,7 @@ class XmlScanner {
   XmlToken fail(XmlError e, const char* at) noexcept;
   bool skip_space() noexcept;  // true when it skipped at least one byte
   bool read_name(std::string_view& out) noexcept;
+  bool read_attribute(Attribute& a) noexcept;
   XmlToken comment() noexcept;
   XmlToken declaration() noexcept;
   XmlToken start_tag() noexcept;
