@@ -51,14 +51,16 @@ cell::RsiControllerConfig controller_from_files(const std::string& dir) {
   cell::RsiControllerConfig c;
   EXPECT_TRUE(std::regex_search(ethernet, m, std::regex("<SENTYPE>([^<]+)</SENTYPE>")));
   c.sentype = m[1];
-  EXPECT_TRUE(std::regex_search(context, m, std::regex(R"re(Name="UpperLimA1" ParamID="\d+" ParamValue="([^"]+)")re")));
-  c.upper_limit_deg = std::stod(m[1]);
-  EXPECT_TRUE(std::regex_search(context, m, std::regex(R"re(Name="LowerLimA1" ParamID="\d+" ParamValue="([^"]+)")re")));
-  c.lower_limit_deg = std::stod(m[1]);
-  EXPECT_TRUE(std::regex_search(context, m, std::regex(R"re(Name="MaxA1" ParamID="\d+" ParamValue="([^"]+)")re")));
-  c.max_correction_deg = std::stod(m[1]);
-  EXPECT_TRUE(std::regex_search(context, m, std::regex(R"re(Name="Timeout" ParamID="\d+" ParamValue="([^"]+)")re")));
-  c.timeout = std::stoi(m[1]);
+  const auto parameter = [&](const std::string& name) {
+    std::smatch p;
+    EXPECT_TRUE(std::regex_search(context, p, std::regex("Name=\"" + name + R"re(" ParamID="\d+" ParamValue="([^"]+)")re")))
+        << name;
+    return std::stod(p[1]);
+  };
+  c.upper_limit_deg = parameter("UpperLimA1");
+  c.lower_limit_deg = parameter("LowerLimA1");
+  c.max_correction_deg = parameter("MaxA1");
+  c.timeout = static_cast<int>(parameter("Timeout"));
   return c;
 }
 
