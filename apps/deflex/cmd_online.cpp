@@ -1,7 +1,10 @@
 // Subcommands of the online strategies: `online` (deflex on a controller link: ABB EGM position
-// guidance or path correction; runs until the session ends, SIGINT or SIGTERM) and `identify-payload`
+// guidance or path correction, KUKA RSI axis correction ...; runs until the session ends, SIGINT or
+// SIGTERM; its field log through field_log.hpp, its status and summary through online_report.hpp)
+// and `identify-payload`
 // (end-effector mass, centre of gravity and sensor bias from static poses).
 #include <atomic>
+#include <cinttypes>
 #include <cmath>
 #include <chrono>
 #include <csignal>
@@ -14,13 +17,17 @@
 
 #include "cli_util.hpp"
 #include "command.hpp"
+#include "fault_dump.hpp"
+#include "field_log.hpp"
 #include "online_links.hpp"
+#include "online_report.hpp"
 #include "deflex/force/force_spec.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/online/csv_force_replay.hpp"
 #include "deflex/online/payload_identification.hpp"
 #include "deflex/online/udp_force_source.hpp"
+#include "deflex/wire/egm_codec.hpp"
 
 namespace deflex::cli {
 
@@ -84,7 +91,10 @@ class CycleLog {
     for (const char* name : {"q_nominal", "q_feedback", "q_command", "dtheta"}) {
       for (int j = 1; j <= joints; ++j) header += fmt::format(",{}{}_deg", name, j);
     }
-    header += ",corr_x_mm,corr_y_mm,corr_z_mm,fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,delay_ms,compute_us\n";
+    header += ",corr_x_mm,corr_y_mm,corr_z_mm,fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,delay_ms,compute_us";
+    // How the cycle's message arrived, and the link's running counts at that cycle.
+    header += ",replied,stamp_ms,arrival_delay_ms,jitter_ms,missed_before,duplicates,superseded,rejected,restarts,late,"
+              "controller_late\n";
     std::fputs(header.c_str(), file_);
   }
   ~CycleLog() {
@@ -92,16 +102,21 @@ class CycleLog {
   }
   CycleLog(const CycleLog&) = delete;
   CycleLog& operator=(const CycleLog&) = delete;
-  void write(const LinkCycleRecord& r) {
+  void write(const LinkCycleRecord& r, const LinkCounters& c) {
     if (file_ == nullptr) return;
-    std::fprintf(file_, "%.6f,%.9f,%u,%d", r.t_s, r.program_time_s, r.sequence, static_cast<int>(r.status));
+    std::fprintf(file_, "%.6f,%.9f,%" PRIu64 ",%d", r.t_s, r.program_time_s, r.sequence, static_cast<int>(r.status));
     for (const JointVector* q : {&r.q_nominal, &r.q_feedback, &r.q_command, &r.dtheta}) {
       for (int j = 0; j < joints_ && j < q->size(); ++j) std::fprintf(file_, ",%.10g", rad_to_deg((*q)[j]));
     }
     std::fprintf(file_, ",%.6f,%.6f,%.6f", r.tcp_correction_m.x() * 1e3, r.tcp_correction_m.y() * 1e3,
                  r.tcp_correction_m.z() * 1e3);
     for (int j = 0; j < 6; ++j) std::fprintf(file_, ",%.6g", r.wrench_base[j]);
-    std::fprintf(file_, ",%.2f,%.2f\n", r.delay_s * 1e3, r.compute_s * 1e6);
+    std::fprintf(file_, ",%.2f,%.2f", r.delay_s * 1e3, r.compute_s * 1e6);
+    std::fprintf(file_, ",%d,%.0f,%.3f,%.3f,%" PRIu64 ",%" PRIu64 ",%" PRIu64 ",%" PRIu64 ",%" PRIu64 ",%" PRIu64
+                        ",%" PRIu64 "\n",
+                 r.replied ? 1 : 0, r.arrival.stamp_s * 1e3, r.arrival.arrival_delay_s * 1e3, r.arrival.jitter_s * 1e3,
+                 r.arrival.missed_before, c.duplicate, c.superseded, c.rejected(), c.restarts, c.late,
+                 c.controller_late);
   }
 
  private:
@@ -137,7 +152,8 @@ void setup_online(CLI::App& sub, int& exit_code) {
         fault_dump, jacobian_at = "nominal";
     double period_ms = 4.0, max_joint_deg = 0.5, max_tcp_mm = 5.0, max_rate_deg_s = 3.0, watchdog_ms = 50.0;
     double end_silence_s = 2.0, duration_s = 0.0, status_s = 1.0;
-    bool loop = false;
+    bool loop = false, json = false;
+    LogOptions log_options;
   };
   auto o = std::make_shared<Opts>();
   std::string link_help = "Controller link:";
@@ -180,7 +196,10 @@ void setup_online(CLI::App& sub, int& exit_code) {
                  "Streaming links: after the program's end, a controller silence this long ends the session, s")
       ->capture_default_str();
   sub.add_option("--log", o->log, "CSV log of every cycle");
-  sub.add_option("--fault-dump", o->fault_dump, "CSV the last cycles are written to when a fault occurs");
+  sub.add_option("--fault-dump", o->fault_dump,
+                 "CSV the last cycles are written to, once per fault episode (checked for writability at start)");
+  sub.add_flag("--json", o->json, "At the end, print one JSON document of the counters and timing on stdout");
+  add_log_options(sub, o->log_options);
   sub.add_option("--duration-s", o->duration_s, "Stop after this many seconds (0: run until SIGINT/SIGTERM)")
       ->capture_default_str();
   sub.add_option("--status-interval-s", o->status_s, "Live status on stderr every this many seconds")
@@ -248,32 +267,30 @@ void setup_online(CLI::App& sub, int& exit_code) {
     std::shared_ptr<const JointTrajectory> program;
     if (kind_info->streams_program) {
       program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o->program, model));
-      if (!model.has_max_speed()) {
-        std::cerr << "deflex online: warning: the robot file gives no joint speed limits, so the program's speeds "
-                     "were not checked (add max_speed to the robot file)\n";
-      }
     }
-    // The fault dump's path is checked now, not at the first fault in the middle of a run.
-    if (!o->fault_dump.empty()) {
-      std::FILE* probe = std::fopen(o->fault_dump.c_str(), "a");
-      if (probe == nullptr) throw Error(fmt::format("{}: cannot write the fault dump", o->fault_dump));
-      std::fclose(probe);
-    }
+    const auto log = make_field_logger("online", o->log_options);
+    // The fault dump's path is checked now, not at the first fault in the middle of a run; an episode
+    // ends after twice the compensator's fault hold without a fault.
+    FaultDump fault_dump(o->fault_dump, 2.0 * cfg.fault_hold_s, log);
     std::string source_text;
     const std::unique_ptr<ForceSource> source = make_force_source(o->force_source, o->loop, o->bind, source_text);
     SteadyClock clock;
     const OnlineContext context{model, comp, strategy, source.get(), clock, o->bind, program, cfg.period_s};
     const std::unique_ptr<LinkSession> session = kind_info->make(context);
     ControllerLink& link = session->link();
-    CycleLog log(o->log, model.dof());
+    CycleLog cycle_log(o->log, model.dof());
+    if (kind_info->streams_program && !model.has_max_speed()) {
+      log->warn("the robot file gives no joint speed limits, so the program's speeds were not checked (add max_speed "
+                "to the robot file)");
+    }
 
-    std::cerr << fmt::format(
-        "deflex online: {} link, strategy {}; robot {}; sensor {}; force from {}; {}; {}bounds {} deg/joint, "
-        "{} mm TCP, {} deg/s; watchdog {} ms. Stop with Ctrl-C.\n",
+    log->info(
+        "deflex online: {} link, strategy {}; robot {}; sensor {}; force from {}; {}; {}bounds {} deg/joint, {} mm TCP, "
+        "{} deg/s; watchdog {} ms; period {} ms. Stop with Ctrl-C.",
         link.name(), to_string(kind), model.name(), sensor.source, source_text, session->where(),
         program ? fmt::format("program {} ({} points, {:.1f} s); ", o->program, program->size(), program->duration_s())
                 : "",
-        o->max_joint_deg, o->max_tcp_mm, o->max_rate_deg_s, o->watchdog_ms);
+        o->max_joint_deg, o->max_tcp_mm, o->max_rate_deg_s, o->watchdog_ms, o->period_ms);
 
     g_stop = false;
     struct sigaction sa {};
@@ -283,27 +300,12 @@ void setup_online(CLI::App& sub, int& exit_code) {
     sigaction(SIGTERM, &sa, nullptr);
 
     const double start = clock.now_s();
-    double next_status = start + o->status_s;
-    // Interval figures (reset at every status line; the line says so).
-    double max_compute_s = 0.0, max_gap_s = 0.0, max_dev_rad = 0.0, last_t = -1.0, last_message = -1.0;
-    std::uint64_t window_cycles = 0, cycles = 0;
+    double next_status = start + o->status_s, last_message = -1.0;
+    OnlineReport report(start);
     bool refused = false, stopped = false;
-    const auto print_status = [&](double now) {
-      const LinkCounters& c = link.counters();
-      const LinkCycleRecord& r = link.last_cycle();
-      const std::string extra = session->status();
-      std::cerr << fmt::format(
-          "[{:8.1f} s] {} | {}{}cycles {} (total {}) | status {} | |F| {:.1f} N | TCP correction {:.3f} mm | delay "
-          "{:.0f} ms | in the last interval: max |command-nominal| {:.4f} deg, compute max {:.1f} us, gap max {:.1f} "
-          "ms | rejected {} restarts {}\n",
-          now - start, to_string(link.state()), extra, extra.empty() ? "" : " | ", window_cycles, cycles,
-          to_string(r.status), r.wrench_measured_base.head<3>().norm(), r.tcp_correction_m.norm() * 1e3,
-          r.delay_s * 1e3, rad_to_deg(max_dev_rad), max_compute_s * 1e6, max_gap_s * 1e3, c.rejected(), c.restarts);
-      max_compute_s = max_gap_s = max_dev_rad = 0.0;
-      window_cycles = 0;
-    };
     // Our own loop over poll(), so that status and the duration limit keep going while no controller
-    // is talking to us.
+    // is talking to us. Everything between two polls (log lines, the CSV row, a fault dump's copy)
+    // is outside the cycle.
     while (!g_stop.load()) {
       const LinkPollResult r = link.poll(0.05);
       const double now = clock.now_s();
@@ -316,33 +318,23 @@ void setup_online(CLI::App& sub, int& exit_code) {
         break;
       }
       if (r == LinkPollResult::kAnswered || r == LinkPollResult::kNotAnswered) {
-        ++cycles;
-        ++window_cycles;
         last_message = now;
         const LinkCycleRecord& rec = link.last_cycle();
-        max_compute_s = std::max(max_compute_s, rec.compute_s);
-        if (last_t >= 0.0) max_gap_s = std::max(max_gap_s, rec.t_s - last_t);
-        last_t = rec.t_s;
-        if (rec.replied) max_dev_rad = std::max(max_dev_rad, (rec.q_command - rec.q_nominal).cwiseAbs().maxCoeff());
-        log.write(rec);
-        if (link.fault_pending() && !o->fault_dump.empty()) {
-          link.write_history_csv(o->fault_dump);
-          std::cerr << fmt::format("deflex online: fault ({}); last cycles written to {}\n", to_string(rec.status),
-                                   o->fault_dump);
-          link.clear_fault();
-        }
+        report.on_cycle(rec);
+        cycle_log.write(rec, link.counters());
+        fault_dump.on_cycle(now, link);
       }
       if (now >= next_status) {
         if (link.state() == LinkState::kWaiting) {
-          std::cerr << fmt::format("[{:8.1f} s] waiting for the controller ({}; received {}, rejected {})\n",
-                                   now - start, session->where(), link.counters().datagrams, link.counters().rejected());
+          log->info("waiting for the controller ({}; received {}, rejected {})", session->where(),
+                    link.counters().datagrams, link.counters().rejected());
         } else {
-          print_status(now);
+          log->info("{}", report.status_line(now, now - start, link, session->status()));
         }
         next_status = now + o->status_s;
       }
       if (link.state() == LinkState::kFinished && last_message >= 0.0 && now - last_message > o->end_silence_s) {
-        std::cerr << "deflex online: the program has ended and the controller went quiet: session over\n";
+        log->info("the program has ended and the controller went quiet: session over");
         break;
       }
       if (o->duration_s > 0.0 && now - start >= o->duration_s) {
@@ -352,27 +344,49 @@ void setup_online(CLI::App& sub, int& exit_code) {
     // A streaming link stops the controller's motion now (simple message: STOP_TRAJECTORY on Ctrl-C,
     // SIGTERM, --duration-s or the end of the session); the others have nothing to stop.
     link.stop();
+    fault_dump.finish(clock.now_s());
     if (refused) {
-      std::cerr << refusal_text(link, *program, 1.0) << "\n";
+      log->error("{}", refusal_text(link, *program, 1.0));
       exit_code = 2;
       return;
     }
     if (stopped) {
       if (!o->fault_dump.empty()) link.write_history_csv(o->fault_dump);
-      std::cerr << fmt::format("deflex online: the {} link stopped the robot's motion ({}): {}{}\n", link.name(),
-                               to_string(link.stop_cause()), link.stop_reason(),
-                               o->fault_dump.empty() ? "" : fmt::format("; last cycles written to {}", o->fault_dump));
+      log->error("the {} link stopped the robot's motion ({}): {}{}", link.name(), to_string(link.stop_cause()),
+                 link.stop_reason(),
+                 o->fault_dump.empty() ? "" : fmt::format("; last cycles written to {}", o->fault_dump));
     }
     const LinkCounters& c = link.counters();
     const std::string extra = session->summary();
-    std::cerr << fmt::format(
+    const std::uint64_t protobuf_lines = egm_protobuf_log_messages();
+    log->info(
         "deflex online: stopped after {} cycles: {} answers; rejected datagrams {} (malformed {}, truncated {}, "
-        "oversized {}, missing joints {}, non-finite {}, duplicate {}, out of order {}, beyond limits {}, other "
-        "sender {}); restarts {}; guard stops {}; force samples ok {}, fault {}, invalid {}{}{}{}\n",
-        cycles, c.replies, c.rejected(), c.malformed, c.truncated, c.oversized, c.missing_joints, c.non_finite,
-        c.duplicate, c.out_of_order, c.out_of_limits, c.foreign_sender, c.restarts, c.guard_trips,
-        comp.counters().samples_ok, comp.counters().samples_fault, comp.counters().samples_invalid,
-        extra.empty() ? "" : "; ", extra, o->log.empty() ? "" : fmt::format("; log {}", o->log));
+        "oversized {}, empty {}, missing header {}, missing joints {}, missing required {}, non-finite {}, duplicate {}, "
+        "out of order {}, far ahead {}, sequence out of range {}, beyond limits {}, other sender {}, foreign document "
+        "{}); superseded {}; restarts {}; guard stops {}; fault episodes {} ({} faulted cycles); force samples ok {}, "
+        "fault {}, invalid {}; {}{}{}{}{}",
+        report.cycles(), c.replies, c.rejected(), c.malformed, c.truncated, c.oversized, c.empty, c.missing_header,
+        c.missing_joints, c.missing_required, c.non_finite, c.duplicate, c.out_of_order, c.far_ahead,
+        c.sequence_out_of_range, c.out_of_limits, c.foreign_sender, c.foreign_document, c.superseded, c.restarts,
+        c.guard_trips, fault_dump.episodes(), fault_dump.faulted_cycles(), comp.counters().samples_ok,
+        comp.counters().samples_fault, comp.counters().samples_invalid, report.timing_text(link),
+        extra.empty() ? "" : "; ", extra, protobuf_lines > 0 ? fmt::format("; protobuf messages {}", protobuf_lines) : "",
+        o->log.empty() ? "" : fmt::format("; log {}", o->log));
+    if (o->json) {
+      nlohmann::json doc = report.json(link);
+      doc["link"] = link.name();
+      doc["strategy"] = to_string(kind);
+      doc["duration_s"] = clock.now_s() - start;
+      doc["fault_episodes"] = fault_dump.episodes();
+      doc["faulted_cycles"] = fault_dump.faulted_cycles();
+      doc["force_samples"] = {{"ok", comp.counters().samples_ok},
+                              {"fault", comp.counters().samples_fault},
+                              {"invalid", comp.counters().samples_invalid},
+                              {"dropped", comp.counters().samples_dropped}};
+      doc["protobuf_log_messages"] = protobuf_lines;
+      doc["log"] = o->log.empty() ? nlohmann::json(nullptr) : nlohmann::json(o->log);
+      print_json(doc);
+    }
     // What the controller sent that the protocol does not allow is bad input (2); a lost connection, a
     // refusing or faulted controller, a safety stop: the job failed (1).
     exit_code = !stopped ? 0 : link.stop_cause() == LinkStopCause::kProtocol ? 2 : 1;

@@ -17,6 +17,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cross/cli_child.hpp"
 #include "cross/cli_runner.hpp"
 #include "deflex/cell/egm_path_controller.hpp"
 #include "deflex/cell/egm_position_controller.hpp"
@@ -30,73 +31,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Child {
-  pid_t pid = -1;
-  std::string stderr_path;
-  ~Child() {
-    if (pid > 0) {
-      ::kill(pid, SIGKILL);
-      ::waitpid(pid, nullptr, 0);
-    }
-  }
-  int stop() {  // SIGINT, then the exit code (-1 if it did not exit)
-    ::kill(pid, SIGINT);
-    int status = 0;
-    ::waitpid(pid, &status, 0);
-    pid = -1;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-  int wait() {
-    int status = 0;
-    ::waitpid(pid, &status, 0);
-    pid = -1;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-};
-
-void spawn(Child& c, const std::vector<std::string>& args, const std::string& stderr_path) {
-  c.stderr_path = stderr_path;
-  fs::remove(stderr_path);
-  c.pid = ::fork();
-  if (c.pid == 0) {
-    std::FILE* f = std::freopen(stderr_path.c_str(), "w", stderr);
-    (void)f;
-    std::vector<char*> argv;
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    ::execv(argv[0], argv.data());
-    std::_Exit(127);
-  }
-}
+using test::Child;
+using test::run_in_real_time;
+using test::spawn;
 
 // The EGM port deflex bound, from its start-up line.
-int egm_port_of(const Child& c) {
-  const std::string key = "EGM on 127.0.0.1:";
-  for (int i = 0; i < 500; ++i) {
-    const std::string text = test::slurp(c.stderr_path);
-    const auto at = text.find(key);
-    if (at != std::string::npos) {
-      const auto end = text.find(';', at);
-      if (end != std::string::npos) return std::stoi(text.substr(at + key.size(), end - at - key.size()));
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return -1;
-}
-
-// Ticks a controller stand-in in real time every 4 ms for `seconds`.
-template <class Controller>
-void run_in_real_time(Controller& controller, double seconds) {
-  const auto start = std::chrono::steady_clock::now();
-  auto next = start;
-  for (;;) {
-    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (t > seconds) break;
-    controller.tick(t);
-    next += std::chrono::milliseconds(4);
-    std::this_thread::sleep_until(next);
-  }
-}
+int egm_port_of(const Child& c) { return test::port_of(c, "EGM on 127.0.0.1:"); }
 
 const std::string kDeflex = DEFLEX_CLI;
 const std::string kReplay = std::string(DEFLEX_SOURCE_DIR) + "/examples/online/force_replay.csv";
@@ -223,7 +163,7 @@ TEST(CliOnline, BadOptionsAndProgramsAreRefusedBeforeAnythingRuns) {
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
     EXPECT_NE(r.err.find(fragment), std::string::npos) << args << "\n" << r.err;
   };
-  expect("--link rsi", "--link");
+  expect("--link fanuc", "--link");
   {
     const auto r = test::run_cli("online --link egm-path --force-source csv:" + kReplay);
     EXPECT_EQ(r.exit_code, 2) << r.err;

@@ -18,7 +18,8 @@ EgmJointLink::EgmJointLink(OnlineCompensator& compensator, OnlineStrategy& strat
       clock_(clock),
       force_(force),
       config_(config),
-      receiver_(transport, clock, compensator.model(), config.receiver, counters_),
+      receiver_(transport, clock, compensator.model(), with_period(config.receiver, compensator.config().period_s),
+                counters_),
       stream_(nominal, config.stream),
       delay_(config.initial_delay_s),
       history_(config.history_cycles, compensator.model().dof()) {
@@ -84,6 +85,7 @@ LinkPollResult EgmJointLink::poll(double timeout_s) noexcept {
   r.status = out.status;
   r.replied = false;
   r.delay_s = delay_.delay_s();
+  r.arrival = receiver_.arrival();
   r.rotation_uncorrected_rad = 0.0;
   if (out.status == CycleStatus::kForceFault || out.status == CycleStatus::kInvalidInput) {
     fault_pending_ = true;

@@ -45,6 +45,7 @@ class EgmJointLink final : public ControllerLink {
   [[nodiscard]] bool fault_pending() const override { return fault_pending_; }
   void clear_fault() override { fault_pending_ = false; }
   void write_history_csv(const std::string& path) const override { history_.write_csv(path); }
+  [[nodiscard]] const LinkHistory* history() const override { return &history_; }
 
   [[nodiscard]] const JointStream& stream() const { return stream_; }
   [[nodiscard]] const DelayEstimator& delay() const { return delay_; }

@@ -45,7 +45,8 @@ EgmPathLink::EgmPathLink(OnlineCompensator& compensator, OnlineStrategy& strateg
       clock_(clock),
       force_(force),
       config_(config),
-      receiver_(transport, clock, compensator.model(), config.receiver, counters_),
+      receiver_(transport, clock, compensator.model(), with_period(config.receiver, compensator.config().period_s),
+                counters_),
       delay_(config.initial_delay_s),
       history_(config.history_cycles, compensator.model().dof()),
       ws_(compensator.model()),
@@ -158,6 +159,7 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
   r.status = out.status;
   r.replied = false;
   r.delay_s = delay_.delay_s();
+  r.arrival = receiver_.arrival();
   if (out.status == CycleStatus::kForceFault || out.status == CycleStatus::kInvalidInput) {
     fault_pending_ = true;
   }

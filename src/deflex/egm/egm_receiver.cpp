@@ -16,11 +16,38 @@ void EgmReceiverConfig::validate() const {
   if (!std::isfinite(restart_silence_s) || !(restart_silence_s > 0.0)) {
     throw InputError("EGM link: restart silence must be > 0 s");
   }
+  if (max_seqno_ahead < 1 || confirm_jump < 1 || confirm_jump > 1000) {
+    throw InputError("EGM link: max_seqno_ahead must be >= 1 and confirm_jump 1..1000");
+  }
+  if (!std::isfinite(period_s) || !(period_s > 0.0)) {
+    throw InputError("EGM link: the controller's period must be > 0 s");
+  }
 }
+
+namespace {
+// EGM's seqno counts cycles and wraps at 2^32; header.tm is a 32-bit millisecond stamp.
+ControllerGateConfig egm_gate(const EgmReceiverConfig& c) {
+  ControllerGateConfig g;
+  g.sequence.bits = 32;
+  g.sequence.max_ahead = c.max_seqno_ahead;
+  g.sequence.restart_max = c.restart_seqno_max;
+  g.sequence.confirm = c.confirm_jump;
+  g.restart_silence_s = c.restart_silence_s;
+  g.period_s = c.period_s;
+  g.numbers_per_cycle = 1.0;
+  g.stamp_bits = 32;
+  return g;
+}
+}  // namespace
 
 EgmReceiver::EgmReceiver(DatagramTransport& transport, const Clock& clock, const RobotModel& model,
                          const EgmReceiverConfig& config, LinkCounters& counters)
-    : transport_(transport), clock_(clock), config_(config), counters_(counters), codec_(model.dof()) {
+    : transport_(transport),
+      clock_(clock),
+      config_(config),
+      counters_(counters),
+      codec_(model.dof()),
+      gate_(egm_gate(config)) {
   config_.validate();
   // The tolerance allows for the controller's own rounding beyond its soft limits.
   lower_ = model.lower_limits().array() - kPi / 180.0;
@@ -59,6 +86,7 @@ EgmReceiver::Result EgmReceiver::drain(double timeout_s, bool& restarted) noexce
       break;
     }
     ++counters_.datagrams;
+    gate_.heard(from, now);  // the silence that ends a session counts from any datagram of the controller
     if (static_cast<std::size_t>(n) > config_.max_packet_bytes) {
       ++counters_.oversized;
       continue;
@@ -71,6 +99,8 @@ EgmReceiver::Result EgmReceiver::drain(double timeout_s, bool& restarted) noexce
       case EgmDecodeStatus::kMissingJoints: ++counters_.missing_joints; continue;
       case EgmDecodeStatus::kNonFinite: ++counters_.non_finite; continue;
       case EgmDecodeStatus::kEmpty: ++counters_.empty; continue;
+      case EgmDecodeStatus::kSequenceOutOfRange: ++counters_.sequence_out_of_range; continue;
+      case EgmDecodeStatus::kMissingRequired: ++counters_.missing_required; continue;
     }
     // A packet whose joints no robot of this model can have (a corrupted or foreign sender) must not
     // be answered: its correction would be computed at a configuration that is not the arm's.
@@ -78,47 +108,24 @@ EgmReceiver::Result EgmReceiver::drain(double timeout_s, bool& restarted) noexce
       ++counters_.out_of_limits;
       continue;
     }
-    const bool silent = have_seq_ && now - last_accept_s_ > config_.restart_silence_s;
-    // One controller owns the link; another sender may take over only after the controller fell silent.
-    if (have_sender_ && !(from == sender_) && !silent) {
-      ++counters_.foreign_sender;
+    bool session_start = false;
+    if (!gate_.take(from, msg_.seqno, msg_.tm_ms, now, counters_, session_start, msg_arrival_)) {
       continue;
-    }
-    bool session_start = !have_seq_ || silent || !(from == sender_);
-    if (have_seq_ && !session_start) {
-      const auto diff = static_cast<std::int32_t>(msg_.seqno - last_seq_);
-      const bool restart_jump =
-          diff < 0 && msg_.seqno <= config_.restart_seqno_max && last_seq_ > msg_.seqno + config_.restart_seqno_max;
-      if (restart_jump) {
-        session_start = true;
-      } else if (diff == 0) {
-        ++counters_.duplicate;
-        continue;
-      } else if (diff < 0) {
-        ++counters_.out_of_order;
-        continue;
-      }
-    }
-    if (session_start && have_seq_) {
-      ++counters_.restarts;
     }
     restarted = restarted || session_start;
     if (have) {
       ++counters_.superseded;
     }
-    have_seq_ = true;
-    last_seq_ = msg_.seqno;
     last_accept_s_ = now;
-    have_sender_ = true;
-    sender_ = from;
     newest_ = msg_;
+    arrival_ = msg_arrival_;
     have = true;
   }
   return have ? Result::kMessage : Result::kNoneUsable;
 }
 
 bool EgmReceiver::reply(const unsigned char* data, std::size_t size) noexcept {
-  if (!have_sender_ || !transport_.send_to(data, size, sender_)) {
+  if (!gate_.has_controller() || !transport_.send_to(data, size, gate_.controller())) {
     ++counters_.send_errors;
     return false;
   }

@@ -1,14 +1,17 @@
 // The receiving half shared by deflex's EGM links: drains the transport every cycle, decodes the
 // EgmRobot messages, and keeps only the newest usable one from the controller. Empty, oversized,
 // truncated, malformed, incomplete and non-finite packets, joints beyond the robot's limits,
-// duplicates and stale sequence numbers, and datagrams from another sender than the controller's are
-// counted and never handed on. A controller restart (sequence numbers starting again, or a message
-// after a silence) is recognised. Never allocates after construction.
+// duplicates and stale sequence numbers, sequence numbers far ahead of the running one or wider than
+// 32 bits, and datagrams from another sender than the controller's are counted and never handed on.
+// A controller restart (sequence numbers starting again, a jump confirmed by the packets after it, or
+// a message after a silence, measured from the last datagram the controller sent) is recognised.
+// It also measures how the messages arrive (link_timing.hpp). Never allocates after construction.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
+#include "deflex/link/controller_gate.hpp"
 #include "deflex/link/controller_link.hpp"
 #include "deflex/model/robot_model.hpp"
 #include "deflex/transport/clock.hpp"
@@ -24,9 +27,23 @@ struct EgmReceiverConfig {
   double restart_silence_s = 0.5;
   /// A backwards jump to a sequence number at most this is a restart, not a stale packet.
   std::uint32_t restart_seqno_max = 16;
+  /// A sequence number more than this ahead of the running one is a stray (far_ahead) unless
+  /// `confirm_jump` packets in a row continue it. The default is 1 s of 4 ms cycles: twice the
+  /// restart silence, so no genuine gap without a silence is that long.
+  std::uint32_t max_seqno_ahead = 250;
+  int confirm_jump = 3;
+  /// The controller's cycle, for the arrival diagnostics (a message later than this is "late"). The
+  /// EGM links set it to their compensator's period (deflex online --period-ms).
+  double period_s = 0.004;
   /// Throws InputError on a value out of its range.
   void validate() const;
 };
+
+/// `config` with the controller's period set to `period_s` (what the EGM links pass their receiver).
+[[nodiscard]] inline EgmReceiverConfig with_period(EgmReceiverConfig config, double period_s) {
+  config.period_s = period_s;
+  return config;
+}
 
 class EgmReceiver {
  public:
@@ -42,10 +59,12 @@ class EgmReceiver {
   /// Sends to the controller (the sender of the newest message).
   bool reply(const unsigned char* data, std::size_t size) noexcept;
   [[nodiscard]] EgmCodec& codec() { return codec_; }
-  [[nodiscard]] bool has_controller() const { return have_sender_; }
-  [[nodiscard]] const DatagramAddress& controller() const { return sender_; }
+  [[nodiscard]] bool has_controller() const { return gate_.has_controller(); }
+  [[nodiscard]] const DatagramAddress& controller() const { return gate_.controller(); }
   /// Clock time of the last usable message (s).
   [[nodiscard]] double last_message_s() const { return last_accept_s_; }
+  /// How the newest message arrived (diagnostics; also counted in the counters).
+  [[nodiscard]] const LinkArrival& arrival() const { return arrival_; }
 
  private:
   bool plausible(const EgmRobotMessage& m) const noexcept;
@@ -58,11 +77,9 @@ class EgmReceiver {
   JointVector lower_, upper_;
   std::vector<unsigned char> rx_;
   EgmRobotMessage msg_, newest_;
-  bool have_sender_ = false;
-  DatagramAddress sender_;
-  bool have_seq_ = false;
-  std::uint32_t last_seq_ = 0;
+  ControllerGate gate_;
   double last_accept_s_ = 0.0;
+  LinkArrival arrival_, msg_arrival_;
 };
 
 }  // namespace deflex

@@ -13,6 +13,8 @@
 
 namespace deflex {
 
+class LinkHistory;
+
 enum class LinkState : int {
   kWaiting = 0,   ///< no controller message yet
   kRunning = 1,   ///< answering every controller message
@@ -59,17 +61,39 @@ struct LinkCounters {
   std::uint64_t guard_trips = 0;     ///< the final check found a command beyond the bound: not sent
   std::uint64_t refused = 0;         ///< messages not answered because the start was refused
   std::uint64_t send_errors = 0;
+  // Sequencing and diagnostics (docs/online.md, "Link diagnostics").
+  std::uint64_t far_ahead = 0;              ///< a sequence number far ahead of the running one (a stray): never answered
+  std::uint64_t sequence_out_of_range = 0;  ///< wider than its field (EGM seqno > 32 bits, IPOC > 64): never answered
+  std::uint64_t missing_required = 0;       ///< a field the schema requires is missing (EGM proto2): never answered
+  std::uint64_t foreign_document = 0;       ///< well-formed, but not the controller's message (RSI): never answered
+  std::uint64_t missed = 0;                 ///< controller cycles never received (gaps in its sequence)
+  std::uint64_t late = 0;                   ///< messages received more than a period later than the quickest ones
+  std::uint64_t controller_late = 0;        ///< answers the controller itself counted late (RSI <Delay>, its last value)
+  double max_arrival_delay_s = 0.0;         ///< the largest LinkArrival::arrival_delay_s so far
+  double jitter_s = 0.0;                    ///< interarrival jitter now (RFC 3550 estimator)
   [[nodiscard]] std::uint64_t rejected() const {
     return malformed + truncated + oversized + empty + missing_header + missing_joints + non_finite + duplicate +
-           out_of_order + out_of_limits + foreign_sender;
+           out_of_order + out_of_limits + foreign_sender + far_ahead + sequence_out_of_range + missing_required +
+           foreign_document;
   }
+};
+
+/// How one controller message arrived, judged by the controller's own time stamp (EGM header.tm, RSI
+/// IPOC: whole milliseconds of the controller's clock) against the link's clock at receipt. The two
+/// clocks are not synchronised, so the absolute transit time is unknown; what is measured is how much
+/// later than the quickest recent message this one came.
+struct LinkArrival {
+  double stamp_s = 0.0;            ///< the controller's time stamp, s since the session began (its clock)
+  double arrival_delay_s = 0.0;    ///< (receipt - stamp) less its minimum over the last seconds; >= 0
+  double jitter_s = 0.0;           ///< RFC 3550 interarrival jitter after this message
+  std::uint64_t missed_before = 0; ///< controller cycles missing between the previous message taken and this one
 };
 
 /// One answered (or refused) cycle, SI units (rad, m, N, Nm, s).
 struct LinkCycleRecord {
   double t_s = 0.0;                ///< the link's clock
   double program_time_s = 0.0;     ///< streaming links: where in the program the nominal is (its own time axis)
-  std::uint32_t sequence = 0;      ///< the controller's sequence number (EGM seqno, RSI IPOC ...)
+  std::uint64_t sequence = 0;      ///< the controller's sequence number (EGM seqno, RSI IPOC ...)
   JointVector q_nominal;           ///< what deflex holds (streaming links); the controller's planned joints otherwise
   JointVector q_feedback;          ///< where the controller says the arm is
   JointVector q_command;           ///< what was sent (streaming links: q_nominal - dtheta)
@@ -82,6 +106,7 @@ struct LinkCycleRecord {
   bool replied = false;
   double delay_s = 0.0;     ///< the link's measured delay (command to feedback) at this cycle
   double compute_s = 0.0;   ///< from the datagram read to the answer sent
+  LinkArrival arrival;      ///< how the message arrived (diagnostics)
 };
 
 class ControllerLink {
@@ -103,6 +128,9 @@ class ControllerLink {
   virtual void clear_fault() = 0;
   /// The last cycles, oldest first, as CSV (set-up time I/O: allocates; throws Error).
   virtual void write_history_csv(const std::string& path) const = 0;
+  /// The ring of the last cycles, so a caller can copy it between polls and write it elsewhere (a
+  /// fault dump on another thread); null when the link keeps none.
+  [[nodiscard]] virtual const LinkHistory* history() const { return nullptr; }
 
   /// Stops the controller's motion as soon as possible (streaming links over a connection: the
   /// simple message link sends STOP_TRAJECTORY) and sends nothing more. Links whose controller stops on

@@ -2,6 +2,7 @@
 #include "deflex/link/link_history.hpp"
 
 #include <algorithm>
+#include <cinttypes>
 #include <cstdio>
 
 #include <fmt/format.h>
@@ -56,13 +57,13 @@ void LinkHistory::write_csv(const std::string& path) const {
     }
   }
   header += ",corr_x_mm,corr_y_mm,corr_z_mm,rot_uncorrected_mrad,fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,"
-            "meas_fx_N,meas_fy_N,meas_fz_N,delay_ms,compute_ms\n";
+            "meas_fx_N,meas_fy_N,meas_fz_N,delay_ms,compute_ms,arrival_delay_ms,jitter_ms,missed_before\n";
   std::fputs(header.c_str(), f);
   const std::size_t size = ring_.size();
   const std::size_t first = (head_ + size - count_) % size;
   for (std::size_t k = 0; k < count_; ++k) {
     const LinkCycleRecord& r = ring_[(first + k) % size];
-    std::fprintf(f, "%.6f,%.6f,%u,%d,%d", r.t_s, r.program_time_s, r.sequence, static_cast<int>(r.status),
+    std::fprintf(f, "%.6f,%.6f,%" PRIu64 ",%d,%d", r.t_s, r.program_time_s, r.sequence, static_cast<int>(r.status),
                  r.replied ? 1 : 0);
     for (const JointVector* q : {&r.q_nominal, &r.q_feedback, &r.q_command, &r.dtheta}) {
       for (int j = 0; j < q->size(); ++j) {
@@ -77,7 +78,8 @@ void LinkHistory::write_csv(const std::string& path) const {
     for (int j = 0; j < 3; ++j) {
       std::fprintf(f, ",%.6g", r.wrench_measured_base[j]);
     }
-    std::fprintf(f, ",%.3f,%.4f\n", r.delay_s * 1e3, r.compute_s * 1e3);
+    std::fprintf(f, ",%.3f,%.4f,%.3f,%.3f,%" PRIu64 "\n", r.delay_s * 1e3, r.compute_s * 1e3,
+                 r.arrival.arrival_delay_s * 1e3, r.arrival.jitter_s * 1e3, r.arrival.missed_before);
   }
   const bool ok = std::ferror(f) == 0;
   if (std::fclose(f) != 0 || !ok) {

@@ -20,7 +20,8 @@ class LinkHistory {
   /// A record with every joint vector sized for the robot (a link's starting value).
   [[nodiscard]] const LinkCycleRecord& blank() const { return blank_; }
   /// Oldest first: t_s, sequence, status, replied, then q_nominal, q_feedback, q_command, dtheta in
-  /// degrees, the TCP correction in mm, the wrenches in N and Nm, the delay and compute time in ms.
+  /// degrees, the TCP correction in mm, the wrenches in N and Nm, the delay and compute time in ms,
+  /// then how the message arrived (arrival delay and jitter in ms, cycles missed before it).
   /// Throws Error naming the path when it cannot be written.
   void write_csv(const std::string& path) const;
 

@@ -6,6 +6,15 @@
 
 namespace deflex {
 
+SequenceRules force_sequence_rules() {
+  SequenceRules r;
+  r.bits = 32;
+  r.max_ahead = 100;
+  r.restart_max = 16;
+  r.confirm = 3;
+  return r;
+}
+
 bool DatagramForceSource::latest(ForceSample& out) noexcept {
   std::array<unsigned char, 2 * kForceDatagramBytes> buf{};
   DatagramAddress from;
@@ -21,16 +30,14 @@ bool DatagramForceSource::latest(ForceSample& out) noexcept {
       ++counters_.malformed;
       continue;
     }
-    // Wrap-safe ordering: a sample not newer than the last one is dropped. A restarted sender (a jump
-    // back to a small sequence number, or a big backwards jump) is accepted.
-    const auto diff = static_cast<std::int32_t>(d.sequence - last_sequence_);
-    const bool restarted = diff <= -1000 || (d.sequence <= 16 && last_sequence_ > d.sequence + 16);
-    if (have_sequence_ && diff <= 0 && !restarted) {
-      ++counters_.out_of_order;
-      continue;
+    switch (sequence_.observe(d.sequence)) {
+      case SequenceVerdict::kDuplicate:
+      case SequenceVerdict::kOutOfOrder: ++counters_.out_of_order; continue;
+      case SequenceVerdict::kFarAhead: ++counters_.far_ahead; continue;
+      case SequenceVerdict::kRestart: ++counters_.restarts; break;
+      case SequenceVerdict::kFirst:
+      case SequenceVerdict::kNext: break;
     }
-    have_sequence_ = true;
-    last_sequence_ = d.sequence;
     ++counters_.accepted;
     out.t_s = d.t_s;
     out.wrench_sensor = d.wrench_sensor;

@@ -1,7 +1,11 @@
 // EGM codec over the protoc-generated classes (egm.proto).
 #include "deflex/wire/egm_codec.hpp"
 
+#include <atomic>
 #include <cmath>
+#include <mutex>
+
+#include <google/protobuf/stubs/logging.h>
 
 #include "egm.pb.h"
 
@@ -16,6 +20,8 @@ const char* to_string(EgmDecodeStatus s) {
     case EgmDecodeStatus::kMissingJoints: return "missing_joints";
     case EgmDecodeStatus::kNonFinite: return "non_finite";
     case EgmDecodeStatus::kEmpty: return "empty";
+    case EgmDecodeStatus::kSequenceOutOfRange: return "sequence_out_of_range";
+    case EgmDecodeStatus::kMissingRequired: return "missing_required";
   }
   return "unknown";
 }
@@ -69,7 +75,51 @@ void set_joints(const JointVector& q, Joints* j) {
   }
 }
 
+// EgmHeader.seqno (field 1 of the header, field 1 of EgmRobot) as the varint says it: protobuf would
+// keep only its low 32 bits. False when any occurrence is wider than 32 bits. The top level has been
+// scanned already; a header that is itself garbled is left to protobuf to refuse.
+bool header_seqno_fits(const unsigned char* data, std::size_t size) {
+  const unsigned char* p = data;
+  const unsigned char* end = data + size;
+  while (p < end) {
+    std::uint64_t tag = 0, len = 0;
+    bool bad = false;
+    if (!read_varint(p, end, tag, bad) || bad) return true;
+    switch (tag & 7) {
+      case 0: if (!read_varint(p, end, len, bad) || bad) return true; break;
+      case 1: p += 8; break;
+      case 5: p += 4; break;
+      case 2: {
+        if (!read_varint(p, end, len, bad) || bad || len > static_cast<std::uint64_t>(end - p)) return true;
+        const unsigned char* h = p;
+        const unsigned char* h_end = p + len;
+        p = h_end;
+        if ((tag >> 3) != 1) break;
+        while (h < h_end) {
+          std::uint64_t htag = 0, value = 0;
+          if (!read_varint(h, h_end, htag, bad) || bad) break;
+          if ((htag & 7) != 0) break;  // seqno and tm are varints; anything else is protobuf's to judge
+          if (!read_varint(h, h_end, value, bad) || bad) break;
+          if ((htag >> 3) == 1 && value > 0xFFFFFFFFULL) return false;
+        }
+        break;
+      }
+      default: return true;
+    }
+  }
+  return true;
+}
+
+std::atomic<std::uint64_t> g_protobuf_log_messages{0};
+
+void count_protobuf_log(google::protobuf::LogLevel /*level*/, const char* /*filename*/, int /*line*/,
+                        const std::string& /*message*/) {
+  g_protobuf_log_messages.fetch_add(1, std::memory_order_relaxed);
+}
+
 }  // namespace
+
+std::uint64_t egm_protobuf_log_messages() noexcept { return g_protobuf_log_messages.load(std::memory_order_relaxed); }
 
 std::uint32_t egm_time_stamp_ms(double t_s) noexcept {
   if (!std::isfinite(t_s) || !(t_s > 0.0)) {
@@ -133,6 +183,10 @@ EgmDecodeStatus scan_wire_format(const unsigned char* data, std::size_t size) no
 }
 
 EgmCodec::EgmCodec(int expected_joints) : impl_(std::make_unique<Impl>()), expected_joints_(expected_joints) {
+  // Protobuf's own error lines would flood stderr on a stream of bad packets (one line each); they
+  // are counted instead (egm_protobuf_log_messages). Set once: the handler is process-wide.
+  static std::once_flag silenced;
+  std::call_once(silenced, [] { google::protobuf::SetLogHandler(&count_protobuf_log); });
   // Warm the messages once so their sub-messages and repeated fields exist before the first cycle.
   EgmRobotMessage r;
   r.feedback_joints_deg = JointVector::Zero(expected_joints);
@@ -162,9 +216,16 @@ EgmDecodeStatus EgmCodec::decode_robot(const unsigned char* data, std::size_t si
   if (wire != EgmDecodeStatus::kOk) {
     return wire;
   }
+  if (!header_seqno_fits(data, size)) {
+    return EgmDecodeStatus::kSequenceOutOfRange;
+  }
   abb::egm::EgmRobot& m = impl_->robot_in;
-  if (!m.ParseFromArray(data, static_cast<int>(size))) {
-    return EgmDecodeStatus::kMalformed;  // includes missing required fields inside sub-messages
+  // ParsePartial + IsInitialized rather than Parse: the same verdict, without protobuf's error line.
+  if (!m.ParsePartialFromArray(data, static_cast<int>(size))) {
+    return EgmDecodeStatus::kMalformed;
+  }
+  if (!m.IsInitialized()) {
+    return EgmDecodeStatus::kMissingRequired;  // a required field inside a sub-message is absent
   }
   if (!m.has_header() || !m.header().has_seqno()) {
     return EgmDecodeStatus::kMissingHeader;
@@ -241,7 +302,8 @@ bool EgmCodec::decode_sensor(const unsigned char* data, std::size_t size, EgmSen
     return false;
   }
   abb::egm::EgmSensor& m = impl_->sensor_in;
-  if (!m.ParseFromArray(data, static_cast<int>(size)) || !m.has_planned() || !m.planned().has_joints()) {
+  if (!m.ParsePartialFromArray(data, static_cast<int>(size)) || !m.IsInitialized() || !m.has_planned() ||
+      !m.planned().has_joints()) {
     return false;
   }
   if (!copy_joints(m.planned().joints(), expected_joints_, out.planned_joints_deg)) {
@@ -282,7 +344,7 @@ bool EgmCodec::decode_path_corr(const unsigned char* data, std::size_t size, Egm
     return false;
   }
   abb::egm::EgmSensorPathCorr& m = impl_->path_in;
-  if (!m.ParseFromArray(data, static_cast<int>(size)) || !m.has_pathcorr()) {
+  if (!m.ParsePartialFromArray(data, static_cast<int>(size)) || !m.IsInitialized() || !m.has_pathcorr()) {
     return false;  // pathCorr's pos and age are required: protobuf refuses a message without them
   }
   out.pos_mm = Vector3(m.pathcorr().pos().x(), m.pathcorr().pos().y(), m.pathcorr().pos().z());

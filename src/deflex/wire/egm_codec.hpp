@@ -56,6 +56,8 @@ enum class EgmDecodeStatus : int {
   kMissingJoints = -4,  ///< feedback joints absent, or feedback or planned joints of another count
   kNonFinite = -5,      ///< NaN or infinite joint values
   kEmpty = -6,          ///< zero-length packet
+  kSequenceOutOfRange = -7,  ///< header.seqno wider than its uint32 field (protobuf would truncate it)
+  kMissingRequired = -8,     ///< a field proto2 requires is missing (protobuf would print an error line)
 };
 [[nodiscard]] const char* to_string(EgmDecodeStatus s);
 
@@ -92,6 +94,11 @@ class EgmCodec {
 /// wraps (after 49.7 days); 0 for a negative or non-finite time. A plain cast of t_s * 1000 to
 /// uint32 would be undefined behaviour past the wrap.
 [[nodiscard]] std::uint32_t egm_time_stamp_ms(double t_s) noexcept;
+
+/// Protobuf messages its own library printed (on stderr, before deflex took them over) since start:
+/// every EgmCodec routes protobuf's log to this counter instead, so a flood of bad packets cannot
+/// flood the log. Parsing never logs in the first place (required fields are checked by deflex).
+[[nodiscard]] std::uint64_t egm_protobuf_log_messages() noexcept;
 
 /// Walks the top level of a protobuf buffer: kTruncated when a field runs past the end, kMalformed on
 /// an impossible tag or wire type, kOk otherwise. Independent of protobuf's parser, so a truncated

@@ -2,7 +2,7 @@
 # deflex online --link simple-message against the Python stand-in of ABB's RAPID streaming server
 # (simple_message_standin.py), over loopback TCP, for 3 s at the paper's 100 ms cycle: the stand-in must
 # have taken the points and the STOP_TRAJECTORY deflex sends when it ends, and every logged command must
-# lie within the 0.5 deg bound of the nominal. Usage: 01_simple_message_standin.sh DEFLEX OUTDIR
+# lie within the 0.5 deg bound of the nominal. Usage: 03_simple_message_standin.sh DEFLEX OUTDIR
 set -eu
 DEFLEX=$1
 OUT=$2

@@ -1,0 +1,151 @@
+// `deflex controller-setup --link egm-joint|egm-path|rsi`: writes what the robot controller needs to talk
+// to `deflex online` over that link (a RAPID module and the UdpUc entry for ABB EGM; the Ethernet
+// config, the RSI context and the KRL lines for KUKA RSI), from the same options and defaults as
+// `deflex online` (ports, period, bounds, SENTYPE), so the controller's side agrees with deflex's.
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include <fmt/format.h>
+
+#include "cli_util.hpp"
+#include "command.hpp"
+#include "deflex/egm/egm_controller_setup.hpp"
+#include "deflex/model/errors.hpp"
+#include "deflex/rsi/rsi_controller_setup.hpp"
+#include "deflex/rsi/rsi_link.hpp"
+
+namespace deflex::cli {
+namespace {
+
+void setup_controller_setup(CLI::App& sub, int& exit_code) {
+  struct Opts {
+    std::string link, sensor_ip, output_dir = ".", sentype = "ImFree", context = "deflex_rsi", device = "DEFLEX",
+                                  egm_config = "default", module = "DeflexEgm", path_frame = "tool", tool = "tool0";
+    int egm_port = 6510, rsi_port = 49152, rsi_timeout = 100, rsi_precision = 4;
+    double period_ms = 0.0, max_joint_deg = 0.5, max_tcp_mm = 5.0, ramp_in_s = 1.0, comm_timeout_s = 1.0,
+           lowpass_hz = 20.0, convergence_deg = 0.1, cond_time_s = 10.0, max_pos_deviation_deg = 1000.0,
+           max_speed_deviation_deg_s = 1000.0, monitor_factor = 1.2;
+    bool json = false;
+  };
+  auto o = std::make_shared<Opts>();
+  sub.add_option("--link", o->link, "egm-joint, egm-path or rsi (as deflex online --link)")->required();
+  sub.add_option("--sensor-ip", o->sensor_ip,
+                 "deflex's IPv4 address as the controller reaches it (the PC on the controller's network)")
+      ->required();
+  sub.add_option("-o,--output-dir", o->output_dir, "Directory the files are written to (must exist)")
+      ->capture_default_str();
+  sub.add_option("--egm-port", o->egm_port, "EGM: deflex online --egm-port")->capture_default_str();
+  sub.add_option("--rsi-port", o->rsi_port, "rsi: deflex online --rsi-port (the Ethernet config's PORT)")
+      ->capture_default_str();
+  sub.add_option("--rsi-sentype", o->sentype, "rsi: deflex online --rsi-sentype (the Ethernet config's SENTYPE)")
+      ->capture_default_str();
+  sub.add_option("--period-ms", o->period_ms,
+                 "deflex online --period-ms: egm-joint 4; egm-path the EGMActMove SampleRate (default 48); rsi 4 "
+                 "(#IPO_FAST) or 12 (#IPO)");
+  sub.add_option("--max-joint-correction-deg", o->max_joint_deg,
+                 "deflex online --max-joint-correction-deg (rsi: AXISCORR's limits on every axis)")
+      ->capture_default_str();
+  sub.add_option("--max-tcp-correction-mm", o->max_tcp_mm, "deflex online --max-tcp-correction-mm")
+      ->capture_default_str();
+  sub.add_option("--ramp-in-s", o->ramp_in_s, "egm-joint: deflex online --ramp-in-s (EGMRunJoint \\RampInTime)")
+      ->capture_default_str();
+  sub.add_option("--path-corr-frame", o->path_frame, "egm-path: deflex online --path-corr-frame (tool, flange, path)")
+      ->capture_default_str();
+  sub.add_option("--egm-device", o->device, "EGM: the UdpUc device's name")->capture_default_str();
+  sub.add_option("--egm-config", o->egm_config, "EGM: the External Motion Interface Data entry EGMSetupUC names")
+      ->capture_default_str();
+  sub.add_option("--module", o->module, "EGM: the RAPID module's name")->capture_default_str();
+  sub.add_option("--tool", o->tool, "EGM: the tooldata the program moves with")->capture_default_str();
+  sub.add_option("--comm-timeout-s", o->comm_timeout_s, "EGM: EGMSetupUC \\CommTimeout, s")->capture_default_str();
+  sub.add_option("--lowpass-hz", o->lowpass_hz, "egm-joint: EGMActJoint \\LpFilter, Hz")->capture_default_str();
+  sub.add_option("--convergence-deg", o->convergence_deg, "egm-joint: the joints' convergence condition, deg")
+      ->capture_default_str();
+  sub.add_option("--cond-time-s", o->cond_time_s, "egm-joint: EGMRunJoint \\CondTime, s")->capture_default_str();
+  sub.add_option("--max-pos-deviation-deg", o->max_pos_deviation_deg, "egm-joint: EGMActJoint \\MaxPosDeviation, deg")
+      ->capture_default_str();
+  sub.add_option("--max-speed-deviation-deg-s", o->max_speed_deviation_deg_s,
+                 "egm-joint: EGMActJoint \\MaxSpeedDeviation, deg/s")
+      ->capture_default_str();
+  sub.add_option("--context", o->context, "rsi: base name of the files and the KRL program")->capture_default_str();
+  sub.add_option("--rsi-timeout", o->rsi_timeout, "rsi: ETHERNET Timeout, late answers before RSI stops")
+      ->capture_default_str();
+  sub.add_option("--rsi-precision", o->rsi_precision, "rsi: ETHERNET Precision, decimals the controller sends")
+      ->capture_default_str();
+  sub.add_option("--rsi-monitor-factor", o->monitor_factor,
+                 "rsi: AXISCORRMON's MaxAi as a multiple of --max-joint-correction-deg")
+      ->capture_default_str();
+  sub.add_flag("--json", o->json, "Print one JSON document (the files written and where each goes) on stdout");
+  sub.callback([o, &exit_code] {
+    const auto port = [](int p, const char* option) {
+      if (p < 1 || p > 65535) throw InputError(fmt::format("option {}: must be 1..65535 (got {})", option, p));
+      return static_cast<std::uint16_t>(p);
+    };
+    std::vector<ControllerFile> files;
+    if (o->link == "egm-joint" || o->link == "egm-path") {
+      EgmSetupOptions e;
+      e.path_correction = o->link == "egm-path";
+      e.sensor_ip = o->sensor_ip;
+      e.port = port(o->egm_port, "--egm-port");
+      e.device = o->device;
+      e.egm_config = o->egm_config;
+      e.module = o->module;
+      e.period_ms = o->period_ms > 0.0 ? o->period_ms : (e.path_correction ? 48.0 : 4.0);
+      if (o->period_ms < 0.0) throw InputError("option --period-ms: must be > 0");
+      e.max_joint_correction_deg = o->max_joint_deg;
+      e.max_tcp_correction_mm = o->max_tcp_mm;
+      e.comm_timeout_s = o->comm_timeout_s;
+      e.lowpass_hz = o->lowpass_hz;
+      e.ramp_in_s = o->ramp_in_s;
+      e.convergence_deg = o->convergence_deg;
+      e.cond_time_s = o->cond_time_s;
+      e.max_pos_deviation_deg = o->max_pos_deviation_deg;
+      e.max_speed_deviation_deg_s = o->max_speed_deviation_deg_s;
+      e.path_frame = o->path_frame;
+      e.tool = o->tool;
+      files = egm_controller_setup(e);
+    } else if (o->link == "rsi") {
+      RsiSetupOptions r;
+      r.sensor_ip = o->sensor_ip;
+      r.port = port(o->rsi_port, "--rsi-port");
+      r.sentype = o->sentype;
+      r.context = o->context;
+      r.period_ms = o->period_ms > 0.0 ? o->period_ms : 4.0;
+      if (o->period_ms < 0.0) throw InputError("option --period-ms: must be > 0");
+      r.max_joint_correction_deg = o->max_joint_deg;
+      r.monitor_factor = o->monitor_factor;
+      r.timeout = o->rsi_timeout;
+      r.precision = o->rsi_precision;
+      r.restart_silence_s = RsiLinkConfig{}.restart_silence_s;
+      files = rsi_controller_setup(r);
+    } else {
+      throw InputError(fmt::format("option --link: '{}' is not egm-joint, egm-path or rsi", o->link));
+    }
+    if (!std::filesystem::is_directory(o->output_dir)) {
+      throw InputError(fmt::format("option --output-dir: '{}' is not a directory", o->output_dir));
+    }
+    write_controller_files(files, o->output_dir);
+    if (o->json) {
+      nlohmann::json list = nlohmann::json::array();
+      for (const auto& f : files) {
+        list.push_back({{"file", (std::filesystem::path(o->output_dir) / f.name).string()}, {"install", f.install}});
+      }
+      print_json({{"link", o->link}, {"files", list}});
+    } else {
+      std::cout << fmt::format("deflex controller-setup --link {}: wrote {} files to {}\n", o->link, files.size(),
+                               o->output_dir);
+      for (const auto& f : files) std::cout << fmt::format("  {}\n      {}\n", f.name, f.install);
+      std::cout << "docs/online.md walks through installing them and names the controller's typical errors.\n";
+    }
+    exit_code = 0;
+  });
+}
+
+}  // namespace
+
+DEFLEX_COMMAND("controller-setup",
+               "Write the robot controller's side of a link (--link egm-joint|egm-path|rsi): RAPID and UdpUc for ABB "
+               "EGM, the Ethernet config, RSI context and KRL for KUKA RSI, agreeing with deflex online's options",
+               setup_controller_setup, 42);
+
+}  // namespace deflex::cli

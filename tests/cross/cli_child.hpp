@@ -1,0 +1,88 @@
+// Test helpers for running `deflex online` as a real process beside a controller stand-in: a child
+// process with its stderr (and stdout) in files, the port it bound read from its start-up line, and a
+// stand-in ticked in real time every 4 ms.
+#pragma once
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cross/cli_runner.hpp"
+
+namespace deflex::test {
+
+struct Child {
+  pid_t pid = -1;
+  std::string stderr_path;
+  ~Child() {
+    if (pid > 0) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, nullptr, 0);
+    }
+  }
+  int stop() {  // SIGINT, then the exit code (-1 if it did not exit)
+    ::kill(pid, SIGINT);
+    return wait();
+  }
+  int wait() {
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    pid = -1;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+};
+
+/// Starts args[0] with args, stderr into `stderr_path` and, when given, stdout into `stdout_path`.
+inline void spawn(Child& c, const std::vector<std::string>& args, const std::string& stderr_path,
+                  const std::string& stdout_path = "") {
+  c.stderr_path = stderr_path;
+  std::filesystem::remove(stderr_path);
+  c.pid = ::fork();
+  if (c.pid == 0) {
+    std::FILE* f = std::freopen(stderr_path.c_str(), "w", stderr);
+    if (!stdout_path.empty()) f = std::freopen(stdout_path.c_str(), "w", stdout);
+    (void)f;
+    std::vector<char*> argv;
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::execv(argv[0], argv.data());
+    std::_Exit(127);
+  }
+}
+
+/// The port after `key` ("EGM on 127.0.0.1:") in the child's start-up line; -1 when it never came.
+inline int port_of(const Child& c, const std::string& key) {
+  for (int i = 0; i < 500; ++i) {
+    const std::string text = slurp(c.stderr_path);
+    const auto at = text.find(key);
+    if (at != std::string::npos) {
+      const auto end = text.find(';', at);
+      if (end != std::string::npos) return std::stoi(text.substr(at + key.size(), end - at - key.size()));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return -1;
+}
+
+/// Ticks a controller stand-in in real time every 4 ms for `seconds`.
+template <class Controller>
+void run_in_real_time(Controller& controller, double seconds) {
+  const auto start = std::chrono::steady_clock::now();
+  auto next = start;
+  for (;;) {
+    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (t > seconds) break;
+    controller.tick(t);
+    next += std::chrono::milliseconds(4);
+    std::this_thread::sleep_until(next);
+  }
+}
+
+}  // namespace deflex::test
