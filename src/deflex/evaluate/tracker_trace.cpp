@@ -1,6 +1,8 @@
 // Laser-tracker traces and their CSV form.
 #include "deflex/evaluate/tracker_trace.hpp"
 
+#include <array>
+
 #include <fmt/format.h>
 
 #include "deflex/model/csv_table.hpp"
@@ -45,8 +47,10 @@ TrackerTrace parse_tracker_csv(const std::string& text, const std::string& sourc
 void write_tracker_csv(const TrackerTrace& trace, const std::string& path) {
   CsvWriter w(path, {"t_s", "x_mm", "y_mm", "z_mm"});
   for (const auto& s : trace) {
-    w.row({s.t_s, s.p_m.x() * 1e3, s.p_m.y() * 1e3, s.p_m.z() * 1e3});
+    const std::array<double, 4> row{s.t_s, s.p_m.x() * 1e3, s.p_m.y() * 1e3, s.p_m.z() * 1e3};
+    w.row(row);
   }
+  w.finish();
 }
 
 double trace_length_m(const TrackerTrace& trace) {

@@ -355,6 +355,7 @@ void write_calibration_plan(const std::string& path, const CalibrationPlan& plan
     }
     w.row(row);
   }
+  w.finish();
 }
 
 }  // namespace deflex

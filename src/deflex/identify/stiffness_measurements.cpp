@@ -159,6 +159,7 @@ void write_stiffness_measurements(const std::string& csv_path, const std::vector
     row.push_back(m.weight);
     w.row(row);
   }
+  w.finish();
 }
 
 }  // namespace deflex

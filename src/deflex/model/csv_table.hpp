@@ -1,34 +1,93 @@
 // Reading numeric CSV data files with a header row whose column names carry units
 // (`q1_deg`, `fx_N`, `t_s`). Every deflex data reader goes through this, so errors look alike:
 // "FILE:LINE: column 'fx_N': 'abc' is not a number".
+//
+// Two ways in: CsvReader streams a file a row at a time (memory independent of the file's length:
+// one 1 MiB read buffer and one row of values), CsvTable keeps every row (a flat array of values,
+// 8 bytes a cell). Both parse the same way: numbers with std::from_chars (the process locale never
+// changes what "1.5" means), a UTF-8 byte-order mark skipped, LF, CRLF and CR-only line endings,
+// '#' comment lines and blank lines skipped, cells trimmed of spaces and tabs.
 #pragma once
 
+#include <cstdio>
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
+
+#include <fmt/format.h>
 
 namespace deflex {
 
-/// A CSV file of numbers: a header row, then one row of values per line. Lines starting with '#'
-/// and blank lines are skipped. Columns may come in any order; they are found by name.
+/// Streams a CSV file of numbers: a header row, then one row of finite numbers per line, every row
+/// with the header's number of cells. Columns may come in any order; they are found by name. Errors
+/// throw DataError naming the file, the line and the column.
+class CsvReader {
+ public:
+  /// Opens the file and reads its header row. Throws DataError when the file cannot be read, has no
+  /// header, a header cell is empty or repeated, or the header is separated by ';' or tabs.
+  explicit CsvReader(const std::string& path);
+  /// Reads from text held in memory; `source` names it in messages.
+  CsvReader(std::string text, std::string source);
+  ~CsvReader();
+  CsvReader(const CsvReader&) = delete;
+  CsvReader& operator=(const CsvReader&) = delete;
+
+  [[nodiscard]] const std::string& source() const { return source_; }
+  [[nodiscard]] const std::vector<std::string>& columns() const { return columns_; }
+  [[nodiscard]] bool has(const std::string& column) const { return index_.count(column) != 0; }
+  /// Column position; throws DataError "FILE: missing column 'x' (have: ...)".
+  [[nodiscard]] std::size_t column(const std::string& name) const;
+  /// Fails when any of `required` is missing, naming all that are.
+  void require(const std::vector<std::string>& required) const;
+
+  /// Reads the next data row; false at the end of the file. Throws DataError for a bad row.
+  bool next();
+  /// The current row's values (valid until the next call to next()).
+  [[nodiscard]] std::span<const double> row() const { return row_; }
+  [[nodiscard]] double operator[](std::size_t column) const { return row_[column]; }
+  /// The file's line number of the current row (1-based).
+  [[nodiscard]] int line() const { return line_of_row_; }
+  /// Throws DataError "FILE:LINE: column 'c': message" for the current row.
+  [[noreturn]] void fail(const std::string& column, const std::string& message) const;
+
+ private:
+  bool next_line(std::string_view& out);  // the next line (without its ending), false at the end
+  void read_header();
+  void parse_row(std::string_view line);
+
+  std::string source_;
+  std::FILE* file_ = nullptr;
+  std::string buffer_;     // the bytes read and not yet consumed, from begin_
+  std::size_t begin_ = 0;  // first unconsumed byte of buffer_
+  bool eof_ = false;
+  bool pending_cr_ = false;  // the last line ended with '\r': a '\n' right after it is the same ending
+  bool first_bytes_ = true;  // a byte-order mark is skipped only at the very start
+  int line_ = 0;
+  int line_of_row_ = 0;
+  std::vector<std::string> columns_;
+  std::map<std::string, std::size_t> index_;
+  std::vector<double> row_;
+};
+
+/// A whole CSV file of numbers in memory (see CsvReader for the rules).
 class CsvTable {
  public:
-  /// Reads and checks the whole file: every cell of every row must be a finite number (NaN, inf and
-  /// empty cells are errors naming the line and column), and every row must have the header's
-  /// number of cells. Throws DataError.
+  /// Reads and checks the whole file. Throws DataError.
   static CsvTable read_file(const std::string& path);
   static CsvTable parse(const std::string& text, const std::string& source);
 
   [[nodiscard]] const std::string& source() const { return source_; }
   [[nodiscard]] const std::vector<std::string>& columns() const { return columns_; }
-  [[nodiscard]] std::size_t rows() const { return values_.size(); }
+  [[nodiscard]] std::size_t rows() const { return lines_.size(); }
   [[nodiscard]] bool has(const std::string& column) const { return index_.count(column) != 0; }
   /// Column position; throws DataError "FILE: missing column 'x' (have: ...)".
   [[nodiscard]] std::size_t column(const std::string& name) const;
   /// Value of a cell by row (0-based data row) and column name.
   [[nodiscard]] double at(std::size_t row, const std::string& column) const;
-  [[nodiscard]] double at(std::size_t row, std::size_t column) const { return values_[row][column]; }
+  [[nodiscard]] double at(std::size_t row, std::size_t column) const { return values_[row * columns_.size() + column]; }
   /// The file's line number of a data row, for messages about a row's meaning (1-based).
   [[nodiscard]] int line_of(std::size_t row) const { return lines_[row]; }
   /// Throws DataError "FILE:LINE: column 'c': message" for a row.
@@ -37,25 +96,39 @@ class CsvTable {
   void require(const std::vector<std::string>& required) const;
 
  private:
+  static CsvTable drain(CsvReader& reader);
+
   std::string source_;
   std::vector<std::string> columns_;
   std::map<std::string, std::size_t> index_;
-  std::vector<std::vector<double>> values_;
+  std::vector<double> values_;  // row-major, rows() x columns().size()
   std::vector<int> lines_;
 };
 
-/// Writes a CSV header row and rows with fixed formatting. Throws Error if the file cannot be written.
+/// Writes a CSV header row and rows of numbers (%.10g), buffered: a row is formatted into the
+/// writer's own buffer, never into a temporary string, and the buffer goes to the file in 64 kB
+/// pieces. Throws Error if the file cannot be written; finish() (or the destructor, silently)
+/// flushes and closes it.
 class CsvWriter {
  public:
   CsvWriter(const std::string& path, const std::vector<std::string>& columns);
-  void row(const std::vector<double>& values);
+  ~CsvWriter();
+  CsvWriter(const CsvWriter&) = delete;
+  CsvWriter& operator=(const CsvWriter&) = delete;
+  void row(std::span<const double> values);
+  void row(const std::vector<double>& values) { row(std::span<const double>(values)); }
   void comment(const std::string& text);  ///< "# text" line
+  /// Flushes and closes; throws Error when the data did not reach the file.
+  void finish();
 
  private:
+  void flush_if_full();
+  void flush();
+
   std::string path_;
   std::size_t width_;
-  struct Impl;
-  std::shared_ptr<Impl> impl_;
+  std::FILE* file_ = nullptr;
+  fmt::memory_buffer buffer_;
 };
 
 }  // namespace deflex
