@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <memory>
 
@@ -22,7 +23,7 @@
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/path_spec.hpp"
-#include "deflex/paths/pose_path_csv.hpp"
+#include "deflex/paths/pose_source.hpp"
 
 namespace deflex::cli {
 namespace {
@@ -144,10 +145,10 @@ void run(const Opts& o, int& exit_code) {
 
   // Path.
   ForceSpecContext context;
-  std::vector<Pose> poses;
+  std::unique_ptr<PoseSource> source;
   std::string path_text;
   if (!o.path_csv.empty()) {
-    poses = read_pose_path_csv(o.path_csv);
+    source = std::make_unique<PoseCsvSource>(o.path_csv);
     path_text = fmt::format("poses from {}", o.path_csv);
     if (o.orientation_given) {
       std::cerr << "deflex offline: warning: --orientation-wxyz is ignored: the path file gives the orientation\n";
@@ -159,7 +160,7 @@ void run(const Opts& o, int& exit_code) {
     if (o.circle_given) {
       const CirclePath c = parse_circle_spec(o.circle == "default" ? "" : o.circle);
       context.circle = c;
-      poses = sample_circle(c, orientation);
+      source = std::make_unique<CirclePoseSource>(c, orientation);
       path_text = fmt::format("circle centre ({:.1f}, {:.1f}, {:.1f}) mm, radius {:.1f} mm, normal ({:g}, {:g}, {:g}), "
                               "{}, {} points",
                               c.centre_m.x() * 1e3, c.centre_m.y() * 1e3, c.centre_m.z() * 1e3, c.radius_m * 1e3,
@@ -167,7 +168,7 @@ void run(const Opts& o, int& exit_code) {
                               c.points);
     } else {
       const LinePath l = parse_line_spec(o.line);
-      poses = sample_line(l, orientation);
+      source = std::make_unique<LinePoseSource>(l, orientation);
       path_text = fmt::format("line from ({:.1f}, {:.1f}, {:.1f}) mm to ({:.1f}, {:.1f}, {:.1f}) mm, {} points",
                               l.start_m.x() * 1e3, l.start_m.y() * 1e3, l.start_m.z() * 1e3, l.end_m.x() * 1e3,
                               l.end_m.y() * 1e3, l.end_m.z() * 1e3, l.points);
@@ -195,8 +196,6 @@ void run(const Opts& o, int& exit_code) {
   if (!o.seed.empty()) {
     first.seed = parse_joints_deg(o.seed, model, "--seed-deg");
   }
-  const JointPath joints = solve_path_ik(model, poses, first);
-
   // Force models: several --force options, or several force_N values, give one run per load.
   std::vector<std::unique_ptr<ForceModel>> forces;
   for (const std::string& spec : o.forces) {
@@ -221,35 +220,15 @@ void run(const Opts& o, int& exit_code) {
     rapid.module_name = o.module;
     check_rapid_options(rapid);  // before anything is computed or written
   }
-  rapid.note = fmt::format("Path: {}; arm configuration [cf1,cf4,cf6,cfx] at the start [{},{},{},{}].", path_text,
-                           joints.configuration.cf1, joints.configuration.cf4, joints.configuration.cf6,
-                           joints.configuration.cfx);
-
-  // Timed joint programs for the streaming links (deflex online --program): the path at the TCP
-  // speed, compensated (per load) or nominal.
   if (!std::isfinite(o.hold_start_s) || o.hold_start_s < 0.0 || o.hold_start_s > 3600.0) {
     throw InputError(fmt::format("option --hold-start-s: must be 0..3600 s (got {})", o.hold_start_s));
   }
-  if ((!o.trajectory_out.empty() || !o.nominal_trajectory_out.empty()) &&
-      (!std::isfinite(o.speed_mm_s) || !(o.speed_mm_s > 0.0) || o.speed_mm_s > 10000.0)) {
+  const bool trajectories = !o.trajectory_out.empty() || !o.nominal_trajectory_out.empty();
+  if (trajectories && (!std::isfinite(o.speed_mm_s) || !(o.speed_mm_s > 0.0) || o.speed_mm_s > 10000.0)) {
     throw InputError(fmt::format("option --speed-mm-s: must be a positive TCP speed up to 10000 mm/s (got {})",
                                  o.speed_mm_s));
   }
-  const auto write_trajectory = [&](const std::vector<JointVector>& q, const std::string& file,
-                                    const std::string& what) {
-    const JointTrajectory t = trajectory_at_tcp_speed(poses, q, o.speed_mm_s * 1e-3, model, o.hold_start_s);
-    t.write_csv(file, fmt::format("deflex offline: {} joint trajectory of {} at {:g} mm/s ({} points, {:.3f} s); "
-                                  "stream it with deflex online --link egm-joint --program {}",
-                                  what, path_text, o.speed_mm_s, t.size(), t.duration_s(), file));
-    return t;
-  };
-  if (!o.nominal_trajectory_out.empty()) {
-    const JointTrajectory t = write_trajectory(joints.q, o.nominal_trajectory_out, "nominal (uncompensated)");
-    (o.json ? std::cerr : std::cout) << fmt::format("wrote {} (nominal joint trajectory, {:.3f} s)\n",
-                                                    o.nominal_trajectory_out, t.duration_s());
-  }
 
-  nlohmann::json runs = nlohmann::json::array();
   const bool several = forces.size() > 1;
   std::vector<std::string> labels;  // file-name labels, made unique so no run overwrites another
   for (std::size_t k = 0; k < forces.size(); ++k) {
@@ -259,43 +238,129 @@ void run(const Opts& o, int& exit_code) {
     }
     labels.push_back(label);
   }
+
+  // One pass over the path: a pose, its inverse kinematics, then every load's compensation and CSV
+  // row. Only what an output needs whole is kept (a RAPID module's points, a timed trajectory's
+  // poses and joints); a path written to CSV alone streams in memory independent of its length.
+  struct Run {
+    std::unique_ptr<PathCompensator> compensator;
+    std::unique_ptr<OfflineCsvWriter> csv;
+    std::string csv_file;
+    std::vector<OfflinePoint> points;      // for the RAPID module
+    std::vector<JointVector> q_command;    // for the compensated trajectory
+    const LdbbForceModel* ldbb = nullptr;  // the bar's length and inclination along the path
+    double lmin = HUGE_VAL, lmax = 0.0, pmin = HUGE_VAL, pmax = -HUGE_VAL;
+    OfflineResult summary;
+  };
+  std::vector<Run> runs_state(forces.size());
+  std::vector<std::string> written;  // removed again if the pass fails: no half-written outputs
+  std::vector<Pose> poses;           // kept only for the trajectories
+  std::vector<JointVector> q_nominal;
+  PathIkSolver ik(model, first);
+  try {
+    for (std::size_t k = 0; k < forces.size(); ++k) {
+      Run& r = runs_state[k];
+      r.compensator = std::make_unique<PathCompensator>(model, *forces[k]);
+      r.ldbb = dynamic_cast<const LdbbForceModel*>(forces[k].get());
+      if (!o.csv_out.empty()) {
+        r.csv_file = several ? suffixed(o.csv_out, labels[k]) : o.csv_out;
+        r.csv = std::make_unique<OfflineCsvWriter>(r.csv_file, model.dof(), model.name(), forces[k]->describe(), true);
+        written.push_back(r.csv_file);
+      }
+    }
+    Pose pose;
+    std::size_t i = 0;
+    for (; source->next(pose); ++i) {
+      const JointVector& q = ik.next(pose);
+      if (trajectories) {
+        poses.push_back(pose);
+        q_nominal.push_back(q);
+      }
+      for (Run& r : runs_state) {
+        const OfflinePoint& pt = r.compensator->compensate(i, q, pose);
+        if (r.csv) {
+          r.csv->write(i, pt);
+        }
+        if (!o.rapid_out.empty()) {
+          r.points.push_back(pt);
+        }
+        if (!o.trajectory_out.empty()) {
+          r.q_command.push_back(pt.q_command);
+        }
+        if (r.ldbb != nullptr) {
+          const double l = r.ldbb->bar_length_m(pose), phi = r.ldbb->inclination_rad(pose);
+          r.lmin = std::min(r.lmin, l);
+          r.lmax = std::max(r.lmax, l);
+          r.pmin = std::min(r.pmin, phi);
+          r.pmax = std::max(r.pmax, phi);
+        }
+      }
+    }
+    if (i == 0) {
+      throw InputError("path: no points");
+    }
+    for (Run& r : runs_state) {
+      r.summary = r.compensator->summary();  // a force table longer than the path fails here
+      if (r.csv) {
+        r.csv->finish();
+      }
+    }
+  } catch (...) {
+    for (Run& r : runs_state) {
+      r.csv.reset();  // closes the file before it is removed
+    }
+    for (const std::string& f : written) {
+      std::remove(f.c_str());
+    }
+    throw;
+  }
+  const ArmConfiguration& configuration = ik.configuration();
+  rapid.note = fmt::format("Path: {}; arm configuration [cf1,cf4,cf6,cfx] at the start [{},{},{},{}].", path_text,
+                           configuration.cf1, configuration.cf4, configuration.cf6, configuration.cfx);
+
+  // Timed joint programs for the streaming links (deflex online --program): the path at the TCP
+  // speed, compensated (per load) or nominal.
+  const auto write_trajectory = [&](const std::vector<JointVector>& q, const std::string& file,
+                                    const std::string& what) {
+    const JointTrajectory t = trajectory_at_tcp_speed(poses, q, o.speed_mm_s * 1e-3, model, o.hold_start_s);
+    t.write_csv(file, fmt::format("deflex offline: {} joint trajectory of {} at {:g} mm/s ({} points, {:.3f} s); "
+                                  "stream it with deflex online --link egm-joint --program {}",
+                                  what, path_text, o.speed_mm_s, t.size(), t.duration_s(), file));
+    return t;
+  };
+  if (!o.nominal_trajectory_out.empty()) {
+    const JointTrajectory t = write_trajectory(q_nominal, o.nominal_trajectory_out, "nominal (uncompensated)");
+    (o.json ? std::cerr : std::cout) << fmt::format("wrote {} (nominal joint trajectory, {:.3f} s)\n",
+                                                    o.nominal_trajectory_out, t.duration_s());
+  }
+
+  nlohmann::json runs = nlohmann::json::array();
   for (std::size_t k = 0; k < forces.size(); ++k) {
     const ForceModel& force = *forces[k];
-    const OfflineResult result = compensate_path(model, joints, poses, force);
+    Run& state = runs_state[k];
+    OfflineResult& result = state.summary;
     const std::string& label = labels[k];
     nlohmann::json run{{"force", force.describe()},
-                       {"points", result.points.size()},
+                       {"points", result.point_count},
                        {"max_deflection_mm", result.max_deflection_m * 1e3},
                        {"mean_deflection_mm", result.mean_deflection_m * 1e3},
                        {"max_residual_mm", result.max_residual_m * 1e3},
                        {"max_correction_mm", result.max_correction_m * 1e3},
                        {"max_joint_correction_deg", rad_to_deg(result.max_joint_correction_rad)}};
     std::string extra;
-    if (const auto* ldbb = dynamic_cast<const LdbbForceModel*>(&force)) {
-      double lmin = HUGE_VAL, lmax = 0.0, pmin = HUGE_VAL, pmax = -HUGE_VAL;
-      for (const Pose& p : poses) {
-        lmin = std::min(lmin, ldbb->bar_length_m(p));
-        lmax = std::max(lmax, ldbb->bar_length_m(p));
-        pmin = std::min(pmin, ldbb->inclination_rad(p));
-        pmax = std::max(pmax, ldbb->inclination_rad(p));
-      }
+    if (state.ldbb != nullptr) {
       extra = fmt::format("LDBB bar: length {:.2f}..{:.2f} mm, inclination to the XY plane {:.2f}..{:.2f} deg\n",
-                          lmin * 1e3, lmax * 1e3, rad_to_deg(pmin), rad_to_deg(pmax));
-      run["bar_length_mm"] = {lmin * 1e3, lmax * 1e3};
-      run["bar_inclination_deg"] = {rad_to_deg(pmin), rad_to_deg(pmax)};
+                          state.lmin * 1e3, state.lmax * 1e3, rad_to_deg(state.pmin), rad_to_deg(state.pmax));
+      run["bar_length_mm"] = {state.lmin * 1e3, state.lmax * 1e3};
+      run["bar_inclination_deg"] = {rad_to_deg(state.pmin), rad_to_deg(state.pmax)};
     }
-    if (!o.csv_out.empty()) {
-      const std::string file = several ? suffixed(o.csv_out, label) : o.csv_out;
-      write_offline_csv(result, file);
-      run["csv"] = file;
-      extra += fmt::format("wrote {}\n", file);
+    if (state.csv) {
+      run["csv"] = state.csv_file;
+      extra += fmt::format("wrote {}\n", state.csv_file);
     }
     if (!o.trajectory_out.empty()) {
       const std::string file = several ? suffixed(o.trajectory_out, label) : o.trajectory_out;
-      std::vector<JointVector> q;
-      q.reserve(result.points.size());
-      for (const auto& p : result.points) q.push_back(p.q_command);
-      const JointTrajectory t = write_trajectory(q, file, "compensated");
+      const JointTrajectory t = write_trajectory(state.q_command, file, "compensated");
       run["joint_trajectory"] = file;
       extra += fmt::format("wrote {} (compensated joint trajectory, {:.3f} s at {:g} mm/s)\n", file, t.duration_s(),
                            o.speed_mm_s);
@@ -306,6 +371,7 @@ void run(const Opts& o, int& exit_code) {
       if (rapid.module_name.size() > 32) {
         rapid.module_name = (o.module + "_" + std::to_string(k + 1)).substr(0, 32);
       }
+      result.points = std::move(state.points);
       write_rapid_module(result, rapid, file);
       run["rapid"] = file;
       extra += fmt::format("wrote {} (module {})\n", file, rapid.module_name);
@@ -320,8 +386,7 @@ void run(const Opts& o, int& exit_code) {
   if (o.json) {
     print_json({{"robot", model.name()},
                 {"path", path_text},
-                {"configuration", {joints.configuration.cf1, joints.configuration.cf4, joints.configuration.cf6,
-                                   joints.configuration.cfx}},
+                {"configuration", {configuration.cf1, configuration.cf4, configuration.cf6, configuration.cfx}},
                 {"runs", runs}});
   }
   exit_code = 0;

@@ -15,12 +15,97 @@ OfflineResult compensate_path(const RobotModel& model, const JointPath& path, co
   return compensate_path(model, path, tcp_poses, force, OfflineOptions{});
 }
 
-OfflineResult compensate_path(const RobotModel& model, const JointPath& path, const std::vector<Pose>& tcp_poses,
-                              const ForceModel& force, const OfflineOptions& options) {
+PathCompensator::PathCompensator(const RobotModel& model, const ForceModel& force, const OfflineOptions& options)
+    : model_(model), force_(force), options_(options), ws_(model), q_actual_(model.dof()) {
   if (!model.has_stiffness()) {
     throw InputError(fmt::format("robot '{}' ({}): no joint stiffness; offline compensation needs one",
                                  model.name(), model.description().source));
   }
+  result_.robot_name = model.name();
+  result_.stiffness_note = model.description().stiffness_note;
+  result_.force_description = force.describe();
+  result_.predicted = options.predict;
+}
+
+const OfflinePoint& PathCompensator::compensate(std::size_t i, const JointVector& q_desired, const Pose& tcp_desired) {
+  const RobotModel& model = model_;
+  Workspace& ws = ws_;
+  OfflinePoint& pt = point_;
+  OfflineResult& result = result_;
+  if (const auto force_points = force_.points(); force_points && i >= *force_points) {
+    throw InputError(fmt::format("offline compensation: the force model ({}) has {} points, the path more",
+                                 force_.describe(), *force_points));
+  }
+  pt.q_desired = q_desired;
+  pt.tcp_desired = tcp_desired;
+  if (pt.q_desired.size() != model.dof() || !pt.q_desired.allFinite()) {
+    throw InputError(fmt::format("path point {}: joint vector must hold {} finite values", i, model.dof()));
+  }
+  const Wrench wrench_tcp = force_.wrench_at(i, pt.tcp_desired);
+  if (!wrench_tcp.allFinite()) {
+    throw InputError(fmt::format("path point {}: the force model gave a non-finite wrench", i));
+  }
+  pt.wrench_base = wrench_tcp;
+  if (!model.wap_is_tcp()) {
+    // Moment about the WAP of a force acting at the TCP: M_wap = M_tcp + (p_tcp - p_wap) x F.
+    forward_kinematics(model, ws, pt.q_desired);
+    pt.wrench_base.tail<3>() +=
+        (ws.base_T_tcp.translation() - ws.base_T_wap.translation()).cross(Vector3(wrench_tcp.head<3>()));
+  }
+
+  compensated_configuration(model, ws, pt.q_desired, pt.wrench_base, pt.q_command);
+  const Pose tcp_at_desired = ws.base_T_tcp;  // compensated_configuration ran FK at q_desired
+  if (!model.within_limits(pt.q_command)) {
+    throw InputError(fmt::format("path point {}: the compensated configuration leaves the joint limits", i));
+  }
+  pt.tcp_command = tcp_pose(model, ws, pt.q_command);
+  pt.configuration_command = arm_configuration(model, ws, pt.q_command);
+  ++count_;
+
+  result.max_correction_m =
+      std::max(result.max_correction_m, (pt.tcp_command.translation() - pt.tcp_desired.translation()).norm());
+  result.max_joint_correction_rad =
+      std::max(result.max_joint_correction_rad, (pt.q_command - pt.q_desired).cwiseAbs().maxCoeff());
+  if (!options_.predict) {
+    return pt;
+  }
+
+  if (deflected_configuration(model, ws, pt.q_desired, pt.wrench_base, q_actual_) != DeflectionStatus::kConverged) {
+    throw InputError(fmt::format("path point {}: the predicted deflection does not converge (load far beyond the "
+                                 "model's range)", i));
+  }
+  pt.predicted_deflection = pose_difference(tcp_at_desired, tcp_pose(model, ws, q_actual_));
+  if (deflected_configuration(model, ws, pt.q_command, pt.wrench_base, q_actual_) != DeflectionStatus::kConverged) {
+    throw InputError(fmt::format("path point {}: the deflection of the compensated command does not converge", i));
+  }
+  pt.predicted_residual = pose_difference(pt.tcp_desired, tcp_pose(model, ws, q_actual_));
+
+  const double d = pt.predicted_deflection.head<3>().norm();
+  sum_deflection_ += d;
+  result.max_deflection_m = std::max(result.max_deflection_m, d);
+  result.max_deflection_rad = std::max(result.max_deflection_rad, pt.predicted_deflection.tail<3>().norm());
+  result.max_residual_m = std::max(result.max_residual_m, pt.predicted_residual.head<3>().norm());
+  result.max_residual_rad = std::max(result.max_residual_rad, pt.predicted_residual.tail<3>().norm());
+  return pt;
+}
+
+OfflineResult PathCompensator::summary() const {
+  if (count_ == 0) {
+    throw InputError("offline compensation: the path has no points");
+  }
+  if (const auto force_points = force_.points(); force_points && *force_points != count_) {
+    throw InputError(fmt::format("offline compensation: the force model ({}) has {} points, the path {}",
+                                 force_.describe(), *force_points, count_));
+  }
+  OfflineResult r = result_;
+  r.point_count = count_;
+  r.mean_deflection_m = sum_deflection_ / static_cast<double>(count_);
+  return r;
+}
+
+OfflineResult compensate_path(const RobotModel& model, const JointPath& path, const std::vector<Pose>& tcp_poses,
+                              const ForceModel& force, const OfflineOptions& options) {
+  PathCompensator compensator(model, force, options);
   const std::size_t n = path.q.size();
   if (n == 0) {
     throw InputError("offline compensation: the path has no points");
@@ -32,69 +117,13 @@ OfflineResult compensate_path(const RobotModel& model, const JointPath& path, co
     throw InputError(fmt::format("offline compensation: the force model ({}) has {} points, the path {}",
                                  force.describe(), *force_points, n));
   }
-  OfflineResult result;
-  result.robot_name = model.name();
-  result.stiffness_note = model.description().stiffness_note;
-  result.force_description = force.describe();
-  result.predicted = options.predict;
-  result.points.resize(n);
-
-  Workspace ws(model);
-  JointVector q_actual(model.dof());
-  double sum_deflection = 0.0;
+  std::vector<OfflinePoint> points;
+  points.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
-    OfflinePoint& pt = result.points[i];
-    pt.q_desired = path.q[i];
-    pt.tcp_desired = tcp_poses[i];
-    if (pt.q_desired.size() != model.dof() || !pt.q_desired.allFinite()) {
-      throw InputError(fmt::format("path point {}: joint vector must hold {} finite values", i, model.dof()));
-    }
-    const Wrench wrench_tcp = force.wrench_at(i, pt.tcp_desired);
-    if (!wrench_tcp.allFinite()) {
-      throw InputError(fmt::format("path point {}: the force model gave a non-finite wrench", i));
-    }
-    pt.wrench_base = wrench_tcp;
-    if (!model.wap_is_tcp()) {
-      // Moment about the WAP of a force acting at the TCP: M_wap = M_tcp + (p_tcp - p_wap) x F.
-      forward_kinematics(model, ws, pt.q_desired);
-      pt.wrench_base.tail<3>() +=
-          (ws.base_T_tcp.translation() - ws.base_T_wap.translation()).cross(Vector3(wrench_tcp.head<3>()));
-    }
-
-    compensated_configuration(model, ws, pt.q_desired, pt.wrench_base, pt.q_command);
-    const Pose tcp_at_desired = ws.base_T_tcp;  // compensated_configuration ran FK at q_desired
-    if (!model.within_limits(pt.q_command)) {
-      throw InputError(fmt::format("path point {}: the compensated configuration leaves the joint limits", i));
-    }
-    pt.tcp_command = tcp_pose(model, ws, pt.q_command);
-    pt.configuration_command = arm_configuration(model, ws, pt.q_command);
-
-    result.max_correction_m =
-        std::max(result.max_correction_m, (pt.tcp_command.translation() - pt.tcp_desired.translation()).norm());
-    result.max_joint_correction_rad =
-        std::max(result.max_joint_correction_rad, (pt.q_command - pt.q_desired).cwiseAbs().maxCoeff());
-    if (!options.predict) {
-      continue;
-    }
-
-    if (deflected_configuration(model, ws, pt.q_desired, pt.wrench_base, q_actual) != DeflectionStatus::kConverged) {
-      throw InputError(fmt::format("path point {}: the predicted deflection does not converge (load far beyond the "
-                                   "model's range)", i));
-    }
-    pt.predicted_deflection = pose_difference(tcp_at_desired, tcp_pose(model, ws, q_actual));
-    if (deflected_configuration(model, ws, pt.q_command, pt.wrench_base, q_actual) != DeflectionStatus::kConverged) {
-      throw InputError(fmt::format("path point {}: the deflection of the compensated command does not converge", i));
-    }
-    pt.predicted_residual = pose_difference(pt.tcp_desired, tcp_pose(model, ws, q_actual));
-
-    const double d = pt.predicted_deflection.head<3>().norm();
-    sum_deflection += d;
-    result.max_deflection_m = std::max(result.max_deflection_m, d);
-    result.max_deflection_rad = std::max(result.max_deflection_rad, pt.predicted_deflection.tail<3>().norm());
-    result.max_residual_m = std::max(result.max_residual_m, pt.predicted_residual.head<3>().norm());
-    result.max_residual_rad = std::max(result.max_residual_rad, pt.predicted_residual.tail<3>().norm());
+    points.push_back(compensator.compensate(i, path.q[i], tcp_poses[i]));
   }
-  result.mean_deflection_m = sum_deflection / static_cast<double>(n);
+  OfflineResult result = compensator.summary();
+  result.points = std::move(points);
   return result;
 }
 

@@ -33,7 +33,8 @@ struct OfflinePoint {
 };
 
 struct OfflineResult {
-  std::vector<OfflinePoint> points;
+  std::vector<OfflinePoint> points;  ///< empty when the path was streamed (PathCompensator)
+  std::size_t point_count = 0;       ///< points compensated
   double max_deflection_m = 0.0;   ///< largest |translation| of predicted_deflection
   double mean_deflection_m = 0.0;  ///< mean |translation| of predicted_deflection over all points
   double max_deflection_rad = 0.0;
@@ -63,5 +64,31 @@ struct OfflineOptions {
                                             const OfflineOptions& options);
 [[nodiscard]] OfflineResult compensate_path(const RobotModel& model, const JointPath& path,
                                             const std::vector<Pose>& tcp_poses, const ForceModel& force);
+
+/// The same a point at a time, for paths too long to hold: compensate() gives exactly the point
+/// compensate_path gives, throws the same errors, and keeps only the summary (max, mean), so memory
+/// does not grow with the path.
+class PathCompensator {
+ public:
+  /// Throws InputError when the robot has no joint stiffness.
+  PathCompensator(const RobotModel& model, const ForceModel& force, const OfflineOptions& options = {});
+  /// Compensates path point `index` (0-based, in order) with joints `q_desired` and pose `tcp_desired`.
+  /// The reference stays valid until the next call.
+  const OfflinePoint& compensate(std::size_t index, const JointVector& q_desired, const Pose& tcp_desired);
+  /// The figures over the points so far (`points` left empty). Throws InputError when no point was
+  /// compensated or a force table's length differs from the path's.
+  [[nodiscard]] OfflineResult summary() const;
+
+ private:
+  const RobotModel& model_;
+  const ForceModel& force_;
+  OfflineOptions options_;
+  Workspace ws_;
+  JointVector q_actual_;
+  OfflinePoint point_;
+  OfflineResult result_;
+  double sum_deflection_ = 0.0;
+  std::size_t count_ = 0;
+};
 
 }  // namespace deflex

@@ -44,47 +44,61 @@ std::vector<std::string> offline_csv_columns(int dof) {
   return c;
 }
 
+OfflineCsvWriter::OfflineCsvWriter(const std::string& path, int dof, const std::string& robot_name,
+                                   const std::string& force_description, bool predicted)
+    : dof_(dof), out_(path, offline_csv_columns(dof)) {
+  out_.comment(fmt::format("deflex offline: robot {}; force {}; wrench in the base frame, moment about the WAP; "
+                           "deflection = loaded minus unloaded TCP pose when commanded to the desired joints{}",
+                           robot_name, force_description, predicted ? "" : " (not predicted: columns are zero)"));
+  row_.reserve(offline_csv_columns(dof).size());
+}
+
+void OfflineCsvWriter::write(std::size_t index, const OfflinePoint& p) {
+  if (p.q_desired.size() != dof_) {
+    throw InputError(fmt::format("path point {}: {} joints for a {}-joint file", index, p.q_desired.size(), dof_));
+  }
+  if (index == 0 || !have_quaternion_) {
+    q_desired_ = canonical_quaternion(p.tcp_desired);
+    have_quaternion_ = true;
+  }
+  row_.clear();
+  row_.push_back(static_cast<double>(index));
+  for (const JointVector* q : {&p.q_desired, &p.q_command}) {
+    for (int j = 0; j < dof_; ++j) {
+      row_.push_back(clean(rad_to_deg((*q)[j])));
+    }
+  }
+  // Signs follow the path and the command follows its desired pose: no flips between columns.
+  q_desired_ = quaternion_near(p.tcp_desired, q_desired_);
+  add_pose(row_, p.tcp_desired, q_desired_);
+  add_pose(row_, p.tcp_command, quaternion_near(p.tcp_command, q_desired_));
+  const ArmConfiguration& c = p.configuration_command;
+  row_.insert(row_.end(), {static_cast<double>(c.cf1), static_cast<double>(c.cf4), static_cast<double>(c.cf6),
+                           static_cast<double>(c.cfx)});
+  for (int k = 0; k < 6; ++k) {
+    row_.push_back(clean(p.wrench_base[k]));
+  }
+  for (int k = 0; k < 6; ++k) {
+    row_.push_back(clean(p.predicted_deflection[k] * 1e3));  // m -> mm, rad -> mrad
+  }
+  row_.push_back(p.predicted_deflection.head<3>().norm() * 1e3);
+  row_.push_back(p.predicted_residual.head<3>().norm() * 1e3);
+  row_.push_back(p.predicted_residual.tail<3>().norm() * 1e3);
+  out_.row(row_);
+}
+
+void OfflineCsvWriter::finish() { out_.finish(); }
+
 void write_offline_csv(const OfflineResult& result, const std::string& path) {
   if (result.points.empty()) {
     throw InputError(fmt::format("{}: no compensated points to write", path));
   }
-  const int dof = static_cast<int>(result.points.front().q_desired.size());
-  const auto columns = offline_csv_columns(dof);
-  CsvWriter out(path, columns);
-  out.comment(fmt::format("deflex offline: robot {}; force {}; wrench in the base frame, moment about the WAP; "
-                          "deflection = loaded minus unloaded TCP pose when commanded to the desired joints{}",
-                          result.robot_name, result.force_description,
-                          result.predicted ? "" : " (not predicted: columns are zero)"));
-  std::vector<double> row;
-  row.reserve(columns.size());
-  Eigen::Quaterniond q_desired = canonical_quaternion(result.points.front().tcp_desired);
+  OfflineCsvWriter out(path, static_cast<int>(result.points.front().q_desired.size()), result.robot_name,
+                       result.force_description, result.predicted);
   for (std::size_t i = 0; i < result.points.size(); ++i) {
-    const OfflinePoint& p = result.points[i];
-    row.clear();
-    row.push_back(static_cast<double>(i));
-    for (const JointVector* q : {&p.q_desired, &p.q_command}) {
-      for (int j = 0; j < dof; ++j) {
-        row.push_back(clean(rad_to_deg((*q)[j])));
-      }
-    }
-    // Signs follow the path and the command follows its desired pose: no flips between columns.
-    q_desired = quaternion_near(p.tcp_desired, q_desired);
-    add_pose(row, p.tcp_desired, q_desired);
-    add_pose(row, p.tcp_command, quaternion_near(p.tcp_command, q_desired));
-    const ArmConfiguration& c = p.configuration_command;
-    row.insert(row.end(), {static_cast<double>(c.cf1), static_cast<double>(c.cf4), static_cast<double>(c.cf6),
-                           static_cast<double>(c.cfx)});
-    for (int k = 0; k < 6; ++k) {
-      row.push_back(clean(p.wrench_base[k]));
-    }
-    for (int k = 0; k < 6; ++k) {
-      row.push_back(clean(p.predicted_deflection[k] * 1e3));  // m -> mm, rad -> mrad
-    }
-    row.push_back(p.predicted_deflection.head<3>().norm() * 1e3);
-    row.push_back(p.predicted_residual.head<3>().norm() * 1e3);
-    row.push_back(p.predicted_residual.tail<3>().norm() * 1e3);
-    out.row(row);
+    out.write(i, result.points[i]);
   }
+  out.finish();
 }
 
 }  // namespace deflex

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "deflex/model/csv_table.hpp"
 #include "deflex/offline/compensate_path.hpp"
 
 namespace deflex {
@@ -16,5 +17,23 @@ namespace deflex {
 /// Writes one row per point (0-based `index` column), after the header a '#' comment naming the
 /// robot and the force model. Throws Error when the file cannot be written.
 void write_offline_csv(const OfflineResult& result, const std::string& path);
+
+/// The same file a point at a time (deflex offline streams long paths through it): the rows are
+/// byte for byte those write_offline_csv writes. Throws Error when the file cannot be written.
+class OfflineCsvWriter {
+ public:
+  OfflineCsvWriter(const std::string& path, int dof, const std::string& robot_name,
+                   const std::string& force_description, bool predicted);
+  void write(std::size_t index, const OfflinePoint& point);
+  /// Flushes and closes the file; throws Error when the data did not reach it.
+  void finish();
+
+ private:
+  int dof_;
+  CsvWriter out_;
+  std::vector<double> row_;
+  Eigen::Quaterniond q_desired_ = Eigen::Quaterniond::Identity();  // sign continuity along the path
+  bool have_quaternion_ = false;
+};
 
 }  // namespace deflex

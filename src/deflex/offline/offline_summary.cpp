@@ -9,7 +9,7 @@ std::string offline_summary(const OfflineResult& result) {
   std::string s;
   s += fmt::format("robot: {}\n", result.robot_name);
   s += fmt::format("force: {}\n", result.force_description);
-  s += fmt::format("points: {}\n", result.points.size());
+  s += fmt::format("points: {}\n", result.point_count);
   if (result.predicted) {
     s += fmt::format("predicted TCP deflection, uncompensated: max {:.4f} mm, mean {:.4f} mm (max rotation {:.4f} "
                      "mrad)\n",

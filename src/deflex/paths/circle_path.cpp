@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/paths/pose_source.hpp"
 
 namespace deflex {
 
@@ -45,29 +46,10 @@ Eigen::Quaterniond checked_unit_quaternion(const Eigen::Quaterniond& q, const ch
 }
 
 std::vector<Pose> sample_circle(const CirclePath& circle, const Eigen::Quaterniond& tcp_orientation) {
-  if (!std::isfinite(circle.radius_m) || circle.radius_m <= 0.0) {
-    throw InputError(fmt::format("circle: radius must be positive and finite (got {} m)", circle.radius_m));
-  }
-  if (!circle.centre_m.allFinite() || !std::isfinite(circle.start_angle_rad)) {
-    throw InputError("circle: centre and start angle must be finite");
-  }
-  if (circle.points < 3) {
-    throw InputError(fmt::format("circle: needs at least 3 points (got {})", circle.points));
-  }
-  const Eigen::Quaterniond orientation = checked_unit_quaternion(tcp_orientation, "circle: TCP orientation");
-  Vector3 u, v;
-  circle_frame(circle, u, v);
-  const double sign = circle.clockwise ? -1.0 : 1.0;
-  const double step = 2.0 * kPi / static_cast<double>(circle.points - 1);
+  CirclePoseSource source(circle, tcp_orientation);
   std::vector<Pose> poses;
-  poses.reserve(static_cast<std::size_t>(circle.points));
-  for (int i = 0; i < circle.points; ++i) {
-    // The last point is set to the first exactly (not by rounding of cos/sin at 2 pi), so a closed
-    // path really closes.
-    const double angle = circle.start_angle_rad + sign * step * static_cast<double>(i % (circle.points - 1));
-    Pose p = Pose::Identity();
-    p.linear() = orientation.toRotationMatrix();
-    p.translation() = circle.centre_m + circle.radius_m * (std::cos(angle) * u + std::sin(angle) * v);
+  poses.reserve(*source.size());
+  for (Pose p; source.next(p);) {
     poses.push_back(p);
   }
   return poses;

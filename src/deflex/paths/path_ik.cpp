@@ -41,41 +41,50 @@ JointPath solve_path_ik(const RobotModel& model, const std::vector<Pose>& poses,
   return solve_path_ik(model, poses, first, PathIkOptions{});
 }
 
+PathIkSolver::PathIkSolver(const RobotModel& model, const IkRequest& first, const PathIkOptions& options)
+    : model_(model), options_(options), ws_(model), request_(first), q_(model.dof()) {}
+
+const JointVector& PathIkSolver::next(const Pose& base_T_tcp) {
+  const std::size_t i = index_;
+  const IkResult r = inverse_kinematics(model_, ws_, base_T_tcp, request_);
+  if (!r.ok() || (r.status == IkStatus::kNearSingular && !options_.allow_near_singular)) {
+    fail_point(i, r);
+  }
+  if (i == 0) {
+    configuration_ = r.configuration;
+    // From here on the branch (cfx) is fixed and the nearest solution wins: the quadrants follow
+    // the joints continuously instead of being forced.
+    request_.configuration = r.configuration;
+    request_.match_quadrants = false;
+  } else {
+    for (int j = 0; j < model_.dof(); ++j) {
+      const double step = std::abs(r.q[j] - q_[j]);
+      if (step > options_.max_joint_step_rad) {
+        throw InputError(fmt::format(
+            "path point {}: joint {} moves {:.2f} deg from point {} (limit {:.2f} deg): the path passes a "
+            "singularity or a joint limit with this configuration, or it is sampled too coarsely",
+            i, j + 1, rad_to_deg(step), i - 1, rad_to_deg(options_.max_joint_step_rad)));
+      }
+    }
+  }
+  q_ = r.q;
+  request_.seed = r.q;
+  ++index_;
+  return q_;
+}
+
 JointPath solve_path_ik(const RobotModel& model, const std::vector<Pose>& poses, const IkRequest& first,
                         const PathIkOptions& options) {
   if (poses.empty()) {
     throw InputError("path: no points");
   }
-  Workspace ws(model);
+  PathIkSolver solver(model, first, options);
   JointPath path;
   path.q.reserve(poses.size());
-  IkRequest request = first;
-  for (std::size_t i = 0; i < poses.size(); ++i) {
-    const IkResult r = inverse_kinematics(model, ws, poses[i], request);
-    if (!r.ok() || (r.status == IkStatus::kNearSingular && !options.allow_near_singular)) {
-      fail_point(i, r);
-    }
-    if (i == 0) {
-      path.configuration = r.configuration;
-      // From here on the branch (cfx) is fixed and the nearest solution wins: the quadrants follow
-      // the joints continuously instead of being forced.
-      request.configuration = r.configuration;
-      request.match_quadrants = false;
-    } else {
-      const JointVector& prev = path.q.back();
-      for (int j = 0; j < model.dof(); ++j) {
-        const double step = std::abs(r.q[j] - prev[j]);
-        if (step > options.max_joint_step_rad) {
-          throw InputError(fmt::format(
-              "path point {}: joint {} moves {:.2f} deg from point {} (limit {:.2f} deg): the path passes a "
-              "singularity or a joint limit with this configuration, or it is sampled too coarsely",
-              i, j + 1, rad_to_deg(step), i - 1, rad_to_deg(options.max_joint_step_rad)));
-        }
-      }
-    }
-    path.q.push_back(r.q);
-    request.seed = r.q;
+  for (const Pose& pose : poses) {
+    path.q.push_back(solver.next(pose));
   }
+  path.configuration = solver.configuration();
   return path;
 }
 

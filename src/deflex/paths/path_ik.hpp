@@ -37,4 +37,25 @@ struct PathIkOptions {
                                       const PathIkOptions& options);
 [[nodiscard]] JointPath solve_path_ik(const RobotModel& model, const std::vector<Pose>& poses, const IkRequest& first);
 
+/// The same, a pose at a time, for paths too long to hold (deflex offline streams them): next()
+/// gives exactly what solve_path_ik gives for that point, and throws the same InputError.
+class PathIkSolver {
+ public:
+  PathIkSolver(const RobotModel& model, const IkRequest& first, const PathIkOptions& options = {});
+  /// Joint values of the next path point (its 0-based index is points() before the call).
+  const JointVector& next(const Pose& base_T_tcp);
+  [[nodiscard]] std::size_t points() const { return index_; }
+  /// The first point's arm configuration (valid once a point was solved).
+  [[nodiscard]] const ArmConfiguration& configuration() const { return configuration_; }
+
+ private:
+  const RobotModel& model_;
+  PathIkOptions options_;
+  Workspace ws_;
+  IkRequest request_;
+  ArmConfiguration configuration_;
+  JointVector q_;
+  std::size_t index_ = 0;
+};
+
 }  // namespace deflex
