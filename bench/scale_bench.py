@@ -1,0 +1,97 @@
+#!/usr/bin/env python3
+"""Wall time and peak memory of deflex's long jobs at growing sizes (the whole program, as a user
+runs it): offline compensation of an N-point line written to CSV, and stiffness identification from
+N measurement rows. Usage: bench/scale_bench.py [--deflex build/bin/deflex] [--sizes 1000,100000,1000000]
+[--offline-max 10000000]. Offline output goes to /dev/null unless --keep-output, so the disk is left
+out; identification reads a file this script writes once (the shipped KR 210 measurements repeated,
+in /tmp)."""
+import argparse
+import os
+import resource
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+
+
+def run(cmd):
+    """Runs cmd as a child; returns (wall s, user+sys CPU s, peak RSS MiB)."""
+    start = time.monotonic()
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, err = proc.communicate()
+    wall = time.monotonic() - start
+    status = proc.returncode
+    if status != 0:
+        sys.exit(f"scale_bench: {' '.join(cmd)} failed ({status}):\n{err.decode()[-2000:]}")
+    return wall
+
+
+def measure(cmd):
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    wall = run(cmd)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    # ru_maxrss of the children is the largest of any child so far (KiB on Linux): run each size
+    # in its own python process when exact peaks matter (see --one).
+    return wall, cpu, after.ru_maxrss / 1024.0
+
+
+def identify_file(n):
+    path = f"/tmp/deflex_scale_identify_{n}.csv"
+    if os.path.exists(path):
+        return path
+    src = os.path.join(ROOT, "examples", "identify", "kr210_synthetic_measurements.csv")
+    with open(src) as f:
+        lines = [l for l in f if l.strip() and not l.startswith("#")]
+    header, rows = lines[0], lines[1:]
+    with open(path, "w") as out:
+        out.write(header)
+        for i in range(n):
+            out.write(rows[i % len(rows)])
+    return path
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--deflex", default=os.path.join(ROOT, "build", "bin", "deflex"))
+    ap.add_argument("--sizes", default="1000,100000,1000000")
+    ap.add_argument("--offline-max", type=int, default=10000000, help="also run offline at this size (0: not)")
+    ap.add_argument("--one", help="internal: run one job (offline:N or identify:N) and print its figures")
+    ap.add_argument("--keep-output", action="store_true", help="write the offline CSV to /tmp instead of /dev/null")
+    a = ap.parse_args()
+
+    if a.one:
+        kind, n = a.one.split(":")
+        n = int(n)
+        if kind == "offline":
+            out = f"/tmp/deflex_scale_offline_{n}.csv" if a.keep_output else "/dev/null"
+            cmd = [a.deflex, "offline", "--line", f"start_mm=1400;-300;900,end_mm=1600;300;900,points={n}",
+                   "--force", "constant:fx_N=120,fz_N=-450", "-o", out]
+        else:
+            cmd = [a.deflex, "identify", "--robot", os.path.join(ROOT, "examples", "identify", "kr210_true_stiffness.yaml"),
+                   "--data", identify_file(n)]
+        wall, cpu, peak = measure(cmd)
+        print(f"{kind},{n},{wall:.3f},{cpu:.3f},{peak:.1f}")
+        return
+
+    sizes = [int(s) for s in a.sizes.split(",")]
+    jobs = [("offline", n) for n in sizes]
+    if a.offline_max and a.offline_max not in sizes:
+        jobs.append(("offline", a.offline_max))
+    jobs += [("identify", n) for n in sizes]
+    print(f"{'job':10} {'N':>10} {'wall s':>9} {'CPU s':>9} {'us/item':>9} {'peak MiB':>9}")
+    for kind, n in jobs:
+        if kind == "identify":
+            identify_file(n)  # written outside the measured run
+        line = subprocess.run([sys.executable, __file__, "--deflex", a.deflex, "--one", f"{kind}:{n}"] +
+                              (["--keep-output"] if a.keep_output else []),
+                              check=True, capture_output=True, text=True).stdout.strip()
+        _, _, wall, cpu, peak = line.split(",")
+        print(f"{kind:10} {n:>10} {float(wall):>9.2f} {float(cpu):>9.2f} {float(cpu) / n * 1e6:>9.2f} {float(peak):>9.1f}",
+              flush=True)
+
+
+if __name__ == "__main__":
+    main()
