@@ -72,7 +72,8 @@ void setup_identify(CLI::App& sub, int& exit_code) {
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code] {
     const RobotModel model = load_cli_robot("identify", o->robot);
-    const auto data = read_stiffness_measurements(o->data);
+    // Streamed: a row at a time from the file into the identifier's compact store.
+    StiffnessMeasurementReader reader(o->data);
     IdentificationOptions opt;
     opt.robust = !o->no_robust;
     opt.rotation_scale_m = o->rotation_scale_m;
@@ -80,11 +81,15 @@ void setup_identify(CLI::App& sub, int& exit_code) {
     if (!o->fixed.empty()) {
       opt.fixed_stiffness_nm_per_rad = parse_fixed(o->fixed, model.dof(), "--fix-stiffness-Nm-per-rad");
     }
-    if (!data.empty() && data.front().q.size() != model.dof()) {
-      throw InputError(fmt::format("{}: {} joint columns, robot '{}' has {} joints", o->data, data.front().q.size(),
+    if (reader.joints() != model.dof()) {
+      throw InputError(fmt::format("{}: {} joint columns, robot '{}' has {} joints", o->data, reader.joints(),
                                    model.name(), model.dof()));
     }
-    const StiffnessEstimate est = identify_stiffness(model, data, opt);
+    StiffnessIdentifier identifier(model, opt);
+    for (StiffnessMeasurement m; reader.next(m);) {
+      identifier.add(m);
+    }
+    const StiffnessEstimate est = identifier.solve();
     const auto n = static_cast<std::size_t>(model.dof());
 
     if (!o->write_robot.empty()) {
@@ -120,10 +125,7 @@ void setup_identify(CLI::App& sub, int& exit_code) {
         se.push_back(number_or_null(est.std_error_nm_per_rad[j]));
         rel.push_back(number_or_null(est.std_error_nm_per_rad[j] / est.stiffness_nm_per_rad[j]));
       }
-      nlohmann::json rejected = nlohmann::json::array();
-      for (int i : est.rejected_measurements) {
-        rejected.push_back(data[static_cast<std::size_t>(i)].line);
-      }
+      const nlohmann::json rejected = est.rejected_lines;
       print_json({{"robot", model.name()},
                   {"data", o->data},
                   {"measurements", est.measurements},

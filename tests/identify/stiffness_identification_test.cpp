@@ -334,3 +334,74 @@ TEST(IdentifyStiffness, BadInputIsAnErrorNamingTheMeasurement) {
 
 }  // namespace
 }  // namespace deflex
+
+namespace deflex {
+namespace {
+
+// The compact store is reduced by QR a slab of 512 rows at a time; over 3000 measurements (about
+// 18 slabs, mixed 3- and 6-row measurements, uneven weights) the plain fit must equal a dense
+// least-squares solve of the whole stacked system, built here from KDL's Jacobian (the compliances
+// are positive, so the c >= 0 bound is inactive and NNLS is least squares).
+TEST(IdentifyStiffness, TheSlabwiseSolveEqualsADenseSolveOfTheWholeStack) {
+  const RobotModel model = kr210();
+  const JointVector k_true = model.stiffness();
+  auto data = kdl_linear_data(model, k_true, 3000, true, false, 99);
+  const auto with_rotation = kdl_linear_data(model, k_true, 500, true, true, 98);
+  data.insert(data.begin() + 1000, with_rotation.begin(), with_rotation.end());
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 20e-6);
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    data[i].dp_m += Vector3(noise(rng), noise(rng), noise(rng));
+    data[i].weight = 0.5 + static_cast<double>(i % 7) * 0.25;
+  }
+  IdentificationOptions plain;
+  plain.robust = false;
+  const StiffnessEstimate est = identify_stiffness(model, data, plain);
+
+  // Dense: rows sqrt(w) [J_lin diag(J^T W)], rhs sqrt(w) dp (and the rotation rows, scale 1 m).
+  const KDL::Chain chain = test::kdl_chain_from_dh(model);
+  KDL::ChainJntToJacSolver solver(chain);
+  Eigen::Index rows = 0;
+  for (const auto& m : data) {
+    rows += m.drot_rad ? 6 : 3;
+  }
+  Eigen::MatrixXd A(rows, 6);
+  Eigen::VectorXd b(rows);
+  Eigen::Index r = 0;
+  for (const auto& m : data) {
+    KDL::JntArray qk(6);
+    for (unsigned j = 0; j < 6; ++j) {
+      qk(j) = m.q[j];
+    }
+    KDL::Jacobian jk(6);
+    ASSERT_GE(solver.JntToJac(qk, jk), 0);
+    const Eigen::MatrixXd J = jk.data;
+    const Eigen::VectorXd tau = J.transpose() * m.wrench_base;
+    const double sw = std::sqrt(m.weight);
+    const int k = m.drot_rad ? 6 : 3;
+    A.middleRows(r, k) = sw * J.topRows(k) * tau.asDiagonal();
+    b.segment(r, 3) = sw * m.dp_m;
+    if (m.drot_rad) {
+      b.segment(r + 3, 3) = sw * *m.drot_rad;
+    }
+    r += k;
+  }
+  const Eigen::VectorXd c = A.colPivHouseholderQr().solve(b);
+  for (int j = 0; j < 6; ++j) {
+    const auto ju = static_cast<std::size_t>(j);
+    EXPECT_NEAR(est.compliance_rad_per_nm[ju], c[j], 1e-9 * c[j]) << "joint " << j + 1;
+  }
+  // The standard errors from the slabwise R against the dense (A^T A)^-1.
+  const Eigen::VectorXd res = b - A * c;
+  const double sigma2 = res.squaredNorm() / static_cast<double>(rows - 6);
+  const Eigen::MatrixXd cov = sigma2 * (A.transpose() * A).inverse();
+  for (int j = 0; j < 6; ++j) {
+    const auto ju = static_cast<std::size_t>(j);
+    EXPECT_NEAR(est.compliance_std_error_rad_per_nm[ju], std::sqrt(cov(j, j)), 1e-6 * std::sqrt(cov(j, j)))
+        << "joint " << j + 1;
+  }
+  EXPECT_EQ(est.measurements, 3500);
+}
+
+}  // namespace
+}  // namespace deflex

@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <memory>
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
@@ -64,100 +66,126 @@ std::string joint_list(const std::vector<int>& joints) {
   return fmt::format("{}", fmt::join(s, ", "));
 }
 
-// The stacked problem, rows already multiplied by sqrt(weight).
-struct Stack {
-  Eigen::MatrixXd A;                 // rows x dof, all joints
-  Eigen::VectorXd b;                 // rows
-  std::vector<Eigen::Index> start;   // first row of each measurement
-  std::vector<int> rows;             // 3 or 6
-  std::vector<double> sqrt_weight;
+// The stacked problem in compact form: per measurement its 3 (or 6) rows [A_i | b_i], already
+// multiplied by sqrt(weight) (rotation rows also by rotation_scale_m), in chunks of 64k rows so that
+// growing never copies what is stored (a doubling vector would hold up to three times the data at
+// its peak). That is what the robust re-weighting needs: each measurement's residual against every
+// new estimate; recomputing the regressor instead (FK and two Jacobians) would cost about 0.3 us a
+// measurement an iteration. 8 (dof + 1) bytes a row: 168 bytes for a 6-joint position measurement.
+class RowStore {
+ public:
+  explicit RowStore(int dof) : width_(dof + 1) {}
+  // Space for `rows` contiguous rows of the next measurement.
+  double* append(int rows) {
+    const std::size_t need = static_cast<std::size_t>(rows * width_);
+    if (chunks_.empty() || chunks_.back().size() + need > chunks_.back().capacity()) {
+      chunks_.emplace_back();
+      chunks_.back().reserve(kChunkRows * static_cast<std::size_t>(width_));
+    }
+    std::vector<double>& c = chunks_.back();
+    const std::size_t at = c.size();
+    c.resize(at + need);
+    rows_.push_back(static_cast<std::uint8_t>(rows));
+    total_rows_ += rows;
+    return c.data() + at;
+  }
+  // f(i, rows, block): block is rows x (dof + 1), row-major, A_i then b_i in the last column.
+  template <typename F>
+  void for_each(F&& f) const {
+    std::size_t i = 0;
+    for (const std::vector<double>& c : chunks_) {
+      for (std::size_t at = 0; at < c.size(); ++i) {
+        const int rows = rows_[i];
+        f(i, rows, c.data() + at);
+        at += static_cast<std::size_t>(rows * width_);
+      }
+    }
+  }
+  template <typename F>
+  void for_each_mutable(F&& f) {
+    std::size_t i = 0;
+    for (std::vector<double>& c : chunks_) {
+      for (std::size_t at = 0; at < c.size(); ++i) {
+        const int rows = rows_[i];
+        f(i, rows, c.data() + at);
+        at += static_cast<std::size_t>(rows * width_);
+      }
+    }
+  }
+  [[nodiscard]] std::size_t size() const { return rows_.size(); }
+  [[nodiscard]] int rows(std::size_t i) const { return rows_[i]; }
+  [[nodiscard]] Eigen::Index total_rows() const { return total_rows_; }
+  [[nodiscard]] int width() const { return width_; }
+
+ private:
+  static constexpr std::size_t kChunkRows = 65536;
+  int width_;
+  std::vector<std::vector<double>> chunks_;
+  std::vector<std::uint8_t> rows_;
+  Eigen::Index total_rows_ = 0;
 };
 
-Stack build_stack(const RobotModel& model, const std::vector<StiffnessMeasurement>& data,
-                  const IdentificationOptions& opt) {
-  const int n = model.dof();
-  Stack s;
-  s.start.reserve(data.size());
-  s.rows.reserve(data.size());
-  Eigen::Index total = 0;
-  for (std::size_t i = 0; i < data.size(); ++i) {
-    const StiffnessMeasurement& m = data[i];
-    if (m.q.size() != n) {
-      throw InputError(fmt::format("{}: {} joint values for a {}-joint robot ({})", where(m, i), m.q.size(), n,
-                                   model.name()));
+using RowBlock = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
+
+// R (p x p, upper) and Q^T y (p) of the tall system whose rows are measurement i's rows, columns
+// `cols` of A divided by scale[col], and b, all multiplied by sqrt(omega_i): Householder QR of the
+// rows a slab at a time, each slab stacked under the R found so far (the same R, up to the signs of
+// its rows, as one QR of the whole tall matrix, without holding it).
+struct Triangular {
+  Eigen::MatrixXd R;
+  Eigen::VectorXd qty;
+};
+Triangular blocked_qr(const RowStore& s, const std::vector<int>& cols, const Eigen::VectorXd& scale,
+                      const std::vector<double>& omega) {
+  const auto p = static_cast<Eigen::Index>(cols.size());
+  const Eigen::Index w = p + 1;
+  constexpr Eigen::Index kSlab = 512;
+  Eigen::MatrixXd buf(w + kSlab, w);
+  Eigen::Index top = 0;   // rows of R so far (at most w)
+  Eigen::Index fill = 0;  // rows in the buffer
+  const Eigen::Index bcol = s.width() - 1;
+  const auto reduce = [&]() {
+    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(buf.topRows(fill));
+    top = std::min(fill, w);
+    buf.topRows(top) = qr.matrixQR().topRows(top).triangularView<Eigen::Upper>();
+    fill = top;
+  };
+  s.for_each([&](std::size_t i, int rows, const double* block) {
+    const RowBlock B(block, rows, s.width());
+    const double sw = std::sqrt(omega[i]);
+    for (int r = 0; r < rows; ++r) {
+      for (Eigen::Index k = 0; k < p; ++k) {
+        const int j = cols[static_cast<std::size_t>(k)];
+        buf(fill, k) = sw * B(r, j) / scale[j];
+      }
+      buf(fill, p) = sw * B(r, bcol);
+      ++fill;
     }
-    if (!m.q.allFinite() || !m.wrench_base.allFinite() || !m.dp_m.allFinite() ||
-        (m.drot_rad && !m.drot_rad->allFinite())) {
-      throw InputError(fmt::format("{}: a value is not finite", where(m, i)));
+    if (fill + 6 > buf.rows()) {
+      reduce();
     }
-    if (!(m.weight > 0.0) || !std::isfinite(m.weight)) {
-      throw InputError(fmt::format("{}: weight {} must be finite and > 0", where(m, i), m.weight));
-    }
-    s.start.push_back(total);
-    s.rows.push_back(m.drot_rad ? 6 : 3);
-    total += s.rows.back();
-  }
-  s.A.resize(total, n);
-  s.b.resize(total);
-  Workspace ws(model);
-  Jacobian block(6, n);
-  for (std::size_t i = 0; i < data.size(); ++i) {
-    const StiffnessMeasurement& m = data[i];
-    stiffness_regressor(model, ws, m.q, m.wrench_base, block);
-    const double sw = std::sqrt(m.weight);
-    s.sqrt_weight.push_back(sw);
-    const Eigen::Index r0 = s.start[i];
-    s.A.block(r0, 0, 3, n) = sw * block.topRows(3);
-    s.b.segment<3>(r0) = sw * m.dp_m;
-    if (m.drot_rad) {
-      s.A.block(r0 + 3, 0, 3, n) = (sw * opt.rotation_scale_m) * block.bottomRows(3);
-      s.b.segment<3>(r0 + 3) = (sw * opt.rotation_scale_m) * *m.drot_rad;
-    }
-  }
-  return s;
+  });
+  reduce();
+  Triangular t;
+  t.R = Eigen::MatrixXd::Zero(p, p);
+  t.qty = Eigen::VectorXd::Zero(p);
+  const Eigen::Index k = std::min(top, p);
+  t.R.topRows(k) = buf.block(0, 0, k, p).triangularView<Eigen::Upper>();
+  t.qty.head(k) = buf.block(0, p, k, 1);
+  return t;
 }
 
-// Columns `cols` of A, each divided by scale[j], rows of measurement i multiplied by sqrt(omega_i).
-Eigen::MatrixXd scaled_columns(const Stack& s, const std::vector<int>& cols, const Eigen::VectorXd& scale,
-                               const std::vector<double>& omega) {
-  Eigen::MatrixXd M(s.A.rows(), static_cast<Eigen::Index>(cols.size()));
-  for (std::size_t k = 0; k < cols.size(); ++k) {
-    M.col(static_cast<Eigen::Index>(k)) = s.A.col(cols[k]) / scale[cols[k]];
-  }
-  for (std::size_t i = 0; i < s.start.size(); ++i) {
-    if (omega[i] != 1.0) {
-      M.middleRows(s.start[i], s.rows[i]) *= std::sqrt(omega[i]);
-    }
-  }
-  return M;
-}
-
-Eigen::VectorXd weighted_rhs(const Stack& s, const Eigen::VectorXd& b, const std::vector<double>& omega) {
-  Eigen::VectorXd y = b;
-  for (std::size_t i = 0; i < s.start.size(); ++i) {
-    if (omega[i] != 1.0) {
-      y.segment(s.start[i], s.rows[i]) *= std::sqrt(omega[i]);
-    }
-  }
-  return y;
-}
-
-// Singular values (descending) and right singular vectors of a tall matrix, through its R factor.
-Eigen::JacobiSVD<Eigen::MatrixXd> svd_of(const Eigen::MatrixXd& M) {
-  Eigen::HouseholderQR<Eigen::MatrixXd> qr(M);
-  const Eigen::Index p = M.cols();
-  const Eigen::MatrixXd R = qr.matrixQR().topRows(std::min(p, M.rows())).triangularView<Eigen::Upper>();
-  return Eigen::JacobiSVD<Eigen::MatrixXd>(R, Eigen::ComputeFullV);
+// Singular values (descending) and right singular vectors of the scaled, weighted columns `cols`.
+Eigen::JacobiSVD<Eigen::MatrixXd> svd_of(const RowStore& s, const std::vector<int>& cols, const Eigen::VectorXd& scale,
+                                         const std::vector<double>& omega) {
+  return Eigen::JacobiSVD<Eigen::MatrixXd>(blocked_qr(s, cols, scale, omega).R, Eigen::ComputeFullV);
 }
 
 }  // namespace
 
-StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<StiffnessMeasurement>& data,
-                                     const IdentificationOptions& options) {
+StiffnessIdentifier::StiffnessIdentifier(const RobotModel& model, const IdentificationOptions& options)
+    : model_(model), options_(options), ws_(model), block_(6, model.dof()) {
   const int n = model.dof();
-  if (data.empty()) {
-    throw InputError("identify_stiffness: no measurements");
-  }
   if (!options.fixed_stiffness_nm_per_rad.empty() &&
       static_cast<int>(options.fixed_stiffness_nm_per_rad.size()) != n) {
     throw InputError(fmt::format("identify_stiffness: {} fixed-stiffness entries for a {}-joint robot",
@@ -166,6 +194,79 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
   if (!(options.rotation_scale_m > 0.0) || !std::isfinite(options.rotation_scale_m)) {
     throw InputError("identify_stiffness: rotation_scale_m must be finite and > 0");
   }
+  store_ = std::make_unique<RowStoreHolder>(n);
+}
+
+StiffnessIdentifier::~StiffnessIdentifier() = default;
+
+struct StiffnessIdentifier::RowStoreHolder {
+  explicit RowStoreHolder(int n) : rows(n) {}
+  RowStore rows;
+  std::vector<double> sqrt_weight;
+  std::vector<int> lines;
+};
+
+void StiffnessIdentifier::add(const StiffnessMeasurement& m) {
+  const int n = model_.dof();
+  const std::size_t i = store_->rows.size();
+  if (m.q.size() != n) {
+    throw InputError(fmt::format("{}: {} joint values for a {}-joint robot ({})", where(m, i), m.q.size(), n,
+                                 model_.name()));
+  }
+  if (!m.q.allFinite() || !m.wrench_base.allFinite() || !m.dp_m.allFinite() ||
+      (m.drot_rad && !m.drot_rad->allFinite())) {
+    throw InputError(fmt::format("{}: a value is not finite", where(m, i)));
+  }
+  if (!(m.weight > 0.0) || !std::isfinite(m.weight)) {
+    throw InputError(fmt::format("{}: weight {} must be finite and > 0", where(m, i), m.weight));
+  }
+  stiffness_regressor(model_, ws_, m.q, m.wrench_base, block_);
+  const double sw = std::sqrt(m.weight);
+  const int rows = m.drot_rad ? 6 : 3;
+  double* out = store_->rows.append(rows);
+  const int width = n + 1;
+  for (int r = 0; r < 3; ++r) {
+    for (int j = 0; j < n; ++j) {
+      out[r * width + j] = sw * block_(r, j);
+    }
+    out[r * width + n] = sw * m.dp_m[r];
+  }
+  if (m.drot_rad) {
+    const double f = sw * options_.rotation_scale_m;
+    for (int r = 0; r < 3; ++r) {
+      for (int j = 0; j < n; ++j) {
+        out[(3 + r) * width + j] = f * block_(3 + r, j);
+      }
+      out[(3 + r) * width + n] = f * (*m.drot_rad)[r];
+    }
+  }
+  store_->sqrt_weight.push_back(sw);
+  store_->lines.push_back(m.line);
+}
+
+std::size_t StiffnessIdentifier::measurements() const { return store_->rows.size(); }
+
+StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<StiffnessMeasurement>& data,
+                                     const IdentificationOptions& options) {
+  StiffnessIdentifier id(model, options);
+  for (const StiffnessMeasurement& m : data) {
+    id.add(m);
+  }
+  return id.solve();
+}
+
+StiffnessEstimate StiffnessIdentifier::solve() {
+  const RobotModel& model = model_;
+  const IdentificationOptions& options = options_;
+  RowStore& s = store_->rows;
+  const int n = model.dof();
+  if (s.size() == 0) {
+    throw InputError("identify_stiffness: no measurements");
+  }
+  if (solved_) {
+    throw InputError("identify_stiffness: solve() runs once (it moves the fixed joints' part into the data)");
+  }
+  solved_ = true;
 
   StiffnessEstimate est;
   const auto nz = static_cast<std::size_t>(n);
@@ -173,13 +274,20 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
   est.std_error_nm_per_rad.assign(nz, kNaN);
   est.compliance_rad_per_nm.assign(nz, kNaN);
   est.compliance_std_error_rad_per_nm.assign(nz, kNaN);
-  est.measurements = static_cast<int>(data.size());
+  est.measurements = static_cast<int>(s.size());
+  const std::size_t m = s.size();
+  const int width = s.width();
 
-  Stack s = build_stack(model, data, options);
-  const std::size_t m = data.size();
+  // b -= A.col(j) * c for a joint whose compliance c is known (in place: b is the last column).
+  const auto move_to_rhs = [&](int j, double c) {
+    s.for_each_mutable([&](std::size_t, int rows, double* block) {
+      for (int r = 0; r < rows; ++r) {
+        block[r * width + n] -= block[r * width + j] * c;
+      }
+    });
+  };
 
   // Joints held at a known value: move their contribution to the right-hand side.
-  Eigen::VectorXd b = s.b;
   std::vector<int> free_joints;
   for (int j = 0; j < n; ++j) {
     const auto ju = static_cast<std::size_t>(j);
@@ -188,7 +296,7 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
       if (!(k > 0.0) || !std::isfinite(k)) {
         throw InputError(fmt::format("identify_stiffness: fixed stiffness of joint {} must be finite and > 0", j + 1));
       }
-      b -= s.A.col(j) / k;
+      move_to_rhs(j, 1.0 / k);
       est.stiffness_nm_per_rad[ju] = k;
       est.std_error_nm_per_rad[ju] = 0.0;
       est.compliance_rad_per_nm[ju] = 1.0 / k;
@@ -205,7 +313,12 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
   // Identifiability before fitting: a joint the loads never turn (or whose turning never moves the
   // measured point) has a zero column; a group of joints whose columns are collinear can only be
   // identified as a combination. Both are flagged and left out of the fit.
-  Eigen::VectorXd col_norm = s.A.colwise().norm().transpose();
+  Eigen::VectorXd col_norm = Eigen::VectorXd::Zero(n);
+  s.for_each([&](std::size_t, int rows, const double* block) {
+    const RowBlock B(block, rows, width);
+    col_norm += B.leftCols(n).colwise().squaredNorm().transpose();
+  });
+  col_norm = col_norm.cwiseSqrt();
   const double max_norm = [&] {
     double v = 0.0;
     for (int j : free_joints) {
@@ -231,7 +344,7 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
   }
   std::vector<double> omega(m, 1.0);
   while (estimated.size() > 1) {
-    const auto svd = svd_of(scaled_columns(s, estimated, col_norm, omega));
+    const auto svd = svd_of(s, estimated, col_norm, omega);
     const Eigen::VectorXd sv = svd.singularValues();
     const Eigen::Index last = sv.size() - 1;
     if (sv[last] >= options.min_relative_singular_value * sv[0]) {
@@ -260,7 +373,7 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
   for (int j : left_out) {
     if (model.has_stiffness()) {
       const double k = model.stiffness()[j];
-      b -= s.A.col(j) / k;
+      move_to_rhs(j, 1.0 / k);
       est.warnings.push_back(fmt::format("joint {}: held at the robot file's {:.4g} Nm/rad while the others were fitted",
                                          j + 1, k));
     } else {
@@ -282,74 +395,77 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
   Eigen::VectorXd scaled(p);  // compliance times column norm
   Eigen::Array<bool, Eigen::Dynamic, 1> at_bound;
   std::vector<double> d(m), d_over(m);
-  // Per-measurement normal-equation pieces of the scaled system, so a re-weighting iteration costs
-  // a matrix-vector product instead of a QR of the tall system; the final solve is done by QR.
-  Eigen::MatrixXd gram_parts, rhs_parts;
-  if (options.robust) {
-    gram_parts.resize(p * p, static_cast<Eigen::Index>(m));
-    rhs_parts.resize(p, static_cast<Eigen::Index>(m));
-    using Block = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, kMaxJoints>;
-    using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxJoints, kMaxJoints>;
-    Block Ai;
-    for (std::size_t i = 0; i < m; ++i) {
-      Ai.resize(s.rows[i], p);
-      for (Eigen::Index k = 0; k < p; ++k) {
-        const int j = estimated[static_cast<std::size_t>(k)];
-        Ai.col(k) = s.A.col(j).segment(s.start[i], s.rows[i]) / col_norm[j];
-      }
-      const Small Gi = Ai.transpose() * Ai;
-      gram_parts.col(static_cast<Eigen::Index>(i)) = Eigen::Map<const Eigen::VectorXd>(Gi.data(), p * p);
-      rhs_parts.col(static_cast<Eigen::Index>(i)) = Ai.transpose() * b.segment(s.start[i], s.rows[i]);
-    }
-  }
+  // The pieces of the scaled system a re-weighting iteration sums (G = sum omega_i A_i^T A_i and
+  // h = sum omega_i A_i^T b_i over the compact rows), so an iteration costs one pass over the
+  // stored rows instead of a QR of the tall system; the first and the final solve are by QR.
+  using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxJoints, kMaxJoints>;
+  using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJoints, 1>;
+  using Block = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, kMaxJoints>;
+  Eigen::VectorXd c_full = Eigen::VectorXd::Zero(n);
+  // d_i = |b_i - A_i c| over the stored rows.
+  const auto residual_norms = [&]() {
+    s.for_each([&](std::size_t i, int rows, const double* block) {
+      const RowBlock B(block, rows, width);
+      d[i] = (B.col(n) - B.leftCols(n) * c_full).norm();
+    });
+  };
   auto solve = [&](bool exact) {
     NnlsResult r;
     bool done = false;
     if (!exact) {
-      const Eigen::VectorXd w = Eigen::Map<const Eigen::VectorXd>(omega.data(), static_cast<Eigen::Index>(m));
-      const Eigen::VectorXd gv = gram_parts * w;
-      const Eigen::Map<const Eigen::MatrixXd> G(gv.data(), p, p);
-      const Eigen::LLT<Eigen::MatrixXd> llt(G);
+      Small G = Small::Zero(p, p);
+      SmallVec h = SmallVec::Zero(p);
+      Block Ai;
+      s.for_each([&](std::size_t i, int rows, const double* block) {
+        if (omega[i] == 0.0) {
+          return;
+        }
+        const RowBlock B(block, rows, width);
+        Ai.resize(rows, p);
+        for (Eigen::Index k = 0; k < p; ++k) {
+          const int j = estimated[static_cast<std::size_t>(k)];
+          Ai.col(k) = B.col(j) / col_norm[j];
+        }
+        G.noalias() += omega[i] * (Ai.transpose() * Ai);
+        h.noalias() += omega[i] * (Ai.transpose() * B.col(n));
+      });
+      const Eigen::LLT<Eigen::MatrixXd> llt{Eigen::MatrixXd(G)};
       if (llt.info() == Eigen::Success) {
         // min ||R s - y|| with R = L^T, y = L^-1 h has the normal equations G s = h.
         const Eigen::MatrixXd R = llt.matrixU();
-        const Eigen::VectorXd y = llt.matrixL().solve(rhs_parts * w);
+        const Eigen::VectorXd y = llt.matrixL().solve(Eigen::VectorXd(h));
         r = nonnegative_least_squares(R, y);
         done = true;
       }
     }
     if (!done) {
-      const Eigen::MatrixXd M = scaled_columns(s, estimated, col_norm, omega);
-      const Eigen::VectorXd y = weighted_rhs(s, b, omega);
       // One QR of the tall system reduces NNLS to a p x p triangular problem with the same solution.
-      Eigen::HouseholderQR<Eigen::MatrixXd> qr(M);
-      const Eigen::MatrixXd R = qr.matrixQR().topRows(p).triangularView<Eigen::Upper>();
-      const Eigen::VectorXd qty = (qr.householderQ().transpose() * y).head(p);
-      r = nonnegative_least_squares(R, qty);
+      const Triangular t = blocked_qr(s, estimated, col_norm, omega);
+      r = nonnegative_least_squares(t.R, t.qty);
     }
     scaled = r.x;
     at_bound = r.at_bound;
-    Eigen::VectorXd c_full = Eigen::VectorXd::Zero(n);
+    c_full.setZero();
     for (Eigen::Index k = 0; k < p; ++k) {
       const int j = estimated[static_cast<std::size_t>(k)];
       c_full[j] = scaled[k] / col_norm[j];
     }
-    const Eigen::VectorXd res = b - s.A * c_full;
-    for (std::size_t i = 0; i < m; ++i) {
-      d[i] = res.segment(s.start[i], s.rows[i]).norm();
-    }
-    return res;
+    residual_norms();
   };
   auto chi_median = [](int k) { return std::sqrt(chi_square_quantile(k, 0.0)); };
-  Eigen::VectorXd res = solve(true);
+  solve(true);
   if (options.robust) {
-    const double rhs_scale = b.norm() / std::sqrt(static_cast<double>(b.size()));
+    double b2 = 0.0;
+    s.for_each([&](std::size_t, int rows, const double* block) {
+      b2 += RowBlock(block, rows, width).col(n).squaredNorm();
+    });
+    const double rhs_scale = std::sqrt(b2 / static_cast<double>(s.total_rows()));
     double sigma = 0.0;
     for (int stage = 0; stage < 2; ++stage) {
       for (int it = 0; it < options.max_robust_iterations; ++it) {
         if (stage == 0) {
           for (std::size_t i = 0; i < m; ++i) {
-            d_over[i] = d[i] / chi_median(s.rows[i]);
+            d_over[i] = d[i] / chi_median(s.rows(i));
           }
           sigma = median(d_over);
         }
@@ -359,45 +475,47 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
         for (std::size_t i = 0; i < m; ++i) {
           const double u = d[i] / sigma;
           if (stage == 0) {
-            const double h = std::sqrt(chi_square_quantile(s.rows[i], 1.645));
+            const double h = std::sqrt(chi_square_quantile(s.rows(i), 1.645));
             omega[i] = u <= h ? 1.0 : h / u;
           } else {
-            const double c = 1.42 * std::sqrt(chi_square_quantile(s.rows[i], 3.090));
+            const double c = 1.42 * std::sqrt(chi_square_quantile(s.rows(i), 3.090));
             const double t = u / c;
             omega[i] = t < 1.0 ? (1.0 - t * t) * (1.0 - t * t) : 0.0;
           }
         }
         const Eigen::VectorXd before = scaled;
-        res = solve(false);
+        solve(false);
         ++est.iterations;
         if ((scaled - before).norm() <= 1e-10 * scaled.norm()) {
           break;
         }
       }
     }
-    res = solve(true);
+    solve(true);
   }
 
   // Fit figures. The residual covariance: sigma^2 = sum omega r^2 / (sum omega k - p), the usual
   // IRLS approximation that treats the final robust weights as known.
   double wr2 = 0.0, wdof = 0.0, pos2 = 0.0, rot2 = 0.0;
   int kept = 0, kept_rot = 0;
-  for (std::size_t i = 0; i < m; ++i) {
+  s.for_each([&](std::size_t i, int rows, const double* block) {
     wr2 += omega[i] * d[i] * d[i];
-    wdof += omega[i] * s.rows[i];
+    wdof += omega[i] * rows;
     if (omega[i] > 0.0) {
-      const auto r = res.segment(s.start[i], s.rows[i]) / s.sqrt_weight[i];
+      const RowBlock B(block, rows, width);
+      const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1> r = (B.col(n) - B.leftCols(n) * c_full) / store_->sqrt_weight[i];
       pos2 += r.head<3>().squaredNorm();
       est.residual_max_m = std::max(est.residual_max_m, r.head<3>().norm());
       ++kept;
-      if (s.rows[i] == 6) {
+      if (rows == 6) {
         rot2 += r.tail<3>().squaredNorm() / (options.rotation_scale_m * options.rotation_scale_m);
         ++kept_rot;
       }
     } else {
       est.rejected_measurements.push_back(static_cast<int>(i));
+      est.rejected_lines.push_back(store_->lines[i]);
     }
-  }
+  });
   est.robust_weights = omega;
   est.residual_rms_m = kept > 0 ? std::sqrt(pos2 / (3.0 * kept)) : 0.0;
   est.residual_rms_rad = kept_rot > 0 ? std::sqrt(rot2 / (3.0 * kept_rot)) : 0.0;
@@ -414,16 +532,14 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
     est.warnings.push_back("no more data than unknowns: standard errors cannot be estimated");
   }
   {
-    const auto svd = svd_of(scaled_columns(s, estimated, col_norm, omega));
+    const auto svd = svd_of(s, estimated, col_norm, omega);
     const Eigen::VectorXd sv = svd.singularValues();
     est.condition_number = sv[sv.size() - 1] > 0.0 ? sv[0] / sv[sv.size() - 1] : std::numeric_limits<double>::infinity();
   }
   Eigen::VectorXd var_scaled = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(passive.size()));
   if (!passive.empty()) {
-    const Eigen::MatrixXd M = scaled_columns(s, passive, col_norm, omega);
-    Eigen::HouseholderQR<Eigen::MatrixXd> qr(M);
     const auto pp = static_cast<Eigen::Index>(passive.size());
-    const Eigen::MatrixXd R = qr.matrixQR().topRows(pp).triangularView<Eigen::Upper>();
+    const Eigen::MatrixXd R = blocked_qr(s, passive, col_norm, omega).R;
     // (R^T R)^-1 = R^-1 R^-T: diagonal = squared row norms of R^-1.
     const Eigen::MatrixXd Rinv =
         R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(pp, pp));
@@ -464,8 +580,8 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
   if (!est.rejected_measurements.empty()) {
     std::vector<std::string> which;
     for (int i : est.rejected_measurements) {
-      const auto& mm = data[static_cast<std::size_t>(i)];
-      which.push_back(mm.line > 0 ? fmt::format("line {}", mm.line) : fmt::format("#{}", i + 1));
+      const int line = store_->lines[static_cast<std::size_t>(i)];
+      which.push_back(line > 0 ? fmt::format("line {}", line) : fmt::format("#{}", i + 1));
     }
     if (which.size() > 10) {
       which.resize(10);

@@ -14,6 +14,7 @@
 // See docs/identify.md for the estimator, its thresholds and the identifiability checks.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -66,6 +67,7 @@ struct StiffnessEstimate {
   /// Final robust weight of each measurement (1 = full, 0 = rejected as an outlier).
   std::vector<double> robust_weights;
   std::vector<int> rejected_measurements;  ///< 0-based indices of measurements with robust weight 0
+  std::vector<int> rejected_lines;         ///< their file lines (0 where a measurement came from no file)
   int measurements = 0;
   int iterations = 0;  ///< robust re-weighting iterations
 };
@@ -76,6 +78,34 @@ struct StiffnessEstimate {
 /// joint is left to estimate; names the measurement (file line when known).
 [[nodiscard]] StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<StiffnessMeasurement>& data,
                                                    const IdentificationOptions& options = {});
+
+/// The same a measurement at a time, for data too large to hold as StiffnessMeasurement objects (a
+/// million rows streamed from a file): add() checks and keeps a measurement's regressor rows in
+/// compact form (8 (dof + 1) bytes a row: 168 bytes for a 6-joint position measurement), solve()
+/// gives exactly what identify_stiffness gives for the same measurements.
+class StiffnessIdentifier {
+ public:
+  /// Throws InputError when the options do not fit the robot.
+  StiffnessIdentifier(const RobotModel& model, const IdentificationOptions& options = {});
+  ~StiffnessIdentifier();
+  StiffnessIdentifier(const StiffnessIdentifier&) = delete;
+  StiffnessIdentifier& operator=(const StiffnessIdentifier&) = delete;
+  /// Throws InputError naming the measurement (and its file line) for a wrong joint count, a value
+  /// that is not finite or a weight that is not > 0.
+  void add(const StiffnessMeasurement& m);
+  [[nodiscard]] std::size_t measurements() const;
+  /// Once: the estimate from every measurement added. Throws as identify_stiffness does.
+  [[nodiscard]] StiffnessEstimate solve();
+
+ private:
+  struct RowStoreHolder;
+  const RobotModel& model_;
+  IdentificationOptions options_;
+  Workspace ws_;
+  Jacobian block_;
+  std::unique_ptr<RowStoreHolder> store_;
+  bool solved_ = false;
+};
 
 /// The regressor block of one measurement: rows 0-2 position (m per rad/Nm), rows 3-5 orientation
 /// (rad per rad/Nm), column j the TCP motion per unit compliance of joint j under the wrench.

@@ -2,6 +2,7 @@
 // CSV file format that holds them. Format reference: docs/identify.md.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -9,6 +10,8 @@
 #include "deflex/model/types.hpp"
 
 namespace deflex {
+
+class CsvReader;
 
 /// One loaded-minus-unloaded observation at one configuration. SI units, robot base frame.
 struct StiffnessMeasurement {
@@ -28,6 +31,36 @@ struct StiffnessMeasurement {
 /// CsvTable), weights <= 0, joint values beyond +-720 deg, displacements beyond 100 mm (a unit
 /// mistake, not an elastic deflection), a file without data rows.
 std::vector<StiffnessMeasurement> read_stiffness_measurements(const std::string& csv_path);
+
+/// The same file a row at a time (deflex identify streams a million rows through it): next() gives
+/// the measurements read_stiffness_measurements gives, with the same errors.
+class StiffnessMeasurementReader {
+ public:
+  /// Opens the file and checks its columns; throws DataError as read_stiffness_measurements does.
+  explicit StiffnessMeasurementReader(const std::string& csv_path);
+  ~StiffnessMeasurementReader();
+  StiffnessMeasurementReader(const StiffnessMeasurementReader&) = delete;
+  StiffnessMeasurementReader& operator=(const StiffnessMeasurementReader&) = delete;
+  /// The next measurement; false after the last. Throws DataError for a bad row, and for a file
+  /// without any data row.
+  bool next(StiffnessMeasurement& out);
+  /// Number of joint columns (q1..qN).
+  [[nodiscard]] int joints() const;
+  [[nodiscard]] const std::string& source() const;
+
+  struct UnitColumn {
+    std::string name;
+    std::size_t index = 0;
+    double to_si = 1.0;
+  };
+
+ private:
+  std::unique_ptr<CsvReader> reader_;
+  std::vector<UnitColumn> q_cols_, d_cols_;
+  std::vector<std::size_t> wrench_cols_, rot_cols_;
+  std::optional<std::size_t> weight_col_;
+  std::size_t rows_ = 0;
+};
 
 /// Writes measurements in the same layout (deg, N, Nm, mm; drx.. only if every row has them).
 /// Throws Error when the file cannot be written.
