@@ -1,0 +1,72 @@
+// NumPy arrays in and out of the deflex module: every array argument is checked here (numeric
+// dtype, shape, finite values) and converted to C-contiguous float64, so a bad array is a
+// deflex.InputError (a ValueError) naming the argument and the shape expected, never a crash.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include "deflex/evaluate/tracker_trace.hpp"
+#include "deflex/model/types.hpp"
+
+namespace deflex::python {
+
+namespace py = pybind11;
+
+/// C-contiguous float64: what every array argument becomes and every array result is.
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+/// Any sequence or array of real numbers (float, int, uint dtypes) as C-contiguous float64, with
+/// `ndim` dimensions (0: any). Throws InputError "argument NAME: ..." otherwise.
+Array to_array(const py::handle& obj, const char* name, int ndim = 0);
+
+/// Throws InputError naming `name` and the first non-finite value (its row when 2-D).
+void require_finite(const Array& a, const char* name);
+
+/// Shape (n,) exactly; finite.
+Array vector_array(const py::handle& obj, const char* name, py::ssize_t n);
+/// Shape (rows, cols) with `rows` any (-1) or fixed; finite.
+Array matrix_array(const py::handle& obj, const char* name, py::ssize_t rows, py::ssize_t cols);
+/// Shape (n,) or (N, n): a single point or a batch. `batch` says which. Finite, row named on failure.
+Array single_or_batch(const py::handle& obj, const char* name, py::ssize_t n, bool& batch);
+
+JointVector joint_vector(const py::handle& obj, const char* name, int dof);
+Vector3 vector3(const py::handle& obj, const char* name);
+Vector6 vector6(const py::handle& obj, const char* name);
+/// A 4x4 homogeneous transform (rotation orthonormal within 1e-6, last row 0 0 0 1).
+Pose pose(const py::handle& obj, const char* name);
+/// (N, 4, 4) transforms, or one (4, 4) as a list of one.
+std::vector<Pose> poses(const py::handle& obj, const char* name);
+/// A tracker trace from (N, 3) positions (m; time = sample index, s) or (N, 4) [t_s, x_m, y_m, z_m].
+TrackerTrace tracker_trace(const py::handle& obj, const char* name);
+
+/// New arrays, shape given, C order.
+Array new_array(std::vector<py::ssize_t> shape);
+Array from_vector(const Eigen::Ref<const Eigen::VectorXd>& v);
+Array from_vector(const std::vector<double>& v);
+/// Row-major copy of a matrix.
+Array from_matrix(const Eigen::Ref<const Eigen::MatrixXd>& m);
+/// The 4x4 homogeneous matrix of a pose.
+Array from_pose(const Pose& p);
+void write_pose(const Pose& p, double* out16);
+/// (N, 4, 4) of poses.
+Array from_poses(const std::vector<Pose>& p);
+/// (N, n) of equally sized vectors (joint vectors, wrenches, displacements).
+template <typename Vec>
+Array from_rows(const std::vector<Vec>& rows, py::ssize_t n) {
+  Array out = new_array({static_cast<py::ssize_t>(rows.size()), n});
+  double* d = out.mutable_data();
+  for (const auto& r : rows) {
+    for (py::ssize_t j = 0; j < n; ++j) {
+      *d++ = r[j];
+    }
+  }
+  return out;
+}
+/// (N, 4) [t_s, x_m, y_m, z_m].
+Array from_trace(const TrackerTrace& t);
+
+}  // namespace deflex::python
