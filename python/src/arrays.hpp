@@ -69,4 +69,46 @@ Array from_rows(const std::vector<Vec>& rows, py::ssize_t n) {
 /// (N, 4) [t_s, x_m, y_m, z_m].
 Array from_trace(const TrackerTrace& t);
 
+/// (N, n) of a vector member of each item (e.g. the joints of each path point).
+template <typename T, typename Vec>
+Array rows_of(const std::vector<T>& items, Vec T::*field, py::ssize_t n) {
+  Array out = new_array({static_cast<py::ssize_t>(items.size()), n});
+  double* d = out.mutable_data();
+  for (const T& item : items) {
+    for (py::ssize_t j = 0; j < n; ++j) {
+      *d++ = (item.*field)[j];
+    }
+  }
+  return out;
+}
+
+/// (N, 4, 4) of a Pose member of each item.
+template <typename T>
+Array poses_of(const std::vector<T>& items, Pose T::*field) {
+  Array out = new_array({static_cast<py::ssize_t>(items.size()), 4, 4});
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    write_pose(items[i].*field, out.mutable_data() + 16 * i);
+  }
+  return out;
+}
+
+/// A read-write property of a fixed-size vector member (Vector3, Vector6), checked on assignment.
+template <typename T, typename Vec>
+void vector_property(py::class_<T>& c, const char* name, Vec T::*field, const char* doc = "") {
+  c.def_property(
+      name, [field](const T& t) { return from_vector(t.*field); },
+      [field, name](T& t, const py::handle& v) {
+        t.*field = Eigen::Map<const Vec>(vector_array(v, name, Vec::RowsAtCompileTime).data());
+      },
+      doc);
+}
+
+/// A read-write property of a Pose member, as a 4x4 homogeneous matrix.
+template <typename T>
+void pose_property(py::class_<T>& c, const char* name, Pose T::*field, const char* doc = "") {
+  c.def_property(
+      name, [field](const T& t) { return from_pose(t.*field); },
+      [field, name](T& t, const py::handle& v) { t.*field = pose(v, name); }, doc);
+}
+
 }  // namespace deflex::python

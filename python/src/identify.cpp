@@ -39,23 +39,19 @@ std::vector<StiffnessMeasurement> measurements_from_arrays(const RobotModel& mod
 
 py::dict measurements_to_dict(const std::vector<StiffnessMeasurement>& data) {
   const py::ssize_t dof = data.empty() ? 0 : data.front().q.size();
-  std::vector<JointVector> q;
-  std::vector<Wrench> w;
-  std::vector<Vector3> dp, drot;
+  std::vector<Vector3> drot;
   std::vector<double> weight;
   std::vector<int> line;
   bool all_rot = !data.empty();
   for (const auto& d : data) {
-    q.push_back(d.q);
-    w.push_back(d.wrench_base);
-    dp.push_back(d.dp_m);
     all_rot = all_rot && d.drot_rad.has_value();
     drot.push_back(d.drot_rad.value_or(Vector3::Zero()));
     weight.push_back(d.weight);
     line.push_back(d.line);
   }
-  py::dict out("q"_a = from_rows(q, dof), "wrench"_a = from_rows(w, 6), "dp"_a = from_rows(dp, 3),
-               "weight"_a = from_vector(weight), "line"_a = line);
+  py::dict out("q"_a = rows_of(data, &StiffnessMeasurement::q, dof),
+               "wrench"_a = rows_of(data, &StiffnessMeasurement::wrench_base, 6),
+               "dp"_a = rows_of(data, &StiffnessMeasurement::dp_m, 3), "weight"_a = from_vector(weight), "line"_a = line);
   out["drot"] = all_rot ? py::object(from_rows(drot, 3)) : py::none();
   return out;
 }
@@ -129,30 +125,16 @@ void bind_identify(py::module_& m) {
         return v;
       }, "1-based pose number of each row")
       .def_property_readonly("q", [](const CalibrationPlan& p) {
-        std::vector<JointVector> v;
-        for (const auto& c : p.points) v.push_back(c.q);
-        return from_rows(v, v.empty() ? 0 : v.front().size());
+        return rows_of(p.points, &CalibrationPoint::q, p.points.empty() ? 0 : p.points.front().q.size());
       }, "(rows, dof) rad")
-      .def_property_readonly("base_T_tcp", [](const CalibrationPlan& p) {
-        std::vector<Pose> v;
-        for (const auto& c : p.points) v.push_back(c.base_T_tcp);
-        return from_poses(v);
-      }, "(rows, 4, 4), m")
-      .def_property_readonly("wrench", [](const CalibrationPlan& p) {
-        std::vector<Wrench> v;
-        for (const auto& c : p.points) v.push_back(c.wrench_base);
-        return from_rows(v, 6);
-      }, "(rows, 6) N, Nm at the WAP, base frame")
-      .def_property_readonly("load_point", [](const CalibrationPlan& p) {
-        std::vector<Vector3> v;
-        for (const auto& c : p.points) v.push_back(c.load_point_base);
-        return from_rows(v, 3);
-      }, "(rows, 3) m, where the force acts")
-      .def_property_readonly("expected_dp", [](const CalibrationPlan& p) {
-        std::vector<Vector3> v;
-        for (const auto& c : p.points) v.push_back(c.expected_dp_m);
-        return from_rows(v, 3);
-      }, "(rows, 3) m, first-order deflection with the robot file's stiffness")
+      .def_property_readonly("base_T_tcp", [](const CalibrationPlan& p) { return poses_of(p.points, &CalibrationPoint::base_T_tcp); },
+                             "(rows, 4, 4), m")
+      .def_property_readonly("wrench", [](const CalibrationPlan& p) { return rows_of(p.points, &CalibrationPoint::wrench_base, 6); },
+                             "(rows, 6) N, Nm at the WAP, base frame")
+      .def_property_readonly("load_point", [](const CalibrationPlan& p) { return rows_of(p.points, &CalibrationPoint::load_point_base, 3); },
+                             "(rows, 3) m, where the force acts")
+      .def_property_readonly("expected_dp", [](const CalibrationPlan& p) { return rows_of(p.points, &CalibrationPoint::expected_dp_m, 3); },
+                             "(rows, 3) m, first-order deflection with the robot file's stiffness")
       .def_readonly("min_singular_value_m", &CalibrationPlan::min_singular_value_m)
       .def_readonly("condition_number", &CalibrationPlan::condition_number)
       .def_property_readonly("predicted_relative_std_error",

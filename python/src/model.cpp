@@ -42,36 +42,39 @@ std::vector<py::ssize_t> result_shape(bool batch, py::ssize_t rows, std::vector<
   return rest;
 }
 
-Array fk(const RobotModel& model, const py::handle& q_obj, const std::string& point) {
-  const EndPoint ep = end_point(point);
+/// The result of a per-configuration call over q: `rest` is its shape for one configuration;
+/// body(q_i, out_i) fills the rest-shaped block of row i, GIL released.
+template <typename Body>
+Array batch_of(const RobotModel& model, const py::handle& q_obj, std::vector<py::ssize_t> rest, Body&& body) {
   bool batch = false;
   const Array q = single_or_batch(q_obj, "q", model.dof(), batch);
   const py::ssize_t rows = batch ? q.shape(0) : 1;
-  Array out = new_array(result_shape(batch, rows, {4, 4}));
+  py::ssize_t block = 1;
+  for (const py::ssize_t r : rest) block *= r;
+  Array out = new_array(result_shape(batch, rows, std::move(rest)));
   double* o = out.mutable_data();
-  Workspace ws(model);
-  for_each_row(model, q, rows, [&](py::ssize_t i, const JointVector& qi) {
-    forward_kinematics(model, ws, qi);
-    write_pose(end_pose(ws, ep), o + 16 * i);
-  });
+  for_each_row(model, q, rows, [&](py::ssize_t i, const JointVector& qi) { body(qi, o + i * block); });
   return out;
+}
+
+Array fk(const RobotModel& model, const py::handle& q_obj, const std::string& point) {
+  const EndPoint ep = end_point(point);
+  Workspace ws(model);
+  return batch_of(model, q_obj, {4, 4}, [&](const JointVector& qi, double* out) {
+    forward_kinematics(model, ws, qi);
+    write_pose(end_pose(ws, ep), out);
+  });
 }
 
 Array jacobian_of(const RobotModel& model, const py::handle& q_obj, const std::string& point) {
   const EndPoint ep = end_point(point);
-  bool batch = false;
-  const Array q = single_or_batch(q_obj, "q", model.dof(), batch);
-  const py::ssize_t rows = batch ? q.shape(0) : 1;
   const int dof = model.dof();
-  Array out = new_array(result_shape(batch, rows, {6, dof}));
-  double* o = out.mutable_data();
   Workspace ws(model);
   Jacobian J(6, dof);
-  for_each_row(model, q, rows, [&](py::ssize_t i, const JointVector& qi) {
+  return batch_of(model, q_obj, {6, dof}, [&](const JointVector& qi, double* out) {
     jacobian(model, ws, qi, ep, J);
-    Eigen::Map<Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>>(o + i * 6 * dof, 6, dof) = J;
+    Eigen::Map<Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>>(out, 6, dof) = J;
   });
-  return out;
 }
 
 /// What deflect() returns: arrays of one configuration or of a batch.

@@ -72,27 +72,18 @@ std::vector<Pose> path_poses(const py::handle& path, const py::handle& orientati
   return poses(path, "path");
 }
 
-template <typename Field>
-Array point_rows(const OfflineResult& r, Field field, py::ssize_t n) {
-  std::vector<Eigen::VectorXd> rows;
-  for (const auto& p : r.points) rows.emplace_back(field(p));
-  return from_rows(rows, n);
-}
+py::ssize_t dof_of(const OfflineResult& r) { return r.points.empty() ? 0 : r.points.front().q_desired.size(); }
 
 }  // namespace
 
 void bind_offline(py::module_& m) {
-  py::class_<CirclePath>(m, "Circle",
-                         "A circle in the base frame (m): centre_m, radius_m, normal, start_angle_rad, clockwise, "
-                         "points (closed: the last repeats the first).")
-      .def(py::init([] { return default_circle(); }), "deflex's reference circle (as `deflex offline --circle`).")
-      .def_property(
-          "centre_m", [](const CirclePath& c) { return from_vector(c.centre_m); },
-          [](CirclePath& c, const py::handle& v) { c.centre_m = vector3(v, "centre_m"); })
+  py::class_<CirclePath> circle(m, "Circle",
+                                "A circle in the base frame (m): centre_m, radius_m, normal, start_angle_rad, "
+                                "clockwise, points (closed: the last repeats the first).");
+  vector_property(circle, "centre_m", &CirclePath::centre_m);
+  vector_property(circle, "normal", &CirclePath::normal);
+  circle.def(py::init([] { return default_circle(); }), "deflex's reference circle (as `deflex offline --circle`).")
       .def_readwrite("radius_m", &CirclePath::radius_m)
-      .def_property(
-          "normal", [](const CirclePath& c) { return from_vector(c.normal); },
-          [](CirclePath& c, const py::handle& v) { c.normal = vector3(v, "normal"); })
       .def_readwrite("start_angle_rad", &CirclePath::start_angle_rad)
       .def_readwrite("clockwise", &CirclePath::clockwise)
       .def_readwrite("points", &CirclePath::points)
@@ -130,31 +121,22 @@ void bind_offline(py::module_& m) {
       "configuration (cf1, cf4, cf6, cfx). InputError names the path point.");
 
   py::class_<OfflineResult>(m, "OfflineResult", "A compensated path: one row a point (rad, m, N, Nm).")
-      .def_property_readonly("q_desired", [](const OfflineResult& r) {
-        return point_rows(r, [](const OfflinePoint& p) { return Eigen::VectorXd(p.q_desired); }, r.points.empty() ? 0 : r.points[0].q_desired.size());
-      }, "(N, dof) rad, from the path's IK")
-      .def_property_readonly("q_command", [](const OfflineResult& r) {
-        return point_rows(r, [](const OfflinePoint& p) { return Eigen::VectorXd(p.q_command); }, r.points.empty() ? 0 : r.points[0].q_command.size());
-      }, "(N, dof) rad: q_desired - K^-1 J_wap(q_desired)^T W")
-      .def_property_readonly("tcp_desired", [](const OfflineResult& r) {
-        std::vector<Pose> v;
-        for (const auto& p : r.points) v.push_back(p.tcp_desired);
-        return from_poses(v);
-      }, "(N, 4, 4) m")
-      .def_property_readonly("tcp_command", [](const OfflineResult& r) {
-        std::vector<Pose> v;
-        for (const auto& p : r.points) v.push_back(p.tcp_command);
-        return from_poses(v);
-      }, "(N, 4, 4) m: FK(q_command)")
-      .def_property_readonly("wrench", [](const OfflineResult& r) {
-        return point_rows(r, [](const OfflinePoint& p) { return Eigen::VectorXd(p.wrench_base); }, 6);
-      }, "(N, 6) N, Nm: base frame, moment about the WAP")
-      .def_property_readonly("predicted_deflection", [](const OfflineResult& r) {
-        return point_rows(r, [](const OfflinePoint& p) { return Eigen::VectorXd(p.predicted_deflection); }, 6);
-      }, "(N, 6) [m, rad]: uncompensated TCP displacement under the load")
-      .def_property_readonly("predicted_residual", [](const OfflineResult& r) {
-        return point_rows(r, [](const OfflinePoint& p) { return Eigen::VectorXd(p.predicted_residual); }, 6);
-      }, "(N, 6) [m, rad]: after compensation (a check of the exact form)")
+      .def_property_readonly("q_desired", [](const OfflineResult& r) { return rows_of(r.points, &OfflinePoint::q_desired, dof_of(r)); },
+                             "(N, dof) rad, from the path's IK")
+      .def_property_readonly("q_command", [](const OfflineResult& r) { return rows_of(r.points, &OfflinePoint::q_command, dof_of(r)); },
+                             "(N, dof) rad: q_desired - K^-1 J_wap(q_desired)^T W")
+      .def_property_readonly("tcp_desired", [](const OfflineResult& r) { return poses_of(r.points, &OfflinePoint::tcp_desired); },
+                             "(N, 4, 4) m")
+      .def_property_readonly("tcp_command", [](const OfflineResult& r) { return poses_of(r.points, &OfflinePoint::tcp_command); },
+                             "(N, 4, 4) m: FK(q_command)")
+      .def_property_readonly("wrench", [](const OfflineResult& r) { return rows_of(r.points, &OfflinePoint::wrench_base, 6); },
+                             "(N, 6) N, Nm: base frame, moment about the WAP")
+      .def_property_readonly("predicted_deflection",
+                             [](const OfflineResult& r) { return rows_of(r.points, &OfflinePoint::predicted_deflection, 6); },
+                             "(N, 6) [m, rad]: uncompensated TCP displacement under the load")
+      .def_property_readonly("predicted_residual",
+                             [](const OfflineResult& r) { return rows_of(r.points, &OfflinePoint::predicted_residual, 6); },
+                             "(N, 6) [m, rad]: after compensation (a check of the exact form)")
       .def_readonly("max_deflection_m", &OfflineResult::max_deflection_m)
       .def_readonly("mean_deflection_m", &OfflineResult::mean_deflection_m)
       .def_readonly("max_deflection_rad", &OfflineResult::max_deflection_rad)

@@ -12,18 +12,6 @@
 
 namespace deflex::python {
 using namespace pybind11::literals;
-namespace {
-
-/// A 4x4 transform property of a struct.
-template <typename T>
-void pose_property(py::class_<T>& c, const char* name, Pose T::*field) {
-  c.def_property(
-      name, [field](const T& t) { return from_pose(t.*field); },
-      [field, name](T& t, const py::handle& v) { t.*field = pose(v, name); });
-}
-
-}  // namespace
-
 void bind_online(py::module_& m) {
   py::class_<SensorConfig> sensor_class(m, "SensorConfig",
                                   "Force-sensor conditioning (docs/online.md): crosstalk, frame, payload, bias, "
@@ -39,12 +27,6 @@ void bind_online(py::module_& m) {
           },
           "6x6 decoupling matrix, sensor frame")
       .def_readwrite("payload_mass_kg", &SensorConfig::payload_mass_kg)
-      .def_property(
-          "payload_cog_sensor_m", [](const SensorConfig& s) { return from_vector(s.payload_cog_sensor_m); },
-          [](SensorConfig& s, const py::handle& v) { s.payload_cog_sensor_m = vector3(v, "payload_cog_sensor_m"); })
-      .def_property(
-          "bias_sensor", [](const SensorConfig& s) { return from_vector(s.bias_sensor); },
-          [](SensorConfig& s, const py::handle& v) { s.bias_sensor = vector6(v, "bias_sensor"); }, "N, Nm")
       .def_readwrite("lowpass_cutoff_hz", &SensorConfig::lowpass_cutoff_hz)
       .def_readwrite("lowpass_order", &SensorConfig::lowpass_order)
       .def_readwrite("sample_rate_hz", &SensorConfig::sample_rate_hz)
@@ -54,7 +36,9 @@ void bind_online(py::module_& m) {
       .def_readwrite("fault_threshold_Nm", &SensorConfig::fault_threshold_Nm)
       .def("validate", &SensorConfig::validate)
       .def("to_yaml", [](const SensorConfig& s) { return sensor_config_to_yaml(s); });
-  pose_property(sensor_class, "flange_T_sensor", &SensorConfig::flange_T_sensor);
+  pose_property(sensor_class, "flange_T_sensor", &SensorConfig::flange_T_sensor, "flange to sensor frame, m");
+  vector_property(sensor_class, "payload_cog_sensor_m", &SensorConfig::payload_cog_sensor_m);
+  vector_property(sensor_class, "bias_sensor", &SensorConfig::bias_sensor, "N, Nm");
   m.def("load_sensor_config", &load_sensor_config, "path"_a, "A sensor configuration YAML (docs/online.md).");
 
   py::class_<OnlineConfig>(m, "OnlineConfig", "Bounds and timing of the compensation cycle (s, rad, m).")
