@@ -15,7 +15,6 @@ namespace deflex::python {
 using namespace pybind11::literals;
 namespace {
 
-
 EndPoint end_point(const std::string& name) {
   if (name == "tcp") return EndPoint::kTcp;
   if (name == "flange") return EndPoint::kFlange;

@@ -145,3 +145,17 @@ def test_robot_properties_from_the_file():
     np.testing.assert_allclose(stiffer.deflect(q, w).dtheta_rad, robot.deflect(q, w).dtheta_rad / 2, rtol=1e-13)
     again = deflex.Robot.from_yaml(robot.to_yaml(), str(KR210.parent))
     np.testing.assert_allclose(again.fk(q), robot.fk(q), atol=1e-12)
+
+
+def test_batch_calls_from_several_threads_at_once(rng):
+    """The batch calls release the GIL and use a workspace of their own: threads sharing one Robot get the
+    single-threaded answer (itself checked against the CLI above)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    robot = deflex.Robot.builtin()
+    q = random_configurations(robot, 20000, rng)
+    expected_T, expected_J = robot.fk(q), robot.jacobian(q)
+    with ThreadPoolExecutor(4) as pool:
+        results = list(pool.map(lambda k: robot.fk(q) if k % 2 else robot.jacobian(q), range(8)))
+    for k, r in enumerate(results):
+        np.testing.assert_array_equal(r, expected_T if k % 2 else expected_J)
