@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/paths/circle_path.hpp"
 
 namespace deflex::python {
 namespace {
@@ -100,6 +101,12 @@ Vector3 vector3(const py::handle& obj, const char* name) {
 
 Vector6 vector6(const py::handle& obj, const char* name) {
   return Eigen::Map<const Vector6>(vector_array(obj, name, 6).data());
+}
+
+Eigen::Quaterniond unit_quaternion(const py::handle& obj, const char* name) {
+  const Array q = vector_array(obj, name, 4);
+  return checked_unit_quaternion(Eigen::Quaterniond(q.data()[0], q.data()[1], q.data()[2], q.data()[3]),
+                                 (std::string("argument ") + name).c_str());
 }
 
 namespace {

@@ -36,6 +36,8 @@ Array single_or_batch(const py::handle& obj, const char* name, py::ssize_t n, bo
 JointVector joint_vector(const py::handle& obj, const char* name, int dof);
 Vector3 vector3(const py::handle& obj, const char* name);
 Vector6 vector6(const py::handle& obj, const char* name);
+/// A unit quaternion (w, x, y, z) within 1e-6, normalised.
+Eigen::Quaterniond unit_quaternion(const py::handle& obj, const char* name);
 /// A 4x4 homogeneous transform (rotation orthonormal within 1e-6, last row 0 0 0 1).
 Pose pose(const py::handle& obj, const char* name);
 /// (N, 4, 4) transforms, or one (4, 4) as a list of one.

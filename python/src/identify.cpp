@@ -156,8 +156,7 @@ void bind_identify(py::module_& m) {
         o.poses = poses;
         o.loads_per_pose = loads_per_pose;
         o.lever_m = lever_m;
-        const Array q = vector_array(orientation, "orientation_wxyz", 4);
-        o.orientation = Eigen::Quaterniond(q.data()[0], q.data()[1], q.data()[2], q.data()[3]);
+        o.orientation = unit_quaternion(orientation, "orientation_wxyz");
         o.grid_per_axis = grid_per_axis;
         o.noise_m = noise_m;
         py::gil_scoped_release release;

@@ -264,13 +264,9 @@ void bind_model(py::module_& m) {
   m.def(
       "pose",
       [](const py::handle& position, const py::handle& quaternion) {
-        const Array q = vector_array(quaternion, "quaternion_wxyz", 4);
-        const Eigen::Quaterniond quat(q.data()[0], q.data()[1], q.data()[2], q.data()[3]);
-        if (std::abs(quat.norm() - 1.0) > 1e-6) {
-          throw InputError(fmt::format("argument quaternion_wxyz: not a unit quaternion (norm {:.9f})", quat.norm()));
-        }
+        const Eigen::Quaterniond quat = unit_quaternion(quaternion, "quaternion_wxyz");
         Pose p = Pose::Identity();
-        p.linear() = quat.normalized().toRotationMatrix();
+        p.linear() = quat.toRotationMatrix();
         p.translation() = vector3(position, "position_m");
         return from_pose(p);
       },

@@ -49,12 +49,6 @@ std::unique_ptr<ForceModel> force_model(const py::handle& force, const ForceSpec
   return std::make_unique<ArrayWrenchModel>(std::move(rows));
 }
 
-Eigen::Quaterniond quaternion(const py::handle& obj, const char* name) {
-  const Array q = vector_array(obj, name, 4);
-  return checked_unit_quaternion(Eigen::Quaterniond(q.data()[0], q.data()[1], q.data()[2], q.data()[3]),
-                                 (std::string("argument ") + name).c_str());
-}
-
 IkRequest first_request(const RobotModel& model, const py::object& configuration, const py::object& seed) {
   IkRequest first;
   first.configuration = arm_configuration_arg(configuration);
@@ -67,7 +61,7 @@ std::vector<Pose> path_poses(const py::handle& path, const py::handle& orientati
   if (py::isinstance<CirclePath>(path)) {
     const auto& c = path.cast<const CirclePath&>();
     context.circle = c;
-    return sample_circle(c, quaternion(orientation, "orientation_wxyz"));
+    return sample_circle(c, unit_quaternion(orientation, "orientation_wxyz"));
   }
   return poses(path, "path");
 }
@@ -90,7 +84,7 @@ void bind_offline(py::module_& m) {
       .def(
           "poses",
           [](const CirclePath& c, const py::handle& orientation) {
-            return from_poses(sample_circle(c, quaternion(orientation, "orientation_wxyz")));
+            return from_poses(sample_circle(c, unit_quaternion(orientation, "orientation_wxyz")));
           },
           "orientation_wxyz"_a = std::vector<double>{0.0, 0.0, 1.0, 0.0}, "The TCP poses (points, 4, 4), m.");
 
@@ -101,7 +95,7 @@ void bind_offline(py::module_& m) {
         l.start_m = vector3(start, "start_m");
         l.end_m = vector3(end, "end_m");
         l.points = points;
-        return from_poses(sample_line(l, quaternion(orientation, "orientation_wxyz")));
+        return from_poses(sample_line(l, unit_quaternion(orientation, "orientation_wxyz")));
       },
       "start_m"_a, "end_m"_a, "points"_a = 2, "orientation_wxyz"_a = std::vector<double>{0.0, 0.0, 1.0, 0.0},
       "TCP poses (points, 4, 4) along a straight segment (m), orientation held.");
