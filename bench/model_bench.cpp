@@ -2,7 +2,6 @@
 // FK, FK + Jacobian, the full deflection (FK + J + dtheta = K^-1 J^T W), and inverse kinematics
 // (every analytic solution of a pose against KDL's numerical Levenberg-Marquardt solver).
 // Run: build/bench/model_bench --benchmark_min_time=1
-#include <random>
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -14,30 +13,17 @@
 #include "deflex/model/inverse_kinematics.hpp"
 #include "deflex/model/opw_ik.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "bench_robot.hpp"
 #include "model/kdl_chain.hpp"
 
 namespace {
 
 using namespace deflex;
 
-const RobotModel& robot() {
-  static const RobotModel m = builtin_irb6700();
-  return m;
-}
+const RobotModel& robot() { return bench::irb6700(); }
 
 const std::vector<JointVector>& configurations() {
-  static const std::vector<JointVector> qs = [] {
-    std::mt19937_64 rng(1);
-    std::vector<JointVector> out;
-    for (int s = 0; s < 1000; ++s) {
-      JointVector q(6);
-      for (int i = 0; i < 6; ++i) {
-        q[i] = std::uniform_real_distribution<double>(robot().lower_limits()[i], robot().upper_limits()[i])(rng);
-      }
-      out.push_back(q);
-    }
-    return out;
-  }();
+  static const std::vector<JointVector> qs = bench::random_configurations(1000);
   return qs;
 }
 

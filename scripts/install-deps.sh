@@ -7,7 +7,8 @@ packages=(
   libeigen3-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev
   protobuf-compiler libprotobuf-dev liburdfdom-dev libtinyxml-dev
   libgtest-dev libgmock-dev libbenchmark-dev liborocos-kdl-dev libboost-dev
-  libspdlog-dev libxml2-dev python3
+  libspdlog-dev libxml2-dev
+  python3 python3-dev python3-numpy python3-pytest pybind11-dev
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -24,6 +24,11 @@ void joint_deflection(const RobotModel& model, Workspace& ws, const JointVector&
 Displacement tcp_deflection(const RobotModel& model, Workspace& ws, const JointVector& q, const Wrench& wrench_base,
                             const ComplianceOptions& options) {
   JointVector dtheta;
+  return tcp_deflection(model, ws, q, wrench_base, dtheta, options);
+}
+
+Displacement tcp_deflection(const RobotModel& model, Workspace& ws, const JointVector& q, const Wrench& wrench_base,
+                            JointVector& dtheta, const ComplianceOptions& options) {
   joint_deflection(model, ws, q, wrench_base, dtheta, options);
   // joint_deflection left the FK of q in ws; the TCP Jacobian reuses it.
   point_jacobian(ws, ws.base_T_tcp.translation(), ws.jacobian);

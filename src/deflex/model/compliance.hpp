@@ -29,6 +29,11 @@ void joint_deflection(const RobotModel& model, Workspace& ws, const JointVector&
 /// First-order TCP deflection [m; rad] at q under W: J_tcp(q) dtheta, dtheta from joint_deflection().
 [[nodiscard]] Displacement tcp_deflection(const RobotModel& model, Workspace& ws, const JointVector& q,
                                           const Wrench& wrench_base, const ComplianceOptions& options = {});
+/// The same, also giving the joint deflection dtheta (rad) it is made of: one FK for both (the
+/// batch calls of the Python module use it).
+[[nodiscard]] Displacement tcp_deflection(const RobotModel& model, Workspace& ws, const JointVector& q,
+                                          const Wrench& wrench_base, JointVector& dtheta,
+                                          const ComplianceOptions& options = {});
 
 /// 6x6 Cartesian compliance at the WAP, C = J K^-1 J^T at q: [m/N, m/Nm; rad/N, rad/Nm].
 [[nodiscard]] Matrix6 cartesian_compliance(const RobotModel& model, Workspace& ws, const JointVector& q);

@@ -1,0 +1,33 @@
+// The parts of the deflex Python module, one function a part of the library (model, identify,
+// offline, evaluate, online, study), each in its own file; module.cpp calls them in this order.
+#pragma once
+
+#include <memory>
+#include <optional>
+
+#include <pybind11/pybind11.h>
+
+#include "deflex/model/arm_configuration.hpp"
+#include "deflex/model/robot_model.hpp"
+
+namespace deflex::python {
+
+namespace py = pybind11;
+
+/// The Python class deflex.Robot holds its RobotModel by shared pointer, so results and compensators
+/// made from it may outlive the Python object.
+using RobotHolder = std::shared_ptr<RobotModel>;
+
+/// ABB confdata (cf1, cf4, cf6, cfx) as a tuple, and from a Python sequence (None: not given).
+py::tuple configuration_tuple(const ArmConfiguration& c);
+std::optional<ArmConfiguration> arm_configuration_arg(const py::object& c);
+
+void bind_errors(py::module_& m);
+void bind_model(py::module_& m);
+void bind_identify(py::module_& m);
+void bind_offline(py::module_& m);
+void bind_evaluate(py::module_& m);
+void bind_online(py::module_& m);
+void bind_study(py::module_& m);
+
+}  // namespace deflex::python

@@ -1,0 +1,51 @@
+// deflex's exceptions as Python exceptions with the same message text (which names the file, line
+// and field): deflex.Error (a RuntimeError) and its subclasses ModelError, DataError and
+// InputError; InputError is also a ValueError, since it means a bad argument (bad arrays included).
+#include <Python.h>
+
+#include "bindings.hpp"
+#include "deflex/model/errors.hpp"
+
+namespace deflex::python {
+namespace {
+
+// Created once with the module and never freed: the translator may run until the interpreter exits.
+PyObject* g_error = nullptr;
+PyObject* g_model_error = nullptr;
+PyObject* g_data_error = nullptr;
+PyObject* g_input_error = nullptr;
+
+PyObject* new_exception(py::module_& m, const char* name, PyObject* bases, const char* doc) {
+  const std::string full = std::string("deflex.") + name;
+  PyObject* type = PyErr_NewExceptionWithDoc(full.c_str(), doc, bases, nullptr);
+  if (type == nullptr) throw py::error_already_set();
+  m.attr(name) = py::handle(type);
+  return type;
+}
+
+}  // namespace
+
+void bind_errors(py::module_& m) {
+  g_error = new_exception(m, "Error", PyExc_RuntimeError, "Base of every deflex error.");
+  g_model_error = new_exception(m, "ModelError", g_error,
+                                "A robot description or configuration file is malformed: names the file and field.");
+  g_data_error = new_exception(m, "DataError", g_error, "A data file (CSV) is malformed: names the file, line and column.");
+  py::tuple input_bases = py::make_tuple(py::handle(g_error), py::handle(PyExc_ValueError));
+  g_input_error = new_exception(m, "InputError", input_bases.ptr(),
+                                "A value given is out of its domain (bad array shape or dtype, NaN, unreachable pose).");
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      PyErr_SetString(g_input_error, e.what());
+    } catch (const DataError& e) {
+      PyErr_SetString(g_data_error, e.what());
+    } catch (const ModelError& e) {
+      PyErr_SetString(g_model_error, e.what());
+    } catch (const Error& e) {
+      PyErr_SetString(g_error, e.what());
+    }
+  });
+}
+
+}  // namespace deflex::python

@@ -1,0 +1,172 @@
+// Stiffness identification (from arrays or the measurement CSV) and calibration planning.
+#include <fmt/format.h>
+#include <pybind11/stl.h>
+
+#include "arrays.hpp"
+#include "bindings.hpp"
+#include "deflex/identify/calibration_planner.hpp"
+#include "deflex/identify/stiffness_identification.hpp"
+#include "deflex/identify/stiffness_measurements.hpp"
+#include "deflex/model/errors.hpp"
+
+namespace deflex::python {
+using namespace pybind11::literals;
+namespace {
+
+/// Measurements from arrays: q (m, dof) rad, wrench (m, 6) N/Nm, dp (m, 3) m, optional drot (m, 3)
+/// rad and weight (m,).
+std::vector<StiffnessMeasurement> measurements_from_arrays(const RobotModel& model, const py::handle& q_obj,
+                                                           const py::handle& w_obj, const py::handle& dp_obj,
+                                                           const py::handle& drot_obj, const py::handle& weight_obj) {
+  const Array q = matrix_array(q_obj, "q", -1, model.dof());
+  const py::ssize_t n = q.shape(0);
+  const Array w = matrix_array(w_obj, "wrench", n, 6);
+  const Array dp = matrix_array(dp_obj, "dp", n, 3);
+  const bool has_rot = !drot_obj.is_none(), has_weight = !weight_obj.is_none();
+  const Array drot = has_rot ? matrix_array(drot_obj, "drot", n, 3) : Array();
+  const Array weight = has_weight ? vector_array(weight_obj, "weight", n) : Array();
+  std::vector<StiffnessMeasurement> data(static_cast<std::size_t>(n));
+  for (py::ssize_t i = 0; i < n; ++i) {
+    auto& d = data[static_cast<std::size_t>(i)];
+    d.q = Eigen::Map<const Eigen::VectorXd>(q.data() + i * model.dof(), model.dof());
+    d.wrench_base = Eigen::Map<const Wrench>(w.data() + 6 * i);
+    d.dp_m = Eigen::Map<const Vector3>(dp.data() + 3 * i);
+    if (has_rot) d.drot_rad = Eigen::Map<const Vector3>(drot.data() + 3 * i);
+    if (has_weight) d.weight = weight.data()[i];
+  }
+  return data;
+}
+
+py::dict measurements_to_dict(const std::vector<StiffnessMeasurement>& data) {
+  const py::ssize_t dof = data.empty() ? 0 : data.front().q.size();
+  std::vector<Vector3> drot;
+  std::vector<double> weight;
+  std::vector<int> line;
+  bool all_rot = !data.empty();
+  for (const auto& d : data) {
+    all_rot = all_rot && d.drot_rad.has_value();
+    drot.push_back(d.drot_rad.value_or(Vector3::Zero()));
+    weight.push_back(d.weight);
+    line.push_back(d.line);
+  }
+  py::dict out("q"_a = rows_of(data, &StiffnessMeasurement::q, dof),
+               "wrench"_a = rows_of(data, &StiffnessMeasurement::wrench_base, 6),
+               "dp"_a = rows_of(data, &StiffnessMeasurement::dp_m, 3), "weight"_a = from_vector(weight), "line"_a = line);
+  out["drot"] = all_rot ? py::object(from_rows(drot, 3)) : py::none();
+  return out;
+}
+
+}  // namespace
+
+void bind_identify(py::module_& m) {
+  py::class_<StiffnessEstimate>(m, "StiffnessEstimate",
+                                "Identified joint stiffness (Nm/rad) with standard errors and identifiability flags.")
+      .def_property_readonly("stiffness_nm_per_rad", [](const StiffnessEstimate& e) { return from_vector(e.stiffness_nm_per_rad); })
+      .def_property_readonly("std_error_nm_per_rad", [](const StiffnessEstimate& e) { return from_vector(e.std_error_nm_per_rad); })
+      .def_property_readonly("compliance_rad_per_nm", [](const StiffnessEstimate& e) { return from_vector(e.compliance_rad_per_nm); })
+      .def_property_readonly("compliance_std_error_rad_per_nm",
+                             [](const StiffnessEstimate& e) { return from_vector(e.compliance_std_error_rad_per_nm); })
+      .def_readonly("residual_rms_m", &StiffnessEstimate::residual_rms_m)
+      .def_readonly("residual_max_m", &StiffnessEstimate::residual_max_m)
+      .def_readonly("residual_rms_rad", &StiffnessEstimate::residual_rms_rad)
+      .def_readonly("sigma_m", &StiffnessEstimate::sigma_m)
+      .def_readonly("condition_number", &StiffnessEstimate::condition_number)
+      .def_readonly("unidentifiable_joints", &StiffnessEstimate::unidentifiable_joints, "1-based joint numbers")
+      .def_readonly("fixed_joints", &StiffnessEstimate::fixed_joints, "1-based joint numbers")
+      .def_readonly("warnings", &StiffnessEstimate::warnings)
+      .def_property_readonly("robust_weights", [](const StiffnessEstimate& e) { return from_vector(e.robust_weights); })
+      .def_readonly("rejected_measurements", &StiffnessEstimate::rejected_measurements, "0-based indices")
+      .def_readonly("measurements", &StiffnessEstimate::measurements)
+      .def_readonly("iterations", &StiffnessEstimate::iterations)
+      .def("__repr__", [](const StiffnessEstimate& e) {
+        return fmt::format("StiffnessEstimate(stiffness_nm_per_rad={}, condition_number={:.3g}, warnings={})",
+                           py::repr(from_vector(e.stiffness_nm_per_rad)).cast<std::string>(), e.condition_number,
+                           e.warnings.size());
+      });
+
+  m.def("read_stiffness_measurements",
+        [](const std::string& path) { return measurements_to_dict(read_stiffness_measurements(path)); }, "path"_a,
+        "The measurement CSV (docs/identify.md) as arrays in SI units: q (m, dof) rad, wrench (m, 6) N/Nm, dp (m, 3) "
+        "m, drot (m, 3) rad or None, weight (m,), line (file line of each row).");
+
+  m.def(
+      "identify_stiffness",
+      [](const RobotModel& model, const py::object& data, const py::object& q, const py::object& wrench,
+         const py::object& dp, const py::object& drot, const py::object& weight, const py::object& fixed, bool robust,
+         double rotation_scale_m, double max_relative_std_error) {
+        std::vector<StiffnessMeasurement> measurements;
+        if (!data.is_none()) {
+          if (!q.is_none() || !wrench.is_none() || !dp.is_none()) {
+            throw InputError("identify_stiffness: give either data (a CSV path) or the arrays q, wrench, dp, not both");
+          }
+          measurements = read_stiffness_measurements(data.cast<std::string>());
+        } else {
+          measurements = measurements_from_arrays(model, q, wrench, dp, drot, weight);
+        }
+        IdentificationOptions options;
+        options.robust = robust;
+        options.rotation_scale_m = rotation_scale_m;
+        options.max_relative_std_error = max_relative_std_error;
+        if (!fixed.is_none()) options.fixed_stiffness_nm_per_rad = fixed.cast<std::vector<std::optional<double>>>();
+        py::gil_scoped_release release;
+        return identify_stiffness(model, measurements, options);
+      },
+      "robot"_a, "data"_a = py::none(), py::kw_only(), "q"_a = py::none(), "wrench"_a = py::none(), "dp"_a = py::none(),
+      "drot"_a = py::none(), "weight"_a = py::none(), "fixed_stiffness_nm_per_rad"_a = py::none(), "robust"_a = true,
+      "rotation_scale_m"_a = 1.0, "max_relative_std_error"_a = 0.5,
+      "Joint stiffness from measured TCP deflections: data is the measurement CSV's path, or give arrays q (m, dof) "
+      "rad, wrench (m, 6) N/Nm (base frame, at the WAP), dp (m, 3) m, optional drot (m, 3) rad and weight (m,). "
+      "fixed_stiffness_nm_per_rad: one entry a joint, a value to hold or None to estimate.");
+
+  py::class_<CalibrationPlan>(m, "CalibrationPlan", "Poses and loads of a compliance-calibration experiment.")
+      .def_property_readonly("pose", [](const CalibrationPlan& p) {
+        std::vector<int> v;
+        for (const auto& c : p.points) v.push_back(c.pose);
+        return v;
+      }, "1-based pose number of each row")
+      .def_property_readonly("q", [](const CalibrationPlan& p) {
+        return rows_of(p.points, &CalibrationPoint::q, p.points.empty() ? 0 : p.points.front().q.size());
+      }, "(rows, dof) rad")
+      .def_property_readonly("base_T_tcp", [](const CalibrationPlan& p) { return poses_of(p.points, &CalibrationPoint::base_T_tcp); },
+                             "(rows, 4, 4), m")
+      .def_property_readonly("wrench", [](const CalibrationPlan& p) { return rows_of(p.points, &CalibrationPoint::wrench_base, 6); },
+                             "(rows, 6) N, Nm at the WAP, base frame")
+      .def_property_readonly("load_point", [](const CalibrationPlan& p) { return rows_of(p.points, &CalibrationPoint::load_point_base, 3); },
+                             "(rows, 3) m, where the force acts")
+      .def_property_readonly("expected_dp", [](const CalibrationPlan& p) { return rows_of(p.points, &CalibrationPoint::expected_dp_m, 3); },
+                             "(rows, 3) m, first-order deflection with the robot file's stiffness")
+      .def_readonly("min_singular_value_m", &CalibrationPlan::min_singular_value_m)
+      .def_readonly("condition_number", &CalibrationPlan::condition_number)
+      .def_property_readonly("predicted_relative_std_error",
+                             [](const CalibrationPlan& p) { return from_vector(p.predicted_relative_std_error); })
+      .def_readonly("candidate_poses", &CalibrationPlan::candidate_poses)
+      .def_readonly("reachable_poses", &CalibrationPlan::reachable_poses)
+      .def_readonly("warnings", &CalibrationPlan::warnings)
+      .def("write_csv", [](const CalibrationPlan& p, const std::string& path) { write_calibration_plan(path, p); },
+           "path"_a, "The plan as the operator's CSV (the same as deflex plan-calibration -o).");
+
+  m.def(
+      "plan_calibration",
+      [](const RobotModel& model, const py::handle& region_min, const py::handle& region_max, double load_n, int poses,
+         int loads_per_pose, double lever_m, const py::handle& orientation, int grid_per_axis, double noise_m) {
+        CalibrationPlanOptions o;
+        o.region_min_m = vector3(region_min, "region_min_m");
+        o.region_max_m = vector3(region_max, "region_max_m");
+        o.load_n = load_n;
+        o.poses = poses;
+        o.loads_per_pose = loads_per_pose;
+        o.lever_m = lever_m;
+        o.orientation = unit_quaternion(orientation, "orientation_wxyz");
+        o.grid_per_axis = grid_per_axis;
+        o.noise_m = noise_m;
+        py::gil_scoped_release release;
+        return plan_calibration(model, o);
+      },
+      "robot"_a, "region_min_m"_a, "region_max_m"_a, "load_n"_a = 500.0, "poses"_a = 12, "loads_per_pose"_a = 2,
+      "lever_m"_a = 0.25, "orientation_wxyz"_a = std::vector<double>{0.0, 0.0, 1.0, 0.0}, "grid_per_axis"_a = 4,
+      "noise_m"_a = 10e-6,
+      "Chooses calibration poses and loads in a box of TCP positions (m, base frame) so that every joint's "
+      "compliance is observable; load in N, lever and noise in m.");
+}
+
+}  // namespace deflex::python

@@ -1,0 +1,113 @@
+"""Errors: deflex's exceptions arrive as Python exceptions with the C++ program's message text, and no
+bad array (shape, dtype, NaN, memory layout) crashes or is silently misread."""
+
+import numpy as np
+import pytest
+
+import deflex
+from conftest import SOURCE_DIR, run_cli
+
+Q = np.radians([0.0, 30.0, 10.0, 0.0, 50.0, 0.0])
+
+
+def test_exception_hierarchy():
+    assert issubclass(deflex.ModelError, deflex.Error) and issubclass(deflex.DataError, deflex.Error)
+    assert issubclass(deflex.InputError, deflex.Error) and issubclass(deflex.InputError, ValueError)
+    assert issubclass(deflex.Error, RuntimeError)
+
+
+@pytest.mark.parametrize("q, expected", [
+    ([0.0, 0.1, 0.2], "argument q: expected shape (6,) or (N, 6), got (3,)"),
+    (np.zeros((4, 5)), "argument q: expected shape (6,) or (N, 6), got (4, 5)"),
+    (np.zeros((2, 3, 6)), "argument q: expected shape (6,) or (N, 6), got (2, 3, 6)"),
+    (np.zeros(0), "got (0,)"),
+])
+def test_wrong_shape_names_argument_and_shape(q, expected):
+    robot = deflex.Robot.builtin()
+    for call in (robot.fk, robot.jacobian, lambda x: robot.deflect(x, np.zeros(6))):
+        with pytest.raises(deflex.InputError) as info:
+            call(q)
+        assert expected in str(info.value)
+
+
+@pytest.mark.parametrize("q", [np.array(["a"] * 6), np.zeros(6, dtype=complex), np.array([None] * 6),
+                               [[0, 1], [2]], "012345", None])
+def test_wrong_dtype_is_refused(q):
+    with pytest.raises(ValueError, match="argument q"):
+        deflex.Robot.builtin().fk(q)
+
+
+def test_nan_names_the_row():
+    q = np.zeros((10, 6))
+    q[7, 2] = np.nan
+    with pytest.raises(deflex.InputError, match=r"argument q: row 7 has a non-finite value \(nan at column 2\)"):
+        deflex.Robot.builtin().fk(q)
+    with pytest.raises(deflex.InputError, match="argument wrench: element 3 is not finite"):
+        deflex.Robot.builtin().deflect(Q, [0, 0, 1, np.inf, 0, 0])
+    with pytest.raises(deflex.InputError, match=r"argument wrench: expected shape \(6,\) or \(10, 6\)"):
+        deflex.Robot.builtin().deflect(np.zeros((10, 6)), np.zeros((9, 6)))
+
+
+def test_non_contiguous_integer_and_fortran_arrays_are_read_correctly(rng):
+    robot = deflex.Robot.builtin()
+    q = rng.uniform(-1, 1, (8, 6))
+    expected = np.stack([robot.fk(row) for row in q.tolist()])
+    wide = np.zeros((8, 12))
+    wide[:, ::2] = q
+    assert not wide[:, ::2].flags.c_contiguous
+    np.testing.assert_array_equal(robot.fk(wide[:, ::2]), expected)
+    np.testing.assert_array_equal(robot.fk(np.asfortranarray(q)), expected)
+    np.testing.assert_array_equal(robot.fk(q[::-1]), expected[::-1])
+    np.testing.assert_array_equal(robot.fk(q.astype(np.float32)), robot.fk(q.astype(np.float32).astype(float)))
+    np.testing.assert_array_equal(robot.fk(np.zeros(6, dtype=np.int64)), robot.fk(np.zeros(6)))
+
+
+def test_bad_robot_file_message_is_the_cli_message(tmp_path):
+    text = (SOURCE_DIR / "examples" / "robots" / "kuka_kr210_r2700.yaml").read_text()
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(text.replace("joint_stiffness_Nm_per_rad: [3.5e6,", "joint_stiffness_Nm_per_rad: [-3.5e6,"))
+    with pytest.raises(deflex.ModelError) as info:
+        deflex.Robot.from_file(str(bad))
+    message = str(info.value)
+    assert str(bad) in message and "stiffness" in message
+    cli = run_cli("fk", "--robot", bad, "--joints-deg", "0,0,0,0,0,0", check=False)
+    assert cli.returncode == 2
+    assert message in cli.stderr
+
+
+def test_missing_file_and_robot_without_stiffness():
+    with pytest.raises(deflex.Error, match="no_such_robot.yaml"):
+        deflex.Robot.from_file("no_such_robot.yaml")
+    urdf = deflex.Robot.from_file(str(SOURCE_DIR / "examples" / "robots" / "ros-industrial" / "fanuc_m10ia.urdf"))
+    assert not urdf.has_stiffness
+    with pytest.raises(deflex.ModelError, match="stiffness"):
+        urdf.deflect(np.zeros(6), np.zeros(6))
+
+
+def test_bad_csv_message_is_the_cli_message(tmp_path):
+    src = (SOURCE_DIR / "examples" / "identify" / "kr210_synthetic_measurements.csv").read_text().splitlines()
+    src[5] = src[5].replace(",800,", ",abc,", 1)
+    bad = tmp_path / "bad.csv"
+    bad.write_text("\n".join(src) + "\n")
+    robot = deflex.Robot.from_file(str(SOURCE_DIR / "examples" / "robots" / "kuka_kr210_r2700.yaml"))
+    with pytest.raises(deflex.DataError) as info:
+        deflex.identify_stiffness(robot, str(bad))
+    message = str(info.value)
+    assert f"{bad}:6:" in message and "abc" in message
+    cli = run_cli("identify", "--robot", SOURCE_DIR / "examples" / "robots" / "kuka_kr210_r2700.yaml", "--data", bad,
+                  check=False)
+    assert cli.returncode != 0 and message in cli.stderr
+
+
+def test_pose_arguments_are_checked():
+    robot = deflex.Robot.builtin()
+    T = robot.fk(Q)
+    T[0, 0] += 0.1
+    with pytest.raises(deflex.InputError, match="argument pose: the top-left 3x3 block is not a rotation matrix"):
+        robot.ik(T)
+    with pytest.raises(deflex.InputError, match=r"argument pose: expected shape \(4, 4\)"):
+        robot.ik(np.eye(3))
+    with pytest.raises(deflex.InputError, match="not a unit quaternion"):
+        deflex.pose([1, 0, 1], [1, 1, 0, 0])
+    with pytest.raises(deflex.InputError, match="argument point"):
+        robot.fk(Q, "elbow")
