@@ -1,59 +1,109 @@
 // CSV data files with a unit-carrying header row.
 #include "deflex/model/csv_table.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/model/input_ranges.hpp"
+#include "deflex/model/nearest_name.hpp"
+#include "deflex/model/parse_number.hpp"
 
 namespace deflex {
 namespace {
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r");
-  if (b == std::string::npos) {
-    return "";
-  }
-  const auto e = s.find_last_not_of(" \t\r");
-  return s.substr(b, e - b + 1);
-}
+// A data file larger than this is refused before it is read: 1 GiB holds some 30 million tracker
+// samples, over eight hours at 1000 Hz.
+constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 30;
+
+std::string trim(std::string_view s) { return std::string(trim_view(s)); }
 
 std::vector<std::string> split(const std::string& line) {
   std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string cell;
-  while (std::getline(ss, cell, ',')) {
-    out.push_back(trim(cell));
-  }
-  if (!line.empty() && line.back() == ',') {
-    out.emplace_back();
+  std::size_t b = 0;
+  while (true) {
+    const auto e = line.find(',', b);
+    out.push_back(trim(std::string_view(line).substr(b, e == std::string::npos ? std::string::npos : e - b)));
+    if (e == std::string::npos) {
+      break;
+    }
+    b = e + 1;
   }
   return out;
 }
 
+// A header cell written quoted by a spreadsheet ("x_mm") names the column x_mm.
+std::string unquote(const std::string& cell) {
+  if (cell.size() >= 2 && cell.front() == '"' && cell.back() == '"') {
+    return cell.substr(1, cell.size() - 2);
+  }
+  return cell;
+}
+
+// Lines ending in LF, CRLF or a lone CR (old Mac, some loggers), all alike.
+std::vector<std::string> split_lines(std::string_view text) {
+  std::vector<std::string> lines;
+  std::size_t b = 0;
+  while (b <= text.size()) {
+    const auto e = text.find_first_of("\r\n", b);
+    if (e == std::string_view::npos) {
+      if (b < text.size()) {
+        lines.emplace_back(text.substr(b));
+      }
+      break;
+    }
+    lines.emplace_back(text.substr(b, e - b));
+    b = e + 1;
+    if (text[e] == '\r' && b < text.size() && text[b] == '\n') {
+      ++b;
+    }
+  }
+  return lines;
+}
+
 }  // namespace
 
-CsvTable CsvTable::read_file(const std::string& path) {
-  std::ifstream in(path);
+std::string read_text_file(const std::string& path, const char* what) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > kMaxFileBytes) {
+    throw DataError(fmt::format("{}: the {} is {} bytes; deflex reads files up to {} bytes", path, what, size,
+                                kMaxFileBytes));
+  }
+  if (!ec && std::filesystem::is_directory(path)) {
+    throw DataError(fmt::format("{}: is a directory, not a {}", path, what));
+  }
+  std::ifstream in(path, std::ios::binary);
   if (!in) {
-    throw DataError(fmt::format("{}: cannot read the file", path));
+    throw DataError(fmt::format("{}: cannot read the {}", path, what));
   }
   std::stringstream ss;
   ss << in.rdbuf();
-  return parse(ss.str(), path);
+  std::string text = ss.str();
+  // A UTF-8 byte order mark (Excel writes one) is not part of the first column's name.
+  if (text.rfind("\xEF\xBB\xBF", 0) == 0) {
+    text.erase(0, 3);
+  }
+  return text;
 }
 
-CsvTable CsvTable::parse(const std::string& text, const std::string& source) {
+CsvTable CsvTable::read_file(const std::string& path) { return parse(read_text_file(path, "file"), path); }
+
+CsvTable CsvTable::parse(const std::string& raw_text, const std::string& source) {
   CsvTable t;
   t.source_ = source;
-  std::stringstream ss(text);
-  std::string line;
+  const std::string_view text =
+      raw_text.rfind("\xEF\xBB\xBF", 0) == 0 ? std::string_view(raw_text).substr(3) : std::string_view(raw_text);
   int line_no = 0;
   bool have_header = false;
-  while (std::getline(ss, line)) {
+  std::vector<const InputRange*> ranges;
+  for (const std::string& line : split_lines(text)) {
     ++line_no;
     const std::string tl = trim(line);
     if (tl.empty() || tl[0] == '#') {
@@ -61,21 +111,41 @@ CsvTable CsvTable::parse(const std::string& text, const std::string& source) {
     }
     const auto cells = split(tl);
     if (!have_header) {
-      t.columns_ = cells;
+      if (cells.size() == 1) {
+        for (const char sep : {';', '\t', '|'}) {
+          if (tl.find(sep) != std::string::npos) {
+            throw DataError(fmt::format("{}:{}: header '{}' is one column: deflex CSV files separate columns with "
+                                        "commas, this one uses '{}'",
+                                        source, line_no, tl, sep == '\t' ? std::string("\\t") : std::string(1, sep)));
+          }
+        }
+      }
       for (std::size_t i = 0; i < cells.size(); ++i) {
-        if (cells[i].empty()) {
+        const std::string name = unquote(cells[i]);
+        if (name.empty()) {
           throw DataError(fmt::format("{}:{}: header: column {} has no name", source, line_no, i + 1));
         }
-        if (!t.index_.emplace(cells[i], i).second) {
-          throw DataError(fmt::format("{}:{}: header: column '{}' appears twice", source, line_no, cells[i]));
+        if (parse_double(name)) {
+          throw DataError(fmt::format("{}:{}: header: column {} is named '{}', a number: the first row must name "
+                                      "the columns (e.g. t_s,x_mm,y_mm,z_mm)",
+                                      source, line_no, i + 1, name));
         }
+        if (!t.index_.emplace(name, i).second) {
+          throw DataError(fmt::format("{}:{}: header: column '{}' appears twice", source, line_no, name));
+        }
+        t.columns_.push_back(name);
+        ranges.push_back(&range_for_name(name));
       }
       have_header = true;
       continue;
     }
     if (cells.size() != t.columns_.size()) {
-      throw DataError(fmt::format("{}:{}: {} cells, the header has {} columns", source, line_no, cells.size(),
-                                  t.columns_.size()));
+      const bool other_sep = tl.find(';') != std::string::npos || tl.find('\t') != std::string::npos;
+      throw DataError(fmt::format("{}:{}: {} cells, the header has {} columns{}", source, line_no, cells.size(),
+                                  t.columns_.size(),
+                                  other_sep ? " (deflex CSV files separate cells with commas, and the decimal "
+                                              "separator is a point)"
+                                            : ""));
     }
     std::vector<double> row(cells.size());
     for (std::size_t i = 0; i < cells.size(); ++i) {
@@ -83,21 +153,14 @@ CsvTable CsvTable::parse(const std::string& text, const std::string& source) {
       if (c.empty()) {
         throw DataError(fmt::format("{}:{}: column '{}': empty cell", source, line_no, t.columns_[i]));
       }
-      std::size_t used = 0;
-      double v = 0.0;
-      try {
-        v = std::stod(c, &used);
-      } catch (const std::logic_error&) {
-        used = 0;
+      const std::optional<double> v = parse_double(c);
+      if (!v) {
+        throw DataError(fmt::format("{}:{}: column '{}': {}", source, line_no, t.columns_[i], not_a_number(c)));
       }
-      if (used != c.size()) {
-        throw DataError(fmt::format("{}:{}: column '{}': '{}' is not a number", source, line_no, t.columns_[i], c));
+      if (const auto bad = range_violation(*v, *ranges[i])) {
+        throw DataError(fmt::format("{}:{}: column '{}': {}", source, line_no, t.columns_[i], *bad));
       }
-      if (!std::isfinite(v)) {
-        throw DataError(fmt::format("{}:{}: column '{}': '{}' is not a finite number", source, line_no,
-                                    t.columns_[i], c));
-      }
-      row[i] = v;
+      row[i] = *v;
     }
     t.values_.push_back(std::move(row));
     t.lines_.push_back(line_no);
@@ -106,6 +169,15 @@ CsvTable CsvTable::parse(const std::string& text, const std::string& source) {
     throw DataError(fmt::format("{}: no header row (the file is empty)", source));
   }
   return t;
+}
+
+void CsvTable::allow_only(const std::vector<std::string>& allowed) const {
+  for (const std::string& c : columns_) {
+    if (std::find(allowed.begin(), allowed.end(), c) == allowed.end()) {
+      throw DataError(fmt::format("{}: unknown column '{}'{} (this file takes: {})", source_, c,
+                                  did_you_mean(c, allowed), fmt::join(allowed, ", ")));
+    }
+  }
 }
 
 std::size_t CsvTable::column(const std::string& name) const {
@@ -133,6 +205,22 @@ void CsvTable::require(const std::vector<std::string>& required) const {
     throw DataError(fmt::format("{}: missing column{} {} (have: {})", source_, missing.size() > 1 ? "s" : "",
                                 fmt::join(missing, ", "), fmt::join(columns_, ", ")));
   }
+}
+
+std::string csv_text_cell(const std::string& text) {
+  const bool plain = text.find_first_of(",\"\r\n") == std::string::npos && trim_view(text).size() == text.size();
+  if (plain) {
+    return text;
+  }
+  std::string out = "\"";
+  for (const char c : text) {
+    out += c;
+    if (c == '"') {
+      out += '"';
+    }
+  }
+  out += '"';
+  return out;
 }
 
 struct CsvWriter::Impl {

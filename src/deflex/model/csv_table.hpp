@@ -14,9 +14,11 @@ namespace deflex {
 /// and blank lines are skipped. Columns may come in any order; they are found by name.
 class CsvTable {
  public:
-  /// Reads and checks the whole file: every cell of every row must be a finite number (NaN, inf and
-  /// empty cells are errors naming the line and column), and every row must have the header's
-  /// number of cells. Throws DataError.
+  /// Reads and checks the whole file: every cell of every row must be a finite number inside the
+  /// range its column's unit allows (input_ranges.hpp; NaN, inf, 1e308 and empty cells are errors
+  /// naming the line and column), and every row must have the header's number of cells. A UTF-8 byte
+  /// order mark, CRLF and CR-only line endings are taken; a header separated by ';' or tabs is named
+  /// as such. Throws DataError.
   static CsvTable read_file(const std::string& path);
   static CsvTable parse(const std::string& text, const std::string& source);
 
@@ -35,6 +37,9 @@ class CsvTable {
   [[noreturn]] void fail(std::size_t row, const std::string& column, const std::string& message) const;
   /// Fails when any of `required` is missing, naming all that are.
   void require(const std::vector<std::string>& required) const;
+  /// Fails on a column not in `allowed`, suggesting the nearest allowed name ('Index' -> 'index'), so
+  /// a misspelt optional column is never silently ignored.
+  void allow_only(const std::vector<std::string>& allowed) const;
 
  private:
   std::string source_;
@@ -43,6 +48,15 @@ class CsvTable {
   std::vector<std::vector<double>> values_;
   std::vector<int> lines_;
 };
+
+/// The whole text of a file, refused with DataError naming it when it cannot be read, is a directory
+/// or is larger than 1 GiB (checked before reading); a leading UTF-8 byte order mark is dropped.
+/// `what` names the kind of file in messages ("robot file", "file").
+[[nodiscard]] std::string read_text_file(const std::string& path, const char* what);
+
+/// A text cell for a CSV file: quoted (RFC 4180, inner quotes doubled) when it holds a comma, a
+/// quote, a line break or blanks at its ends; as it is otherwise.
+[[nodiscard]] std::string csv_text_cell(const std::string& text);
 
 /// Writes a CSV header row and rows with fixed formatting. Throws Error if the file cannot be written.
 class CsvWriter {

@@ -13,6 +13,7 @@ namespace {
 
 std::vector<Pose> poses_from_table(const CsvTable& table) {
   table.require({"x_mm", "y_mm", "z_mm", "qw", "qx", "qy", "qz"});
+  table.allow_only({"x_mm", "y_mm", "z_mm", "qw", "qx", "qy", "qz"});
   if (table.rows() == 0) {
     throw DataError(fmt::format("{}: no pose rows", table.source()));
   }

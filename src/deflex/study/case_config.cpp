@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -168,6 +169,23 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
     }
     c.setups.push_back(sc);
   }
+  {
+    // The sweep runs each setup at its load nearest to sweep_load_N: a value outside every setup's
+    // loads would silently become another load.
+    double lo = HUGE_VAL, hi = 0.0;
+    for (const auto& sc : c.setups) {
+      for (double l : sc.loads_n) {
+        lo = std::min(lo, l);
+        hi = std::max(hi, l);
+      }
+    }
+    if (c.sweep_load_n < lo || c.sweep_load_n > hi) {
+      (proto.has("sweep_load_N") ? proto.at("sweep_load_N") : proto)
+          .fail(fmt::format("{:g} N is outside the setups' loads ({:g}..{:g} N); the sweep runs each setup at its "
+                            "load nearest to this",
+                            c.sweep_load_n, lo, hi));
+    }
+  }
 
   const auto r = root.at("true_robot");
   r.only_keys({"stiffness_scale", "stiffness_spread_pct", "coupling_23", "forearm_EI_Nm2", "forearm_length_mm",
@@ -198,7 +216,10 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   if (std::abs(c.cell.robot.coupling_23) >= 0.9) r.at("coupling_23").fail("must be within +-0.9");
   c.cell.robot.forearm_ei_nm2 = non_negative(r.at("forearm_EI_Nm2"));
   c.cell.robot.forearm_length_m = positive(r.at("forearm_length_mm")) * kMm;
-  c.cell.robot.lost_motion_rad = r.at("lost_motion_urad").as_doubles();
+  // Per-joint lists: one entry a joint of the built-in arm (a shorter list would silently leave the
+  // last joints without the effect, a longer one would be silently cut).
+  const std::size_t per_joint = c.cell.robot_file.empty() ? 6 : 0;
+  c.cell.robot.lost_motion_rad = r.at("lost_motion_urad").as_doubles(per_joint);
   for (double& v : c.cell.robot.lost_motion_rad) {
     if (v < 0) r.at("lost_motion_urad").fail("must not be negative");
     v *= kUm;
@@ -213,7 +234,7 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   c.cell.robot.dh_length_sigma_m = non_negative(r.at("dh_length_sigma_mm")) * kMm;
   c.cell.robot.dh_angle_sigma_rad = deg_to_rad(non_negative(r.at("dh_angle_sigma_deg")));
   if (r.has("hardening_softening") || r.has("hardening_torque_Nm")) {
-    c.cell.robot.hardening_softening = r.at("hardening_softening").as_doubles();
+    c.cell.robot.hardening_softening = r.at("hardening_softening").as_doubles(per_joint);
     for (double v : c.cell.robot.hardening_softening) {
       if (!(v >= 0.0 && v <= 5.0)) r.at("hardening_softening").fail("must be within 0..5");
     }
