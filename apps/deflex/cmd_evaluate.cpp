@@ -90,8 +90,8 @@ void setup_evaluate(CLI::App& sub, int& exit_code) {
   sub.add_option("--commanded", o->commanded,
                  "CSV of the commanded path (same columns; t_s may be 0): ISO 9283 accuracy is then taken against "
                  "it instead of the first unloaded run");
-  sub.add_option("--evaluation-points", o->points, "ISO 9283: planes normal to the path (default 81, the paper's)")
-      ->check(CLI::Range(1, 100000));
+  sub.add_option("--evaluation-points", o->points,
+                 "ISO 9283: planes normal to the path, 1..100000 (default 81, the paper's)");
   sub.add_option("--max-offset-mm", o->max_offset_mm,
                  "ISO 9283: a run crossing a plane farther than this from the path does not count there (default 10)");
   sub.add_flag("--split-laps", o->split,
