@@ -166,6 +166,9 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
   if (!(options.rotation_scale_m > 0.0) || !std::isfinite(options.rotation_scale_m)) {
     throw InputError("identify_stiffness: rotation_scale_m must be finite and > 0");
   }
+  if (!(options.max_relative_std_error > 0.0) || !std::isfinite(options.max_relative_std_error)) {
+    throw InputError("identify_stiffness: max_relative_std_error must be finite and > 0");
+  }
 
   StiffnessEstimate est;
   const auto nz = static_cast<std::size_t>(n);
@@ -234,10 +237,13 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
     const auto svd = svd_of(scaled_columns(s, estimated, col_norm, omega));
     const Eigen::VectorXd sv = svd.singularValues();
     const Eigen::Index last = sv.size() - 1;
-    if (sv[last] >= options.min_relative_singular_value * sv[0]) {
+    // Fewer equations than joints: the SVD has fewer singular values than columns, and V's trailing
+    // columns span a null space the smallest singular value does not show.
+    const bool underdetermined = sv.size() < static_cast<Eigen::Index>(estimated.size());
+    if (!underdetermined && sv[last] >= options.min_relative_singular_value * sv[0]) {
       break;
     }
-    const Eigen::VectorXd v = svd.matrixV().col(last);
+    const Eigen::VectorXd v = svd.matrixV().col(underdetermined ? svd.matrixV().cols() - 1 : last);
     std::vector<int> group;
     for (Eigen::Index k = 0; k < v.size(); ++k) {
       if (std::abs(v[k]) > 0.1) {
@@ -248,7 +254,7 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
         "joints {}: their effects on the measured displacements are collinear in these data (relative singular "
         "value {:.1e}); only a combination is observable, so none of them is identified: add poses or load "
         "directions that separate them (deflex plan-calibration)",
-        joint_list(group), sv[last] / sv[0]));
+        joint_list(group), underdetermined ? 0.0 : sv[last] / sv[0]));
     for (int j : group) {
       left_out.push_back(j);
       estimated.erase(std::find(estimated.begin(), estimated.end(), j));
@@ -449,7 +455,8 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
     est.stiffness_nm_per_rad[ju] = 1.0 / c;
     est.std_error_nm_per_rad[ju] = se_c / (c * c);  // delta method: dk = -dc / c^2
     const double rel = se_c / c;
-    if (rel > options.max_relative_std_error) {
+    // NaN (no residual degrees of freedom: as many equations as unknowns) counts as unidentified.
+    if (!(rel <= options.max_relative_std_error)) {
       left_out.push_back(j);
       est.warnings.push_back(fmt::format(
           "joint {}: poorly identified (relative standard error {:.0f}% > {:.0f}%); the value is shown but should "
