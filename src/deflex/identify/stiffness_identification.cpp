@@ -243,18 +243,27 @@ StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<
     if (!underdetermined && sv[last] >= options.min_relative_singular_value * sv[0]) {
       break;
     }
-    const Eigen::VectorXd v = svd.matrixV().col(underdetermined ? svd.matrixV().cols() - 1 : last);
+    // The joints in the unobservable direction: the smallest singular value's vector or, with fewer
+    // equations than joints, every joint with a component in the null space (V's trailing columns).
+    const Eigen::MatrixXd null_basis =
+        underdetermined ? Eigen::MatrixXd(svd.matrixV().rightCols(svd.matrixV().cols() - sv.size()))
+                        : Eigen::MatrixXd(svd.matrixV().col(last));
     std::vector<int> group;
-    for (Eigen::Index k = 0; k < v.size(); ++k) {
-      if (std::abs(v[k]) > 0.1) {
+    for (Eigen::Index k = 0; k < null_basis.rows(); ++k) {
+      if (null_basis.row(k).norm() > 0.1) {
         group.push_back(estimated[static_cast<std::size_t>(k)]);
       }
     }
-    est.warnings.push_back(fmt::format(
-        "joints {}: their effects on the measured displacements are collinear in these data (relative singular "
-        "value {:.1e}); only a combination is observable, so none of them is identified: add poses or load "
-        "directions that separate them (deflex plan-calibration)",
-        joint_list(group), underdetermined ? 0.0 : sv[last] / sv[0]));
+    est.warnings.push_back(
+        underdetermined
+            ? fmt::format("joints {}: {} equations for {} unknown compliances; these joints are not determined by "
+                          "the data: add measurements (deflex plan-calibration)",
+                          joint_list(group), sv.size(), estimated.size())
+            : fmt::format(
+                  "joints {}: their effects on the measured displacements are collinear in these data (relative "
+                  "singular value {:.1e}); only a combination is observable, so none of them is identified: add "
+                  "poses or load directions that separate them (deflex plan-calibration)",
+                  joint_list(group), sv[last] / sv[0]));
     for (int j : group) {
       left_out.push_back(j);
       estimated.erase(std::find(estimated.begin(), estimated.end(), j));
