@@ -238,7 +238,12 @@ void setup_plan(CLI::App& sub, int& exit_code) {
       }
     }
     opt.spin_rad.clear();
-    for (double s : parse_numbers(o->spin, "--spin-deg")) {
+    const std::vector<double> spins = parse_numbers(o->spin, "--spin-deg");
+    if (spins.size() > 360) {
+      throw InputError(fmt::format("option --spin-deg: {} turns; give at most 360 (each multiplies the candidates)",
+                                   spins.size()));
+    }
+    for (double s : spins) {
       opt.spin_rad.push_back(deg_to_rad(s));
     }
     const CalibrationPlan plan = plan_calibration(model, opt);

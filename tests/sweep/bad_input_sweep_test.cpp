@@ -292,7 +292,8 @@ std::vector<BadInput> file_cases() {
                    {"servo_period_tiny", "servo_period_ms: 4", "servo_period_ms: 1e-9", "controller.servo_period_ms"},
                    {"paper_uc_short", "paper_uc_mm: [0.12, 0.38, 0.62]", "paper_uc_mm: [0.12, 0.38]",
                     "setups[1].paper_uc_mm"},
-                   {"points_huge", "points: 81 ", "points: 1e9 ", "circle.points"}}},
+                   {"points_huge", "points: 81 ", "points: 1e9 ", "circle.points"},
+                   {"sensor_rate_huge", "rate_Hz: 1000\n  gravity_mass", "rate_Hz: 100000\n  gravity_mass", "sensor.rate_Hz"}}},
                  cases);
 
   // URDF structure (the URDF reader names the line and the joint).
@@ -387,6 +388,12 @@ std::vector<BadInput> option_cases() {
                    {}, {"--stiffness-Nm-per-rad", "outside"}});
   cases.push_back({"force_spec_typo", "offline --circle default --force 'ldbb:phi_deg=45,forse_N=125' -o {D}/o.csv", {},
                    {"forse_N", "did you mean 'force_N'"}});
+  cases.push_back({"circle_points_huge", "offline --circle points=100000000 --force constant:fz_N=1 -o {D}/o.csv", {},
+                   {"key 'points'", "3..1000000"}});
+  cases.push_back({"line_points_huge",
+                   "offline --line 'start_mm=1500;0;1000,end_mm=1600;0;1000,points=100000000' --force constant:fz_N=1 "
+                   "-o {D}/o.csv",
+                   {}, {"key 'points'", "2..1000000"}});
   cases.push_back({"force_spec_huge", "offline --circle default --force 'constant:fz_N=1e308' -o {D}/o.csv", {},
                    {"fz_N", "outside"}});
   return cases;

@@ -14,6 +14,10 @@ namespace {
 std::vector<Pose> poses_from_table(const CsvTable& table) {
   table.require({"x_mm", "y_mm", "z_mm", "qw", "qx", "qy", "qz"});
   table.allow_only({"x_mm", "y_mm", "z_mm", "qw", "qx", "qy", "qz"});
+  if (table.rows() > static_cast<std::size_t>(kMaxPathPoints)) {
+    throw DataError(fmt::format("{}: {} path points; deflex takes up to {}", table.source(), table.rows(),
+                                kMaxPathPoints));
+  }
   if (table.rows() == 0) {
     throw DataError(fmt::format("{}: no pose rows", table.source()));
   }

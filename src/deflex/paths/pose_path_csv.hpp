@@ -9,6 +9,10 @@
 
 namespace deflex {
 
+/// The most points a path may have (a circle or line spec, a path CSV): ten times the largest path
+/// the benchmarks time, refused before the poses are allocated.
+inline constexpr int kMaxPathPoints = 1'000'000;
+
 /// Reads base_T_tcp poses (converted to m). Throws DataError naming the file, line and column on a
 /// missing column, a non-numeric cell, a quaternion whose norm is off 1 by more than 1e-3 (a typo,
 /// not rounding), or a file without rows.

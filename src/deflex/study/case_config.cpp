@@ -266,6 +266,8 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   c.cell.sensor.noise_n = non_negative(s.at("noise_N"));
   c.cell.sensor.bias_n = s.at("bias_N").as_vector3();
   c.cell.sensor.rate_hz = positive(s.at("rate_Hz"));
+  // The cell simulates every sample: beyond 10 kHz a study takes minutes and gigabytes.
+  if (c.cell.sensor.rate_hz > 10000.0) s.at("rate_Hz").fail("must be at most 10000 Hz (the simulated cell computes every sample)");
   c.cell.sensor.gravity_mass_error = s.at("gravity_mass_error_pct").as_double() / 100.0;
   c.cell.sensor.sensitivity_error = s.get("sensitivity_error_pct", 0.0) / 100.0;
   if (!(c.cell.sensor.sensitivity_error >= 0.0 && c.cell.sensor.sensitivity_error < 0.2))
@@ -306,6 +308,8 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   tr.only_keys({"noise_um", "rate_Hz"});
   c.cell.tracker.noise_m = non_negative(tr.at("noise_um")) * kUm;
   c.cell.tracker.rate_hz = positive(tr.at("rate_Hz"));
+  // The cell simulates every sample: beyond 10 kHz a study takes minutes and gigabytes.
+  if (c.cell.tracker.rate_hz > 10000.0) tr.at("rate_Hz").fail("must be at most 10000 Hz (the simulated cell computes every sample)");
 
   const auto ct = root.at("controller");
   ct.only_keys({"servo_period_ms", "network_latency_ms", "egm_period_ms", "egm_dead_time_ms", "egm_lowpass_Hz",
