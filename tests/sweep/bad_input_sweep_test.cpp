@@ -260,6 +260,25 @@ std::vector<BadInput> file_cases() {
                  "online --link egm-path --egm-port 0 --force-source csv:{F} --duration-s 0.1", "fx_N", true},
                 cases);
 
+  {
+    // In-range forces 10,000 times the example's: a payload of some 85 t, which online would refuse,
+    // so identify-payload must not write it.
+    std::string heavy;
+    std::istringstream in(read("examples/online/payload_poses.csv"));
+    for (std::string line; std::getline(in, line);) {
+      if (!line.empty() && line[0] != '#' && line.rfind("qw", 0) != 0) {
+        std::vector<std::string> cells;
+        std::istringstream cs(line);
+        for (std::string c; std::getline(cs, c, ',');) cells.push_back(c);
+        for (std::size_t k = 4; k < 7; ++k) cells[k] = std::to_string(std::stod(cells[k]) * 1e4);
+        line.clear();
+        for (std::size_t k = 0; k < cells.size(); ++k) line += (k ? "," : "") + cells[k];
+      }
+      heavy += line + "\n";
+    }
+    cases.push_back({"payload_absurd_mass", "identify-payload --data {D}/heavy.csv -o {D}/p.yaml", {{"heavy.csv", heavy}},
+                     {"{D}/heavy.csv", "payload mass", "outside"}});
+  }
   const std::string fk = "fk --robot {F} --joints-deg 0,30,10,0,50,0";
   add_yaml_cases({"robot", read("examples/robots/kuka_kr210_r2700.yaml"), fk,
                   {{"stiffness_huge", "3.5e6,", "1e308,", "joint_stiffness_Nm_per_rad[1]"},
