@@ -312,6 +312,10 @@ std::vector<BadInput> file_cases() {
                    {"paper_uc_short", "paper_uc_mm: [0.12, 0.38, 0.62]", "paper_uc_mm: [0.12, 0.38]",
                     "setups[1].paper_uc_mm"},
                    {"points_huge", "points: 81 ", "points: 1e9 ", "circle.points"},
+                   {"lost_motion_short", "lost_motion_urad: [25, 25, 25, 40, 40, 40]",
+                    "lost_motion_urad: [25, 25, 25]", "true_robot.lost_motion_urad"},
+                   {"hardening_long", "hardening_softening: [0.5, 0.5, 0.5, 0.5, 0.5, 0.5]",
+                    "hardening_softening: [0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5]", "true_robot.hardening_softening"},
                    {"sensor_rate_huge", "rate_Hz: 1000\n  gravity_mass", "rate_Hz: 100000\n  gravity_mass", "sensor.rate_Hz"}}},
                  cases);
 
