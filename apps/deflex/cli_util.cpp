@@ -8,6 +8,8 @@
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/model/input_ranges.hpp"
+#include "deflex/model/parse_number.hpp"
 #include "deflex/model/robot_io.hpp"
 
 namespace deflex::cli {
@@ -20,20 +22,15 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& op
     const auto b = item.find_first_not_of(" \t");
     const auto e = item.find_last_not_of(" \t");
     const std::string t = b == std::string::npos ? "" : item.substr(b, e - b + 1);
-    double v = 0.0;
-    std::size_t used = 0;
-    try {
-      v = std::stod(t, &used);
-    } catch (const std::logic_error&) {
-      used = 0;
+    const std::optional<double> v = parse_double(t);
+    if (!v) {
+      throw InputError(
+          fmt::format("option {}: {} (value {} of '{}')", option, not_a_number(t), out.size() + 1, text));
     }
-    if (t.empty() || used != t.size()) {
-      throw InputError(fmt::format("option {}: '{}' is not a number (value {} of '{}')", option, t, out.size() + 1, text));
+    if (const auto bad = range_violation(*v, range::kAnyValue)) {
+      throw InputError(fmt::format("option {}: value {}: {}", option, out.size() + 1, *bad));
     }
-    if (!std::isfinite(v)) {
-      throw InputError(fmt::format("option {}: value {} is not finite", option, out.size() + 1));
-    }
-    out.push_back(v);
+    out.push_back(*v);
   }
   if (expected != 0 && out.size() != expected) {
     throw InputError(fmt::format("option {}: expected {} comma-separated numbers, got {}", option, expected, out.size()));
@@ -55,7 +52,7 @@ const char* const kStiffnessHelp =
 
 RobotModel load_cli_robot(const std::string& command, const std::string& robot_path,
                           const std::string& stiffness_text) {
-  RobotModel model = load_robot_or_builtin(robot_path);
+  RobotModel model = load_robot_or_builtin(robot_path == "builtin" ? std::string() : robot_path);
   for (const std::string& note : model.description().notes) {
     std::cerr << fmt::format("deflex {}: note: {}\n", command, note);
   }
@@ -65,9 +62,8 @@ RobotModel load_cli_robot(const std::string& command, const std::string& robot_p
   const std::vector<double> k =
       parse_numbers(stiffness_text, "--stiffness-Nm-per-rad", static_cast<std::size_t>(model.dof()));
   for (std::size_t i = 0; i < k.size(); ++i) {
-    if (!(k[i] > 0.0)) {
-      throw InputError(
-          fmt::format("option --stiffness-Nm-per-rad: value {} ({} Nm/rad) must be positive", i + 1, k[i]));
+    if (const auto bad = range_violation(k[i], range::kJointStiffness)) {
+      throw InputError(fmt::format("option --stiffness-Nm-per-rad: value {}: {}", i + 1, *bad));
     }
   }
   return model.with_stiffness(k, "given on the command line (--stiffness-Nm-per-rad)");

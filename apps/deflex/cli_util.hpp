@@ -18,7 +18,7 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& op
 /// Joint values given in degrees on the command line, to rad, checked against the robot's dof.
 JointVector parse_joints_deg(const std::string& text, const RobotModel& model, const std::string& option);
 
-/// The robot of `--robot` (empty: the built-in IRB6700). `stiffness_text` (the option
+/// The robot of `--robot` (empty or "builtin": the built-in IRB6700). `stiffness_text` (the option
 /// --stiffness-Nm-per-rad, "k1,...,kN" in Nm/rad) replaces the file's joint stiffness when given.
 /// The loader's notes (e.g. which URDF chain was chosen) go to stderr as "deflex COMMAND: note: ...".
 /// Throws ModelError or InputError naming the file or the option.

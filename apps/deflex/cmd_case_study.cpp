@@ -208,19 +208,16 @@ void run(const Opts& o, int& exit_code) {
 void setup(CLI::App& sub, int& exit_code) {
   auto o = std::make_shared<Opts>();
   sub.add_option("--case", o->case_file, "Case file (YAML, see data/cases/paper.yaml); default: the paper's case");
-  sub.add_option("--seed", o->seed, "Seed of every random effect (default: the case file's)")
-      ->check(CLI::NonNegativeNumber);
+  sub.add_option("--seed", o->seed, "Seed of every random effect (default: the case file's)");
   sub.add_option("--out", o->out_dir,
                  "Directory for report.html, the SVG figures and the tables (default ./case-study-out)");
   sub.add_option("--seeds", o->seeds,
                  "Seeds to run, from --seed up: each its own cell and runs; the tables give mean and spread "
-                 "(default: the case file's protocol.seeds)")
-      ->check(CLI::Range(1, 1000));
+                 "(default: the case file's protocol.seeds; 1..1000)");
   sub.add_option("--write-traces", o->traces_dir,
                  "Directory for the simulated tracker CSVs of the first seed at the error budget's speed and each "
                  "setup's highest load (unloaded, UC and C), to try `deflex evaluate` on");
-  sub.add_option("--threads", o->threads, "Worker threads (default: one per hardware thread)")
-      ->check(CLI::NonNegativeNumber);
+  sub.add_option("--threads", o->threads, "Worker threads, 0..256 (default 0: one per hardware thread)");
   sub.add_flag("--json", o->json, "Print only the JSON document of the results on stdout");
   sub.add_flag("--quick", o->quick, "One clockwise and one anticlockwise lap per run instead of the protocol's 3 + 3");
   sub.add_flag("--no-sweep", o->no_sweep, "Skip the speed sweep");

@@ -1,4 +1,5 @@
 // `deflex evaluate`: the paper's mean deformation and ISO 9283 path figures from tracker files.
+#include <algorithm>
 #include <iostream>
 #include <memory>
 
@@ -90,8 +91,8 @@ void setup_evaluate(CLI::App& sub, int& exit_code) {
   sub.add_option("--commanded", o->commanded,
                  "CSV of the commanded path (same columns; t_s may be 0): ISO 9283 accuracy is then taken against "
                  "it instead of the first unloaded run");
-  sub.add_option("--evaluation-points", o->points, "ISO 9283: planes normal to the path (default 81, the paper's)")
-      ->check(CLI::Range(1, 100000));
+  sub.add_option("--evaluation-points", o->points,
+                 "ISO 9283: planes normal to the path, 1..100000 (default 81, the paper's)");
   sub.add_option("--max-offset-mm", o->max_offset_mm,
                  "ISO 9283: a run crossing a plane farther than this from the path does not count there (default 10)");
   sub.add_flag("--split-laps", o->split,
@@ -112,7 +113,14 @@ void setup_evaluate(CLI::App& sub, int& exit_code) {
     if (o->mean_reference) {
       TrackerTrace all;
       for (const auto& t : unloaded) all.insert(all.end(), t.begin(), t.end());
-      distance_reference.push_back(mean_closed_path(all));
+      // Bins of about two samples a lap each, at most 3600 (0.1 deg): fewer than that would leave bins
+      // empty on a sparse file (50 Hz), more would average too few laps' samples per bin.
+      const auto per_lap = static_cast<int>(all.size() / std::max<std::size_t>(1, unloaded.size()));
+      distance_reference.push_back(mean_closed_path(all, std::clamp(per_lap / 2, 36, 3600)));
+    }
+    if (!o->mean_reference && o->split && unloaded.size() > 1) {
+      std::cerr << "deflex evaluate: note: the nearest-point distance to noisy unloaded laps is biased low by their "
+                   "noise; --mean-reference takes the distance to their mean instead (docs/evaluation.md)\n";
     }
     const PathDeviationStats dev = path_deviation(loaded, o->mean_reference ? distance_reference : unloaded);
     const std::string distance_to = o->mean_reference ? "the mean of the unloaded laps" : "the unloaded path";

@@ -17,9 +17,10 @@
 namespace deflex::cli {
 namespace {
 
+// Required: fitting the built-in IRB 6700 to another arm's data gives confident nonsense (J5 negative).
 const char* const kRobotHelp =
-    "Robot file (.yaml deflex format or .urdf); default: the built-in ABB IRB 6700-300/2.70 with no tool (the WAP "
-    "and TCP are the flange centre)";
+    "Robot file (.yaml deflex format or .urdf) whose kinematics, tool and WAP the data were taken with; required "
+    "('builtin' names the built-in ABB IRB 6700-300/2.70 with no tool: WAP and TCP at the flange centre)";
 
 nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
@@ -55,7 +56,7 @@ void setup_identify(CLI::App& sub, int& exit_code) {
     double rotation_scale_m = 1.0, max_rel = 0.5;
   };
   auto o = std::make_shared<Opts>();
-  sub.add_option("--robot", o->robot, kRobotHelp);
+  sub.add_option("--robot", o->robot, kRobotHelp)->required();
   sub.add_option("--data", o->data,
                  "Measurement CSV: q1_deg..q6_deg, fx_N,fy_N,fz_N, mx_Nm,my_Nm,mz_Nm (at the WAP, base frame), "
                  "dx_mm,dy_mm,dz_mm (TCP, loaded minus unloaded, base frame); optional drx_rad,dry_rad,drz_rad, weight")
@@ -155,8 +156,12 @@ void setup_identify(CLI::App& sub, int& exit_code) {
         if (std::isfinite(k) && std::isfinite(file_k) && se > 0.0) {
           dev = fmt::format("{:+.2f}", (k - file_k) / se);
         }
+        const bool flagged = std::find(est.unidentifiable_joints.begin(), est.unidentifiable_joints.end(),
+                                       static_cast<int>(j) + 1) != est.unidentifiable_joints.end();
         std::cout << fmt::format("{:>5}  {:>14}  {:>16}  {:>9}  {:>16}  {:>12}\n", j + 1,
-                                 std::isfinite(k) ? fmt::format("{:.4e}", k) : "not identified",
+                                 std::isfinite(k) && !flagged ? fmt::format("{:.4e}", k)
+                                 : std::isfinite(k)           ? fmt::format("({:.2e})?", k)
+                                                              : "not identified",
                                  fixed ? "fixed" : (std::isfinite(se) ? fmt::format("{:.3e}", se) : "-"),
                                  std::isfinite(se) && std::isfinite(k) && !fixed ? fmt::format("{:.2f}%", 100 * se / k)
                                                                                   : "-",
@@ -169,7 +174,8 @@ void setup_identify(CLI::App& sub, int& exit_code) {
           opt.robust ? "nonnegative least squares with Huber then Tukey-bisquare IRLS" : "nonnegative least squares",
           est.iterations);
       if (!est.unidentifiable_joints.empty()) {
-        std::cout << fmt::format("unidentifiable joints: {}\n", fmt::join(est.unidentifiable_joints, ", "));
+        std::cout << fmt::format("unidentifiable joints: {} (a value in brackets must not be used; see the warnings)\n",
+                                 fmt::join(est.unidentifiable_joints, ", "));
       }
     }
     for (const auto& w : est.warnings) {
@@ -188,7 +194,7 @@ void setup_plan(CLI::App& sub, int& exit_code) {
     bool json = false;
   };
   auto o = std::make_shared<Opts>();
-  sub.add_option("--robot", o->robot, kRobotHelp);
+  sub.add_option("--robot", o->robot, kRobotHelp)->required();
   sub.add_option("--region-mm", o->region,
                  "Box of TCP positions to calibrate in, base frame: \"xmin,xmax,ymin,ymax,zmin,zmax\" (mm)")
       ->required();
@@ -234,7 +240,12 @@ void setup_plan(CLI::App& sub, int& exit_code) {
       }
     }
     opt.spin_rad.clear();
-    for (double s : parse_numbers(o->spin, "--spin-deg")) {
+    const std::vector<double> spins = parse_numbers(o->spin, "--spin-deg");
+    if (spins.size() > 360) {
+      throw InputError(fmt::format("option --spin-deg: {} turns; give at most 360 (each multiplies the candidates)",
+                                   spins.size()));
+    }
+    for (double s : spins) {
       opt.spin_rad.push_back(deg_to_rad(s));
     }
     const CalibrationPlan plan = plan_calibration(model, opt);
@@ -293,6 +304,18 @@ void setup_plan(CLI::App& sub, int& exit_code) {
     }
     for (const auto& w : plan.warnings) {
       std::cerr << "deflex plan-calibration: warning: " << w << "\n";
+    }
+    // The commonest cause of an infinite condition number: the measured point (the TCP) on the last
+    // axis, so turning that joint never moves it and no load or lever can show its stiffness.
+    const auto last = static_cast<std::size_t>(model.dof() - 1);
+    const Vector3 tcp_in_flange = model.description().flange_T_tcp.translation();
+    if (!std::isfinite(plan.predicted_relative_std_error[last]) && tcp_in_flange.head<2>().norm() < 1e-6) {
+      std::cerr << fmt::format(
+          "deflex plan-calibration: warning: the TCP of '{}' lies on axis {} (tool_frame x = y = 0), so joint {} "
+          "cannot be observed whatever the loads: measure a point off the axis (a tool_frame with x or y of, say, "
+          "60 mm in the robot file, and that point on the tracker), or hold joint {} at a known stiffness with "
+          "deflex identify --fix-stiffness-Nm-per-rad {}=K\n",
+          model.name(), last + 1, last + 1, last + 1, last + 1);
     }
     exit_code = 0;
   });

@@ -1,4 +1,5 @@
 // Subcommands of the model layer: fk, ik, deflect, robot.
+#include <cmath>
 #include <iostream>
 #include <memory>
 
@@ -184,12 +185,36 @@ void setup_deflect(CLI::App& sub, int& exit_code) {
 void setup_robot(CLI::App& sub, int& exit_code) {
   struct Opts {
     std::string robot, stiffness;
+    bool json = false;
   };
   auto o = std::make_shared<Opts>();
   sub.add_option("--robot", o->robot, kRobotHelp);
   sub.add_option("--stiffness-Nm-per-rad", o->stiffness, kStiffnessHelp);
+  sub.add_flag("--json", o->json,
+               "Print one JSON document on stdout: name, source, dof, joint limits (deg), stiffness (Nm/rad), the "
+               "tool and the robot file text (yaml)");
   sub.callback([o, &exit_code] {
-    std::cout << robot_to_yaml(load_cli_robot("robot", o->robot, o->stiffness));
+    const RobotModel model = load_cli_robot("robot", o->robot, o->stiffness);
+    const std::string yaml = robot_to_yaml(model);
+    if (!o->json) {
+      std::cout << yaml;
+      exit_code = 0;
+      return;
+    }
+    nlohmann::json joints = nlohmann::json::array();
+    for (const JointSpec& j : model.description().joints) {
+      joints.push_back({{"name", j.name},
+                        {"min_deg", std::isfinite(j.lower_rad) ? nlohmann::json(rad_to_deg(j.lower_rad)) : nullptr},
+                        {"max_deg", std::isfinite(j.upper_rad) ? nlohmann::json(rad_to_deg(j.upper_rad)) : nullptr}});
+    }
+    print_json({{"name", model.name()},
+                {"source", model.description().source},
+                {"dof", model.dof()},
+                {"joints", joints},
+                {"stiffness_Nm_per_rad",
+                 model.has_stiffness() ? vector_to_json(model.stiffness()) : nlohmann::json(nullptr)},
+                {"flange_T_tcp", pose_json(model.description().flange_T_tcp)},
+                {"yaml", yaml}});
     exit_code = 0;
   });
 }

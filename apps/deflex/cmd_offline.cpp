@@ -272,6 +272,9 @@ void run(const Opts& o, int& exit_code) {
     std::size_t i = 0;
     for (; source->next(pose); ++i) {
       const JointVector& q = ik.next(pose);
+      if (trajectories || !o.rapid_out.empty()) {
+        check_held_path_points(i);  // these outputs need the whole path
+      }
       if (trajectories) {
         poses.push_back(pose);
         q_nominal.push_back(q);

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "command.hpp"
+#include "option_ranges.hpp"
 #include "deflex/model/errors.hpp"
 
 namespace deflex::cli {
@@ -37,10 +38,15 @@ int main(int argc, char** argv) {
     c.setup(*sub, exit_code);
     sub->preparse_callback([&active, name = c.name](std::size_t) { active = name; });
   }
+  add_option_range_checks(app);
   try {
     app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);  // --help, --version: printed, exit 0
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // Every usage error is bad input: exit 2 like a bad file, never CLI11's own codes (104-114).
+    std::cerr << usage_error_message(app, active, std::vector<std::string>(argv + 1, argv + argc), e) << "\n";
+    return 2;
   } catch (const deflex::Error& e) {
     std::cerr << fmt::format("deflex {}: error: {}\n", active, e.what());
     return 2;

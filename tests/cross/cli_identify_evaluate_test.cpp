@@ -40,7 +40,7 @@ TEST(CliIdentify, BadMeasurementFileNamesLineAndColumn) {
   std::ofstream(p) << "q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg,fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,dx_mm,dy_mm,dz_mm\n"
                       "0,30,10,0,50,0,100,0,0,0,0,0,0.1,0,0\n"
                       "0,30,10,0,50,0,100,0,nan,0,0,0,0.1,0,0\n";
-  const auto r = run_cli("identify --data " + p.string());
+  const auto r = run_cli("identify --robot builtin --data " + p.string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find(p.string() + ":3"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("fz_N"), std::string::npos) << r.err;

@@ -150,7 +150,7 @@ TEST(CsvReader, AMissingFileIsNamed) {
 
 TEST(CsvWriter, WritesPrintfsTenDigitsAndReadsBack) {
   const std::string path = temp_path("write.csv");
-  const std::vector<double> values{0.1, -2.5e-12, 123456789012.0, 1.0 / 3.0, 0.0, -0.0, 1e300};
+  const std::vector<double> values{0.1, -2.5e-12, 123456789012.0, 1.0 / 3.0, 0.0, -0.0, 1e11};
   {
     CsvWriter w(path, {"a", "b", "c", "d", "e", "f", "g"});
     w.comment("made by a test");

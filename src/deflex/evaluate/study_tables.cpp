@@ -8,7 +8,9 @@
 #include <fmt/format.h>
 
 #include "deflex/evaluate/path_metrics.hpp"
+#include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
+#include "deflex/model/parse_number.hpp"
 
 namespace deflex {
 namespace {
@@ -43,15 +45,13 @@ nlohmann::json spread_json(const Spread& s) {
 
 double mean_of(const std::vector<double>& v) { return spread_of(v).mean; }
 
-// A text cell of a CSV file: quoted (quotes doubled) when it holds a comma, a quote or a line break.
-std::string csv_text(const std::string& text) {
-  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
-  std::string out = "\"";
-  for (const char c : text) {
-    out += c;
-    if (c == '"') out += '"';
+// A results.json key naming a TCP speed in whole mm/s.
+int speed_key(const std::string& key, const std::string& where) {
+  const auto v = parse_int64(key);
+  if (!v || *v < 0 || *v > 1000000) {
+    throw DataError(fmt::format("{}: key '{}' is not a speed in mm/s", where, key));
   }
-  return out + "\"";
+  return static_cast<int>(*v);
 }
 
 // The table number a setup gets: the paper's own numbers for its two, then 3, 4, ... in order.
@@ -150,16 +150,7 @@ std::map<int, double> read_speed_map(const nlohmann::json& j, const std::string&
     throw DataError(fmt::format("{}: must be an object keyed by speed in mm/s", where));
   }
   for (const auto& [key, value] : j.items()) {
-    std::size_t used = 0;
-    int speed = 0;
-    try {
-      speed = std::stoi(key, &used);
-    } catch (const std::logic_error&) {
-      used = 0;
-    }
-    if (used != key.size() || key.empty()) {
-      throw DataError(fmt::format("{}: key '{}' is not a speed in mm/s", where, key));
-    }
+    const int speed = speed_key(key, where);
     if (value.is_null()) {
       m[speed] = kNaN;
     } else if (value.is_number()) {
@@ -190,16 +181,7 @@ std::map<int, std::vector<double>> read_speed_lists(const nlohmann::json& j, con
   std::map<int, std::vector<double>> m;
   if (!j.is_object()) throw DataError(fmt::format("{}: must be an object keyed by speed in mm/s", where));
   for (const auto& [key, value] : j.items()) {
-    std::size_t used = 0;
-    int speed = 0;
-    try {
-      speed = std::stoi(key, &used);
-    } catch (const std::logic_error&) {
-      used = 0;
-    }
-    if (used != key.size() || key.empty()) {
-      throw DataError(fmt::format("{}: key '{}' is not a speed in mm/s", where, key));
-    }
+    const int speed = speed_key(key, where);
     m[speed] = read_numbers(value, fmt::format("{}.\"{}\"", where, key));
   }
   return m;
@@ -789,7 +771,7 @@ void write_study_csv(const StudyResult& study, const std::string& path) {
       for (const int v : study_speeds_mm_s(study)) {
         const auto at = [&](const std::map<int, double>& m) { return cell(value_at_speed(m, v)); };
         const Spread cs = l.c_spread(v);
-        f << fmt::format("{},{:g},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", csv_text(s.setup),
+        f << fmt::format("{},{:g},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", csv_text_cell(s.setup),
                          l.load_N, v, at(l.uc_mm), at(l.c_mm), at(l.compensation), at(l.uc_std_mm), at(l.c_std_mm),
                          at(l.uc_max_mm), at(l.c_max_mm), at(l.iso_accuracy_uc_mm), at(l.iso_accuracy_c_mm),
                          at(l.iso_repeatability_mm), at(l.uc_sync_mm), at(l.c_sync_mm), cs.n, cell(cs.sd),
@@ -812,7 +794,7 @@ void write_sweep_csv(const StudyResult& study, const std::string& path) {
   f << "setup,load_N,speed_mm_s,uc_mm,c_mm,compensation,c_sync_mm,seeds,c_mm_seed_sd,c_mm_seed_min,c_mm_seed_max\n";
   for (const auto& p : study.speed_sweep) {
     const Spread cs = p.c_mm_by_seed.empty() ? spread_of({p.c_mm}) : spread_of(p.c_mm_by_seed);
-    f << fmt::format("{},{:g},{:g},{},{},{},{},{},{},{},{}\n", csv_text(p.setup), p.load_N, p.speed_mm_s, cell(p.uc_mm),
+    f << fmt::format("{},{:g},{:g},{},{},{},{},{},{},{},{}\n", csv_text_cell(p.setup), p.load_N, p.speed_mm_s, cell(p.uc_mm),
                      cell(p.c_mm), cell(p.compensation), cell(p.c_sync_mm), cs.n, cell(cs.sd), cell(cs.min),
                      cell(cs.max));
   }
@@ -830,8 +812,8 @@ void write_error_budget_csv(const StudyResult& study, const std::string& path) {
   f << "setup,load_N,speed_mm_s,seed,laps,residual_mm_all,uc_mm,effect,size,residual_mm_without_it,share_of_residual\n";
   for (const auto& b : study.error_budgets) {
     for (const auto& e : b.entries) {
-      f << fmt::format("{},{:g},{:g},{},{},{},{},{},{},{},{}\n", csv_text(b.setup), b.load_N, b.speed_mm_s, b.seed,
-                       b.laps, cell(b.residual_mm_all), cell(b.uc_mm), csv_text(e.effect), csv_text(e.size),
+      f << fmt::format("{},{:g},{:g},{},{},{},{},{},{},{},{}\n", csv_text_cell(b.setup), b.load_N, b.speed_mm_s, b.seed,
+                       b.laps, cell(b.residual_mm_all), cell(b.uc_mm), csv_text_cell(e.effect), csv_text_cell(e.size),
                        cell(e.residual_mm_without_it), cell(e.share_of_residual));
     }
   }

@@ -12,6 +12,8 @@ namespace deflex {
 
 WrenchTableModel::WrenchTableModel(const CsvTable& table) : source_(table.source()) {
   table.require({"fx_N", "fy_N", "fz_N"});
+  // A misspelt index column ("Index") would otherwise be ignored and every row taken in file order.
+  table.allow_only({"index", "fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm"});
   if (table.rows() == 0) {
     throw DataError(fmt::format("{}: no wrench rows", table.source()));
   }

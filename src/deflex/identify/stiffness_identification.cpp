@@ -132,8 +132,9 @@ using RowBlock = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::D
 // rows a slab at a time, each slab stacked under the R found so far (the same R, up to the signs of
 // its rows, as one QR of the whole tall matrix, without holding it).
 struct Triangular {
-  Eigen::MatrixXd R;
+  Eigen::MatrixXd R;      // p x p, zero below row `rows`
   Eigen::VectorXd qty;
+  Eigen::Index rows = 0;  // min(equations, p): fewer equations than unknowns leave R short
 };
 Triangular blocked_qr(const RowStore& s, const std::vector<int>& cols, const Eigen::VectorXd& scale,
                       const std::vector<double>& omega) {
@@ -172,13 +173,15 @@ Triangular blocked_qr(const RowStore& s, const std::vector<int>& cols, const Eig
   const Eigen::Index k = std::min(top, p);
   t.R.topRows(k) = buf.block(0, 0, k, p).triangularView<Eigen::Upper>();
   t.qty.head(k) = buf.block(0, p, k, 1);
+  t.rows = k;
   return t;
 }
 
 // Singular values (descending) and right singular vectors of the scaled, weighted columns `cols`.
 Eigen::JacobiSVD<Eigen::MatrixXd> svd_of(const RowStore& s, const std::vector<int>& cols, const Eigen::VectorXd& scale,
                                          const std::vector<double>& omega) {
-  return Eigen::JacobiSVD<Eigen::MatrixXd>(blocked_qr(s, cols, scale, omega).R, Eigen::ComputeFullV);
+  const Triangular t = blocked_qr(s, cols, scale, omega);
+  return Eigen::JacobiSVD<Eigen::MatrixXd>(t.R.topRows(t.rows), Eigen::ComputeFullV);
 }
 
 }  // namespace
@@ -193,6 +196,9 @@ StiffnessIdentifier::StiffnessIdentifier(const RobotModel& model, const Identifi
   }
   if (!(options.rotation_scale_m > 0.0) || !std::isfinite(options.rotation_scale_m)) {
     throw InputError("identify_stiffness: rotation_scale_m must be finite and > 0");
+  }
+  if (!(options.max_relative_std_error > 0.0) || !std::isfinite(options.max_relative_std_error)) {
+    throw InputError("identify_stiffness: max_relative_std_error must be finite and > 0");
   }
   store_ = std::make_unique<RowStoreHolder>(n);
 }
@@ -347,21 +353,33 @@ StiffnessEstimate StiffnessIdentifier::solve() {
     const auto svd = svd_of(s, estimated, col_norm, omega);
     const Eigen::VectorXd sv = svd.singularValues();
     const Eigen::Index last = sv.size() - 1;
-    if (sv[last] >= options.min_relative_singular_value * sv[0]) {
+    // Fewer equations than joints: the SVD has fewer singular values than columns, and V's trailing
+    // columns span a null space the smallest singular value does not show.
+    const bool underdetermined = sv.size() < static_cast<Eigen::Index>(estimated.size());
+    if (!underdetermined && sv[last] >= options.min_relative_singular_value * sv[0]) {
       break;
     }
-    const Eigen::VectorXd v = svd.matrixV().col(last);
+    // The joints in the unobservable direction: the smallest singular value's vector or, with fewer
+    // equations than joints, every joint with a component in the null space (V's trailing columns).
+    const Eigen::MatrixXd null_basis =
+        underdetermined ? Eigen::MatrixXd(svd.matrixV().rightCols(svd.matrixV().cols() - sv.size()))
+                        : Eigen::MatrixXd(svd.matrixV().col(last));
     std::vector<int> group;
-    for (Eigen::Index k = 0; k < v.size(); ++k) {
-      if (std::abs(v[k]) > 0.1) {
+    for (Eigen::Index k = 0; k < null_basis.rows(); ++k) {
+      if (null_basis.row(k).norm() > 0.1) {
         group.push_back(estimated[static_cast<std::size_t>(k)]);
       }
     }
-    est.warnings.push_back(fmt::format(
-        "joints {}: their effects on the measured displacements are collinear in these data (relative singular "
-        "value {:.1e}); only a combination is observable, so none of them is identified: add poses or load "
-        "directions that separate them (deflex plan-calibration)",
-        joint_list(group), sv[last] / sv[0]));
+    est.warnings.push_back(
+        underdetermined
+            ? fmt::format("joints {}: {} equations for {} unknown compliances; these joints are not determined by "
+                          "the data: add measurements (deflex plan-calibration)",
+                          joint_list(group), sv.size(), estimated.size())
+            : fmt::format(
+                  "joints {}: their effects on the measured displacements are collinear in these data (relative "
+                  "singular value {:.1e}); only a combination is observable, so none of them is identified: add "
+                  "poses or load directions that separate them (deflex plan-calibration)",
+                  joint_list(group), sv[last] / sv[0]));
     for (int j : group) {
       left_out.push_back(j);
       estimated.erase(std::find(estimated.begin(), estimated.end(), j));
@@ -565,7 +583,8 @@ StiffnessEstimate StiffnessIdentifier::solve() {
     est.stiffness_nm_per_rad[ju] = 1.0 / c;
     est.std_error_nm_per_rad[ju] = se_c / (c * c);  // delta method: dk = -dc / c^2
     const double rel = se_c / c;
-    if (rel > options.max_relative_std_error) {
+    // NaN (no residual degrees of freedom: as many equations as unknowns) counts as unidentified.
+    if (!(rel <= options.max_relative_std_error)) {
       left_out.push_back(j);
       est.warnings.push_back(fmt::format(
           "joint {}: poorly identified (relative standard error {:.0f}% > {:.0f}%); the value is shown but should "

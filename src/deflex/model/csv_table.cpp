@@ -10,8 +10,14 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/model/input_ranges.hpp"
+#include "deflex/model/nearest_name.hpp"
+#include "deflex/model/parse_number.hpp"
 
 namespace deflex {
 namespace {
@@ -44,23 +50,25 @@ void for_each_cell(std::string_view line, F&& f) {
   }
 }
 
-/// A cell as a number, locale-independently; false when the whole cell is not one number.
-bool parse_double(std::string_view cell, double& out) {
-  const char* first = cell.data();
-  const char* last = cell.data() + cell.size();
-  if (first != last && *first == '+') {  // from_chars takes no plus sign; people write one
-    ++first;
-    if (first == last || *first == '-' || *first == '+') {
-      return false;
-    }
+// A header cell written quoted by a spreadsheet ("x_mm") names the column x_mm.
+std::string_view unquote(std::string_view cell) {
+  if (cell.size() >= 2 && cell.front() == '"' && cell.back() == '"') {
+    return cell.substr(1, cell.size() - 2);
   }
-  const auto [ptr, ec] = std::from_chars(first, last, out);
-  return ec == std::errc() && ptr == last && first != last;
+  return cell;
 }
+
+// A data file larger than this is refused before read_text_file reads it: 1 GiB holds some 30
+// million tracker samples, over eight hours at 1000 Hz. (CsvReader streams and needs no such bound.)
+constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 30;
 
 }  // namespace
 
 CsvReader::CsvReader(const std::string& path) : source_(path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw DataError(fmt::format("{}: is a directory, not a CSV file", path));
+  }
   file_ = std::fopen(path.c_str(), "rb");
   if (file_ == nullptr) {
     throw DataError(fmt::format("{}: cannot read the file", path));
@@ -149,24 +157,32 @@ void CsvReader::read_header() {
       continue;
     }
     if (tl.find(',') == std::string_view::npos) {
-      for (const char sep : {';', '\t'}) {
+      for (const char sep : {';', '\t', '|'}) {
         if (tl.find(sep) != std::string_view::npos) {
-          throw DataError(fmt::format("{}:{}: header: the columns are separated by '{}': deflex reads comma-separated "
-                                      "values (export with ',' as the separator and '.' as the decimal point)",
-                                      source_, line_, sep == '\t' ? "\\t" : ";"));
+          throw DataError(fmt::format("{}:{}: header: the columns are separated by '{}': deflex CSV files separate "
+                                      "columns with commas (export with ',' as the separator and '.' as the decimal "
+                                      "point)",
+                                      source_, line_, sep == '\t' ? std::string("\\t") : std::string(1, sep)));
         }
       }
     }
     std::size_t i = 0;
     for_each_cell(tl, [&](std::string_view cell) {
       ++i;
-      if (cell.empty()) {
+      const std::string_view name = unquote(cell);
+      if (name.empty()) {
         throw DataError(fmt::format("{}:{}: header: column {} has no name", source_, line_, i));
       }
-      if (!index_.emplace(std::string(cell), i - 1).second) {
-        throw DataError(fmt::format("{}:{}: header: column '{}' appears twice", source_, line_, cell));
+      if (parse_double(name)) {
+        throw DataError(fmt::format("{}:{}: header: column {} is named '{}', a number: the first row must name the "
+                                    "columns (e.g. t_s,x_mm,y_mm,z_mm)",
+                                    source_, line_, i, name));
       }
-      columns_.emplace_back(cell);
+      if (!index_.emplace(std::string(name), i - 1).second) {
+        throw DataError(fmt::format("{}:{}: header: column '{}' appears twice", source_, line_, name));
+      }
+      columns_.emplace_back(name);
+      ranges_.push_back(&range_for_name(columns_.back()));
     });
     row_.resize(columns_.size());
     return;
@@ -186,22 +202,26 @@ void CsvReader::parse_row(std::string_view line) {
     if (cell.empty()) {
       throw DataError(fmt::format("{}:{}: column '{}': empty cell", source_, line_, name));
     }
-    double v = 0.0;
-    if (!parse_double(cell, v)) {
+    const std::optional<double> v = parse_double(cell);
+    if (!v) {
       if (cell.find(';') != std::string_view::npos) {
         throw DataError(fmt::format("{}:{}: column '{}': '{}' is not a number (the row is separated by ';': deflex "
-                                    "reads comma-separated values)",
+                                    "CSV files separate cells with commas)",
                                     source_, line_, name, cell));
       }
-      throw DataError(fmt::format("{}:{}: column '{}': '{}' is not a number", source_, line_, name, cell));
+      throw DataError(fmt::format("{}:{}: column '{}': {}", source_, line_, name, not_a_number(cell)));
     }
-    if (!std::isfinite(v)) {
-      throw DataError(fmt::format("{}:{}: column '{}': '{}' is not a finite number", source_, line_, name, cell));
+    if (const auto bad = range_violation(*v, *ranges_[i])) {
+      throw DataError(fmt::format("{}:{}: column '{}': {}", source_, line_, name, *bad));
     }
-    row_[i++] = v;
+    row_[i++] = *v;
   });
   if (i != width) {
-    throw DataError(fmt::format("{}:{}: {} cells, the header has {} columns", source_, line_, i, width));
+    const bool other_sep = line.find(';') != std::string_view::npos || line.find('\t') != std::string_view::npos;
+    throw DataError(fmt::format("{}:{}: {} cells, the header has {} columns{}", source_, line_, i, width,
+                                other_sep ? " (deflex CSV files separate cells with commas, and the decimal "
+                                            "separator is a point)"
+                                          : ""));
   }
 }
 
@@ -245,6 +265,22 @@ void require_columns(const std::string& source, const std::vector<std::string>& 
 
 void CsvReader::require(const std::vector<std::string>& required) const {
   require_columns(source_, columns_, index_, required);
+}
+
+namespace {
+void allow_only_columns(const std::string& source, const std::vector<std::string>& columns,
+                        const std::vector<std::string>& allowed) {
+  for (const std::string& c : columns) {
+    if (std::find(allowed.begin(), allowed.end(), c) == allowed.end()) {
+      throw DataError(fmt::format("{}: unknown column '{}'{} (this file takes: {})", source, c, did_you_mean(c, allowed),
+                                  fmt::join(allowed, ", ")));
+    }
+  }
+}
+}  // namespace
+
+void CsvReader::allow_only(const std::vector<std::string>& allowed) const {
+  allow_only_columns(source_, columns_, allowed);
 }
 
 void CsvReader::fail(const std::string& name, const std::string& message) const {
@@ -292,6 +328,50 @@ void CsvTable::fail(std::size_t row, const std::string& name, const std::string&
 
 void CsvTable::require(const std::vector<std::string>& required) const {
   require_columns(source_, columns_, index_, required);
+}
+
+void CsvTable::allow_only(const std::vector<std::string>& allowed) const {
+  allow_only_columns(source_, columns_, allowed);
+}
+
+std::string read_text_file(const std::string& path, const char* what) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > kMaxFileBytes) {
+    throw DataError(fmt::format("{}: the {} is {} bytes; deflex reads files up to {} bytes", path, what, size,
+                                kMaxFileBytes));
+  }
+  if (!ec && std::filesystem::is_directory(path)) {
+    throw DataError(fmt::format("{}: is a directory, not a {}", path, what));
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw DataError(fmt::format("{}: cannot read the {}", path, what));
+  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  // A UTF-8 byte order mark (Excel writes one) is not part of the first column's name.
+  if (text.rfind("\xEF\xBB\xBF", 0) == 0) {
+    text.erase(0, 3);
+  }
+  return text;
+}
+
+std::string csv_text_cell(const std::string& text) {
+  const bool plain = text.find_first_of(",\"\r\n") == std::string::npos && trim_view(text).size() == text.size();
+  if (plain) {
+    return text;
+  }
+  std::string out = "\"";
+  for (const char c : text) {
+    out += c;
+    if (c == '"') {
+      out += '"';
+    }
+  }
+  out += '"';
+  return out;
 }
 
 CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& columns)

@@ -21,8 +21,11 @@
 
 namespace deflex {
 
+struct InputRange;
+
 /// Streams a CSV file of numbers: a header row, then one row of finite numbers per line, every row
-/// with the header's number of cells. Columns may come in any order; they are found by name. Errors
+/// with the header's number of cells, each number inside the range its column's unit allows
+/// (input_ranges.hpp: 1e308 mm is an error naming the line and column). Columns may come in any order; they are found by name. Errors
 /// throw DataError naming the file, the line and the column.
 class CsvReader {
  public:
@@ -42,6 +45,9 @@ class CsvReader {
   [[nodiscard]] std::size_t column(const std::string& name) const;
   /// Fails when any of `required` is missing, naming all that are.
   void require(const std::vector<std::string>& required) const;
+  /// Fails on a column not in `allowed`, suggesting the nearest allowed name ('Index' -> 'index'), so
+  /// a misspelt optional column is never silently ignored.
+  void allow_only(const std::vector<std::string>& allowed) const;
 
   /// Reads the next data row; false at the end of the file. Throws DataError for a bad row.
   bool next();
@@ -69,6 +75,7 @@ class CsvReader {
   int line_of_row_ = 0;
   std::vector<std::string> columns_;
   std::map<std::string, std::size_t> index_;
+  std::vector<const InputRange*> ranges_;  // each column's physical range, from the unit in its name
   std::vector<double> row_;
 };
 
@@ -94,6 +101,8 @@ class CsvTable {
   [[noreturn]] void fail(std::size_t row, const std::string& column, const std::string& message) const;
   /// Fails when any of `required` is missing, naming all that are.
   void require(const std::vector<std::string>& required) const;
+  /// Fails on a column not in `allowed` (see CsvReader::allow_only).
+  void allow_only(const std::vector<std::string>& allowed) const;
 
  private:
   static CsvTable drain(CsvReader& reader);
@@ -104,6 +113,15 @@ class CsvTable {
   std::vector<double> values_;  // row-major, rows() x columns().size()
   std::vector<int> lines_;
 };
+
+/// The whole text of a file, refused with DataError naming it when it cannot be read, is a directory
+/// or is larger than 1 GiB (checked before reading); a leading UTF-8 byte order mark is dropped.
+/// `what` names the kind of file in messages ("robot file", "file").
+[[nodiscard]] std::string read_text_file(const std::string& path, const char* what);
+
+/// A text cell for a CSV file: quoted (RFC 4180, inner quotes doubled) when it holds a comma, a
+/// quote, a line break or blanks at its ends; as it is otherwise.
+[[nodiscard]] std::string csv_text_cell(const std::string& text);
 
 /// Writes a CSV header row and rows of numbers (%.10g), buffered: a row is formatted into the
 /// writer's own buffer, never into a temporary string, and the buffer goes to the file in 64 kB

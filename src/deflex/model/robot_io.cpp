@@ -9,7 +9,9 @@
 #include <fmt/format.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
+#include "deflex/model/input_ranges.hpp"
 #include "deflex/model/urdf_tree.hpp"
 #include "deflex/model/yaml_fields.hpp"
 
@@ -63,13 +65,12 @@ Pose urdf_pose(const urdf::Pose& p) {
 }  // namespace
 
 RobotDescription load_urdf_chain(const std::string& path, const std::string& base_link, const std::string& tip_link) {
-  std::ifstream in(path);
-  if (!in) {
-    throw ModelError(fmt::format("{}: cannot read the URDF file", path));
+  std::string text;
+  try {
+    text = read_text_file(path, "URDF file");
+  } catch (const DataError& e) {
+    throw ModelError(e.what());
   }
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string text = ss.str();
   // The structure first, with line numbers; urdfdom then gives the numbers of a tree known to be valid.
   const UrdfTree tree = read_urdf_tree(path, text);
   const UrdfChain chain = choose_urdf_chain(tree, base_link, tip_link);
@@ -89,6 +90,22 @@ RobotDescription load_urdf_chain(const std::string& path, const std::string& bas
     const urdf::JointConstSharedPtr j = urdf_model->getJoint(name);
     if (!j) {
       throw ModelError(fmt::format("{}: joint '{}' not found by urdfdom", path, name));
+    }
+    const auto& xyz = j->parent_to_joint_origin_transform.position;
+    for (const double v : {xyz.x, xyz.y, xyz.z}) {
+      if (const auto bad = range_violation(v, range::kLengthM)) {
+        throw ModelError(fmt::format("{}: joint '{}': origin xyz: {}", path, name, *bad));
+      }
+    }
+    if (j->limits) {
+      for (const double v : {j->limits->lower, j->limits->upper}) {
+        if (const auto bad = range_violation(v, range::kAngleRad)) {
+          throw ModelError(fmt::format("{}: joint '{}': limit: {}", path, name, *bad));
+        }
+      }
+      if (const auto bad = range_violation(j->limits->velocity, {"joint speed", "rad/s", 0.0, 100.0})) {
+        throw ModelError(fmt::format("{}: joint '{}': limit velocity: {}", path, name, *bad));
+      }
     }
     const Pose origin = urdf_pose(j->parent_to_joint_origin_transform);
     if (j->type == urdf::Joint::FIXED) {
@@ -151,23 +168,20 @@ RobotModel load_robot_yaml_text(const std::string& text, const std::string& sour
       const yaml::Field j = joints.at(i);
       j.only_keys({"a", "alpha", "d", "offset", "min", "max", "max_speed"});
       DhRow r;
-      r.a_m = j.at("a").as_double() * u.length;
-      r.alpha_rad = j.at("alpha").as_double() * u.angle;
-      r.d_m = j.at("d").as_double() * u.length;
-      r.theta_offset_rad = j.get("offset", 0.0) * u.angle;
+      r.a_m = j.at("a").as_in(range::kLengthM, u.length);
+      r.alpha_rad = j.at("alpha").as_in(range::kAngleRad, u.angle);
+      r.d_m = j.at("d").as_in(range::kLengthM, u.length);
+      r.theta_offset_rad = j.has("offset") ? j.at("offset").as_in(range::kAngleRad, u.angle) : 0.0;
       rows.push_back(r);
-      lo.push_back(j.at("min").as_double() * u.angle);
-      hi.push_back(j.at("max").as_double() * u.angle);
+      lo.push_back(j.at("min").as_in(range::kAngleRad, u.angle));
+      hi.push_back(j.at("max").as_in(range::kAngleRad, u.angle));
       if (!(lo.back() < hi.back())) {
         j.fail("'min' must be below 'max'");
       }
       // The file's angle unit per second (deg/s with angle: deg).
       speed.push_back(HUGE_VAL);
       if (j.has("max_speed")) {
-        speed.back() = j.at("max_speed").as_double() * u.angle;
-        if (!(speed.back() > 0.0)) {
-          j.at("max_speed").fail("joint speed limit must be positive (angle unit per second)");
-        }
+        speed.back() = j.at("max_speed").as_in(range::kJointSpeedRadS, u.angle);
       }
     }
     set_dh_chain(d, convention == "standard_dh" ? DhConvention::kStandard : DhConvention::kModified, rows, lo, hi,
@@ -186,12 +200,7 @@ RobotModel load_robot_yaml_text(const std::string& text, const std::string& sour
   d.name = root.get("name", d.name.empty() ? std::string("unnamed robot") : d.name);
   if (root.has("joint_stiffness_Nm_per_rad")) {
     const yaml::Field k = root.at("joint_stiffness_Nm_per_rad");
-    d.stiffness_nm_per_rad = k.as_doubles(d.joints.size());
-    for (std::size_t i = 0; i < d.stiffness_nm_per_rad.size(); ++i) {
-      if (d.stiffness_nm_per_rad[i] <= 0.0) {
-        k.at(i).fail("stiffness must be positive (Nm/rad)");
-      }
-    }
+    d.stiffness_nm_per_rad = k.as_doubles_in(range::kJointStiffness, d.joints.size());
   }
   d.stiffness_note = root.get("stiffness_note", std::string());
   if (root.has("base_frame")) {
@@ -214,13 +223,13 @@ RobotModel load_robot(const std::string& path) {
   if (ext != ".yaml" && ext != ".yml") {
     throw ModelError(fmt::format("{}: unknown robot file type '{}' (use .yaml, .yml or .urdf)", path, ext));
   }
-  std::ifstream in(path);
-  if (!in) {
-    throw ModelError(fmt::format("{}: cannot read the robot file", path));
+  std::string text;
+  try {
+    text = read_text_file(path, "robot file");
+  } catch (const DataError& e) {
+    throw ModelError(e.what());
   }
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return load_robot_yaml_text(ss.str(), path, fs::path(path).parent_path().string());
+  return load_robot_yaml_text(text, path, fs::path(path).parent_path().string());
 }
 
 const std::string& builtin_irb6700_yaml() {
@@ -244,7 +253,7 @@ std::string pose_yaml(const Pose& p) {
 std::string robot_to_yaml(const RobotModel& model) {
   const RobotDescription& d = model.description();
   std::string out = "# deflex robot description (docs/robot-file.md)\ndeflex_robot: 1\n";
-  out += fmt::format("name: \"{}\"\nunits: {{length: m, angle: deg}}\nkinematics:\n", d.name);
+  out += fmt::format("name: {}\nunits: {{length: m, angle: deg}}\nkinematics:\n", yaml::scalar_text(d.name));
   if (d.dh_convention) {
     out += fmt::format("  convention: {}\n  joints:\n",
                        *d.dh_convention == DhConvention::kStandard ? "standard_dh" : "modified_dh");
@@ -257,8 +266,9 @@ std::string robot_to_yaml(const RobotModel& model) {
                          std::isfinite(speed) ? fmt::format(", max_speed: {:.9g}", rad_to_deg(speed)) : "");
     }
   } else if (!d.urdf_file.empty()) {
-    out += fmt::format("  convention: urdf\n  file: \"{}\"\n  base_link: \"{}\"\n  tip_link: \"{}\"\n", d.urdf_file,
-                       d.urdf_base_link, d.urdf_tip_link);
+    out += fmt::format("  convention: urdf\n  file: {}\n  base_link: {}\n  tip_link: {}\n",
+                       yaml::scalar_text(d.urdf_file), yaml::scalar_text(d.urdf_base_link),
+                       yaml::scalar_text(d.urdf_tip_link));
   } else {
     throw InputError("robot_to_yaml: the chain was built in code (neither DH nor URDF) and has no file form");
   }
@@ -270,7 +280,7 @@ std::string robot_to_yaml(const RobotModel& model) {
     out += "]\n";
   }
   if (!d.stiffness_note.empty()) {
-    out += fmt::format("stiffness_note: \"{}\"\n", d.stiffness_note);
+    out += fmt::format("stiffness_note: {}\n", yaml::scalar_text(d.stiffness_note));
   }
   out += "base_frame: " + pose_yaml(d.base_T_chain) + "\n";
   out += "tool_frame: " + pose_yaml(d.flange_T_tcp) + "\n";

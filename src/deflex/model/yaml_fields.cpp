@@ -3,32 +3,91 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <string_view>
+#include <utility>
 
 #include <fmt/format.h>
 
+#include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
+#include "deflex/model/nearest_name.hpp"
+#include "deflex/model/parse_number.hpp"
 
 namespace deflex::yaml {
 
 Field::Field(YAML::Node node, std::string file, std::string path)
     : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
 
-Field Field::load_file(const std::string& path) {
-  try {
-    return Field(YAML::LoadFile(path), path, "");
-  } catch (const YAML::BadFile&) {
-    throw ModelError(fmt::format("{}: cannot read the file", path));
-  } catch (const YAML::ParserException& e) {
-    throw ModelError(fmt::format("{}:{}: YAML syntax error: {}", path, e.mark.line + 1, e.msg));
+namespace {
+
+std::string where_of(const std::string& file, const YAML::Mark& m) {
+  return m.line >= 0 ? fmt::format("{}:{}:{}", file, m.line + 1, m.column + 1) : file;
+}
+
+// yaml-cpp keeps both entries of a key given twice and answers lookups with the first, so a
+// second value would be silently ignored: every map of the document is checked here.
+void refuse_duplicate_keys(const YAML::Node& node, const std::string& file, const std::string& path, int depth,
+                           std::size_t& visited) {
+  // Aliases can make a small document a huge tree ("billion laughs"); no deflex file comes near this.
+  if (++visited > 1000000) {
+    throw ModelError(fmt::format("{}: more than a million YAML nodes (aliases expanding?)", file));
+  }
+  if (depth > 64) {
+    throw ModelError(fmt::format("{}: field '{}': nested deeper than 64 levels", where_of(file, node.Mark()), path));
+  }
+  if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      refuse_duplicate_keys(node[i], file, fmt::format("{}[{}]", path, i + 1), depth + 1, visited);
+    }
+    return;
+  }
+  if (!node.IsMap()) {
+    return;
+  }
+  std::vector<std::pair<std::string, YAML::Mark>> seen;
+  for (const auto& kv : node) {
+    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string("<non-scalar key>");
+    const std::string child = path.empty() ? key : path + "." + key;
+    for (const auto& [k, mark] : seen) {
+      if (k == key) {
+        throw ModelError(fmt::format("{}: field '{}': key given twice (first at line {}); each key may appear once",
+                                     where_of(file, kv.first.Mark()), child, mark.line + 1));
+      }
+    }
+    seen.emplace_back(key, kv.first.Mark());
+    refuse_duplicate_keys(kv.second, file, child, depth + 1, visited);
   }
 }
 
-Field Field::load_string(const std::string& text, const std::string& source) {
+}  // namespace
+
+Field Field::load_file(const std::string& path) {
+  std::string text;
   try {
-    return Field(YAML::Load(text), source, "");
+    text = read_text_file(path, "file");
+  } catch (const DataError& e) {
+    throw ModelError(e.what());
+  }
+  return load_string(text, path);
+}
+
+Field Field::load_string(const std::string& text, const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text.rfind("\xEF\xBB\xBF", 0) == 0 ? text.substr(3) : text);
   } catch (const YAML::ParserException& e) {
     throw ModelError(fmt::format("{}:{}: YAML syntax error: {}", source, e.mark.line + 1, e.msg));
   }
+  std::size_t visited = 0;
+  refuse_duplicate_keys(root, source, "", 0, visited);
+  return Field(root, source, "");
+}
+
+std::string scalar_text(const std::string& text) {
+  YAML::Emitter e;
+  e << YAML::DoubleQuoted << text;
+  return e.c_str();
 }
 
 int Field::line() const {
@@ -71,27 +130,45 @@ double Field::as_double() const {
   if (!node_.IsScalar()) {
     fail("expected a number");
   }
-  const std::string s = node_.Scalar();
-  double v = 0.0;
-  try {
-    std::size_t used = 0;
-    v = std::stod(s, &used);
-    if (used != s.size()) {
-      fail(fmt::format("'{}' is not a number", s));
-    }
-  } catch (const std::logic_error&) {
-    fail(fmt::format("'{}' is not a number", s));
+  const std::string& s = node_.Scalar();
+  const std::optional<double> v = parse_double(trim_view(s));
+  if (!v) {
+    fail(not_a_number(s));
   }
-  if (!std::isfinite(v)) {
-    fail(fmt::format("'{}' is not a finite number", s));
+  // The key names its unit ("rate_Hz", "offset_um", "joint_stiffness_Nm_per_rad[2]"): its range applies.
+  std::string_view key = path_;
+  key = key.substr(key.rfind('.') == std::string_view::npos ? 0 : key.rfind('.') + 1);
+  key = key.substr(0, key.find('['));
+  if (const auto bad = range_violation(*v, range_for_name(key))) {
+    fail(*bad);
   }
-  return v;
+  return *v;
+}
+
+double Field::as_in(const InputRange& r, double scale) const {
+  const double v = as_double();
+  if (const auto bad = range_violation(v * scale, r)) {
+    fail(scale == 1.0 ? *bad : fmt::format("{:g} in the file's unit: {}", v, *bad));
+  }
+  return v * scale;
+}
+
+double Field::get_in(const std::string& key, double fallback, const InputRange& r) const {
+  return has(key) ? at(key).as_in(r) : fallback;
+}
+
+std::vector<double> Field::as_doubles_in(const InputRange& r, std::size_t expected_size, double scale) const {
+  std::vector<double> out = as_doubles(expected_size);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i] = at(i).as_in(r, scale);
+  }
+  return out;
 }
 
 int Field::as_int() const {
   const double v = as_double();
   if (v != std::floor(v) || std::abs(v) > 1e9) {
-    fail(fmt::format("expected a whole number, got {}", v));
+    fail(fmt::format("expected a whole number, got {:g}", v));
   }
   return static_cast<int>(v);
 }
@@ -145,7 +222,7 @@ void Field::only_keys(const std::vector<std::string>& allowed) const {
     const std::string key = kv.first.as<std::string>();
     if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
       Field(kv.first, file_, path_.empty() ? key : path_ + "." + key)
-          .fail(fmt::format("unknown field (allowed here: {})", fmt::join(allowed, ", ")));
+          .fail(fmt::format("unknown field{} (allowed here: {})", did_you_mean(key, allowed), fmt::join(allowed, ", ")));
     }
   }
 }
@@ -154,7 +231,8 @@ Pose parse_pose(const Field& f, double length_scale, double angle_scale) {
   f.only_keys({"position", "quaternion_wxyz", "rpy"});
   Pose pose = Pose::Identity();
   if (f.has("position")) {
-    pose.translation() = f.at("position").as_vector3() * length_scale;
+    const auto p = f.at("position").as_doubles_in(range::kLengthM, 3, length_scale);
+    pose.translation() = Vector3(p[0], p[1], p[2]);
   }
   if (f.has("quaternion_wxyz") && f.has("rpy")) {
     f.fail("give either quaternion_wxyz or rpy, not both");

@@ -7,6 +7,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "deflex/model/input_ranges.hpp"
 #include "deflex/model/types.hpp"
 
 namespace deflex::yaml {
@@ -16,7 +17,9 @@ class Field {
  public:
   Field(YAML::Node node, std::string file, std::string path);
 
-  /// Parses a whole file; throws ModelError "FILE: cannot read" or "FILE:LINE: YAML syntax error".
+  /// Parses a whole file; throws ModelError "FILE: cannot read" or "FILE:LINE: YAML syntax error", and
+  /// "FILE:LINE:COL: field 'a.b': key given twice" for a key repeated in a map (yaml-cpp would
+  /// silently keep the first). Files over 1 GiB are refused before reading; a UTF-8 BOM is dropped.
   static Field load_file(const std::string& path);
   /// Parses text; `source` names it in messages.
   static Field load_string(const std::string& text, const std::string& source);
@@ -30,7 +33,14 @@ class Field {
   [[nodiscard]] bool is_sequence() const { return node_.IsSequence(); }
   [[nodiscard]] bool is_map() const { return node_.IsMap(); }
 
-  [[nodiscard]] double as_double() const;  ///< finite number, else ModelError
+  [[nodiscard]] double as_double() const;  ///< finite number within +-1e12, else ModelError
+  /// The number times `scale` (the file's unit to the range's unit), checked against `r`:
+  /// "FILE:LINE: field 'F': 1e+308 Nm/rad is outside 100..1e+10 Nm/rad (...)".
+  [[nodiscard]] double as_in(const InputRange& r, double scale = 1.0) const;
+  [[nodiscard]] std::vector<double> as_doubles_in(const InputRange& r, std::size_t expected_size = 0,
+                                                  double scale = 1.0) const;
+  /// as_in() of a key, or `fallback` when the key is absent.
+  [[nodiscard]] double get_in(const std::string& key, double fallback, const InputRange& r) const;
   [[nodiscard]] int as_int() const;
   [[nodiscard]] bool as_bool() const;
   [[nodiscard]] std::string as_string() const;
@@ -58,6 +68,10 @@ class Field {
   std::string file_;
   std::string path_;
 };
+
+/// `text` as a double-quoted YAML scalar written by yaml-cpp's emitter (quotes, backslashes and
+/// control characters escaped), so any name or note reads back as it was.
+[[nodiscard]] std::string scalar_text(const std::string& text);
 
 /// A pose written as {position: [x, y, z], quaternion_wxyz: [w, x, y, z]} or
 /// {position: [...], rpy: [roll, pitch, yaw]} (fixed-axis X-Y-Z, i.e. R = Rz(yaw) Ry(pitch) Rx(roll)).

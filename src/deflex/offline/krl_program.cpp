@@ -3,6 +3,7 @@
 #include "deflex/offline/krl_program.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -125,7 +126,7 @@ std::optional<std::size_t> parse_aggregate(const KrlFile& f, std::size_t i, std:
     c.end = v.end;
     if (v.kind == TokenKind::kNumber) {
       c.kind = Component::Kind::kNumber;
-      c.number = sign * std::stod(f.str(i));
+      c.number = sign * token_number(f, i);
       ++i;
     } else if (v.kind == TokenKind::kBitLiteral) {
       const std::string s = f.str(i);  // 'B0110' or 'H1F'
@@ -135,7 +136,13 @@ std::optional<std::size_t> parse_aggregate(const KrlFile& f, std::size_t i, std:
       }
       c.kind = Component::Kind::kBits;
       c.bit_digits = base == 'B' ? static_cast<int>(s.size()) - 3 : 0;
-      c.number = static_cast<double>(std::stol(s.substr(2, s.size() - 3), nullptr, base == 'B' ? 2 : 16));
+      const std::string digits = s.size() >= 3 ? s.substr(2, s.size() - 3) : std::string();
+      long bits = 0;
+      const auto r = std::from_chars(digits.data(), digits.data() + digits.size(), bits, base == 'B' ? 2 : 16);
+      if (digits.empty() || r.ec != std::errc() || r.ptr != digits.data() + digits.size()) {
+        f.fail(i, fmt::format("{} is not a KRL bit literal ('B0110' or 'H1F')", s));
+      }
+      c.number = static_cast<double>(bits);
       ++i;
     } else if (v.kind == TokenKind::kPunct && f.is_punct(i, "{")) {
       Aggregate inner;
@@ -311,7 +318,7 @@ class KrlReader {
         d.type = t->second;
         d.name_tok = i;
         d.name = f.str(i);
-        d.element = static_cast<int>(std::stod(f.str(i + 2)));
+        d.element = token_index(f, i + 2);
         i += 4;
       } else {
         continue;
@@ -423,7 +430,7 @@ class KrlReader {
     if (e == b + 4 && src_.is_ident(b, table) && src_.is_punct(b + 1, "[") &&
         src_.tok[b + 2].kind == TokenKind::kNumber && src_.is_punct(b + 3, "]")) {
       s.kind = FrameState::Kind::kNamed;
-      s.name = fmt::format("{}[{}]", table, static_cast<int>(std::stod(src_.str(b + 2))));
+      s.name = fmt::format("{}[{}]", table, token_index(src_, b + 2));
       return s;
     }
     Aggregate a;
@@ -529,7 +536,7 @@ ProgramCompensation KrlReader::run(const std::string& output_src) {
     if (first == "BAS" && f.is_punct(b + 1, "(") && b + 5 < e && f.tok[b + 2].kind == TokenKind::kEnum &&
         f.is_punct(b + 3, ",") && f.tok[b + 4].kind == TokenKind::kNumber) {
       const std::string what = to_upper(f.str(b + 2));
-      const int n = static_cast<int>(std::stod(f.str(b + 4)));
+      const int n = token_index(f, b + 4);
       if (what == "#TOOL") {
         tool = numbered("TOOL_DATA", n);
       } else if (what == "#BASE") {
@@ -600,7 +607,7 @@ ProgramCompensation KrlReader::run(const std::string& output_src) {
         key = to_upper(f.str(tb));
         if (f.is_punct(tb + 1, "[") && tb + 3 < te && f.tok[tb + 2].kind == TokenKind::kNumber &&
             f.is_punct(tb + 3, "]")) {
-          key += fmt::format("[{}]", static_cast<int>(std::stod(f.str(tb + 2))));
+          key += fmt::format("[{}]", token_index(f, tb + 2));
           after = tb + 4;
         }
       } else {

@@ -3,8 +3,13 @@
 // skipped (they are never touched).
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
+
+#include <fmt/format.h>
+
+#include "deflex/model/parse_number.hpp"
 
 namespace deflex {
 
@@ -31,5 +36,27 @@ struct Token {
 /// The tokens of a KRL .src or .dat file. ';' starts a comment to the end of the line (fold
 /// markers included). Throws DataError "FILE:LINE: ..." for an unterminated string or literal.
 [[nodiscard]] std::vector<Token> lex_krl(const std::string& text, const std::string& file);
+
+/// The value of number token `i` of a RAPID or KRL source (anything with str(i) and fail(i, what)),
+/// read locale-independently; "FILE:LINE: '1E999' is not a finite number" otherwise.
+template <class Source>
+[[nodiscard]] double token_number(const Source& s, std::size_t i) {
+  const auto v = parse_double(s.str(i));
+  if (!v) {
+    s.fail(i, fmt::format("'{}' is not a finite number", s.str(i)));
+  }
+  return *v;
+}
+
+/// A number token used as an array size or index, truncated to int like the controller does;
+/// beyond +-1e6 it is refused (no array is that large, and the cast would overflow).
+template <class Source>
+[[nodiscard]] int token_index(const Source& s, std::size_t i) {
+  const double v = token_number(s, i);
+  if (std::abs(v) > 1e6) {
+    s.fail(i, fmt::format("'{}' is not an array size or index (within +-1000000)", s.str(i)));
+  }
+  return static_cast<int>(v);
+}
 
 }  // namespace deflex

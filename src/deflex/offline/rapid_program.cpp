@@ -117,7 +117,7 @@ std::optional<std::size_t> parse_value(const Source& s, std::size_t i, std::size
   switch (u.kind) {
     case TokenKind::kNumber:
       v.kind = Value::Kind::kNumber;
-      v.number = sign * std::stod(s.str(i));
+      v.number = sign * token_number(s, i);
       return i + 1;
     case TokenKind::kString:
       v.kind = Value::Kind::kString;
@@ -348,7 +348,7 @@ class RapidReader {
         ++k;
         while (k < j && !src_.is_punct(k, "}")) {
           if (t[k].kind == TokenKind::kNumber) {
-            d.dims.push_back(static_cast<int>(std::stod(src_.str(k))));
+            d.dims.push_back(token_index(src_, k));
           } else if (!src_.is_punct(k, ",")) {
             d.dims.push_back(-1);  // a dimension given by a name: unknown size
           }
@@ -491,7 +491,7 @@ class RapidReader {
         why = "computed at run time (an expression or a variable index)";
         return std::nullopt;
       }
-      index = static_cast<int>(std::stod(src_.str(b + 2))) - 1;
+      index = token_index(src_, b + 2) - 1;
     }
     const Decl* d = find_decl(src_.str(b), type, why);
     if (d == nullptr) {

@@ -11,6 +11,7 @@ namespace deflex {
 CsvForceReplay::CsvForceReplay(const std::string& csv_path, bool loop) : loop_(loop) {
   const CsvTable t = CsvTable::read_file(csv_path);
   t.require({"t_s", "fx_N", "fy_N", "fz_N"});
+  t.allow_only({"t_s", "fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm"});
   const bool moments = t.has("mx_Nm") || t.has("my_Nm") || t.has("mz_Nm");
   if (moments) {
     t.require({"mx_Nm", "my_Nm", "mz_Nm"});

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/model/input_ranges.hpp"
 #include "deflex/model/yaml_fields.hpp"
 
 namespace deflex {
@@ -24,8 +25,16 @@ void SensorConfig::validate() const {
       !gravity_base_m_s2.allFinite()) {
     fail("non-finite pose, bias, centre of gravity or gravity");
   }
-  if (!std::isfinite(payload_mass_kg) || payload_mass_kg < 0.0) {
-    fail("payload mass must be finite and >= 0 kg");
+  if (const auto bad = range_violation(payload_mass_kg, range::kMassKg)) {
+    fail("payload mass: " + *bad);
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (const auto bad = range_violation(payload_cog_sensor_m[i], {"centre of gravity", "m", -10.0, 10.0})) {
+      fail("payload centre of gravity: " + *bad);
+    }
+    if (const auto bad = range_violation(bias_sensor[i], range::kForceN)) {
+      fail("force bias: " + *bad);
+    }
   }
   if (!(sample_rate_hz > 0.0) || !std::isfinite(sample_rate_hz)) {
     fail("sample_rate_hz must be > 0");
@@ -149,7 +158,8 @@ std::string sensor_config_to_yaml(const SensorConfig& c) {
   const auto v3 = [](const Vector3& v) { return fmt::format("[{:.9g}, {:.9g}, {:.9g}]", v.x(), v.y(), v.z()); };
   std::string out = "# deflex force-sensor configuration (docs/online.md). SI units; angles in degrees.\n";
   out += "deflex_sensor: 1\n";
-  out += fmt::format("name: \"{}\"\ncomponents: {}\nsample_rate_hz: {:.9g}\n", c.name, c.components, c.sample_rate_hz);
+  out += fmt::format("name: {}\ncomponents: {}\nsample_rate_hz: {:.9g}\n", yaml::scalar_text(c.name), c.components,
+                     c.sample_rate_hz);
   const int n = c.components == 3 && c.crosstalk.block<3, 3>(0, 3).isZero() && c.crosstalk.block<3, 3>(3, 0).isZero() &&
                         c.crosstalk.block<3, 3>(3, 3).isIdentity()
                     ? 3

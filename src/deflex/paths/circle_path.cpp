@@ -47,6 +47,7 @@ Eigen::Quaterniond checked_unit_quaternion(const Eigen::Quaterniond& q, const ch
 
 std::vector<Pose> sample_circle(const CirclePath& circle, const Eigen::Quaterniond& tcp_orientation) {
   CirclePoseSource source(circle, tcp_orientation);
+  check_held_path_points(*source.size() - 1);
   std::vector<Pose> poses;
   poses.reserve(*source.size());
   for (Pose p; source.next(p);) {

@@ -8,6 +8,9 @@
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/model/input_ranges.hpp"
+#include "deflex/model/nearest_name.hpp"
+#include "deflex/model/parse_number.hpp"
 
 namespace deflex {
 
@@ -49,7 +52,7 @@ KeyValueSpec::KeyValueSpec(std::string spec, const std::string& body, std::vecto
       known = known || a == key;
     }
     if (!known) {
-      fail(fmt::format("unknown key '{}' (allowed: {})", key, fmt::join(allowed_, ", ")));
+      fail(fmt::format("unknown key '{}'{} (allowed: {})", key, did_you_mean(key, allowed_), fmt::join(allowed_, ", ")));
     }
     if (values_.count(key) != 0) {
       fail(fmt::format("key '{}' given twice", key));
@@ -65,17 +68,14 @@ void KeyValueSpec::fail(const std::string& message) const {
 std::vector<double> KeyValueSpec::numbers(const std::string& key, std::size_t count) const {
   std::vector<double> out;
   for (const std::string& part : split_trimmed(text(key), ';')) {
-    double v = 0.0;
-    std::size_t used = 0;
-    try {
-      v = std::stod(part, &used);
-    } catch (const std::logic_error&) {
-      used = 0;
+    const std::optional<double> v = parse_double(part);
+    if (!v) {
+      fail(fmt::format("key '{}': {}", key, not_a_number(part)));
     }
-    if (part.empty() || used != part.size() || !std::isfinite(v)) {
-      fail(fmt::format("key '{}': '{}' is not a finite number", key, part));
+    if (const auto bad = range_violation(*v, range::kAnyValue)) {
+      fail(fmt::format("key '{}': {}", key, *bad));
     }
-    out.push_back(v);
+    out.push_back(*v);
   }
   if (out.empty() || (count != 0 && out.size() != count)) {
     fail(fmt::format("key '{}': expected {} ';'-separated numbers, got {}", key,

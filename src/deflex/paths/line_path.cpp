@@ -11,6 +11,7 @@ namespace deflex {
 
 std::vector<Pose> sample_line(const LinePath& line, const Eigen::Quaterniond& tcp_orientation) {
   LinePoseSource source(line, tcp_orientation);
+  check_held_path_points(*source.size() - 1);
   std::vector<Pose> poses;
   poses.reserve(*source.size());
   for (Pose p; source.next(p);) {

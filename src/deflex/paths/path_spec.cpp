@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "deflex/paths/key_value_spec.hpp"
+#include "deflex/paths/pose_path_csv.hpp"
 
 namespace deflex {
 namespace {
@@ -55,8 +56,8 @@ CirclePath parse_circle_spec(const std::string& spec) {
     c.clockwise = d == "cw";
   }
   c.points = keys.integer("points", c.points);
-  if (c.points < 3) {
-    keys.fail("key 'points': a circle needs at least 3");
+  if (c.points < 3 || c.points > kMaxPathPoints) {
+    keys.fail(fmt::format("key 'points': a circle needs 3..{} points", kMaxPathPoints));
   }
   return c;
 }
@@ -70,8 +71,8 @@ LinePath parse_line_spec(const std::string& spec) {
   l.start_m = vector_of(keys, "start_mm", Vector3::Zero(), 1e-3);
   l.end_m = vector_of(keys, "end_mm", Vector3::Zero(), 1e-3);
   l.points = keys.integer("points", 2);
-  if (l.points < 2) {
-    keys.fail("key 'points': a line needs at least 2");
+  if (l.points < 2 || l.points > kMaxPathPoints) {
+    keys.fail(fmt::format("key 'points': a line needs 2..{} points", kMaxPathPoints));
   }
   return l;
 }

@@ -9,6 +9,7 @@ namespace {
 std::vector<Pose> drain(PoseSource& source) {
   std::vector<Pose> poses;
   for (Pose p; source.next(p);) {
+    check_held_path_points(poses.size());
     poses.push_back(p);
   }
   return poses;

@@ -9,6 +9,12 @@
 
 namespace deflex {
 
+/// The most points a path may have (a circle or line spec, a path CSV): deflex offline streams a
+/// path to CSV in constant memory, so this bounds the run time (about 10 min at 6 us a point), not
+/// the memory.
+inline constexpr int kMaxPathPoints = 100'000'000;
+
+
 /// Reads base_T_tcp poses (converted to m). Throws DataError naming the file, line and column on a
 /// missing column, a non-numeric cell, a quaternion whose norm is off 1 by more than 1e-3 (a typo,
 /// not rounding), or a file without rows.

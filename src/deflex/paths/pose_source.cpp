@@ -6,8 +6,17 @@
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/paths/pose_path_csv.hpp"
 
 namespace deflex {
+
+void check_held_path_points(std::size_t held) {
+  if (held >= kMaxHeldPathPoints) {
+    throw InputError(fmt::format("path: more than {} poses to hold in memory; deflex offline streams longer paths to "
+                                 "CSV (without --rapid, --joint-trajectory and --nominal-trajectory)",
+                                 kMaxHeldPathPoints));
+  }
+}
 
 CirclePoseSource::CirclePoseSource(const CirclePath& circle, const Eigen::Quaterniond& tcp_orientation)
     : circle_(circle) {
@@ -73,6 +82,7 @@ PoseCsvSource::PoseCsvSource(std::string text, std::string source) : reader_(std
 
 void PoseCsvSource::find_columns() {
   reader_.require({"x_mm", "y_mm", "z_mm", "qw", "qx", "qy", "qz"});
+  reader_.allow_only({"x_mm", "y_mm", "z_mm", "qw", "qx", "qy", "qz"});
   x_ = reader_.column("x_mm");
   y_ = reader_.column("y_mm");
   z_ = reader_.column("z_mm");
@@ -83,6 +93,10 @@ void PoseCsvSource::find_columns() {
 }
 
 bool PoseCsvSource::next(Pose& out) {
+  if (rows_ >= static_cast<std::size_t>(kMaxPathPoints)) {
+    throw DataError(fmt::format("{}: more than {} path points; deflex takes up to {}", reader_.source(), kMaxPathPoints,
+                                kMaxPathPoints));
+  }
   if (!reader_.next()) {
     if (rows_ == 0) {
       throw DataError(fmt::format("{}: no pose rows", reader_.source()));

@@ -12,6 +12,14 @@
 
 namespace deflex {
 
+/// The most poses held in memory at once (sample_circle, sample_line, read_pose_path_csv, and deflex
+/// offline's RAPID module and timed trajectories): about 1 GB at 1 kB a point. A path streamed to
+/// CSV holds none of them and may be longer.
+inline constexpr std::size_t kMaxHeldPathPoints = 1'000'000;
+
+/// Throws InputError "path: more than N poses to hold in memory..." when `held` reaches the bound.
+void check_held_path_points(std::size_t held);
+
 class PoseSource {
  public:
   virtual ~PoseSource() = default;
@@ -66,6 +74,7 @@ class PoseCsvSource final : public PoseSource {
 
  private:
   void find_columns();
+
 
   CsvReader reader_;
   std::size_t x_, y_, z_, qw_, qx_, qy_, qz_;

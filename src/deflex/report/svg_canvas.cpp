@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "deflex/model/parse_number.hpp"
+
 #include "deflex/report/svg_charts.hpp"
 
 namespace deflex::svg {
@@ -67,7 +69,7 @@ std::vector<double> log_ticks(double lo, double hi) {
   for (int k = static_cast<int>(std::floor(std::log10(lo))); k <= static_cast<int>(std::ceil(std::log10(hi))); ++k) {
     for (const double m : {1.0, 2.0, 5.0}) {
       // m * 10^k written from the decimal text, so 0.2 is the double nearest 0.2, not 2 * 0.1.
-      const double t = std::stod(fmt::format("{:g}e{}", m, k));
+      const double t = parse_double(fmt::format("{:g}e{}", m, k)).value_or(m * std::pow(10.0, k));
       if (t >= lo * (1.0 - 1e-9) && t <= hi * (1.0 + 1e-9)) {
         ticks.push_back(t);
       }

@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -168,6 +169,23 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
     }
     c.setups.push_back(sc);
   }
+  {
+    // The sweep runs each setup at its load nearest to sweep_load_N: a value outside every setup's
+    // loads would silently become another load.
+    double lo = HUGE_VAL, hi = 0.0;
+    for (const auto& sc : c.setups) {
+      for (double l : sc.loads_n) {
+        lo = std::min(lo, l);
+        hi = std::max(hi, l);
+      }
+    }
+    if (c.sweep_load_n < lo || c.sweep_load_n > hi) {
+      (proto.has("sweep_load_N") ? proto.at("sweep_load_N") : proto)
+          .fail(fmt::format("{:g} N is outside the setups' loads ({:g}..{:g} N); the sweep runs each setup at its "
+                            "load nearest to this",
+                            c.sweep_load_n, lo, hi));
+    }
+  }
 
   const auto r = root.at("true_robot");
   r.only_keys({"stiffness_scale", "stiffness_spread_pct", "coupling_23", "forearm_EI_Nm2", "forearm_length_mm",
@@ -198,7 +216,10 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   if (std::abs(c.cell.robot.coupling_23) >= 0.9) r.at("coupling_23").fail("must be within +-0.9");
   c.cell.robot.forearm_ei_nm2 = non_negative(r.at("forearm_EI_Nm2"));
   c.cell.robot.forearm_length_m = positive(r.at("forearm_length_mm")) * kMm;
-  c.cell.robot.lost_motion_rad = r.at("lost_motion_urad").as_doubles();
+  // Per-joint lists: one entry a joint of the built-in arm (a shorter list would silently leave the
+  // last joints without the effect, a longer one would be silently cut).
+  const std::size_t per_joint = c.cell.robot_file.empty() ? 6 : 0;
+  c.cell.robot.lost_motion_rad = r.at("lost_motion_urad").as_doubles(per_joint);
   for (double& v : c.cell.robot.lost_motion_rad) {
     if (v < 0) r.at("lost_motion_urad").fail("must not be negative");
     v *= kUm;
@@ -213,7 +234,7 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   c.cell.robot.dh_length_sigma_m = non_negative(r.at("dh_length_sigma_mm")) * kMm;
   c.cell.robot.dh_angle_sigma_rad = deg_to_rad(non_negative(r.at("dh_angle_sigma_deg")));
   if (r.has("hardening_softening") || r.has("hardening_torque_Nm")) {
-    c.cell.robot.hardening_softening = r.at("hardening_softening").as_doubles();
+    c.cell.robot.hardening_softening = r.at("hardening_softening").as_doubles(per_joint);
     for (double v : c.cell.robot.hardening_softening) {
       if (!(v >= 0.0 && v <= 5.0)) r.at("hardening_softening").fail("must be within 0..5");
     }
@@ -245,6 +266,8 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   c.cell.sensor.noise_n = non_negative(s.at("noise_N"));
   c.cell.sensor.bias_n = s.at("bias_N").as_vector3();
   c.cell.sensor.rate_hz = positive(s.at("rate_Hz"));
+  // The cell simulates every sample: beyond 10 kHz a study takes minutes and gigabytes.
+  if (c.cell.sensor.rate_hz > 10000.0) s.at("rate_Hz").fail("must be at most 10000 Hz (the simulated cell computes every sample)");
   c.cell.sensor.gravity_mass_error = s.at("gravity_mass_error_pct").as_double() / 100.0;
   c.cell.sensor.sensitivity_error = s.get("sensitivity_error_pct", 0.0) / 100.0;
   if (!(c.cell.sensor.sensitivity_error >= 0.0 && c.cell.sensor.sensitivity_error < 0.2))
@@ -285,6 +308,8 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   tr.only_keys({"noise_um", "rate_Hz"});
   c.cell.tracker.noise_m = non_negative(tr.at("noise_um")) * kUm;
   c.cell.tracker.rate_hz = positive(tr.at("rate_Hz"));
+  // The cell simulates every sample: beyond 10 kHz a study takes minutes and gigabytes.
+  if (c.cell.tracker.rate_hz > 10000.0) tr.at("rate_Hz").fail("must be at most 10000 Hz (the simulated cell computes every sample)");
 
   const auto ct = root.at("controller");
   ct.only_keys({"servo_period_ms", "network_latency_ms", "egm_period_ms", "egm_dead_time_ms", "egm_lowpass_Hz",
