@@ -13,6 +13,7 @@
 #include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/paths/path_spec.hpp"
+#include "support/error_of.hpp"
 
 namespace deflex {
 namespace {
@@ -23,14 +24,7 @@ Pose at(const Vector3& p) {
   return pose;
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "no error";
-}
+using test::error_of;
 
 std::string write_temp(const std::string& name, const std::string& text) {
   const std::string path = ::testing::TempDir() + name;

@@ -11,19 +11,12 @@
 #include "deflex/model/nearest_name.hpp"
 #include "deflex/model/parse_number.hpp"
 #include "deflex/model/yaml_fields.hpp"
+#include "support/error_of.hpp"
 
 namespace deflex {
 namespace {
 
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "no error";
-}
+using test::error_of;
 
 TEST(ParseNumber, DecimalNumbersOnlyWholeTextFinite) {
   EXPECT_EQ(parse_double("12"), 12.0);

@@ -15,6 +15,7 @@
 #include "deflex/offline/program_compensation.hpp"
 #include "deflex/offline/program_text.hpp"
 #include "deflex/offline/rapid_program.hpp"
+#include "support/error_of.hpp"
 
 namespace deflex {
 namespace {
@@ -34,14 +35,7 @@ ProgramCompensation rapid(const std::string& text, const ProgramOptions& options
   return compensate_rapid_module(builtin_irb6700(), force, "t.mod", text, "out.mod", options);
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "no error";
-}
+using test::error_of;
 
 void expect_error(const std::string& text, const std::vector<std::string>& fragments,
                   const ProgramOptions& options = {}) {

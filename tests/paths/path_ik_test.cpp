@@ -7,20 +7,14 @@
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/path_spec.hpp"
 #include "deflex/paths/pose_path_csv.hpp"
+#include "support/error_of.hpp"
 
 namespace deflex {
 namespace {
 
 const Eigen::Quaterniond kDown(0.0, 0.0, 1.0, 0.0);
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "no error";
-}
+using test::error_of;
 
 TEST(PathIk, DefaultCircleRoundTripsThroughFkWithOneConfiguration) {
   const RobotModel model = builtin_irb6700();
