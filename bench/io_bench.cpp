@@ -1,5 +1,6 @@
 // CSV reading and writing per row: the streaming reader over a 100,000-row file of the offline
 // output's width, and the writer's %.10g row into its buffer (to /dev/null, so the disk is left out).
+#include <charconv>
 #include <cstdio>
 #include <filesystem>
 #include <random>
@@ -10,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "deflex/model/csv_table.hpp"
+#include "deflex/model/format_number.hpp"
 
 namespace {
 
@@ -44,6 +46,54 @@ void BM_CsvWriteRow(benchmark::State& state) {
   state.counters["cells_per_row"] = static_cast<double>(kColumns);
 }
 BENCHMARK(BM_CsvWriteRow);
+
+// The numbers of an offline row as they come: joint angles (deg), positions (mm), quaternion parts,
+// configuration integers, forces (N), small deflections (mm, mrad), zeros and rounding noise.
+std::vector<double> offline_like_numbers() {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> deg(-180.0, 180.0), mm(-2500.0, 2500.0), unit(-1.0, 1.0),
+      force(-650.0, 650.0), small(-0.6, 0.6), noise(1e-13, 1e-11);
+  std::vector<double> v;
+  for (int r = 0; r < 1000; ++r) {
+    v.push_back(r);
+    for (int k = 0; k < 12; ++k) v.push_back(deg(rng));
+    for (int k = 0; k < 6; ++k) v.push_back(mm(rng));
+    for (int k = 0; k < 8; ++k) v.push_back(unit(rng));
+    for (int k = 0; k < 4; ++k) v.push_back(static_cast<double>(static_cast<int>(unit(rng) * 3)));
+    for (int k = 0; k < 3; ++k) v.push_back(force(rng));
+    for (int k = 0; k < 3; ++k) v.push_back(0.0);
+    for (int k = 0; k < 7; ++k) v.push_back(small(rng));
+    for (int k = 0; k < 2; ++k) v.push_back(noise(rng));
+  }
+  return v;
+}
+
+// One number of that mix as "%.10g": deflex's formatter against std::to_chars (general, 10).
+void BM_FormatG10(benchmark::State& state) {
+  const std::vector<double> v = offline_like_numbers();
+  char buf[64];
+  std::size_t i = 0, bytes = 0;
+  for (auto _ : state) {
+    bytes += static_cast<std::size_t>(deflex::format_g10(buf, v[i]) - buf);
+    i = i + 1 == v.size() ? 0 : i + 1;
+  }
+  benchmark::DoNotOptimize(bytes);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_FormatG10);
+
+void BM_ToCharsG10(benchmark::State& state) {
+  const std::vector<double> v = offline_like_numbers();
+  char buf[64];
+  std::size_t i = 0, bytes = 0;
+  for (auto _ : state) {
+    bytes += static_cast<std::size_t>(std::to_chars(buf, buf + sizeof buf, v[i], std::chars_format::general, 10).ptr - buf);
+    i = i + 1 == v.size() ? 0 : i + 1;
+  }
+  benchmark::DoNotOptimize(bytes);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_ToCharsG10);
 
 void BM_CsvReadRows(benchmark::State& state) {
   const auto path = std::filesystem::temp_directory_path() / "deflex_io_bench.csv";

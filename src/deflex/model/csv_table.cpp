@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/model/format_number.hpp"
 #include "deflex/model/input_ranges.hpp"
 #include "deflex/model/nearest_name.hpp"
 #include "deflex/model/parse_number.hpp"
@@ -410,14 +411,14 @@ void CsvWriter::row(std::span<const double> values) {
   if (values.size() != width_) {
     throw InputError(fmt::format("{}: row of {} values for {} columns", path_, values.size(), width_));
   }
-  // std::to_chars with precision 10 is printf's %.10g, locale-free, straight into the buffer.
-  char cell[32];
+  // printf's %.10g, locale-free, straight into the buffer (format_g10: exactly std::to_chars', faster).
+  char cell[kFormatG10MaxChars + 1];
   for (std::size_t i = 0; i < values.size(); ++i) {
+    char* p = cell;
     if (i > 0) {
-      buffer_.push_back(',');
+      *p++ = ',';
     }
-    const auto r = std::to_chars(cell, cell + sizeof cell, values[i], std::chars_format::general, 10);
-    buffer_.append(cell, r.ptr);
+    buffer_.append(cell, format_g10(p, values[i]));
   }
   buffer_.push_back('\n');
   flush_if_full();
