@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 
 #include <Eigen/SVD>
 #include <fmt/format.h>
@@ -381,15 +382,17 @@ IkResult inverse_kinematics(const RobotModel& model, Workspace& ws, const Pose& 
   IkResult best;
   double best_score = HUGE_VAL;
   bool any_fits = false;
-  std::string available;
+  // The configurations on offer, for the message when none is the one asked for; kept as numbers
+  // and written only then, so a path of a million poses formats no text.
+  std::array<std::pair<ArmConfiguration, KukaConfiguration>, 8> available;
+  int available_count = 0;
   for (int k = 0; k < branches.count; ++k) {
     const OpwBranch& b = branches.branch[static_cast<std::size_t>(k)];
     IkResult r;
     bool fits = false;
     if (choose_turns(model, b, request, false, r.q, fits)) {
       fill_configuration(model, r);
-      available += ' ';
-      available += configuration_text(r.configuration, r.kuka);
+      available[static_cast<std::size_t>(available_count++)] = {r.configuration, r.kuka};
     }
     any_fits = any_fits || fits;
     if (!fits || !choose_turns(model, b, request, true, r.q, fits)) {
@@ -422,7 +425,13 @@ IkResult inverse_kinematics(const RobotModel& model, Workspace& ws, const Pose& 
     if (request.kuka_configuration) {
       wanted += fmt::format(" Status {} Turn {}", request.kuka_configuration->status, request.kuka_configuration->turn);
     }
-    fail.message = fmt::format("no solution with{}; available [cf1,cf4,cf6,cfx] (S T):{}", wanted, available);
+    std::string offered;
+    for (int k = 0; k < available_count; ++k) {
+      offered += ' ';
+      offered += configuration_text(available[static_cast<std::size_t>(k)].first,
+                                    available[static_cast<std::size_t>(k)].second);
+    }
+    fail.message = fmt::format("no solution with{}; available [cf1,cf4,cf6,cfx] (S T):{}", wanted, offered);
     return fail;
   }
   best.analytic = true;
