@@ -122,6 +122,61 @@ TEST(Compliance, CompensatedCommandDeflectsExactlyOntoTheDesiredConfiguration) {
   }
 }
 
+TEST(Compliance, WarmStartedDeflectionFindsTheSameFixedPointInFewerSteps) {
+  const RobotModel m = test::irb6700_with_tool();
+  Workspace ws(m);
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int s = 0; s < 50; ++s) {
+    JointVector q_cmd(6);
+    q_cmd << 0.5 * u(rng), 0.3 + 0.3 * u(rng), 0.2 * u(rng), u(rng), 0.9 + 0.3 * u(rng), u(rng);
+    Wrench w;
+    w << 650 * u(rng), 650 * u(rng), 650 * u(rng), 30 * u(rng), 30 * u(rng), 30 * u(rng);
+    JointVector cold;
+    ASSERT_EQ(deflected_configuration(m, ws, q_cmd, w, cold), DeflectionStatus::kConverged);
+    // The fixed point itself, checked on the equation: q = q_cmd + K^-1 J(q)^T W with J by central
+    // differences of the WAP position and the axes (not the code's Jacobian).
+    Jacobian J(6, 6);
+    const double h = 1e-6;
+    for (int k = 0; k < 6; ++k) {
+      JointVector qp = cold, qm = cold;
+      qp[k] += h;
+      qm[k] -= h;
+      forward_kinematics(m, ws, qp);
+      const Pose tp = ws.base_T_wap;
+      forward_kinematics(m, ws, qm);
+      const Pose tm = ws.base_T_wap;
+      J.col(k).head<3>() = (tp.translation() - tm.translation()) / (2 * h);
+      const Eigen::Matrix3d dR = (tp.linear() - tm.linear()) / (2 * h) * tp.linear().transpose();
+      J.col(k).tail<3>() = Vector3(dR(2, 1), dR(0, 2), dR(1, 0));
+    }
+    const JointVector fixed = q_cmd + m.compliance().cwiseProduct(J.transpose() * w);
+    EXPECT_LT((fixed - cold).cwiseAbs().maxCoeff(), 1e-9);
+    // Started beside the answer, at the first step's point, or far off: the same point to 1e-13
+    // rad, and a start nearer than q_cmd needs fewer iterations (the step test still decides).
+    JointVector dtheta;
+    joint_deflection(m, ws, q_cmd, w, dtheta);
+    const JointVector first_step = q_cmd + dtheta;
+    JointVector far_off = q_cmd;
+    far_off.array() += 0.02;
+    for (const JointVector* start : std::initializer_list<const JointVector*>{&first_step, &cold, &far_off}) {
+      JointVector warm;
+      ASSERT_EQ(deflected_configuration_from(m, ws, q_cmd, w, *start, warm), DeflectionStatus::kConverged);
+      EXPECT_LT((warm - cold).cwiseAbs().maxCoeff(), 1e-13);
+    }
+    int cold_steps = 1, warm_steps = 1;
+    JointVector out;
+    while (deflected_configuration(m, ws, q_cmd, w, out, 1e-13, cold_steps) != DeflectionStatus::kConverged) {
+      ++cold_steps;
+    }
+    while (deflected_configuration_from(m, ws, q_cmd, w, first_step, out, 1e-13, warm_steps) !=
+           DeflectionStatus::kConverged) {
+      ++warm_steps;
+    }
+    EXPECT_EQ(warm_steps, cold_steps - 1);
+  }
+}
+
 TEST(Compliance, ComplementaryStiffnessMatchesFiniteDifferences) {
   const RobotModel m = test::irb6700_with_tool();
   Workspace ws(m);

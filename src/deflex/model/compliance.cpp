@@ -80,7 +80,13 @@ void compensated_configuration(const RobotModel& model, Workspace& ws, const Joi
 DeflectionStatus deflected_configuration(const RobotModel& model, Workspace& ws, const JointVector& q_cmd,
                                          const Wrench& wrench_base, JointVector& q_actual, double tol_rad,
                                          int max_iterations) {
-  q_actual = q_cmd;
+  return deflected_configuration_from(model, ws, q_cmd, wrench_base, q_cmd, q_actual, tol_rad, max_iterations);
+}
+
+DeflectionStatus deflected_configuration_from(const RobotModel& model, Workspace& ws, const JointVector& q_cmd,
+                                              const Wrench& wrench_base, const JointVector& q_start,
+                                              JointVector& q_actual, double tol_rad, int max_iterations) {
+  q_actual = q_start;
   JointVector dtheta;
   for (int it = 0; it < max_iterations; ++it) {
     joint_deflection(model, ws, q_actual, wrench_base, dtheta);

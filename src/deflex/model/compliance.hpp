@@ -62,4 +62,13 @@ DeflectionStatus deflected_configuration(const RobotModel& model, Workspace& ws,
                                          const Wrench& wrench_base, JointVector& q_actual,
                                          double tol_rad = 1e-13, int max_iterations = 50);
 
+/// The same fixed point, iterated from `q_start` instead of q_cmd: a caller that knows where the
+/// arm will nearly be (q_cmd + K^-1 J(q_cmd)^T W, or the configuration the command was computed for)
+/// saves the iterations that would only get there. The answer is the same fixed point to tol_rad;
+/// the step test still certifies it, so a poor start costs iterations, never accuracy.
+DeflectionStatus deflected_configuration_from(const RobotModel& model, Workspace& ws, const JointVector& q_cmd,
+                                              const Wrench& wrench_base, const JointVector& q_start,
+                                              JointVector& q_actual, double tol_rad = 1e-13,
+                                              int max_iterations = 50);
+
 }  // namespace deflex

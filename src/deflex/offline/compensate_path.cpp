@@ -9,6 +9,11 @@
 #include "deflex/model/errors.hpp"
 
 namespace deflex {
+namespace {
+
+constexpr double kDeflectionTolRad = 1e-13;  // fixed-point step at which a deflection counts as solved
+
+}  // namespace
 
 OfflineResult compensate_path(const RobotModel& model, const JointPath& path, const std::vector<Pose>& tcp_poses,
                               const ForceModel& force) {
@@ -16,7 +21,13 @@ OfflineResult compensate_path(const RobotModel& model, const JointPath& path, co
 }
 
 PathCompensator::PathCompensator(const RobotModel& model, const ForceModel& force, const OfflineOptions& options)
-    : model_(model), force_(force), options_(options), ws_(model), q_actual_(model.dof()) {
+    : model_(model),
+      force_(force),
+      options_(options),
+      ws_(model),
+      q_actual_(model.dof()),
+      dtheta_desired_(model.dof()),
+      q_start_(model.dof()) {
   if (!model.has_stiffness()) {
     throw InputError(fmt::format("robot '{}' ({}): no joint stiffness; offline compensation needs one",
                                  model.name(), model.description().source));
@@ -53,8 +64,10 @@ const OfflinePoint& PathCompensator::compensate(std::size_t i, const JointVector
         (ws.base_T_tcp.translation() - ws.base_T_wap.translation()).cross(Vector3(wrench_tcp.head<3>()));
   }
 
-  compensated_configuration(model, ws, pt.q_desired, pt.wrench_base, pt.q_command);
-  const Pose tcp_at_desired = ws.base_T_tcp;  // compensated_configuration ran FK at q_desired
+  // The exact compensation (compensated_configuration): q_cmd = q_desired - K^-1 J(q_desired)^T W.
+  joint_deflection(model, ws, pt.q_desired, pt.wrench_base, dtheta_desired_);
+  pt.q_command = pt.q_desired - dtheta_desired_;
+  const Pose tcp_at_desired = ws.base_T_tcp;  // joint_deflection ran FK at q_desired
   if (!model.within_limits(pt.q_command)) {
     throw InputError(fmt::format("path point {}: the compensated configuration leaves the joint limits", i));
   }
@@ -70,13 +83,26 @@ const OfflinePoint& PathCompensator::compensate(std::size_t i, const JointVector
     return pt;
   }
 
-  if (deflected_configuration(model, ws, pt.q_desired, pt.wrench_base, q_actual_) != DeflectionStatus::kConverged) {
+  // Both solves start where the first fixed-point step from their command would take them, or
+  // nearer: commanded to q_desired the arm first goes to q_desired + dtheta_desired (the step
+  // already computed above); commanded to q_cmd it goes back to q_desired, the configuration the
+  // command was computed for. The step test still certifies each fixed point to 1e-13 rad.
+  q_start_ = pt.q_desired + dtheta_desired_;
+  if (deflected_configuration_from(model, ws, pt.q_desired, pt.wrench_base, q_start_, q_actual_,
+                                   kDeflectionTolRad) != DeflectionStatus::kConverged) {
     throw InputError(fmt::format("path point {}: the predicted deflection does not converge (load far beyond the "
                                  "model's range)", i));
   }
   pt.predicted_deflection = pose_difference(tcp_at_desired, tcp_pose(model, ws, q_actual_));
-  if (deflected_configuration(model, ws, pt.q_command, pt.wrench_base, q_actual_) != DeflectionStatus::kConverged) {
-    throw InputError(fmt::format("path point {}: the deflection of the compensated command does not converge", i));
+  // Its first step from q_desired needs K^-1 J(q_desired)^T W, which is dtheta_desired: taken here
+  // without computing it again; the step test decides as deflected_configuration's would.
+  q_actual_ = pt.q_command + dtheta_desired_;
+  if ((q_actual_ - pt.q_desired).cwiseAbs().maxCoeff() >= kDeflectionTolRad) {
+    q_start_ = q_actual_;
+    if (deflected_configuration_from(model, ws, pt.q_command, pt.wrench_base, q_start_, q_actual_,
+                                     kDeflectionTolRad) != DeflectionStatus::kConverged) {
+      throw InputError(fmt::format("path point {}: the deflection of the compensated command does not converge", i));
+    }
   }
   pt.predicted_residual = pose_difference(pt.tcp_desired, tcp_pose(model, ws, q_actual_));
 

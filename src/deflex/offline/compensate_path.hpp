@@ -85,6 +85,8 @@ class PathCompensator {
   OfflineOptions options_;
   Workspace ws_;
   JointVector q_actual_;
+  JointVector dtheta_desired_;  // K^-1 J(q_desired)^T W, rad: the compensation, and where the arm nearly goes
+  JointVector q_start_;
   OfflinePoint point_;
   OfflineResult result_;
   double sum_deflection_ = 0.0;
