@@ -91,6 +91,13 @@ void setup_identify(CLI::App& sub, int& exit_code) {
       identifier.add(m);
     }
     const StiffnessEstimate est = identifier.solve();
+    if (identifier.scratch_bytes() > 0) {
+      std::cerr << fmt::format(
+          "deflex identify: {} measurements; {:.0f} MiB of their rows were kept in a scratch file in the temporary "
+          "directory (TMPDIR) beyond the {:.0f} MiB held in memory\n",
+          identifier.measurements(), static_cast<double>(identifier.scratch_bytes()) / 1048576.0,
+          static_cast<double>(opt.rows_in_memory_bytes) / 1048576.0);
+    }
     const auto n = static_cast<std::size_t>(model.dof());
 
     if (!o->write_robot.empty()) {

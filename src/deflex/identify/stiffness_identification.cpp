@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "deflex/identify/nonnegative_least_squares.hpp"
+#include "deflex/identify/spill_file.hpp"
 #include "deflex/model/errors.hpp"
 
 namespace deflex {
@@ -45,7 +46,8 @@ std::string where(const StiffnessMeasurement& m, std::size_t i) {
   return m.line > 0 ? fmt::format("measurement {} (line {})", i + 1, m.line) : fmt::format("measurement {}", i + 1);
 }
 
-double median(std::vector<double> v) {
+// The median of v, which it reorders (the caller's scratch: no copy of a million values).
+double median_in_place(std::vector<double>& v) {
   if (v.empty()) {
     return 0.0;
   }
@@ -72,17 +74,24 @@ std::string joint_list(const std::vector<int>& joints) {
 // its peak). That is what the robust re-weighting needs: each measurement's residual against every
 // new estimate; recomputing the regressor instead (FK and two Jacobians) would cost about 0.3 us a
 // measurement an iteration. 8 (dof + 1) bytes a row: 168 bytes for a 6-joint position measurement.
+// Chunks beyond IdentificationOptions::rows_in_memory_bytes go to an unlinked scratch file and are
+// read back a chunk at a time on every pass: the same doubles in the same order, so the results are
+// bit for bit those of an all-in-memory store, with memory bounded by the budget (plus two chunks)
+// and the per-measurement scalars the re-weighting keeps (37 bytes: weights, residual norms, lines).
 class RowStore {
  public:
-  explicit RowStore(int dof) : width_(dof + 1) {}
+  RowStore(int dof, std::size_t memory_bytes) : width_(dof + 1), memory_budget_(memory_bytes) {}
   // Space for `rows` contiguous rows of the next measurement.
   double* append(int rows) {
     const std::size_t need = static_cast<std::size_t>(rows * width_);
-    if (chunks_.empty() || chunks_.back().size() + need > chunks_.back().capacity()) {
+    if (chunks_.empty() || chunks_.back().values.size() + need > chunk_capacity()) {
+      if (!chunks_.empty()) {
+        retire(chunks_.back());
+      }
       chunks_.emplace_back();
-      chunks_.back().reserve(kChunkRows * static_cast<std::size_t>(width_));
+      chunks_.back().values.reserve(chunk_capacity());
     }
-    std::vector<double>& c = chunks_.back();
+    std::vector<double>& c = chunks_.back().values;
     const std::size_t at = c.size();
     c.resize(at + need);
     rows_.push_back(static_cast<std::uint8_t>(rows));
@@ -93,10 +102,11 @@ class RowStore {
   template <typename F>
   void for_each(F&& f) const {
     std::size_t i = 0;
-    for (const std::vector<double>& c : chunks_) {
-      for (std::size_t at = 0; at < c.size(); ++i) {
+    for (const Chunk& c : chunks_) {
+      const double* data = c.on_disk() ? load(c) : c.values.data();
+      for (std::size_t at = 0; at < c.count(); ++i) {
         const int rows = rows_[i];
-        f(i, rows, c.data() + at);
+        f(i, rows, data + at);
         at += static_cast<std::size_t>(rows * width_);
       }
     }
@@ -104,11 +114,15 @@ class RowStore {
   template <typename F>
   void for_each_mutable(F&& f) {
     std::size_t i = 0;
-    for (std::vector<double>& c : chunks_) {
-      for (std::size_t at = 0; at < c.size(); ++i) {
+    for (Chunk& c : chunks_) {
+      double* data = c.on_disk() ? load(c) : c.values.data();
+      for (std::size_t at = 0; at < c.count(); ++i) {
         const int rows = rows_[i];
-        f(i, rows, c.data() + at);
+        f(i, rows, data + at);
         at += static_cast<std::size_t>(rows * width_);
+      }
+      if (c.on_disk()) {
+        spill_.write_at(static_cast<std::uint64_t>(c.offset), data, c.size);
       }
     }
   }
@@ -116,13 +130,43 @@ class RowStore {
   [[nodiscard]] int rows(std::size_t i) const { return rows_[i]; }
   [[nodiscard]] Eigen::Index total_rows() const { return total_rows_; }
   [[nodiscard]] int width() const { return width_; }
+  [[nodiscard]] std::uint64_t bytes_on_disk() const { return spill_.bytes(); }
 
  private:
+  struct Chunk {
+    std::vector<double> values;  // empty once on disk
+    std::size_t size = 0;        // doubles, once on disk
+    [[nodiscard]] std::size_t count() const { return offset >= 0 ? size : values.size(); }
+    std::int64_t offset = -1;    // in the scratch file, or -1
+    [[nodiscard]] bool on_disk() const { return offset >= 0; }
+  };
   static constexpr std::size_t kChunkRows = 65536;
+  [[nodiscard]] std::size_t chunk_capacity() const { return kChunkRows * static_cast<std::size_t>(width_); }
+  // A chunk is full: keep it while the budget lasts, else write it out and free it.
+  void retire(Chunk& c) {
+    const std::size_t bytes = c.values.size() * sizeof(double);
+    if (in_memory_ + bytes <= memory_budget_) {
+      in_memory_ += bytes;
+      return;
+    }
+    c.size = c.values.size();
+    c.offset = static_cast<std::int64_t>(spill_.append(c.values.data(), c.size));
+    std::vector<double>().swap(c.values);
+  }
+  double* load(const Chunk& c) const {
+    buffer_.resize(c.size);
+    spill_.read_at(static_cast<std::uint64_t>(c.offset), buffer_.data(), c.size);
+    return buffer_.data();
+  }
+
   int width_;
-  std::vector<std::vector<double>> chunks_;
+  std::size_t memory_budget_;
+  std::size_t in_memory_ = 0;
+  std::vector<Chunk> chunks_;
   std::vector<std::uint8_t> rows_;
   Eigen::Index total_rows_ = 0;
+  SpillFile spill_{"identification rows"};
+  mutable std::vector<double> buffer_;  // one chunk read back from the scratch file
 };
 
 using RowBlock = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
@@ -200,13 +244,13 @@ StiffnessIdentifier::StiffnessIdentifier(const RobotModel& model, const Identifi
   if (!(options.max_relative_std_error > 0.0) || !std::isfinite(options.max_relative_std_error)) {
     throw InputError("identify_stiffness: max_relative_std_error must be finite and > 0");
   }
-  store_ = std::make_unique<RowStoreHolder>(n);
+  store_ = std::make_unique<RowStoreHolder>(n, options.rows_in_memory_bytes);
 }
 
 StiffnessIdentifier::~StiffnessIdentifier() = default;
 
 struct StiffnessIdentifier::RowStoreHolder {
-  explicit RowStoreHolder(int n) : rows(n) {}
+  RowStoreHolder(int n, std::size_t memory_bytes) : rows(n, memory_bytes) {}
   RowStore rows;
   std::vector<double> sqrt_weight;
   std::vector<int> lines;
@@ -251,6 +295,8 @@ void StiffnessIdentifier::add(const StiffnessMeasurement& m) {
 }
 
 std::size_t StiffnessIdentifier::measurements() const { return store_->rows.size(); }
+
+std::uint64_t StiffnessIdentifier::scratch_bytes() const { return store_->rows.bytes_on_disk(); }
 
 StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<StiffnessMeasurement>& data,
                                      const IdentificationOptions& options) {
@@ -485,7 +531,7 @@ StiffnessEstimate StiffnessIdentifier::solve() {
           for (std::size_t i = 0; i < m; ++i) {
             d_over[i] = d[i] / chi_median(s.rows(i));
           }
-          sigma = median(d_over);
+          sigma = median_in_place(d_over);
         }
         if (!(sigma > 1e-12 * rhs_scale)) {
           break;  // an exact fit: nothing to re-weight
@@ -534,7 +580,6 @@ StiffnessEstimate StiffnessIdentifier::solve() {
       est.rejected_lines.push_back(store_->lines[i]);
     }
   });
-  est.robust_weights = omega;
   est.residual_rms_m = kept > 0 ? std::sqrt(pos2 / (3.0 * kept)) : 0.0;
   est.residual_rms_rad = kept_rot > 0 ? std::sqrt(rot2 / (3.0 * kept_rot)) : 0.0;
   std::vector<int> passive;
@@ -609,6 +654,7 @@ StiffnessEstimate StiffnessIdentifier::solve() {
     est.warnings.push_back(fmt::format("{} of {} measurements rejected as outliers (Tukey weight 0): {}",
                                        est.rejected_measurements.size(), m, fmt::join(which, ", ")));
   }
+  est.robust_weights = std::move(omega);
   return est;
 }
 
