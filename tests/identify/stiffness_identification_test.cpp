@@ -3,7 +3,9 @@
 // deflection the arm really takes), with Gaussian noise and injected outliers.
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <random>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <kdl/chainjnttojacsolver.hpp>
@@ -465,6 +467,36 @@ TEST(IdentifyStiffness, RowsKeptInAScratchFileGiveTheSameEstimateBitForBit) {
                 5.0 * b.std_error_nm_per_rad[static_cast<std::size_t>(j)])
         << "joint " << j + 1;
   }
+}
+
+// With nowhere to write the scratch file the identification stops with an error naming the
+// directory and what to do, not a crash or a partial result.
+TEST(IdentifyStiffness, AScratchFileThatCannotBeMadeIsAnErrorNamingTheDirectory) {
+  const RobotModel truth = kr210();
+  const std::vector<StiffnessMeasurement> data = deflected_data(truth, 25000, 20e-6, 5);
+  const char* old = std::getenv("TMPDIR");
+  const std::string saved = old != nullptr ? old : "";
+  ::setenv("TMPDIR", "/proc", 1);  // a directory no one can create files in, root included
+  IdentificationOptions o;
+  o.rows_in_memory_bytes = 0;
+  std::string message;
+  try {
+    StiffnessIdentifier id(truth, o);
+    for (const StiffnessMeasurement& m : data) {
+      id.add(m);
+    }
+    (void)id.solve();
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  if (old != nullptr) {
+    ::setenv("TMPDIR", saved.c_str(), 1);
+  } else {
+    ::unsetenv("TMPDIR");
+  }
+  EXPECT_NE(message.find("identification rows"), std::string::npos) << message;
+  EXPECT_NE(message.find("/proc"), std::string::npos) << message;
+  EXPECT_NE(message.find("TMPDIR"), std::string::npos) << message;
 }
 
 }  // namespace
