@@ -8,6 +8,7 @@
 
 #include "deflex/model/compliance.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "online/fd_jacobian.hpp"
 #include "support/allocation_guard.hpp"
 #include "test_robots.hpp"
 
@@ -101,16 +102,22 @@ TEST(Compliance, Irb6700DeflectionHasThePapersOrderOfMagnitude) {
   EXPECT_NEAR(hi, 0.22e-3, 0.01e-3);
 }
 
+// An IRB 6700 configuration in its working range and a wrench of up to 650 N and 30 Nm per axis.
+void random_loaded_configuration(std::mt19937_64& rng, JointVector& q, Wrench& w) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  q.resize(6);
+  q << 0.5 * u(rng), 0.3 + 0.3 * u(rng), 0.2 * u(rng), u(rng), 0.9 + 0.3 * u(rng), u(rng);
+  w << 650 * u(rng), 650 * u(rng), 650 * u(rng), 30 * u(rng), 30 * u(rng), 30 * u(rng);
+}
+
 TEST(Compliance, CompensatedCommandDeflectsExactlyOntoTheDesiredConfiguration) {
   const RobotModel m = test::irb6700_with_tool();
   Workspace ws(m);
   std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int s = 0; s < 50; ++s) {
-    JointVector q_des(6);
-    q_des << 0.5 * u(rng), 0.3 + 0.3 * u(rng), 0.2 * u(rng), u(rng), 0.9 + 0.3 * u(rng), u(rng);
+    JointVector q_des;
     Wrench w;
-    w << 650 * u(rng), 650 * u(rng), 650 * u(rng), 30 * u(rng), 30 * u(rng), 30 * u(rng);
+    random_loaded_configuration(rng, q_des, w);
     JointVector q_cmd;
     compensated_configuration(m, ws, q_des, w, q_cmd);
     JointVector q_actual;
@@ -126,30 +133,15 @@ TEST(Compliance, WarmStartedDeflectionFindsTheSameFixedPointInFewerSteps) {
   const RobotModel m = test::irb6700_with_tool();
   Workspace ws(m);
   std::mt19937_64 rng(17);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int s = 0; s < 50; ++s) {
-    JointVector q_cmd(6);
-    q_cmd << 0.5 * u(rng), 0.3 + 0.3 * u(rng), 0.2 * u(rng), u(rng), 0.9 + 0.3 * u(rng), u(rng);
+    JointVector q_cmd;
     Wrench w;
-    w << 650 * u(rng), 650 * u(rng), 650 * u(rng), 30 * u(rng), 30 * u(rng), 30 * u(rng);
+    random_loaded_configuration(rng, q_cmd, w);
     JointVector cold;
     ASSERT_EQ(deflected_configuration(m, ws, q_cmd, w, cold), DeflectionStatus::kConverged);
     // The fixed point itself, checked on the equation: q = q_cmd + K^-1 J(q)^T W with J by central
-    // differences of the WAP position and the axes (not the code's Jacobian).
-    Jacobian J(6, 6);
-    const double h = 1e-6;
-    for (int k = 0; k < 6; ++k) {
-      JointVector qp = cold, qm = cold;
-      qp[k] += h;
-      qm[k] -= h;
-      forward_kinematics(m, ws, qp);
-      const Pose tp = ws.base_T_wap;
-      forward_kinematics(m, ws, qm);
-      const Pose tm = ws.base_T_wap;
-      J.col(k).head<3>() = (tp.translation() - tm.translation()) / (2 * h);
-      const Eigen::Matrix3d dR = (tp.linear() - tm.linear()) / (2 * h) * tp.linear().transpose();
-      J.col(k).tail<3>() = Vector3(dR(2, 1), dR(0, 2), dR(1, 0));
-    }
+    // differences of forward kinematics (not the code's Jacobian).
+    const Jacobian J = test::fd_wap_jacobian(m, cold);
     const JointVector fixed = q_cmd + m.compliance().cwiseProduct(J.transpose() * w);
     EXPECT_LT((fixed - cold).cwiseAbs().maxCoeff(), 1e-9);
     // Started beside the answer, at the first step's point, or far off: the same point to 1e-13
