@@ -853,19 +853,8 @@ ProgramCompensation KrlReader::run(const std::string& output_src) {
 
   for (std::size_t a = 0; a < info.size(); ++a) {
     const Use& x = info[a];
-    const ProgramTargetResult& r = results[x.use_index];
-    ProgramTargetReport rep;
-    rep.file = src_.file;
-    rep.line = x.line;
-    rep.instruction = x.instruction;
-    rep.target = x.written;
-    rep.action = actions[a];
-    rep.deflection_m = r.deflection.head<3>().norm();
-    rep.deflection_rad = r.deflection.tail<3>().norm();
-    rep.correction_m = (r.tcp_command.translation() - r.tcp_desired.translation()).norm();
-    rep.joint_correction_rad = (r.q_command - r.q_desired).cwiseAbs().maxCoeff();
-    rep.wrench_base = r.wrench_base;
-    result.targets.push_back(rep);
+    result.targets.push_back(
+        target_report(results[x.use_index], src_.file, x.line, x.instruction, x.written, actions[a]));
   }
   result.outputs.push_back({output_src, apply_edits(src_.text, src_edits)});
   if (!dat_.file.empty()) {

@@ -116,4 +116,21 @@ std::vector<ProgramTargetResult> compensate_program_targets(const RobotModel& mo
   return out;
 }
 
+ProgramTargetReport target_report(const ProgramTargetResult& result, const std::string& file, int line,
+                                  const std::string& instruction, const std::string& target,
+                                  const std::string& action) {
+  ProgramTargetReport rep;
+  rep.file = file;
+  rep.line = line;
+  rep.instruction = instruction;
+  rep.target = target;
+  rep.action = action;
+  rep.deflection_m = result.deflection.head<3>().norm();
+  rep.deflection_rad = result.deflection.tail<3>().norm();
+  rep.correction_m = (result.tcp_command.translation() - result.tcp_desired.translation()).norm();
+  rep.joint_correction_rad = (result.q_command - result.q_desired).cwiseAbs().maxCoeff();
+  rep.wrench_base = result.wrench_base;
+  return rep;
+}
+
 }  // namespace deflex

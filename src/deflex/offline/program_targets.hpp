@@ -8,6 +8,7 @@
 
 #include "deflex/force/force_model.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
+#include "deflex/offline/program_compensation.hpp"
 
 namespace deflex {
 
@@ -47,5 +48,11 @@ struct ProgramTargetResult {
 [[nodiscard]] std::vector<ProgramTargetResult> compensate_program_targets(const RobotModel& model,
                                                                           const std::vector<ProgramTargetUse>& uses,
                                                                           const ForceModel& force);
+
+/// The report line of one compensated use: where it is and what was done to it (`action`), with
+/// the deflection, correction and wrench of its result. Shared by the RAPID and KRL readers.
+[[nodiscard]] ProgramTargetReport target_report(const ProgramTargetResult& result, const std::string& file, int line,
+                                                const std::string& instruction, const std::string& target,
+                                                const std::string& action);
 
 }  // namespace deflex
