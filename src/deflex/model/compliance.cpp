@@ -73,6 +73,11 @@ void complementary_stiffness(const RobotModel& model, Workspace& ws, const Joint
 void compensated_configuration(const RobotModel& model, Workspace& ws, const JointVector& q_desired,
                                const Wrench& wrench_base, JointVector& q_cmd) {
   JointVector dtheta;
+  compensated_configuration(model, ws, q_desired, wrench_base, q_cmd, dtheta);
+}
+
+void compensated_configuration(const RobotModel& model, Workspace& ws, const JointVector& q_desired,
+                               const Wrench& wrench_base, JointVector& q_cmd, JointVector& dtheta) {
   joint_deflection(model, ws, q_desired, wrench_base, dtheta);
   q_cmd = q_desired - dtheta;
 }

@@ -49,6 +49,10 @@ void complementary_stiffness(const RobotModel& model, Workspace& ws, const Joint
 /// with J evaluated at q_desired. Exact for the lumped model; no iteration.
 void compensated_configuration(const RobotModel& model, Workspace& ws, const JointVector& q_desired,
                                const Wrench& wrench_base, JointVector& q_cmd);
+/// The same, also giving the joint deflection dtheta = K^-1 J_wap(q_desired)^T W (rad) it subtracted:
+/// where the arm commanded to q_desired goes first (the offline prediction starts there).
+void compensated_configuration(const RobotModel& model, Workspace& ws, const JointVector& q_desired,
+                               const Wrench& wrench_base, JointVector& q_cmd, JointVector& dtheta);
 
 enum class DeflectionStatus : int {
   kConverged = 0,

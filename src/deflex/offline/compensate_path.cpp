@@ -64,10 +64,8 @@ const OfflinePoint& PathCompensator::compensate(std::size_t i, const JointVector
         (ws.base_T_tcp.translation() - ws.base_T_wap.translation()).cross(Vector3(wrench_tcp.head<3>()));
   }
 
-  // The exact compensation (compensated_configuration): q_cmd = q_desired - K^-1 J(q_desired)^T W.
-  joint_deflection(model, ws, pt.q_desired, pt.wrench_base, dtheta_desired_);
-  pt.q_command = pt.q_desired - dtheta_desired_;
-  const Pose tcp_at_desired = ws.base_T_tcp;  // joint_deflection ran FK at q_desired
+  compensated_configuration(model, ws, pt.q_desired, pt.wrench_base, pt.q_command, dtheta_desired_);
+  const Pose tcp_at_desired = ws.base_T_tcp;  // compensated_configuration ran FK at q_desired
   if (!model.within_limits(pt.q_command)) {
     throw InputError(fmt::format("path point {}: the compensated configuration leaves the joint limits", i));
   }
