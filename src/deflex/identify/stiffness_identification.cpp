@@ -136,9 +136,9 @@ class RowStore {
   struct Chunk {
     std::vector<double> values;  // empty once on disk
     std::size_t size = 0;        // doubles, once on disk
-    [[nodiscard]] std::size_t count() const { return offset >= 0 ? size : values.size(); }
     std::int64_t offset = -1;    // in the scratch file, or -1
     [[nodiscard]] bool on_disk() const { return offset >= 0; }
+    [[nodiscard]] std::size_t count() const { return on_disk() ? size : values.size(); }  // doubles held
   };
   static constexpr std::size_t kChunkRows = 65536;
   [[nodiscard]] std::size_t chunk_capacity() const { return kChunkRows * static_cast<std::size_t>(width_); }

@@ -7,7 +7,6 @@
 #include "deflex/model/csv_table.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
