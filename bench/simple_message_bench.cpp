@@ -15,7 +15,7 @@
 #include <benchmark/benchmark.h>
 
 #include "deflex/cell/simple_message_server.hpp"
-#include "deflex/link/simple_message_link.hpp"
+#include "deflex/simple_message/simple_message_link.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/transport/memory_stream.hpp"
 #include "deflex/transport/tcp_stream.hpp"

@@ -1,41 +1,31 @@
-// `deflex online`: deflex on a controller link (ABB EGM position guidance or path correction, KUKA
-// RSI axis correction ...); runs until the session ends, SIGINT or SIGTERM; its field log through
-// field_log.hpp, its status and summary through online_report.hpp.
+// `deflex online`: deflex on a controller link (ABB EGM position guidance or path correction, KUKA RSI
+// axis correction, ROS-Industrial simple message). This file only turns options into a session
+// (runtime/session.hpp: the link by kind, the loop and its stop rules, the cycle log, the fault dump,
+// the status, the summary) and prints what it says; the exit code is the session's stop reason's
+// (docs/online.md, "Faults and exit codes").
 #include <atomic>
-#include <cinttypes>
 #include <cmath>
-#include <chrono>
 #include <csignal>
-#include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 
 #include "cli_util.hpp"
 #include "command.hpp"
-#include "fault_dump.hpp"
 #include "field_log.hpp"
-#include "online_links.hpp"
-#include "online_report.hpp"
 #include "deflex/force/force_spec.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/model/robot_io.hpp"
-#include "deflex/online/csv_force_replay.hpp"
-#include "deflex/online/udp_force_source.hpp"
+#include "deflex/runtime/session.hpp"
+#include "deflex/sensors/force_source_spec.hpp"
 #include "deflex/wire/egm_codec.hpp"
 
 namespace deflex::cli {
-
-std::vector<LinkKindInfo>& link_kind_registry() {
-  static std::vector<LinkKindInfo> registry;
-  return registry;
-}
-
-LinkKindRegistrar::LinkKindRegistrar(LinkKindInfo info) { link_kind_registry().push_back(std::move(info)); }
-
 namespace {
+
+using runtime::LinkKind;
 
 const char* const kRobotHelp = "Robot file (.yaml deflex format or .urdf); default: the built-in ABB IRB 6700-300/2.70";
 
@@ -51,118 +41,340 @@ SensorConfig sensor_or_default(const std::string& path) {
   return load_sensor_config(path);
 }
 
-std::unique_ptr<ForceSource> make_force_source(const std::string& spec, bool loop, const std::string& bind,
-                                               std::string& description) {
-  const std::size_t colon = spec.find(':');
-  const std::string kind = spec.substr(0, colon);
-  const std::string arg = colon == std::string::npos ? "" : spec.substr(colon + 1);
-  if (kind == "udp" && !arg.empty()) {
-    const double port = parse_numbers(arg, "--force-source", 1)[0];
-    if (port < 0 || port > 65535 || port != std::floor(port)) {
-      throw InputError(fmt::format("option --force-source: '{}' is not a UDP port", arg));
-    }
-    auto src = std::make_unique<UdpForceSource>(static_cast<std::uint16_t>(port), bind);
-    description = fmt::format("UDP force samples on port {}", src->port());
-    return src;
-  }
-  if (kind == "csv" && !arg.empty()) {
-    auto src = std::make_unique<CsvForceReplay>(arg, loop);
-    description = fmt::format("CSV replay of {} ({} samples{})", arg, src->size(), loop ? ", looped" : "");
-    return src;
-  }
-  throw InputError(fmt::format("option --force-source: '{}' is not udp:PORT or csv:FILE", spec));
-}
-
-// The per-cycle CSV log (degrees, mm, N, microseconds), written outside the link's cycle.
-class CycleLog {
- public:
-  CycleLog(const std::string& path, int joints) : joints_(joints) {
-    if (path.empty()) return;
-    file_ = std::fopen(path.c_str(), "w");
-    if (file_ == nullptr) {
-      throw Error(fmt::format("{}: cannot write the cycle log", path));
-    }
-    buffer_.resize(1 << 20);
-    std::setvbuf(file_, buffer_.data(), _IOFBF, buffer_.size());
-    std::string header = "t_s,program_t_s,sequence,status";
-    for (const char* name : {"q_nominal", "q_feedback", "q_command", "dtheta"}) {
-      for (int j = 1; j <= joints; ++j) header += fmt::format(",{}{}_deg", name, j);
-    }
-    header += ",corr_x_mm,corr_y_mm,corr_z_mm,fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,delay_ms,compute_us";
-    // How the cycle's message arrived, and the link's running counts at that cycle.
-    header += ",replied,stamp_ms,arrival_delay_ms,jitter_ms,missed_before,duplicates,superseded,rejected,restarts,late,"
-              "controller_late\n";
-    std::fputs(header.c_str(), file_);
-  }
-  ~CycleLog() {
-    if (file_ != nullptr) std::fclose(file_);
-  }
-  CycleLog(const CycleLog&) = delete;
-  CycleLog& operator=(const CycleLog&) = delete;
-  void write(const LinkCycleRecord& r, const LinkCounters& c) {
-    if (file_ == nullptr) return;
-    std::fprintf(file_, "%.6f,%.9f,%" PRIu64 ",%d", r.t_s, r.program_time_s, r.sequence, static_cast<int>(r.status));
-    for (const JointVector* q : {&r.q_nominal, &r.q_feedback, &r.q_command, &r.dtheta}) {
-      for (int j = 0; j < joints_ && j < q->size(); ++j) std::fprintf(file_, ",%.10g", rad_to_deg((*q)[j]));
-    }
-    std::fprintf(file_, ",%.6f,%.6f,%.6f", r.tcp_correction_m.x() * 1e3, r.tcp_correction_m.y() * 1e3,
-                 r.tcp_correction_m.z() * 1e3);
-    for (int j = 0; j < 6; ++j) std::fprintf(file_, ",%.6g", r.wrench_base[j]);
-    std::fprintf(file_, ",%.2f,%.2f", r.delay_s * 1e3, r.compute_s * 1e6);
-    std::fprintf(file_, ",%d,%.0f,%.3f,%.3f,%" PRIu64 ",%" PRIu64 ",%" PRIu64 ",%" PRIu64 ",%" PRIu64 ",%" PRIu64
-                        ",%" PRIu64 "\n",
-                 r.replied ? 1 : 0, r.arrival.stamp_s * 1e3, r.arrival.arrival_delay_s * 1e3, r.arrival.jitter_s * 1e3,
-                 r.arrival.missed_before, c.duplicate, c.superseded, c.rejected(), c.restarts, c.late,
-                 c.controller_late);
-  }
-
- private:
-  std::FILE* file_ = nullptr;
-  std::vector<char> buffer_;
-  int joints_;
+struct Opts {
+  std::string link, robot, sensor, force_source, program, strategy = "online", force_model, log, fault_dump,
+      jacobian_at = "nominal";
+  double period_ms = 0.0, max_joint_deg = 0.5, max_tcp_mm = 5.0, max_rate_deg_s = 3.0, max_tcp_rate_mm_s = 5.0,
+         watchdog_ms = 50.0;
+  double end_silence_s = 2.0, stop_silence_s = 0.0, duration_s = 0.0, status_s = 1.0;
+  bool loop = false, json = false, end_on_silence = false;
+  // Real time.
+  bool realtime = false, rt_no_mlock = false;
+  int rt_priority = 80, rt_cpu = -1;
+  // Network.
+  std::string bind = "127.0.0.1", robot_host;
+  int egm_port = -1, rsi_port = -1, motion_port = 11000, state_port = 11002;
+  double connect_timeout_s = 5.0;
+  // EGM.
+  double ramp_in_s = 1.0, correction_latency_ms = 0.0, rotation_warning_mrad = 0.1;
+  bool no_speed_ref = false;
+  std::string path_frame = "tool";
+  // RSI.
+  std::string sentype = "ImFree";
+  double rsi_correction_latency_ms = 0.0;
+  int rsi_max_document_bytes = 4096, rsi_timeout = 100;
+  // Simple message.
+  std::string byte_order = "little";
+  int buffer_depth = 2, max_failures = 3, max_frame_bytes = 1024;
+  double reply_timeout_s = 1.0, state_timeout_s = 1.0, max_behind_s = 2.0;
+  LogOptions log_options;
 };
 
-
-std::string refusal_text(const ControllerLink& link, const JointTrajectory& program, double tolerance_deg) {
-  std::string joints;
-  const JointVector& d = link.start_distance();
-  for (int j = 0; j < d.size(); ++j) {
-    if (rad_to_deg(d[j]) > tolerance_deg) {
-      joints += fmt::format("{}joint {} is {:.3f} deg away", joints.empty() ? "" : ", ", j + 1, rad_to_deg(d[j]));
-    }
-  }
-  return fmt::format(
-      "deflex online: refusing to start: the controller reports the arm more than {:g} deg from where the program "
-      "{} is ({}). Move the robot to the program's start first; nothing was sent to the controller.",
-      tolerance_deg, program.source(), joints);
+// Options that belong to some links only: given with another link they are refused, so a user
+// never believes a setting took effect that the chosen link ignores.
+struct LinkOption {
+  const char* name;
+  std::vector<LinkKind> links;
+};
+const std::vector<LinkOption>& link_options() {
+  static const std::vector<LinkOption> options{
+      {"--egm-port", {LinkKind::kEgmJoint, LinkKind::kEgmPath}},
+      {"--ramp-in-s", {LinkKind::kEgmJoint, LinkKind::kSimpleMessage}},
+      {"--no-speed-reference", {LinkKind::kEgmJoint}},
+      {"--path-corr-frame", {LinkKind::kEgmPath}},
+      {"--correction-latency-ms", {LinkKind::kEgmPath}},
+      {"--rotation-warning-mrad", {LinkKind::kEgmPath}},
+      {"--rsi-port", {LinkKind::kRsi}},
+      {"--rsi-sentype", {LinkKind::kRsi}},
+      {"--rsi-correction-latency-ms", {LinkKind::kRsi}},
+      {"--rsi-max-document-bytes", {LinkKind::kRsi}},
+      {"--rsi-timeout", {LinkKind::kRsi}},
+      {"--robot-host", {LinkKind::kSimpleMessage}},
+      {"--motion-port", {LinkKind::kSimpleMessage}},
+      {"--state-port", {LinkKind::kSimpleMessage}},
+      {"--byte-order", {LinkKind::kSimpleMessage}},
+      {"--buffer-depth", {LinkKind::kSimpleMessage}},
+      {"--connect-timeout-s", {LinkKind::kSimpleMessage}},
+      {"--reply-timeout-s", {LinkKind::kSimpleMessage}},
+      {"--state-timeout-s", {LinkKind::kSimpleMessage}},
+      {"--max-failures", {LinkKind::kSimpleMessage}},
+      {"--max-frame-bytes", {LinkKind::kSimpleMessage}},
+      {"--max-behind-s", {LinkKind::kSimpleMessage}},
+      {"--end-on-silence", {LinkKind::kEgmPath, LinkKind::kRsi}},
+      {"--end-silence-s", {LinkKind::kEgmJoint, LinkKind::kSimpleMessage}},
+  };
+  return options;
 }
 
-std::string link_names() {
-  std::string names;
-  for (const auto& k : link_kind_registry()) names += (names.empty() ? "" : ", ") + k.name;
-  return names;
+void add_link_options(CLI::App& sub, Opts& o) {
+  sub.add_option("--egm-port", o.egm_port, "EGM: UDP port the controller's EGM messages arrive on (ABB examples: 6510)");
+  sub.add_option("--ramp-in-s", o.ramp_in_s,
+                 "egm-joint, simple-message: blend from where the controller is to the program over this time, s")
+      ->capture_default_str();
+  sub.add_flag("--no-speed-reference", o.no_speed_ref, "egm-joint: do not send the target's joint speeds");
+  sub.add_option("--path-corr-frame", o.path_frame,
+                 "egm-path: the frame EGMActMove was given: tool (tool.tframe), flange (tool0) or path (path "
+                 "coordinates)")
+      ->capture_default_str();
+  sub.add_option("--correction-latency-ms", o.correction_latency_ms,
+                 "egm-path, predictive: the controller's correction latency beyond the measured servo delay, ms")
+      ->capture_default_str();
+  sub.add_option("--rotation-warning-mrad", o.rotation_warning_mrad,
+                 "egm-path: report when the model predicts a TCP rotation above this (it cannot be corrected), mrad")
+      ->capture_default_str();
+  sub.add_option("--rsi-port", o.rsi_port,
+                 "rsi: UDP port the controller's <Rob> documents arrive on (its Ethernet config's <PORT>; ROS "
+                 "examples: 49152 or 59152)");
+  sub.add_option("--rsi-sentype", o.sentype,
+                 "rsi: the Type of every answer, the controller's <SENTYPE> (letters, digits, '_', '-')")
+      ->capture_default_str();
+  sub.add_option("--rsi-correction-latency-ms", o.rsi_correction_latency_ms,
+                 "rsi, predictive: AXISCORR's latency beyond the delay the link measures (ASPos to AIPos), ms")
+      ->capture_default_str();
+  sub.add_option("--rsi-max-document-bytes", o.rsi_max_document_bytes,
+                 "rsi: larger datagrams are counted oversized and never answered")
+      ->capture_default_str();
+  sub.add_option("--rsi-timeout", o.rsi_timeout,
+                 "rsi: the ETHERNET object's Timeout on the controller (late answers before RSI stops; deflex "
+                 "controller-setup writes the same): with the <Delay> it reports, an RSI stopped by it is recognised")
+      ->capture_default_str();
+  sub.add_option("--robot-host", o.robot_host,
+                 "simple-message: the controller's address (its motion and state servers listen there)");
+  sub.add_option("--motion-port", o.motion_port, "simple-message: TCP port of the motion server (JOINT_TRAJ_PT)")
+      ->capture_default_str();
+  sub.add_option("--state-port", o.state_port, "simple-message: TCP port of the state server (JOINT_POSITION)")
+      ->capture_default_str();
+  sub.add_option("--byte-order", o.byte_order,
+                 "simple-message: the server's byte order: little (ABB RAPID, Motoman DX100/DX200/YRC1000) or big "
+                 "(Fanuc KAREL, Motoman FS100)")
+      ->capture_default_str();
+  sub.add_option("--buffer-depth", o.buffer_depth,
+                 "simple-message: points kept queued on the controller; each adds one cycle of lag (reported; the "
+                 "predictive strategy leads by the measured delay)")
+      ->capture_default_str();
+  sub.add_option("--connect-timeout-s", o.connect_timeout_s, "simple-message: wait this long for each connection, s")
+      ->capture_default_str();
+  sub.add_option("--reply-timeout-s", o.reply_timeout_s,
+                 "simple-message: a point unanswered this long stops the motion, s")
+      ->capture_default_str();
+  sub.add_option("--state-timeout-s", o.state_timeout_s,
+                 "simple-message: no JOINT_POSITION this long stops the motion, s")
+      ->capture_default_str();
+  sub.add_option("--max-failures", o.max_failures,
+                 "simple-message: FAILURE replies in a row (buffer full, point refused) before the motion is stopped")
+      ->capture_default_str();
+  sub.add_option("--max-frame-bytes", o.max_frame_bytes,
+                 "simple-message: the largest frame LENGTH accepted; a larger one means the stream is out of step")
+      ->capture_default_str();
+  sub.add_option("--max-behind-s", o.max_behind_s,
+                 "simple-message: a controller that takes points slower than the program's cycle may fall this far "
+                 "behind the program, s, before the motion is stopped (exit code 8)")
+      ->capture_default_str();
+}
+
+void check_link_options(const CLI::App& sub, LinkKind kind) {
+  const runtime::LinkKindInfo& info = runtime::link_kind(kind);
+  for (const LinkOption& lo : link_options()) {
+    if (sub.get_option(lo.name)->count() == 0) continue;
+    if (std::find(lo.links.begin(), lo.links.end(), kind) != lo.links.end()) continue;
+    std::string links;
+    for (LinkKind k : lo.links) links += fmt::format("{}{}", links.empty() ? "" : " or ", runtime::link_kind(k).name);
+    throw InputError(fmt::format("option {}: applies to --link {}, not {}", lo.name, links, info.name));
+  }
+}
+
+runtime::SessionConfig session_config(const Opts& o, const CLI::App& sub) {
+  runtime::SessionConfig c;
+  c.link = runtime::parse_link_kind(o.link);
+  check_link_options(sub, c.link);
+  const runtime::LinkKindInfo& info = runtime::link_kind(c.link);
+  c.strategy = parse_strategy(o.strategy);
+  const auto positive = [](double v, const char* option) {
+    if (!std::isfinite(v) || !(v > 0.0)) throw InputError(fmt::format("option {}: must be a number > 0 (got {})", option, v));
+  };
+  const auto non_negative = [](double v, const char* option) {
+    if (!std::isfinite(v) || v < 0.0) throw InputError(fmt::format("option {}: must be a number >= 0 (got {})", option, v));
+  };
+  const bool period_given = sub.get_option("--period-ms")->count() > 0;
+  if (period_given) positive(o.period_ms, "--period-ms");
+  positive(o.max_joint_deg, "--max-joint-correction-deg");
+  positive(o.max_tcp_mm, "--max-tcp-correction-mm");
+  positive(o.max_rate_deg_s, "--max-rate-deg-s");
+  positive(o.max_tcp_rate_mm_s, "--max-tcp-rate-mm-s");
+  positive(o.watchdog_ms, "--watchdog-ms");
+  positive(o.status_s, "--status-interval-s");
+  positive(o.end_silence_s, "--end-silence-s");
+  non_negative(o.duration_s, "--duration-s");
+  if (period_given && o.period_ms > 1000.0) throw InputError("option --period-ms: at most 1000 ms");
+  if (o.max_joint_deg > 10.0) {
+    throw InputError("option --max-joint-correction-deg: at most 10 deg (a compliance correction is a fraction of one)");
+  }
+  c.online.period_s = period_given ? o.period_ms * 1e-3 : info.default_period_s;
+  c.online.max_joint_correction_rad = deg_to_rad(o.max_joint_deg);
+  c.online.max_tcp_correction_m = o.max_tcp_mm * 1e-3;
+  c.online.max_correction_rate_rad_s = deg_to_rad(o.max_rate_deg_s);
+  c.online.max_tcp_rate_m_s = o.max_tcp_rate_mm_s * 1e-3;
+  c.online.watchdog_s = o.watchdog_ms * 1e-3;
+  if (o.jacobian_at == "nominal" || o.jacobian_at == "planned") {
+    c.online.jacobian_at = JacobianAt::kPlanned;
+  } else if (o.jacobian_at == "feedback") {
+    c.online.jacobian_at = JacobianAt::kFeedback;
+  } else {
+    throw InputError("option --jacobian-at: must be nominal or feedback");
+  }
+  if (sub.get_option("--stop-silence-s")->count() > 0) {
+    positive(o.stop_silence_s, "--stop-silence-s");
+    c.stop_silence_s = o.stop_silence_s;
+  }
+  c.end_silence_s = o.end_silence_s;
+  c.end_on_silence = o.end_on_silence;
+  c.duration_s = o.duration_s;
+  c.status_interval_s = o.status_s;
+  c.log_path = o.log;
+  c.fault_dump_path = o.fault_dump;
+  c.realtime.enabled = o.realtime;
+  c.realtime.priority = o.rt_priority;
+  c.realtime.cpu = o.rt_cpu;
+  c.realtime.lock_memory = !o.rt_no_mlock;
+  if (!o.realtime && (sub.get_option("--rt-priority")->count() > 0 || sub.get_option("--rt-cpu")->count() > 0 ||
+                      o.rt_no_mlock)) {
+    throw InputError("options --rt-priority, --rt-cpu, --rt-no-mlock: apply with --realtime");
+  }
+  // Network.
+  c.network.bind_address = o.bind;
+  c.network.egm_port = o.egm_port;
+  c.network.rsi_port = o.rsi_port;
+  c.network.robot_host = o.robot_host;
+  c.network.motion_port = o.motion_port;
+  c.network.state_port = o.state_port;
+  c.network.connect_timeout_s = o.connect_timeout_s;
+  // Each link's own settings.
+  non_negative(o.ramp_in_s, "--ramp-in-s");
+  c.egm_joint.stream.ramp_in_s = o.ramp_in_s;
+  c.egm_joint.send_speed_reference = !o.no_speed_ref;
+  non_negative(o.correction_latency_ms, "--correction-latency-ms");
+  non_negative(o.rotation_warning_mrad, "--rotation-warning-mrad");
+  c.egm_path.frame = parse_path_corr_frame(o.path_frame);
+  c.egm_path.correction_latency_s = o.correction_latency_ms * 1e-3;
+  c.egm_path.rotation_warning_rad = o.rotation_warning_mrad * 1e-3;
+  non_negative(o.rsi_correction_latency_ms, "--rsi-correction-latency-ms");
+  if (!valid_rsi_sentype(o.sentype)) {
+    throw InputError(fmt::format(
+        "option --rsi-sentype: '{}' must be 1..32 letters, digits, '_' or '-', starting with a letter", o.sentype));
+  }
+  if (o.rsi_max_document_bytes < 64 || o.rsi_max_document_bytes > 65507) {
+    throw InputError("option --rsi-max-document-bytes: must be 64..65507");
+  }
+  if (o.rsi_timeout < 1) throw InputError(fmt::format("option --rsi-timeout: at least 1 (got {})", o.rsi_timeout));
+  c.rsi.sentype = o.sentype;
+  c.rsi.correction_latency_s = o.rsi_correction_latency_ms * 1e-3;
+  c.rsi.max_document_bytes = static_cast<std::size_t>(o.rsi_max_document_bytes);
+  c.rsi.controller_timeout = o.rsi_timeout;
+  if (c.link == LinkKind::kSimpleMessage && !(c.online.period_s >= 0.02)) {
+    throw InputError(fmt::format(
+        "option --period-ms: simple-message sends one point a cycle to a robot program; give its cycle (the paper's: "
+        "100), at least 20 ms (got {:g} ms)",
+        c.online.period_s * 1e3));
+  }
+  runtime::SessionConfig& s = c;
+  try {
+    s.simple_message.byte_order = simple_message::parse_byte_order(o.byte_order);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("option --byte-order: {}", e.what()));
+  }
+  if (o.buffer_depth < 1 || o.buffer_depth > 64) {
+    throw InputError(fmt::format("option --buffer-depth: must be 1..64 points (got {})", o.buffer_depth));
+  }
+  if (o.max_failures < 1) throw InputError(fmt::format("option --max-failures: must be >= 1 (got {})", o.max_failures));
+  if (o.max_frame_bytes < 64 || o.max_frame_bytes > (1 << 20)) {
+    throw InputError(fmt::format("option --max-frame-bytes: must be 64..1048576 (got {})", o.max_frame_bytes));
+  }
+  positive(o.reply_timeout_s, "--reply-timeout-s");
+  positive(o.state_timeout_s, "--state-timeout-s");
+  positive(o.max_behind_s, "--max-behind-s");
+  s.simple_message.buffer_depth = o.buffer_depth;
+  s.simple_message.reply_timeout_s = o.reply_timeout_s;
+  s.simple_message.state_timeout_s = o.state_timeout_s;
+  s.simple_message.max_failures = o.max_failures;
+  s.simple_message.max_frame_bytes = static_cast<std::size_t>(o.max_frame_bytes);
+  s.simple_message.max_behind_s = o.max_behind_s;
+  s.simple_message.stream.ramp_in_s = o.ramp_in_s;
+  return c;
+}
+
+void run_online(const Opts& o, const CLI::App& sub, int& exit_code) {
+  const runtime::SessionConfig config = session_config(o, sub);
+  const runtime::LinkKindInfo& info = runtime::link_kind(config.link);
+  const RobotModel model = load_cli_robot("online", o.robot);
+  const SensorConfig sensor = sensor_or_default(o.sensor);
+  std::unique_ptr<ForceModel> force_model;
+  if (!o.force_model.empty()) force_model = parse_force_spec(o.force_model);
+  std::shared_ptr<const JointTrajectory> program;
+  if (!o.program.empty()) program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o.program, model));
+  const auto log = make_field_logger("online", o.log_options);
+  ForceSourceOptions fo;
+  fo.loop = o.loop;
+  fo.bind_address = o.bind;
+  const OpenedForceSource force = open_force_source(o.force_source, fo);
+  SteadyClock clock;
+  runtime::Session session(config, model, sensor, program, force_model.get(), force.source.get(), clock, {},
+                           [log](runtime::LogLevel level, const std::string& text) {
+                             switch (level) {
+                               case runtime::LogLevel::kInfo: log->info("{}", text); break;
+                               case runtime::LogLevel::kWarn: log->warn("{}", text); break;
+                               case runtime::LogLevel::kError: log->error("{}", text); break;
+                             }
+                           });
+  if (info.streams_program && !model.has_max_speed()) {
+    log->warn("the robot file gives no joint speed limits, so the program's speeds were not checked (add max_speed "
+              "to the robot file)");
+  }
+  log->info("deflex online: {}; robot {}; sensor {}; force from {}. Stop with Ctrl-C.", session.describe(), model.name(),
+            sensor.source, force.description);
+
+  g_stop = false;
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  (void)session.run(0.0);  // real time is asked for (and refused, exit 2) before anything is answered
+  if (config.realtime.enabled) log->info("real time: {}", session.realtime_text());
+  while (!session.ended()) {
+    if (g_stop.load()) session.request_stop();
+    (void)session.run(0.1);
+  }
+  const runtime::SessionSummary& summary = session.finish();
+  const bool planned = summary.exit_code == 0;
+  for (std::string_view text = summary.text; !text.empty();) {
+    const std::size_t eol = text.find('\n');
+    const std::string_view line = text.substr(0, eol);
+    if (planned) {
+      log->info("{}", line);
+    } else {
+      log->error("{}", line);
+    }
+    text = eol == std::string_view::npos ? std::string_view() : text.substr(eol + 1);
+  }
+  if (o.json) {
+    nlohmann::json doc = summary.json;
+    doc["protobuf_log_messages"] = egm_protobuf_log_messages();
+    print_json(doc);
+  }
+  exit_code = summary.exit_code;
 }
 
 void setup_online(CLI::App& sub, int& exit_code) {
-  struct Opts {
-    std::string link, robot, sensor, force_source, program, strategy = "online", force_model, log, bind = "127.0.0.1",
-        fault_dump, jacobian_at = "nominal";
-    double period_ms = 4.0, max_joint_deg = 0.5, max_tcp_mm = 5.0, max_rate_deg_s = 3.0, watchdog_ms = 50.0;
-    double end_silence_s = 2.0, duration_s = 0.0, status_s = 1.0;
-    bool loop = false, json = false;
-    LogOptions log_options;
-  };
   auto o = std::make_shared<Opts>();
   std::string link_help = "Controller link:";
-  for (const auto& k : link_kind_registry()) link_help += fmt::format(" {} ({});", k.name, k.help);
+  for (const runtime::LinkKindInfo& k : runtime::link_kinds()) link_help += fmt::format(" {} ({});", k.name, k.help);
   sub.add_option("--link", o->link, link_help)->required();
   sub.add_option("--robot", o->robot, kRobotHelp);
   sub.add_option("--sensor-config", o->sensor,
                  "Force-sensor YAML (docs/online.md); default: identity crosstalk, no payload, no bias, at the flange");
   sub.add_option("--bind", o->bind, "Address to bind the link's and the UDP force port to (0.0.0.0 for a real cell)")
       ->capture_default_str();
-  sub.add_option("--force-source", o->force_source, "udp:PORT (docs/online.md, UDP force-sample format) or csv:FILE")
-      ->required();
+  sub.add_option("--force-source", o->force_source, force_source_kinds())->required();
   sub.add_flag("--loop", o->loop, "With csv:FILE, replay the file again and again");
   sub.add_option("--program", o->program,
                  "Streaming links: the nominal joint trajectory deflex streams, CSV t_s,q1_deg..qN_deg (deflex offline "
@@ -175,226 +387,60 @@ void setup_online(CLI::App& sub, int& exit_code) {
                  "Force model of the process, a pose model: ldbb:pivot_mm=X;Y;Z,force_N=F,mode=push|pull or "
                  "constant:fx_N=.. (hybrid: required; predictive: optional)");
   sub.add_option("--period-ms", o->period_ms,
-                 "The controller's cycle in ms (egm-joint: 4; egm-path: the EGMActMove SampleRate; simple-message: "
-                 "the point cycle, the paper's 100)")
-      ->capture_default_str();
+                 "The controller's cycle in ms (default: egm-joint and rsi 4; egm-path 48, the EGMActMove SampleRate; "
+                 "simple-message 100, the paper's)");
   sub.add_option("--max-joint-correction-deg", o->max_joint_deg,
                  "Bound on each joint's correction, degrees: no command leaves the nominal by more")
       ->capture_default_str();
   sub.add_option("--max-tcp-correction-mm", o->max_tcp_mm, "Bound on the TCP displacement of the correction, mm")
       ->capture_default_str();
-  sub.add_option("--max-rate-deg-s", o->max_rate_deg_s, "Bound on each joint's correction rate, deg/s")
+  sub.add_option("--max-rate-deg-s", o->max_rate_deg_s,
+                 "Bound on each joint's correction rate, deg/s (times the period: the correction's largest step a "
+                 "cycle, which must fit in its bound)")
+      ->capture_default_str();
+  sub.add_option("--max-tcp-rate-mm-s", o->max_tcp_rate_mm_s,
+                 "Bound on the rate of the correction's TCP translation, mm/s: a stale force ramps out at it on every "
+                 "link (egm-path: the offset's largest step a cycle)")
       ->capture_default_str();
   sub.add_option("--watchdog-ms", o->watchdog_ms, "No valid force sample for this long: ramp the correction to zero")
       ->capture_default_str();
   sub.add_option("--jacobian-at", o->jacobian_at, "nominal (the configuration the command is for) or feedback")
       ->capture_default_str();
+  sub.add_option("--stop-silence-s", o->stop_silence_s,
+                 "No usable controller message this long: the controller is gone and the session stops (exit code 5); "
+                 "shorter silences are ridden through. Default: egm-joint, egm-path 3; rsi 1");
   sub.add_option("--end-silence-s", o->end_silence_s,
-                 "Streaming links: after the program's end, a controller silence this long ends the session, s")
+                 "Streaming links: after the program's end, a controller silence this long ends the session (exit 0), s")
       ->capture_default_str();
-  sub.add_option("--log", o->log, "CSV log of every cycle");
+  sub.add_flag("--end-on-silence", o->end_on_silence,
+               "egm-path, rsi: a silence longer than --stop-silence-s after a healthy session is the planned end (the "
+               "program's EGMStop or RSI_OFF): exit 0 instead of 5");
+  sub.add_option("--log", o->log, "CSV log of every cycle (written off the loop's thread)");
   sub.add_option("--fault-dump", o->fault_dump,
-                 "CSV the last cycles are written to, once per fault episode (checked for writability at start)");
+                 "CSV the last cycles are written to, once per fault episode and at a stop for a fault (checked for "
+                 "writability at start)");
   sub.add_flag("--json", o->json, "At the end, print one JSON document of the counters and timing on stdout");
   add_log_options(sub, o->log_options);
   sub.add_option("--duration-s", o->duration_s, "Stop after this many seconds (0: run until SIGINT/SIGTERM)")
       ->capture_default_str();
   sub.add_option("--status-interval-s", o->status_s, "Live status on stderr every this many seconds")
       ->capture_default_str();
-  for (const auto& k : link_kind_registry()) k.add_options(sub);
-  sub.callback([o, &exit_code] {
-    const LinkKindInfo* kind_info = nullptr;
-    for (const auto& k : link_kind_registry()) {
-      if (k.name == o->link) kind_info = &k;
-    }
-    if (kind_info == nullptr) {
-      throw InputError(fmt::format("option --link: '{}' is not one of {}", o->link, link_names()));
-    }
-    const RobotModel model = load_cli_robot("online", o->robot);
-    const SensorConfig sensor = sensor_or_default(o->sensor);
-    const auto positive = [](double v, const char* option) {
-      if (!std::isfinite(v) || !(v > 0.0)) {
-        throw InputError(fmt::format("option {}: must be a number > 0 (got {})", option, v));
-      }
-    };
-    positive(o->period_ms, "--period-ms");
-    positive(o->max_joint_deg, "--max-joint-correction-deg");
-    positive(o->max_tcp_mm, "--max-tcp-correction-mm");
-    positive(o->max_rate_deg_s, "--max-rate-deg-s");
-    positive(o->watchdog_ms, "--watchdog-ms");
-    positive(o->status_s, "--status-interval-s");
-    positive(o->end_silence_s, "--end-silence-s");
-    if (!std::isfinite(o->duration_s) || o->duration_s < 0.0) {
-      throw InputError(fmt::format("option --duration-s: must be a number >= 0 (got {})", o->duration_s));
-    }
-    if (o->period_ms > 1000.0) throw InputError("option --period-ms: at most 1000 ms");
-    if (o->max_joint_deg > 10.0) {
-      throw InputError("option --max-joint-correction-deg: at most 10 deg (a compliance correction is a fraction of one)");
-    }
-    const StrategyKind kind = parse_strategy(o->strategy);
-    if (kind_info->streams_program && o->program.empty()) {
-      throw InputError(fmt::format("option --program: {} streams a nominal program: give --program P.csv (deflex "
-                                   "offline --nominal-trajectory writes one)",
-                                   kind_info->name));
-    }
-    if (!kind_info->streams_program && !o->program.empty()) {
-      throw InputError(fmt::format("option --program: {} corrects the controller's own program; deflex streams none",
-                                   kind_info->name));
-    }
-    OnlineConfig cfg;
-    cfg.period_s = o->period_ms * 1e-3;
-    cfg.max_joint_correction_rad = deg_to_rad(o->max_joint_deg);
-    cfg.max_tcp_correction_m = o->max_tcp_mm * 1e-3;
-    cfg.max_correction_rate_rad_s = deg_to_rad(o->max_rate_deg_s);
-    cfg.watchdog_s = o->watchdog_ms * 1e-3;
-    if (o->jacobian_at == "nominal" || o->jacobian_at == "planned") {
-      cfg.jacobian_at = JacobianAt::kPlanned;
-    } else if (o->jacobian_at == "feedback") {
-      cfg.jacobian_at = JacobianAt::kFeedback;
-    } else {
-      throw InputError("option --jacobian-at: must be nominal or feedback");
-    }
-    cfg.validate();
-    std::unique_ptr<ForceModel> force_model;
-    if (!o->force_model.empty()) {
-      force_model = parse_force_spec(o->force_model);
-    }
-    OnlineCompensator comp(model, sensor, cfg);
-    OnlineStrategy strategy(model, kind, force_model.get());
-    std::shared_ptr<const JointTrajectory> program;
-    if (kind_info->streams_program) {
-      program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o->program, model));
-    }
-    const auto log = make_field_logger("online", o->log_options);
-    // The fault dump's path is checked now, not at the first fault in the middle of a run; an episode
-    // ends after twice the compensator's fault hold without a fault.
-    FaultDump fault_dump(o->fault_dump, 2.0 * cfg.fault_hold_s, log);
-    std::string source_text;
-    const std::unique_ptr<ForceSource> source = make_force_source(o->force_source, o->loop, o->bind, source_text);
-    SteadyClock clock;
-    const OnlineContext context{model, comp, strategy, source.get(), clock, o->bind, program, cfg.period_s};
-    const std::unique_ptr<LinkSession> session = kind_info->make(context);
-    ControllerLink& link = session->link();
-    CycleLog cycle_log(o->log, model.dof());
-    if (kind_info->streams_program && !model.has_max_speed()) {
-      log->warn("the robot file gives no joint speed limits, so the program's speeds were not checked (add max_speed "
-                "to the robot file)");
-    }
-
-    log->info(
-        "deflex online: {} link, strategy {}; robot {}; sensor {}; force from {}; {}; {}bounds {} deg/joint, {} mm TCP, "
-        "{} deg/s; watchdog {} ms; period {} ms. Stop with Ctrl-C.",
-        link.name(), to_string(kind), model.name(), sensor.source, source_text, session->where(),
-        program ? fmt::format("program {} ({} points, {:.1f} s); ", o->program, program->size(), program->duration_s())
-                : "",
-        o->max_joint_deg, o->max_tcp_mm, o->max_rate_deg_s, o->watchdog_ms, o->period_ms);
-
-    g_stop = false;
-    struct sigaction sa {};
-    sa.sa_handler = on_stop_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, nullptr);
-    sigaction(SIGTERM, &sa, nullptr);
-
-    const double start = clock.now_s();
-    double next_status = start + o->status_s, last_message = -1.0;
-    OnlineReport report(start);
-    bool refused = false, stopped = false;
-    // Our own loop over poll(), so that status and the duration limit keep going while no controller
-    // is talking to us. Everything between two polls (log lines, the CSV row, a fault dump's copy)
-    // is outside the cycle.
-    while (!g_stop.load()) {
-      const LinkPollResult r = link.poll(0.05);
-      const double now = clock.now_s();
-      if (r == LinkPollResult::kRefused) {
-        refused = true;
-        break;
-      }
-      if (r == LinkPollResult::kStopped) {  // a streaming link stopped the motion for a fault
-        stopped = true;
-        break;
-      }
-      if (r == LinkPollResult::kAnswered || r == LinkPollResult::kNotAnswered) {
-        last_message = now;
-        const LinkCycleRecord& rec = link.last_cycle();
-        report.on_cycle(rec);
-        cycle_log.write(rec, link.counters());
-        fault_dump.on_cycle(now, link);
-      }
-      if (now >= next_status) {
-        if (link.state() == LinkState::kWaiting) {
-          log->info("waiting for the controller ({}; received {}, rejected {})", session->where(),
-                    link.counters().datagrams, link.counters().rejected());
-        } else {
-          log->info("{}", report.status_line(now, now - start, link, session->status()));
-        }
-        next_status = now + o->status_s;
-      }
-      if (link.state() == LinkState::kFinished && last_message >= 0.0 && now - last_message > o->end_silence_s) {
-        log->info("the program has ended and the controller went quiet: session over");
-        break;
-      }
-      if (o->duration_s > 0.0 && now - start >= o->duration_s) {
-        break;
-      }
-    }
-    // A streaming link stops the controller's motion now (simple message: STOP_TRAJECTORY on Ctrl-C,
-    // SIGTERM, --duration-s or the end of the session); the others have nothing to stop.
-    link.stop();
-    fault_dump.finish(clock.now_s());
-    if (refused) {
-      log->error("{}", refusal_text(link, *program, 1.0));
-      exit_code = 2;
-      return;
-    }
-    if (stopped) {
-      if (!o->fault_dump.empty()) link.write_history_csv(o->fault_dump);
-      log->error("the {} link stopped the robot's motion ({}): {}{}", link.name(), to_string(link.stop_cause()),
-                 link.stop_reason(),
-                 o->fault_dump.empty() ? "" : fmt::format("; last cycles written to {}", o->fault_dump));
-    }
-    const LinkCounters& c = link.counters();
-    const std::string extra = session->summary();
-    const std::uint64_t protobuf_lines = egm_protobuf_log_messages();
-    log->info(
-        "deflex online: stopped after {} cycles: {} answers; rejected datagrams {} (malformed {}, truncated {}, "
-        "oversized {}, empty {}, missing header {}, missing joints {}, missing required {}, non-finite {}, duplicate {}, "
-        "out of order {}, far ahead {}, sequence out of range {}, beyond limits {}, other sender {}, foreign document "
-        "{}); superseded {}; restarts {}; guard stops {}; fault episodes {} ({} faulted cycles); force samples ok {}, "
-        "fault {}, invalid {}; {}{}{}{}{}",
-        report.cycles(), c.replies, c.rejected(), c.malformed, c.truncated, c.oversized, c.empty, c.missing_header,
-        c.missing_joints, c.missing_required, c.non_finite, c.duplicate, c.out_of_order, c.far_ahead,
-        c.sequence_out_of_range, c.out_of_limits, c.foreign_sender, c.foreign_document, c.superseded, c.restarts,
-        c.guard_trips, fault_dump.episodes(), fault_dump.faulted_cycles(), comp.counters().samples_ok,
-        comp.counters().samples_fault, comp.counters().samples_invalid, report.timing_text(link),
-        extra.empty() ? "" : "; ", extra, protobuf_lines > 0 ? fmt::format("; protobuf messages {}", protobuf_lines) : "",
-        o->log.empty() ? "" : fmt::format("; log {}", o->log));
-    if (o->json) {
-      nlohmann::json doc = report.json(link);
-      doc["link"] = link.name();
-      doc["strategy"] = to_string(kind);
-      doc["duration_s"] = clock.now_s() - start;
-      doc["fault_episodes"] = fault_dump.episodes();
-      doc["faulted_cycles"] = fault_dump.faulted_cycles();
-      doc["force_samples"] = {{"ok", comp.counters().samples_ok},
-                              {"fault", comp.counters().samples_fault},
-                              {"invalid", comp.counters().samples_invalid},
-                              {"dropped", comp.counters().samples_dropped}};
-      doc["protobuf_log_messages"] = protobuf_lines;
-      doc["log"] = o->log.empty() ? nlohmann::json(nullptr) : nlohmann::json(o->log);
-      print_json(doc);
-    }
-    // What the controller sent that the protocol does not allow is bad input (2); a lost connection, a
-    // refusing or faulted controller, a safety stop: the job failed (1).
-    exit_code = !stopped ? 0 : link.stop_cause() == LinkStopCause::kProtocol ? 2 : 1;
-  });
+  sub.add_flag("--realtime", o->realtime,
+               "Run the loop with SCHED_FIFO, memory locked (and pinned with --rt-cpu); exit 2 naming the missing "
+               "permission when the system refuses (docs/online.md \"Real-time setup\")");
+  sub.add_option("--rt-priority", o->rt_priority, "With --realtime: the SCHED_FIFO priority, 1..99")
+      ->capture_default_str();
+  sub.add_option("--rt-cpu", o->rt_cpu, "With --realtime: the CPU to pin the loop to (an isolated core)");
+  sub.add_flag("--rt-no-mlock", o->rt_no_mlock, "With --realtime: do not lock the process's memory");
+  add_link_options(sub, *o);
+  sub.callback([o, &sub, &exit_code] { run_online(*o, sub, exit_code); });
 }
 
 }  // namespace
 
 DEFLEX_COMMAND("online",
-               "Online compensation on a controller link (--link egm-joint|egm-path|...): condition force samples and "
-               "answer the controller, never beyond the bound of the nominal",
+               "Online compensation on a controller link (--link egm-joint|egm-path|rsi|simple-message): condition "
+               "force samples and answer the controller, never beyond the bound of the nominal",
                setup_online, 40);
 
 }  // namespace deflex::cli

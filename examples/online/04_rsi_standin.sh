@@ -13,8 +13,10 @@ mkdir -p "$OUT/setup"
 PORT=$(python3 -c 'import socket; s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 "$DEFLEX" controller-setup --link rsi --sensor-ip 127.0.0.1 --rsi-port "$PORT" --max-joint-correction-deg 0.5 \
     -o "$OUT/setup"
-"$DEFLEX" online --link rsi --rsi-port "$PORT" --max-joint-correction-deg 0.5 \
-    --force-source "csv:$HERE/force_replay.csv" --loop --duration-s 4 --log "$OUT/cycles.csv" \
+# The stand-in ends after 2.5 s the way a KRL program's RSI_OFF does (it stops sending): with
+# --end-on-silence that silence is the session's planned end (exit 0) unless RSI had stopped on its Timeout.
+"$DEFLEX" online --link rsi --rsi-port "$PORT" --max-joint-correction-deg 0.5 --end-on-silence \
+    --force-source "csv:$HERE/force_replay.csv" --loop --duration-s 6 --log "$OUT/cycles.csv" \
     --log-file "$OUT/online.log" --json > "$OUT/summary.json" &
 ONLINE=$!
 sleep 0.5

@@ -118,7 +118,7 @@ TEST(CliOnline, EgmJointRefusesAStartAwayFromTheProgramAndNamesTheJoint) {
   cell::EgmPositionGuidanceController controller(cc, start, transport,
                                                  make_datagram_address("127.0.0.1", static_cast<std::uint16_t>(port)));
   run_in_real_time(controller, 0.3);
-  EXPECT_EQ(deflex.wait(), 2);
+  EXPECT_EQ(deflex.wait(), 4);
   EXPECT_EQ(controller.counters().targets, 0u);  // nothing was ever sent to the controller
   const std::string err = test::slurp(deflex.stderr_path);
   EXPECT_NE(err.find("refusing to start"), std::string::npos) << err;

@@ -2,9 +2,9 @@
 // simulated cell's RAPID streaming server (run here in real time, the test accepting the connections as
 // the robot program would). Every logged command stays within the bound of a nominal that is the
 // program itself; Ctrl-C sends STOP_TRAJECTORY and exits 0; a start away from the program is refused
-// with the joint named and nothing sent (exit 2); a lost connection stops with exit 1 and says which;
-// a frame that cannot be one is bad input (exit 2, naming the LENGTH); bad options are refused before
-// anything connects, naming the option.
+// with the joint named and nothing sent (exit 4); a lost connection stops the motion with exit 6
+// (controller stopped) and says which; a frame that cannot be one is bad input (exit 2, naming the
+// LENGTH); bad options are refused before anything connects, naming the option.
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -197,14 +197,14 @@ TEST(CliSimpleMessage, RefusesAStartAwayFromTheProgramAndSendsNothing) {
   start[2] += deg_to_rad(2.0);
   cell::SimpleMessageServer server({}, robot, start, *c.motion, *c.state);
   RealTime().run(server, 1.0, kNever);
-  EXPECT_EQ(deflex.wait(), 2);
+  EXPECT_EQ(deflex.wait(), 4);
   EXPECT_EQ(server.counters().requests, 0u);
   const std::string err = deflex.err();
   EXPECT_NE(err.find("refusing to start"), std::string::npos) << err;
   EXPECT_NE(err.find("joint 3 is 2.000 deg away"), std::string::npos) << err;
 }
 
-TEST(CliSimpleMessage, ALostConnectionStopsWithExitCodeOneAndSaysWhich) {
+TEST(CliSimpleMessage, ALostConnectionStopsWithExitCodeSixAndSaysWhich) {
   const std::string dir = temp_dir("cli_sm_lost");
   const std::string program_path = nominal_program(dir);
   const RobotModel robot = builtin_irb6700();
@@ -220,10 +220,10 @@ TEST(CliSimpleMessage, ALostConnectionStopsWithExitCodeOneAndSaysWhich) {
   clock.run(server, 1.0, kNever);
   c.state->close();  // the state server's connection goes
   clock.run(server, 3.0, [&] { return server.counters().stops > 0; });
-  EXPECT_EQ(deflex.wait(), 1);
+  EXPECT_EQ(deflex.wait(), 6);
   EXPECT_EQ(server.counters().stops, 1u);  // the motion connection still carried STOP_TRAJECTORY
   const std::string err = deflex.err();
-  EXPECT_NE(err.find("stopped the robot's motion (connection lost): the controller closed the state connection"),
+  EXPECT_NE(err.find("controller-stopped (exit code 6): the controller closed the state connection"),
             std::string::npos)
       << err;
   EXPECT_TRUE(fs::exists(dir + "/dump.csv"));
@@ -244,7 +244,7 @@ TEST(CliSimpleMessage, AFrameThatCannotBeOneIsBadInputAndNamed) {
   EXPECT_EQ(deflex.wait(), 2);
   const std::string err = deflex.err();
   EXPECT_NE(err.find("state connection: frame LENGTH 5000"), std::string::npos) << err;
-  EXPECT_NE(err.find("(protocol error)"), std::string::npos) << err;
+  EXPECT_NE(err.find("ended: protocol (exit code 2)"), std::string::npos) << err;
 }
 
 TEST(CliSimpleMessage, BadOptionsAreRefusedBeforeAnythingConnects) {
@@ -257,7 +257,9 @@ TEST(CliSimpleMessage, BadOptionsAreRefusedBeforeAnythingConnects) {
     EXPECT_NE(r.err.find(fragment), std::string::npos) << args << "\n" << r.err;
   };
   expect(base + " --period-ms 100", "--robot-host");
-  expect(base + " --robot-host 127.0.0.1", "option --period-ms: simple-message sends one point a cycle");
+  expect(base + " --robot-host 127.0.0.1 --period-ms 4", "option --period-ms: simple-message sends one point a cycle");
+  expect(base + " --robot-host 127.0.0.1 --period-ms 100 --egm-port 6510",
+         "option --egm-port: applies to --link egm-joint or egm-path, not simple-message");
   expect(base + " --robot-host 127.0.0.1 --period-ms 100 --byte-order middle",
          "option --byte-order: byte order 'middle'");
   expect(base + " --robot-host 127.0.0.1 --period-ms 100 --buffer-depth 0", "option --buffer-depth");

@@ -57,7 +57,7 @@ TEST(EgmJointLink, ZeroForceStreamsTheNominalExactly) {
     ASSERT_EQ(bench.tick(), LinkPollResult::kAnswered);
     const LinkCycleRecord& r = bench.link.last_cycle();
     // The nominal is the program itself (the arm started exactly at its start: no blend).
-    program->sample(bench.link.stream().program_time_s(), nominal, &velocity);
+    program->sample(r.program_time_s, nominal, &velocity);
     EXPECT_LT((r.q_nominal - nominal).cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_EQ(r.q_command, r.q_nominal) << "cycle " << k;
   }
@@ -206,21 +206,29 @@ TEST(EgmJointLink, StaleForceRampsTheCorrectionToZeroWhileTheNominalKeepsStreami
   EXPECT_EQ(bench.link.last_cycle().q_command, bench.link.last_cycle().q_nominal);
 }
 
-TEST(EgmJointLink, ASilencePausesTheProgramClockAndItResumesWhereItWas) {
+TEST(EgmJointLink, ASilenceHoldsTheProgramAndItGoesOnOneCycleLater) {
   const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
   const auto program = test::sweep_program(test::bench_robot(), q0, pose_deg(10, 0, 0, 0, 0, 0), 10.0);
   JointBench bench(program, q0);
   bench.force.reading = Vector6::Zero();
   for (int k = 0; k < 500; ++k) bench.tick();  // 2 s of program
-  const double paused_at = bench.link.stream().program_time_s();
-  bench.t_s += 0.8;  // the controller is silent for 0.8 s (longer than the link's 0.5 s pause, shorter
-                     // than its own 1 s timeout; its state holds: the stand-in is not ticked)
+  const double last_sent = bench.link.last_cycle().program_time_s;
+  const JointVector last_command = bench.link.last_cycle().q_command;
+  bench.t_s += 0.8;  // the controller is silent for 0.8 s (longer than the link's 0.5 s restart silence,
+                     // shorter than its own 1 s timeout; its state holds: the stand-in is not ticked)
   bench.controller->tick(bench.t_s);  // it drains nothing and sends its next message
   bench.clock.set(bench.t_s + 0.0002);
-  // The arm is where it stopped, so the link resumes at the program time it paused at.
+  // The controller held deflex's last command, so the link goes on from it: the next target is one
+  // cycle of the program further on, not 0.8 s.
   EXPECT_EQ(bench.link.poll(0.0), LinkPollResult::kAnswered);
-  EXPECT_NEAR(bench.link.stream().program_time_s(), paused_at, 1e-12);
+  const LinkCycleRecord& r = bench.link.last_cycle();
+  EXPECT_NEAR(r.program_time_s, last_sent + 0.004, 1e-12);
+  JointVector step_allowed(6);
+  for (int j = 0; j < 6; ++j) step_allowed[j] = 0.004 * (program->peak_speed()[j] + 1.5 * kPi / 180.0 + 0.2) + 1e-12;
+  EXPECT_TRUE(((r.q_command - last_command).cwiseAbs().array() <= step_allowed.array()).all())
+      << (r.q_command - last_command).transpose();
   EXPECT_EQ(bench.link.counters().restarts, 1u);
+  EXPECT_EQ(bench.link.counters().silences, 1u);
 }
 
 TEST(EgmJointLink, SteadyStateCycleDoesNotAllocate) {

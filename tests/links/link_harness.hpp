@@ -62,7 +62,9 @@ inline SensorConfig bench_sensor() {
 inline OnlineConfig bench_online(double period_s = 0.004) {
   OnlineConfig c;
   c.period_s = period_s;
-  c.max_correction_rate_rad_s = 0.2;
+  // A rate bound whose step a cycle fits in the 0.01 rad bound at any period up to 100 ms.
+  c.max_correction_rate_rad_s = std::min(0.2, 0.009 / period_s);
+  c.max_tcp_rate_m_s = 0.04;
   c.watchdog_s = 0.05;
   return c;
 }

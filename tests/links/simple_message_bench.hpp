@@ -9,7 +9,7 @@
 #include <memory>
 
 #include "deflex/cell/simple_message_server.hpp"
-#include "deflex/link/simple_message_link.hpp"
+#include "deflex/simple_message/simple_message_link.hpp"
 #include "deflex/transport/memory_stream.hpp"
 #include "links/link_harness.hpp"
 #include "support/simple_message_frames.hpp"

@@ -65,6 +65,7 @@ class Compensator : public ::testing::Test {
     OnlineConfig c;
     c.period_s = 0.004;
     c.max_correction_rate_rad_s = 1.0;
+    c.max_tcp_rate_m_s = 10.0;  // the joint rate bound is the one these tests look at
     return c;
   }();
   JointVector q = deg({10, 20, -10, 30, 40, -20});

@@ -110,6 +110,13 @@ const JointVector& EgmPathCorrectionController::tick(double t_s) {
   return position_;
 }
 
+void EgmPathCorrectionController::restart() {
+  seqno_ = 0;
+  pending_count_ = 0;
+  active_frame_m_.setZero();
+  applied_m_.setZero();
+}
+
 void EgmPathCorrectionController::encoders(const JointVector& q_motor_rad) {
   encoders_ = q_motor_rad;
   have_encoders_ = true;

@@ -31,6 +31,9 @@ class EgmPathCorrectionController final : public RobotController {
   [[nodiscard]] const EgmControllerCounters& counters() const { return counters_; }
   /// The TCP offset applied now (m, base frame).
   [[nodiscard]] const Vector3& applied_offset_m() const { return applied_m_; }
+  /// A new path-correction session from the next message on (EGMActMove again): the sequence starts
+  /// again and the correction with it, from no offset (offsets already read are dropped).
+  void restart();
 
  private:
   enum class Frame { kTool, kFlange, kPath };

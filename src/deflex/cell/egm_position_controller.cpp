@@ -62,7 +62,7 @@ const JointVector& EgmPositionGuidanceController::tick(double t_s) {
     const JointVector& v = delay_speed_[delay_head_];
     position_ += dt * (config_.egm_position_gain_per_s * (r - position_) + v);
   }
-  if (!stopped_ && t_s + 1e-12 >= next_send_s_) {
+  if ((!stopped_ || streaming_after_stop_) && t_s + 1e-12 >= next_send_s_) {
     next_send_s_ += config_.egm_period_s;
     robot_.seqno = ++seqno_;
     robot_.tm_ms = egm_time_stamp_ms(t_s);
@@ -74,6 +74,29 @@ const JointVector& EgmPositionGuidanceController::tick(double t_s) {
     if (n > 0 && transport_.send_to(buffer_.data(), n, sensor_)) ++counters_.sent;
   }
   return position_;
+}
+
+void EgmPositionGuidanceController::restart(bool reset_reference) {
+  seqno_ = 0;
+  if (reset_reference) {
+    target_ = filtered_target_ = have_encoders_ ? encoders_ : position_;
+    speed_ref_.setZero();
+    filtered_speed_.setZero();
+    for (auto& q : delay_target_) q = target_;
+    for (auto& v : delay_speed_) v.setZero();
+  }
+}
+
+void EgmPositionGuidanceController::end_session(int mci_state) {
+  stopped_ = true;
+  streaming_after_stop_ = true;
+  robot_.mci_state = mci_state;
+}
+
+void EgmPositionGuidanceController::motors_off() {
+  stopped_ = true;
+  streaming_after_stop_ = true;
+  robot_.motor_state = 2;
 }
 
 void EgmPositionGuidanceController::encoders(const JointVector& q_motor_rad) {

@@ -6,7 +6,12 @@
 //     filters them (\LpFilter), and its servo follows them after a dead time with
 //       speed = k (target - position) + speed reference
 //     (k the position gain: PosCorrGain x the configured proportional position gain);
-//   - with no answer for egm_comm_timeout_s EGM stops and the arm holds where it is.
+//   - with no answer for egm_comm_timeout_s EGM stops and the arm holds where it is;
+//   - the faults of a real cell on request (tests): a new EGM session (EGMRunJoint called again: the
+//     sequence starts again, and the reference starts from where the arm is or stays the one
+//     followed), EGM ended by the program (mciState STOPPED) or an error (ERROR) while it goes on
+//     streaming its state, the motors off (an emergency stop). A network outage is the network's
+//     (MemoryNetwork::add_outage).
 // It knows nothing of deflex: only the wire format, over a datagram transport.
 #pragma once
 
@@ -41,6 +46,16 @@ class EgmPositionGuidanceController final : public RobotController {
   /// The target the controller follows now (rad): the sensor's last one.
   [[nodiscard]] const JointVector& target() const { return target_; }
 
+  /// A new EGM session from the next message on: the sequence number starts again at 1; with
+  /// `reset_reference` the reference is where the arm is now (a new EGMRunJoint), else the one it
+  /// followed stays.
+  void restart(bool reset_reference);
+  /// EGM ends with `mci_state` (2 STOPPED, 1 ERROR): targets are no longer taken, the arm holds, the
+  /// controller keeps streaming its state.
+  void end_session(int mci_state);
+  /// The motors go off (an emergency stop): the arm stops where it is, motorState OFF is reported.
+  void motors_off();
+
  private:
   ControllerConfig config_;
   DatagramTransport& transport_;
@@ -58,6 +73,7 @@ class EgmPositionGuidanceController final : public RobotController {
   double last_t_s_ = 0.0, next_send_s_ = 0.0, last_answer_s_ = 0.0;
   std::uint32_t seqno_ = 0;
   bool stopped_ = false;
+  bool streaming_after_stop_ = false;  // EGM ended by the program: the state goes on being sent
   EgmControllerCounters counters_;
 };
 

@@ -46,6 +46,20 @@ RsiController::RsiController(const RsiControllerConfig& config, const RobotModel
   next_ipoc_ = config_.first_ipoc;
 }
 
+void RsiController::restart(std::uint64_t ipoc_jump_ms) {
+  counters_.stopped = RsiStop::kRunning;
+  counters_.late = 0;
+  applied_.setZero();
+  pending_count_ = 0;
+  awaiting_ = false;
+  next_ipoc_ += ipoc_jump_ms;
+}
+
+void RsiController::pause(double from_s, double to_s) {
+  pause_from_s_ = from_s;
+  pause_to_s_ = to_s;
+}
+
 void RsiController::pose_of(const JointVector& q, std::array<double, 6>& xyzabc) {
   forward_kinematics(model_, ws_, q);
   const Vector3 p = ws_.base_T_tcp.translation() * 1e3;
@@ -115,6 +129,11 @@ const JointVector& RsiController::tick(double t_s) {
 
   if (t_s + 1e-12 >= next_cycle_s_) {
     next_cycle_s_ += config_.cycle_s;
+    const bool paused = t_s >= pause_from_s_ && t_s < pause_to_s_;
+    if (paused) {
+      awaiting_ = false;
+      return position_;
+    }
     if (running() && awaiting_ && !answered_) {
       ++counters_.late;
       if (counters_.late >= static_cast<std::uint64_t>(config_.timeout)) stop(RsiStop::kTimeout);

@@ -74,6 +74,11 @@ class RsiController final : public RobotController {
   /// The IPOC of the last <Rob> sent.
   [[nodiscard]] std::uint64_t last_ipoc() const { return robot_.ipoc; }
   [[nodiscard]] bool running() const { return counters_.stopped == RsiStop::kRunning; }
+  /// RSI switched off (RSI_OFF, or stopped) and on again (RSI_ON) at the next cycle: a new session,
+  /// its IPOC `ipoc_jump_ms` further on, the late count and the applied offset back to zero.
+  void restart(std::uint64_t ipoc_jump_ms = 60000);
+  /// RSI is off in [from_s, to_s): no documents, no late count (the KRL program runs without RSI).
+  void pause(double from_s, double to_s);
 
  private:
   void stop(RsiStop why) { if (counters_.stopped == RsiStop::kRunning) counters_.stopped = why; }
@@ -97,6 +102,7 @@ class RsiController final : public RobotController {
   JointVector applied_, planned_, position_;
   double next_cycle_s_ = 0.0, program_t_s_ = 0.0, last_t_s_ = 0.0;
   bool started_ = false, awaiting_ = false, answered_ = false;
+  double pause_from_s_ = 0.0, pause_to_s_ = 0.0;
   std::uint64_t next_ipoc_ = 0;
   RsiControllerCounters counters_;
 };

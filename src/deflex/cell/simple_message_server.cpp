@@ -157,7 +157,10 @@ void SimpleMessageServer::publish_state(double /*t_s*/) {
 
 const JointVector& SimpleMessageServer::tick(double t_s) {
   moves_.advance(t_s);
-  serve_motion(t_s);
+  if (t_s + 1e-12 >= next_read_s_) {
+    next_read_s_ = t_s + config_.read_period_s;
+    serve_motion(t_s);
+  }
   // The state connection carries nothing in; reading it finds the client gone.
   if (!counters_.state_closed) {
     unsigned char sink[64];

@@ -37,6 +37,9 @@ struct SimpleMessageServerConfig {
   bool reply_with_data = false;      ///< ABB: header-only replies; industrial_core servers echo the point
   std::size_t max_frame_bytes = simple_message::kDefaultMaxFrameBytes;
   JointMoveConfig motion;            ///< the motion task's MoveAbsJ with its zone
+  /// The server task reads the motion connection at most once this often (0: every tick): a slow
+  /// robot program (a busy task, a slow loop) that takes points less often than deflex sends them.
+  double read_period_s = 0.0;
   /// Throws InputError naming the setting.
   void validate() const;
 };
@@ -92,6 +95,7 @@ class SimpleMessageServer final : public RobotController {
   simple_message::FrameOutbox motion_out_, state_out_;
   SimpleMessageServerCounters counters_;
   double next_publish_s_;
+  double next_read_s_ = 0.0;
   bool estopped_ = false;
   JointVector q_, last_target_;
   std::int32_t last_sequence_ = -1;

@@ -1,6 +1,7 @@
 // ABB EGM position guidance, joint mode (see egm_joint_link.hpp).
 #include "deflex/egm/egm_joint_link.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -10,128 +11,183 @@
 
 namespace deflex {
 
+namespace {
+
+const char* mci_name(int state) {
+  switch (state) {
+    case 1: return "ERROR";
+    case 2: return "STOPPED";
+    case 3: return "RUNNING";
+    default: return "UNDEFINED";
+  }
+}
+
+CommandLimits joint_limits(const OnlineCompensator& c, const JointTrajectory* program, const JointStreamConfig& s) {
+  if (program == nullptr) throw InputError("EGM joint link: no program to stream");
+  if (program->dof() != c.model().dof()) {
+    throw InputError(
+        fmt::format("EGM joint link: the program has {} joints, the robot {}", program->dof(), c.model().dof()));
+  }
+  return command_limits(CommandForm::kJointTarget, c.config(), c.model().dof(), program, &s);
+}
+
+}  // namespace
+
 EgmJointLink::EgmJointLink(OnlineCompensator& compensator, OnlineStrategy& strategy,
                            std::shared_ptr<const JointTrajectory> nominal, DatagramTransport& transport,
                            const Clock& clock, ForceSource* force, const EgmJointLinkConfig& config)
-    : comp_(compensator),
-      strategy_(strategy),
-      clock_(clock),
-      force_(force),
+    : ControllerLink(compensator, strategy, force, clock, joint_limits(compensator, nominal.get(), config.stream),
+                     config.stop, config.history_cycles),
       config_(config),
       receiver_(transport, clock, compensator.model(), with_period(config.receiver, compensator.config().period_s),
                 counters_),
       stream_(nominal, config.stream),
       delay_(config.initial_delay_s),
-      history_(config.history_cycles, compensator.model().dof()) {
+      period_s_(compensator.config().period_s) {
   const int n = compensator.model().dof();
-  if (nominal->dof() != n) {
-    throw InputError(fmt::format("EGM joint link: the program has {} joints, the robot {}", nominal->dof(), n));
-  }
-  for (JointVector* q : {&input_.q_planned, &input_.q_feedback, &nominal_, &nominal_velocity_, &feedback_, &command_,
-                         &previous_dtheta_, &reply_.planned_joints_deg}) {
+  for (JointVector* q : {&feedback_, &planned_, &program_, &program_velocity_, &blend_, &blend_velocity_, &nominal_,
+                         &reply_.planned_joints_deg}) {
     *q = JointVector::Zero(n);
   }
   reply_.speed_ref_joints_deg_s = config_.send_speed_reference ? JointVector::Zero(n) : JointVector();
   tx_.assign(1024, 0);
-  last_ = history_.blank();
+}
+
+bool EgmJointLink::controller_state(const EgmRobotMessage& m) noexcept {
+  if (m.motor_state == 2) {
+    stop_link(LinkStopCause::kController,
+              "the controller reports its motors off (EgmRobot motorState OFF: an emergency or protective stop) at "
+              "program time %.3f s",
+              stream_.program_time_s() - stream_.trajectory().start_time_s());
+    return false;
+  }
+  if (m.mci_state == 3) {
+    egm_ran_ = true;
+  } else if (m.mci_state == 1 || m.mci_state == 2) {
+    if (!egm_ran_) {
+      // EGM streams (EGMStreamStart) but does not move yet: nothing is consumed, the program waits.
+      ++counters_.not_running;
+      return false;
+    }
+    if (stream_.finished() && m.mci_state == 2) {
+      stop_link(LinkStopCause::kEnded, "the controller ended EGM (mciState STOPPED) after the program's end");
+    } else {
+      stop_link(LinkStopCause::kController,
+                "the controller ended EGM (mciState %s) at program time %.3f s of %.3f s, before the program's end",
+                mci_name(m.mci_state), stream_.program_time_s() - stream_.trajectory().start_time_s(),
+                stream_.trajectory().duration_s());
+    }
+    return false;
+  }
+  return true;
 }
 
 LinkPollResult EgmJointLink::poll(double timeout_s) noexcept {
+  if (state_ == LinkState::kStopped || state_ == LinkState::kRefused) {
+    bool ignored = false;
+    if (receiver_.drain(0.0, ignored) == EgmReceiver::Result::kMessage && state_ == LinkState::kRefused) {
+      ++counters_.refused;
+    }
+    return announce_terminal();
+  }
   bool restarted = false;
   const EgmReceiver::Result got = receiver_.drain(timeout_s, restarted);
-  if (got == EgmReceiver::Result::kNothing) return LinkPollResult::kIdle;
-  if (got == EgmReceiver::Result::kNoneUsable) return LinkPollResult::kRejected;
-  const auto t_read = std::chrono::steady_clock::now();
   const double now = clock_.now_s();
+  if (got != EgmReceiver::Result::kMessage) {
+    if (apply_silence_rules(now)) return announce_terminal();
+    return got == EgmReceiver::Result::kNothing ? LinkPollResult::kIdle : LinkPollResult::kRejected;
+  }
+  const auto t_read = std::chrono::steady_clock::now();
   const EgmRobotMessage& m = receiver_.message();
-  for (int i = 0; i < feedback_.size(); ++i) feedback_[i] = deg_to_rad(m.feedback_joints_deg[i]);
+  for (int i = 0; i < feedback_.size(); ++i) {
+    feedback_[i] = deg_to_rad(m.feedback_joints_deg[i]);
+    planned_[i] = m.has_planned ? deg_to_rad(m.planned_joints_deg[i]) : feedback_[i];
+  }
+  heard(now);
+  if (!controller_state(m)) {
+    return state_ == LinkState::kStopped ? announce_terminal() : LinkPollResult::kNotAnswered;
+  }
 
-  if (state_ == LinkState::kRefused) {
-    ++counters_.refused;
-    return LinkPollResult::kRefused;
-  }
-  // A new session (the first message, or the first after a silence) must find the arm where the
-  // program is; otherwise nothing is ever sent.
-  if (restarted || stream_.paused_at(now) || state_ == LinkState::kWaiting) {
-    if (!stream_.begin(now, feedback_)) {
-      state_ = LinkState::kRefused;
-      ++counters_.refused;
-      fault_pending_ = true;
-      return LinkPollResult::kRefused;
+  // A session (the first message, a restart) starts from the reference the controller holds. A
+  // controller that kept following deflex's stream reports one of its last commands: the stream goes
+  // on from the last one sent, as if nothing happened. One that reset its reference (a new EGMRunJoint)
+  // reports where it now is: the stream goes on from there.
+  const bool session_start = restarted || state_ == LinkState::kWaiting;
+  if (session_start) {
+    const JointVector* anchor = &planned_;
+    if (cycle_.has_sent()) {
+      double ratio = 0.0;
+      for (int j = 0; j < planned_.size(); ++j) {
+        ratio = std::max(ratio, std::abs(planned_[j] - cycle_.last_command()[j]) / cycle_.limits().joint_step_rad[j]);
+      }
+      if (ratio <= 2.0) anchor = &cycle_.last_command();
     }
-    state_ = LinkState::kRunning;
+    nominal_ = *anchor;  // begin() and anchor_joints() must not see the cycle's own buffer change
+    if (!stream_.begin(nominal_, cycle_.correction())) {
+      if (state_ == LinkState::kWaiting) {
+        refuse_start(stream_.distance());
+      } else {
+        Eigen::Index j = 0;
+        const double d = stream_.distance().maxCoeff(&j);
+        stop_link(LinkStopCause::kController,
+                  "the controller restarted holding joint %d %.3f deg from deflex's command (tolerance %.3f deg): not "
+                  "resumed",
+                  static_cast<int>(j) + 1, rad_to_deg(d), rad_to_deg(config_.stream.start_tolerance_rad));
+      }
+      return announce_terminal();
+    }
+    cycle_.anchor_joints(nominal_);
+    if (state_ == LinkState::kWaiting || state_ == LinkState::kRunning) state_ = LinkState::kRunning;
   }
-  stream_.advance(now, nominal_, nominal_velocity_);
-  if (stream_.finished()) state_ = LinkState::kFinished;
+  stream_.sample(program_, program_velocity_, blend_, blend_velocity_);
+  nominal_ = program_ + blend_;
 
   delay_.observe_feedback(now, feedback_);
-  input_.t_s = now;
-  input_.q_planned = nominal_;
-  input_.q_feedback = feedback_;
-  const StrategyStatus ss =
-      strategy_.prepare(input_, feedback_, nominal_, delay_.delay_s(), comp_.filter_delay_s());
-  input_.hold_to_zero = input_.hold_to_zero || ss != StrategyStatus::kOk;
-  const CycleOutput out = force_ != nullptr ? comp_.step(input_, *force_) : comp_.step(input_);
-
-  LinkCycleRecord& r = last_;
-  r.t_s = now;
-  r.program_time_s = stream_.program_time_s();
-  r.sequence = m.seqno;
-  r.q_nominal = nominal_;
-  r.q_feedback = feedback_;
-  r.dtheta = out.dtheta;
-  r.wrench_base = out.wrench_base;
-  r.wrench_measured_base = out.wrench_measured_base;
-  r.status = out.status;
-  r.replied = false;
-  r.delay_s = delay_.delay_s();
-  r.arrival = receiver_.arrival();
-  r.rotation_uncorrected_rad = 0.0;
-  if (out.status == CycleStatus::kForceFault || out.status == CycleStatus::kInvalidInput) {
-    fault_pending_ = true;
+  CycleRequest rq;
+  rq.t_s = now;
+  rq.sequence = m.seqno;
+  rq.program_time_s = stream_.program_time_s();
+  rq.nominal = &program_;
+  rq.blend = &blend_;
+  rq.feedback = &feedback_;
+  rq.target = &nominal_;
+  rq.delay_s = rq.lead_s = delay_.delay_s();
+  rq.session_start = session_start;
+  rq.arrival = receiver_.arrival();
+  const LinkCycle::Verdict verdict = cycle_.run(rq);
+  const auto compute = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_read).count(); };
+  if (verdict == LinkCycle::Verdict::kInvalid) {
+    cycle_.not_sent(compute());
+    return LinkPollResult::kNotAnswered;
   }
-  LinkPollResult result = LinkPollResult::kNotAnswered;
-  if (static_cast<int>(out.status) < 0) {
-    ++counters_.invalid_cycles;
-  } else {
-    command_ = nominal_ - out.dtheta;
-    r.q_command = command_;
-    r.tcp_correction_m = -out.tcp_deflection_base_m;  // what the correction moves the TCP by
-    // The last check before anything leaves deflex: every joint within the bound of the nominal.
-    const double bound = comp_.config().max_joint_correction_rad * (1.0 + 1e-9) + 1e-12;
-    if (!command_.allFinite() || (command_ - nominal_).cwiseAbs().maxCoeff() > bound) {
-      ++counters_.guard_trips;
-      fault_pending_ = true;
-    } else {
-      reply_.seqno = ++reply_seq_;
-      reply_.tm_ms = egm_time_stamp_ms(now);
-      // The speed reference is the target's own velocity: the nominal's, less the correction's change
-      // (the controller's position loop alone would follow a moving correction late).
-      const double dt = now - previous_reply_s_;
-      const bool have_rate = have_previous_reply_ && dt > 0.0 && dt < 0.1;
-      for (int i = 0; i < command_.size(); ++i) {
-        reply_.planned_joints_deg[i] = rad_to_deg(command_[i]);
-        if (config_.send_speed_reference) {
-          const double correction_rate = have_rate ? (out.dtheta[i] - previous_dtheta_[i]) / dt : 0.0;
-          reply_.speed_ref_joints_deg_s[i] = rad_to_deg(nominal_velocity_[i] - correction_rate);
-        }
-      }
-      previous_dtheta_ = out.dtheta;
-      previous_reply_s_ = now;
-      have_previous_reply_ = true;
-      const std::size_t n = receiver_.codec().encode_sensor(reply_, tx_.data(), tx_.size());
-      if (n > 0 && receiver_.reply(tx_.data(), n)) {
-        r.replied = true;
-        result = LinkPollResult::kAnswered;
-        delay_.record_reference(now, command_);
-      } else if (n == 0) {
-        ++counters_.send_errors;
-      }
+  if (verdict == LinkCycle::Verdict::kGuard) {
+    cycle_.not_sent(compute());
+    stop_link(LinkStopCause::kSafety, "%s", cycle_.guard_message());
+    return announce_terminal();
+  }
+  const JointVector& command = cycle_.joint_command();
+  reply_.seqno = ++reply_seq_;
+  reply_.tm_ms = egm_time_stamp_ms(now);
+  for (int i = 0; i < command.size(); ++i) {
+    reply_.planned_joints_deg[i] = rad_to_deg(command[i]);
+    if (config_.send_speed_reference) {
+      // The target's own velocity: the program's and the blend's, less the correction's change this
+      // cycle (the controller's position loop alone would follow a moving target late).
+      const double correction_rate = (cycle_.output().dtheta[i] - cycle_.correction()[i]) / period_s_;
+      reply_.speed_ref_joints_deg_s[i] = rad_to_deg(program_velocity_[i] + blend_velocity_[i] - correction_rate);
     }
   }
-  r.compute_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_read).count();
-  history_.record(r);
-  return result;
+  const std::size_t n = receiver_.codec().encode_sensor(reply_, tx_.data(), tx_.size());
+  if (n == 0) ++counters_.send_errors;
+  if (n == 0 || !receiver_.reply(tx_.data(), n)) {
+    cycle_.not_sent(compute());
+    return LinkPollResult::kNotAnswered;
+  }
+  cycle_.sent(compute(), receiver_.answer_time_s(clock_.now_s()));
+  delay_.record_reference(now, command);
+  stream_.consumed(period_s_);
+  if (stream_.finished() && state_ == LinkState::kRunning) state_ = LinkState::kFinished;
+  return LinkPollResult::kAnswered;
 }
 
 }  // namespace deflex

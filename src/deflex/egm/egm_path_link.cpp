@@ -30,6 +30,7 @@ PathCorrFrame parse_path_corr_frame(const std::string& name) {
 
 void EgmPathLinkConfig::validate() const {
   receiver.validate();
+  stop.validate();
   if (!std::isfinite(rotation_warning_rad) || rotation_warning_rad < 0.0) {
     throw InputError("EGM path link: the rotation warning must be >= 0 rad");
   }
@@ -38,31 +39,33 @@ void EgmPathLinkConfig::validate() const {
   }
 }
 
+namespace {
+CommandLimits path_limits(const OnlineCompensator& c, const EgmPathLinkConfig& config) {
+  config.validate();
+  return command_limits(CommandForm::kTcpOffset, c.config(), c.model().dof());
+}
+}  // namespace
+
 EgmPathLink::EgmPathLink(OnlineCompensator& compensator, OnlineStrategy& strategy, DatagramTransport& transport,
                          const Clock& clock, ForceSource* force, const EgmPathLinkConfig& config)
-    : comp_(compensator),
-      strategy_(strategy),
-      clock_(clock),
-      force_(force),
+    : ControllerLink(compensator, strategy, force, clock, path_limits(compensator, config), config.stop,
+                     config.history_cycles),
       config_(config),
       receiver_(transport, clock, compensator.model(), with_period(config.receiver, compensator.config().period_s),
                 counters_),
       delay_(config.initial_delay_s),
-      history_(config.history_cycles, compensator.model().dof()),
       ws_(compensator.model()),
       jac_(6, compensator.model().dof()) {
-  config_.validate();
   const int n = compensator.model().dof();
-  for (JointVector* q : {&input_.q_planned, &input_.q_feedback, &feedback_, &planned_, &previous_feedback_, &velocity_,
-                         &target_, &no_distance_, &sent_offset_joints_, &reference_}) {
+  for (JointVector* q : {&feedback_, &planned_, &previous_feedback_, &velocity_, &target_, &sent_offset_joints_,
+                         &reference_}) {
     *q = JointVector::Zero(n);
   }
   tx_.assign(512, 0);
-  last_ = history_.blank();
 }
 
 bool EgmPathLink::correction_frame(const JointVector& q_feedback, Matrix3& base_R_frame) noexcept {
-  forward_kinematics(comp_.model(), ws_, q_feedback);
+  forward_kinematics(cycle_.compensator().model(), ws_, q_feedback);
   switch (config_.frame) {
     case PathCorrFrame::kTool:
       base_R_frame = ws_.base_T_tcp.linear();
@@ -85,27 +88,66 @@ bool EgmPathLink::correction_frame(const JointVector& q_feedback, Matrix3& base_
   return false;
 }
 
+bool EgmPathLink::controller_state(const EgmRobotMessage& m) noexcept {
+  if (m.motor_state == 2) {
+    stop_link(LinkStopCause::kController,
+              "the controller reports its motors off (EgmRobot motorState OFF: an emergency or protective stop)");
+    return false;
+  }
+  if (m.mci_state == 3) {
+    egm_ran_ = true;
+  } else if ((m.mci_state == 1 || m.mci_state == 2) && egm_ran_) {
+    if (m.mci_state == 2) {
+      stop_link(LinkStopCause::kEnded, "the controller ended path correction (mciState STOPPED: EGMStop)");
+    } else {
+      stop_link(LinkStopCause::kController, "the controller reports an EGM error (mciState ERROR)");
+    }
+    return false;
+  }
+  return true;
+}
+
+std::string EgmPathLink::protocol_summary() const {
+  return fmt::format("egm-path: largest TCP rotation the model predicted {:.3f} mrad ({} cycles above {:g} mrad; path "
+                     "correction cannot rotate)",
+                     max_rotation_rad_ * 1e3, rotation_warnings_, config_.rotation_warning_rad * 1e3);
+}
+
 LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
+  if (state_ == LinkState::kStopped) {
+    bool ignored = false;
+    (void)receiver_.drain(0.0, ignored);
+    return announce_terminal();
+  }
   bool restarted = false;
   const EgmReceiver::Result got = receiver_.drain(timeout_s, restarted);
-  if (got == EgmReceiver::Result::kNothing) return LinkPollResult::kIdle;
-  if (got == EgmReceiver::Result::kNoneUsable) return LinkPollResult::kRejected;
-  const auto t_read = std::chrono::steady_clock::now();
   const double now = clock_.now_s();
+  if (got != EgmReceiver::Result::kMessage) {
+    if (apply_silence_rules(now)) return announce_terminal();
+    return got == EgmReceiver::Result::kNothing ? LinkPollResult::kIdle : LinkPollResult::kRejected;
+  }
+  const auto t_read = std::chrono::steady_clock::now();
   const EgmRobotMessage& m = receiver_.message();
   for (int i = 0; i < feedback_.size(); ++i) {
     feedback_[i] = deg_to_rad(m.feedback_joints_deg[i]);
     planned_[i] = deg_to_rad(m.planned_joints_deg[i]);
   }
-  state_ = LinkState::kRunning;
-  if (restarted) {
+  heard(now);
+  if (!controller_state(m)) return announce_terminal();
+  const bool session_start = restarted || state_ == LinkState::kWaiting;
+  if (session_start) {
+    // A path-correction session on the controller starts from no offset: so does deflex's correction
+    // (it then ramps in at the rate bound), or the first answer would step the path.
+    cycle_.restart_from_zero();
     have_previous_ = false;  // the direction of travel is kept: the path is the same program
+    state_ = LinkState::kRunning;
   }
 
   // Where the arm goes: its joint velocity and the controller's period from the feedback; the
   // direction of travel (path coordinates) from the controller's planned path, which the correction
   // does not move (from the feedback it would chase its own correction), else from the feedback.
-  forward_kinematics(comp_.model(), ws_, m.has_planned ? planned_ : feedback_);
+  const RobotModel& model = cycle_.compensator().model();
+  forward_kinematics(model, ws_, m.has_planned ? planned_ : feedback_);
   const Vector3 tcp = ws_.base_T_tcp.translation();
   if (have_previous_) {
     const double dt = now - previous_t_s_;
@@ -135,80 +177,68 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
   // half a correction period: the predictive strategy evaluates it where the arm will be by then.
   const double lead = delay_.delay_s() + config_.correction_latency_s + 0.5 * period_s_;
   target_ = feedback_;
-  if (strategy_.kind() == StrategyKind::kPredictive) {
-    target_ += lead * velocity_;
-  }
+  if (cycle_.strategy().kind() == StrategyKind::kPredictive) target_ += lead * velocity_;
   Matrix3 base_R_frame = Matrix3::Identity();
-  const bool frame_ok = correction_frame(feedback_, base_R_frame);
-  input_.t_s = now;
-  input_.q_planned = target_;
-  input_.q_feedback = feedback_;
-  const StrategyStatus ss = strategy_.prepare(input_, feedback_, target_, lead, comp_.filter_delay_s());
-  input_.hold_to_zero = input_.hold_to_zero || ss != StrategyStatus::kOk || !frame_ok;
-  const CycleOutput out = force_ != nullptr ? comp_.step(input_, *force_) : comp_.step(input_);
-
-  LinkCycleRecord& r = last_;
-  r.t_s = now;
-  r.sequence = m.seqno;
-  r.q_nominal = planned_;
-  r.q_feedback = feedback_;
-  r.q_command = feedback_;
-  r.dtheta = out.dtheta;
-  r.wrench_base = out.wrench_base;
-  r.wrench_measured_base = out.wrench_measured_base;
-  r.status = out.status;
-  r.replied = false;
-  r.delay_s = delay_.delay_s();
-  r.arrival = receiver_.arrival();
-  if (out.status == CycleStatus::kForceFault || out.status == CycleStatus::kInvalidInput) {
-    fault_pending_ = true;
+  if (correction_frame(feedback_, base_R_frame)) {
+    last_frame_ = base_R_frame;
+    have_frame_ = true;
   }
-  LinkPollResult result = LinkPollResult::kNotAnswered;
-  if (static_cast<int>(out.status) < 0) {
-    ++counters_.invalid_cycles;
-  } else {
-    jacobian(comp_.model(), ws_, target_, EndPoint::kTcp, jac_);
-    const Vector3 correction = -(jac_.topRows<3>() * out.dtheta);
-    const double rotation = (jac_.bottomRows<3>() * out.dtheta).norm();
-    r.tcp_correction_m = correction;
-    r.rotation_uncorrected_rad = rotation;
-    max_rotation_rad_ = std::max(max_rotation_rad_, rotation);
-    if (rotation > config_.rotation_warning_rad) ++rotation_warnings_;
-    // The last check before anything leaves deflex: the offset within the TCP bound of "no offset".
-    const double bound = comp_.config().max_tcp_correction_m * (1.0 + 1e-9) + 1e-12;
-    if (!correction.allFinite() || correction.norm() > bound) {
-      ++counters_.guard_trips;
-      fault_pending_ = true;
-    } else {
-      reply_.seqno = ++reply_seq_;
-      reply_.tm_ms = egm_time_stamp_ms(now);
-      reply_.pos_mm = frame_ok ? Vector3(base_R_frame.transpose() * correction * 1e3) : Vector3::Zero();
-      const double age_ms = std::clamp(out.force_age_s * 1e3, 0.0, 4.0e9);
-      reply_.age_ms = static_cast<std::uint32_t>(age_ms);
-      const std::size_t n = receiver_.codec().encode_path_corr(reply_, tx_.data(), tx_.size());
-      if (n > 0 && receiver_.reply(tx_.data(), n)) {
-        r.replied = true;
-        result = LinkPollResult::kAnswered;
-        // The joints' share of this offset, orientation held (6-axis arms; a fixed-size solve, no
-        // allocation). A singular Jacobian leaves the previous value: the delay measurement only.
-        if (comp_.model().dof() == 6 && frame_ok) {
-          const Eigen::Matrix<double, 6, 6> j6 = jac_;
-          Eigen::Matrix<double, 6, 1> twist;
-          twist << correction, Vector3::Zero();
-          const Eigen::PartialPivLU<Eigen::Matrix<double, 6, 6>> lu(j6);
-          if (std::abs(lu.determinant()) > 1e-9) {
-            const Eigen::Matrix<double, 6, 1> dq = lu.solve(twist);
-            if (dq.allFinite()) sent_offset_joints_ = dq;
-          }
-        }
-      } else if (n == 0) {
-        ++counters_.send_errors;
-      }
+  CycleRequest rq;
+  rq.t_s = now;
+  rq.sequence = m.seqno;
+  rq.nominal = &planned_;
+  rq.feedback = &feedback_;
+  rq.target = &target_;
+  rq.delay_s = delay_.delay_s();
+  rq.lead_s = lead;
+  // No frame yet (path coordinates before the arm moved): nothing can be expressed, the correction
+  // is held at zero. Later, a moment without a frame keeps the last one.
+  rq.hold = !have_frame_;
+  rq.session_start = session_start;
+  rq.arrival = receiver_.arrival();
+  const LinkCycle::Verdict verdict = cycle_.run(rq);
+  const auto compute = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_read).count(); };
+  if (verdict == LinkCycle::Verdict::kInvalid) {
+    cycle_.not_sent(compute());
+    return LinkPollResult::kNotAnswered;
+  }
+  // The rotation the model predicts, which this mode cannot correct.
+  jacobian(model, ws_, target_, EndPoint::kTcp, jac_);
+  const double rotation = (jac_.bottomRows<3>() * cycle_.output().dtheta).norm();
+  cycle_.note_uncorrected_rotation(rotation);
+  max_rotation_rad_ = std::max(max_rotation_rad_, rotation);
+  if (rotation > config_.rotation_warning_rad) ++rotation_warnings_;
+  if (verdict == LinkCycle::Verdict::kGuard) {
+    cycle_.not_sent(compute());
+    stop_link(LinkStopCause::kSafety, "%s", cycle_.guard_message());
+    return announce_terminal();
+  }
+  const Vector3& correction = cycle_.tcp_offset_m();
+  reply_.seqno = ++reply_seq_;
+  reply_.tm_ms = egm_time_stamp_ms(now);
+  reply_.pos_mm = Vector3(last_frame_.transpose() * correction * 1e3);
+  const double age_ms = std::clamp(cycle_.output().force_age_s * 1e3, 0.0, 4.0e9);
+  reply_.age_ms = static_cast<std::uint32_t>(age_ms);
+  const std::size_t n = receiver_.codec().encode_path_corr(reply_, tx_.data(), tx_.size());
+  if (n == 0) ++counters_.send_errors;
+  if (n == 0 || !receiver_.reply(tx_.data(), n)) {
+    cycle_.not_sent(compute());
+    return LinkPollResult::kNotAnswered;
+  }
+  cycle_.sent(compute(), receiver_.answer_time_s(clock_.now_s()));
+  // The joints' share of this offset, orientation held (6-axis arms; a fixed-size solve, no
+  // allocation). A singular Jacobian leaves the previous value: the delay measurement only.
+  if (model.dof() == 6) {
+    const Eigen::Matrix<double, 6, 6> j6 = jac_;
+    Eigen::Matrix<double, 6, 1> twist;
+    twist << correction, Vector3::Zero();
+    const Eigen::PartialPivLU<Eigen::Matrix<double, 6, 6>> lu(j6);
+    if (std::abs(lu.determinant()) > 1e-9) {
+      const Eigen::Matrix<double, 6, 1> dq = lu.solve(twist);
+      if (dq.allFinite()) sent_offset_joints_ = dq;
     }
   }
-  r.compute_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_read).count();
-  history_.record(r);
-  return result;
+  return LinkPollResult::kAnswered;
 }
 
 }  // namespace deflex

@@ -3,15 +3,18 @@
 // EgmRobot with an EgmSensorPathCorr carrying the whole current TCP position correction (an absolute
 // offset, never an increment, so nothing accumulates), expressed in the correction frame the RAPID
 // program declared, with its age. The nominal deflex holds is "no offset": what it sends is bounded
-// by the TCP bound. Orientation cannot be corrected in this mode; the link reports the rotation the
-// model predicts so the user sees when it matters.
+// by the TCP bound, and its change from one answer to the next by the TCP rate bound times the
+// period (the link cycle's step limit), so a stale force ramps the offset out over several answers.
+// A new session on the controller (a restart of its sequence, or a message after the restart
+// silence) starts its correction afresh from zero offset, and so does deflex's. Orientation cannot
+// be corrected in this mode; the link reports the rotation the model predicts so the user sees when
+// it matters. The controller's own state ends the session: motors off (a stop), EGM no longer
+// running after it ran (EGMStop: the planned end; an error: a stop).
 #pragma once
 
 #include "deflex/egm/egm_receiver.hpp"
 #include "deflex/link/controller_link.hpp"
-#include "deflex/link/link_history.hpp"
 #include "deflex/online/delay_estimator.hpp"
-#include "deflex/online/online_strategy.hpp"
 
 namespace deflex {
 
@@ -28,6 +31,7 @@ enum class PathCorrFrame {
 struct EgmPathLinkConfig {
   EgmReceiverConfig receiver;
   PathCorrFrame frame = PathCorrFrame::kTool;
+  LinkStopRules stop;
   /// Rotation of the TCP the model predicts above which the status says it is left uncorrected.
   double rotation_warning_rad = 1e-4;
   /// Predictive strategy: latency of the controller's correction channel beyond the servo delay the
@@ -46,39 +50,27 @@ class EgmPathLink final : public ControllerLink {
 
   LinkPollResult poll(double timeout_s) noexcept override;
   [[nodiscard]] const char* name() const override { return "egm-path"; }
-  [[nodiscard]] LinkState state() const override { return state_; }
-  [[nodiscard]] const LinkCounters& counters() const override { return counters_; }
-  [[nodiscard]] const LinkCycleRecord& last_cycle() const override { return last_; }
-  [[nodiscard]] const JointVector& start_distance() const override { return no_distance_; }
-  [[nodiscard]] bool fault_pending() const override { return fault_pending_; }
-  void clear_fault() override { fault_pending_ = false; }
-  void write_history_csv(const std::string& path) const override { history_.write_csv(path); }
-  [[nodiscard]] const LinkHistory* history() const override { return &history_; }
 
   [[nodiscard]] const DelayEstimator& delay() const { return delay_; }
+  [[nodiscard]] const DelayEstimator* delay_estimator() const override { return &delay_; }
+  [[nodiscard]] std::string protocol_summary() const override;
   /// Cycles whose predicted rotation exceeded the warning threshold, and the largest one (rad).
   [[nodiscard]] std::uint64_t rotation_warnings() const { return rotation_warnings_; }
   [[nodiscard]] double max_rotation_rad() const { return max_rotation_rad_; }
   /// The correction period the controller asks at (s, measured; 0 before two messages).
   [[nodiscard]] double period_s() const { return period_s_; }
+  [[nodiscard]] const EgmPathLinkConfig& config() const { return config_; }
 
  private:
   bool correction_frame(const JointVector& q_feedback, Matrix3& base_R_frame) noexcept;
+  bool controller_state(const EgmRobotMessage& m) noexcept;
 
-  OnlineCompensator& comp_;
-  OnlineStrategy& strategy_;
-  const Clock& clock_;
-  ForceSource* force_;
   EgmPathLinkConfig config_;
-  LinkCounters counters_;
   EgmReceiver receiver_;
   DelayEstimator delay_;
-  LinkHistory history_;
-  LinkState state_ = LinkState::kWaiting;
-  bool fault_pending_ = false;
+  bool egm_ran_ = false;
 
-  CycleInput input_;
-  JointVector feedback_, planned_, previous_feedback_, velocity_, target_, no_distance_;
+  JointVector feedback_, planned_, previous_feedback_, velocity_, target_;
   /// The joint motion the last offset sent asks of the controller (the arm's joints move by it,
   /// orientation held): the delay is measured between planned + this and the feedback, which carries
   /// the applied offset.
@@ -90,12 +82,13 @@ class EgmPathLink final : public ControllerLink {
   Vector3 previous_tcp_m_ = Vector3::Zero();
   Vector3 travel_direction_ = Vector3::Zero();
   bool have_direction_ = false;
+  Matrix3 last_frame_ = Matrix3::Identity();  // the correction frame last known (kept when it cannot be formed)
+  bool have_frame_ = false;
   std::uint64_t rotation_warnings_ = 0;
   double max_rotation_rad_ = 0.0;
   EgmPathCorrMessage reply_;
   std::vector<unsigned char> tx_;
   std::uint32_t reply_seq_ = 0;
-  LinkCycleRecord last_;
   Workspace ws_;
   Jacobian jac_;
 };

@@ -117,6 +117,8 @@ EgmReceiver::Result EgmReceiver::drain(double timeout_s, bool& restarted) noexce
       ++counters_.superseded;
     }
     last_accept_s_ = now;
+    receipt_age_s_ = transport_.since_receipt_s();
+    taken_at_s_ = clock_.now_s();
     newest_ = msg_;
     arrival_ = msg_arrival_;
     have = true;

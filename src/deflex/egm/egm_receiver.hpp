@@ -63,6 +63,9 @@ class EgmReceiver {
   [[nodiscard]] const DatagramAddress& controller() const { return gate_.controller(); }
   /// Clock time of the last usable message (s).
   [[nodiscard]] double last_message_s() const { return last_accept_s_; }
+  /// From the newest message's arrival at the host to `now_s` (the link's clock), s; NaN when the
+  /// transport cannot tell.
+  [[nodiscard]] double answer_time_s(double now_s) const noexcept { return receipt_age_s_ + (now_s - taken_at_s_); }
   /// How the newest message arrived (diagnostics; also counted in the counters).
   [[nodiscard]] const LinkArrival& arrival() const { return arrival_; }
 
@@ -79,6 +82,7 @@ class EgmReceiver {
   EgmRobotMessage msg_, newest_;
   ControllerGate gate_;
   double last_accept_s_ = 0.0;
+  double receipt_age_s_ = 0.0, taken_at_s_ = 0.0;  // the taken message's age when it was read, and when
   LinkArrival arrival_, msg_arrival_;
 };
 

@@ -9,7 +9,7 @@
 
 #include <cstdint>
 
-#include "deflex/link/controller_link.hpp"
+#include "deflex/link/link_record.hpp"
 #include "deflex/link/link_timing.hpp"
 #include "deflex/transport/datagram_transport.hpp"
 #include "deflex/transport/sequence_tracker.hpp"

@@ -1,26 +1,28 @@
 // One small interface for every controller link deflex speaks (ABB EGM position guidance and path
-// correction here; KUKA RSI and ROS-Industrial simple message beside them), so that the command
-// line, the case study and a user's own program drive any of them alike, and a further controller is
-// a new file rather than a rewrite. A link owns its protocol and its safety rules; it runs the
-// compensation cycle (online/) on each controller message and never sends anything that is not
-// within its stated bound of a nominal deflex itself holds.
+// correction, KUKA RSI, ROS-Industrial simple message), so that the runtime, the case study and a
+// user's own program drive any of them alike, and a further controller is a new folder rather than a
+// rewrite. A link owns its protocol: it receives and decodes the controller's messages, runs the one
+// link cycle (link_cycle.hpp: strategy, compensation, the bound, the per-cycle step limit, the final
+// guard, the record) and encodes and sends the answer. What every link shares (its state, counters,
+// the stop rules and the stop reason) lives here, once.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 
-#include "deflex/online/online_compensator.hpp"
+#include "deflex/link/link_cycle.hpp"
+#include "deflex/online/delay_estimator.hpp"
+#include "deflex/transport/clock.hpp"
 
 namespace deflex {
-
-class LinkHistory;
 
 enum class LinkState : int {
   kWaiting = 0,   ///< no controller message yet
   kRunning = 1,   ///< answering every controller message
   kFinished = 2,  ///< the program has ended; the last point is held (streaming links)
-  kRefused = 3,   ///< the start was refused (the robot was not at the program's start): never answers
-  kStopped = 4,   ///< a streaming link stopped the controller's motion (fault or stop()): sends nothing more
+  kRefused = 3,   ///< the start was refused (the arm was not where the program is): never answers
+  kStopped = 4,   ///< the link stopped (stop_cause() says why): sends nothing more
 };
 [[nodiscard]] const char* to_string(LinkState s);
 
@@ -30,121 +32,122 @@ enum class LinkPollResult : int {
   kAnswered = 0,     ///< a controller message was handled and answered
   kIdle = 1,         ///< nothing arrived
   kRejected = 2,     ///< datagrams arrived but none was usable (counted)
-  kNotAnswered = -1, ///< a usable message was not answered (invalid cycle, guard): counted
-  kRefused = -2,     ///< the start was refused: see start_distance()
-  kStopped = -3,     ///< the link stopped the controller's motion for a fault: see stop_reason()
+  kNotAnswered = -1, ///< a usable message was not answered (invalid cycle): counted
+  kRefused = -2,     ///< the start was refused: see start_distance() (returned once)
+  kStopped = -3,     ///< the link stopped: see stop_cause(), stop_reason() (returned once)
 };
 
-/// Why a streaming link stopped the controller's motion (LinkState::kStopped).
+/// Why a link stopped (LinkState::kStopped). The runtime maps each to a stop reason and an exit code
+/// (runtime/stop_reason.hpp, docs/online.md "Faults and exit codes").
 enum class LinkStopCause : int {
   kNone = 0,
   kRequested = 1,   ///< the caller's stop() (Ctrl-C, the end of a session)
-  kProtocol = 2,    ///< the controller sent what the protocol does not allow (bad input: malformed, unknown ...)
-  kConnection = 3,  ///< the connection was lost, or the controller went silent
-  kController = 4,  ///< the controller refused points, or reports an emergency stop or an error
-  kSafety = 5,      ///< deflex's own checks: the final bound check, an invalid cycle
+  kEnded = 2,       ///< the controller ended the session as planned (after the program's end, EGM stopped)
+  kProtocol = 3,    ///< the controller sent what the protocol does not allow (bad input: malformed, unknown ...)
+  kSilent = 4,      ///< the controller went silent for longer than the link's stop silence
+  kConnection = 5,  ///< the connection was closed or broke
+  kController = 6,  ///< the controller stopped or faulted: RSI's Timeout, EGM ended early, motors off, e-stop,
+                    ///< an error, refused points
+  kSafety = 7,      ///< deflex's own final guard: a command beyond the bound or the step limit, an invalid cycle
+  kTooSlow = 8,     ///< the controller falls behind the program by more than the link allows
 };
 [[nodiscard]] const char* to_string(LinkStopCause c);
 
-/// What a link counts. Every datagram lands in exactly one of the reasons or is handled.
-struct LinkCounters {
-  std::uint64_t datagrams = 0;  ///< everything received
-  std::uint64_t replies = 0;    ///< answers sent
-  std::uint64_t malformed = 0, truncated = 0, oversized = 0, empty = 0;
-  std::uint64_t missing_header = 0, missing_joints = 0, non_finite = 0;
-  std::uint64_t duplicate = 0, out_of_order = 0;
-  std::uint64_t out_of_limits = 0;   ///< joints beyond the robot's limits (plus 1 deg): never answered
-  std::uint64_t foreign_sender = 0;  ///< from another address than the controller's: never answered
-  std::uint64_t superseded = 0;      ///< valid but a newer one arrived in the same drain: not answered
-  std::uint64_t restarts = 0;        ///< controller restarts recognised
-  std::uint64_t invalid_cycles = 0;  ///< the compensator refused the input: not answered
-  std::uint64_t guard_trips = 0;     ///< the final check found a command beyond the bound: not sent
-  std::uint64_t refused = 0;         ///< messages not answered because the start was refused
-  std::uint64_t send_errors = 0;
-  // Sequencing and diagnostics (docs/online.md, "Link diagnostics").
-  std::uint64_t far_ahead = 0;              ///< a sequence number far ahead of the running one (a stray): never answered
-  std::uint64_t sequence_out_of_range = 0;  ///< wider than its field (EGM seqno > 32 bits, IPOC > 64): never answered
-  std::uint64_t missing_required = 0;       ///< a field the schema requires is missing (EGM proto2): never answered
-  std::uint64_t foreign_document = 0;       ///< well-formed, but not the controller's message (RSI): never answered
-  std::uint64_t missed = 0;                 ///< controller cycles never received (gaps in its sequence)
-  std::uint64_t late = 0;                   ///< messages received more than a period later than the quickest ones
-  std::uint64_t controller_late = 0;        ///< answers the controller itself counted late (RSI <Delay>, its last value)
-  double max_arrival_delay_s = 0.0;         ///< the largest LinkArrival::arrival_delay_s so far
-  double jitter_s = 0.0;                    ///< interarrival jitter now (RFC 3550 estimator)
-  [[nodiscard]] std::uint64_t rejected() const {
-    return malformed + truncated + oversized + empty + missing_header + missing_joints + non_finite + duplicate +
-           out_of_order + out_of_limits + foreign_sender + far_ahead + sequence_out_of_range + missing_required +
-           foreign_document;
-  }
-};
-
-/// How one controller message arrived, judged by the controller's own time stamp (EGM header.tm, RSI
-/// IPOC: whole milliseconds of the controller's clock) against the link's clock at receipt. The two
-/// clocks are not synchronised, so the absolute transit time is unknown; what is measured is how much
-/// later than the quickest recent message this one came.
-struct LinkArrival {
-  double stamp_s = 0.0;            ///< the controller's time stamp, s since the session began (its clock)
-  double arrival_delay_s = 0.0;    ///< (receipt - stamp) less its minimum over the last seconds; >= 0
-  double jitter_s = 0.0;           ///< RFC 3550 interarrival jitter after this message
-  std::uint64_t missed_before = 0; ///< controller cycles missing between the previous message taken and this one
-};
-
-/// One answered (or refused) cycle, SI units (rad, m, N, Nm, s).
-struct LinkCycleRecord {
-  double t_s = 0.0;                ///< the link's clock
-  double program_time_s = 0.0;     ///< streaming links: where in the program the nominal is (its own time axis)
-  std::uint64_t sequence = 0;      ///< the controller's sequence number (EGM seqno, RSI IPOC ...)
-  JointVector q_nominal;           ///< what deflex holds (streaming links); the controller's planned joints otherwise
-  JointVector q_feedback;          ///< where the controller says the arm is
-  JointVector q_command;           ///< what was sent (streaming links: q_nominal - dtheta)
-  JointVector dtheta;              ///< the bounded correction, joint space
-  Vector3 tcp_correction_m = Vector3::Zero();  ///< the TCP offset the correction amounts to (base frame)
-  double rotation_uncorrected_rad = 0.0;       ///< the model's TCP rotation a link could not correct
-  Wrench wrench_base = Wrench::Zero();         ///< wrench the model used
-  Wrench wrench_measured_base = Wrench::Zero();
-  CycleStatus status = CycleStatus::kNoForceYet;
-  bool replied = false;
-  double delay_s = 0.0;     ///< the link's measured delay (command to feedback) at this cycle
-  double compute_s = 0.0;   ///< from the datagram read to the answer sent
-  LinkArrival arrival;      ///< how the message arrived (diagnostics)
+/// Settings every link shares: when a silent controller counts as gone.
+struct LinkStopRules {
+  /// The controller silent (no usable message) this long while the session runs: the link stops
+  /// (kSilent). Shorter silences are ridden through (the program waits, nothing steps).
+  double stop_silence_s = 3.0;
+  /// Streaming links, after the program's end: a silence this long is the session's planned end.
+  double end_silence_s = 2.0;
+  /// Links that correct the controller's own program (egm-path, rsi): a silence longer than
+  /// stop_silence_s after a healthy session is the planned end (the program's RSI_OFF or EGMStop),
+  /// not a fault. Off: such a silence stops the link as kSilent.
+  bool end_on_silence = false;
+  /// Throws InputError naming the setting.
+  void validate() const;
 };
 
 class ControllerLink {
  public:
   virtual ~ControllerLink() = default;
+  ControllerLink(const ControllerLink&) = delete;
+  ControllerLink& operator=(const ControllerLink&) = delete;
 
   /// Waits up to timeout_s for controller messages, drains them, handles the newest usable one and
-  /// answers it. Never allocates, locks or throws.
+  /// answers it; applies the stop rules when nothing comes. Never allocates, locks or throws.
   virtual LinkPollResult poll(double timeout_s) noexcept = 0;
-
   [[nodiscard]] virtual const char* name() const = 0;  ///< "egm-joint", "egm-path", ...
-  [[nodiscard]] virtual LinkState state() const = 0;
-  [[nodiscard]] virtual const LinkCounters& counters() const = 0;
-  [[nodiscard]] virtual const LinkCycleRecord& last_cycle() const = 0;
-  /// When the start was refused: each joint's distance from the program's start (rad).
-  [[nodiscard]] virtual const JointVector& start_distance() const = 0;
-  /// True after a cycle with a force fault or an invalid input, until clear_fault().
-  [[nodiscard]] virtual bool fault_pending() const = 0;
-  virtual void clear_fault() = 0;
-  /// The last cycles, oldest first, as CSV (set-up time I/O: allocates; throws Error).
-  virtual void write_history_csv(const std::string& path) const = 0;
-  /// The ring of the last cycles, so a caller can copy it between polls and write it elsewhere (a
-  /// fault dump on another thread); null when the link keeps none.
-  [[nodiscard]] virtual const LinkHistory* history() const { return nullptr; }
 
-  /// Stops the controller's motion as soon as possible (streaming links over a connection: the
-  /// simple message link sends STOP_TRAJECTORY) and sends nothing more. Links whose controller stops on
-  /// its own when answers stop (EGM) have nothing to do. Never allocates or throws.
-  virtual void stop() noexcept {}
-  /// Why the link stopped (kNone while it has not).
-  [[nodiscard]] virtual LinkStopCause stop_cause() const { return LinkStopCause::kNone; }
-  /// A sentence saying why, naming the frame or field at fault ("" while the link has not stopped).
-  [[nodiscard]] virtual const char* stop_reason() const { return ""; }
+  /// Stops the link: it sends nothing more (streaming links over a connection stop the controller's
+  /// motion first: simple message sends STOP_TRAJECTORY). Links whose controller stops on its own when
+  /// answers stop (EGM, RSI) have nothing else to do. Never allocates or throws.
+  virtual void stop() noexcept { stop_link(LinkStopCause::kRequested, "stop requested"); }
+
+  [[nodiscard]] LinkState state() const { return state_; }
+  [[nodiscard]] const LinkCounters& counters() const { return counters_; }
+  [[nodiscard]] const LinkCycleRecord& last_cycle() const { return cycle_.record(); }
+  [[nodiscard]] const LinkHistory& history() const { return cycle_.history(); }
+  [[nodiscard]] const CycleStats& cycle_stats() const { return cycle_.stats(); }
+  [[nodiscard]] const CommandLimits& limits() const { return cycle_.limits(); }
+  /// When the start was refused: each joint's distance from where the program is (rad); empty otherwise.
+  [[nodiscard]] const JointVector& start_distance() const { return start_distance_; }
+  /// True after a cycle with a force fault, an invalid input or a guard trip, until clear_fault().
+  [[nodiscard]] bool fault_pending() const { return cycle_.fault_pending(); }
+  void clear_fault() { cycle_.clear_fault(); }
+  /// Why the link stopped (kNone while it has not), and a sentence naming the frame or field at fault.
+  [[nodiscard]] LinkStopCause stop_cause() const { return stop_cause_; }
+  [[nodiscard]] const char* stop_reason() const { return stop_reason_.data(); }
+  /// The link's clock when the last usable controller message was taken (s; NaN before the first).
+  [[nodiscard]] double last_message_s() const { return last_message_s_; }
+  /// The link's clock (what poll() measures time by).
+  [[nodiscard]] const Clock& clock() const { return clock_; }
+  [[nodiscard]] const LinkStopRules& stop_rules() const { return rules_; }
+  /// True while a stopped link still owes the controller something (simple message: the
+  /// STOP_TRAJECTORY's bytes, or the controller's reply to it, which must be read before the
+  /// connection closes, or the controller sees a reset). A session polls it a little longer.
+  [[nodiscard]] virtual bool winding_down() const { return false; }
+  /// What the link's protocol adds to a session's summary ("simple message: 812 points sent ..."), or
+  /// "" (outside the cycle: allocates).
+  [[nodiscard]] virtual std::string protocol_summary() const { return {}; }
+  /// The link's measurement of its delay (command to feedback); null for a link that keeps none.
+  [[nodiscard]] virtual const DelayEstimator* delay_estimator() const { return nullptr; }
+  /// The strategy's and the compensator's (read-only).
+  [[nodiscard]] const OnlineCompensator& compensator() const { return cycle_.compensator(); }
 
  protected:
-  ControllerLink() = default;
-  ControllerLink(const ControllerLink&) = default;
-  ControllerLink& operator=(const ControllerLink&) = default;
+  /// Every reference must outlive the link. Throws InputError on bad limits or rules.
+  ControllerLink(OnlineCompensator& compensator, OnlineStrategy& strategy, ForceSource* force, const Clock& clock,
+                 const CommandLimits& limits, const LinkStopRules& rules, std::size_t history_cycles);
+
+  /// Stops the link once (later calls keep the first reason): state kStopped, the cause and a
+  /// printf-style sentence. Never allocates.
+  void stop_link(LinkStopCause cause, const char* format, ...) noexcept __attribute__((format(printf, 3, 4)));
+  /// The start was refused: state kRefused, the distance kept, a fault pending.
+  void refuse_start(const JointVector& distance) noexcept;
+  /// A usable controller message was taken at `now`.
+  void heard(double now) noexcept;
+  /// The stop rules when nothing usable came: a silence longer than the link allows stops it (kSilent,
+  /// or kEnded when the silence is the planned end). True when the link stopped now.
+  bool apply_silence_rules(double now) noexcept;
+  /// The terminal states: kRefused / kStopped returned once, then kIdle.
+  LinkPollResult announce_terminal() noexcept;
+  /// Whether the session so far ended healthy enough for a silence to be its planned end (links that
+  /// correct the controller's program; RSI: its late count below the Timeout).
+  [[nodiscard]] virtual bool silence_is_planned_end() const { return rules_.end_on_silence; }
+
+  LinkCycle cycle_;
+  const Clock& clock_;
+  LinkCounters counters_;
+  LinkState state_ = LinkState::kWaiting;
+  LinkStopRules rules_;
+  JointVector start_distance_;
+
+ private:
+  LinkStopCause stop_cause_ = LinkStopCause::kNone;
+  std::array<char, 320> stop_reason_{};
+  double last_message_s_;
+  bool announced_ = false;
 };
 
 }  // namespace deflex

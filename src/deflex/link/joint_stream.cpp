@@ -11,14 +11,11 @@
 namespace deflex {
 
 void JointStreamConfig::validate() const {
-  if (!std::isfinite(ramp_in_s) || ramp_in_s < 0.0) {
-    throw InputError(fmt::format("stream: ramp-in time must be >= 0 s (got {})", ramp_in_s));
+  if (!std::isfinite(ramp_in_s) || ramp_in_s < 0.0 || ramp_in_s > 600.0) {
+    throw InputError(fmt::format("stream: ramp-in time must be 0..600 s (got {})", ramp_in_s));
   }
-  if (!std::isfinite(start_tolerance_rad) || !(start_tolerance_rad > 0.0)) {
-    throw InputError("stream: the start tolerance must be a positive angle");
-  }
-  if (!std::isfinite(pause_after_s) || !(pause_after_s > 0.0)) {
-    throw InputError(fmt::format("stream: the pause silence must be > 0 s (got {})", pause_after_s));
+  if (!std::isfinite(start_tolerance_rad) || !(start_tolerance_rad > 0.0) || start_tolerance_rad > kPi / 18.0) {
+    throw InputError("stream: the start tolerance must be a positive angle of at most 10 deg");
   }
 }
 
@@ -29,49 +26,52 @@ JointStream::JointStream(std::shared_ptr<const JointTrajectory> trajectory, cons
     throw InputError("stream: no trajectory to stream");
   }
   program_t_s_ = trajectory_->start_time_s();
-  offset_ = distance_ = scratch_ = JointVector::Zero(trajectory_->dof());
+  offset_ = distance_ = scratch_ = scratch_velocity_ = JointVector::Zero(trajectory_->dof());
 }
 
-bool JointStream::begin(double t_s, const JointVector& q_feedback) noexcept {
+bool JointStream::begin(const JointVector& anchor, const JointVector& dtheta) noexcept {
   trajectory_->sample(program_t_s_, scratch_);
-  if (q_feedback.size() != scratch_.size() || !q_feedback.allFinite()) {
+  if (anchor.size() != scratch_.size() || dtheta.size() != scratch_.size() || !anchor.allFinite() ||
+      !dtheta.allFinite()) {
     distance_.setConstant(HUGE_VAL);
     return false;
   }
-  offset_ = q_feedback - scratch_;
-  distance_ = offset_.cwiseAbs();
+  // The command would be program - dtheta; the controller holds the anchor.
+  scratch_velocity_ = anchor - (scratch_ - dtheta);
+  distance_ = scratch_velocity_.cwiseAbs();
   if (distance_.maxCoeff() > config_.start_tolerance_rad) {
     return false;
   }
+  offset_ = scratch_velocity_;
+  blend_t_s_ = 0.0;
+  blend_cycles_ = 0;
   started_ = true;
-  last_t_s_ = t_s;
-  blend_start_s_ = program_t_s_;
   return true;
 }
 
-void JointStream::advance(double t_s, JointVector& q, JointVector& qd) noexcept {
-  if (started_) {
-    const double dt = t_s - last_t_s_;
-    // Only time the controller was talking moves the program (a pause must begin() again first).
-    if (dt > 0.0 && dt <= config_.pause_after_s) {
-      program_t_s_ = std::min(program_t_s_ + dt, trajectory_->end_time_s());
-    }
-    last_t_s_ = std::max(last_t_s_, t_s);
+void JointStream::sample(JointVector& program, JointVector& program_velocity, JointVector& blend,
+                         JointVector& blend_velocity) const noexcept {
+  trajectory_->sample(program_t_s_, program, &program_velocity);
+  if (finished()) program_velocity.setZero();
+  // Smoothstep from 1 to 0 over the ramp: the first command is the anchor, and the blend adds no
+  // velocity step at either end.
+  if (config_.ramp_in_s > 0.0 && blend_t_s_ < config_.ramp_in_s) {
+    const double u = std::clamp(blend_t_s_ / config_.ramp_in_s, 0.0, 1.0);
+    blend = (1.0 - u * u * (3.0 - 2.0 * u)) * offset_;
+    blend_velocity = (-6.0 * u * (1.0 - u) / config_.ramp_in_s) * offset_;
+  } else {
+    blend.setZero();
+    blend_velocity.setZero();
   }
-  trajectory_->sample(program_t_s_, q, &qd);
-  if (finished()) {
-    qd.setZero();
-  }
-  // Smoothstep blend of the start offset from 1 to 0 over the ramp: the first command is where the
-  // arm is, and the blend adds no velocity step at either end.
-  const double tau = program_t_s_ - blend_start_s_;
-  if (config_.ramp_in_s > 0.0 && tau < config_.ramp_in_s) {
-    const double u = std::clamp(tau / config_.ramp_in_s, 0.0, 1.0);
-    const double w = 1.0 - u * u * (3.0 - 2.0 * u);
-    const double dw = -6.0 * u * (1.0 - u) / config_.ramp_in_s;
-    q += w * offset_;
-    if (!finished()) qd += dw * offset_;
-  }
+}
+
+void JointStream::consumed(double period_s) noexcept {
+  if (!started_ || !(period_s > 0.0)) return;
+  if (program_t_s_ < trajectory_->end_time_s()) ++cycles_;
+  ++blend_cycles_;
+  program_t_s_ = std::min(trajectory_->start_time_s() + static_cast<double>(cycles_) * period_s,
+                          trajectory_->end_time_s());
+  blend_t_s_ = static_cast<double>(blend_cycles_) * period_s;
 }
 
 }  // namespace deflex

@@ -1,15 +1,20 @@
 // The nominal a streaming link holds (ABB EGM position guidance, ROS-Industrial simple message): the
-// program deflex streams, on a clock that starts with the controller's first message. The program
-// never comes from the controller's echo: in position guidance the controller reports deflex's own
-// last command as "planned", and a reply built on it would integrate its own correction.
-//   - start: the arm must be within a tolerance of the program's start, or the link refuses;
-//   - ramp-in: the small offset between where the arm is and the program's start is blended out
-//     (smoothstep) over the ramp time, so the first command equals where the arm is;
-//   - pauses: a silence of the controller stops the program clock (the arm held its target); when
-//     messages come again the arm must again be within the tolerance, and the blend starts afresh;
-//   - end: the last point is held.
+// program deflex streams. The program never comes from the controller's echo: in position guidance
+// the controller reports deflex's own last command as "planned", and a reply built on it would
+// integrate its own correction.
+//   - The program's clock is the controller's consumption, not the wall clock: it moves on by one
+//     controller cycle for each answer the controller is given (consumed()). A silence, a stalled PC
+//     or a late answer therefore never makes the program run ahead of what the controller has taken,
+//     and after any of them the next target is one cycle of the program further on.
+//   - A session (the first, and each after a controller restart) starts from what the controller
+//     holds, its anchor (its reference, or where the arm is): the offset between the anchor and the
+//     command deflex would send (the program less the correction) is blended out (smoothstep) over the
+//     ramp time, so the first command equals the anchor and the correction is applied once. The
+//     offset must be within the start tolerance on every joint, or the session is refused.
+//   - The blend has its own clock (it goes on after the program's end); the end's last point is held.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 
 #include "deflex/paths/joint_trajectory.hpp"
@@ -17,9 +22,8 @@
 namespace deflex {
 
 struct JointStreamConfig {
-  double ramp_in_s = 1.0;                        ///< s, blend from the arm's start to the program
-  double start_tolerance_rad = kPi / 180.0;      ///< the arm must be this close to the program (1 deg)
-  double pause_after_s = 0.5;                    ///< a silence this long stops the program clock
+  double ramp_in_s = 1.0;                        ///< s, blend from the anchor to the program
+  double start_tolerance_rad = kPi / 180.0;      ///< the anchor must be this close to the command (1 deg)
   /// Throws InputError on a negative or non-finite value.
   void validate() const;
 };
@@ -29,32 +33,39 @@ class JointStream {
   /// `trajectory` is shared (a long program is not copied). Throws InputError on a bad config.
   JointStream(std::shared_ptr<const JointTrajectory> trajectory, const JointStreamConfig& config);
 
-  /// A session starts (first message, or the first after a pause) with the arm at q_feedback. False
-  /// when any joint is farther than the tolerance from where the program is; distance() tells each
-  /// joint's distance (rad). Never allocates.
-  bool begin(double t_s, const JointVector& q_feedback) noexcept;
-  /// True when the controller was silent for pause_after_s before t_s (a new session must begin).
-  [[nodiscard]] bool paused_at(double t_s) const noexcept { return started_ && t_s - last_t_s_ > config_.pause_after_s; }
-  /// Advances the program clock to t_s and gives the nominal (rad) and its velocity (rad/s).
-  void advance(double t_s, JointVector& q, JointVector& qd) noexcept;
+  /// A session starts with the controller holding `anchor` (rad) while deflex's correction is
+  /// `dtheta` (rad): the blend starts at anchor - (program - dtheta). False when any joint of it is
+  /// beyond the tolerance (distance() tells each joint's, rad); the stream is then unchanged. Never
+  /// allocates.
+  bool begin(const JointVector& anchor, const JointVector& dtheta) noexcept;
+  /// The program at the stream's time and its velocity (rad, rad/s), the blend now and its velocity.
+  void sample(JointVector& program, JointVector& program_velocity, JointVector& blend,
+              JointVector& blend_velocity) const noexcept;
+  /// One controller cycle consumed (an answer went out): the program and the blend move on by period_s.
+  void consumed(double period_s) noexcept;
 
   [[nodiscard]] bool started() const { return started_; }
   [[nodiscard]] bool finished() const { return program_t_s_ >= trajectory_->end_time_s(); }
+  /// True while a blend is still being taken out.
+  [[nodiscard]] bool blending() const { return blend_t_s_ < config_.ramp_in_s && offset_.cwiseAbs().maxCoeff() > 0.0; }
   /// Time along the program (its own time axis).
   [[nodiscard]] double program_time_s() const { return program_t_s_; }
   [[nodiscard]] const JointVector& distance() const { return distance_; }
   [[nodiscard]] const JointTrajectory& trajectory() const { return *trajectory_; }
+  [[nodiscard]] const JointStreamConfig& config() const { return config_; }
 
  private:
   std::shared_ptr<const JointTrajectory> trajectory_;
   JointStreamConfig config_;
   bool started_ = false;
-  double last_t_s_ = 0.0;
   double program_t_s_ = 0.0;
-  double blend_start_s_ = 0.0;  // program time the current blend began
-  JointVector offset_;          // arm minus program at the session's start
+  double blend_t_s_ = 0.0;  // time since the current blend began (cycles consumed)
+  // Cycles consumed, counted: the times are start + n x period, so thousands of cycles add no
+  // rounding (a sum of 0.1 s steps would miss the program's end by an ulp).
+  std::uint64_t cycles_ = 0, blend_cycles_ = 0;
+  JointVector offset_;      // the blend's offset at its start
   JointVector distance_;
-  JointVector scratch_;
+  mutable JointVector scratch_, scratch_velocity_;
 };
 
 }  // namespace deflex

@@ -1,12 +1,12 @@
 // The last cycles of a controller link in a preallocated ring (libfranka keeps its last cycles the
-// same way), written out as CSV for a post-mortem after a fault. Recording never allocates.
+// same way), for a post-mortem after a fault (the runtime writes them out, runtime/cycle_log.hpp).
+// Recording never allocates.
 #pragma once
 
 #include <cstddef>
-#include <string>
 #include <vector>
 
-#include "deflex/link/controller_link.hpp"
+#include "deflex/link/link_record.hpp"
 
 namespace deflex {
 
@@ -17,13 +17,16 @@ class LinkHistory {
 
   void record(const LinkCycleRecord& r) noexcept;
   [[nodiscard]] std::size_t size() const { return count_; }
+  [[nodiscard]] std::size_t capacity() const { return ring_.size(); }
+  /// The k-th record kept, oldest first (k < size()).
+  [[nodiscard]] const LinkCycleRecord& at(std::size_t k) const {
+    return ring_[(head_ + ring_.size() - count_ + k) % ring_.size()];
+  }
+  /// Forgets every record (the ring keeps its storage).
+  void clear() noexcept { head_ = count_ = 0; }
   /// A record with every joint vector sized for the robot (a link's starting value).
   [[nodiscard]] const LinkCycleRecord& blank() const { return blank_; }
-  /// Oldest first: t_s, sequence, status, replied, then q_nominal, q_feedback, q_command, dtheta in
-  /// degrees, the TCP correction in mm, the wrenches in N and Nm, the delay and compute time in ms,
-  /// then how the message arrived (arrival delay and jitter in ms, cycles missed before it).
-  /// Throws Error naming the path when it cannot be written.
-  void write_csv(const std::string& path) const;
+  [[nodiscard]] int joints() const { return joints_; }
 
  private:
   std::vector<LinkCycleRecord> ring_;

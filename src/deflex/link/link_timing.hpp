@@ -12,7 +12,7 @@
 #include <array>
 #include <cstdint>
 
-#include "deflex/link/controller_link.hpp"
+#include "deflex/link/link_record.hpp"
 
 namespace deflex {
 

@@ -20,6 +20,7 @@ void OnlineConfig::validate() const {
   positive(max_joint_correction_rad, "max_joint_correction_rad");
   positive(max_tcp_correction_m, "max_tcp_correction_m");
   positive(max_correction_rate_rad_s, "max_correction_rate_rad_s");
+  positive(max_tcp_rate_m_s, "max_tcp_rate_m_s");
   positive(watchdog_s, "watchdog_s");
   if (!std::isfinite(fault_hold_s) || fault_hold_s < 0.0) {
     throw InputError("online configuration: fault_hold_s must be finite and >= 0");
@@ -140,11 +141,12 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
     out.dtheta = JointVector::Zero(n);
     return out;
   }
-  // Time since the last cycle; a first cycle counts as one period and a long gap (pause, debugger)
-  // as at most ten, so the rate bound never lets a large step through after a pause.
+  // Time since the last cycle, at most one period: the rate bound holds per cycle, so after a gap
+  // (a silence, a stalled PC, a late cycle) the correction moves by no more than one cycle's worth:
+  // the controller takes one command a cycle, whatever the time between them.
   double dt = config_.period_s;
   if (have_cycle_) {
-    dt = std::min(in.t_s - last_cycle_t_s_, 10.0 * config_.period_s);
+    dt = std::min(in.t_s - last_cycle_t_s_, config_.period_s);
   }
   last_cycle_t_s_ = in.t_s;
   have_cycle_ = true;
@@ -222,25 +224,31 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
     }
   }
   out.wrench_base = out.status == CycleStatus::kOk && used.allFinite() ? used : wrench_base_;
+  if (out.status != CycleStatus::kOk) {
+    point_jacobian(ws_, ws_.base_T_tcp.translation(), jac_);  // FK is at q_feedback here
+  }
+  // jac_ is now the TCP Jacobian at the configuration FK holds.
 
-  // Rate bound; also the ramp to zero when the target dropped to zero. The change is scaled as a
-  // whole, not clamped joint by joint: the new correction then lies on the segment from the old one
-  // to the target, and as both meet the size bounds (a box and a TCP ball, convex sets) so does
-  // every cycle of the ramp. Clamping each joint bent the path and could pass the TCP bound.
-  const double max_step = config_.max_correction_rate_rad_s * dt;
+  // Rate bounds, joint and TCP; also the ramp to zero when the target dropped to zero. The change is
+  // scaled as a whole, not clamped joint by joint: the new correction then lies on the segment from
+  // the old one to the target, and as both meet the size bounds (a box and a TCP ball, convex sets)
+  // so does every cycle of the ramp. Clamping each joint bent the path and could pass the TCP bound.
   const JointVector change = target - correction_;
+  double scale = 1.0;
   const double largest = change.cwiseAbs().maxCoeff();
-  if (largest > max_step) {
-    correction_ += (max_step / largest) * change;
+  const double max_step = config_.max_correction_rate_rad_s * dt;
+  if (largest > max_step) scale = max_step / largest;
+  const double tcp_change = (jac_.topRows<3>() * change).norm();
+  const double max_tcp_step = config_.max_tcp_rate_m_s * dt;
+  if (tcp_change * scale > max_tcp_step) scale = max_tcp_step / tcp_change;
+  if (scale < 1.0) {
+    correction_ += scale * change;
     out.rate_limited = true;
   } else {
     correction_ += change;
   }
   out.dtheta = correction_;
   out.q_command = in.q_planned - correction_;
-  if (out.status != CycleStatus::kOk) {
-    point_jacobian(ws_, ws_.base_T_tcp.translation(), jac_);  // FK is at q_feedback here
-  }
   out.tcp_deflection_base_m = jac_.topRows<3>() * correction_;
   out.tcp_correction_m = out.tcp_deflection_base_m.norm();
   return out;

@@ -27,6 +27,9 @@ struct OnlineConfig {
   double max_joint_correction_rad = 0.01;     ///< per joint |dtheta_i| bound
   double max_tcp_correction_m = 0.005;        ///< bound on |J_p dtheta| (TCP translation)
   double max_correction_rate_rad_s = 0.05;    ///< per joint |d(dtheta_i)/dt| bound, also the ramp to zero
+  /// Bound on the rate of the correction's TCP translation |J_p d(dtheta)/dt| (m/s): the ramp of a
+  /// correction that is a TCP offset (EGM path correction), and at the TCP for every link.
+  double max_tcp_rate_m_s = 0.005;
   double watchdog_s = 0.05;                   ///< no valid force sample for this long: ramp to zero
   double fault_hold_s = 0.5;                  ///< after a fault sample, hold the correction target at zero
   JacobianAt jacobian_at = JacobianAt::kPlanned;
@@ -69,7 +72,7 @@ struct CycleOutput {
   Wrench wrench_measured_base = Wrench::Zero();  ///< conditioned measurement, before offset and lead
   CycleStatus status = CycleStatus::kNoForceYet;
   bool size_limited = false;            ///< the joint or TCP bound cut the correction
-  bool rate_limited = false;            ///< the rate bound cut the change of correction
+  bool rate_limited = false;            ///< a rate bound (joint or TCP) cut the change of correction
   double tcp_correction_m = 0.0;        ///< |J_p dtheta|, m
   Vector3 tcp_deflection_base_m = Vector3::Zero();  ///< J_p dtheta (base frame, m): the TCP offset the correction cancels
   double force_age_s = 0.0;             ///< time since the last valid force sample

@@ -32,6 +32,10 @@ void RsiLinkConfig::validate() const {
   if (!std::isfinite(initial_delay_s) || initial_delay_s < 0.0) {
     throw InputError("RSI link: the initial delay must be >= 0 s");
   }
+  if (controller_timeout < 1 || controller_timeout > 1000000) {
+    throw InputError("RSI link: the controller's Timeout must be 1..1000000 late answers");
+  }
+  stop.validate();
 }
 
 namespace {
@@ -55,19 +59,23 @@ const RsiLinkConfig& validated(const RsiLinkConfig& c) {
 }
 }  // namespace
 
+namespace {
+CommandLimits offset_limits(const OnlineCompensator& c) {
+  CommandLimits l = command_limits(CommandForm::kJointOffset, c.config(), c.model().dof());
+  l.rounding = WireRounding::kDecimalsDeg;  // the <AK> values: degrees with 6 decimals (rsi_xml.cpp)
+  l.decimals = 6;
+  return l;
+}
+}  // namespace
+
 RsiLink::RsiLink(OnlineCompensator& compensator, OnlineStrategy& strategy, DatagramTransport& transport,
                  const Clock& clock, ForceSource* force, const RsiLinkConfig& config)
-    : comp_(compensator),
-      strategy_(strategy),
+    : ControllerLink(compensator, strategy, force, clock, offset_limits(compensator), validated(config).stop,
+                     config.history_cycles),
       transport_(transport),
-      clock_(clock),
-      force_(force),
-      config_(validated(config)),
+      config_(config),
       delay_(config.initial_delay_s),
-      history_(config.history_cycles, compensator.model().dof()),
-      gate_(rsi_gate(config, compensator.config().period_s)),
-      ws_(compensator.model()),
-      jac_(6, compensator.model().dof()) {
+      gate_(rsi_gate(config, compensator.config().period_s)) {
   const RobotModel& model = compensator.model();
   const int n = model.dof();
   // The tolerance allows for the controller's own rounding beyond its software limits.
@@ -76,11 +84,30 @@ RsiLink::RsiLink(OnlineCompensator& compensator, OnlineStrategy& strategy, Datag
   rx_.assign(config_.max_document_bytes + 1, 0);  // one byte more: an oversized datagram shows as such
   tx_.assign(kRsiMaxEncodedBytes, 0);
   for (RsiRobotMessage* m : {&msg_, &newest_}) m->actual_deg = m->setpoint_deg = JointVector::Zero(n);
-  for (JointVector* q : {&input_.q_planned, &input_.q_feedback, &feedback_, &planned_, &previous_feedback_, &velocity_,
-                         &target_, &command_, &no_distance_, &reply_.correction_deg}) {
+  for (JointVector* q : {&feedback_, &planned_, &previous_feedback_, &velocity_, &target_, &reply_.correction_deg}) {
     *q = JointVector::Zero(n);
   }
-  last_ = history_.blank();
+}
+
+bool RsiLink::silence_is_planned_end() const {
+  return rules_.end_on_silence &&
+         counters_.controller_late + 1 < static_cast<std::uint64_t>(config_.controller_timeout);
+}
+
+bool RsiLink::timeout_reached(double now) noexcept {
+  if (state_ != LinkState::kRunning || !std::isfinite(last_message_s())) return false;
+  // The controller reported a late count one short of its Timeout, and the next cycle's document did
+  // not come: its count reached the Timeout and RSI stopped. (Silence alone cannot tell RSI stopped on
+  // its Timeout from RSI_OFF or a network outage: the stop silence rules decide those.)
+  const double period = cycle_.compensator().config().period_s;
+  if (now - last_message_s() < 2.0 * period) return false;
+  if (counters_.controller_late + 1 < static_cast<std::uint64_t>(config_.controller_timeout)) return false;
+  stop_link(LinkStopCause::kController,
+            "RSI stopped: the controller's late count reached its Timeout of %d (its last <Delay> was %llu, and no "
+            "document came for %.0f ms)",
+            config_.controller_timeout, static_cast<unsigned long long>(counters_.controller_late),
+            (now - last_message_s()) * 1e3);
+  return true;
 }
 
 bool RsiLink::plausible(const RsiRobotMessage& m) const noexcept {
@@ -98,7 +125,7 @@ bool RsiLink::plausible(const RsiRobotMessage& m) const noexcept {
 RsiLink::Drain RsiLink::drain(double timeout_s, bool& restarted) noexcept {
   restarted = false;
   if (!transport_.wait_readable(timeout_s)) return Drain::kNothing;
-  const int axes = comp_.model().dof();
+  const int axes = cycle_.compensator().model().dof();
   const double now = clock_.now_s();
   bool have = false;
   // Drain: only the newest usable document is answered (an older one's answer would be late anyway).
@@ -133,30 +160,46 @@ RsiLink::Drain RsiLink::drain(double timeout_s, bool& restarted) noexcept {
     if (have) ++counters_.superseded;
     std::swap(newest_, msg_);
     arrival_ = msg_arrival_;
+    receipt_age_s_ = transport_.since_receipt_s();
+    taken_at_s_ = clock_.now_s();
     have = true;
   }
   return have ? Drain::kMessage : Drain::kNoneUsable;
 }
 
+std::string RsiLink::protocol_summary() const {
+  return fmt::format("rsi: the controller counted {} answers late (its <Delay>; RSI stops at its Timeout of {})",
+                     counters_.controller_late, config_.controller_timeout);
+}
+
 LinkPollResult RsiLink::poll(double timeout_s) noexcept {
+  if (state_ == LinkState::kStopped) {
+    bool ignored = false;
+    (void)drain(0.0, ignored);
+    return announce_terminal();
+  }
   bool restarted = false;
   const Drain got = drain(timeout_s, restarted);
-  if (got == Drain::kNothing) return LinkPollResult::kIdle;
-  if (got == Drain::kNoneUsable) return LinkPollResult::kRejected;
-  const auto t_read = std::chrono::steady_clock::now();
   const double now = clock_.now_s();
+  if (got != Drain::kMessage) {
+    if (timeout_reached(now) || apply_silence_rules(now)) return announce_terminal();
+    return got == Drain::kNothing ? LinkPollResult::kIdle : LinkPollResult::kRejected;
+  }
+  const auto t_read = std::chrono::steady_clock::now();
   const RsiRobotMessage& m = newest_;
   for (int i = 0; i < feedback_.size(); ++i) {
     feedback_[i] = deg_to_rad(m.actual_deg[i]);
     planned_[i] = m.has_setpoint ? deg_to_rad(m.setpoint_deg[i]) : feedback_[i];
   }
-  state_ = LinkState::kRunning;
+  heard(now);
   if (m.has_delay) counters_.controller_late = m.delay;
-  if (restarted) {
+  const bool session_start = restarted || state_ == LinkState::kWaiting;
+  if (session_start) {
     // A new RSI session: the controller's AXISCORR starts again from zero offset, so must deflex's
     // correction (it then ramps at the rate bound), or the first answer would step the arm.
-    if (answered_once_) comp_.reset();
+    cycle_.restart_from_zero();
     have_previous_ = false;
+    state_ = LinkState::kRunning;
   }
 
   // The axes' velocity and the controller's period from the actual axes and the link's clock.
@@ -179,63 +222,40 @@ LinkPollResult RsiLink::poll(double timeout_s) noexcept {
   // the predictive strategy evaluates it where the program will be by then.
   const double lead = delay_.delay_s() + config_.correction_latency_s;
   target_ = planned_;
-  if (strategy_.kind() == StrategyKind::kPredictive) target_ += lead * velocity_;
-  input_.t_s = now;
-  input_.q_planned = target_;
-  input_.q_feedback = feedback_;
-  const StrategyStatus ss = strategy_.prepare(input_, feedback_, target_, lead, comp_.filter_delay_s());
-  input_.hold_to_zero = input_.hold_to_zero || ss != StrategyStatus::kOk;
-  const CycleOutput out = force_ != nullptr ? comp_.step(input_, *force_) : comp_.step(input_);
-
-  LinkCycleRecord& r = last_;
-  r.t_s = now;
-  r.program_time_s = 0.0;
-  r.sequence = m.ipoc;
-  r.q_nominal = planned_;
-  r.q_feedback = feedback_;
-  r.dtheta = out.dtheta;
-  r.wrench_base = out.wrench_base;
-  r.wrench_measured_base = out.wrench_measured_base;
-  r.status = out.status;
-  r.replied = false;
-  r.delay_s = delay_.delay_s();
-  r.arrival = arrival_;
-  r.rotation_uncorrected_rad = 0.0;
-  if (out.status == CycleStatus::kForceFault || out.status == CycleStatus::kInvalidInput) fault_pending_ = true;
-  LinkPollResult result = LinkPollResult::kNotAnswered;
-  if (static_cast<int>(out.status) < 0) {
-    ++counters_.invalid_cycles;
-  } else {
-    command_ = planned_ - out.dtheta;
-    r.q_command = command_;
-    jacobian(comp_.model(), ws_, target_, EndPoint::kTcp, jac_);
-    const Vector3 tcp = -(jac_.topRows<3>() * out.dtheta);
-    r.tcp_correction_m = tcp;
-    // The last check before anything leaves deflex: every axis and the TCP within the bounds of
-    // "no correction".
-    const double joint_bound = comp_.config().max_joint_correction_rad * (1.0 + 1e-9) + 1e-12;
-    const double tcp_bound = comp_.config().max_tcp_correction_m * (1.0 + 1e-9) + 1e-12;
-    if (!out.dtheta.allFinite() || !tcp.allFinite() || out.dtheta.cwiseAbs().maxCoeff() > joint_bound ||
-        tcp.norm() > tcp_bound) {
-      ++counters_.guard_trips;
-      fault_pending_ = true;
-    } else {
-      reply_.ipoc = m.ipoc;
-      for (int i = 0; i < out.dtheta.size(); ++i) reply_.correction_deg[i] = rad_to_deg(-out.dtheta[i]);
-      const std::size_t n = encode_rsi_sensor(config_.sentype, reply_, tx_.data(), tx_.size());
-      if (n > 0 && transport_.send_to(tx_.data(), n, gate_.controller())) {
-        ++counters_.replies;
-        answered_once_ = true;
-        r.replied = true;
-        result = LinkPollResult::kAnswered;
-      } else {
-        ++counters_.send_errors;
-      }
-    }
+  if (cycle_.strategy().kind() == StrategyKind::kPredictive) target_ += lead * velocity_;
+  CycleRequest rq;
+  rq.t_s = now;
+  rq.sequence = m.ipoc;
+  rq.nominal = &planned_;
+  rq.feedback = &feedback_;
+  rq.target = &target_;
+  rq.delay_s = delay_.delay_s();
+  rq.lead_s = lead;
+  rq.session_start = session_start;
+  rq.arrival = arrival_;
+  const LinkCycle::Verdict verdict = cycle_.run(rq);
+  const auto compute = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_read).count(); };
+  if (verdict == LinkCycle::Verdict::kInvalid) {
+    cycle_.not_sent(compute());
+    return LinkPollResult::kNotAnswered;
   }
-  r.compute_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_read).count();
-  history_.record(r);
-  return result;
+  if (verdict == LinkCycle::Verdict::kGuard) {
+    cycle_.not_sent(compute());
+    stop_link(LinkStopCause::kSafety, "%s", cycle_.guard_message());
+    return announce_terminal();
+  }
+  reply_.ipoc = m.ipoc;
+  const JointVector& ak = cycle_.joint_command();  // the whole offset, rounded as the answer carries it
+  for (int i = 0; i < ak.size(); ++i) reply_.correction_deg[i] = rad_to_deg(ak[i]);
+  const std::size_t n = encode_rsi_sensor(config_.sentype, reply_, tx_.data(), tx_.size());
+  if (n == 0 || !transport_.send_to(tx_.data(), n, gate_.controller())) {
+    ++counters_.send_errors;
+    cycle_.not_sent(compute());
+    return LinkPollResult::kNotAnswered;
+  }
+  ++counters_.replies;
+  cycle_.sent(compute(), receipt_age_s_ + (clock_.now_s() - taken_at_s_));
+  return LinkPollResult::kAnswered;
 }
 
 }  // namespace deflex

@@ -4,13 +4,17 @@
 // fast as it can, with a <Sen> carrying the echoed IPOC and <AK>, the whole joint correction
 //     AK = -dtheta (degrees),   |AK_i| <= max_joint_correction,   |J_p dtheta| <= max_tcp_correction,
 // an absolute offset from where RSI started (never an increment, so nothing accumulates), computed by
-// the same compensator and strategy as the EGM links at the setpoint (ASPos) with the sensor turned
-// as the actual axes say. The nominal deflex holds is "no correction": zero force gives AK = 0.
-// Malformed, truncated, oversized and foreign documents, non-finite values, axes beyond the robot's
-// limits, duplicate, stale or stray IPOCs and other senders are counted and never answered; an
-// unanswered cycle is one the controller counts late (it stops RSI at its Timeout), which is the safe
-// side. A new RSI session (after a silence, or an IPOC jump the next documents confirm) starts from
-// zero correction, as the controller's AXISCORR does.
+// the one link cycle at the setpoint (ASPos) with the sensor turned as the actual axes say, its change
+// from one answer to the next within the rate bound times the cycle, rounded to the 6 decimals the
+// answer carries before the final guard checks it. The nominal deflex holds is "no correction": zero
+// force gives AK = 0. Malformed, truncated, oversized and foreign documents, non-finite values, axes
+// beyond the robot's limits, duplicate, stale or stray IPOCs and other senders are counted and never
+// answered; an unanswered cycle is one the controller counts late (it stops RSI at its Timeout),
+// which is the safe side. A new RSI session (after a silence, or an IPOC jump the next documents
+// confirm) starts from zero correction, as the controller's AXISCORR does. RSI stopped by its Timeout
+// is recognised from the late count the controller reports (<Delay>, one short of the Timeout) and the
+// missing document after it, within two cycles; any other silence longer than the stop silence stops
+// the link too (or ends the session as planned, with end_on_silence, when the count was below it).
 #pragma once
 
 #include <cstdint>
@@ -19,9 +23,7 @@
 
 #include "deflex/link/controller_gate.hpp"
 #include "deflex/link/controller_link.hpp"
-#include "deflex/link/link_history.hpp"
 #include "deflex/online/delay_estimator.hpp"
-#include "deflex/online/online_strategy.hpp"
 #include "deflex/transport/clock.hpp"
 #include "deflex/transport/datagram_transport.hpp"
 #include "deflex/wire/rsi_xml.hpp"
@@ -38,6 +40,11 @@ struct RsiLinkConfig {
   /// in a row continue it (a new RSI session that came without a silence).
   std::uint64_t ipoc_max_ahead_ms = 1000;
   int confirm_jump = 3;
+  /// The ETHERNET object's Timeout on the controller (deflex controller-setup writes the same): late
+  /// answers that stop RSI. With the <Delay> the controller reports, it tells an RSI stopped by its
+  /// Timeout from a network outage.
+  int controller_timeout = 100;
+  LinkStopRules stop{1.0, 2.0, false};
   std::size_t history_cycles = 1000;  ///< ring of the last cycles (4 s at 4 ms)
   double initial_delay_s = 0.012;     ///< the delay assumed until it is measured
   /// Predictive strategy: latency of AXISCORR beyond the delay the link measures (ASPos to AIPos), s.
@@ -54,55 +61,42 @@ class RsiLink final : public ControllerLink {
 
   LinkPollResult poll(double timeout_s) noexcept override;
   [[nodiscard]] const char* name() const override { return "rsi"; }
-  [[nodiscard]] LinkState state() const override { return state_; }
-  [[nodiscard]] const LinkCounters& counters() const override { return counters_; }
-  [[nodiscard]] const LinkCycleRecord& last_cycle() const override { return last_; }
-  [[nodiscard]] const JointVector& start_distance() const override { return no_distance_; }
-  [[nodiscard]] bool fault_pending() const override { return fault_pending_; }
-  void clear_fault() override { fault_pending_ = false; }
-  void write_history_csv(const std::string& path) const override { history_.write_csv(path); }
-  [[nodiscard]] const LinkHistory* history() const override { return &history_; }
 
   [[nodiscard]] const DelayEstimator& delay() const { return delay_; }
+  [[nodiscard]] const DelayEstimator* delay_estimator() const override { return &delay_; }
+  [[nodiscard]] std::string protocol_summary() const override;
   [[nodiscard]] const DatagramAddress& controller() const { return gate_.controller(); }
   /// The controller's cycle as its IPOCs show it (s; 0 before two documents).
   [[nodiscard]] double period_s() const { return period_s_; }
   [[nodiscard]] const RsiLinkConfig& config() const { return config_; }
 
+ protected:
+  /// A silence is the planned end (--end-on-silence) only when RSI was not stopped by its Timeout.
+  [[nodiscard]] bool silence_is_planned_end() const override;
+
  private:
   enum class Drain { kNothing, kNoneUsable, kMessage };
   Drain drain(double timeout_s, bool& restarted) noexcept;
   [[nodiscard]] bool plausible(const RsiRobotMessage& m) const noexcept;
+  bool timeout_reached(double now) noexcept;
 
-  OnlineCompensator& comp_;
-  OnlineStrategy& strategy_;
   DatagramTransport& transport_;
-  const Clock& clock_;
-  ForceSource* force_;
   RsiLinkConfig config_;
-  LinkCounters counters_;
   DelayEstimator delay_;
-  LinkHistory history_;
   ControllerGate gate_;
-  LinkState state_ = LinkState::kWaiting;
-  bool fault_pending_ = false;
 
   // Receiving (preallocated).
   std::vector<unsigned char> rx_, tx_;
   RsiRobotMessage msg_, newest_;
   LinkArrival msg_arrival_, arrival_;
-  bool answered_once_ = false;
+  double receipt_age_s_ = 0.0, taken_at_s_ = 0.0;  // the taken document's age when it was read, and when
   JointVector lower_, upper_;
 
   // The cycle (preallocated).
-  CycleInput input_;
-  JointVector feedback_, planned_, previous_feedback_, velocity_, target_, command_, no_distance_;
+  JointVector feedback_, planned_, previous_feedback_, velocity_, target_;
   double previous_t_s_ = 0.0, period_s_ = 0.0;
   bool have_previous_ = false;
   RsiSensorMessage reply_;
-  LinkCycleRecord last_;
-  Workspace ws_;
-  Jacobian jac_;
 };
 
 }  // namespace deflex

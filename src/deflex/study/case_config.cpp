@@ -338,7 +338,8 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
 
   const auto on = root.at("online");
   on.only_keys({"lowpass_Hz", "dead_band_N", "fault_threshold_N", "max_joint_correction_mrad", "max_tcp_correction_mm",
-                "max_rate_mrad_s", "watchdog_ms", "ramp_in_s", "stream_period_ms", "stream_buffer_depth"});
+                "max_rate_mrad_s", "max_tcp_rate_mm_s", "watchdog_ms", "ramp_in_s", "stream_period_ms",
+                "stream_buffer_depth"});
   c.online.stream_period_s = on.get("stream_period_ms", 100.0) * 1e-3;
   if (!(c.online.stream_period_s >= 0.02 && c.online.stream_period_s <= 1.0))
     on.at("stream_period_ms").fail("must be 20..1000 ms");
@@ -351,6 +352,7 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   c.online.max_joint_correction_rad = positive(on.at("max_joint_correction_mrad")) * kMm;
   c.online.max_tcp_correction_m = positive(on.at("max_tcp_correction_mm")) * kMm;
   c.online.max_rate_rad_s = positive(on.at("max_rate_mrad_s")) * kMm;
+  c.online.max_tcp_rate_m_s = on.has("max_tcp_rate_mm_s") ? positive(on.at("max_tcp_rate_mm_s")) * kMm : 0.005;
   c.online.watchdog_s = positive(on.at("watchdog_ms")) * kMm;
   c.online.ramp_in_s = non_negative(on.at("ramp_in_s"));
 

@@ -54,6 +54,7 @@ struct OnlineSettings {
   double max_joint_correction_rad = 0.01;
   double max_tcp_correction_m = 0.005;
   double max_rate_rad_s = 0.05;
+  double max_tcp_rate_m_s = 0.005;  ///< the correction's TCP rate bound (deflex online --max-tcp-rate-mm-s)
   double watchdog_s = 0.05;
   double ramp_in_s = 1.0;
   double stream_period_s = 0.1;  ///< simple message: a point every this long (the paper's ~100 ms)

@@ -15,16 +15,14 @@
 #include "deflex/cell/path_drift.hpp"
 #include "deflex/cell/robot_controller.hpp"
 #include "deflex/cell/simple_message_server.hpp"
-#include "deflex/egm/egm_joint_link.hpp"
-#include "deflex/egm/egm_path_link.hpp"
-#include "deflex/link/simple_message_link.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/model/compliance.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/offline/compensate_path.hpp"
-#include "deflex/online/datagram_force_source.hpp"
+#include "deflex/sensors/datagram_force_source.hpp"
 #include "deflex/online/online_strategy.hpp"
 #include "deflex/paths/circle_path.hpp"
+#include "deflex/runtime/session.hpp"
 #include "deflex/transport/memory_network.hpp"
 #include "deflex/transport/memory_stream.hpp"
 
@@ -225,55 +223,50 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
                               splitmix(config.seed ^ 0x5e5503ULL));
   cell::DaqStream daq(daq_port, kDeflexForce);
 
-  // deflex's side, built as `deflex online` builds it: the sensor's calibration sheet and identified
-  // payload, the identified robot model, the user's settings, the strategy, the link.
-  std::unique_ptr<OnlineCompensator> compensator;
+  // deflex's side, run as `deflex online` runs it: a session of the runtime on the cell's network, from
+  // the sensor's calibration sheet and identified payload, the identified robot model, the user's
+  // settings, the strategy and the link.
   std::unique_ptr<LdbbForceModel> force_model;
-  std::unique_ptr<OnlineStrategy> strategy;
   std::unique_ptr<DatagramForceSource> force_source;
-  std::unique_ptr<ControllerLink> link;
+  std::unique_ptr<runtime::Session> session;
   if (linked) {
-    const deflex::SensorConfig sc = sensor_config_from_sheet(config, sensor.calibration());
-    deflex::OnlineConfig oc;
+    runtime::SessionConfig sc;
+    sc.link = spec.link == LinkKind::kEgmPath         ? runtime::LinkKind::kEgmPath
+              : spec.link == LinkKind::kSimpleMessage ? runtime::LinkKind::kSimpleMessage
+                                                      : runtime::LinkKind::kEgmJoint;
+    deflex::OnlineConfig& oc = sc.online;
     oc.period_s = spec.link == LinkKind::kEgmPath         ? c.controller.path_corr_period_s
                   : spec.link == LinkKind::kSimpleMessage ? config.online.stream_period_s
                                                           : c.controller.egm_period_s;
     oc.max_joint_correction_rad = config.online.max_joint_correction_rad;
     oc.max_tcp_correction_m = config.online.max_tcp_correction_m;
     oc.max_correction_rate_rad_s = config.online.max_rate_rad_s;
+    oc.max_tcp_rate_m_s = config.online.max_tcp_rate_m_s;
     oc.watchdog_s = std::max(config.online.watchdog_s, 2.0 * oc.period_s);
-    compensator = std::make_unique<OnlineCompensator>(identified, sc, oc);
     StrategyKind kind = StrategyKind::kNone;  // the reference runs stream the program uncorrected
     if (compensated) {
       kind = spec.strategy == Strategy::kHybrid       ? StrategyKind::kHybrid
              : spec.strategy == Strategy::kPredictive ? StrategyKind::kPredictive
                                                       : StrategyKind::kOnline;
     }
+    sc.strategy = kind;
     if (kind == StrategyKind::kHybrid || kind == StrategyKind::kPredictive) {
       // The user's force model: the LDBB with its nominal pivot and set-point force.
       force_model = std::make_unique<LdbbForceModel>(config.pivot_m(), std::max(spec.load_n, 1.0), c.ldbb.push);
     }
-    strategy = std::make_unique<OnlineStrategy>(identified, kind, force_model.get());
+    sc.egm_joint.stream.ramp_in_s = config.online.ramp_in_s;
+    sc.simple_message.buffer_depth = config.online.stream_buffer_depth;
+    sc.simple_message.stream.ramp_in_s = config.online.ramp_in_s;
+    sc.egm_path.frame = parse_path_corr_frame(c.controller.path_corr_frame);
+    sc.history_cycles = 16;
     force_source = std::make_unique<DatagramForceSource>(deflex_force_port);
-    if (spec.link == LinkKind::kEgmJoint) {
-      EgmJointLinkConfig lc;
-      lc.stream.ramp_in_s = config.online.ramp_in_s;
-      lc.history_cycles = 16;
-      link = std::make_unique<EgmJointLink>(*compensator, *strategy, program, deflex_egm_port, clock,
-                                            force_source.get(), lc);
-    } else if (spec.link == LinkKind::kSimpleMessage) {
-      SimpleMessageLinkConfig lc;
-      lc.buffer_depth = config.online.stream_buffer_depth;
-      lc.stream.ramp_in_s = config.online.ramp_in_s;
-      lc.history_cycles = 16;
-      link = std::make_unique<SimpleMessageLink>(*compensator, *strategy, program, motion_stream.client(),
-                                                 state_stream.client(), clock, force_source.get(), lc);
-    } else {
-      EgmPathLinkConfig lc;
-      lc.frame = parse_path_corr_frame(c.controller.path_corr_frame);
-      lc.history_cycles = 16;
-      link = std::make_unique<EgmPathLink>(*compensator, *strategy, deflex_egm_port, clock, force_source.get(), lc);
-    }
+    runtime::SessionEndpoints endpoints;
+    endpoints.datagram = &deflex_egm_port;
+    endpoints.motion = &motion_stream.client();
+    endpoints.state = &state_stream.client();
+    session = std::make_unique<runtime::Session>(
+        sc, identified, sensor_config_from_sheet(config, sensor.calibration()),
+        spec.link == LinkKind::kEgmPath ? nullptr : program, force_model.get(), force_source.get(), clock, endpoints);
   }
 
   const double settle_s = c.ldbb.settle_s;
@@ -324,24 +317,15 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
         daq.send(next_daq, sensor.sample(w.head<3>(), base_R_flange, next_daq));
       }
       clock.set(t + c.controller.network_latency_s);
-      for (;;) {
-        const LinkPollResult r = link->poll(0.0);
+      while (!session->ended()) {
+        const LinkPollResult r = session->poll(0.0);
+        if (session->ended() && runtime::exit_code(session->stop_reason()) != 0) {
+          const runtime::SessionSummary& end = session->finish();
+          throw Error(fmt::format("run: deflex's {} session ended: {} ({})", end.link, runtime::to_string(end.reason),
+                                  end.reason_text));
+        }
         if (r == LinkPollResult::kIdle) break;
-        if (r == LinkPollResult::kStopped) {
-          throw Error(fmt::format("run: deflex's {} link stopped the motion: {}", link->name(), link->stop_reason()));
-        }
-        if (r == LinkPollResult::kRefused) {
-          throw Error(fmt::format("run: deflex's {} link refused the start (the arm was not at the program's start)",
-                                  link->name()));
-        }
-        if (r != LinkPollResult::kAnswered) continue;
-        ++out.link_cycles;
-        const LinkCycleRecord& rec = link->last_cycle();
-        if (spec.link == LinkKind::kEgmJoint || spec.link == LinkKind::kSimpleMessage) {
-          out.max_command_deviation_rad =
-              std::max(out.max_command_deviation_rad, (rec.q_command - rec.q_nominal).cwiseAbs().maxCoeff());
-        }
-        out.max_tcp_correction_m = std::max(out.max_tcp_correction_m, rec.tcp_correction_m.norm());
+        if (r == LinkPollResult::kAnswered) ++out.link_cycles;
       }
     }
     tracker.observe(t - dt, p_prev, t, p, out.trace);
@@ -349,14 +333,11 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
     p_prev = p;
   }
   if (linked) {
-    out.link_counters = link->counters();
-    if (const auto* joint = dynamic_cast<const EgmJointLink*>(link.get())) {
-      out.measured_delay_s = joint->delay().mean_s();
-    } else if (const auto* path = dynamic_cast<const EgmPathLink*>(link.get())) {
-      out.measured_delay_s = path->delay().mean_s();
-    } else if (const auto* stream = dynamic_cast<const SimpleMessageLink*>(link.get())) {
-      out.measured_delay_s = stream->delay().mean_s();
-    }
+    const runtime::SessionSummary& summary = session->finish();
+    out.link_counters = summary.counters;
+    out.measured_delay_s = summary.measured_delay_s;
+    out.max_command_deviation_rad = spec.link == LinkKind::kEgmPath ? 0.0 : summary.stats.max_deviation_rad;
+    out.max_tcp_correction_m = summary.stats.max_deviation_m;
     const auto* egm = dynamic_cast<const cell::EgmPositionGuidanceController*>(controller.get());
     if (egm != nullptr && egm->counters().timed_out) {
       throw Error("run: the simulated controller stopped EGM for lack of answers (a broken setup, not a result)");

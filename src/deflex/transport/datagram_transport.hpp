@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 
 namespace deflex {
@@ -36,6 +37,11 @@ class DatagramTransport {
   virtual bool send_to(const unsigned char* data, std::size_t size, const DatagramAddress& to) noexcept = 0;
   /// The address datagrams to this transport are sent to.
   [[nodiscard]] virtual DatagramAddress local_address() const noexcept = 0;
+  /// How long ago (s) the datagram last returned by receive() reached this host: for UDP the
+  /// kernel's receive time stamp (SO_TIMESTAMPNS), so it includes every scheduling delay before the
+  /// program read it; NaN when the transport cannot tell. The answer time of a link is this, taken
+  /// when its answer is sent.
+  [[nodiscard]] virtual double since_receipt_s() const noexcept { return std::numeric_limits<double>::quiet_NaN(); }
 
  protected:
   DatagramTransport() = default;

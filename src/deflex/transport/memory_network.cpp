@@ -30,12 +30,15 @@ long MemoryTransport::receive(unsigned char* buffer, std::size_t capacity, Datag
   const Slot& s = slots_[head_];
   std::memcpy(buffer, s.bytes.data(), std::min(capacity, s.size));
   from = s.from;
+  receipt_s_ = s.deliver_at_s;
   const auto size = static_cast<long>(s.size);
   head_ = (head_ + 1) % slots_.size();
   --count_;
   ++network_.counters_.delivered;
   return size;
 }
+
+double MemoryTransport::since_receipt_s() const noexcept { return network_.clock().now_s() - receipt_s_; }
 
 bool MemoryTransport::send_to(const unsigned char* data, std::size_t size, const DatagramAddress& to) noexcept {
   return network_.route(data, size, address_, to, latency_s_);
@@ -75,11 +78,25 @@ MemoryTransport& MemoryNetwork::add_endpoint(const DatagramAddress& address, dou
   return *endpoints_.back();
 }
 
+void MemoryNetwork::add_outage(double from_s, double to_s, const DatagramAddress& address) {
+  if (!std::isfinite(from_s) || !std::isfinite(to_s) || !(to_s > from_s)) {
+    throw InputError("memory network: an outage needs a finite start before its end");
+  }
+  outages_.push_back(Outage{from_s, to_s, address});
+}
+
 bool MemoryNetwork::route(const unsigned char* data, std::size_t size, const DatagramAddress& from,
                           const DatagramAddress& to, double latency_s) noexcept {
   if (size > max_bytes_) {
     ++counters_.dropped_oversized;
     return false;
+  }
+  const double now = clock_.now_s();
+  for (const Outage& o : outages_) {
+    if (now >= o.from_s && now < o.to_s && (o.address == DatagramAddress{} || o.address == from || o.address == to)) {
+      ++counters_.dropped_outage;  // the cable is out: sent, and lost
+      return true;
+    }
   }
   for (const auto& e : endpoints_) {
     if (e->local_address() == to) {

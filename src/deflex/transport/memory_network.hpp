@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -24,6 +25,7 @@ struct MemoryNetworkCounters {
   std::uint64_t dropped_full = 0;    ///< the destination's queue was full (a lost datagram)
   std::uint64_t dropped_no_route = 0;  ///< no endpoint has the destination address
   std::uint64_t dropped_oversized = 0;  ///< larger than the network's datagram size (send_to fails)
+  std::uint64_t dropped_outage = 0;     ///< sent during an outage (add_outage): lost
 };
 
 /// One endpoint of a MemoryNetwork. Datagrams come out in the order they were sent to it, each once
@@ -35,6 +37,8 @@ class MemoryTransport final : public DatagramTransport {
   long receive(unsigned char* buffer, std::size_t capacity, DatagramAddress& from) noexcept override;
   bool send_to(const unsigned char* data, std::size_t size, const DatagramAddress& to) noexcept override;
   [[nodiscard]] DatagramAddress local_address() const noexcept override { return address_; }
+  /// The simulated clock since the last datagram received was delivered.
+  [[nodiscard]] double since_receipt_s() const noexcept override;
   /// Datagrams queued here, arrived or not.
   [[nodiscard]] std::size_t queued() const { return count_; }
 
@@ -55,6 +59,7 @@ class MemoryTransport final : public DatagramTransport {
   double latency_s_;
   std::vector<Slot> slots_;
   std::size_t head_ = 0, count_ = 0;
+  double receipt_s_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 class MemoryNetwork {
@@ -66,6 +71,11 @@ class MemoryNetwork {
   /// A new endpoint at `address`; what it sends arrives `latency_s` (>= 0) later. The endpoint lives
   /// as long as the network. Throws InputError when the address is taken or the latency is bad.
   MemoryTransport& add_endpoint(const DatagramAddress& address, double latency_s = 0.0);
+
+  /// Faults for tests: every datagram sent in [from_s, to_s) from or to `address` (any address when
+  /// it is the default, 0.0.0.0:0) is lost, as with a pulled cable or a switch that reboots.
+  /// Throws InputError on an empty or non-finite window.
+  void add_outage(double from_s, double to_s, const DatagramAddress& address = {});
 
   [[nodiscard]] const Clock& clock() const { return clock_; }
   [[nodiscard]] const MemoryNetworkCounters& counters() const { return counters_; }
@@ -79,6 +89,11 @@ class MemoryNetwork {
   std::size_t max_bytes_;
   std::size_t depth_;
   std::deque<std::unique_ptr<MemoryTransport>> endpoints_;
+  struct Outage {
+    double from_s, to_s;
+    DatagramAddress address;
+  };
+  std::vector<Outage> outages_;
   MemoryNetworkCounters counters_;
 };
 

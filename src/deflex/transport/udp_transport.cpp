@@ -5,6 +5,8 @@
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
+#include <sys/uio.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -53,6 +55,10 @@ UdpTransport::UdpTransport(const std::string& address, std::uint16_t port) {
     ::close(fd_);
     throw Error(fmt::format("cannot bind UDP {}:{}: {}", address, port, std::strerror(err)));
   }
+  // The kernel's receive time stamp of every datagram (CLOCK_REALTIME): a link's answer time then
+  // includes the time the datagram waited for the program to be scheduled.
+  const int on = 1;
+  stamped_ = ::setsockopt(fd_, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof(on)) == 0;
   sockaddr_in bound{};
   socklen_t len = sizeof(bound);
   ::getsockname(fd_, reinterpret_cast<sockaddr*>(&bound), &len);
@@ -79,13 +85,37 @@ bool UdpTransport::wait_readable(double timeout_s) noexcept {
 
 long UdpTransport::receive(unsigned char* buffer, std::size_t capacity, DatagramAddress& from) noexcept {
   sockaddr_in s{};
-  socklen_t len = sizeof(s);
-  const ssize_t n = ::recvfrom(fd_, buffer, capacity, MSG_DONTWAIT | MSG_TRUNC, reinterpret_cast<sockaddr*>(&s), &len);
+  iovec iov{buffer, capacity};
+  alignas(cmsghdr) unsigned char control[CMSG_SPACE(sizeof(timespec))];
+  msghdr m{};
+  m.msg_name = &s;
+  m.msg_namelen = sizeof(s);
+  m.msg_iov = &iov;
+  m.msg_iovlen = 1;
+  m.msg_control = control;
+  m.msg_controllen = sizeof(control);
+  const ssize_t n = ::recvmsg(fd_, &m, MSG_DONTWAIT | MSG_TRUNC);
   if (n < 0) {
     return -1;
   }
+  receipt_ns_ = -1;
+  for (cmsghdr* c = CMSG_FIRSTHDR(&m); c != nullptr; c = CMSG_NXTHDR(&m, c)) {
+    if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
+      timespec ts{};
+      std::memcpy(&ts, CMSG_DATA(c), sizeof(ts));
+      receipt_ns_ = static_cast<long long>(ts.tv_sec) * 1000000000LL + ts.tv_nsec;
+    }
+  }
   from = DatagramAddress{ntohl(s.sin_addr.s_addr), ntohs(s.sin_port)};
   return static_cast<long>(n);
+}
+
+double UdpTransport::since_receipt_s() const noexcept {
+  if (receipt_ns_ < 0) return std::numeric_limits<double>::quiet_NaN();
+  timespec now{};
+  ::clock_gettime(CLOCK_REALTIME, &now);
+  const long long now_ns = static_cast<long long>(now.tv_sec) * 1000000000LL + now.tv_nsec;
+  return static_cast<double>(now_ns - receipt_ns_) * 1e-9;
 }
 
 bool UdpTransport::send_to(const unsigned char* data, std::size_t size, const DatagramAddress& to) noexcept {

@@ -1,10 +1,11 @@
 // ROS-Industrial simple message streaming link (see simple_message_link.hpp).
-#include "deflex/link/simple_message_link.hpp"
+#include "deflex/simple_message/simple_message_link.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdarg>
+#include <array>
 #include <cstdio>
 
 #include <fmt/format.h>
@@ -18,12 +19,6 @@ namespace sm = simple_message;
 namespace {
 
 constexpr std::size_t kPointFrameBytes = sm::kLengthBytes + sm::kHeaderBytes + sm::kJointTrajPtBytes;  // 68
-
-// The float32 the wire carries is the command rounded to 24 bits: the final check allows that rounding
-// (half an ulp of the value, below 1e-7 rad for any joint angle) and nothing else.
-double float_rounding(double value) {
-  return std::max(std::abs(value), 1.0) * static_cast<double>(std::numeric_limits<float>::epsilon());
-}
 
 }  // namespace
 
@@ -48,57 +43,58 @@ void SimpleMessageLinkConfig::validate() const {
   if (!std::isnan(initial_delay_s) && !(std::isfinite(initial_delay_s) && initial_delay_s >= 0.0)) {
     throw InputError(fmt::format("simple message link: the initial delay must be >= 0 s (got {})", initial_delay_s));
   }
+  if (!std::isfinite(max_behind_s) || !(max_behind_s > 0.0)) {
+    throw InputError(fmt::format("simple message link: the largest delay behind the program must be > 0 s (got {})",
+                                 max_behind_s));
+  }
   stream.validate();
+  stop.validate();
 }
+
+namespace {
+CommandLimits point_limits(const OnlineCompensator& c, const JointTrajectory* program,
+                           const SimpleMessageLinkConfig& config) {
+  config.validate();
+  if (program == nullptr) throw InputError("simple message link: no program to stream");
+  if (program->dof() != c.model().dof()) {
+    throw InputError(
+        fmt::format("simple message link: the program has {} joints, the robot {}", program->dof(), c.model().dof()));
+  }
+  CommandLimits l = command_limits(CommandForm::kJointTarget, c.config(), c.model().dof(), program, &config.stream);
+  l.rounding = WireRounding::kFloat32;  // JOINT_TRAJ_PT carries float32 radians
+  return l;
+}
+}  // namespace
 
 SimpleMessageLink::SimpleMessageLink(OnlineCompensator& compensator, OnlineStrategy& strategy,
                                      std::shared_ptr<const JointTrajectory> nominal, StreamTransport& motion,
                                      StreamTransport& state, const Clock& clock, ForceSource* force,
                                      const SimpleMessageLinkConfig& config)
-    : comp_(compensator),
-      strategy_(strategy),
+    : ControllerLink(compensator, strategy, force, clock, point_limits(compensator, nominal.get(), config), config.stop,
+                     config.history_cycles),
       motion_(motion),
       state_port_(state),
-      clock_(clock),
-      force_(force),
-      config_([&] {
-        config.validate();
-        return config;
-      }()),
+      config_(config),
       period_s_(compensator.config().period_s),
-      stream_(nominal, [&] {
-        // The program clock here is the points' own (one cycle a point), so no step of it is a silence.
-        JointStreamConfig c = config.stream;
-        c.pause_after_s = std::max(c.pause_after_s, 2.0 * compensator.config().period_s);
-        return c;
-      }()),
+      stream_(nominal, config.stream),
       delay_(std::isnan(config.initial_delay_s) ? config.buffer_depth * compensator.config().period_s
                                                 : config.initial_delay_s,
              (config.buffer_depth + 4) * compensator.config().period_s + 0.5),
-      history_(config.history_cycles, compensator.model().dof()),
       motion_reader_(config.byte_order, config.max_frame_bytes),
       state_reader_(config.byte_order, config.max_frame_bytes),
-      outbox_(64 * kPointFrameBytes),
-      ws_(compensator.model()),
-      jac_(6, compensator.model().dof()) {
+      outbox_(64 * kPointFrameBytes) {
   const RobotModel& model = compensator.model();
   const int n = model.dof();
-  if (nominal->dof() != n) {
-    throw InputError(
-        fmt::format("simple message link: the program has {} joints, the robot {}", nominal->dof(), n));
-  }
   if (n > static_cast<int>(sm::kWireJoints)) {
     throw InputError(fmt::format("simple message link: the robot has {} joints, the protocol carries {}", n,
                                  sm::kWireJoints));
   }
-  for (JointVector* q : {&input_.q_planned, &input_.q_feedback, &nominal_, &nominal_velocity_, &command_, &last_sent_,
-                         &feedback_}) {
+  for (JointVector* q : {&program_, &program_velocity_, &blend_, &blend_velocity_, &nominal_, &last_sent_, &feedback_}) {
     *q = JointVector::Zero(n);
   }
   // A controller that reports joints beyond its own limits (plus 1 deg) is sending garbage.
   lower_ = model.lower_limits().array() - deg_to_rad(1.0);
   upper_ = model.upper_limits().array() + deg_to_rad(1.0);
-  last_ = history_.blank();
 }
 
 double SimpleMessageLink::next_due_s() const noexcept {
@@ -108,23 +104,19 @@ double SimpleMessageLink::next_due_s() const noexcept {
 
 void SimpleMessageLink::fault(LinkStopCause cause, const char* format, ...) noexcept {
   if (state_ == LinkState::kStopped) return;
+  std::array<char, 256> text{};
   va_list args;
   va_start(args, format);
-  std::vsnprintf(stop_reason_.data(), stop_reason_.size(), format, args);
+  std::vsnprintf(text.data(), text.size(), format, args);
   va_end(args);
-  stop_cause_ = cause;
-  fault_pending_ = true;
-  state_ = LinkState::kStopped;
-  announced_ = false;
+  stop_link(cause, "%s", text.data());
   if (sent_any_) send_stop();
 }
 
 void SimpleMessageLink::stop() noexcept {
   if (state_ == LinkState::kStopped || state_ == LinkState::kRefused) return;
-  std::snprintf(stop_reason_.data(), stop_reason_.size(), "stopped on request");
-  stop_cause_ = LinkStopCause::kRequested;
-  state_ = LinkState::kStopped;
-  announced_ = true;
+  stop_link(LinkStopCause::kRequested, "stopped on request");
+  (void)announce_terminal();  // the caller asked: nothing to announce
   if (sent_any_) send_stop();
 }
 
@@ -143,7 +135,29 @@ void SimpleMessageLink::send_stop() noexcept {
                                    stop, at, kPointFrameBytes);
   outbox_.commit(n);
   ++sm_.stops_sent;
+  stop_reply_due_ = true;
   flush();
+}
+
+bool SimpleMessageLink::winding_down() const {
+  return !motion_closed_ && (outbox_.pending_bytes() > 0 || stop_reply_due_);
+}
+
+void SimpleMessageLink::discard_input() noexcept {
+  // After a stop nothing the controller sends matters, but it must be read: a connection closed with
+  // unread bytes is reset, and the controller's program would see an error instead of a close.
+  unsigned char sink[256];
+  for (StreamTransport* s : {&motion_, &state_port_}) {
+    bool& closed = s == &motion_ ? motion_closed_ : state_closed_;
+    if (closed) continue;
+    for (long n = s->read(sink, sizeof(sink)); n != 0; n = s->read(sink, sizeof(sink))) {
+      if (n == StreamTransport::kClosed) {
+        closed = true;
+        break;
+      }
+      if (s == &motion_) stop_reply_due_ = false;  // the reply to STOP_TRAJECTORY (or whatever came): read
+    }
+  }
 }
 
 bool SimpleMessageLink::flush() noexcept {
@@ -173,7 +187,10 @@ bool SimpleMessageLink::read_port(Port port, double now) noexcept {
     const long n = s.read(reader.space(), reader.space_bytes());
     if (n == StreamTransport::kClosed) {
       closed = true;
-      if (state_ == LinkState::kFinished) return true;  // the program is over: a server may hang up
+      if (state_ == LinkState::kFinished) {  // the program is over: a server may hang up
+        stop_link(LinkStopCause::kEnded, "the controller closed the %s connection after the program's end", which);
+        return false;
+      }
       fault(LinkStopCause::kConnection, "the controller closed the %s connection (or it broke)", which);
       return false;
     }
@@ -241,6 +258,7 @@ bool SimpleMessageLink::handle_state_frame(const sm::FrameView& f, double now) n
     }
     have_feedback_ = true;
     last_state_s_ = now;
+    heard(now);
     ++sm_.joint_positions;
     delay_.observe_feedback(now, feedback_);
     return true;
@@ -328,7 +346,11 @@ bool SimpleMessageLink::handle_motion_frame(const sm::FrameView& f, double now) 
     ++counters_.replies;
     failures_in_row_ = 0;
     ++next_sequence_;
-    if (waiting_is_last_) state_ = LinkState::kFinished;
+    stream_.consumed(period_s_);  // the program moves on by the point the controller took
+    if (waiting_is_last_ && state_ == LinkState::kRunning) {
+      state_ = LinkState::kFinished;
+      finished_at_s_ = now;
+    }
     return true;
   }
   if (f.header.reply_code == sm::kReplyFailure) {
@@ -354,37 +376,48 @@ bool SimpleMessageLink::handle_motion_frame(const sm::FrameView& f, double now) 
   return false;
 }
 
+std::string SimpleMessageLink::protocol_summary() const {
+  return fmt::format(
+      "simple message: {} points sent, {} taken, {} FAILURE replies; buffer {} points = {:.0f} ms of lag, measured "
+      "command-to-feedback delay {:.0f} ms ({} measurements); the program ran at most {:.2f} s behind its schedule "
+      "(limit {:g} s); JOINT_POSITION {}, ROBOT_STATUS {}; unknown types {}, unexpected {}, wrong sequence {}; "
+      "STOP_TRAJECTORY sent {}",
+      sm_.points_sent, sm_.points_accepted, sm_.failures, config_.buffer_depth, buffer_lag_s() * 1e3,
+      delay_.delay_s() * 1e3, delay_.measurements(), sm_.max_behind_s, config_.max_behind_s, sm_.joint_positions,
+      sm_.robot_statuses, sm_.unknown_type, sm_.unexpected, sm_.wrong_sequence, sm_.stops_sent);
+}
+
 LinkPollResult SimpleMessageLink::poll(double timeout_s) noexcept {
   if (state_ == LinkState::kRefused || state_ == LinkState::kStopped) {
     if (!motion_closed_) flush();  // the STOP_TRAJECTORY, if the window held it back
-    if (!announced_) {
-      announced_ = true;
-      return state_ == LinkState::kRefused ? LinkPollResult::kRefused : LinkPollResult::kStopped;
-    }
-    return LinkPollResult::kIdle;
+    if (winding_down()) wait_readable_any(motion_, state_port_, std::isfinite(timeout_s) ? std::max(timeout_s, 0.0) : 0.0);
+    discard_input();
+    return announce_terminal();
   }
   double now = clock_.now_s();
   double wait = std::isfinite(timeout_s) ? std::max(timeout_s, 0.0) : 0.0;
   if (state_ == LinkState::kRunning && !waiting_reply_) wait = std::min(wait, std::max(0.0, next_due_s() - now));
   wait_readable_any(motion_, state_port_, wait);
   now = clock_.now_s();
-  const auto stopped = [this] {
-    announced_ = true;
-    return LinkPollResult::kStopped;
-  };
-  if (!read_port(Port::kState, now) || !read_port(Port::kMotion, now)) return stopped();
+  if (!read_port(Port::kState, now) || !read_port(Port::kMotion, now)) return announce_terminal();
 
   if (state_ == LinkState::kRunning) {
     if (now - last_state_s_ > config_.state_timeout_s) {
-      fault(LinkStopCause::kConnection, "no JOINT_POSITION on the state connection for %.2f s (timeout %.2f s)",
+      fault(LinkStopCause::kSilent, "no JOINT_POSITION on the state connection for %.2f s (timeout %.2f s)",
             now - last_state_s_, config_.state_timeout_s);
-      return stopped();
+      return announce_terminal();
     }
     if (waiting_reply_ && now - waiting_since_s_ > config_.reply_timeout_s) {
-      fault(LinkStopCause::kConnection, "no reply to point %d for %.2f s (timeout %.2f s)", waiting_sequence_,
+      fault(LinkStopCause::kSilent, "no reply to point %d for %.2f s (timeout %.2f s)", waiting_sequence_,
             now - waiting_since_s_, config_.reply_timeout_s);
-      return stopped();
+      return announce_terminal();
     }
+  }
+  if (state_ == LinkState::kFinished && now - finished_at_s_ > rules_.end_silence_s) {
+    // The program's last point was taken: the session is over (the controller runs out its queue).
+    stop_link(LinkStopCause::kEnded, "the program's last point was taken %.2f s ago: the session is over",
+              now - finished_at_s_);
+    return announce_terminal();
   }
   if (state_ == LinkState::kWaiting) {
     if (!have_feedback_) {
@@ -393,100 +426,76 @@ LinkPollResult SimpleMessageLink::poll(double timeout_s) noexcept {
     }
     // The session starts with the arm where the controller says it is: it must be at the program's
     // start, or nothing is ever sent.
-    if (!stream_.begin(0.0, feedback_)) {
-      state_ = LinkState::kRefused;
-      ++counters_.refused;
-      fault_pending_ = true;
-      announced_ = true;
-      return LinkPollResult::kRefused;
+    if (!stream_.begin(feedback_, cycle_.correction())) {
+      refuse_start(stream_.distance());
+      return announce_terminal();
     }
+    cycle_.anchor_joints(feedback_);
     state_ = LinkState::kRunning;
-    schedule_origin_s_ = now;
+    schedule_origin_s_ = first_origin_s_ = now;
   }
   if (state_ == LinkState::kRunning && !waiting_reply_ && now + 1e-9 >= next_due_s()) return send_point(now);
   if (!flush() && state_ == LinkState::kRunning) {
     fault(LinkStopCause::kConnection, "the motion connection is closed (a write failed)");
-    return stopped();
+    return announce_terminal();
   }
   return LinkPollResult::kIdle;
 }
 
 LinkPollResult SimpleMessageLink::send_point(double now) noexcept {
   const auto t_start = std::chrono::steady_clock::now();
-  // The program clock of the points: one cycle a point, however late the controller takes them.
-  stream_.advance(static_cast<double>(next_sequence_) * period_s_, nominal_, nominal_velocity_);
+  const auto compute = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count(); };
+  // How far behind its schedule the program runs: a controller that takes a point less often than once
+  // a cycle (FAILURE replies, slow replies) makes it late; past the limit the motion stops.
+  const double due = first_origin_s_ + (static_cast<double>(accepted_) + 1.0 - config_.buffer_depth) * period_s_;
+  sm_.behind_s = std::max(0.0, now - due);
+  sm_.max_behind_s = std::max(sm_.max_behind_s, sm_.behind_s);
+  if (sm_.behind_s > config_.max_behind_s) {
+    fault(LinkStopCause::kTooSlow,
+          "the controller has taken %llu points in %.2f s, %.2f s behind the program's %.0f ms a point (limit %.2f s): "
+          "it runs the program slower than planned",
+          static_cast<unsigned long long>(accepted_), now - first_origin_s_, sm_.behind_s, period_s_ * 1e3,
+          config_.max_behind_s);
+    return announce_terminal();
+  }
+  const double due_at_send = next_due_s();
+  stream_.sample(program_, program_velocity_, blend_, blend_velocity_);
+  nominal_ = program_ + blend_;
   const bool last = stream_.finished();
-
-  input_.t_s = now;
-  input_.q_planned = nominal_;
-  input_.q_feedback = feedback_;
   // The point is executed buffer_depth cycles from now: the strategy is told the measured delay and
   // the configuration the point is for.
-  const StrategyStatus ss = strategy_.prepare(input_, feedback_, nominal_, delay_.delay_s(), comp_.filter_delay_s());
-  input_.hold_to_zero = input_.hold_to_zero || ss != StrategyStatus::kOk;
-  const CycleOutput out = force_ != nullptr ? comp_.step(input_, *force_) : comp_.step(input_);
-
-  LinkCycleRecord& r = last_;
-  r.t_s = now;
-  r.program_time_s = stream_.program_time_s();
-  r.sequence = static_cast<std::uint32_t>(next_sequence_);
-  r.q_nominal = nominal_;
-  r.q_feedback = feedback_;
-  r.dtheta = out.dtheta;
-  r.wrench_base = out.wrench_base;
-  r.wrench_measured_base = out.wrench_measured_base;
-  r.status = out.status;
-  r.replied = false;
-  r.delay_s = delay_.delay_s();
-  r.rotation_uncorrected_rad = 0.0;
-  if (out.status == CycleStatus::kForceFault || out.status == CycleStatus::kInvalidInput) fault_pending_ = true;
-  const auto finish = [&](LinkPollResult result) {
-    r.compute_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-    history_.record(r);
-    return result;
-  };
-  if (static_cast<int>(out.status) < 0) {
-    ++counters_.invalid_cycles;
-    r.q_command = nominal_;
+  CycleRequest rq;
+  rq.t_s = now;
+  rq.sequence = static_cast<std::uint32_t>(next_sequence_);
+  rq.program_time_s = stream_.program_time_s();
+  rq.nominal = &program_;
+  rq.blend = &blend_;
+  rq.feedback = &feedback_;
+  rq.target = &nominal_;
+  rq.delay_s = rq.lead_s = delay_.delay_s();
+  rq.session_start = !sent_any_;
+  const LinkCycle::Verdict verdict = cycle_.run(rq);
+  if (verdict == LinkCycle::Verdict::kInvalid) {
+    cycle_.not_sent(compute());
     fault(LinkStopCause::kSafety, "the compensator refused point %d (%s): nothing sent", next_sequence_,
-          to_string(out.status));
-    announced_ = true;
-    return finish(LinkPollResult::kStopped);
+          to_string(cycle_.output().status));
+    return announce_terminal();
   }
-  command_ = nominal_ - out.dtheta;
-
-  // The last check before anything leaves deflex, on the float32 values the wire carries: every joint
-  // within the bound of the nominal.
-  const double bound = comp_.config().max_joint_correction_rad * (1.0 + 1e-9) + 1e-12;
-  int bad_joint = -1;
+  if (verdict == LinkCycle::Verdict::kGuard) {
+    cycle_.not_sent(compute());
+    fault(LinkStopCause::kSafety, "point %d: %s", next_sequence_, cycle_.guard_message());
+    return announce_terminal();
+  }
+  const JointVector& command = cycle_.joint_command();  // float32-rounded: what the wire carries
   point_ = sm::JointTrajPt{};
-  for (int j = 0; j < command_.size(); ++j) {
-    const auto f = static_cast<float>(command_[j]);
-    point_.joints_rad[static_cast<std::size_t>(j)] = f;
-    const double sent = static_cast<double>(f);
-    if (!std::isfinite(sent) || std::abs(sent - nominal_[j]) > bound + float_rounding(nominal_[j])) {
-      bad_joint = j;
-      break;
-    }
-    command_[j] = sent;
-  }
-  r.q_command = command_;
-  if (bad_joint >= 0) {
-    ++counters_.guard_trips;
-    fault(LinkStopCause::kSafety,
-          "the final check found joint %d of point %d %.6f deg from the nominal (bound %.6f deg): nothing sent",
-          bad_joint + 1, next_sequence_, rad_to_deg(std::abs(command_[bad_joint] - nominal_[bad_joint])),
-          rad_to_deg(comp_.config().max_joint_correction_rad));
-    announced_ = true;
-    return finish(LinkPollResult::kStopped);
-  }
+  for (int j = 0; j < command.size(); ++j) point_.joints_rad[static_cast<std::size_t>(j)] = static_cast<float>(command[j]);
   // The velocity field: the fastest joint's share of its top speed (ABB's and Fanuc's servers ignore it).
   double velocity = 0.0;
-  const RobotModel& model = comp_.model();
+  const RobotModel& model = cycle_.compensator().model();
   if (model.has_max_speed()) {
     const JointVector& from = sent_any_ ? last_sent_ : feedback_;
-    for (int j = 0; j < command_.size(); ++j) {
-      velocity = std::max(velocity, std::abs(command_[j] - from[j]) / period_s_ / model.max_speed()[j]);
+    for (int j = 0; j < command.size(); ++j) {
+      velocity = std::max(velocity, std::abs(command[j] - from[j]) / period_s_ / model.max_speed()[j]);
     }
   }
   point_.sequence = next_sequence_;
@@ -496,31 +505,31 @@ LinkPollResult SimpleMessageLink::send_point(double now) noexcept {
   unsigned char* at = outbox_.reserve(2 * kPointFrameBytes);
   if (at == nullptr) {
     ++counters_.send_errors;
-    fault(LinkStopCause::kConnection, "the controller has not read %zu bytes of earlier points: it stopped reading",
+    cycle_.not_sent(compute());
+    fault(LinkStopCause::kTooSlow, "the controller has not read %zu bytes of earlier points: it stopped reading",
           outbox_.pending_bytes());
-    announced_ = true;
-    return finish(LinkPollResult::kStopped);
+    return announce_terminal();
   }
   const std::size_t n = sm::encode(config_.byte_order, {sm::kJointTrajPt, sm::kServiceRequest, sm::kReplyInvalid},
                                    point_, at, kPointFrameBytes);
   outbox_.commit(n);
   if (!flush()) {
+    cycle_.not_sent(compute());
     fault(LinkStopCause::kConnection, "the motion connection is closed: point %d could not be sent", next_sequence_);
-    announced_ = true;
-    return finish(LinkPollResult::kStopped);
+    return announce_terminal();
   }
   waiting_reply_ = true;
   waiting_sequence_ = next_sequence_;
   waiting_since_s_ = now;
   waiting_is_last_ = last;
   sent_any_ = true;
-  last_sent_ = command_;
+  last_sent_ = command;
   ++sm_.points_sent;
-  delay_.record_reference(now, command_);
-  jacobian(model, ws_, nominal_, EndPoint::kTcp, jac_);
-  r.tcp_correction_m = -(jac_.topRows<3>() * out.dtheta);  // what the correction moves the TCP by
-  r.replied = true;
-  return finish(LinkPollResult::kAnswered);
+  delay_.record_reference(now, command);
+  // The controller does not wait for a point the way EGM and RSI wait for an answer: what counts is
+  // how late the point left against its schedule (its "answer time").
+  cycle_.sent(compute(), std::max(0.0, now - due_at_send));
+  return LinkPollResult::kAnswered;
 }
 
 }  // namespace deflex

@@ -1,5 +1,5 @@
 // Force samples from deflex force datagrams (see datagram_force_source.hpp).
-#include "deflex/online/datagram_force_source.hpp"
+#include "deflex/sensors/datagram_force_source.hpp"
 
 #include <array>
 #include <cmath>
@@ -13,6 +13,16 @@ SequenceRules force_sequence_rules() {
   r.restart_max = 16;
   r.confirm = 3;
   return r;
+}
+
+ForceSourceStats DatagramForceSource::stats() const noexcept {
+  ForceSourceStats s;
+  s.received = counters_.received;
+  s.accepted = counters_.accepted;
+  s.malformed = counters_.malformed + counters_.far_ahead;
+  s.out_of_order = counters_.out_of_order;
+  s.restarts = counters_.restarts;
+  return s;
 }
 
 bool DatagramForceSource::latest(ForceSample& out) noexcept {

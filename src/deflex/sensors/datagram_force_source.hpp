@@ -34,6 +34,7 @@ class DatagramForceSource : public ForceSource {
   /// (a jump back to a sequence number <= 16, or any jump that 3 samples in a row continue) is accepted.
   bool latest(ForceSample& out) noexcept override;
   [[nodiscard]] const ForceSourceCounters& counters() const { return counters_; }
+  [[nodiscard]] ForceSourceStats stats() const noexcept override;
 
  private:
   DatagramTransport& transport_;

@@ -22,20 +22,21 @@
 //     stop_reason() says why. stop() does the same on request (Ctrl-C).
 //   - A force fault is not a link fault: the compensator ramps the correction to zero and the nominal
 //     keeps streaming, as on the EGM links.
-// Nothing leaves deflex that is farther than the bound from the nominal: a final check on the float32
-// values actually sent. poll() never allocates, locks or throws.
+//   - A slow controller (one that takes a point less often than once a cycle) makes the program run
+//     late: the link reports how far behind its schedule the program is, and stops the motion once
+//     that exceeds max_behind_s (kTooSlow).
+// Each point is the one link cycle's command (link_cycle.hpp): within the bound of the nominal and the
+// step limit of the previous point, checked on the float32 values actually sent. The program moves on
+// one cycle a point taken (SUCCESS), never by the wall clock. poll() never allocates, locks or throws.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <limits>
 #include <memory>
 
 #include "deflex/link/controller_link.hpp"
 #include "deflex/link/joint_stream.hpp"
-#include "deflex/link/link_history.hpp"
 #include "deflex/online/delay_estimator.hpp"
-#include "deflex/online/online_strategy.hpp"
 #include "deflex/transport/clock.hpp"
 #include "deflex/transport/stream_transport.hpp"
 #include "deflex/wire/simple_message_stream.hpp"
@@ -48,6 +49,10 @@ struct SimpleMessageLinkConfig {
   double reply_timeout_s = 1.0;  ///< a point unanswered this long: the controller is not listening
   double state_timeout_s = 1.0;  ///< no JOINT_POSITION this long while streaming (ABB publishes every 0.1 s)
   int max_failures = 3;          ///< FAILURE replies in a row before the link stops
+  /// The program may fall this far behind its schedule (a controller slower than one point a cycle)
+  /// before the link stops the motion (kTooSlow), s.
+  double max_behind_s = 2.0;
+  LinkStopRules stop;            ///< end_silence_s: after the program's last point is taken, the session ends
   std::size_t max_frame_bytes = simple_message::kDefaultMaxFrameBytes;  ///< a longer LENGTH is out of step
   JointStreamConfig stream;
   std::size_t history_cycles = 1000;  ///< ring of the last cycles (100 s at 100 ms)
@@ -69,6 +74,8 @@ struct SimpleMessageCounters {
   std::uint64_t wrong_sequence = 0;    ///< a reply naming another point than the one waiting
   std::uint64_t partial_writes = 0;    ///< writes the stream took only part of (the rest went later)
   std::uint64_t stops_sent = 0;        ///< STOP_TRAJECTORY requests
+  double behind_s = 0.0;               ///< how far behind its schedule the program is now (s)
+  double max_behind_s = 0.0;           ///< the most it was
 };
 
 class SimpleMessageLink final : public ControllerLink {
@@ -86,33 +93,30 @@ class SimpleMessageLink final : public ControllerLink {
   /// kIdle: nothing to send yet; kRefused / kStopped once, when the link refuses the start or stops.
   LinkPollResult poll(double timeout_s) noexcept override;
   [[nodiscard]] const char* name() const override { return "simple-message"; }
-  [[nodiscard]] LinkState state() const override { return state_; }
-  [[nodiscard]] const LinkCounters& counters() const override { return counters_; }
-  [[nodiscard]] const LinkCycleRecord& last_cycle() const override { return last_; }
-  [[nodiscard]] const JointVector& start_distance() const override { return stream_.distance(); }
-  [[nodiscard]] bool fault_pending() const override { return fault_pending_; }
-  void clear_fault() override { fault_pending_ = false; }
-  void write_history_csv(const std::string& path) const override { history_.write_csv(path); }
+  /// Stops the motion with STOP_TRAJECTORY (the last target sent) and sends nothing more.
   void stop() noexcept override;
-  [[nodiscard]] LinkStopCause stop_cause() const override { return stop_cause_; }
-  [[nodiscard]] const char* stop_reason() const override { return stop_reason_.data(); }
+  [[nodiscard]] std::string protocol_summary() const override;
+  [[nodiscard]] bool winding_down() const override;
 
   [[nodiscard]] const SimpleMessageCounters& protocol_counters() const { return sm_; }
   [[nodiscard]] const JointStream& stream() const { return stream_; }
   [[nodiscard]] const DelayEstimator& delay() const { return delay_; }
+  [[nodiscard]] const DelayEstimator* delay_estimator() const override { return &delay_; }
   /// The lag the controller's buffer adds between a point sent and the arm reaching it (s).
   [[nodiscard]] double buffer_lag_s() const { return config_.buffer_depth * period_s_; }
-  /// The last feedback (rad) and the clock time it arrived; false before the first.
+  /// The last feedback (rad); false before the first.
   [[nodiscard]] bool has_feedback() const { return have_feedback_; }
   [[nodiscard]] const JointVector& feedback() const { return feedback_; }
   /// True when the link has sent the program's last point and it was taken.
   [[nodiscard]] bool program_done() const { return state_ == LinkState::kFinished; }
   /// Bytes written to the motion connection's outbox that the stream has not taken yet.
   [[nodiscard]] std::size_t unsent_bytes() const { return outbox_.pending_bytes(); }
+  [[nodiscard]] const SimpleMessageLinkConfig& config() const { return config_; }
 
  private:
   enum class Port { kMotion, kState };
   bool read_port(Port port, double now) noexcept;
+  void discard_input() noexcept;
   bool handle_state_frame(const simple_message::FrameView& f, double now) noexcept;
   bool handle_motion_frame(const simple_message::FrameView& f, double now) noexcept;
   LinkPollResult send_point(double now) noexcept;
@@ -121,40 +125,31 @@ class SimpleMessageLink final : public ControllerLink {
   void send_stop() noexcept;
   [[nodiscard]] double next_due_s() const noexcept;
 
-  OnlineCompensator& comp_;
-  OnlineStrategy& strategy_;
   StreamTransport& motion_;
   StreamTransport& state_port_;
-  const Clock& clock_;
-  ForceSource* force_;
   SimpleMessageLinkConfig config_;
   double period_s_;
-  LinkCounters counters_;
   SimpleMessageCounters sm_;
   JointStream stream_;
   DelayEstimator delay_;
-  LinkHistory history_;
-  LinkState state_ = LinkState::kWaiting;
-  bool fault_pending_ = false;
-  LinkStopCause stop_cause_ = LinkStopCause::kNone;
-  std::array<char, 256> stop_reason_{};
-  bool announced_ = false;  // kRefused / kStopped returned once
 
   simple_message::FrameReader motion_reader_, state_reader_;
   simple_message::FrameOutbox outbox_;
   bool motion_closed_ = false, state_closed_ = false;
+  bool stop_reply_due_ = false;  // STOP_TRAJECTORY sent, its reply not read yet
 
-  // Pacing: points accepted, the one waiting for its reply, the schedule's origin.
+  // Pacing: points accepted, the one waiting for its reply, the schedule's origin (moved by each
+  // FAILURE) and the original one (how far behind the program runs).
   std::int32_t next_sequence_ = 0;
   std::uint64_t accepted_ = 0;
   bool waiting_reply_ = false;
   std::int32_t waiting_sequence_ = 0;
   double waiting_since_s_ = 0.0;
   bool waiting_is_last_ = false;
-  double schedule_origin_s_ = 0.0;
+  double schedule_origin_s_ = 0.0, first_origin_s_ = 0.0;
+  double finished_at_s_ = 0.0;
   int failures_in_row_ = 0;
   bool sent_any_ = false;
-  bool last_point_taken_ = false;
 
   // Feedback.
   bool have_feedback_ = false;
@@ -162,14 +157,10 @@ class SimpleMessageLink final : public ControllerLink {
   JointVector feedback_, lower_, upper_;
 
   // Preallocated per-cycle buffers.
-  CycleInput input_;
-  JointVector nominal_, nominal_velocity_, command_, last_sent_;
+  JointVector program_, program_velocity_, blend_, blend_velocity_, nominal_, last_sent_;
   simple_message::JointTrajPt point_;
   simple_message::JointPosition position_;
   simple_message::RobotStatus status_;
-  LinkCycleRecord last_;
-  Workspace ws_;
-  Jacobian jac_;
 };
 
 }  // namespace deflex

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "deflex/online/datagram_force_source.hpp"
+#include "deflex/sensors/datagram_force_source.hpp"
 #include "deflex/transport/udp_transport.hpp"
 
 namespace deflex {
@@ -19,6 +19,7 @@ class UdpForceSource final : public ForceSource {
   bool latest(ForceSample& out) noexcept override { return source_.latest(out); }
   [[nodiscard]] std::uint16_t port() const { return transport_.port(); }
   [[nodiscard]] const ForceSourceCounters& counters() const { return source_.counters(); }
+  [[nodiscard]] ForceSourceStats stats() const noexcept override { return source_.stats(); }
 
  private:
   UdpTransport transport_;

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/online/datagram_force_source.hpp"
+#include "deflex/sensors/datagram_force_source.hpp"
 #include "deflex/transport/memory_network.hpp"
 
 namespace deflex {

@@ -1,0 +1,49 @@
+// The table of controller links (see link_table.hpp).
+#include "deflex/runtime/link_table.hpp"
+
+#include <fmt/format.h>
+
+#include "deflex/model/errors.hpp"
+
+namespace deflex::runtime {
+
+const std::array<LinkKindInfo, 4>& link_kinds() {
+  // Stop silences: EGM rides through outages up to 3 s (its controller holds the last target; the
+  // generated RAPID's CommTimeout matches); RSI's controller stops itself long before (its Timeout of
+  // late answers), so 1 s of silence means it stopped; simple message has its own state timeout.
+  static const std::array<LinkKindInfo, 4> kinds{{
+      {LinkKind::kEgmJoint, "egm-joint",
+       "ABB EGM position guidance (EGMActJoint/EGMRunJoint): deflex streams --program", true,
+       CommandForm::kJointTarget, 0.004, 3.0},
+      {LinkKind::kEgmPath, "egm-path",
+       "ABB EGM path correction (EGMActMove + EGMMoveL/EGMMoveC): the controller runs its own program, deflex sends "
+       "whole TCP offsets",
+       false, CommandForm::kTcpOffset, 0.048, 3.0},
+      {LinkKind::kRsi, "rsi",
+       "KUKA RSI axis correction (RSI_ON(#ABSOLUTE), ETHERNET to AXISCORR): the controller runs its own KRL program, "
+       "deflex answers each <Rob> with whole AK offsets",
+       false, CommandForm::kJointOffset, 0.004, 1.0},
+      {LinkKind::kSimpleMessage, "simple-message",
+       "ROS-Industrial simple message over TCP to a robot program (ABB RAPID, Fanuc KAREL servers): deflex streams "
+       "--program one point a cycle",
+       true, CommandForm::kJointTarget, 0.1, 1.0},
+  }};
+  return kinds;
+}
+
+const LinkKindInfo& link_kind(LinkKind kind) { return link_kinds()[static_cast<std::size_t>(kind)]; }
+
+std::string link_kind_names() {
+  std::string names;
+  for (const LinkKindInfo& k : link_kinds()) names += (names.empty() ? "" : ", ") + std::string(k.name);
+  return names;
+}
+
+LinkKind parse_link_kind(const std::string& name) {
+  for (const LinkKindInfo& k : link_kinds()) {
+    if (name == k.name) return k.kind;
+  }
+  throw InputError(fmt::format("option --link: '{}' is not one of {}", name, link_kind_names()));
+}
+
+}  // namespace deflex::runtime

@@ -1,0 +1,32 @@
+// The controller links a session can run, as one explicit table (no static self-registration): each
+// kind's name, what it needs and what its command is, and the defaults that differ between them. A
+// further link is a row here and a case in Session::open_link.
+#pragma once
+
+#include <array>
+#include <string>
+
+#include "deflex/link/link_cycle.hpp"
+
+namespace deflex::runtime {
+
+enum class LinkKind : int { kEgmJoint = 0, kEgmPath = 1, kRsi = 2, kSimpleMessage = 3 };
+
+struct LinkKindInfo {
+  LinkKind kind;
+  const char* name;             ///< the --link value
+  const char* help;
+  bool streams_program;         ///< deflex is the motion source: needs a program (--program)
+  CommandForm form;             ///< what goes on the wire
+  double default_period_s;      ///< the controller's cycle when none is given
+  double default_stop_silence_s;  ///< how long a silence is ridden through by default
+};
+
+[[nodiscard]] const std::array<LinkKindInfo, 4>& link_kinds();
+[[nodiscard]] const LinkKindInfo& link_kind(LinkKind kind);
+/// The kind named `name`; throws InputError naming it and listing the known names.
+[[nodiscard]] LinkKind parse_link_kind(const std::string& name);
+/// "egm-joint, egm-path, rsi, simple-message".
+[[nodiscard]] std::string link_kind_names();
+
+}  // namespace deflex::runtime

@@ -1,0 +1,183 @@
+// An online compensation session: what `deflex online`, the Python module and the case study all run
+// a controller link through. It owns the compensator, the strategy, the link (chosen by kind from the
+// table in link_table.hpp, configured by plain structs) and the sockets a real cell needs; it runs the
+// loop and its stop rules, and sends every cycle off the loop's thread to the reporter (the cycle log,
+// the fault dump, the status lines, the summary: session_report.hpp).
+//
+// Two ways to drive it:
+//   - real time: run() is the whole loop (optionally SCHED_FIFO, memory locked, pinned: realtime.hpp);
+//     the reporter works on a thread of its own, so nothing on the loop's thread writes a file;
+//   - stepped: the caller owns time (a simulated cell on an in-memory network, tests, Python's
+//     stand-ins) and calls poll() whenever its controller has spoken, and service() between polls
+//     for the reporter's work.
+// Either way the session ends with a StopReason (stop_reason.hpp: the exit code), and finish() gives
+// the summary. Options are validated once, at construction (the bounds, the per-cycle step limits
+// the link's command is held to, the stop rules): the loop only computes and reports.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "deflex/egm/egm_joint_link.hpp"
+#include "deflex/egm/egm_path_link.hpp"
+#include "deflex/rsi/rsi_link.hpp"
+#include "deflex/runtime/link_table.hpp"
+#include "deflex/runtime/realtime.hpp"
+#include "deflex/runtime/session_report.hpp"
+#include "deflex/simple_message/simple_message_link.hpp"
+#include "deflex/transport/stream_transport.hpp"
+
+namespace deflex::runtime {
+
+/// Where a real cell's controller is reached (the sockets the session opens when it is given none).
+struct NetworkConfig {
+  std::string bind_address = "127.0.0.1";  ///< UDP links bind here (0.0.0.0 or the cell network's address on a cell)
+  int egm_port = -1;                       ///< EGM links: the UDP port the controller sends to (required)
+  int rsi_port = -1;                       ///< rsi: the UDP port the controller sends to (required)
+  std::string robot_host;                  ///< simple message: the controller's address (required)
+  int motion_port = 11000, state_port = 11002;
+  double connect_timeout_s = 5.0;
+};
+
+struct SessionConfig {
+  LinkKind link = LinkKind::kEgmJoint;
+  StrategyKind strategy = StrategyKind::kOnline;
+  OnlineConfig online;                   ///< bounds, rates, watchdog; period_s is the controller's cycle
+  std::optional<double> stop_silence_s;  ///< default: the link's (link_table.hpp)
+  double end_silence_s = 2.0;            ///< streaming links: silence after the program's end that ends the session
+  bool end_on_silence = false;           ///< correcting links: a silence after a healthy session is the planned end
+  NetworkConfig network;
+  // Each link's own settings (the session sets their stop rules from the fields above).
+  EgmJointLinkConfig egm_joint;
+  EgmPathLinkConfig egm_path;
+  RsiLinkConfig rsi;
+  SimpleMessageLinkConfig simple_message;
+  double duration_s = 0.0;               ///< > 0: the session ends (planned) after this long
+  double status_interval_s = 1.0;        ///< a status line this often (0: none)
+  std::string log_path;                  ///< the cycle log CSV ("" none)
+  std::string fault_dump_path;           ///< the fault dump CSV ("" none)
+  std::size_t history_cycles = 1000;     ///< cycles kept for a fault dump
+  double fault_quiet_s = 1.0;            ///< a fault episode ends after this long without a fault
+  std::size_t queue_entries = 8192;      ///< the loop-to-reporter ring (32 s of 4 ms cycles)
+  bool collect_cycles = false;           ///< keep every cycle in memory (Python's cycle log)
+  RealtimeOptions realtime;
+};
+
+/// Transports the caller gives (a simulated cell's in-memory network, tests). Null: the session opens
+/// real sockets from NetworkConfig.
+struct SessionEndpoints {
+  DatagramTransport* datagram = nullptr;  ///< EGM, RSI
+  StreamTransport* motion = nullptr;      ///< simple message
+  StreamTransport* state = nullptr;
+};
+
+/// How a session ended and what it did.
+struct SessionSummary {
+  StopReason reason = StopReason::kRunning;
+  int exit_code = 0;
+  std::string reason_text;       ///< a sentence naming what stopped it
+  std::string link;              ///< "egm-joint" ...
+  double duration_s = 0.0;
+  std::uint64_t cycles = 0, answers = 0;
+  LinkCounters counters;
+  CycleStats stats;              ///< the command against its invariants, on the wire values
+  CommandLimits limits;
+  CompensatorCounters compensator;
+  double measured_delay_s = 0.0; ///< the mean of the link's delay measurements (NaN before one)
+  std::uint64_t log_dropped = 0; ///< entries the reporter never saw (a full ring: the log has gaps)
+  std::uint64_t fault_episodes = 0, faulted_cycles = 0;
+  std::uint64_t late_answers = 0;
+  double program_time_s = 0.0;   ///< streaming links: where the program was at the end (its own axis)
+  double program_behind_s = 0.0; ///< how far behind real time the program ran
+  std::string text;              ///< the summary as lines for a person
+  nlohmann::json json;           ///< the same for a program
+};
+
+class Session {
+ public:
+  /// Builds everything and validates every option (InputError naming it): the link's options, the
+  /// per-cycle step limit against the bound, a program for a streaming link, the log paths (Error
+  /// naming the path). `robot`, `clock`, `force` (may be null: push samples into compensator()),
+  /// `force_model` (hybrid and predictive) and the endpoints' transports must outlive the session.
+  Session(const SessionConfig& config, const RobotModel& robot, const SensorConfig& sensor,
+          std::shared_ptr<const JointTrajectory> program, const ForceModel* force_model, ForceSource* force,
+          const Clock& clock, const SessionEndpoints& endpoints = {}, LogSink sink = {});
+  ~Session();
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  /// Stepped: one poll of the link (waits up to timeout_s on real sockets), then the stop rules.
+  /// Returns the link's result. Never allocates, locks or throws.
+  LinkPollResult poll(double timeout_s) noexcept;
+  /// Stepped: the reporter's work (log rows, status lines, dumps) for what the loop has handed over.
+  void service();
+  /// Real time: the loop, until the session ends or `max_s` of the session's clock has passed (then
+  /// it returns kRunning and can be called again). The first call makes its thread real-time when
+  /// asked (InputError naming the missing permission when refused) and starts the reporter's thread.
+  StopReason run(double max_s = std::numeric_limits<double>::infinity());
+  /// Asks the loop to end the session (planned: a user stop). Safe from another thread or a signal
+  /// handler (an atomic flag).
+  void request_stop() noexcept { stop_requested_.store(true); }
+  /// Ends the session (a running link is stopped: simple message sends STOP_TRAJECTORY), drains the
+  /// reporter, writes the fault dump when the end was a fault, closes the cycle log, and builds the
+  /// summary. Idempotent.
+  const SessionSummary& finish();
+
+  [[nodiscard]] bool ended() const { return reason_ != StopReason::kRunning; }
+  [[nodiscard]] StopReason stop_reason() const { return reason_; }
+  [[nodiscard]] ControllerLink& link() { return *link_; }
+  [[nodiscard]] const ControllerLink& link() const { return *link_; }
+  [[nodiscard]] OnlineCompensator& compensator() { return *compensator_; }
+  [[nodiscard]] const SessionConfig& config() const { return config_; }
+  [[nodiscard]] const LinkKindInfo& kind() const { return link_kind(config_.link); }
+  /// "EGM on 127.0.0.1:6510" (where the controller reaches deflex).
+  [[nodiscard]] const std::string& where() const { return where_; }
+  /// The start-up line: link, strategy, bounds and limits, where, program.
+  [[nodiscard]] std::string describe() const;
+  /// What run() got of real time ("SCHED_FIFO priority 80 on CPU 1, memory locked").
+  [[nodiscard]] const std::string& realtime_text() const { return realtime_.text; }
+  /// The cycles kept (collect_cycles), oldest first; read after finish() or between service() calls.
+  [[nodiscard]] const std::vector<LinkCycleRecord>& collected() const;
+  [[nodiscard]] const SessionReporter* reporter() const { return reporter_.get(); }
+
+ private:
+  void open_link(const SessionEndpoints& endpoints, ForceSource* force, std::shared_ptr<const JointTrajectory> program);
+  void push(SessionEntry::Kind kind, double now) noexcept;
+  void end(StopReason reason) noexcept;
+  void reporter_loop();
+  void drain_reporter(double now);
+  void build_summary();
+
+  SessionConfig config_;
+  const Clock& clock_;
+  LogSink sink_;
+  std::unique_ptr<OnlineCompensator> compensator_;
+  std::unique_ptr<OnlineStrategy> strategy_;
+  std::unique_ptr<DatagramTransport> own_datagram_;
+  std::unique_ptr<StreamTransport> own_motion_, own_state_;
+  std::unique_ptr<ControllerLink> link_;
+  std::shared_ptr<const JointTrajectory> program_;
+  std::string where_;
+  StopReason reason_ = StopReason::kRunning;
+  std::string reason_text_;
+  double start_s_ = 0.0, last_push_s_ = -1.0;
+  std::atomic<bool> stop_requested_{false};
+  // Loop -> reporter.
+  bool reporting_ = false;  // anything consumes the entries (a log, a dump, a sink, collection)
+  std::unique_ptr<SpscRing<SessionEntry>> queue_;
+  SessionEntry entry_;
+  std::atomic<std::uint64_t> dropped_{0};
+  std::unique_ptr<SessionReporter> reporter_;
+  std::thread reporter_thread_;
+  std::atomic<bool> reporter_stop_{false};
+  bool started_ = false, finished_ = false;
+  RealtimeGrant realtime_;
+  SessionSummary summary_;
+};
+
+}  // namespace deflex::runtime
