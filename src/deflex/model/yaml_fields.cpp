@@ -9,7 +9,7 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/csv_table.hpp"
+#include "deflex/model/input_file.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/model/nearest_name.hpp"
 #include "deflex/model/parse_number.hpp"
@@ -62,10 +62,10 @@ void refuse_duplicate_keys(const YAML::Node& node, const std::string& file, cons
 
 }  // namespace
 
-Field Field::load_file(const std::string& path) {
+Field Field::load_file(const std::string& path, InputKind kind) {
   std::string text;
   try {
-    text = read_text_file(path, "file");
+    text = read_input_file(path, kind);
   } catch (const DataError& e) {
     throw ModelError(e.what());
   }
