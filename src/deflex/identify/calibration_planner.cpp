@@ -314,6 +314,12 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
 
 void write_calibration_plan(const std::string& path, const CalibrationPlan& plan,
                             const std::vector<std::string>& comments) {
+  OutputFile out(path, "calibration plan");
+  write_calibration_plan(out, plan, comments);
+  out.commit();
+}
+
+void write_calibration_plan(OutputFile& out, const CalibrationPlan& plan, const std::vector<std::string>& comments) {
   const Eigen::Index n = plan.points.empty() ? 0 : plan.points.front().q.size();
   std::vector<std::string> cols = {"pose"};
   for (Eigen::Index j = 1; j <= n; ++j) {
@@ -324,7 +330,7 @@ void write_calibration_plan(const std::string& path, const CalibrationPlan& plan
                         "expected_dz_mm"}) {
     cols.emplace_back(c);
   }
-  CsvWriter w(path, cols);
+  CsvWriter w(out, cols);
   for (const auto& c : comments) {
     w.comment(c);
   }
