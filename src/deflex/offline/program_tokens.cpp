@@ -53,7 +53,8 @@ struct Lexer {
   /// when the character at `i` is none of them.
   bool common(std::size_t& i, char comment) {
     const char c = text[i];
-    if (c == '\n') {
+    // A line ends with LF, CR LF or a lone CR (old Mac editors, some controllers' exports).
+    if (c == '\n' || (c == '\r' && (i + 1 >= text.size() || text[i + 1] != '\n'))) {
       ++line;
       ++i;
       return true;
@@ -63,14 +64,14 @@ struct Lexer {
       return true;
     }
     if (c == comment) {
-      while (i < text.size() && text[i] != '\n') {
+      while (i < text.size() && text[i] != '\n' && text[i] != '\r') {
         ++i;
       }
       return true;
     }
     if (c == '"') {
       std::size_t j = i + 1;
-      while (j < text.size() && text[j] != '"' && text[j] != '\n') {
+      while (j < text.size() && text[j] != '"' && text[j] != '\n' && text[j] != '\r') {
         ++j;
       }
       if (j >= text.size() || text[j] != '"') {
@@ -145,7 +146,7 @@ std::vector<Token> lex_krl(const std::string& text, const std::string& file) {
     }
     if (c == '\'') {
       std::size_t j = i + 1;
-      while (j < text.size() && text[j] != '\'' && text[j] != '\n') {
+      while (j < text.size() && text[j] != '\'' && text[j] != '\n' && text[j] != '\r') {
         ++j;
       }
       if (j >= text.size() || text[j] != '\'') {
