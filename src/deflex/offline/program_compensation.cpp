@@ -68,17 +68,21 @@ ProgramCompensation compensate_program(const RobotModel& model, const ForceModel
                                        const std::string& output_path, const ProgramOptions& options) {
   const std::vector<std::string> outputs = program_output_paths(input_path, output_path);
   const bool krl = outputs.size() == 2;
-  const std::string dat = krl ? krl_data_list(input_path) : std::string();
-  for (const std::string& out : outputs) {
-    for (const std::string& in : {input_path, dat}) {
-      if (!in.empty() && same_file(in, out)) {
+  const auto refuse_same = [&](const std::string& in) {
+    for (const std::string& out : outputs) {
+      if (same_file(in, out)) {
         throw InputError(fmt::format("{}: the compensated program must go to another file than the input {} (it is "
                                      "the same file)",
                                      out, in));
       }
     }
-  }
+  };
+  refuse_same(input_path);  // before anything is read
   const std::string text = read_input_file(input_path, InputKind::kProgram);
+  const std::string dat = krl ? krl_data_list(input_path) : std::string();
+  if (krl) {
+    refuse_same(dat);
+  }
   if (!krl) {
     return compensate_rapid_module(model, force, input_path, text, output_path, options);
   }

@@ -327,6 +327,11 @@ class RapidReader {
     if (src_.is_punct(k, ":=")) {
       const auto end = parse_rapid_value(src_, k + 1, j, d.value);
       d.literal = end && *end == j;
+      if (end && *end != j && src_.tok[*end].kind == TokenKind::kIdentifier) {
+        // A value followed by a name, not an operator: the ';' is missing (the next line's declaration
+        // would otherwise be swallowed into this one).
+        src_.fail(d.name_tok, fmt::format("';' expected after the value of '{}'", d.name));
+      }
     } else if (k != j) {
       src_.fail(k, fmt::format("declaration of '{}': ':=' or ';' expected after the name", d.name));
     }
