@@ -12,7 +12,8 @@
 
 namespace deflex {
 
-KrlFile::KrlFile(std::string f, const std::string& t) : file(std::move(f)), text(t), tok(lex_krl(t, file)) {
+KrlFile::KrlFile(std::string f, const std::string& t) : ProgramSource{std::move(f), t, {}} {
+  tok = lex_krl(text, file);
   for (std::size_t i = 0; i < tok.size();) {
     std::size_t j = i;
     while (j < tok.size() && tok[j].line == tok[i].line) {
@@ -21,30 +22,6 @@ KrlFile::KrlFile(std::string f, const std::string& t) : file(std::move(f)), text
     lines.emplace_back(i, j);
     i = j;
   }
-}
-
-std::string KrlFile::str(std::size_t i) const {
-  return i < tok.size() ? text.substr(tok[i].begin, tok[i].end - tok[i].begin) : std::string();
-}
-
-bool KrlFile::is_ident(std::size_t i, const char* word) const {
-  return i < tok.size() && tok[i].kind == TokenKind::kIdentifier && (word == nullptr || iequals(str(i), word));
-}
-
-bool KrlFile::is_punct(std::size_t i, const char* p) const {
-  return i < tok.size() && tok[i].kind == TokenKind::kPunct && str(i) == p;
-}
-
-std::string KrlFile::span(std::size_t b, std::size_t e) const {
-  if (b >= e) {
-    return {};
-  }
-  const std::string s = text.substr(tok[b].begin, tok[e - 1].end - tok[b].begin);
-  return s.size() > 100 ? s.substr(0, 97) + "..." : s;
-}
-
-void KrlFile::fail(std::size_t i, const std::string& what) const {
-  throw DataError(fmt::format("{}:{}: {}", file, i < tok.size() ? tok[i].line : 0, what));
 }
 
 const KrlComponent* KrlAggregate::find(const char* name) const {

@@ -15,21 +15,10 @@ namespace deflex {
 
 using KrlRange = std::pair<std::size_t, std::size_t>;  // tokens [first, last)
 
-/// A .src or .dat file: text, tokens, the tokens of each non-empty line, the name for messages.
-struct KrlFile {
-  std::string file;
-  const std::string& text;
-  std::vector<Token> tok;
+/// A .src or .dat file (program_tokens.hpp) and the tokens of each of its non-empty lines.
+struct KrlFile : ProgramSource {
   std::vector<KrlRange> lines;
-
   KrlFile(std::string f, const std::string& t);
-  [[nodiscard]] std::string str(std::size_t i) const;
-  [[nodiscard]] bool is_ident(std::size_t i, const char* word = nullptr) const;
-  [[nodiscard]] bool is_punct(std::size_t i, const char* p) const;
-  /// The source text of tokens [b, e), at most 100 characters.
-  [[nodiscard]] std::string span(std::size_t b, std::size_t e) const;
-  /// Throws DataError "FILE:LINE: what" with the line of token i.
-  [[noreturn]] void fail(std::size_t i, const std::string& what) const;
 };
 
 /// One component of an aggregate {NAME value, ...}.

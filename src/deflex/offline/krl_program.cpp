@@ -21,6 +21,7 @@
 #include "deflex/offline/krl_aggregate.hpp"
 #include "deflex/offline/program_targets.hpp"
 #include "deflex/offline/program_text.hpp"
+#include "deflex/offline/program_write_back.hpp"
 
 namespace deflex {
 namespace {
@@ -62,15 +63,6 @@ const char* const kUnsupported[] = {"PTP_REL", "LIN_REL",  "CIRC_REL", "SPTP",  
                                     "SPL",     "SLIN_REL", "SPTP_REL", "SCIRC_REL", "PTP_SPLINE", "SPLINE"};
 const char* const kAxes[6] = {"A1", "A2", "A3", "A4", "A5", "A6"};
 const char* const kFrameNames[6] = {"X", "Y", "Z", "A", "B", "C"};
-
-bool same_numbers(const Use& a, const Use& b) {
-  for (std::size_t k = 0; k < a.numbers.size(); ++k) {
-    if (a.numbers[k].second != b.numbers[k].second) {
-      return false;
-    }
-  }
-  return true;
-}
 
 /// Fails unless the file holds `begin` ... `end` (DEF ... END, DEFDAT ... ENDDAT).
 void check_frame(const KrlFile& f, const char* what, std::initializer_list<const char*> begin, const char* end) {
@@ -665,88 +657,50 @@ class KrlReader {
            apply_edits(dat_.text.substr(d.value.begin, d.value.end - d.value.begin), rel) + eol;
   }
 
-  /// Write back, as for RAPID: inline targets and agreeing, otherwise unreferenced points in place;
-  /// a copy per distinct value otherwise.
-  void write_back(std::vector<Use>& info, std::vector<std::string>& actions, std::vector<TextEdit>& src_edits,
+  /// The new numbers written back (program_write_back.hpp): literals into the .src, points and their
+  /// copies into the .dat, a copy's name into the .src.
+  void write_back(const std::vector<Use>& info, std::vector<std::string>& actions, std::vector<TextEdit>& src_edits,
                   std::vector<TextEdit>& dat_edits) const {
     const KrlFile& f = src_;
-    std::set<std::string> taken;
-    for (const KrlFile* file : {&src_, &dat_}) {
-      for (const Token& tk : file->tok) {
-        if (tk.kind == TokenKind::kIdentifier) {
-          taken.insert(to_upper(file->text.substr(tk.begin, tk.end - tk.begin)));
-        }
-      }
-    }
-    std::map<std::string, int> resolved_refs;
+    std::vector<WriteBackUse> uses;
     for (const Use& x : info) {
-      if (x.decl != nullptr) {
-        ++resolved_refs[to_upper(x.decl->name)];
+      WriteBackUse u;
+      u.target = x.decl;
+      u.name = x.decl == nullptr ? std::string() : to_upper(x.decl->name);
+      for (const auto& [c, text] : x.numbers) {
+        u.numbers.push_back(text);
       }
+      uses.push_back(std::move(u));
     }
+    const std::vector<WriteBackStep> steps = plan_write_back(uses, references_);
+    std::set<std::string> taken;
+    add_identifiers(src_, taken);
+    add_identifiers(dat_, taken);
     const std::string eol = line_terminator(dat_.text);
     actions.assign(info.size(), {});
-    std::set<std::size_t> done;
+    std::vector<std::string> names(info.size());  // the copy each use declares
     for (std::size_t a = 0; a < info.size(); ++a) {
       const Use& x = info[a];
-      if (x.decl == nullptr) {
-        for (const auto& [c, text] : x.numbers) {
-          src_edits.push_back({c->begin, c->end - c->begin, text});
-        }
-        actions[a] = "literal edited";
-        continue;
-      }
-      if (done.count(a) != 0) {
-        continue;
-      }
-      std::vector<std::size_t> group;
-      for (std::size_t b = a; b < info.size(); ++b) {
-        if (info[b].decl == x.decl) {
-          group.push_back(b);
-          done.insert(b);
-        }
-      }
-      const std::string key = to_upper(x.decl->name);
-      const bool only_resolved_uses = references_.at(key) == resolved_refs[key];
-      const bool agree = std::all_of(group.begin(), group.end(), [&](std::size_t b) { return same_numbers(x, info[b]); });
-      if (only_resolved_uses && agree) {
-        for (const auto& [c, text] : x.numbers) {
-          dat_edits.push_back({c->begin, c->end - c->begin, text});
-        }
-        for (const std::size_t b : group) {
-          actions[b] = "edited in place";
-        }
-        continue;
-      }
-      const KrlDecl& d = *x.decl;
-      const std::size_t at = end_of_line(dat_.text, dat_.tok[d.name_tok].begin);
-      const bool unterminated = at == dat_.text.size() && dat_.text.back() != '\n' && dat_.text.back() != '\r';
-      const std::string lead = unterminated ? eol : "";
-      const std::string base_name = d.element > 0 ? fmt::format("{}{}", d.name, d.element) : d.name;
-      int k = 1;
-      std::vector<std::pair<std::size_t, std::string>> made;  // a use that got a copy, and the copy's name
-      for (const std::size_t b : group) {
-        const Use& y = info[b];
-        const auto same = std::find_if(made.begin(), made.end(), [&](const auto& m) { return same_numbers(info[m.first], y); });
-        if (same != made.end()) {
-          src_edits.push_back({f.tok[y.ref_b].begin, f.tok[y.ref_e - 1].end - f.tok[y.ref_b].begin, same->second});
-          actions[b] = "copy " + same->second;
-          continue;
-        }
-        std::string name;
-        for (;; ++k) {
-          const std::string suffix = fmt::format("_C{}", k);
-          name = base_name.substr(0, std::min(base_name.size(), 24 - suffix.size())) + suffix;
-          if (taken.count(to_upper(name)) == 0) {
-            break;
+      const WriteBackStep& step = steps[a];
+      if (step.kind != WriteBackStep::Kind::kCopy) {
+        if (step.kind == WriteBackStep::Kind::kLiteral || step.first) {
+          for (const auto& [c, text] : x.numbers) {
+            (x.decl == nullptr ? src_edits : dat_edits).push_back({c->begin, c->end - c->begin, text});
           }
         }
-        taken.insert(to_upper(name));
-        made.emplace_back(b, name);
-        dat_edits.push_back({at, 0, lead + copy_line(d, y, name, eol)});
-        src_edits.push_back({f.tok[y.ref_b].begin, f.tok[y.ref_e - 1].end - f.tok[y.ref_b].begin, name});
-        actions[b] = "copy " + name;
+        actions[a] = step.kind == WriteBackStep::Kind::kLiteral ? "literal edited" : "edited in place";
+        continue;
       }
+      if (step.first) {
+        const KrlDecl& d = *x.decl;
+        names[a] = copy_name(d.element > 0 ? fmt::format("{}{}", d.name, d.element) : d.name, "_C", 24, taken);
+        const std::size_t at = end_of_line(dat_.text, dat_.tok[d.name_tok].begin);
+        const bool unterminated = at == dat_.text.size() && dat_.text.back() != '\n' && dat_.text.back() != '\r';
+        dat_edits.push_back({at, 0, (unterminated ? eol : "") + copy_line(d, x, names[a], eol)});
+      }
+      const std::string& name = names[step.source];
+      src_edits.push_back({f.tok[x.ref_b].begin, f.tok[x.ref_e - 1].end - f.tok[x.ref_b].begin, name});
+      actions[a] = "copy " + name;
     }
   }
 

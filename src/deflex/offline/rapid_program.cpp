@@ -17,6 +17,7 @@
 #include "deflex/model/errors.hpp"
 #include "deflex/offline/program_targets.hpp"
 #include "deflex/offline/program_text.hpp"
+#include "deflex/offline/program_write_back.hpp"
 #include "deflex/offline/quaternion_sign.hpp"
 #include "deflex/offline/rapid_values.hpp"
 
@@ -147,25 +148,6 @@ std::vector<const RapidValue*> target_numbers(const RapidValue& v, const std::st
     }
   }
   return out;
-}
-
-std::string valid_identifier(const std::string& base, int k, const std::set<std::string>& taken) {
-  for (;; ++k) {
-    const std::string suffix = fmt::format("_c{}", k);
-    std::string name = base.substr(0, std::min(base.size(), 32 - suffix.size())) + suffix;
-    if (taken.count(to_upper(name)) == 0) {
-      return name;
-    }
-  }
-}
-
-bool same_numbers(const Use& a, const Use& b) {
-  for (std::size_t k = 0; k < a.numbers.size(); ++k) {
-    if (a.numbers[k].second != b.numbers[k].second) {
-      return false;
-    }
-  }
-  return true;
 }
 
 Matrix3 reltool_rotation(const Vector3& rot_deg) {
@@ -944,87 +926,58 @@ class RapidReader {
     }
   }
 
-  /// Write back: literals in place; a declaration in place when every reference to it is a resolved
-  /// use and all its uses agree; otherwise a copy per distinct value, declared after the original.
-  std::string write_back(std::vector<Use>& info, std::vector<std::string>& actions) const {
+  /// The module with the new numbers written back (program_write_back.hpp).
+  std::string write_back(const std::vector<Use>& info, std::vector<std::string>& actions) const {
     const Tokens& t = src_.tok;
-    std::vector<TextEdit> edits;
-    std::set<std::string> taken;
-    for (const Token& tk : t) {
-      if (tk.kind == TokenKind::kIdentifier) {
-        taken.insert(to_upper(src_.text.substr(tk.begin, tk.end - tk.begin)));
-      }
-    }
-    std::map<std::string, int> resolved_refs;  // per declaration name
+    std::vector<WriteBackUse> uses;
     for (const Use& x : info) {
-      if (!x.ref.literal) {
-        ++resolved_refs[to_upper(x.ref.decl->name)];
+      WriteBackUse u;
+      u.target = x.ref.literal ? nullptr : x.ref.value;  // a declaration's value node: one per element
+      u.name = x.ref.literal ? std::string() : to_upper(x.ref.decl->name);
+      for (const auto& [node, text] : x.numbers) {
+        u.numbers.push_back(text);
       }
+      uses.push_back(std::move(u));
     }
+    const std::vector<WriteBackStep> steps = plan_write_back(uses, references_);
+    std::set<std::string> taken;
+    add_identifiers(src_, taken);
     const std::string eol = line_terminator(src_.text);
+    std::vector<TextEdit> edits;
     actions.assign(info.size(), {});
-    std::set<std::size_t> done;
+    std::vector<std::string> names(info.size());  // the copy each use declares
     for (std::size_t a = 0; a < info.size(); ++a) {
       const Use& x = info[a];
-      if (x.ref.literal) {
-        for (const auto& [node, text] : x.numbers) {
-          edits.push_back({node->begin, node->end - node->begin, text});
+      const WriteBackStep& step = steps[a];
+      if (step.kind != WriteBackStep::Kind::kCopy) {
+        if (step.kind == WriteBackStep::Kind::kLiteral || step.first) {
+          for (const auto& [node, text] : x.numbers) {
+            edits.push_back({node->begin, node->end - node->begin, text});
+          }
         }
-        actions[a] = "literal edited";
+        actions[a] = step.kind == WriteBackStep::Kind::kLiteral ? "literal edited" : "edited in place";
         continue;
       }
-      if (done.count(a) != 0) {
-        continue;
-      }
-      std::vector<std::size_t> group;
-      for (std::size_t b = a; b < info.size(); ++b) {
-        if (!info[b].ref.literal && info[b].ref.decl == x.ref.decl && info[b].ref.element == x.ref.element) {
-          group.push_back(b);
-          done.insert(b);
-        }
-      }
-      const std::string key = to_upper(x.ref.decl->name);
-      const bool only_resolved_uses = references_.at(key) == resolved_refs[key];
-      const bool agree = std::all_of(group.begin(), group.end(), [&](std::size_t b) { return same_numbers(x, info[b]); });
-      if (only_resolved_uses && agree) {
-        for (const auto& [node, text] : x.numbers) {
-          edits.push_back({node->begin, node->end - node->begin, text});
-        }
-        for (const std::size_t b : group) {
-          actions[b] = "edited in place";
-        }
-        continue;
-      }
-      const Decl& d = *x.ref.decl;
-      const std::size_t at = end_of_line(src_.text, t[d.end_tok].end);
-      const bool unterminated = at == src_.text.size() && src_.text.back() != '\n' && src_.text.back() != '\r';
-      const std::string lead = unterminated ? eol : "";
-      const std::string indent = indentation_of(src_.text, t[d.first_tok].begin);
-      const std::string prefix = src_.text.substr(t[d.first_tok].begin, t[d.name_tok].begin - t[d.first_tok].begin);
-      const std::string base = x.ref.element >= 0 ? fmt::format("{}{}", d.name, x.ref.element + 1) : d.name;
-      int k = 1;
-      std::vector<std::pair<std::size_t, std::string>> made;  // a use that got a copy, and the copy's name
-      for (const std::size_t b : group) {
-        const Use& y = info[b];
-        const auto same = std::find_if(made.begin(), made.end(), [&](const auto& m) { return same_numbers(info[m.first], y); });
-        if (same != made.end()) {
-          edits.push_back({t[y.ref.ref_b].begin, t[y.ref.ref_e - 1].end - t[y.ref.ref_b].begin, same->second});
-          actions[b] = "copy " + same->second;
-          continue;
-        }
-        const std::string name = valid_identifier(base, k++, taken);
-        taken.insert(to_upper(name));
-        made.emplace_back(b, name);
-        const RapidValue& v = *y.ref.value;
+      if (step.first) {
+        const Decl& d = *x.ref.decl;
+        names[a] = copy_name(x.ref.element >= 0 ? fmt::format("{}{}", d.name, x.ref.element + 1) : d.name, "_c", 32,
+                             taken);
+        const std::size_t at = end_of_line(src_.text, t[d.end_tok].end);
+        const bool unterminated = at == src_.text.size() && src_.text.back() != '\n' && src_.text.back() != '\r';
+        const RapidValue& v = *x.ref.value;
         std::vector<TextEdit> rel;
-        for (const auto& [node, text] : y.numbers) {
+        for (const auto& [node, text] : x.numbers) {
           rel.push_back({node->begin - v.begin, node->end - node->begin, text});
         }
-        const std::string value = apply_edits(src_.text.substr(v.begin, v.end - v.begin), rel);
-        edits.push_back({at, 0, lead + indent + prefix + name + ":=" + value + ";" + eol});
-        edits.push_back({t[y.ref.ref_b].begin, t[y.ref.ref_e - 1].end - t[y.ref.ref_b].begin, name});
-        actions[b] = "copy " + name;
+        edits.push_back({at, 0,
+                         (unterminated ? eol : "") + indentation_of(src_.text, t[d.first_tok].begin) +
+                             src_.text.substr(t[d.first_tok].begin, t[d.name_tok].begin - t[d.first_tok].begin) +
+                             names[a] + ":=" + apply_edits(src_.text.substr(v.begin, v.end - v.begin), rel) + ";" +
+                             eol});
       }
+      const std::string& name = names[step.source];
+      edits.push_back({t[x.ref.ref_b].begin, t[x.ref.ref_e - 1].end - t[x.ref.ref_b].begin, name});
+      actions[a] = "copy " + name;
     }
     return apply_edits(src_.text, edits);
   }

@@ -11,43 +11,6 @@
 
 namespace deflex {
 
-std::string RapidSource::str(std::size_t i) const {
-  return i < tok.size() ? text.substr(tok[i].begin, tok[i].end - tok[i].begin) : std::string();
-}
-
-bool RapidSource::is_ident(std::size_t i, const char* word) const {
-  return i < tok.size() && tok[i].kind == TokenKind::kIdentifier && (word == nullptr || iequals(str(i), word));
-}
-
-bool RapidSource::is_punct(std::size_t i, const char* p) const {
-  return i < tok.size() && tok[i].kind == TokenKind::kPunct && str(i) == p;
-}
-
-std::string RapidSource::span(std::size_t b, std::size_t e) const {
-  if (b >= e || b >= tok.size()) {
-    return {};
-  }
-  const std::string s = text.substr(tok[b].begin, tok[std::min(e, tok.size()) - 1].end - tok[b].begin);
-  std::string out;
-  bool blank = false;
-  for (const char c : s) {
-    if (c == '\n' || c == '\r' || c == '\t' || c == ' ') {
-      blank = true;
-      continue;
-    }
-    if (blank && !out.empty()) {
-      out += ' ';
-    }
-    blank = false;
-    out += c;
-  }
-  return out.size() > 100 ? out.substr(0, 97) + "..." : out;
-}
-
-void RapidSource::fail(std::size_t i, const std::string& what) const {
-  throw DataError(fmt::format("{}:{}: {}", file, i < tok.size() ? tok[i].line : 0, what));
-}
-
 std::optional<std::size_t> parse_rapid_value(const RapidSource& s, std::size_t i, std::size_t end, RapidValue& v) {
   if (i >= end) {
     return std::nullopt;

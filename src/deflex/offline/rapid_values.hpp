@@ -16,20 +16,8 @@
 
 namespace deflex {
 
-/// The source being read: text, tokens, file name for messages.
-struct RapidSource {
-  std::string file;
-  const std::string& text;
-  std::vector<Token> tok;
-
-  [[nodiscard]] std::string str(std::size_t i) const;
-  [[nodiscard]] bool is_ident(std::size_t i, const char* word = nullptr) const;
-  [[nodiscard]] bool is_punct(std::size_t i, const char* p) const;
-  /// The source text of tokens [b, e) on one line (blanks collapsed, at most 100 characters).
-  [[nodiscard]] std::string span(std::size_t b, std::size_t e) const;
-  /// Throws DataError "FILE:LINE: what" with the line of token i.
-  [[noreturn]] void fail(std::size_t i, const std::string& what) const;
-};
+/// A RAPID module being read (program_tokens.hpp).
+using RapidSource = ProgramSource;
 
 /// A literal RAPID value: aggregates [..], numbers (a sign included), strings, names (TRUE/FALSE).
 struct RapidValue {
