@@ -129,6 +129,14 @@ def test_values_outside_their_documented_range_are_refused():
         robot.compensated_configuration([0, 1e3, 0, 0, 0, 0], np.zeros(6))
     with pytest.raises(deflex.InputError, match="argument force: element 0"):
         deflex.compensate_path(robot, deflex.Circle(), [2e6, 0, 0, 0, 0, 0])
+    # Counts and loads of the calibration planner and ISO 9283, bounded as the program's options are.
+    with pytest.raises(deflex.InputError, match=r"poses must be 1\.\.100000"):
+        deflex.plan_calibration(robot, [1.3, -0.4, 0.5], [1.9, 0.4, 1.1], poses=10**9)
+    with pytest.raises(deflex.InputError, match=r"the load: 1e\+12 N is outside"):
+        deflex.plan_calibration(robot, [1.3, -0.4, 0.5], [1.9, 0.4, 1.1], load_n=1e12)
+    circle = robot.fk(np.zeros((5, 6)))[:, :3, 3]
+    with pytest.raises(deflex.InputError, match=r"1000000000 evaluation points \(need 1\.\.100000\)"):
+        deflex.iso9283_path([circle], circle, evaluation_points=10**9)
     # In range, the deflection is the model's: doubling the load doubles it.
     one = robot.deflect(Q, [0, 0, -1e6, 0, 0, 0]).dtheta_rad
     half = robot.deflect(Q, [0, 0, -5e5, 0, 0, 0]).dtheta_rad
