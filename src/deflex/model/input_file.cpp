@@ -28,18 +28,18 @@ const char* kind_of_file(mode_t mode) {
   return "not a regular file";
 }
 
-[[noreturn]] void refuse(const std::string& path, const InputKindInfo& info, const std::string& what) {
-  throw DataError(fmt::format("{}: {}", path, what.empty() ? std::string(info.what) : what));
+[[noreturn]] void refuse(const std::string& path, const std::string& what) {
+  throw DataError(fmt::format("{}: {}", path, what));
 }
 
 void check_stat(const std::string& path, const InputKindInfo& info, const struct stat& st) {
   if (!S_ISREG(st.st_mode)) {
-    refuse(path, info,
+    refuse(path,
            fmt::format("is {}, not a regular file: deflex reads the {} from a regular file", kind_of_file(st.st_mode),
                        info.what));
   }
   if (static_cast<std::uint64_t>(st.st_size) > info.max_bytes) {
-    refuse(path, info,
+    refuse(path,
            fmt::format("the {} is {} bytes; deflex reads a {} of up to {} bytes ({} MiB)", info.what, st.st_size,
                        info.what, info.max_bytes, info.max_bytes / kMiB));
   }
@@ -71,22 +71,22 @@ const InputKindInfo& input_kind_info(InputKind kind) {
 InputFile::InputFile(const std::string& path, InputKind kind) : path_(path), kind_(kind) {
   const InputKindInfo& info = input_kind_info(kind);
   if (path.empty()) {
-    refuse("<empty path>", info, fmt::format("no file name given for the {}", info.what));
+    refuse("<empty path>", fmt::format("no file name given for the {}", info.what));
   }
   // stat first: a device is never opened (opening some has side effects), a FIFO never waited on.
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
-    refuse(path, info, fmt::format("cannot read the {}: {}", info.what, std::strerror(errno)));
+    refuse(path, fmt::format("cannot read the {}: {}", info.what, std::strerror(errno)));
   }
   check_stat(path, info, st);
   fd_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
   if (fd_ < 0) {
-    refuse(path, info, fmt::format("cannot read the {}: {}", info.what, std::strerror(errno)));
+    refuse(path, fmt::format("cannot read the {}: {}", info.what, std::strerror(errno)));
   }
   try {
     // What was opened, not what the path named a moment before.
     if (::fstat(fd_, &st) != 0) {
-      refuse(path, info, fmt::format("cannot read the {}: {}", info.what, std::strerror(errno)));
+      refuse(path, fmt::format("cannot read the {}: {}", info.what, std::strerror(errno)));
     }
     check_stat(path, info, st);
     ::fcntl(fd_, F_SETFL, ::fcntl(fd_, F_GETFL) & ~O_NONBLOCK);
