@@ -74,6 +74,7 @@ int check_stdout(const std::string& active, int exit_code) {
 int main(int argc, char** argv) {
   using namespace deflex::cli;
   hold_closed_standard_streams();
+  deflex::remove_temporaries_on_signals();  // Ctrl-C leaves no temporary file beside an output
   CLI::App app{
       "deflex: predicts and compensates the elastic deflection of industrial robots under process forces.\n"
       "Units: SI inside (m, rad, N, Nm, s); options and CSV columns name their unit (mm, deg where users expect them)."};

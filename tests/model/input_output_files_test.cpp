@@ -9,7 +9,10 @@
 #include <set>
 #include <thread>
 
+#include <csignal>
+
 #include <fcntl.h>
+#include <sys/wait.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -257,6 +260,27 @@ TEST(OutputTransaction, CommitsEveryFileAndRefusesTwoOutputsNamingOneFile) {
   u.add(s.at("c.csv"), "option -o");
   const std::string msg = error_of([&] { u.add(s.at("sub/../c.csv"), "option --rapid"); });
   EXPECT_NE(msg.find("are the same file"), std::string::npos) << msg;
+}
+
+TEST(OutputFile, AnInterruptedProgramRemovesItsTemporaryFiles) {
+  const Scratch s;
+  s.write("out.csv", "the user's data\n");
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    // The program: handlers installed, two outputs half written, then Ctrl-C.
+    remove_temporaries_on_signals();
+    OutputTransaction t;
+    t.add(s.at("out.csv"), "option -o").write(std::string(100000, 'x'));
+    t.add(s.at("new.csv"), "option --rapid").write("half");
+    ::raise(SIGINT);
+    ::_exit(0);  // not reached
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT);  // it died of the signal, as without us
+  EXPECT_EQ(s.names(), std::set<std::string>{"out.csv"});          // no temporary file left
+  EXPECT_EQ(slurp(s.at("out.csv")), "the user's data\n");
 }
 
 // --- one run: inputs and outputs apart -----------------------------------------------------------

@@ -9,6 +9,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include <csignal>
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -52,6 +54,49 @@ void sync_folder(const std::string& dir) noexcept {
 }
 
 std::atomic<unsigned> g_closed_streams{0};  // bit fd: standard stream fd was closed at start
+
+// The temporary files alive now, for the signal handler to remove: fixed slots, so the handler
+// touches no allocator, and unlink() is async-signal-safe. A file without a slot (more than 256
+// outputs at once) is still removed on every other way out.
+struct TemporarySlot {
+  std::atomic<bool> claimed{false};
+  std::atomic<bool> live{false};
+  char path[PATH_MAX] = {};
+};
+TemporarySlot g_temporaries[256];
+
+int claim_slot(const std::string& path) {
+  if (path.size() >= PATH_MAX) {
+    return -1;
+  }
+  for (int i = 0; i < 256; ++i) {
+    bool free = false;
+    if (g_temporaries[i].claimed.compare_exchange_strong(free, true)) {
+      std::memcpy(g_temporaries[i].path, path.c_str(), path.size() + 1);
+      g_temporaries[i].live.store(true, std::memory_order_release);
+      return i;
+    }
+  }
+  return -1;
+}
+
+void release_slot(int& slot) noexcept {
+  if (slot >= 0) {
+    g_temporaries[slot].live.store(false, std::memory_order_release);
+    g_temporaries[slot].claimed.store(false, std::memory_order_release);
+    slot = -1;
+  }
+}
+
+extern "C" void remove_temporaries_and_die(int signal_number) {
+  for (TemporarySlot& t : g_temporaries) {
+    if (t.live.load(std::memory_order_acquire)) {
+      ::unlink(t.path);
+    }
+  }
+  ::signal(signal_number, SIG_DFL);
+  ::raise(signal_number);
+}
 
 const char* special_kind(mode_t mode) {
   if (S_ISBLK(mode)) return "a block device";
@@ -160,6 +205,7 @@ void OutputFile::create_temporary(const std::string& target_path, bool existed, 
                                    std::strerror(err)));
     }
   }
+  slot_ = claim_slot(temp_);
   if (existed) {
     (void)::fchmod(fd_, static_cast<mode_t>(mode));  // best effort: the owner may differ
   }
@@ -176,6 +222,7 @@ void OutputFile::discard() noexcept {
     ::unlink(temp_.c_str());  // our own temporary file, never the target
     temp_.clear();
   }
+  release_slot(slot_);
 }
 
 void OutputFile::flush_buffer() {
@@ -231,6 +278,7 @@ void OutputFile::rename_into_place() {
   }
   committed_ = true;
   temp_.clear();
+  release_slot(slot_);
 }
 
 void OutputFile::commit() {
@@ -326,6 +374,20 @@ void OutputTransaction::commit() {
 }
 
 void mark_standard_stream_closed(int fd) { g_closed_streams |= 1U << fd; }
+
+void remove_temporaries_on_signals() {
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction before {};
+    ::sigaction(signal_number, nullptr, &before);
+    if (before.sa_handler == SIG_IGN) {
+      continue;  // ignored by whoever started us (nohup, a background job): it stays ignored
+    }
+    struct sigaction action {};
+    action.sa_handler = remove_temporaries_and_die;
+    sigemptyset(&action.sa_mask);
+    ::sigaction(signal_number, &action, nullptr);
+  }
+}
 
 void write_output_file(const std::string& path, std::string_view text, const std::string& what) {
   OutputFile file(path, what);

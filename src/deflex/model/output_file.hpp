@@ -10,7 +10,9 @@
 // - a character device or a FIFO (/dev/null, /dev/stdout, a pipe) is written in place as a stream,
 //   never renamed, truncated or removed; what was written to a stream cannot be taken back;
 // - a folder, a block device or a socket is refused, as is a missing folder;
-// - a file the same run reads is refused before it is written (run_files.hpp).
+// - a file the same run reads is refused before it is written (run_files.hpp);
+// - interrupted by a signal, a program that called remove_temporaries_on_signals() removes the
+//   temporary files it was writing.
 // Problems with the path itself are InputError (exit code 2), failed writes OutputError (exit
 // code 1), both naming the file.
 #pragma once
@@ -64,6 +66,7 @@ class OutputFile {
   bool existed_ = false;
   bool finished_ = false;
   bool committed_ = false;
+  int slot_ = -1;  // in the table the signal handler removes temporary files from
   std::string buffer_;
 };
 
@@ -92,6 +95,12 @@ class OutputTransaction {
 /// Tells the output layer that standard stream `fd` (1 or 2) was closed when the program started and
 /// now holds a placeholder that fails every write: an output naming it (/dev/stdout) is refused then.
 void mark_standard_stream_closed(int fd);
+
+/// Installs handlers for SIGINT, SIGTERM and SIGHUP that remove the temporary files of the outputs
+/// being written, then end the process as the signal would: an interrupted run leaves no trace in
+/// the outputs' folders. For programs (the command-line program calls it); a library leaves the
+/// signals to its host.
+void remove_temporaries_on_signals();
 
 /// `text` as the whole content of `path`, committed at once (an OutputFile of its own).
 void write_output_file(const std::string& path, std::string_view text, const std::string& what = "output");
