@@ -1,6 +1,7 @@
 // Command-line parsing helpers shared by the subcommands.
 #include "cli_util.hpp"
 
+#include <array>
 #include <cmath>
 #include <iostream>
 #include <sstream>
@@ -14,7 +15,8 @@
 
 namespace deflex::cli {
 
-std::vector<double> parse_numbers(const std::string& text, const std::string& option, std::size_t expected) {
+std::vector<double> parse_numbers(const std::string& text, const std::string& option, std::size_t expected,
+                                  const InputRange& range) {
   std::vector<double> out;
   std::stringstream ss(text);
   std::string item;
@@ -27,7 +29,7 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& op
       throw InputError(
           fmt::format("option {}: {} (value {} of '{}')", option, not_a_number(t), out.size() + 1, text));
     }
-    if (const auto bad = range_violation(*v, range::kAnyValue)) {
+    if (const auto bad = range_violation(*v, range)) {
       throw InputError(fmt::format("option {}: value {}: {}", option, out.size() + 1, *bad));
     }
     out.push_back(*v);
@@ -39,12 +41,25 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& op
 }
 
 JointVector parse_joints_deg(const std::string& text, const RobotModel& model, const std::string& option) {
-  const auto v = parse_numbers(text, option, static_cast<std::size_t>(model.dof()));
+  const auto v = parse_numbers(text, option, static_cast<std::size_t>(model.dof()), range::kAngleDeg);
   JointVector q(model.dof());
   for (int i = 0; i < model.dof(); ++i) {
     q[i] = deg_to_rad(v[static_cast<std::size_t>(i)]);
   }
   return q;
+}
+
+Wrench parse_wrench(const std::string& text, const std::string& option) {
+  const auto v = parse_numbers(text, option, 6);
+  Wrench w;
+  for (int i = 0; i < 6; ++i) {
+    w[i] = v[static_cast<std::size_t>(i)];
+    if (const auto bad = range_violation(w[i], i < 3 ? range::kForceN : range::kMomentNm)) {
+      throw InputError(fmt::format("option {}: value {} ({}): {}", option, i + 1,
+                                   std::array{"Fx", "Fy", "Fz", "Mx", "My", "Mz"}[static_cast<std::size_t>(i)], *bad));
+    }
+  }
+  return w;
 }
 
 const char* const kStiffnessHelp =
@@ -98,6 +113,10 @@ nlohmann::json vector_to_json(const Eigen::Ref<const Eigen::VectorXd>& v) {
   return out;
 }
 
-void print_json(const nlohmann::json& doc) { std::cout << doc.dump(2) << std::endl; }
+void print_json(const nlohmann::json& doc) {
+  // A byte that is not UTF-8 (a file name, a program's text) becomes U+FFFD rather than an exception:
+  // the readers refuse such text in the fields they take, names given by the shell may still carry it.
+  std::cout << doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
+}
 
 }  // namespace deflex::cli

@@ -7,16 +7,22 @@
 
 #include <nlohmann/json.hpp>
 
+#include "deflex/model/input_ranges.hpp"
 #include "deflex/model/robot_model.hpp"
 
 namespace deflex::cli {
 
-/// "1, 2.5,3" -> {1, 2.5, 3}. Throws InputError naming `option` on a bad number, NaN/inf, or when
-/// `expected` (if non-zero) does not match the count.
-std::vector<double> parse_numbers(const std::string& text, const std::string& option, std::size_t expected = 0);
+/// "1, 2.5,3" -> {1, 2.5, 3}. Throws InputError naming `option` on a bad number, NaN/inf, a value
+/// outside `range` (input_ranges.hpp), or when `expected` (if non-zero) does not match the count.
+std::vector<double> parse_numbers(const std::string& text, const std::string& option, std::size_t expected = 0,
+                                  const InputRange& range = range::kAnyValue);
 
-/// Joint values given in degrees on the command line, to rad, checked against the robot's dof.
+/// Joint values given in degrees on the command line (each within +-3600 deg), to rad, checked
+/// against the robot's dof.
 JointVector parse_joints_deg(const std::string& text, const RobotModel& model, const std::string& option);
+
+/// A wrench "Fx,Fy,Fz,Mx,My,Mz" in N and Nm, each within the force and moment ranges (+-1e6).
+Wrench parse_wrench(const std::string& text, const std::string& option);
 
 /// The robot of `--robot` (empty or "builtin": the built-in IRB6700). `stiffness_text` (the option
 /// --stiffness-Nm-per-rad, "k1,...,kN" in Nm/rad) replaces the file's joint stiffness when given.

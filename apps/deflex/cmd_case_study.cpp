@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <mutex>
 
 #include "cli_util.hpp"
 #include "command.hpp"
@@ -15,6 +16,7 @@
 #include "deflex/evaluate/study_tables.hpp"
 #include "deflex/evaluate/tracker_trace.hpp"
 #include "deflex/model/errors.hpp"
+#include "deflex/model/output_file.hpp"
 #include "deflex/report/html_report.hpp"
 
 namespace deflex::cli {
@@ -111,6 +113,13 @@ std::vector<std::string> honest_notes(const study::CaseConfig& config, const Stu
 
 void run(const Opts& o, int& exit_code) {
   study::CaseConfig config = o.case_file.empty() ? study::paper_case() : study::load_case(o.case_file);
+  // The report's folder before the study runs, so a path that cannot be one fails at once.
+  std::error_code folder_error;
+  std::filesystem::create_directories(o.out_dir, folder_error);
+  if (folder_error) {
+    throw InputError(fmt::format("option --out '{}': cannot create the folder: {}", o.out_dir, folder_error.message()));
+  }
+  OutputTransaction outputs;  // the report and the traces: all or none
   if (o.seed >= 0) config.seed = static_cast<std::uint64_t>(o.seed);
   study::CaseStudyOptions options;
   options.quick = o.quick;
@@ -120,13 +129,15 @@ void run(const Opts& o, int& exit_code) {
   options.seeds = o.seeds;
   if (!o.no_progress) options.progress = draw_progress;
   std::vector<std::string> traces_written;
+  std::mutex trace_mutex;
   if (!o.traces_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(o.traces_dir, ec);
     if (ec) throw Error(fmt::format("{}: cannot create the directory: {}", o.traces_dir, ec.message()));
     options.trace_sink = [&](const std::string& name, const TrackerTrace& trace) {
       const std::string path = (std::filesystem::path(o.traces_dir) / (name + ".csv")).string();
-      write_tracker_csv(trace, path);
+      const std::lock_guard lock(trace_mutex);
+      write_tracker_csv(trace, outputs.add(path, "option --write-traces"));
       traces_written.push_back(path);
     };
   }
@@ -153,7 +164,8 @@ void run(const Opts& o, int& exit_code) {
   }
   report.notes = honest_notes(config, result.study);
   report.case_text = o.case_file.empty() ? study::paper_case_yaml() : std::string();
-  write_report(report, o.out_dir);
+  write_report(report, o.out_dir, outputs);
+  outputs.commit();
 
   if (o.json) {
     print_json(study_to_json(result.study));

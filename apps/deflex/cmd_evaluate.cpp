@@ -17,12 +17,15 @@ namespace deflex::cli {
 namespace {
 
 // Each file is one run, or with --split-laps each lap of a closed path in a file is one run.
-std::vector<TrackerTrace> read_all(const std::vector<std::string>& paths, bool split, const char* what) {
+// `names` gets each run's file (and lap), for messages about a run.
+std::vector<TrackerTrace> read_all(const std::vector<std::string>& paths, bool split, const char* what,
+                                   std::vector<std::string>& names) {
   std::vector<TrackerTrace> out;
   for (const auto& p : paths) {
     TrackerTrace t = read_tracker_csv(p);
     if (!split) {
       out.push_back(std::move(t));
+      names.push_back(p);
       continue;
     }
     LapSplit s = split_laps(t);
@@ -33,11 +36,26 @@ std::vector<TrackerTrace> read_all(const std::vector<std::string>& paths, bool s
                              s.dropped_partial > 0 ? fmt::format(" ({} partial piece{} left out)", s.dropped_partial,
                                                                  s.dropped_partial == 1 ? "" : "s")
                                                    : "");
-    for (auto& lap : s.laps) {
-      out.push_back(std::move(lap));
+    for (std::size_t k = 0; k < s.laps.size(); ++k) {
+      out.push_back(std::move(s.laps[k]));
+      names.push_back(fmt::format("{} lap {}", p, k + 1));
     }
   }
   return out;
+}
+
+/// ISO 9283 figures of `runs` against `reference`; an error names the files ("run 2" alone would not).
+Iso9283Path iso_of(const std::vector<TrackerTrace>& runs, const std::vector<std::string>& names,
+                   const TrackerTrace& reference, const std::string& reference_name, int points, double max_offset_m) {
+  try {
+    return iso9283_path(runs, reference, points, max_offset_m);
+  } catch (const InputError& e) {
+    std::string legend;
+    for (std::size_t k = 0; k < names.size(); ++k) {
+      legend += fmt::format("{}run {} = {}", legend.empty() ? "" : ", ", k + 1, names[k]);
+    }
+    throw InputError(fmt::format("{} ({}; reference = {})", e.what(), legend, reference_name));
+  }
 }
 
 std::size_t samples_of(const std::vector<TrackerTrace>& traces) {
@@ -107,8 +125,10 @@ void setup_evaluate(CLI::App& sub, int& exit_code) {
     if (!(o->max_offset_mm > 0.0)) {
       throw InputError("option --max-offset-mm: must be a positive number of mm");
     }
-    const std::vector<TrackerTrace> unloaded = read_all(o->unloaded, o->split, "unloaded");
-    const std::vector<TrackerTrace> loaded = read_all(o->loaded, o->split, "loaded");
+    std::vector<std::string> unloaded_names;
+    std::vector<std::string> loaded_names;
+    const std::vector<TrackerTrace> unloaded = read_all(o->unloaded, o->split, "unloaded", unloaded_names);
+    const std::vector<TrackerTrace> loaded = read_all(o->loaded, o->split, "loaded", loaded_names);
     std::vector<TrackerTrace> distance_reference;
     if (o->mean_reference) {
       TrackerTrace all;
@@ -128,10 +148,12 @@ void setup_evaluate(CLI::App& sub, int& exit_code) {
     const bool have_commanded = !o->commanded.empty();
     const TrackerTrace reference = have_commanded ? read_tracker_csv(o->commanded) : unloaded.front();
     const std::string ref_name = have_commanded ? "commanded" : "unloaded (first run)";
-    const Iso9283Path iso_loaded = iso9283_path(loaded, reference, o->points, o->max_offset_mm * 1e-3);
+    const std::string ref_file = have_commanded ? o->commanded : unloaded_names.front();
+    const Iso9283Path iso_loaded =
+        iso_of(loaded, loaded_names, reference, ref_file, o->points, o->max_offset_mm * 1e-3);
     Iso9283Path iso_unloaded;
     if (have_commanded) {
-      iso_unloaded = iso9283_path(unloaded, reference, o->points, o->max_offset_mm * 1e-3);
+      iso_unloaded = iso_of(unloaded, unloaded_names, reference, ref_file, o->points, o->max_offset_mm * 1e-3);
     }
     if (o->json) {
       nlohmann::json doc{{"mean_deformation_mm", dev.mean_m * 1e3},

@@ -12,6 +12,7 @@
 #include "deflex/identify/calibration_simulation.hpp"
 #include "deflex/identify/stiffness_identification.hpp"
 #include "deflex/model/errors.hpp"
+#include "deflex/model/output_file.hpp"
 #include "deflex/model/robot_io.hpp"
 
 namespace deflex::cli {
@@ -40,8 +41,11 @@ std::vector<std::optional<double>> parse_fixed(const std::string& text, int dof,
     if (j < 1 || j > dof || j != std::floor(j)) {
       throw InputError(fmt::format("option {}: joint {} is not 1..{}", option, j, dof));
     }
-    if (!(k > 0.0)) {
-      throw InputError(fmt::format("option {}: stiffness of joint {} must be > 0 Nm/rad", option, j));
+    if (const auto bad = range_violation(k, range::kJointStiffness)) {
+      throw InputError(fmt::format("option {}: stiffness of joint {}: {}", option, j, *bad));
+    }
+    if (fixed[static_cast<std::size_t>(j) - 1]) {
+      throw InputError(fmt::format("option {}: joint {} is given twice ('{}'); give each joint once", option, j, text));
     }
     fixed[static_cast<std::size_t>(j) - 1] = k;
     start = end + 1;
@@ -72,6 +76,8 @@ void setup_identify(CLI::App& sub, int& exit_code) {
                  "Write the robot file with the identified stiffness (unidentified joints keep the file's value)");
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code] {
+    OutputTransaction outputs;  // prepared first: the robot file written is never one read
+    OutputFile* robot_out = o->write_robot.empty() ? nullptr : &outputs.add(o->write_robot, "option --write-robot");
     const RobotModel model = load_cli_robot("identify", o->robot);
     // Streamed: a row at a time from the file into the identifier's compact store.
     StiffnessMeasurementReader reader(o->data);
@@ -90,7 +96,12 @@ void setup_identify(CLI::App& sub, int& exit_code) {
     for (StiffnessMeasurement m; reader.next(m);) {
       identifier.add(m);
     }
-    const StiffnessEstimate est = identifier.solve();
+    StiffnessEstimate est;
+    try {
+      est = identifier.solve();
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: {}", o->data, e.what()));  // the data that cannot identify the joints
+    }
     if (identifier.scratch_bytes() > 0) {
       std::cerr << fmt::format(
           "deflex identify: {} measurements; {:.0f} MiB of their rows were kept in a scratch file in the temporary "
@@ -122,7 +133,10 @@ void setup_identify(CLI::App& sub, int& exit_code) {
       if (!kept.empty()) {
         note += fmt::format("; joints {} kept from the previous file", fmt::join(kept, ", "));
       }
-      write_robot_yaml(model.with_stiffness(k, note), o->write_robot);
+      robot_out->write(robot_to_yaml(model.with_stiffness(k, note)));
+    }
+    outputs.commit();
+    if (robot_out != nullptr) {
       std::cerr << fmt::format("deflex identify: wrote {}\n", o->write_robot);
     }
 
@@ -225,8 +239,12 @@ void setup_plan(CLI::App& sub, int& exit_code) {
   sub.add_option("--seed", o->seed, "Seed of the synthetic noise (default 1)");
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code] {
+    OutputTransaction outputs;  // both files or neither
+    OutputFile& plan_out = outputs.add(o->out, "option -o");
+    OutputFile* synthetic_out =
+        o->synth_out.empty() ? nullptr : &outputs.add(o->synth_out, "option --synthetic-measurements");
     const RobotModel model = load_cli_robot("plan-calibration", o->robot);
-    const auto r = parse_numbers(o->region, "--region-mm", 6);
+    const auto r = parse_numbers(o->region, "--region-mm", 6, range::kLengthMm);
     CalibrationPlanOptions opt;
     opt.region_min_m = Vector3(r[0], r[2], r[4]) * 1e-3;
     opt.region_max_m = Vector3(r[1], r[3], r[5]) * 1e-3;
@@ -240,14 +258,14 @@ void setup_plan(CLI::App& sub, int& exit_code) {
     opt.grid_per_axis = o->grid;
     opt.noise_m = o->noise_mm * 1e-3;
     if (!o->quaternion.empty()) {
-      const auto q = parse_numbers(o->quaternion, "--quaternion-wxyz", 4);
+      const auto q = parse_numbers(o->quaternion, "--quaternion-wxyz", 4, range::kUnitQuaternion);
       opt.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
       if (std::abs(opt.orientation.norm() - 1.0) > 1e-3) {
         throw InputError("option --quaternion-wxyz: not a unit quaternion");
       }
     }
     opt.spin_rad.clear();
-    const std::vector<double> spins = parse_numbers(o->spin, "--spin-deg");
+    const std::vector<double> spins = parse_numbers(o->spin, "--spin-deg", 0, range::kAngleDeg);
     if (spins.size() > 360) {
       throw InputError(fmt::format("option --spin-deg: {} turns; give at most 360 (each multiplies the candidates)",
                                    spins.size()));
@@ -269,16 +287,19 @@ void setup_plan(CLI::App& sub, int& exit_code) {
                                 return v;
                               }()),
                               "%, "))};
-    write_calibration_plan(o->out, plan, comments);
-    if (!o->synth_out.empty()) {
+    write_calibration_plan(plan_out, plan, comments);
+    if (synthetic_out != nullptr) {
       const RobotModel truth = o->synth_robot.empty() ? model : load_robot(o->synth_robot);
       const auto data = simulate_calibration(truth, plan, o->synth_noise_mm * 1e-3, o->seed);
       write_stiffness_measurements(
-          o->synth_out, data,
+          *synthetic_out, data,
           {fmt::format("SYNTHETIC measurements: plan {} run on '{}' (stiffness {} Nm/rad) by deflex plan-calibration "
                        "--synthetic-measurements; exact deflection + Gaussian noise {:.4f} mm per axis, seed {}",
                        o->out, truth.name(), fmt::join(truth.description().stiffness_nm_per_rad, ", "),
                        o->synth_noise_mm, o->seed)});
+    }
+    outputs.commit();
+    if (synthetic_out != nullptr) {
       std::cerr << fmt::format("deflex plan-calibration: wrote synthetic measurements {}\n", o->synth_out);
     }
     if (o->json) {

@@ -1,6 +1,5 @@
 // `deflex identify-payload`: the end effector's mass, centre of gravity and the force sensor's bias
 // from static poses (docs/online.md, "Payload identification").
-#include <fstream>
 #include <iostream>
 #include <memory>
 
@@ -9,6 +8,7 @@
 #include "cli_util.hpp"
 #include "command.hpp"
 #include "deflex/model/errors.hpp"
+#include "deflex/model/output_file.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/online/payload_identification.hpp"
 #include "deflex/online/sensor_config.hpp"
@@ -44,11 +44,17 @@ void setup_identify_payload(CLI::App& sub, int& exit_code) {
   sub.add_option("--sensor-config", o->sensor, "Sensor YAML giving the crosstalk matrix and the flange-to-sensor mount");
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code] {
+    OutputFile out(o->out, "option -o");  // prepared first: the file written is never one read
     SensorConfig sensor = sensor_or_default(o->sensor);
     const RobotModel model = load_cli_robot("identify-payload", o->robot);
     bool has_moments = false;
     const auto poses = read_payload_observations(o->data, &model, sensor.flange_T_sensor, sensor.crosstalk, has_moments);
-    const PayloadEstimate e = identify_payload(poses, has_moments, sensor.gravity_base_m_s2);
+    PayloadEstimate e;
+    try {
+      e = identify_payload(poses, has_moments, sensor.gravity_base_m_s2);
+    } catch (const InputError& error) {
+      throw InputError(fmt::format("{}: {}", o->data, error.what()));  // the poses that cannot identify it
+    }
     sensor.payload_mass_kg = e.mass_kg;
     sensor.payload_cog_sensor_m = e.cog_sensor_m;
     sensor.bias_sensor = e.bias_sensor;
@@ -58,12 +64,9 @@ void setup_identify_payload(CLI::App& sub, int& exit_code) {
     // What `online` would refuse is not written: a payload of 2.8e305 kg, a centre of gravity 1 km away.
     sensor.source = o->data + " (identified payload)";
     sensor.validate();
-    std::ofstream out(o->out);
-    if (!out) {
-      throw Error(fmt::format("{}: cannot write", o->out));
-    }
-    out << fmt::format("# identified by deflex identify-payload from {} ({} static poses)\n", o->data, e.poses)
-        << sensor_config_to_yaml(sensor);
+    out.write(fmt::format("# identified by deflex identify-payload from {} ({} static poses)\n", o->data, e.poses));
+    out.write(sensor_config_to_yaml(sensor));
+    out.commit();
     if (o->json) {
       print_json({{"mass_kg", e.mass_kg},
                   {"cog_sensor_m", vector_to_json(e.cog_sensor_m)},

@@ -74,8 +74,8 @@ void setup_ik(CLI::App& sub, int& exit_code) {
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code] {
     const RobotModel model = load_cli_robot("ik", o->robot);
-    const auto p = parse_numbers(o->position, "--position-mm", 3);
-    const auto qv = parse_numbers(o->quaternion, "--quaternion-wxyz", 4);
+    const auto p = parse_numbers(o->position, "--position-mm", 3, range::kLengthMm);
+    const auto qv = parse_numbers(o->quaternion, "--quaternion-wxyz", 4, range::kUnitQuaternion);
     Eigen::Quaterniond quat(qv[0], qv[1], qv[2], qv[3]);
     if (std::abs(quat.norm() - 1.0) > 1e-3) {
       throw InputError(fmt::format("option --quaternion-wxyz: not a unit quaternion (norm {:.6f})", quat.norm()));
@@ -149,11 +149,7 @@ void setup_deflect(CLI::App& sub, int& exit_code) {
     // Without stiffness the deflection would print as zero: refuse, as offline and online do.
     require_stiffness(model);
     const JointVector q = parse_joints_deg(o->joints, model, "--joints-deg");
-    const auto w = parse_numbers(o->wrench, "--wrench", 6);
-    Wrench wrench;
-    for (int i = 0; i < 6; ++i) {
-      wrench[i] = w[static_cast<std::size_t>(i)];
-    }
+    const Wrench wrench = parse_wrench(o->wrench, "--wrench");
     Workspace ws(model);
     ComplianceOptions opt;
     opt.complementary_stiffness = o->complementary;

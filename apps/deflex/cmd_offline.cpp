@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <cstdio>
 #include <iostream>
 #include <memory>
 
@@ -14,6 +13,7 @@
 #include "deflex/force/force_spec.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/model/errors.hpp"
+#include "deflex/model/output_file.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/offline/offline_csv.hpp"
@@ -58,34 +58,7 @@ std::string identifier_safe(const std::string& s) {
   return out;
 }
 
-/// --program-in: an existing RAPID or KRL program compensated target by target.
-void run_program(const Opts& o, const RobotModel& model, int& exit_code) {
-  if (o.program_out.empty()) {
-    throw InputError("option --program-in needs --program-out FILE (the input is never overwritten)");
-  }
-  if (!o.csv_out.empty() || !o.rapid_out.empty()) {
-    throw InputError("options -o and --rapid write a new path's files; with --program-in the output is --program-out");
-  }
-  std::vector<std::unique_ptr<ForceModel>> forces;
-  for (const std::string& spec : o.forces) {
-    for (auto& m : parse_force_specs(spec, {})) {
-      forces.push_back(std::move(m));
-    }
-  }
-  if (forces.size() != 1) {
-    throw InputError(fmt::format("--program-in compensates for one load: the --force options describe {}",
-                                 forces.size()));
-  }
-  ProgramOptions options;
-  options.tooldata = o.tooldata;
-  options.wobjdata = o.wobjdata;
-  const ProgramCompensation result = compensate_program(model, *forces.front(), o.program_in, o.program_out, options);
-  write_program_outputs(result);  // only once every target has been resolved and compensated
-  if (!o.json) {
-    std::cout << "robot: " << model.name() << "\n" << program_summary(result);
-    exit_code = 0;
-    return;
-  }
+nlohmann::json program_json(const RobotModel& model, const ProgramCompensation& result) {
   nlohmann::json targets = nlohmann::json::array();
   for (const ProgramTargetReport& t : result.targets) {
     targets.push_back({{"file", t.file},
@@ -93,6 +66,7 @@ void run_program(const Opts& o, const RobotModel& model, int& exit_code) {
                        {"instruction", t.instruction},
                        {"target", t.target},
                        {"action", t.action},
+                       {"configuration", t.configuration_note},
                        {"deflection_mm", t.deflection_m * 1e3},
                        {"deflection_mrad", t.deflection_rad * 1e3},
                        {"correction_mm", t.correction_m * 1e3},
@@ -108,74 +82,88 @@ void run_program(const Opts& o, const RobotModel& model, int& exit_code) {
   for (const ProgramFile& f : result.outputs) {
     outputs.push_back(f.path);
   }
-  print_json({{"robot", model.name()},
-              {"language", result.language},
-              {"force", result.force_description},
-              {"targets", targets},
-              {"unresolved", unresolved},
-              {"outputs", outputs}});
+  return {{"robot", model.name()},      {"language", result.language}, {"force", result.force_description},
+          {"targets", targets},         {"unresolved", unresolved},    {"outputs", outputs}};
+}
+
+/// --program-in: an existing RAPID or KRL program compensated target by target. The outputs are
+/// prepared before the program is read, so an output that is an input is refused first.
+void run_program(const Opts& o, int& exit_code) {
+  if (o.program_out.empty()) {
+    throw InputError("option --program-in needs --program-out FILE (the input is never overwritten)");
+  }
+  if (!o.csv_out.empty() || !o.rapid_out.empty() || !o.trajectory_out.empty() || !o.nominal_trajectory_out.empty()) {
+    throw InputError("options -o, --rapid, --joint-trajectory and --nominal-trajectory write a new path's files; "
+                     "with --program-in the output is --program-out");
+  }
+  OutputTransaction outputs;
+  std::vector<OutputFile*> files;
+  for (const std::string& path : program_output_paths(o.program_in, o.program_out)) {
+    files.push_back(&outputs.add(path, files.empty() ? "option --program-out" : "the data list beside --program-out"));
+  }
+  const RobotModel model = load_cli_robot("offline", o.robot, o.stiffness);
+  require_stiffness(model);
+  std::vector<std::unique_ptr<ForceModel>> forces;
+  for (const std::string& spec : o.forces) {
+    for (auto& m : parse_force_specs(spec, {})) {
+      forces.push_back(std::move(m));
+    }
+  }
+  if (forces.size() != 1) {
+    throw InputError(fmt::format("--program-in compensates for one load: the --force options describe {}",
+                                 forces.size()));
+  }
+  ProgramOptions options;
+  options.tooldata = o.tooldata;
+  options.wobjdata = o.wobjdata;
+  const ProgramCompensation result = compensate_program(model, *forces.front(), o.program_in, o.program_out, options);
+  for (const ProgramFile& f : result.outputs) {
+    for (OutputFile* file : files) {
+      if (file->path() == f.path) {
+        file->write(f.text);
+      }
+    }
+  }
+  outputs.commit();  // only once every target has been resolved and compensated: all files or none
+  if (!o.json) {
+    std::cout << "robot: " << model.name() << "\n" << program_summary(result);
+    exit_code = 0;
+    return;
+  }
+  print_json(program_json(model, result));
   exit_code = 0;
 }
 
-void run(const Opts& o, int& exit_code) {
-  if (!o.program_in.empty()) {
-    if (o.circle_given || !o.line.empty() || !o.path_csv.empty()) {
-      throw InputError("--program-in takes its targets from the program: give no --circle, --line or --path");
-    }
-    if (o.forces.empty()) {
-      throw InputError("give a force model: --force ldbb:...|constant:...|tool:...|table:FILE.csv");
-    }
-    const RobotModel model = load_cli_robot("offline", o.robot, o.stiffness);
-    require_stiffness(model);
-    run_program(o, model, exit_code);
-    return;
-  }
-  if (!o.program_out.empty() || !o.tooldata.empty() || !o.wobjdata.empty()) {
-    throw InputError("options --program-out, --tooldata and --wobjdata go with --program-in");
-  }
-  const int sources = (o.circle_given ? 1 : 0) + (o.line.empty() ? 0 : 1) + (o.path_csv.empty() ? 0 : 1);
-  if (sources != 1) {
-    throw InputError("give exactly one path: --circle [SPEC], --line SPEC, --path FILE.csv or --program-in FILE");
-  }
-  if (o.forces.empty()) {
-    throw InputError("give a force model: --force ldbb:...|constant:...|tool:...|table:FILE.csv");
-  }
-  const RobotModel model = load_cli_robot("offline", o.robot, o.stiffness);
-  require_stiffness(model);  // before any path is solved
-
-  // Path.
-  ForceSpecContext context;
-  std::unique_ptr<PoseSource> source;
-  std::string path_text;
+/// The pose source of --circle, --line or --path, and its description for the outputs.
+std::unique_ptr<PoseSource> make_pose_source(const Opts& o, ForceSpecContext& context, std::string& path_text) {
   if (!o.path_csv.empty()) {
-    source = std::make_unique<PoseCsvSource>(o.path_csv);
-    path_text = fmt::format("poses from {}", o.path_csv);
     if (o.orientation_given) {
       std::cerr << "deflex offline: warning: --orientation-wxyz is ignored: the path file gives the orientation\n";
     }
-  } else {
-    const auto qv = parse_numbers(o.orientation, "--orientation-wxyz", 4);
-    const Eigen::Quaterniond orientation =
-        checked_unit_quaternion(Eigen::Quaterniond(qv[0], qv[1], qv[2], qv[3]), "option --orientation-wxyz", 1e-3);
-    if (o.circle_given) {
-      const CirclePath c = parse_circle_spec(o.circle == "default" ? "" : o.circle);
-      context.circle = c;
-      source = std::make_unique<CirclePoseSource>(c, orientation);
-      path_text = fmt::format("circle centre ({:.1f}, {:.1f}, {:.1f}) mm, radius {:.1f} mm, normal ({:g}, {:g}, {:g}), "
-                              "{}, {} points",
-                              c.centre_m.x() * 1e3, c.centre_m.y() * 1e3, c.centre_m.z() * 1e3, c.radius_m * 1e3,
-                              c.normal.x(), c.normal.y(), c.normal.z(), c.clockwise ? "clockwise" : "counter-clockwise",
-                              c.points);
-    } else {
-      const LinePath l = parse_line_spec(o.line);
-      source = std::make_unique<LinePoseSource>(l, orientation);
-      path_text = fmt::format("line from ({:.1f}, {:.1f}, {:.1f}) mm to ({:.1f}, {:.1f}, {:.1f}) mm, {} points",
-                              l.start_m.x() * 1e3, l.start_m.y() * 1e3, l.start_m.z() * 1e3, l.end_m.x() * 1e3,
-                              l.end_m.y() * 1e3, l.end_m.z() * 1e3, l.points);
-    }
+    path_text = fmt::format("poses from {}", o.path_csv);
+    return std::make_unique<PoseCsvSource>(o.path_csv);
   }
+  const auto qv = parse_numbers(o.orientation, "--orientation-wxyz", 4, range::kUnitQuaternion);
+  const Eigen::Quaterniond orientation =
+      checked_unit_quaternion(Eigen::Quaterniond(qv[0], qv[1], qv[2], qv[3]), "option --orientation-wxyz", 1e-3);
+  if (o.circle_given) {
+    const CirclePath& c = *context.circle;
+    path_text = fmt::format("circle centre ({:.1f}, {:.1f}, {:.1f}) mm, radius {:.1f} mm, normal ({:g}, {:g}, {:g}), "
+                            "{}, {} points",
+                            c.centre_m.x() * 1e3, c.centre_m.y() * 1e3, c.centre_m.z() * 1e3, c.radius_m * 1e3,
+                            c.normal.x(), c.normal.y(), c.normal.z(), c.clockwise ? "clockwise" : "counter-clockwise",
+                            c.points);
+    return std::make_unique<CirclePoseSource>(c, orientation);
+  }
+  const LinePath l = parse_line_spec(o.line);
+  path_text = fmt::format("line from ({:.1f}, {:.1f}, {:.1f}) mm to ({:.1f}, {:.1f}, {:.1f}) mm, {} points",
+                          l.start_m.x() * 1e3, l.start_m.y() * 1e3, l.start_m.z() * 1e3, l.end_m.x() * 1e3,
+                          l.end_m.y() * 1e3, l.end_m.z() * 1e3, l.points);
+  return std::make_unique<LinePoseSource>(l, orientation);
+}
 
-  // Inverse kinematics along the path, one configuration kept.
+/// The first point's IK request from --config and --seed-deg.
+IkRequest first_ik_request(const Opts& o, const RobotModel& model) {
   IkRequest first;
   if (!o.config.empty()) {
     const auto c = parse_numbers(o.config, "--config", 4);
@@ -196,14 +184,10 @@ void run(const Opts& o, int& exit_code) {
   if (!o.seed.empty()) {
     first.seed = parse_joints_deg(o.seed, model, "--seed-deg");
   }
-  // Force models: several --force options, or several force_N values, give one run per load.
-  std::vector<std::unique_ptr<ForceModel>> forces;
-  for (const std::string& spec : o.forces) {
-    for (auto& m : parse_force_specs(spec, context)) {
-      forces.push_back(std::move(m));
-    }
-  }
+  return first;
+}
 
+RapidOptions rapid_options(const Opts& o) {
   RapidOptions rapid;
   if (o.motion == "absj") {
     rapid.motion = RapidMotion::kMoveAbsJ;
@@ -220,6 +204,68 @@ void run(const Opts& o, int& exit_code) {
     rapid.module_name = o.module;
     check_rapid_options(rapid);  // before anything is computed or written
   }
+  return rapid;
+}
+
+/// One load's run: its compensator, its outputs, what its outputs need of the whole path.
+struct Run {
+  const ForceModel* force = nullptr;
+  std::unique_ptr<PathCompensator> compensator;
+  std::string label;
+  std::string module_name;  // of the RAPID module
+  OutputFile* csv_file = nullptr;
+  OutputFile* rapid_file = nullptr;
+  OutputFile* trajectory_file = nullptr;
+  std::unique_ptr<OfflineCsvWriter> csv;
+  std::vector<OfflinePoint> points;      // for the RAPID module
+  std::vector<JointVector> q_command;    // for the compensated trajectory
+  const LdbbForceModel* ldbb = nullptr;  // the bar's length and inclination along the path
+  double lmin = HUGE_VAL, lmax = 0.0, pmin = HUGE_VAL, pmax = -HUGE_VAL;
+  OfflineResult summary;
+  std::string trajectory_text;  // "(compensated joint trajectory, 1.234 s at 10 mm/s)"
+};
+
+/// File-name labels of the loads, unique so that no run's file is another's.
+std::vector<std::string> run_labels(const std::vector<std::unique_ptr<ForceModel>>& forces) {
+  std::vector<std::string> labels;
+  for (std::size_t k = 0; k < forces.size(); ++k) {
+    std::string label = identifier_safe(forces[k]->label());
+    if (std::find(labels.begin(), labels.end(), label) != labels.end()) {
+      label += "_" + std::to_string(k + 1);
+    }
+    labels.push_back(label);
+  }
+  return labels;
+}
+
+/// Every output of every run, prepared before the robot and the path are read.
+void prepare_outputs(const Opts& o, std::vector<Run>& runs, OutputTransaction& outputs, OutputFile*& nominal) {
+  const bool several = runs.size() > 1;
+  const auto name = [&](const std::string& path, const Run& r) { return several ? suffixed(path, r.label) : path; };
+  for (Run& r : runs) {
+    if (!o.csv_out.empty()) {
+      r.csv_file = &outputs.add(name(o.csv_out, r), "option -o");
+    }
+    if (!o.rapid_out.empty()) {
+      r.rapid_file = &outputs.add(name(o.rapid_out, r), "option --rapid");
+    }
+    if (!o.trajectory_out.empty()) {
+      r.trajectory_file = &outputs.add(name(o.trajectory_out, r), "option --joint-trajectory");
+    }
+  }
+  if (!o.nominal_trajectory_out.empty()) {
+    nominal = &outputs.add(o.nominal_trajectory_out, "option --nominal-trajectory");
+  }
+}
+
+void check_path_options(const Opts& o) {
+  if (!o.program_out.empty() || !o.tooldata.empty() || !o.wobjdata.empty()) {
+    throw InputError("options --program-out, --tooldata and --wobjdata go with --program-in");
+  }
+  const int sources = (o.circle_given ? 1 : 0) + (o.line.empty() ? 0 : 1) + (o.path_csv.empty() ? 0 : 1);
+  if (sources != 1) {
+    throw InputError("give exactly one path: --circle [SPEC], --line SPEC, --path FILE.csv or --program-in FILE");
+  }
   if (!std::isfinite(o.hold_start_s) || o.hold_start_s < 0.0 || o.hold_start_s > 3600.0) {
     throw InputError(fmt::format("option --hold-start-s: must be 0..3600 s (got {})", o.hold_start_s));
   }
@@ -228,122 +274,74 @@ void run(const Opts& o, int& exit_code) {
     throw InputError(fmt::format("option --speed-mm-s: must be a positive TCP speed up to 10000 mm/s (got {})",
                                  o.speed_mm_s));
   }
+}
 
-  const bool several = forces.size() > 1;
-  std::vector<std::string> labels;  // file-name labels, made unique so no run overwrites another
-  for (std::size_t k = 0; k < forces.size(); ++k) {
-    std::string label = identifier_safe(forces[k]->label());
-    if (std::find(labels.begin(), labels.end(), label) != labels.end()) {
-      label += "_" + std::to_string(k + 1);
+/// The one pass over the path: a pose, its IK, then every load's compensation and CSV row. Only
+/// what an output needs whole is kept (a RAPID module's points, a trajectory's poses and joints), so
+/// a path written to CSV alone streams in memory independent of its length.
+void compensate_along(const Opts& o, const RobotModel& model, PoseSource& source, PathIkSolver& ik,
+                      std::vector<Run>& runs, std::vector<Pose>& poses, std::vector<JointVector>& q_nominal) {
+  const bool trajectories = !o.trajectory_out.empty() || !o.nominal_trajectory_out.empty();
+  for (Run& r : runs) {
+    if (r.csv_file != nullptr) {
+      r.csv = std::make_unique<OfflineCsvWriter>(*r.csv_file, model.dof(), model.name(), r.force->describe(), true);
     }
-    labels.push_back(label);
   }
-
-  // One pass over the path: a pose, its inverse kinematics, then every load's compensation and CSV
-  // row. Only what an output needs whole is kept (a RAPID module's points, a timed trajectory's
-  // poses and joints); a path written to CSV alone streams in memory independent of its length.
-  struct Run {
-    std::unique_ptr<PathCompensator> compensator;
-    std::unique_ptr<OfflineCsvWriter> csv;
-    std::string csv_file;
-    std::vector<OfflinePoint> points;      // for the RAPID module
-    std::vector<JointVector> q_command;    // for the compensated trajectory
-    const LdbbForceModel* ldbb = nullptr;  // the bar's length and inclination along the path
-    double lmin = HUGE_VAL, lmax = 0.0, pmin = HUGE_VAL, pmax = -HUGE_VAL;
-    OfflineResult summary;
-  };
-  std::vector<Run> runs_state(forces.size());
-  std::vector<std::string> written;  // removed again if the pass fails: no half-written outputs
-  std::vector<Pose> poses;           // kept only for the trajectories
-  std::vector<JointVector> q_nominal;
-  PathIkSolver ik(model, first);
-  try {
-    for (std::size_t k = 0; k < forces.size(); ++k) {
-      Run& r = runs_state[k];
-      r.compensator = std::make_unique<PathCompensator>(model, *forces[k]);
-      r.ldbb = dynamic_cast<const LdbbForceModel*>(forces[k].get());
-      if (!o.csv_out.empty()) {
-        r.csv_file = several ? suffixed(o.csv_out, labels[k]) : o.csv_out;
-        r.csv = std::make_unique<OfflineCsvWriter>(r.csv_file, model.dof(), model.name(), forces[k]->describe(), true);
-        written.push_back(r.csv_file);
-      }
+  Pose pose;
+  std::size_t i = 0;
+  for (; source.next(pose); ++i) {
+    const JointVector& q = ik.next(pose);
+    if (trajectories || !o.rapid_out.empty()) {
+      check_held_path_points(i);  // these outputs need the whole path
     }
-    Pose pose;
-    std::size_t i = 0;
-    for (; source->next(pose); ++i) {
-      const JointVector& q = ik.next(pose);
-      if (trajectories || !o.rapid_out.empty()) {
-        check_held_path_points(i);  // these outputs need the whole path
-      }
-      if (trajectories) {
-        poses.push_back(pose);
-        q_nominal.push_back(q);
-      }
-      for (Run& r : runs_state) {
-        const OfflinePoint& pt = r.compensator->compensate(i, q, pose);
-        if (r.csv) {
-          r.csv->write(i, pt);
-        }
-        if (!o.rapid_out.empty()) {
-          r.points.push_back(pt);
-        }
-        if (!o.trajectory_out.empty()) {
-          r.q_command.push_back(pt.q_command);
-        }
-        if (r.ldbb != nullptr) {
-          const double l = r.ldbb->bar_length_m(pose), phi = r.ldbb->inclination_rad(pose);
-          r.lmin = std::min(r.lmin, l);
-          r.lmax = std::max(r.lmax, l);
-          r.pmin = std::min(r.pmin, phi);
-          r.pmax = std::max(r.pmax, phi);
-        }
-      }
+    if (trajectories) {
+      poses.push_back(pose);
+      q_nominal.push_back(q);
     }
-    if (i == 0) {
-      throw InputError("path: no points");
-    }
-    for (Run& r : runs_state) {
-      r.summary = r.compensator->summary();  // a force table longer than the path fails here
+    for (Run& r : runs) {
+      const OfflinePoint& pt = r.compensator->compensate(i, q, pose);
       if (r.csv) {
-        r.csv->finish();
+        r.csv->write(i, pt);
+      }
+      if (r.rapid_file != nullptr) {
+        r.points.push_back(pt);
+      }
+      if (r.trajectory_file != nullptr) {
+        r.q_command.push_back(pt.q_command);
+      }
+      if (r.ldbb != nullptr) {
+        const double l = r.ldbb->bar_length_m(pose), phi = r.ldbb->inclination_rad(pose);
+        r.lmin = std::min(r.lmin, l);
+        r.lmax = std::max(r.lmax, l);
+        r.pmin = std::min(r.pmin, phi);
+        r.pmax = std::max(r.pmax, phi);
       }
     }
-  } catch (...) {
-    for (Run& r : runs_state) {
-      r.csv.reset();  // closes the file before it is removed
-    }
-    for (const std::string& f : written) {
-      std::remove(f.c_str());
-    }
-    throw;
   }
-  const ArmConfiguration& configuration = ik.configuration();
-  rapid.note = fmt::format("Path: {}; arm configuration [cf1,cf4,cf6,cfx] at the start [{},{},{},{}].", path_text,
-                           configuration.cf1, configuration.cf4, configuration.cf6, configuration.cfx);
-
-  // Timed joint programs for the streaming links (deflex online --program): the path at the TCP
-  // speed, compensated (per load) or nominal.
-  const auto write_trajectory = [&](const std::vector<JointVector>& q, const std::string& file,
-                                    const std::string& what) {
-    const JointTrajectory t = trajectory_at_tcp_speed(poses, q, o.speed_mm_s * 1e-3, model, o.hold_start_s);
-    t.write_csv(file, fmt::format("deflex offline: {} joint trajectory of {} at {:g} mm/s ({} points, {:.3f} s); "
-                                  "stream it with deflex online --link egm-joint --program {}",
-                                  what, path_text, o.speed_mm_s, t.size(), t.duration_s(), file));
-    return t;
-  };
-  if (!o.nominal_trajectory_out.empty()) {
-    const JointTrajectory t = write_trajectory(q_nominal, o.nominal_trajectory_out, "nominal (uncompensated)");
-    (o.json ? std::cerr : std::cout) << fmt::format("wrote {} (nominal joint trajectory, {:.3f} s)\n",
-                                                    o.nominal_trajectory_out, t.duration_s());
+  if (i == 0) {
+    throw InputError("path: no points");
   }
+  for (Run& r : runs) {
+    r.summary = r.compensator->summary();  // a force table longer than the path fails here
+    if (r.csv) {
+      r.csv->finish();
+    }
+  }
+}
 
-  nlohmann::json runs = nlohmann::json::array();
-  for (std::size_t k = 0; k < forces.size(); ++k) {
-    const ForceModel& force = *forces[k];
-    Run& state = runs_state[k];
-    OfflineResult& result = state.summary;
-    const std::string& label = labels[k];
-    nlohmann::json run{{"force", force.describe()},
+/// The summary (text or JSON) once every output is in place.
+void report_offline(const Opts& o, const RobotModel& model, const std::string& path_text,
+                    const ArmConfiguration& configuration, const std::vector<Run>& runs, const OutputFile* nominal,
+                    double nominal_s) {
+  if (nominal != nullptr) {
+    (o.json ? std::cerr : std::cout) << fmt::format("wrote {} (nominal joint trajectory, {:.3f} s)\n", nominal->path(),
+                                                    nominal_s);
+  }
+  nlohmann::json json_runs = nlohmann::json::array();
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const Run& r = runs[k];
+    const OfflineResult& result = r.summary;
+    nlohmann::json run{{"force", r.force->describe()},
                        {"points", result.point_count},
                        {"max_deflection_mm", result.max_deflection_m * 1e3},
                        {"mean_deflection_mm", result.mean_deflection_m * 1e3},
@@ -351,35 +349,25 @@ void run(const Opts& o, int& exit_code) {
                        {"max_correction_mm", result.max_correction_m * 1e3},
                        {"max_joint_correction_deg", rad_to_deg(result.max_joint_correction_rad)}};
     std::string extra;
-    if (state.ldbb != nullptr) {
+    if (r.ldbb != nullptr) {
       extra = fmt::format("LDBB bar: length {:.2f}..{:.2f} mm, inclination to the XY plane {:.2f}..{:.2f} deg\n",
-                          state.lmin * 1e3, state.lmax * 1e3, rad_to_deg(state.pmin), rad_to_deg(state.pmax));
-      run["bar_length_mm"] = {state.lmin * 1e3, state.lmax * 1e3};
-      run["bar_inclination_deg"] = {rad_to_deg(state.pmin), rad_to_deg(state.pmax)};
+                          r.lmin * 1e3, r.lmax * 1e3, rad_to_deg(r.pmin), rad_to_deg(r.pmax));
+      run["bar_length_mm"] = {r.lmin * 1e3, r.lmax * 1e3};
+      run["bar_inclination_deg"] = {rad_to_deg(r.pmin), rad_to_deg(r.pmax)};
     }
-    if (state.csv) {
-      run["csv"] = state.csv_file;
-      extra += fmt::format("wrote {}\n", state.csv_file);
+    if (r.csv_file != nullptr) {
+      run["csv"] = r.csv_file->path();
+      extra += fmt::format("wrote {}\n", r.csv_file->path());
     }
-    if (!o.trajectory_out.empty()) {
-      const std::string file = several ? suffixed(o.trajectory_out, label) : o.trajectory_out;
-      const JointTrajectory t = write_trajectory(state.q_command, file, "compensated");
-      run["joint_trajectory"] = file;
-      extra += fmt::format("wrote {} (compensated joint trajectory, {:.3f} s at {:g} mm/s)\n", file, t.duration_s(),
-                           o.speed_mm_s);
+    if (r.trajectory_file != nullptr) {
+      run["joint_trajectory"] = r.trajectory_file->path();
+      extra += fmt::format("wrote {} {}\n", r.trajectory_file->path(), r.trajectory_text);
     }
-    if (!o.rapid_out.empty()) {
-      const std::string file = several ? suffixed(o.rapid_out, label) : o.rapid_out;
-      rapid.module_name = several ? o.module + "_" + label : o.module;
-      if (rapid.module_name.size() > 32) {
-        rapid.module_name = (o.module + "_" + std::to_string(k + 1)).substr(0, 32);
-      }
-      result.points = std::move(state.points);
-      write_rapid_module(result, rapid, file);
-      run["rapid"] = file;
-      extra += fmt::format("wrote {} (module {})\n", file, rapid.module_name);
+    if (r.rapid_file != nullptr) {
+      run["rapid"] = r.rapid_file->path();
+      extra += fmt::format("wrote {} (module {})\n", r.rapid_file->path(), r.module_name);
     }
-    runs.push_back(run);
+    json_runs.push_back(run);
     if (!o.json) {
       std::cout << (k == 0 ? "" : "\n") << offline_summary(result) << extra;
     } else {
@@ -390,8 +378,89 @@ void run(const Opts& o, int& exit_code) {
     print_json({{"robot", model.name()},
                 {"path", path_text},
                 {"configuration", {configuration.cf1, configuration.cf4, configuration.cf6, configuration.cfx}},
-                {"runs", runs}});
+                {"runs", json_runs}});
   }
+}
+
+void run(const Opts& o, int& exit_code) {
+  if (o.forces.empty()) {
+    throw InputError("give a force model: --force ldbb:...|constant:...|tool:...|table:FILE.csv");
+  }
+  if (!o.program_in.empty()) {
+    if (o.circle_given || !o.line.empty() || !o.path_csv.empty()) {
+      throw InputError("--program-in takes its targets from the program: give no --circle, --line or --path");
+    }
+    run_program(o, exit_code);
+    return;
+  }
+  check_path_options(o);
+  ForceSpecContext context;
+  if (o.circle_given) {
+    context.circle = parse_circle_spec(o.circle == "default" ? "" : o.circle);
+  }
+  // Force models: several --force options, or several force_N values, give one run per load.
+  std::vector<std::unique_ptr<ForceModel>> forces;
+  for (const std::string& spec : o.forces) {
+    for (auto& m : parse_force_specs(spec, context)) {
+      forces.push_back(std::move(m));
+    }
+  }
+  RapidOptions rapid = rapid_options(o);
+  std::vector<Run> runs(forces.size());
+  const std::vector<std::string> labels = run_labels(forces);
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    runs[k].label = labels[k];
+    runs[k].force = forces[k].get();
+    runs[k].ldbb = dynamic_cast<const LdbbForceModel*>(forces[k].get());
+  }
+  OutputTransaction outputs;
+  OutputFile* nominal_file = nullptr;
+  prepare_outputs(o, runs, outputs, nominal_file);
+
+  const RobotModel model = load_cli_robot("offline", o.robot, o.stiffness);
+  require_stiffness(model);  // before any path is solved
+  std::string path_text;
+  const std::unique_ptr<PoseSource> source = make_pose_source(o, context, path_text);
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    runs[k].compensator = std::make_unique<PathCompensator>(model, *forces[k]);
+  }
+  PathIkSolver ik(model, first_ik_request(o, model));
+  std::vector<Pose> poses;  // kept only for the trajectories
+  std::vector<JointVector> q_nominal;
+  compensate_along(o, model, *source, ik, runs, poses, q_nominal);
+  const ArmConfiguration& configuration = ik.configuration();
+  rapid.note = fmt::format("Path: {}; arm configuration [cf1,cf4,cf6,cfx] at the start [{},{},{},{}].", path_text,
+                           configuration.cf1, configuration.cf4, configuration.cf6, configuration.cfx);
+
+  // Timed joint programs for the streaming links (deflex online --program): the path at the TCP
+  // speed, compensated (per load) or nominal.
+  const auto write_trajectory = [&](const std::vector<JointVector>& q, OutputFile& file, const std::string& what) {
+    const JointTrajectory t = trajectory_at_tcp_speed(poses, q, o.speed_mm_s * 1e-3, model, o.hold_start_s);
+    file.write(t.csv_text(fmt::format("deflex offline: {} joint trajectory of {} at {:g} mm/s ({} points, {:.3f} s); "
+                                      "stream it with deflex online --link egm-joint --program {}",
+                                      what, path_text, o.speed_mm_s, t.size(), t.duration_s(), file.path())));
+    return t.duration_s();
+  };
+  const double nominal_s =
+      nominal_file != nullptr ? write_trajectory(q_nominal, *nominal_file, "nominal (uncompensated)") : 0.0;
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    Run& r = runs[k];
+    if (r.trajectory_file != nullptr) {
+      r.trajectory_text = fmt::format("(compensated joint trajectory, {:.3f} s at {:g} mm/s)",
+                                      write_trajectory(r.q_command, *r.trajectory_file, "compensated"), o.speed_mm_s);
+    }
+    if (r.rapid_file != nullptr) {
+      rapid.module_name = runs.size() > 1 ? o.module + "_" + r.label : o.module;
+      if (rapid.module_name.size() > 32) {
+        rapid.module_name = (o.module + "_" + std::to_string(k + 1)).substr(0, 32);
+      }
+      r.module_name = rapid.module_name;
+      r.summary.points = std::move(r.points);
+      r.rapid_file->write(rapid_module(r.summary, rapid));
+    }
+  }
+  outputs.commit();  // every file of every load, or none
+  report_offline(o, model, path_text, configuration, runs, nominal_file, nominal_s);
   exit_code = 0;
 }
 

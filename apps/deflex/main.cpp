@@ -1,13 +1,21 @@
 // deflex: the command-line program. Parses options, calls the library, prints. Subcommands live in
 // cmd_*.cpp files and register themselves (command.hpp).
 #include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <iostream>
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #include <fmt/format.h>
 
 #include "command.hpp"
 #include "option_ranges.hpp"
 #include "deflex/model/errors.hpp"
+#include "deflex/model/output_file.hpp"
+#include "deflex/model/run_files.hpp"
 
 namespace deflex::cli {
 
@@ -20,10 +28,53 @@ CommandRegistrar::CommandRegistrar(std::string name, std::string help, CommandSe
   command_registry().push_back({std::move(name), std::move(help), std::move(setup), order});
 }
 
+namespace {
+
+/// A standard stream closed by the caller (`deflex ... >&-`) gets a placeholder that fails every
+/// write: the read end of a pipe of its own. Otherwise the first file deflex opens would take its
+/// number, and the summary meant for stdout would land in an output file.
+void hold_closed_standard_streams() {
+  for (int fd = STDIN_FILENO; fd <= STDERR_FILENO; ++fd) {
+    if (::fcntl(fd, F_GETFD) != -1 || errno != EBADF) {
+      continue;
+    }
+    int p[2];
+    if (::pipe(p) != 0) {
+      continue;
+    }
+    if (p[0] != fd) {
+      ::dup2(p[0], fd);  // closes p[1] first when that took fd's number
+      ::close(p[0]);
+    }
+    if (p[1] != fd) {
+      ::close(p[1]);
+    }
+    if (fd != STDIN_FILENO) {
+      deflex::mark_standard_stream_closed(fd);
+    }
+  }
+}
+
+/// The command's stdout must have reached it: a closed stdout or a full disk is a failed job.
+int check_stdout(const std::string& active, int exit_code) {
+  std::cout.flush();
+  const bool failed = std::cout.fail() || std::fflush(stdout) != 0 || std::ferror(stdout) != 0;
+  if (!failed) {
+    return exit_code;
+  }
+  std::cerr << fmt::format("deflex {}: error: writing to stdout failed ({})\n", active,
+                           errno != 0 ? std::strerror(errno) : "stream error");
+  return exit_code == 0 ? 1 : exit_code;
+}
+
+}  // namespace
+
 }  // namespace deflex::cli
 
 int main(int argc, char** argv) {
   using namespace deflex::cli;
+  hold_closed_standard_streams();
+  deflex::remove_temporaries_on_signals();  // Ctrl-C leaves no temporary file beside an output
   CLI::App app{
       "deflex: predicts and compensates the elastic deflection of industrial robots under process forces.\n"
       "Units: SI inside (m, rad, N, Nm, s); options and CSV columns name their unit (mm, deg where users expect them)."};
@@ -39,14 +90,20 @@ int main(int argc, char** argv) {
     sub->preparse_callback([&active, name = c.name](std::size_t) { active = name; });
   }
   add_option_range_checks(app);
+  // One run: no file is both read and written by the command (run_files.hpp).
+  const deflex::RunFilesScope run_files;
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
-    return app.exit(e);  // --help, --version: printed, exit 0
+    return check_stdout("", app.exit(e));  // --help, --version: printed, exit 0
   } catch (const CLI::ParseError& e) {
     // Every usage error is bad input: exit 2 like a bad file, never CLI11's own codes (104-114).
     std::cerr << usage_error_message(app, active, std::vector<std::string>(argv + 1, argv + argc), e) << "\n";
     return 2;
+  } catch (const deflex::OutputError& e) {
+    // An output could not be written: the job failed (nothing was left half-written).
+    std::cerr << fmt::format("deflex {}: error: {}\n", active, e.what());
+    return check_stdout(active, 1);
   } catch (const deflex::Error& e) {
     std::cerr << fmt::format("deflex {}: error: {}\n", active, e.what());
     return 2;
@@ -54,5 +111,5 @@ int main(int argc, char** argv) {
     std::cerr << fmt::format("deflex {}: internal error: {}\n", active, e.what());
     return 3;
   }
-  return exit_code;
+  return check_stdout(active, exit_code);
 }

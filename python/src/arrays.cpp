@@ -64,6 +64,23 @@ void require_finite(const Array& a, const char* name) {
   }
 }
 
+void require_in_ranges(const Array& a, const char* name, std::initializer_list<const InputRange*> columns) {
+  const double* d = a.data();
+  const py::ssize_t n = a.size();
+  const py::ssize_t width = a.ndim() == 0 ? 1 : a.shape(a.ndim() - 1);
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const py::ssize_t column = width > 0 ? i % width : 0;
+    const InputRange& r =
+        *(columns.size() == 1 ? *columns.begin() : *(columns.begin() + static_cast<std::ptrdiff_t>(column)));
+    if (const auto bad = range_violation(d[i], r)) {
+      if (a.ndim() >= 2) {
+        throw InputError(fmt::format("argument {}: row {}, column {}: {}", name, i / width, column, *bad));
+      }
+      throw InputError(fmt::format("argument {}: element {}: {}", name, i, *bad));
+    }
+  }
+}
+
 Array vector_array(const py::handle& obj, const char* name, py::ssize_t n) {
   Array a = to_array(obj, name);
   if (a.ndim() != 1 || a.shape(0) != n) wrong_shape(a, name, fmt::format("({},)", n));
@@ -92,7 +109,32 @@ Array single_or_batch(const py::handle& obj, const char* name, py::ssize_t n, bo
 
 JointVector joint_vector(const py::handle& obj, const char* name, int dof) {
   const Array a = vector_array(obj, name, dof);
+  require_in_ranges(a, name, {&range::kAngleRad});
   return Eigen::Map<const Eigen::VectorXd>(a.data(), dof);
+}
+
+Array joint_rows(const py::handle& obj, const char* name, int dof, bool& batch) {
+  Array a = single_or_batch(obj, name, dof, batch);
+  require_in_ranges(a, name, {&range::kAngleRad});
+  return a;
+}
+
+namespace {
+const std::initializer_list<const InputRange*> kWrenchRanges = {&range::kForceN,   &range::kForceN,
+                                                                &range::kForceN,   &range::kMomentNm,
+                                                                &range::kMomentNm, &range::kMomentNm};
+}  // namespace
+
+Vector6 wrench_vector(const py::handle& obj, const char* name) {
+  const Array a = vector_array(obj, name, 6);
+  require_in_ranges(a, name, kWrenchRanges);
+  return Eigen::Map<const Vector6>(a.data());
+}
+
+Array wrench_rows(const py::handle& obj, const char* name, bool& batch) {
+  Array a = single_or_batch(obj, name, 6, batch);
+  require_in_ranges(a, name, kWrenchRanges);
+  return a;
 }
 
 Vector3 vector3(const py::handle& obj, const char* name) {

@@ -3,6 +3,7 @@
 // deflex.InputError (a ValueError) naming the argument and the shape expected, never a crash.
 #pragma once
 
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include <pybind11/pybind11.h>
 
 #include "deflex/evaluate/tracker_trace.hpp"
+#include "deflex/model/input_ranges.hpp"
 #include "deflex/model/types.hpp"
 
 namespace deflex::python {
@@ -26,6 +28,11 @@ Array to_array(const py::handle& obj, const char* name, int ndim = 0);
 /// Throws InputError naming `name` and the first non-finite value (its row when 2-D).
 void require_finite(const Array& a, const char* name);
 
+/// Throws InputError naming `name`, the row and the column of the first value outside its column's
+/// range (input_ranges.hpp, the table the command-line program and the files use). `columns`: one
+/// range a column of the last dimension, or a single range for every column.
+void require_in_ranges(const Array& a, const char* name, std::initializer_list<const InputRange*> columns);
+
 /// Shape (n,) exactly; finite.
 Array vector_array(const py::handle& obj, const char* name, py::ssize_t n);
 /// Shape (rows, cols) with `rows` any (-1) or fixed; finite.
@@ -33,7 +40,14 @@ Array matrix_array(const py::handle& obj, const char* name, py::ssize_t rows, py
 /// Shape (n,) or (N, n): a single point or a batch. `batch` says which. Finite, row named on failure.
 Array single_or_batch(const py::handle& obj, const char* name, py::ssize_t n, bool& batch);
 
+/// Joint values (rad), each within the angle range (+-63 rad).
 JointVector joint_vector(const py::handle& obj, const char* name, int dof);
+/// Joint values (dof,) or (N, dof), rad, each within the angle range.
+Array joint_rows(const py::handle& obj, const char* name, int dof, bool& batch);
+/// A wrench [Fx Fy Fz Mx My Mz] (N, Nm) within the force and moment ranges (+-1e6 N, +-1e6 Nm).
+Vector6 wrench_vector(const py::handle& obj, const char* name);
+/// Wrenches (6,) or (N, 6), each within the force and moment ranges.
+Array wrench_rows(const py::handle& obj, const char* name, bool& batch);
 Vector3 vector3(const py::handle& obj, const char* name);
 Vector6 vector6(const py::handle& obj, const char* name);
 /// A unit quaternion (w, x, y, z) within 1e-6, normalised.

@@ -25,6 +25,13 @@ std::vector<StiffnessMeasurement> measurements_from_arrays(const RobotModel& mod
   const bool has_rot = !drot_obj.is_none(), has_weight = !weight_obj.is_none();
   const Array drot = has_rot ? matrix_array(drot_obj, "drot", n, 3) : Array();
   const Array weight = has_weight ? vector_array(weight_obj, "weight", n) : Array();
+  // The ranges of the measurement file's columns (q_deg, fx_N, dx_mm ...), in SI here.
+  require_in_ranges(q, "q", {&range::kAngleRad});
+  require_in_ranges(w, "wrench", {&range::kForceN, &range::kForceN, &range::kForceN, &range::kMomentNm,
+                                  &range::kMomentNm, &range::kMomentNm});
+  require_in_ranges(dp, "dp", {&range::kLengthM});
+  if (has_rot) require_in_ranges(drot, "drot", {&range::kAngleRad});
+  if (has_weight) require_in_ranges(weight, "weight", {&range::kWeight});
   std::vector<StiffnessMeasurement> data(static_cast<std::size_t>(n));
   for (py::ssize_t i = 0; i < n; ++i) {
     auto& d = data[static_cast<std::size_t>(i)];

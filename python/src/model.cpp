@@ -46,7 +46,7 @@ std::vector<py::ssize_t> result_shape(bool batch, py::ssize_t rows, std::vector<
 template <typename Body>
 Array batch_of(const RobotModel& model, const py::handle& q_obj, std::vector<py::ssize_t> rest, Body&& body) {
   bool batch = false;
-  const Array q = single_or_batch(q_obj, "q", model.dof(), batch);
+  const Array q = joint_rows(q_obj, "q", model.dof(), batch);
   const py::ssize_t rows = batch ? q.shape(0) : 1;
   py::ssize_t block = 1;
   for (const py::ssize_t r : rest) block *= r;
@@ -85,8 +85,8 @@ struct Deflection {
 Deflection deflect(const RobotModel& model, const py::handle& q_obj, const py::handle& w_obj, bool complementary) {
   if (!model.has_stiffness()) (void)model.stiffness();  // throws ModelError naming the file
   bool batch = false, w_batch = false;
-  const Array q = single_or_batch(q_obj, "q", model.dof(), batch);
-  const Array w = single_or_batch(w_obj, "wrench", 6, w_batch);
+  const Array q = joint_rows(q_obj, "q", model.dof(), batch);
+  const Array w = wrench_rows(w_obj, "wrench", w_batch);
   const py::ssize_t rows = batch ? q.shape(0) : 1;
   if (w_batch && (!batch || w.shape(0) != rows)) {
     throw InputError(fmt::format("argument wrench: expected shape (6,) or ({}, 6) (one wrench a configuration), got "
@@ -214,7 +214,7 @@ void bind_model(py::module_& m) {
           [](const RobotModel& r, const py::handle& q, const py::handle& w) {
             Workspace ws(r);
             JointVector out;
-            compensated_configuration(r, ws, joint_vector(q, "q_desired", r.dof()), vector6(w, "wrench"), out);
+            compensated_configuration(r, ws, joint_vector(q, "q_desired", r.dof()), wrench_vector(w, "wrench"), out);
             return from_vector(out);
           },
           "q_desired"_a, "wrench"_a, "q_desired - K^-1 J_wap(q_desired)^T W (rad): the exact command for a known wrench.")
@@ -223,7 +223,7 @@ void bind_model(py::module_& m) {
           [](const RobotModel& r, const py::handle& q, const py::handle& w) {
             Workspace ws(r);
             JointVector out;
-            if (deflected_configuration(r, ws, joint_vector(q, "q_command", r.dof()), vector6(w, "wrench"), out) !=
+            if (deflected_configuration(r, ws, joint_vector(q, "q_command", r.dof()), wrench_vector(w, "wrench"), out) !=
                 DeflectionStatus::kConverged) {
               throw InputError("deflected_configuration: the fixed-point iteration did not converge (load too large)");
             }

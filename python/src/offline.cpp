@@ -42,7 +42,7 @@ class ArrayWrenchModel final : public ForceModel {
 std::unique_ptr<ForceModel> force_model(const py::handle& force, const ForceSpecContext& context) {
   if (py::isinstance<py::str>(force)) return parse_force_spec(force.cast<std::string>(), context);
   bool table = false;
-  const Array w = single_or_batch(force, "force", 6, table);
+  const Array w = wrench_rows(force, "force", table);
   if (!table) return std::make_unique<ConstantWrenchModel>(Eigen::Map<const Wrench>(w.data()));
   std::vector<Wrench> rows(static_cast<std::size_t>(w.shape(0)));
   for (std::size_t i = 0; i < rows.size(); ++i) rows[i] = Eigen::Map<const Wrench>(w.data() + 6 * i);

@@ -1,6 +1,9 @@
 """Errors: deflex's exceptions arrive as Python exceptions with the C++ program's message text, and no
 bad array (shape, dtype, NaN, memory layout) crashes or is silently misread."""
 
+import os
+import stat
+
 import numpy as np
 import pytest
 
@@ -111,3 +114,64 @@ def test_pose_arguments_are_checked():
         deflex.pose([1, 0, 1], [1, 1, 0, 0])
     with pytest.raises(deflex.InputError, match="argument point"):
         robot.fk(Q, "elbow")
+
+
+def test_values_outside_their_documented_range_are_refused():
+    robot = deflex.Robot.builtin()
+    # Forces and moments to +-1e6 N and Nm, joints to +-63 rad: the table the program and files use.
+    with pytest.raises(deflex.InputError, match=r"argument wrench: element 2: -1e\+308 N is outside -1e\+06\.\.1e\+06 N"):
+        robot.deflect(Q, [0, 0, -1e308, 0, 0, 0])
+    with pytest.raises(deflex.InputError, match=r"argument wrench: row 1, column 4: 2e\+06 Nm is outside"):
+        robot.deflect(np.zeros((2, 6)), [[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, 2e6, 0]])
+    with pytest.raises(deflex.InputError, match=r"argument q: row 3, column 0: 100 rad is outside -63\.\.63 rad"):
+        robot.fk(np.vstack([np.zeros((3, 6)), [100, 0, 0, 0, 0, 0]]))
+    with pytest.raises(deflex.InputError, match="argument q_desired: element 1"):
+        robot.compensated_configuration([0, 1e3, 0, 0, 0, 0], np.zeros(6))
+    with pytest.raises(deflex.InputError, match="argument force: element 0"):
+        deflex.compensate_path(robot, deflex.Circle(), [2e6, 0, 0, 0, 0, 0])
+    # Counts and loads of the calibration planner and ISO 9283, bounded as the program's options are.
+    with pytest.raises(deflex.InputError, match=r"poses must be 1\.\.100000"):
+        deflex.plan_calibration(robot, [1.3, -0.4, 0.5], [1.9, 0.4, 1.1], poses=10**9)
+    with pytest.raises(deflex.InputError, match=r"the load: 1e\+12 N is outside"):
+        deflex.plan_calibration(robot, [1.3, -0.4, 0.5], [1.9, 0.4, 1.1], load_n=1e12)
+    circle = robot.fk(np.zeros((5, 6)))[:, :3, 3]
+    with pytest.raises(deflex.InputError, match=r"1000000000 evaluation points \(need 1\.\.100000\)"):
+        deflex.iso9283_path([circle], circle, evaluation_points=10**9)
+    # In range, the deflection is the model's: doubling the load doubles it.
+    one = robot.deflect(Q, [0, 0, -1e6, 0, 0, 0]).dtheta_rad
+    half = robot.deflect(Q, [0, 0, -5e5, 0, 0, 0]).dtheta_rad
+    np.testing.assert_allclose(one, 2 * half, rtol=1e-12)
+
+
+def test_inputs_must_be_regular_files_within_their_size(tmp_path):
+    # A device: refused at once, not read until the memory runs out (it took 4 GiB).
+    with pytest.raises(deflex.Error, match="/dev/zero: is a character device"):
+        deflex.load_sensor_config("/dev/zero")
+    fifo = tmp_path / "robot.yaml"
+    os.mkfifo(fifo)
+    with pytest.raises(deflex.Error, match="is a FIFO"):  # no writer: a blocking open would hang
+        deflex.Robot.from_file(str(fifo))
+    with pytest.raises(deflex.Error, match="is a directory"):
+        deflex.read_tracker_csv(str(tmp_path))
+    big = tmp_path / "big.yaml"
+    with open(big, "wb") as f:
+        f.truncate((16 << 20) + 1)
+    with pytest.raises(deflex.Error, match=r"16777217 bytes; deflex reads a robot file of up to 16777216 bytes"):
+        deflex.Robot.from_file(str(big))
+
+
+def test_write_csv_never_leaves_half_a_file(tmp_path):
+    robot = deflex.Robot.builtin()
+    result = deflex.compensate_path(robot, deflex.Circle(), [0, 0, -300, 0, 0, 0])
+    out = tmp_path / "out.csv"
+    out.write_text("the user's file\n")
+    inode = out.stat().st_ino
+    with pytest.raises(deflex.Error, match="the folder"):
+        result.write_csv(str(tmp_path / "missing" / "out.csv"))
+    with pytest.raises(deflex.Error, match="/dev/full"):
+        result.write_csv("/dev/full")
+    assert os.path.exists("/dev/full") and stat.S_ISCHR(os.lstat("/dev/full").st_mode)
+    result.write_csv(str(out))
+    assert out.read_text().startswith("index,q1_des_deg")
+    assert out.stat().st_ino != inode  # replaced whole by a rename, never truncated in place
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.csv"]  # no temporary file left

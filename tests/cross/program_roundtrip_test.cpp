@@ -468,6 +468,102 @@ TEST(ProgramRoundTrip, KrlProgramChangesOnlyItsPointsAndMatchesTheModel) {
   fs::remove_all(out_dir);
 }
 
+/// The IK solution of `pose` nearest `seed` (largest joint difference), chosen here among all.
+JointVector nearest_solution(const RobotModel& m, const Pose& pose, const JointVector& seed) {
+  Workspace ws(m);
+  const std::vector<IkResult> all = all_ik_solutions(m, ws, pose, {});
+  EXPECT_FALSE(all.empty());
+  JointVector best = all.front().q;
+  for (const IkResult& r : all) {
+    if ((r.q - seed).cwiseAbs().maxCoeff() < (best - seed).cwiseAbs().maxCoeff()) {
+      best = r.q;
+    }
+  }
+  return best;
+}
+
+// A module taught on another cell (examples/programs/migrated_pocket.mod): its confdata fit no
+// solution of this robot. With ConfJ\Off and ConfL\Off every Cartesian target is solved as the
+// controller does, nearest the previous target's joints (chosen here among all IK solutions), and
+// compensated as the model says (J by central differences); without them the first is refused.
+TEST(ProgramRoundTrip, MigratedModuleWithConfOffIsCompensatedNearestThePreviousTarget) {
+  const std::string out_dir = (fs::temp_directory_path() / ("deflex_migrated_" + std::to_string(::getpid()))).string();
+  fs::create_directories(out_dir);
+  const std::string in = kExamples + "migrated_pocket.mod";
+  const auto r = run_cli("offline --program-in " + in + " --force tool:fz_N=-300 --program-out " + out_dir +
+                         "/out.mod --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto doc = nlohmann::json::parse(r.out);
+  ASSERT_EQ(doc["targets"].size(), 9u);
+  EXPECT_EQ(doc["unresolved"].size(), 0u);
+  int noted = 0;
+  for (const auto& t : doc["targets"]) {
+    const std::string note = t["configuration"];
+    noted += note.find("nearest the previous target's") != std::string::npos ? 1 : 0;
+  }
+  EXPECT_EQ(noted, 7);  // every MoveJ and MoveL; not the two MoveAbsJ
+
+  const std::string a = slurp(in);
+  const std::string b = slurp(out_dir + "/out.mod");
+  const auto din = rapid_declarations(a);
+  const auto dout = rapid_declarations(b);
+  const auto min = rapid_motions(a);
+  const auto mout = rapid_motions(b);
+  ASSERT_EQ(min.size(), mout.size());
+  const RobotModel m = builtin_irb6700().with_tool(pose_mm(Vector3(0, 0, 250), Eigen::Quaterniond::Identity()));
+  const Pose wobj = pose_mm(Vector3(1300, -200, 500), Eigen::Quaterniond::Identity());
+  Wrench wrench_tool;
+  wrench_tool << 0, 0, -300, 0, 0, 0;
+  Workspace ws(m);
+  JointVector previous;
+  for (std::size_t i = 0; i < min.size(); ++i) {
+    RapidTarget t_in, t_out;
+    ASSERT_TRUE(rapid_reach(min[i].targets[0], din, t_in));
+    ASSERT_TRUE(rapid_reach(mout[i].targets[0], dout, t_out));
+    JointVector q_des(6);
+    if (t_in.joint) {
+      for (int j = 0; j < 6; ++j) {
+        q_des[j] = deg_to_rad(t_in.joints[static_cast<std::size_t>(j)]);
+      }
+    } else {
+      ASSERT_EQ(previous.size(), 6) << "a Cartesian target before any joint target";
+      q_des = nearest_solution(m, wobj * pose_mm(t_in.p_mm, t_in.q), previous);
+      const ArmConfiguration own = arm_configuration(m, ws, q_des);
+      EXPECT_NE((std::array<int, 4>{own.cf1, own.cf4, own.cf6, own.cfx}), t_in.conf) << "not a migrated target";
+    }
+    const JointVector q_cmd = expected_command(m, q_des, wrench_tool);
+    if (t_in.joint) {
+      for (int j = 0; j < 6; ++j) {
+        EXPECT_NEAR(t_out.joints[static_cast<std::size_t>(j)], rad_to_deg(q_cmd[j]), 6e-5) << min[i].targets[0];
+      }
+    } else {
+      const Pose want = wobj.inverse() * tcp_pose(m, ws, q_cmd);
+      EXPECT_LT((t_out.p_mm - want.translation() * 1e3).norm(), 1e-4) << mout[i].targets[0];
+      EXPECT_LT(Eigen::AngleAxisd(want.linear() * t_out.q.normalized().toRotationMatrix().transpose()).angle(), 5e-8)
+          << mout[i].targets[0];
+      const ArmConfiguration c = arm_configuration(m, ws, q_cmd);
+      EXPECT_EQ((std::array<int, 4>{c.cf1, c.cf4, c.cf6, c.cfx}), t_out.conf) << "the confdata of this robot";
+      EXPECT_GT((t_out.p_mm - t_in.p_mm).norm(), 0.1) << mout[i].targets[0];
+    }
+    previous = q_des;
+  }
+
+  // Without ConfJ\Off and ConfL\Off the controller stops at the first Cartesian target, and so does deflex.
+  std::string strict = a;
+  for (const char* conf : {"ConfJ\\Off;", "ConfL\\Off;"}) {
+    strict.replace(strict.find(conf), std::string(conf).size(), std::string(conf).substr(0, 6) + "On; ");
+  }
+  std::ofstream(out_dir + "/strict.mod", std::ios::binary) << strict;
+  const auto refused =
+      run_cli("offline --program-in " + out_dir + "/strict.mod --force tool:fz_N=-300 --program-out " + out_dir +
+              "/strict_out.mod");
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find("strict.mod:41: MoveJ pApproach: configuration_unavailable"), std::string::npos)
+      << refused.err;
+  EXPECT_FALSE(fs::exists(out_dir + "/strict_out.mod"));
+  fs::remove_all(out_dir);
+}
+
 TEST(ProgramCli, BadInputExitsWithTwoAndWritesNothing) {
   const std::string dir = (fs::temp_directory_path() / ("deflex_badprog_" + std::to_string(::getpid()))).string();
   fs::create_directories(dir);

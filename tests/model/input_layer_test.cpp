@@ -10,6 +10,7 @@
 #include "deflex/model/input_ranges.hpp"
 #include "deflex/model/nearest_name.hpp"
 #include "deflex/model/parse_number.hpp"
+#include "deflex/model/utf8_text.hpp"
 #include "deflex/model/yaml_fields.hpp"
 #include "support/error_of.hpp"
 
@@ -105,6 +106,29 @@ TEST(YamlInput, RepeatedKeysAreRefusedWithTheirLine) {
   const std::string msg = error_of([] { (void)yaml::Field::load_string("a: 1\nb:\n  c: 2\n  c: 3\n", "f.yaml"); });
   EXPECT_NE(msg.find("f.yaml:4:3: field 'b.c': key given twice (first at line 3)"), std::string::npos) << msg;
   EXPECT_NO_THROW((void)yaml::Field::load_string("\xEF\xBB\xBF" "a: 1\n", "bom.yaml"));
+}
+
+TEST(YamlInput, OneDocumentPlainKeysAndUtf8Text) {
+  // A second document would be dropped by yaml-cpp's Load: refused with its line.
+  const std::string second = error_of([] { (void)yaml::Field::load_string("a: 1\n---\na: 2\n", "f.yaml"); });
+  EXPECT_NE(second.find("f.yaml:3: a second YAML document"), std::string::npos) << second;
+  EXPECT_NO_THROW((void)yaml::Field::load_string("---\na: 1\n", "start_marker.yaml"));
+  // A key that is a list (YAML's "? [a, b]") was an internal error.
+  const std::string key = error_of([] { (void)yaml::Field::load_string("name: x\n? [a, b]\n: 1\n", "f.yaml"); });
+  EXPECT_NE(key.find("f.yaml:2:3: field '<document>': a key must be a plain name"), std::string::npos) << key;
+  // A Latin-1 byte in a name: named with its field, not found later by the JSON writer.
+  const std::string latin1 = error_of([] { (void)yaml::Field::load_string("name: \"Bras \xE9l\"\n", "f.yaml"); });
+  EXPECT_NE(latin1.find("f.yaml:1:7: field 'name': byte 0xE9 at position 6 is not UTF-8"), std::string::npos) << latin1;
+  EXPECT_EQ(yaml::Field::load_string("name: \"Bras \xC3\xA9l\"\n", "f.yaml").at("name").as_string(), "Bras \xC3\xA9l");
+}
+
+TEST(Utf8Text, ValidSequencesOnly) {
+  EXPECT_FALSE(invalid_utf8_at("ascii, \xC3\xA9, \xE2\x82\xAC, \xF0\x9F\x98\x80"));
+  EXPECT_EQ(invalid_utf8_at("a\xC3"), 1u);              // cut short
+  EXPECT_EQ(invalid_utf8_at("\xC0\xAF"), 0u);           // overlong '/'
+  EXPECT_EQ(invalid_utf8_at("ab\xED\xA0\x80"), 2u);     // a surrogate
+  EXPECT_EQ(invalid_utf8_at("\xF4\x90\x80\x80"), 0u);   // past U+10FFFF
+  EXPECT_EQ(invalid_utf8_at("x\x80"), 1u);              // a continuation byte alone
 }
 
 TEST(YamlInput, KeysWithUnitsAreRangeChecked) {

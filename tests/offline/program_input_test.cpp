@@ -15,35 +15,14 @@
 #include "deflex/offline/program_compensation.hpp"
 #include "deflex/offline/program_text.hpp"
 #include "deflex/offline/rapid_program.hpp"
+#include "offline/program_fixtures.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex {
 namespace {
 
-const ConstantWrenchModel kPush(Wrench((Wrench() << 0, 0, -300, 0, 0, 0).finished()));
-
-// Reachable IRB 6700 targets (made with deflex ik): tool0 pointing down 1.6 m ahead.
-const char* const kP1 = "[[1600,0,1200],[0,0,1,0],[0,0,0,0],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]]";
-const char* const kP2 = "[[1600,200,1200],[0,0,1,0],[0,0,0,0],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]]";
-
-std::string module(const std::string& data, const std::string& body) {
-  return "MODULE T\n" + data + "  PROC main()\n" + body + "  ENDPROC\nENDMODULE\n";
-}
-
-ProgramCompensation rapid(const std::string& text, const ProgramOptions& options = {},
-                          const ForceModel& force = kPush) {
-  return compensate_rapid_module(builtin_irb6700(), force, "t.mod", text, "out.mod", options);
-}
-
+using namespace program_fixtures;
 using test::error_of;
-
-void expect_error(const std::string& text, const std::vector<std::string>& fragments,
-                  const ProgramOptions& options = {}) {
-  const std::string msg = error_of([&] { (void)rapid(text, options); });
-  for (const auto& f : fragments) {
-    EXPECT_NE(msg.find(f), std::string::npos) << "'" << msg << "' lacks '" << f << "'";
-  }
-}
 
 TEST(RapidProgram, SingleUseTargetsAreEditedInPlaceAndNothingElseChanges) {
   const std::string in = module(std::string("  CONST robtarget p1:=") + kP1 + ";\n  ! keep: p1\n",
@@ -114,17 +93,22 @@ TEST(RapidProgram, ToolsAndWorkObjectsFromTheModuleOrTheCommandLine) {
   o.wobjdata = {"wTable=[FALSE,TRUE,\"\",[[1200,0,400],[1,0,0,0]],[[0,0,0],[1,0,0,0]]]"};
   const ProgramCompensation r = rapid(module(data, body), o);
   ASSERT_EQ(r.targets.size(), 1u);
-  // A stationary tool cannot be compensated statically: listed, left alone.
+  // A stationary tool cannot be compensated statically: listed, left alone (the motion with tool0
+  // after it is compensated; a program with nothing to compensate is an error that lists why).
   ProgramOptions s = o;
   s.tooldata = {"tSpindle=[FALSE,[[0,0,200],[1,0,0,0]],[5,[0,0,100],[1,0,0,0],0,0,0]]"};
-  const ProgramCompensation st = rapid(module(data, body), s);
-  EXPECT_TRUE(st.targets.empty());
+  const ProgramCompensation st =
+      rapid(module(std::string("  CONST robtarget p2:=") + kP1 + ";\n" + data, body + "    MoveL p2,v100,fine,tool0;\n"),
+            s);
+  EXPECT_EQ(st.targets.size(), 1u);
   ASSERT_EQ(st.unresolved.size(), 1u);
   EXPECT_NE(st.unresolved[0].reason.find("stationary"), std::string::npos);
+  expect_error(module(data, body), {"t.mod: none of its motion targets can be compensated", "t.mod:4", "stationary"},
+               s);
   // Bad command-line values name the option.
   ProgramOptions bad;
   bad.tooldata = {"tSpindle=[TRUE,[[0,0,200]]]"};
-  expect_error(module(data, body), {"option --tooldata", "tSpindle", "not a literal tooldata"}, bad);
+  expect_error(module(data, body), {"option --tooldata", "tSpindle", "a tooldata has 3"}, bad);
 }
 
 TEST(RapidProgram, BadMotionsFailNamingTheFileLineAndName) {
@@ -199,21 +183,6 @@ TEST(ProgramEntry, NothingIsWrittenOnErrorAndTheInputIsNeverTheOutput) {
 // ---------------------------------------------------------------------------------------------
 // KRL.
 
-ProgramCompensation krl(const std::string& src, const std::string& dat, const ProgramOptions& options) {
-  return compensate_krl_program(
-      load_robot(std::string(DEFLEX_SOURCE_DIR) + "/examples/robots/kuka_kr210_r3100_2_flange.yaml"), kPush, "p.src",
-      src, "p.dat", dat, "out.src", options);
-}
-
-const char* const kDat =
-    "DEFDAT dxt\n"
-    "DECL E6POS XP1={X 1800.0,Y -300.0,Z 600.0,A 20.0,B 75.0,C 15.0,S 2,T 10,E1 0.0}\n"
-    "DECL FDAT FP1={TOOL_NO 1,BASE_NO 0,IPO_FRAME #BASE,POINT2[] \" \",TQ_STATE FALSE}\n"
-    "DECL FRAME TSPINDLE={X 250,Y 0,Z 0,A 0,B 0,C 0}\n"
-    "DECL E6POS P[2]\n"
-    "P[1]={X 1800.0,Y -200.0,Z 600.0,A 20.0,B 75.0,C 15.0,S 2,T 10}\n"
-    "ENDDAT\n";
-
 TEST(KrlProgram, PointsToolsAndErrors) {
   ProgramOptions o;
   o.tooldata = {"TOOL_DATA[1]={X 250,Y 0,Z 0,A 0,B 0,C 0}"};
@@ -245,10 +214,12 @@ TEST(KrlProgram, PointsToolsAndErrors) {
   const ProgramCompensation from_dat = krl("DEF dxt()\n$TOOL=TSPINDLE\n$BASE=$NULLFRAME\nPTP XP1\nEND\n", kDat, {});
   EXPECT_EQ(from_dat.targets.size(), 1u);
   EXPECT_NEAR(from_dat.targets[0].correction_m, r.targets[0].correction_m, 1e-12);  // the same tool as TOOL_DATA[1]
-  // A point without Status/Turn and nothing before it to continue from: listed.
-  const ProgramCompensation nost =
-      krl("DEF dxt()\n$TOOL=TOOL_DATA[1]\n$BASE=$NULLFRAME\nLIN {X 1800,Y -300,Z 600,A 20,B 75,C 15}\nEND\n", kDat, o);
+  // A point without Status/Turn and nothing before it to continue from: the arm's configuration
+  // when the program runs decides it, so it is listed.
+  const ProgramCompensation nost = krl(
+      "DEF dxt()\n$TOOL=TOOL_DATA[1]\n$BASE=$NULLFRAME\nLIN {X 1800,Y -300,Z 600,A 20,B 75,C 15}\nPTP XP1\nEND\n", kDat, o);
   ASSERT_EQ(nost.unresolved.size(), 1u);
+  EXPECT_EQ(nost.unresolved[0].line, 4);
   EXPECT_NE(nost.unresolved[0].reason.find("no Status and Turn"), std::string::npos);
   // After a point with them, it continues from it.
   const ProgramCompensation cont =

@@ -2,7 +2,6 @@
 #include "deflex/evaluate/study_tables.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <limits>
 
 #include <fmt/format.h>
@@ -10,6 +9,7 @@
 #include "deflex/evaluate/path_metrics.hpp"
 #include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
+#include "deflex/model/output_file.hpp"
 #include "deflex/model/parse_number.hpp"
 
 namespace deflex {
@@ -753,15 +753,12 @@ std::string study_tables_markdown(const StudyResult& study) {
   return out;
 }
 
-void write_study_csv(const StudyResult& study, const std::string& path) {
-  // Written directly rather than with CsvWriter: the first column is text (the setup's name).
-  std::ofstream f(path);
-  if (!f) {
-    throw Error(fmt::format("{}: cannot write the file", path));
-  }
+std::string study_csv_text(const StudyResult& study) {
+  // Not through CsvWriter: the first column is text (the setup's name).
+  std::string f;
   const PaperFigures paper = paper_reference();
   auto cell = [](double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : std::string(); };
-  f << "setup,load_N,speed_mm_s,uc_mm,c_mm,compensation,uc_std_mm,c_std_mm,uc_max_mm,c_max_mm,"
+  f += "setup,load_N,speed_mm_s,uc_mm,c_mm,compensation,uc_std_mm,c_std_mm,uc_max_mm,c_max_mm,"
        "iso_accuracy_uc_mm,iso_accuracy_c_mm,iso_repeatability_mm,uc_sync_mm,c_sync_mm,seeds,c_mm_seed_sd,"
        "c_mm_seed_min,c_mm_seed_max,paper_uc_mm,paper_c_mm\n";
   for (const auto& s : study.setups) {
@@ -771,7 +768,7 @@ void write_study_csv(const StudyResult& study, const std::string& path) {
       for (const int v : study_speeds_mm_s(study)) {
         const auto at = [&](const std::map<int, double>& m) { return cell(value_at_speed(m, v)); };
         const Spread cs = l.c_spread(v);
-        f << fmt::format("{},{:g},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", csv_text_cell(s.setup),
+        f += fmt::format("{},{:g},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", csv_text_cell(s.setup),
                          l.load_N, v, at(l.uc_mm), at(l.c_mm), at(l.compensation), at(l.uc_std_mm), at(l.c_std_mm),
                          at(l.uc_max_mm), at(l.c_max_mm), at(l.iso_accuracy_uc_mm), at(l.iso_accuracy_c_mm),
                          at(l.iso_repeatability_mm), at(l.uc_sync_mm), at(l.c_sync_mm), cs.n, cell(cs.sd),
@@ -780,46 +777,46 @@ void write_study_csv(const StudyResult& study, const std::string& path) {
       }
     }
   }
-  if (!f) {
-    throw Error(fmt::format("{}: write failed", path));
-  }
+  return f;
 }
 
-void write_sweep_csv(const StudyResult& study, const std::string& path) {
-  std::ofstream f(path);
-  if (!f) {
-    throw Error(fmt::format("{}: cannot write the file", path));
-  }
+std::string sweep_csv_text(const StudyResult& study) {
+  std::string f;
   auto cell = [](double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : std::string(); };
-  f << "setup,load_N,speed_mm_s,uc_mm,c_mm,compensation,c_sync_mm,seeds,c_mm_seed_sd,c_mm_seed_min,c_mm_seed_max\n";
+  f += "setup,load_N,speed_mm_s,uc_mm,c_mm,compensation,c_sync_mm,seeds,c_mm_seed_sd,c_mm_seed_min,c_mm_seed_max\n";
   for (const auto& p : study.speed_sweep) {
     const Spread cs = p.c_mm_by_seed.empty() ? spread_of({p.c_mm}) : spread_of(p.c_mm_by_seed);
-    f << fmt::format("{},{:g},{:g},{},{},{},{},{},{},{},{}\n", csv_text_cell(p.setup), p.load_N, p.speed_mm_s, cell(p.uc_mm),
+    f += fmt::format("{},{:g},{:g},{},{},{},{},{},{},{},{}\n", csv_text_cell(p.setup), p.load_N, p.speed_mm_s, cell(p.uc_mm),
                      cell(p.c_mm), cell(p.compensation), cell(p.c_sync_mm), cs.n, cell(cs.sd), cell(cs.min),
                      cell(cs.max));
   }
-  if (!f) {
-    throw Error(fmt::format("{}: write failed", path));
-  }
+  return f;
 }
 
-void write_error_budget_csv(const StudyResult& study, const std::string& path) {
-  std::ofstream f(path);
-  if (!f) {
-    throw Error(fmt::format("{}: cannot write the file", path));
-  }
+std::string error_budget_csv_text(const StudyResult& study) {
+  std::string f;
   auto cell = [](double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : std::string(); };
-  f << "setup,load_N,speed_mm_s,seed,laps,residual_mm_all,uc_mm,effect,size,residual_mm_without_it,share_of_residual\n";
+  f += "setup,load_N,speed_mm_s,seed,laps,residual_mm_all,uc_mm,effect,size,residual_mm_without_it,share_of_residual\n";
   for (const auto& b : study.error_budgets) {
     for (const auto& e : b.entries) {
-      f << fmt::format("{},{:g},{:g},{},{},{},{},{},{},{},{}\n", csv_text_cell(b.setup), b.load_N, b.speed_mm_s, b.seed,
+      f += fmt::format("{},{:g},{:g},{},{},{},{},{},{},{},{}\n", csv_text_cell(b.setup), b.load_N, b.speed_mm_s, b.seed,
                        b.laps, cell(b.residual_mm_all), cell(b.uc_mm), csv_text_cell(e.effect), csv_text_cell(e.size),
                        cell(e.residual_mm_without_it), cell(e.share_of_residual));
     }
   }
-  if (!f) {
-    throw Error(fmt::format("{}: write failed", path));
-  }
+  return f;
+}
+
+void write_study_csv(const StudyResult& study, const std::string& path) {
+  write_output_file(path, study_csv_text(study));
+}
+
+void write_sweep_csv(const StudyResult& study, const std::string& path) {
+  write_output_file(path, sweep_csv_text(study));
+}
+
+void write_error_budget_csv(const StudyResult& study, const std::string& path) {
+  write_output_file(path, error_budget_csv_text(study));
 }
 
 }  // namespace deflex

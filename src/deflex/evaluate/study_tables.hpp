@@ -118,11 +118,15 @@ std::string study_tables_text(const StudyResult& study);
 std::string study_tables_markdown(const StudyResult& study);
 /// Long format, one row per setup, load and speed: setup,load_N,speed_mm_s,uc_mm,c_mm,compensation,
 /// ... ,seeds,c_mm_seed_sd,c_mm_seed_min,c_mm_seed_max,paper_uc_mm,paper_c_mm (empty cell where there
-/// is no figure). Throws Error on a write failure.
-void write_study_csv(const StudyResult& study, const std::string& path);
+/// is no figure).
+[[nodiscard]] std::string study_csv_text(const StudyResult& study);
 /// The speed sweep, one row per setup and speed (means and spread over the seeds).
-void write_sweep_csv(const StudyResult& study, const std::string& path);
+[[nodiscard]] std::string sweep_csv_text(const StudyResult& study);
 /// The error budget, one row per setup and effect.
+[[nodiscard]] std::string error_budget_csv_text(const StudyResult& study);
+/// The three as files of their own (output_file.hpp). Throw InputError or OutputError naming the file.
+void write_study_csv(const StudyResult& study, const std::string& path);
+void write_sweep_csv(const StudyResult& study, const std::string& path);
 void write_error_budget_csv(const StudyResult& study, const std::string& path);
 
 }  // namespace deflex

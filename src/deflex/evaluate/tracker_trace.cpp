@@ -45,7 +45,13 @@ TrackerTrace parse_tracker_csv(const std::string& text, const std::string& sourc
 }
 
 void write_tracker_csv(const TrackerTrace& trace, const std::string& path) {
-  CsvWriter w(path, {"t_s", "x_mm", "y_mm", "z_mm"});
+  OutputFile out(path, "tracker file");
+  write_tracker_csv(trace, out);
+  out.commit();
+}
+
+void write_tracker_csv(const TrackerTrace& trace, OutputFile& out) {
+  CsvWriter w(out, {"t_s", "x_mm", "y_mm", "z_mm"});
   for (const auto& s : trace) {
     const std::array<double, 4> row{s.t_s, s.p_m.x() * 1e3, s.p_m.y() * 1e3, s.p_m.z() * 1e3};
     w.row(row);

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "deflex/model/output_file.hpp"
 #include "deflex/model/types.hpp"
 
 namespace deflex {
@@ -26,8 +27,10 @@ TrackerTrace read_tracker_csv(const std::string& path);
 /// The same from text in memory; `source` names it in messages.
 TrackerTrace parse_tracker_csv(const std::string& text, const std::string& source);
 
-/// Writes t_s,x_mm,y_mm,z_mm (positions in mm, 10 significant digits). Throws Error when the file
-/// cannot be written.
+/// Writes t_s,x_mm,y_mm,z_mm (positions in mm, 10 significant digits) into an output of the caller's
+/// transaction (output_file.hpp). Throws OutputError when a write fails.
+void write_tracker_csv(const TrackerTrace& trace, OutputFile& out);
+/// The same into a file of its own.
 void write_tracker_csv(const TrackerTrace& trace, const std::string& path);
 
 /// Total length of the polyline through the samples (m).

@@ -13,6 +13,7 @@
 #include "deflex/identify/stiffness_identification.hpp"
 #include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
+#include "deflex/model/input_ranges.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
 
 namespace deflex {
@@ -39,18 +40,32 @@ double min_eigenvalue(const JointMatrix& G) {
 double log_det(const JointMatrix& G) { return Eigen::LDLT<JointMatrix>(G).vectorD().array().abs().log().sum(); }
 
 void check_options(const CalibrationPlanOptions& o) {
-  if (!o.region_min_m.allFinite() || !o.region_max_m.allFinite() ||
-      (o.region_max_m - o.region_min_m).minCoeff() < 0.0) {
+  // The ranges of input_ranges.hpp, which the command line applies to its options too (the Python
+  // module calls this directly).
+  for (int i = 0; i < 3; ++i) {
+    for (const double v : {o.region_min_m[i], o.region_max_m[i]}) {
+      if (const auto bad = range_violation(v, range::kLengthM)) {
+        throw InputError("plan_calibration: region: " + *bad);
+      }
+    }
+  }
+  if ((o.region_max_m - o.region_min_m).minCoeff() < 0.0) {
     throw InputError("plan_calibration: the region's minimum must not exceed its maximum on any axis");
   }
   if (!(o.load_n > 0.0) || !std::isfinite(o.load_n)) {
     throw InputError("plan_calibration: the load must be a force > 0 N");
   }
-  if (o.poses < 1 || o.loads_per_pose < 1 || o.loads_per_pose > 30) {
-    throw InputError("plan_calibration: poses must be >= 1 and loads per pose 1..30");
+  if (const auto bad = range_violation(o.load_n, range::kForceN)) {
+    throw InputError("plan_calibration: the load: " + *bad);
+  }
+  if (o.poses < 1 || o.poses > 100000 || o.loads_per_pose < 1 || o.loads_per_pose > 30) {
+    throw InputError("plan_calibration: poses must be 1..100000 and loads per pose 1..30");
   }
   if (!(o.lever_m >= 0.0) || !std::isfinite(o.lever_m)) {
     throw InputError("plan_calibration: the lever must be >= 0 m");
+  }
+  if (const auto bad = range_violation(o.lever_m, range::kLengthM)) {
+    throw InputError("plan_calibration: the lever: " + *bad);
   }
   if (o.grid_per_axis < 1 || o.grid_per_axis > 50 || o.spin_rad.empty()) {
     throw InputError("plan_calibration: grid per axis must be 1..50 and at least one tool spin given");
@@ -58,8 +73,8 @@ void check_options(const CalibrationPlanOptions& o) {
   if (std::abs(o.orientation.norm() - 1.0) > 1e-3) {
     throw InputError("plan_calibration: the orientation is not a unit quaternion");
   }
-  if (!(o.noise_m > 0.0)) {
-    throw InputError("plan_calibration: the noise must be > 0 m");
+  if (!(o.noise_m > 0.0) || range_violation(o.noise_m, range::kLengthM)) {
+    throw InputError("plan_calibration: the noise must be > 0 m and at most 100 m");
   }
 }
 
@@ -314,6 +329,12 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
 
 void write_calibration_plan(const std::string& path, const CalibrationPlan& plan,
                             const std::vector<std::string>& comments) {
+  OutputFile out(path, "calibration plan");
+  write_calibration_plan(out, plan, comments);
+  out.commit();
+}
+
+void write_calibration_plan(OutputFile& out, const CalibrationPlan& plan, const std::vector<std::string>& comments) {
   const Eigen::Index n = plan.points.empty() ? 0 : plan.points.front().q.size();
   std::vector<std::string> cols = {"pose"};
   for (Eigen::Index j = 1; j <= n; ++j) {
@@ -324,7 +345,7 @@ void write_calibration_plan(const std::string& path, const CalibrationPlan& plan
                         "expected_dz_mm"}) {
     cols.emplace_back(c);
   }
-  CsvWriter w(path, cols);
+  CsvWriter w(out, cols);
   for (const auto& c : comments) {
     w.comment(c);
   }

@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include "deflex/model/output_file.hpp"
 #include "deflex/model/robot_model.hpp"
 
 namespace deflex {
@@ -63,6 +64,8 @@ struct CalibrationPlan {
 
 /// Writes the plan as CSV for the cell operator (docs/identify.md): pose, q1_deg.., x_mm..,
 /// qw..qz, fx_N..mz_Nm, load_x_mm.., expected_dx_mm..; the plan figures as comment lines.
+void write_calibration_plan(OutputFile& out, const CalibrationPlan& plan, const std::vector<std::string>& comments = {});
+/// The same into a file of its own (output_file.hpp).
 void write_calibration_plan(const std::string& path, const CalibrationPlan& plan,
                             const std::vector<std::string>& comments = {});
 

@@ -134,6 +134,13 @@ std::vector<StiffnessMeasurement> read_stiffness_measurements(const std::string&
 
 void write_stiffness_measurements(const std::string& csv_path, const std::vector<StiffnessMeasurement>& data,
                                   const std::vector<std::string>& comments) {
+  OutputFile out(csv_path, "measurement file");
+  write_stiffness_measurements(out, data, comments);
+  out.commit();
+}
+
+void write_stiffness_measurements(OutputFile& out, const std::vector<StiffnessMeasurement>& data,
+                                  const std::vector<std::string>& comments) {
   const Eigen::Index n = data.empty() ? 0 : data.front().q.size();
   bool all_rot = !data.empty();
   for (const auto& m : data) {
@@ -155,7 +162,7 @@ void write_stiffness_measurements(const std::string& csv_path, const std::vector
     }
   }
   cols.emplace_back("weight");
-  CsvWriter w(csv_path, cols);
+  CsvWriter w(out, cols);
   for (const auto& c : comments) {
     w.comment(c);
   }

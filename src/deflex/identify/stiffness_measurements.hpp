@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "deflex/model/output_file.hpp"
 #include "deflex/model/types.hpp"
 
 namespace deflex {
@@ -62,8 +63,11 @@ class StiffnessMeasurementReader {
   std::size_t rows_ = 0;
 };
 
-/// Writes measurements in the same layout (deg, N, Nm, mm; drx.. only if every row has them).
-/// Throws Error when the file cannot be written.
+/// Writes measurements in the same layout (deg, N, Nm, mm; drx.. only if every row has them) into an
+/// output of the caller's transaction (output_file.hpp). Throws OutputError when a write fails.
+void write_stiffness_measurements(OutputFile& out, const std::vector<StiffnessMeasurement>& data,
+                                  const std::vector<std::string>& comments = {});
+/// The same into a file of its own.
 void write_stiffness_measurements(const std::string& csv_path, const std::vector<StiffnessMeasurement>& data,
                                   const std::vector<std::string>& comments = {});
 

@@ -9,12 +9,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
+#include <stdexcept>
 
 #include "deflex/model/errors.hpp"
 #include "deflex/model/format_number.hpp"
+#include "deflex/model/input_file.hpp"
 #include "deflex/model/input_ranges.hpp"
 #include "deflex/model/nearest_name.hpp"
 #include "deflex/model/parse_number.hpp"
@@ -58,28 +57,11 @@ std::string_view unquote(std::string_view cell) {
   return cell;
 }
 
-// A data file larger than this is refused before read_text_file reads it: 1 GiB holds some 30
-// million tracker samples, over eight hours at 1000 Hz. (CsvReader streams and needs no such bound.)
-constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 30;
-
 }  // namespace
 
-CsvReader::CsvReader(const std::string& path) : source_(path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    throw DataError(fmt::format("{}: is a directory, not a CSV file", path));
-  }
-  file_ = std::fopen(path.c_str(), "rb");
-  if (file_ == nullptr) {
-    throw DataError(fmt::format("{}: cannot read the file", path));
-  }
-  try {
-    read_header();
-  } catch (...) {
-    std::fclose(file_);
-    file_ = nullptr;
-    throw;
-  }
+CsvReader::CsvReader(const std::string& path, InputKind kind)
+    : source_(path), file_(std::make_unique<InputFile>(path, kind)) {
+  read_header();
 }
 
 CsvReader::CsvReader(std::string text, std::string source) : source_(std::move(source)), buffer_(std::move(text)) {
@@ -87,11 +69,7 @@ CsvReader::CsvReader(std::string text, std::string source) : source_(std::move(s
   read_header();
 }
 
-CsvReader::~CsvReader() {
-  if (file_ != nullptr) {
-    std::fclose(file_);
-  }
-}
+CsvReader::~CsvReader() = default;
 
 bool CsvReader::next_line(std::string_view& out) {
   while (true) {
@@ -138,14 +116,9 @@ bool CsvReader::next_line(std::string_view& out) {
     begin_ = 0;
     const std::size_t kept = buffer_.size();
     buffer_.resize(kept + kReadChunk);
-    const std::size_t got = std::fread(buffer_.data() + kept, 1, kReadChunk, file_);
+    const std::size_t got = file_->read(buffer_.data() + kept, kReadChunk);
     buffer_.resize(kept + got);
-    if (got < kReadChunk) {
-      if (std::ferror(file_) != 0) {
-        throw DataError(fmt::format("{}: read error after line {}", source_, line_));
-      }
-      eof_ = true;
-    }
+    eof_ = got == 0;
   }
 }
 
@@ -303,7 +276,7 @@ CsvTable CsvTable::drain(CsvReader& reader) {
 }
 
 CsvTable CsvTable::read_file(const std::string& path) {
-  CsvReader reader(path);
+  CsvReader reader(path, InputKind::kCsvTable);
   return drain(reader);
 }
 
@@ -334,30 +307,6 @@ void CsvTable::allow_only(const std::vector<std::string>& allowed) const {
   allow_only_columns(source_, columns_, allowed);
 }
 
-std::string read_text_file(const std::string& path, const char* what) {
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  if (!ec && size > kMaxFileBytes) {
-    throw DataError(fmt::format("{}: the {} is {} bytes; deflex reads files up to {} bytes", path, what, size,
-                                kMaxFileBytes));
-  }
-  if (!ec && std::filesystem::is_directory(path)) {
-    throw DataError(fmt::format("{}: is a directory, not a {}", path, what));
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw DataError(fmt::format("{}: cannot read the {}", path, what));
-  }
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
-  // A UTF-8 byte order mark (Excel writes one) is not part of the first column's name.
-  if (text.rfind("\xEF\xBB\xBF", 0) == 0) {
-    text.erase(0, 3);
-  }
-  return text;
-}
-
 std::string csv_text_cell(const std::string& text) {
   const bool plain = text.find_first_of(",\"\r\n") == std::string::npos && trim_view(text).size() == text.size();
   if (plain) {
@@ -374,29 +323,23 @@ std::string csv_text_cell(const std::string& text) {
   return out;
 }
 
-CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& columns)
-    : path_(path), width_(columns.size()) {
-  file_ = std::fopen(path.c_str(), "wb");
-  if (file_ == nullptr) {
-    throw Error(fmt::format("{}: cannot write the file", path));
-  }
+CsvWriter::CsvWriter(OutputFile& out, const std::vector<std::string>& columns) : out_(&out), width_(columns.size()) {
   fmt::format_to(std::back_inserter(buffer_), "{}\n", fmt::join(columns, ","));
 }
 
-CsvWriter::~CsvWriter() {
-  if (file_ != nullptr) {
-    std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
-    std::fclose(file_);
-  }
+CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& columns)
+    : own_(std::make_unique<OutputFile>(path)), out_(own_.get()), width_(columns.size()) {
+  fmt::format_to(std::back_inserter(buffer_), "{}\n", fmt::join(columns, ","));
 }
 
+// Unfinished, nothing more is written: a file of its own is discarded with own_.
+CsvWriter::~CsvWriter() = default;
+
 void CsvWriter::flush() {
-  if (file_ == nullptr) {
-    throw Error(fmt::format("{}: written after it was finished", path_));
+  if (finished_) {
+    throw std::logic_error(fmt::format("{}: CSV written after it was finished", out_->path()));
   }
-  if (buffer_.size() > 0 && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
-    throw Error(fmt::format("{}: write failed", path_));
-  }
+  out_->write(std::string_view(buffer_.data(), buffer_.size()));
   buffer_.clear();
 }
 
@@ -408,7 +351,7 @@ void CsvWriter::flush_if_full() {
 
 void CsvWriter::row(std::span<const double> values) {
   if (values.size() != width_) {
-    throw InputError(fmt::format("{}: row of {} values for {} columns", path_, values.size(), width_));
+    throw InputError(fmt::format("{}: row of {} values for {} columns", out_->path(), values.size(), width_));
   }
   // printf's %.10g, locale-free, straight into the buffer (format_g10: exactly std::to_chars', faster).
   char cell[kFormatG10MaxChars + 1];
@@ -430,11 +373,9 @@ void CsvWriter::comment(const std::string& text) {
 
 void CsvWriter::finish() {
   flush();
-  const bool ok = std::fflush(file_) == 0 && std::ferror(file_) == 0;
-  const bool closed = std::fclose(file_) == 0;
-  file_ = nullptr;
-  if (!ok || !closed) {
-    throw Error(fmt::format("{}: write failed", path_));
+  finished_ = true;
+  if (own_) {
+    own_->commit();
   }
 }
 

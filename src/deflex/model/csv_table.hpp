@@ -19,6 +19,9 @@
 
 #include <fmt/format.h>
 
+#include "deflex/model/input_file.hpp"
+#include "deflex/model/output_file.hpp"
+
 namespace deflex {
 
 struct InputRange;
@@ -29,9 +32,10 @@ struct InputRange;
 /// throw DataError naming the file, the line and the column.
 class CsvReader {
  public:
-  /// Opens the file and reads its header row. Throws DataError when the file cannot be read, has no
-  /// header, a header cell is empty or repeated, or the header is separated by ';' or tabs.
-  explicit CsvReader(const std::string& path);
+  /// Opens the file (input_file.hpp: a regular file within the limit of `kind`) and reads its header
+  /// row. Throws DataError when the file cannot be read, has no header, a header cell is empty or
+  /// repeated, or the header is separated by ';' or tabs.
+  explicit CsvReader(const std::string& path, InputKind kind = InputKind::kCsvStream);
   /// Reads from text held in memory; `source` names it in messages.
   CsvReader(std::string text, std::string source);
   ~CsvReader();
@@ -65,7 +69,7 @@ class CsvReader {
   void parse_row(std::string_view line);
 
   std::string source_;
-  std::FILE* file_ = nullptr;
+  std::unique_ptr<InputFile> file_;  // null when reading text held in memory
   std::string buffer_;     // the bytes read and not yet consumed, from begin_
   std::size_t begin_ = 0;  // first unconsumed byte of buffer_
   bool eof_ = false;
@@ -82,7 +86,7 @@ class CsvReader {
 /// A whole CSV file of numbers in memory (see CsvReader for the rules).
 class CsvTable {
  public:
-  /// Reads and checks the whole file. Throws DataError.
+  /// Reads and checks the whole file (at most 1 GiB, InputKind::kCsvTable). Throws DataError.
   static CsvTable read_file(const std::string& path);
   static CsvTable parse(const std::string& text, const std::string& source);
 
@@ -114,21 +118,19 @@ class CsvTable {
   std::vector<int> lines_;
 };
 
-/// The whole text of a file, refused with DataError naming it when it cannot be read, is a directory
-/// or is larger than 1 GiB (checked before reading); a leading UTF-8 byte order mark is dropped.
-/// `what` names the kind of file in messages ("robot file", "file").
-[[nodiscard]] std::string read_text_file(const std::string& path, const char* what);
-
 /// A text cell for a CSV file: quoted (RFC 4180, inner quotes doubled) when it holds a comma, a
 /// quote, a line break or blanks at its ends; as it is otherwise.
 [[nodiscard]] std::string csv_text_cell(const std::string& text);
 
 /// Writes a CSV header row and rows of numbers (%.10g), buffered: a row is formatted into the
-/// writer's own buffer, never into a temporary string, and the buffer goes to the file in 64 kB
-/// pieces. Throws Error if the file cannot be written; finish() (or the destructor, silently)
-/// flushes and closes it.
+/// writer's own buffer, never into a temporary string, and the buffer goes to the output in 64 kB
+/// pieces. The output is an OutputFile (output_file.hpp): nothing appears at the path before the
+/// file is committed, and a failed write throws OutputError naming it.
 class CsvWriter {
  public:
+  /// Into `out`, one output of a transaction: finish() flushes, the transaction commits.
+  CsvWriter(OutputFile& out, const std::vector<std::string>& columns);
+  /// Into a file of its own: finish() commits it; destroyed unfinished, nothing is written.
   CsvWriter(const std::string& path, const std::vector<std::string>& columns);
   ~CsvWriter();
   CsvWriter(const CsvWriter&) = delete;
@@ -136,16 +138,17 @@ class CsvWriter {
   void row(std::span<const double> values);
   void row(const std::vector<double>& values) { row(std::span<const double>(values)); }
   void comment(const std::string& text);  ///< "# text" line
-  /// Flushes and closes; throws Error when the data did not reach the file.
+  /// Flushes (and commits a file of its own); throws OutputError when the data did not reach it.
   void finish();
 
  private:
   void flush_if_full();
   void flush();
 
-  std::string path_;
+  std::unique_ptr<OutputFile> own_;  // the file of its own, when given a path
+  OutputFile* out_;
   std::size_t width_;
-  std::FILE* file_ = nullptr;
+  bool finished_ = false;
   fmt::memory_buffer buffer_;
 };
 

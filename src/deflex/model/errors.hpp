@@ -32,4 +32,12 @@ class InputError : public Error {
   using Error::Error;
 };
 
+/// An output could not be written or put in place (a full disk, /dev/full, a failed rename): the job
+/// failed, not its input (the command-line program exits with code 1). output_file.hpp guarantees that
+/// nothing was left half-written.
+class OutputError : public Error {
+ public:
+  using Error::Error;
+};
+
 }  // namespace deflex

@@ -11,7 +11,9 @@
 
 #include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
+#include "deflex/model/input_file.hpp"
 #include "deflex/model/input_ranges.hpp"
+#include "deflex/model/output_file.hpp"
 #include "deflex/model/urdf_tree.hpp"
 #include "deflex/model/yaml_fields.hpp"
 
@@ -67,7 +69,7 @@ Pose urdf_pose(const urdf::Pose& p) {
 RobotDescription load_urdf_chain(const std::string& path, const std::string& base_link, const std::string& tip_link) {
   std::string text;
   try {
-    text = read_text_file(path, "URDF file");
+    text = read_input_file(path, InputKind::kUrdf);
   } catch (const DataError& e) {
     throw ModelError(e.what());
   }
@@ -225,7 +227,7 @@ RobotModel load_robot(const std::string& path) {
   }
   std::string text;
   try {
-    text = read_text_file(path, "robot file");
+    text = read_input_file(path, InputKind::kRobotFile);
   } catch (const DataError& e) {
     throw ModelError(e.what());
   }
@@ -291,14 +293,7 @@ std::string robot_to_yaml(const RobotModel& model) {
 }
 
 void write_robot_yaml(const RobotModel& model, const std::string& path) {
-  std::ofstream out(path);
-  if (!out) {
-    throw Error(fmt::format("{}: cannot write the robot file", path));
-  }
-  out << robot_to_yaml(model);
-  if (!out) {
-    throw Error(fmt::format("{}: write failed", path));
-  }
+  write_output_file(path, robot_to_yaml(model), "robot file");
 }
 
 }  // namespace deflex

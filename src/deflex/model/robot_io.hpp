@@ -37,7 +37,7 @@ RobotDescription load_urdf_chain(const std::string& path, const std::string& bas
 /// stiffness with its note, base, tool and WAP frames. load_robot_yaml_text() reads it back.
 std::string robot_to_yaml(const RobotModel& model);
 
-/// Writes robot_to_yaml() to a file. Throws Error when the file cannot be written.
+/// Writes robot_to_yaml() to a file of its own (output_file.hpp). Throws InputError or OutputError.
 void write_robot_yaml(const RobotModel& model, const std::string& path);
 
 }  // namespace deflex

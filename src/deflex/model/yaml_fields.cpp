@@ -9,10 +9,11 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/csv_table.hpp"
+#include "deflex/model/input_file.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/model/nearest_name.hpp"
 #include "deflex/model/parse_number.hpp"
+#include "deflex/model/utf8_text.hpp"
 
 namespace deflex::yaml {
 
@@ -36,6 +37,14 @@ void refuse_duplicate_keys(const YAML::Node& node, const std::string& file, cons
   if (depth > 64) {
     throw ModelError(fmt::format("{}: field '{}': nested deeper than 64 levels", where_of(file, node.Mark()), path));
   }
+  if (node.IsScalar()) {
+    // Names and notes go into JSON and YAML, which require UTF-8: a Latin-1 byte is named here.
+    if (const auto bad = utf8_problem(node.Scalar())) {
+      throw ModelError(fmt::format("{}: field '{}': {}", where_of(file, node.Mark()), path.empty() ? "<document>" : path,
+                                   *bad));
+    }
+    return;
+  }
   if (node.IsSequence()) {
     for (std::size_t i = 0; i < node.size(); ++i) {
       refuse_duplicate_keys(node[i], file, fmt::format("{}[{}]", path, i + 1), depth + 1, visited);
@@ -47,7 +56,15 @@ void refuse_duplicate_keys(const YAML::Node& node, const std::string& file, cons
   }
   std::vector<std::pair<std::string, YAML::Mark>> seen;
   for (const auto& kv : node) {
-    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string("<non-scalar key>");
+    if (!kv.first.IsScalar()) {
+      throw ModelError(fmt::format("{}: field '{}': a key must be a plain name, not a list or a map ('? [a, b]')",
+                                   where_of(file, kv.first.Mark()), path.empty() ? "<document>" : path));
+    }
+    const std::string key = kv.first.Scalar();
+    if (const auto bad = utf8_problem(key)) {
+      throw ModelError(fmt::format("{}: a key of field '{}': {}", where_of(file, kv.first.Mark()),
+                                   path.empty() ? "<document>" : path, *bad));
+    }
     const std::string child = path.empty() ? key : path + "." + key;
     for (const auto& [k, mark] : seen) {
       if (k == key) {
@@ -62,10 +79,10 @@ void refuse_duplicate_keys(const YAML::Node& node, const std::string& file, cons
 
 }  // namespace
 
-Field Field::load_file(const std::string& path) {
+Field Field::load_file(const std::string& path, InputKind kind) {
   std::string text;
   try {
-    text = read_text_file(path, "file");
+    text = read_input_file(path, kind);
   } catch (const DataError& e) {
     throw ModelError(e.what());
   }
@@ -73,12 +90,20 @@ Field Field::load_file(const std::string& path) {
 }
 
 Field Field::load_string(const std::string& text, const std::string& source) {
-  YAML::Node root;
+  std::vector<YAML::Node> documents;
   try {
-    root = YAML::Load(text.rfind("\xEF\xBB\xBF", 0) == 0 ? text.substr(3) : text);
+    documents = YAML::LoadAll(text.rfind("\xEF\xBB\xBF", 0) == 0 ? text.substr(3) : text);
   } catch (const YAML::ParserException& e) {
     throw ModelError(fmt::format("{}:{}: YAML syntax error: {}", source, e.mark.line + 1, e.msg));
   }
+  // yaml-cpp's Load() would read the first document and drop any after a '---' silently.
+  if (documents.size() > 1) {
+    const YAML::Mark m = documents[1].Mark();
+    throw ModelError(fmt::format("{}: a second YAML document (after '---'{}): a deflex file holds one document",
+                                 m.line >= 0 ? fmt::format("{}:{}", source, m.line + 1) : source,
+                                 m.line >= 0 ? "" : ", at the end"));
+  }
+  YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
   std::size_t visited = 0;
   refuse_duplicate_keys(root, source, "", 0, visited);
   return Field(root, source, "");

@@ -7,6 +7,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "deflex/model/input_file.hpp"
 #include "deflex/model/input_ranges.hpp"
 #include "deflex/model/types.hpp"
 
@@ -17,10 +18,10 @@ class Field {
  public:
   Field(YAML::Node node, std::string file, std::string path);
 
-  /// Parses a whole file; throws ModelError "FILE: cannot read" or "FILE:LINE: YAML syntax error", and
-  /// "FILE:LINE:COL: field 'a.b': key given twice" for a key repeated in a map (yaml-cpp would
-  /// silently keep the first). Files over 1 GiB are refused before reading; a UTF-8 BOM is dropped.
-  static Field load_file(const std::string& path);
+  /// Parses a whole file (input_file.hpp: a regular file within the limit of `kind`); throws ModelError
+  /// "FILE: cannot read" or "FILE:LINE: YAML syntax error", and "FILE:LINE:COL: field 'a.b': key given
+  /// twice" for a key repeated in a map (yaml-cpp would silently keep the first). A UTF-8 BOM is dropped.
+  static Field load_file(const std::string& path, InputKind kind = InputKind::kConfig);
   /// Parses text; `source` names it in messages.
   static Field load_string(const std::string& text, const std::string& source);
 

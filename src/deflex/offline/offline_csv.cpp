@@ -44,9 +44,9 @@ std::vector<std::string> offline_csv_columns(int dof) {
   return c;
 }
 
-OfflineCsvWriter::OfflineCsvWriter(const std::string& path, int dof, const std::string& robot_name,
+OfflineCsvWriter::OfflineCsvWriter(OutputFile& out, int dof, const std::string& robot_name,
                                    const std::string& force_description, bool predicted)
-    : dof_(dof), out_(path, offline_csv_columns(dof)) {
+    : dof_(dof), out_(out, offline_csv_columns(dof)) {
   out_.comment(fmt::format("deflex offline: robot {}; force {}; wrench in the base frame, moment about the WAP; "
                            "deflection = loaded minus unloaded TCP pose when commanded to the desired joints{}",
                            robot_name, force_description, predicted ? "" : " (not predicted: columns are zero)"));
@@ -93,12 +93,14 @@ void write_offline_csv(const OfflineResult& result, const std::string& path) {
   if (result.points.empty()) {
     throw InputError(fmt::format("{}: no compensated points to write", path));
   }
-  OfflineCsvWriter out(path, static_cast<int>(result.points.front().q_desired.size()), result.robot_name,
+  OutputFile file(path);
+  OfflineCsvWriter out(file, static_cast<int>(result.points.front().q_desired.size()), result.robot_name,
                        result.force_description, result.predicted);
   for (std::size_t i = 0; i < result.points.size(); ++i) {
     out.write(i, result.points[i]);
   }
   out.finish();
+  file.commit();
 }
 
 }  // namespace deflex

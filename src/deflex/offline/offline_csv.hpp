@@ -15,17 +15,18 @@ namespace deflex {
 [[nodiscard]] std::vector<std::string> offline_csv_columns(int dof);
 
 /// Writes one row per point (0-based `index` column), after the header a '#' comment naming the
-/// robot and the force model. Throws Error when the file cannot be written.
+/// robot and the force model, into a file of its own (output_file.hpp: it appears whole or not at
+/// all). Throws InputError for a path that cannot be written, OutputError when a write fails.
 void write_offline_csv(const OfflineResult& result, const std::string& path);
 
 /// The same file a point at a time (deflex offline streams long paths through it): the rows are
-/// byte for byte those write_offline_csv writes. Throws Error when the file cannot be written.
+/// byte for byte those write_offline_csv writes, into an output of the caller's transaction.
 class OfflineCsvWriter {
  public:
-  OfflineCsvWriter(const std::string& path, int dof, const std::string& robot_name,
-                   const std::string& force_description, bool predicted);
+  OfflineCsvWriter(OutputFile& out, int dof, const std::string& robot_name, const std::string& force_description,
+                   bool predicted);
   void write(std::size_t index, const OfflinePoint& point);
-  /// Flushes and closes the file; throws Error when the data did not reach it.
+  /// Flushes the rows to the output; throws OutputError when a write failed.
   void finish();
 
  private:

@@ -27,6 +27,9 @@ struct ProgramTargetReport {
   std::string instruction;
   std::string target;         ///< as written in the input
   std::string action;         ///< "edited in place", "literal edited" or "copy NAME"
+  /// How the arm configuration was chosen: "" when the target's own (confdata, Status/Turn);
+  /// otherwise why not, e.g. "ConfL\\Off: the configuration nearest the previous target's".
+  std::string configuration_note;
   double deflection_m = 0.0;  ///< predicted TCP deflection without compensation
   double deflection_rad = 0.0;
   double correction_m = 0.0;          ///< |p_command - p_desired|
@@ -55,16 +58,22 @@ struct ProgramCompensation {
   std::vector<ProgramFile> outputs;  ///< what write_program_outputs() writes
 };
 
-/// Reads `input_path` (.mod/.modx/.prg/.sys: RAPID; .src: KRL with the .dat beside it), resolves and
-/// compensates every motion target, and returns the output texts for `output_path` (KRL: the .src
-/// there and its .dat beside it). Writes nothing. Throws DataError or InputError naming the file, the
-/// line and the name for malformed input, an undeclared tool or work object, an unknown argument in
-/// a motion instruction, an unreachable or singular target.
+/// The files compensate_program() returns for `output_path`: the module for RAPID; for KRL the .src
+/// and the .dat beside it. Throws InputError for an unknown program type or a KRL output that is not
+/// a .src.
+[[nodiscard]] std::vector<std::string> program_output_paths(const std::string& input_path,
+                                                            const std::string& output_path);
+
+/// Reads `input_path` (.mod/.modx/.prg/.sys: RAPID; .src: KRL with the .dat beside it, which must
+/// exist), resolves and compensates every motion target, and returns the output texts for
+/// `output_path` (program_output_paths()). Writes nothing. Throws DataError or InputError naming the
+/// file, the line and the name for malformed input, an undeclared tool or work object, an unknown
+/// argument in a motion instruction, an unreachable or singular target, an output that is an input.
 [[nodiscard]] ProgramCompensation compensate_program(const RobotModel& model, const ForceModel& force,
                                                      const std::string& input_path, const std::string& output_path,
                                                      const ProgramOptions& options = {});
 
-/// Writes every output file; throws Error when one cannot be written.
+/// Writes every output file, all or none (output_file.hpp); throws InputError or OutputError naming it.
 void write_program_outputs(const ProgramCompensation& result);
 
 /// A few lines per target and per unresolved construct (mm, mrad, deg).

@@ -74,7 +74,11 @@ std::vector<ProgramTargetResult> compensate_program_targets(const RobotModel& mo
       r.tcp_desired = tcp_pose(m, ws, u.q);
     } else {
       IkRequest req = u.ik;
-      if (u.continue_from_previous) {
+      if (u.nearest_previous && previous != nullptr) {
+        req.seed = previous->q_desired;
+        req.configuration.reset();
+        req.kuka_configuration.reset();
+      } else if (u.continue_from_previous) {
         if (previous == nullptr) {
           throw InputError(fmt::format("{}: no configuration given and no earlier target to continue from", where));
         }

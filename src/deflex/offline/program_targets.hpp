@@ -26,6 +26,10 @@ struct ProgramTargetUse {
   /// (`continue_from_previous`), the solution nearest the previous use, on the previous use's branch.
   IkRequest ik;
   bool continue_from_previous = false;
+  /// RAPID's ConfJ\Off / ConfL\Off: the solution nearest the previous use's joints, whatever its
+  /// configuration (the controller takes the one closest to where the arm is). `ik` is used for the
+  /// first use, which has no previous one.
+  bool nearest_previous = false;
   std::size_t force_index = 0;  ///< the force model's point index of this use
 };
 

@@ -30,18 +30,26 @@ std::string apply_edits(const std::string& text, std::vector<TextEdit> edits) {
 }
 
 int line_of(const std::string& text, std::size_t offset) {
-  return 1 + static_cast<int>(std::count(
-                 text.begin(), text.begin() + static_cast<std::ptrdiff_t>(std::min(offset, text.size())), '\n'));
+  int line = 1;
+  const std::size_t end = std::min(offset, text.size());
+  for (std::size_t i = 0; i < end; ++i) {
+    // LF, CR LF (counted at its LF) and a lone CR each end a line.
+    line += text[i] == '\n' || (text[i] == '\r' && (i + 1 >= text.size() || text[i + 1] != '\n')) ? 1 : 0;
+  }
+  return line;
 }
 
 std::size_t end_of_line(const std::string& text, std::size_t offset) {
-  const std::size_t nl = text.find('\n', offset);
-  return nl == std::string::npos ? text.size() : nl + 1;
+  const std::size_t at = text.find_first_of("\r\n", offset);
+  if (at == std::string::npos) {
+    return text.size();
+  }
+  return text[at] == '\r' && at + 1 < text.size() && text[at + 1] == '\n' ? at + 2 : at + 1;
 }
 
 std::string indentation_of(const std::string& text, std::size_t offset) {
   std::size_t begin = std::min(offset, text.size());
-  while (begin > 0 && text[begin - 1] != '\n') {
+  while (begin > 0 && text[begin - 1] != '\n' && text[begin - 1] != '\r') {
     --begin;
   }
   std::size_t end = begin;
@@ -52,8 +60,11 @@ std::string indentation_of(const std::string& text, std::size_t offset) {
 }
 
 std::string line_terminator(const std::string& text) {
-  const std::size_t nl = text.find('\n');
-  return nl != std::string::npos && nl > 0 && text[nl - 1] == '\r' ? "\r\n" : "\n";
+  const std::size_t at = text.find_first_of("\r\n");
+  if (at == std::string::npos || text[at] == '\n') {
+    return "\n";
+  }
+  return at + 1 < text.size() && text[at + 1] == '\n' ? "\r\n" : "\r";
 }
 
 std::string program_number(double value, int decimals) {

@@ -18,16 +18,16 @@ struct TextEdit {
 /// programming error (std::logic_error), two inserts at one offset keep their given order.
 [[nodiscard]] std::string apply_edits(const std::string& text, std::vector<TextEdit> edits);
 
-/// 1-based line number of a byte offset.
+/// 1-based line number of a byte offset (lines end with LF, CR LF or a lone CR).
 [[nodiscard]] int line_of(const std::string& text, std::size_t offset);
 
-/// Offset just past the end of the line holding `offset` (past its '\n', or the text's end).
+/// Offset just past the end of the line holding `offset` (past its LF, CR LF or CR, or the text's end).
 [[nodiscard]] std::size_t end_of_line(const std::string& text, std::size_t offset);
 
 /// The line's leading blanks (spaces and tabs) for the line holding `offset`.
 [[nodiscard]] std::string indentation_of(const std::string& text, std::size_t offset);
 
-/// The line terminator the text uses ("\r\n" when its first line ends so, else "\n").
+/// The line terminator the text uses: its first line's ("\r\n", "\r" or "\n"; "\n" for one line).
 [[nodiscard]] std::string line_terminator(const std::string& text);
 
 /// A number as robot programs write it: fixed `decimals`, trailing zeros and a bare '.' dropped,

@@ -1,11 +1,13 @@
 // RAPID and KRL lexers.
 #include "deflex/offline/program_tokens.hpp"
 
+#include <algorithm>
 #include <cctype>
 
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/offline/program_text.hpp"
 
 namespace deflex {
 namespace {
@@ -53,7 +55,8 @@ struct Lexer {
   /// when the character at `i` is none of them.
   bool common(std::size_t& i, char comment) {
     const char c = text[i];
-    if (c == '\n') {
+    // A line ends with LF, CR LF or a lone CR (old Mac editors, some controllers' exports).
+    if (c == '\n' || (c == '\r' && (i + 1 >= text.size() || text[i + 1] != '\n'))) {
       ++line;
       ++i;
       return true;
@@ -63,14 +66,14 @@ struct Lexer {
       return true;
     }
     if (c == comment) {
-      while (i < text.size() && text[i] != '\n') {
+      while (i < text.size() && text[i] != '\n' && text[i] != '\r') {
         ++i;
       }
       return true;
     }
     if (c == '"') {
       std::size_t j = i + 1;
-      while (j < text.size() && text[j] != '"' && text[j] != '\n') {
+      while (j < text.size() && text[j] != '"' && text[j] != '\n' && text[j] != '\r') {
         ++j;
       }
       if (j >= text.size() || text[j] != '"') {
@@ -99,6 +102,43 @@ struct Lexer {
 };
 
 }  // namespace
+
+std::string ProgramSource::str(std::size_t i) const {
+  return i < tok.size() ? text.substr(tok[i].begin, tok[i].end - tok[i].begin) : std::string();
+}
+
+bool ProgramSource::is_ident(std::size_t i, const char* word) const {
+  return i < tok.size() && tok[i].kind == TokenKind::kIdentifier && (word == nullptr || iequals(str(i), word));
+}
+
+bool ProgramSource::is_punct(std::size_t i, const char* p) const {
+  return i < tok.size() && tok[i].kind == TokenKind::kPunct && str(i) == p;
+}
+
+std::string ProgramSource::span(std::size_t b, std::size_t e) const {
+  if (b >= e || b >= tok.size()) {
+    return {};
+  }
+  const std::string s = text.substr(tok[b].begin, tok[std::min(e, tok.size()) - 1].end - tok[b].begin);
+  std::string out;
+  bool blank = false;
+  for (const char c : s) {
+    if (c == '\n' || c == '\r' || c == '\t' || c == ' ') {
+      blank = true;
+      continue;
+    }
+    if (blank && !out.empty()) {
+      out += ' ';
+    }
+    blank = false;
+    out += c;
+  }
+  return out.size() > 100 ? out.substr(0, 97) + "..." : out;
+}
+
+void ProgramSource::fail(std::size_t i, const std::string& what) const {
+  throw DataError(fmt::format("{}:{}: {}", file, i < tok.size() ? tok[i].line : 0, what));
+}
 
 std::vector<Token> lex_rapid(const std::string& text, const std::string& file) {
   Lexer lx{text, file, {}};
@@ -145,7 +185,7 @@ std::vector<Token> lex_krl(const std::string& text, const std::string& file) {
     }
     if (c == '\'') {
       std::size_t j = i + 1;
-      while (j < text.size() && text[j] != '\'' && text[j] != '\n') {
+      while (j < text.size() && text[j] != '\'' && text[j] != '\n' && text[j] != '\r') {
         ++j;
       }
       if (j >= text.size() || text[j] != '\'') {

@@ -29,6 +29,22 @@ struct Token {
   int line = 0;
 };
 
+/// A program file's text and tokens, with the file's name for messages: what the RAPID and KRL readers
+/// look at.
+struct ProgramSource {
+  std::string file;
+  const std::string& text;
+  std::vector<Token> tok;
+
+  [[nodiscard]] std::string str(std::size_t i) const;
+  [[nodiscard]] bool is_ident(std::size_t i, const char* word = nullptr) const;  ///< word: case-insensitive
+  [[nodiscard]] bool is_punct(std::size_t i, const char* p) const;
+  /// The source text of tokens [b, e) on one line (blanks collapsed, at most 100 characters).
+  [[nodiscard]] std::string span(std::size_t b, std::size_t e) const;
+  /// Throws DataError "FILE:LINE: what" with the line of token i.
+  [[noreturn]] void fail(std::size_t i, const std::string& what) const;
+};
+
 /// The tokens of a RAPID module. '!' starts a comment to the end of the line. Throws DataError
 /// "FILE:LINE: ..." for an unterminated string or a character RAPID does not know.
 [[nodiscard]] std::vector<Token> lex_rapid(const std::string& text, const std::string& file);

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/model/output_file.hpp"
 #include "deflex/offline/quaternion_sign.hpp"
 
 namespace deflex {
@@ -151,15 +152,7 @@ std::string rapid_module(const OfflineResult& result, const RapidOptions& option
 }
 
 void write_rapid_module(const OfflineResult& result, const RapidOptions& options, const std::string& path) {
-  const std::string text = rapid_module(result, options);
-  std::ofstream out(path);
-  if (!out) {
-    throw Error(fmt::format("{}: cannot write the file", path));
-  }
-  out << text;
-  if (!out) {
-    throw Error(fmt::format("{}: write failed", path));
-  }
+  write_output_file(path, rapid_module(result, options), "RAPID module");
 }
 
 }  // namespace deflex

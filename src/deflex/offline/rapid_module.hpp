@@ -35,7 +35,7 @@ struct RapidOptions {
 /// computes or writes anything. Throws InputError.
 void check_rapid_options(const RapidOptions& options);
 
-/// rapid_module() to a file. Throws Error when it cannot be written.
+/// rapid_module() to a file of its own (output_file.hpp). Throws InputError or OutputError naming it.
 void write_rapid_module(const OfflineResult& result, const RapidOptions& options, const std::string& path);
 
 /// True for a valid RAPID identifier (used to check module, tool and work object names).

@@ -10,6 +10,7 @@
 
 #include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
+#include "deflex/model/output_file.hpp"
 
 namespace deflex {
 namespace {
@@ -141,30 +142,28 @@ JointTrajectory JointTrajectory::read_csv(const std::string& path, const RobotMo
   return JointTrajectory(std::move(t), std::move(q), model, path, std::move(lines));
 }
 
-void JointTrajectory::write_csv(const std::string& path, const std::string& comment) const {
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (f == nullptr) {
-    throw Error(fmt::format("{}: cannot write the joint trajectory", path));
-  }
+std::string JointTrajectory::csv_text(const std::string& comment) const {
+  fmt::memory_buffer out;
   if (!comment.empty()) {
-    std::fprintf(f, "# %s\n", comment.c_str());
+    fmt::format_to(std::back_inserter(out), "# {}\n", comment);
   }
-  std::fputs("t_s", f);
+  fmt::format_to(std::back_inserter(out), "t_s");
   for (int j = 1; j <= dof(); ++j) {
-    std::fprintf(f, ",q%d_deg", j);
+    fmt::format_to(std::back_inserter(out), ",q{}_deg", j);
   }
-  std::fputc('\n', f);
+  out.push_back('\n');
   for (std::size_t i = 0; i < t_.size(); ++i) {
-    std::fprintf(f, "%.9f", t_[i]);
+    fmt::format_to(std::back_inserter(out), "{:.9f}", t_[i]);
     for (int j = 0; j < dof(); ++j) {
-      std::fprintf(f, ",%.10f", rad_to_deg(q_[i][j]));
+      fmt::format_to(std::back_inserter(out), ",{:.10f}", rad_to_deg(q_[i][j]));
     }
-    std::fputc('\n', f);
+    out.push_back('\n');
   }
-  const bool ok = std::ferror(f) == 0;
-  if (std::fclose(f) != 0 || !ok) {
-    throw Error(fmt::format("{}: write failed", path));
-  }
+  return fmt::to_string(out);
+}
+
+void JointTrajectory::write_csv(const std::string& path, const std::string& comment) const {
+  write_output_file(path, csv_text(comment), "joint trajectory");
 }
 
 void JointTrajectory::sample(double t_s, JointVector& q, JointVector* qd) const noexcept {

@@ -28,7 +28,9 @@ class JointTrajectory {
   /// DataError for a malformed file and InputError for a trajectory the robot cannot follow, both
   /// naming the file and line.
   static JointTrajectory read_csv(const std::string& path, const RobotModel& model);
-  /// Writes the CSV form (degrees, times as given). Throws Error when the file cannot be written.
+  /// The CSV form (degrees, times as given), with `comment` as a '#' line first when not empty.
+  [[nodiscard]] std::string csv_text(const std::string& comment = "") const;
+  /// csv_text() to a file of its own (output_file.hpp). Throws InputError or OutputError naming it.
   void write_csv(const std::string& path, const std::string& comment = "") const;
 
   /// Joints (rad) and, if asked, joint velocities (rad/s) at time t_s. Never allocates or throws.

@@ -56,8 +56,8 @@ CirclePath parse_circle_spec(const std::string& spec) {
     c.clockwise = d == "cw";
   }
   c.points = keys.integer("points", c.points);
-  if (c.points < 3 || c.points > kMaxPathPoints) {
-    keys.fail(fmt::format("key 'points': a circle needs 3..{} points", kMaxPathPoints));
+  if (c.points < 3 || c.points > kMaxCirclePoints) {
+    keys.fail(fmt::format("key 'points': a circle needs 3..{} points", kMaxCirclePoints));
   }
   return c;
 }

@@ -16,6 +16,10 @@
 
 namespace deflex {
 
+/// The most points of a circle: 0.00036 deg apart, finer than any controller interpolates, and
+/// compensated in some 4 s (4 us a point). (A line may have kMaxPathPoints: long streamed paths.)
+inline constexpr int kMaxCirclePoints = 1'000'000;
+
 /// The reference circle described above.
 [[nodiscard]] CirclePath default_circle();
 

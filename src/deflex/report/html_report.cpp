@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 
@@ -421,17 +420,6 @@ std::string figures_html(const StudyResult& study) {
   return h;
 }
 
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary);
-  if (!f) {
-    throw Error(fmt::format("{}: cannot write the file", path));
-  }
-  f << text;
-  if (!f) {
-    throw Error(fmt::format("{}: write failed", path));
-  }
-}
-
 }  // namespace
 
 std::string html_report(const ReportContent& content) {
@@ -525,39 +513,47 @@ std::string html_report(const ReportContent& content) {
   return h;
 }
 
-void write_report(const ReportContent& content, const std::string& out_dir) {
+void write_report(const ReportContent& content, const std::string& out_dir, OutputTransaction& outputs) {
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
   if (ec) {
     throw Error(fmt::format("{}: cannot create the directory: {}", out_dir, ec.message()));
   }
   const std::filesystem::path dir(out_dir);
+  const auto write_text = [&](const std::string& name, const std::string& text) {
+    outputs.add((dir / name).string(), "report file").write(text);
+  };
   const StudyResult& study = content.study;
-  write_text((dir / "report.html").string(), html_report(content));
+  write_text("report.html", html_report(content));
   const bool paper_setups = any_setup(study, true);
-  write_text((dir / "figure5.svg").string(),
-             svg_figure5(study, paper_setups ? SetupSelection::kPaper : SetupSelection::kAll));
+  write_text("figure5.svg", svg_figure5(study, paper_setups ? SetupSelection::kPaper : SetupSelection::kAll));
   if (paper_setups && any_setup(study, false)) {
-    write_text((dir / "figure5_beyond.svg").string(), svg_figure5(study, SetupSelection::kBeyondPaper));
+    write_text("figure5_beyond.svg", svg_figure5(study, SetupSelection::kBeyondPaper));
   }
-  write_text((dir / "compensation.svg").string(), svg_compensation(study));
+  write_text("compensation.svg", svg_compensation(study));
   if (paper_setups) {
-    write_text((dir / "parity.svg").string(), svg_parity(study));
+    write_text("parity.svg", svg_parity(study));
   }
   if (!study.speed_sweep.empty()) {
-    write_text((dir / "speed_sweep.svg").string(), svg_speed_sweep(study));
+    write_text("speed_sweep.svg", svg_speed_sweep(study));
   }
   for (std::size_t i = 0; i < content.path_plots.size(); ++i) {
     const PathPlot& p = content.path_plots[i];
-    write_text((dir / fmt::format("path_{}.svg", i + 1)).string(), svg_path_plot(p));
-    write_text((dir / fmt::format("polar_{}.svg", i + 1)).string(), svg_polar_deviation(p));
-    write_text((dir / fmt::format("laps_{}.svg", i + 1)).string(), svg_lap_overlay(p));
+    write_text(fmt::format("path_{}.svg", i + 1), svg_path_plot(p));
+    write_text(fmt::format("polar_{}.svg", i + 1), svg_polar_deviation(p));
+    write_text(fmt::format("laps_{}.svg", i + 1), svg_lap_overlay(p));
   }
-  write_text((dir / "tables.md").string(), study_tables_markdown(study));
-  write_study_csv(study, (dir / "tables.csv").string());
-  if (!study.speed_sweep.empty()) write_sweep_csv(study, (dir / "sweep.csv").string());
-  if (!study.error_budgets.empty()) write_error_budget_csv(study, (dir / "error_budget.csv").string());
-  write_text((dir / "results.json").string(), study_to_json(study).dump(2) + "\n");
+  write_text("tables.md", study_tables_markdown(study));
+  write_text("tables.csv", study_csv_text(study));
+  if (!study.speed_sweep.empty()) write_text("sweep.csv", sweep_csv_text(study));
+  if (!study.error_budgets.empty()) write_text("error_budget.csv", error_budget_csv_text(study));
+  write_text("results.json", study_to_json(study).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+}
+
+void write_report(const ReportContent& content, const std::string& out_dir) {
+  OutputTransaction outputs;
+  write_report(content, out_dir, outputs);
+  outputs.commit();
 }
 
 }  // namespace deflex

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/model/input_file.hpp"
 #include "deflex/model/yaml_fields.hpp"
 
 namespace deflex {
@@ -410,13 +411,13 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
 }
 
 CaseConfig load_case(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    throw ModelError(path + ": cannot read the case file");
+  std::string text;
+  try {
+    text = read_input_file(path, InputKind::kConfig);  // a regular file within the size limit
+  } catch (const DataError& e) {
+    throw ModelError(e.what());
   }
-  std::ostringstream text;
-  text << in.rdbuf();
-  CaseConfig c = load_case_text(text.str(), path);
+  CaseConfig c = load_case_text(text, path);
   // A robot file named in the case is found next to the case file, as users expect.
   if (!c.cell.robot_file.empty() && std::filesystem::path(c.cell.robot_file).is_relative()) {
     c.cell.robot_file = (std::filesystem::path(path).parent_path() / c.cell.robot_file).string();

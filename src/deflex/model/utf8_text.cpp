@@ -1,0 +1,58 @@
+// UTF-8 validation (RFC 3629: at most four bytes, no overlong forms, no surrogates).
+#include "deflex/model/utf8_text.hpp"
+
+#include <fmt/format.h>
+
+namespace deflex {
+
+std::optional<std::size_t> invalid_utf8_at(std::string_view text) {
+  const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(text[i]); };
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const unsigned char c = byte(i);
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    std::size_t n = 0;
+    unsigned char lo = 0x80;  // the bounds of the second byte, which rule out overlong forms and surrogates
+    unsigned char hi = 0xBF;
+    if (c >= 0xC2 && c <= 0xDF) {
+      n = 1;
+    } else if (c >= 0xE0 && c <= 0xEF) {
+      n = 2;
+      lo = c == 0xE0 ? 0xA0 : 0x80;
+      hi = c == 0xED ? 0x9F : 0xBF;
+    } else if (c >= 0xF0 && c <= 0xF4) {
+      n = 3;
+      lo = c == 0xF0 ? 0x90 : 0x80;
+      hi = c == 0xF4 ? 0x8F : 0xBF;
+    } else {
+      return i;
+    }
+    if (i + n >= text.size()) {
+      return i;  // cut short at the end
+    }
+    if (byte(i + 1) < lo || byte(i + 1) > hi) {
+      return i;
+    }
+    for (std::size_t k = 2; k <= n; ++k) {
+      if ((byte(i + k) & 0xC0) != 0x80) {
+        return i;
+      }
+    }
+    i += n + 1;
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> utf8_problem(std::string_view text) {
+  const auto at = invalid_utf8_at(text);
+  if (!at) {
+    return std::nullopt;
+  }
+  return fmt::format("byte 0x{:02X} at position {} is not UTF-8 text (save the file as UTF-8)",
+                     static_cast<unsigned char>(text[*at]), *at + 1);
+}
+
+}  // namespace deflex
