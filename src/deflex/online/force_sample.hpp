@@ -2,6 +2,8 @@
 // (UDP stream, CSV replay, the simulated cell's sensor), so the compensator does not care which.
 #pragma once
 
+#include <cstdint>
+
 #include "deflex/model/types.hpp"
 
 namespace deflex {
@@ -17,6 +19,19 @@ struct ForceSample {
   bool valid = true;  ///< false: the source knows this sample is bad (DAQ overrun, saturation)
 };
 
+/// What a force source counts, for the session's status and summary; each source fills what applies
+/// to it (a CSV replay has no sequence numbers).
+struct ForceSourceStats {
+  std::uint64_t received = 0;      ///< samples (records) read from the wire or the file
+  std::uint64_t accepted = 0;      ///< samples handed on
+  std::uint64_t malformed = 0;     ///< datagrams of the wrong size, header or layout
+  std::uint64_t out_of_order = 0;  ///< samples older than one already handed on (dropped)
+  std::uint64_t duplicates = 0;    ///< samples seen before (dropped)
+  std::uint64_t lost = 0;          ///< samples the sequence numbers say were sent but never arrived
+  std::uint64_t faulty = 0;        ///< samples the sensor itself flagged (status bits, saturation): handed on invalid
+  std::uint64_t restarts = 0;      ///< the sender's sequence restarted, or the stream was requested again
+};
+
 /// A source of force samples. `latest` is non-blocking and never allocates: it returns true with a
 /// sample not returned before (oldest first; a source that fell behind may skip samples) and false
 /// when there is nothing new. The compensator calls it until it returns false, once per cycle, so
@@ -25,6 +40,8 @@ class ForceSource {
  public:
   virtual ~ForceSource() = default;
   virtual bool latest(ForceSample& out) noexcept = 0;
+  /// Its counts so far (read between cycles, on the loop's thread). Never allocates.
+  [[nodiscard]] virtual ForceSourceStats stats() const noexcept { return {}; }
 };
 
 }  // namespace deflex
