@@ -374,6 +374,7 @@ void RdtUdpForceSource::start() {
       return;
     }
   }
+  source_.poll();  // the state reads kNoAnswer from here on
   const RdtCounters& c = source_.counters();
   throw Error(fmt::format(
       "rdt sensor {}: no record within {} s of the stream request ({} datagrams from other addresses, {} malformed, "
