@@ -207,6 +207,9 @@ TEST(RdtForceSource, AStolenStreamIsTakenBackAndCounted) {
   EXPECT_EQ(b.sensor.target, b.mine.local_address());  // and we asked it back
   EXPECT_EQ(b.source.counters().re_requests, 1u);
   EXPECT_EQ(b.source.counters().sequence_restarts, 0u);  // the restart at 1 was our own request's
+  // What the thief got, the sensor's counter tells: at least the 0.1 s before we asked again.
+  EXPECT_GE(b.source.counters().unseen, 100u);
+  EXPECT_LE(b.source.counters().unseen, static_cast<std::uint64_t>(stolen) + 8);
   EXPECT_EQ(b.source.state(), RdtStreamState::kStreaming);
   expect_increasing_times(b.got);
 }

@@ -247,6 +247,10 @@ bool RdtForceSource::advance_time(std::uint32_t ft_sequence, std::int64_t rdt_st
     if (ft_step_ == 0 && rdt_step > 0) {
       ft_step_ = std::max<std::uint32_t>(1u, static_cast<std::uint32_t>(forward / static_cast<std::uint64_t>(rdt_step)));
     }
+    if (rdt_step <= 0 && ft_step_ > 0 && forward > ft_step_) {
+      // A new stream: rdt_sequence started again and cannot tell the gap; the sensor's own counter can.
+      counters_.unseen += forward / ft_step_ - 1;
+    }
     ft_ticks_ += forward;
     last_ft_ = ft_sequence;
     return true;

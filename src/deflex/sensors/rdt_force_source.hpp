@@ -80,6 +80,9 @@ struct RdtCounters {
   std::uint64_t re_requests = 0;     ///< of those, sent because the stream stopped or never came
   std::uint64_t sequence_restarts = 0;  ///< the rdt_sequence restarted without our request (another client's request, a jump)
   std::uint64_t ft_restarts = 0;     ///< ft_sequence went back (the sensor restarted)
+  /// Samples the sensor measured (by ft_sequence) while its stream was not ours: between the last
+  /// record before a new stream and the first after it (a stall, another client, a stop)
+  std::uint64_t unseen = 0;
   std::uint64_t send_failures = 0;   ///< requests the transport could not send
   std::uint32_t last_status = 0;     ///< the last non-zero status word seen (0: none)
 };
@@ -126,6 +129,11 @@ class RdtForceSource final : public ForceSource {
   [[nodiscard]] const RdtStreamSettings& settings() const { return settings_; }
   /// The rate the samples come at (Hz): what the compensator's filter must be designed for.
   [[nodiscard]] double sample_rate_hz() const { return calibration_.rate_hz; }
+  /// Seconds since the last record arrived, on the source's clock (0 before the first): the
+  /// age of the stream as this host sees it.
+  [[nodiscard]] double since_last_record_s() const noexcept {
+    return ever_received_ ? clock_.now_s() - last_record_s_ : 0.0;
+  }
   /// Samples queued, not yet handed on.
   [[nodiscard]] std::size_t queued() const { return count_; }
   [[nodiscard]] const DatagramAddress& sensor() const { return sensor_; }
