@@ -25,16 +25,7 @@ using test::RdtTestSensor;
 
 // 1,000,000 counts per N and 100,000 counts per Nm: the test sensor's default counts
 // {1000000, -2000000, 3000000, 40000, -50000, 60000} are 1, -2, 3 N and 0.4, -0.5, 0.6 Nm.
-RdtCalibration test_calibration(double rate_hz) {
-  RdtCalibration c;
-  c.source = "test";
-  c.counts_per_force = 1000000.0;
-  c.counts_per_torque = 100000.0;
-  c.force_unit = "N";
-  c.torque_unit = "Nm";
-  c.rate_hz = rate_hz;
-  return c;
-}
+RdtCalibration test_calibration(double rate_hz) { return test::test_rdt_calibration(rate_hz); }
 
 struct Bench {
   explicit Bench(double rate_hz, RdtStreamSettings settings = {}, RdtCalibration calibration = {})
@@ -309,24 +300,27 @@ TEST(RdtForceSource, MalformedAndForeignDatagramsAreCountedAndIgnored) {
   EXPECT_EQ(b.source.stats().lost, 0u);
 }
 
+// Starts the stream, asks for the sensor's bias, and returns what the sensor received.
+std::vector<std::array<unsigned char, 8>> start_and_bias(Bench& b) {
+  b.source.start();
+  b.source.request_sensor_bias();
+  b.run(0.004);
+  std::vector<std::array<unsigned char, 8>> out;
+  for (const auto& r : b.sensor.requests) out.push_back(r.bytes);
+  return out;
+}
+
+using Bytes = std::vector<std::array<unsigned char, 8>>;
+
 TEST(RdtForceSource, RequestsAndBiasAreTheManualsBytes) {
   Bench ati(1000.0);
-  ati.source.start();
-  ati.source.request_sensor_bias();
-  ati.run(0.004);
-  ASSERT_EQ(ati.sensor.requests.size(), 2u);
-  EXPECT_EQ(ati.sensor.requests[0].bytes, (std::array<unsigned char, 8>{0x12, 0x34, 0x00, 0x02, 0, 0, 0, 0}));
-  EXPECT_EQ(ati.sensor.requests[1].bytes, (std::array<unsigned char, 8>{0x12, 0x34, 0x00, 0x42, 0, 0, 0, 0}));
+  EXPECT_EQ(start_and_bias(ati), (Bytes{{0x12, 0x34, 0x00, 0x02, 0, 0, 0, 0}, {0x12, 0x34, 0x00, 0x42, 0, 0, 0, 0}}));
 
   // OnRobot's Compute Box: the rate first (1000 / 2 = 500 Hz), then the stream; bias "on" is 0xFF.
   Bench hex(500.0, {}, onrobot_hex_calibration(500.0));
-  hex.source.start();
-  hex.source.request_sensor_bias();
-  hex.run(0.004);
-  ASSERT_EQ(hex.sensor.requests.size(), 3u);
-  EXPECT_EQ(hex.sensor.requests[0].bytes, (std::array<unsigned char, 8>{0x12, 0x34, 0x00, 0x82, 0, 0, 0, 2}));
-  EXPECT_EQ(hex.sensor.requests[1].bytes, (std::array<unsigned char, 8>{0x12, 0x34, 0x00, 0x02, 0, 0, 0, 0}));
-  EXPECT_EQ(hex.sensor.requests[2].bytes, (std::array<unsigned char, 8>{0x12, 0x34, 0x00, 0x42, 0, 0, 0, 0xFF}));
+  EXPECT_EQ(start_and_bias(hex), (Bytes{{0x12, 0x34, 0x00, 0x82, 0, 0, 0, 2},
+                                        {0x12, 0x34, 0x00, 0x02, 0, 0, 0, 0},
+                                        {0x12, 0x34, 0x00, 0x42, 0, 0, 0, 0xFF}}));
   hex.run(0.1);
   ASSERT_FALSE(hex.got.empty());
   EXPECT_DOUBLE_EQ(hex.got.back().wrench_sensor(0), 100.0);  // 1000000 counts / 10000

@@ -11,6 +11,7 @@
 #include <sys/socket.h>
 
 #include <chrono>
+#include <memory>
 #include <cmath>
 #include <string>
 #include <thread>
@@ -22,6 +23,7 @@
 #include "deflex/model/errors.hpp"
 #include "deflex/sensors/rdt_force_source.hpp"
 #include "deflex/wire/rdt.hpp"
+#include "sensors/rdt_test_sensor.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex {
@@ -58,6 +60,16 @@ struct Standin {
   }
   [[nodiscard]] std::string page() const { return "http://127.0.0.1:" + std::to_string(http_port) + "/netftapi2.xml"; }
 };
+
+/// A source on the stand-in, its calibration fetched from the stand-in's page, started.
+std::unique_ptr<RdtUdpForceSource> connect(const Standin& sensor, const RdtStreamSettings& settings = {}) {
+  RdtCalibrationOptions options;
+  options.spec = sensor.page();
+  auto source = std::make_unique<RdtUdpForceSource>(sensor.address(), resolve_rdt_calibration(options, "127.0.0.1"),
+                                                    settings, "127.0.0.1");
+  source->start();
+  return source;
+}
 
 /// Reads until `done` or `limit_s` of wall time, into `got`.
 template <class Done>
@@ -118,13 +130,11 @@ TEST(RdtStandin, CalibrationFromItsPageAndEveryFaultCountedAsItReports) {
 
 TEST(RdtStandin, BufferedStreamingOfFortyRecordsADatagramAt7kHz) {
   Standin sensor({"--rate", "7000", "--buffer", "40", "--max-records", "7000"});
-  RdtCalibrationOptions options;
-  options.spec = sensor.page();
   RdtStreamSettings settings;
   settings.buffered = true;
   settings.stall_timeout_s = 1.0;
-  RdtUdpForceSource source(sensor.address(), resolve_rdt_calibration(options, ""), settings, "127.0.0.1");
-  source.start();
+  auto connected = connect(sensor, settings);
+  RdtUdpForceSource& source = *connected;
   std::vector<ForceSample> got;
   read_until(source, got, 20.0, [&] { return got.size() >= 7000; });
   ASSERT_EQ(got.size(), 7000u);
@@ -137,10 +147,8 @@ TEST(RdtStandin, BufferedStreamingOfFortyRecordsADatagramAt7kHz) {
 
 TEST(RdtStandin, AStallAndAStolenStreamAreRecoveredFrom) {
   Standin sensor({"--rate", "1000", "--stall-at", "0.8", "--stall-s", "0.6"});
-  RdtCalibrationOptions options;
-  options.spec = sensor.page();
-  RdtUdpForceSource source(sensor.address(), resolve_rdt_calibration(options, ""), {}, "127.0.0.1");
-  source.start();
+  auto connected = connect(sensor);
+  RdtUdpForceSource& source = *connected;
   std::vector<ForceSample> got;
   // Through the stall (the stand-in's 0.8 s to 1.4 s) and back.
   read_until(source, got, 10.0, [&] {
@@ -178,10 +186,8 @@ TEST(RdtStandin, AStallAndAStolenStreamAreRecoveredFrom) {
 
 TEST(RdtStandin, ARestartedSensorIsRequestedAgainAndItsCounterRestartIsCounted) {
   Standin sensor({"--rate", "1000", "--ft-start", "0x10000000", "--restart-at", "0.5", "--restart-s", "0.5"});
-  RdtCalibrationOptions options;
-  options.spec = sensor.page();
-  RdtUdpForceSource source(sensor.address(), resolve_rdt_calibration(options, ""), {}, "127.0.0.1");
-  source.start();
+  auto connected = connect(sensor);
+  RdtUdpForceSource& source = *connected;
   std::vector<ForceSample> got;
   read_until(source, got, 15.0, [&] {
     return source.source().counters().ft_restarts > 0 && source.source().state() == RdtStreamState::kStreaming &&
@@ -195,10 +201,8 @@ TEST(RdtStandin, ARestartedSensorIsRequestedAgainAndItsCounterRestartIsCounted) 
 
 TEST(RdtStandin, TheSensorsOwnBiasAndDeflexsTareAreApart) {
   Standin sensor({"--rate", "1000", "--wrench", "3,-4,-50,0.5,0,0", "--noise", "0.05"});
-  RdtCalibrationOptions options;
-  options.spec = sensor.page();
-  RdtUdpForceSource source(sensor.address(), resolve_rdt_calibration(options, ""), {}, "127.0.0.1");
-  source.start();
+  auto connected = connect(sensor);
+  RdtUdpForceSource& source = *connected;
   // deflex's tare: the offset is taken out here; the sensor still reads the load.
   TareSettings tare;
   tare.window_s = 0.2;
@@ -220,10 +224,7 @@ TEST(RdtStandin, TheSensorsOwnBiasAndDeflexsTareAreApart) {
 }
 
 TEST(RdtStandin, ASensorThatNeverAnswersIsAClearErrorAtStart) {
-  RdtCalibration cal;
-  cal.source = "test";
-  cal.counts_per_force = cal.counts_per_torque = 1000000.0;
-  cal.rate_hz = 1000.0;
+  const RdtCalibration cal = test::test_rdt_calibration(1000.0);
   RdtStreamSettings settings;
   settings.answer_timeout_s = 0.3;
   // A port nobody listens on: the request goes out, nothing comes back.

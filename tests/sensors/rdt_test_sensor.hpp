@@ -12,9 +12,23 @@
 #include <set>
 #include <vector>
 
+#include "deflex/sensors/rdt_calibration.hpp"
 #include "deflex/transport/memory_network.hpp"
 
 namespace deflex::test {
+
+/// A calibration for tests: `counts_per_force` counts a newton, `counts_per_torque` a newton-metre.
+inline RdtCalibration test_rdt_calibration(double rate_hz, double counts_per_force = 1000000.0,
+                                          double counts_per_torque = 100000.0) {
+  RdtCalibration c;
+  c.source = "test";
+  c.counts_per_force = counts_per_force;
+  c.counts_per_torque = counts_per_torque;
+  c.force_unit = "N";
+  c.torque_unit = "Nm";
+  c.rate_hz = rate_hz;
+  return c;
+}
 
 class RdtTestSensor {
  public:

@@ -110,14 +110,7 @@ TEST(WrenchTare, ThePayloadsWeightAsTheSensorReadsIt) {
   EXPECT_NEAR(w(5), 0.0, 1e-12);
 }
 
-RdtCalibration micro_newton_calibration() {
-  RdtCalibration c;
-  c.source = "test";
-  c.counts_per_force = 1000000.0;
-  c.counts_per_torque = 1000000.0;
-  c.rate_hz = 1000.0;
-  return c;
-}
+RdtCalibration micro_newton_calibration() { return test::test_rdt_calibration(1000.0, 1000000.0, 1000000.0); }
 
 TEST(WrenchTare, InsideTheSourceNothingIsHandedOnUntilTheTareIsDone) {
   ManualClock clock;

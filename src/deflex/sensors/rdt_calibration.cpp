@@ -8,12 +8,11 @@
 #include <array>
 #include <cctype>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <utility>
 
 #include <fmt/format.h>
 
+#include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/model/parse_number.hpp"
 #include "deflex/paths/key_value_spec.hpp"
@@ -166,16 +165,6 @@ class Page {
   const TiXmlElement* root_ = nullptr;
 };
 
-std::string read_file_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw ModelError(fmt::format("{}: cannot open the sensor calibration file", path));
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 bool same_rate(double a, double b) { return std::abs(a - b) <= 0.005 * std::max(a, b); }
 
 }  // namespace
@@ -251,7 +240,9 @@ RdtCalibration parse_netft_xml(const std::string& text, const std::string& origi
   return c;
 }
 
-RdtCalibration load_netft_xml(const std::string& path) { return parse_netft_xml(read_file_text(path), path); }
+RdtCalibration load_netft_xml(const std::string& path) {
+  return parse_netft_xml(read_text_file(path, "sensor calibration page"), path);
+}
 
 RdtCalibration fetch_netft_xml(const std::string& url, double timeout_s) {
   return parse_netft_xml(http_get_text(url, timeout_s), url);

@@ -49,7 +49,7 @@ struct RdtCalibration {
 /// missing or non-positive count or an unknown unit. The rate may be missing (rate_hz = 0): the caller
 /// then needs it from elsewhere (resolve_rdt_calibration).
 [[nodiscard]] RdtCalibration parse_netft_xml(const std::string& text, const std::string& origin);
-/// The same from a file. Throws ModelError naming the path when it cannot be read.
+/// The same from a file. Throws DataError naming the path when it cannot be read.
 [[nodiscard]] RdtCalibration load_netft_xml(const std::string& path);
 /// The same fetched over HTTP (http_fetch.hpp). Throws Error naming the URL when the sensor does not
 /// answer in `timeout_s`.
