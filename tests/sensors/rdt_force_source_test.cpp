@@ -205,6 +205,31 @@ TEST(RdtForceSource, AStolenStreamIsTakenBackAndCounted) {
   expect_increasing_times(b.got);
 }
 
+TEST(RdtForceSource, AStreamRequestedAgainEarlyLosesNoRecord) {
+  Bench b(1000.0);
+  b.source.start();
+  b.run(0.012);  // a few records, numbers still small
+  ASSERT_GT(b.got.size(), 3u);
+  b.sensor.streaming = false;  // the stream stops without a word
+  b.run(0.5);
+  EXPECT_EQ(b.source.counters().re_requests, 1u);
+  EXPECT_EQ(b.got.size(), b.sensor.sent_records);  // the new stream's 1, 2, 3 are not "late"
+  EXPECT_EQ(b.source.counters().out_of_order + b.source.counters().far_ahead, 0u);
+  EXPECT_EQ(b.source.counters().sequence_restarts, 0u);
+  EXPECT_GT(b.source.counters().unseen, 90u);  // the 0.1 s of silence, by the sensor's counter
+}
+
+TEST(RdtForceSource, ASequenceThatRestartsWithoutOurRequestIsCounted) {
+  Bench b(1000.0);
+  b.source.start();
+  b.run(0.2);
+  b.sensor.renumber();
+  b.run(0.2);
+  EXPECT_EQ(b.source.counters().sequence_restarts, 1u);
+  EXPECT_EQ(b.got.size(), b.sensor.sent_records);
+  EXPECT_EQ(b.source.stats().restarts, 1u);
+}
+
 TEST(RdtForceSource, ASensorThatRestartsIsFollowedAndItsTimeKeepsIncreasing) {
   Bench b(1000.0);
   b.sensor.ft_start = 5000000;  // powered up long ago

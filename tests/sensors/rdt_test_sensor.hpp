@@ -77,6 +77,9 @@ class RdtTestSensor {
     if (!streaming) next_sample_ = due + 1;
   }
 
+  /// Numbers the next record rdt_start again, with no request (as if another program had asked).
+  void renumber() { rdt_ = rdt_start; }
+
   /// A power cycle: forgets the client, stops streaming, the ft counter starts again from 0.
   void power_cycle(double now_s) {
     streaming = false;

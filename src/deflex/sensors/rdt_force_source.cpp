@@ -91,7 +91,7 @@ bool RdtForceSource::send(RdtCommand command, std::uint32_t sample_count) noexce
 
 bool RdtForceSource::request_stream() noexcept {
   ++counters_.requests;
-  expect_restart_ = true;
+  expect_restart_ = true;  // the answer numbers its records from 1 again
   bool ok = true;
   if (calibration_.onrobot) {
     // Sent with every request: a Compute Box that restarted has forgotten it.
@@ -193,6 +193,15 @@ void RdtForceSource::drain() noexcept {
 }
 
 bool RdtForceSource::in_order(std::uint32_t rdt_sequence) noexcept {
+  if (expect_restart_ && order_.started() && rdt_sequence <= order_.rules().restart_max &&
+      order_.distance(rdt_sequence) < 0) {
+    // Our request's new stream, numbered from 1 again, even when the old one had not gone far (the
+    // tracker's own rule takes a jump back to a small number only from a number well above it).
+    // Not reset at the request itself: when the request is lost and the old stream comes back, its
+    // gap is loss and must be counted.
+    order_.reset();
+    expect_restart_ = false;
+  }
   const std::int64_t d = order_.started() ? order_.distance(rdt_sequence) : 0;
   switch (order_.observe(rdt_sequence)) {
     case SequenceVerdict::kFirst:
@@ -207,6 +216,8 @@ bool RdtForceSource::in_order(std::uint32_t rdt_sequence) noexcept {
       rdt_step_ = 0;
       return true;
     case SequenceVerdict::kNext:
+      // Well into the new stream: a restart from here on is not our request's.
+      if (rdt_sequence > 2 * order_.rules().restart_max) expect_restart_ = false;
       counters_.lost += static_cast<std::uint64_t>(d - 1);
       seen_ = (d >= kSeenWindow ? 0 : seen_ << d) | 1u;
       rdt_step_ = d;
