@@ -1,6 +1,8 @@
 // RDT calibration: the example netftapi2.xml page (examples/online/rdt_netftapi2.xml, fields of ATI
 // manual 9620-05), pages in other units (converted by the exact definitions of lbf, kgf, in and ft,
 // written out here by hand), and every bad page or option named by file, line and field.
+#include "deflex/sensors/rdt_calibration.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,7 +12,6 @@
 #include <utility>
 
 #include "deflex/model/errors.hpp"
-#include "deflex/sensors/rdt_calibration.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex {
@@ -69,10 +70,13 @@ TEST(RdtCalibration, TheExamplePageGivesCountsUnitsAndRates) {
 
 TEST(RdtCalibration, PoundForceAndPoundForceInchAreConverted) {
   // 80 counts per lbf and 2000 counts per lbf-in; codes 1 and 1 say the same units.
-  const RdtCalibration c = parse_netft_xml(
-      page_with({{"scfgfu", "lbf"}, {"cfgfu", "1"}, {"scfgtu", "lbf-in"}, {"cfgtu", "1"}, {"cfgcpf", "80"},
-                 {"cfgcpt", "2000"}}),
-      "imperial.xml");
+  const RdtCalibration c = parse_netft_xml(page_with({{"scfgfu", "lbf"},
+                                                      {"cfgfu", "1"},
+                                                      {"scfgtu", "lbf-in"},
+                                                      {"cfgtu", "1"},
+                                                      {"cfgcpf", "80"},
+                                                      {"cfgcpt", "2000"}}),
+                                           "imperial.xml");
   EXPECT_NEAR(c.force_n_per_count(), 4.4482216152605 / 80.0, 1e-15);
   EXPECT_NEAR(c.torque_nm_per_count(), 0.1129848290276167 / 2000.0, 1e-16);
 }
@@ -92,7 +96,7 @@ TEST(RdtCalibration, EveryUnitOfTheManualIsKnownInItsSpellings) {
   EXPECT_DOUBLE_EQ(newton_metres_per_torque_unit("kgf-cm"), 0.0980665);
   EXPECT_DOUBLE_EQ(newton_metres_per_torque_unit("kNm"), 1000.0);
   EXPECT_EQ(newtons_per_force_unit("dN"), 0.0);
-  EXPECT_EQ(newtons_per_force_unit("Nm"), 0.0);   // a torque unit is no force unit
+  EXPECT_EQ(newtons_per_force_unit("Nm"), 0.0);  // a torque unit is no force unit
   EXPECT_EQ(newton_metres_per_torque_unit("N"), 0.0);
   EXPECT_EQ(newton_metres_per_torque_unit("in-lb"), 0.0);  // not the manual's spelling: refused, not guessed
   EXPECT_EQ(force_unit_of_code(2), "N");
@@ -101,10 +105,13 @@ TEST(RdtCalibration, EveryUnitOfTheManualIsKnownInItsSpellings) {
 }
 
 TEST(RdtCalibration, NewtonMillimetresAndKilogramForceFromCodesAlone) {
-  const RdtCalibration c = parse_netft_xml(
-      page_with({{"scfgfu", nullptr}, {"scfgtu", nullptr}, {"cfgfu", "5"}, {"cfgtu", "4"}, {"cfgcpf", "1000"},
-                 {"cfgcpt", "1000"}}),
-      "codes.xml");
+  const RdtCalibration c = parse_netft_xml(page_with({{"scfgfu", nullptr},
+                                                      {"scfgtu", nullptr},
+                                                      {"cfgfu", "5"},
+                                                      {"cfgtu", "4"},
+                                                      {"cfgcpf", "1000"},
+                                                      {"cfgcpt", "1000"}}),
+                                           "codes.xml");
   EXPECT_EQ(c.force_unit, "kgf");
   EXPECT_EQ(c.torque_unit, "N-mm");
   EXPECT_NEAR(c.force_n_per_count(), 9.80665e-3, 1e-15);
@@ -112,8 +119,9 @@ TEST(RdtCalibration, NewtonMillimetresAndKilogramForceFromCodesAlone) {
 }
 
 TEST(RdtCalibration, MissingOrNonPositiveCountsAreNamedWithFileLineAndField) {
-  EXPECT_EQ(error_of([] { (void)parse_netft_xml(page_with({{"cfgcpf", nullptr}}), "page.xml"); }).rfind(
-                "page.xml:", 0),
+  EXPECT_EQ(error_of([] {
+              (void)parse_netft_xml(page_with({{"cfgcpf", nullptr}}), "page.xml");
+            }).rfind("page.xml:", 0),
             0u);
   const std::string missing = error_of([] { (void)parse_netft_xml(page_with({{"cfgcpf", nullptr}}), "page.xml"); });
   EXPECT_NE(missing.find("field 'cfgcpf'"), std::string::npos) << missing;
@@ -131,8 +139,9 @@ TEST(RdtCalibration, MissingOrNonPositiveCountsAreNamedWithFileLineAndField) {
 }
 
 TEST(RdtCalibration, UnknownOrContradictoryUnitsAreRefused) {
-  const std::string unknown =
-      error_of([] { (void)parse_netft_xml(page_with({{"scfgfu", "dN"}, {"cfgfu", nullptr}}), "p.xml"); });
+  const std::string unknown = error_of([] {
+    (void)parse_netft_xml(page_with({{"scfgfu", "dN"}, {"cfgfu", nullptr}}), "p.xml");
+  });
   EXPECT_NE(unknown.find("p.xml:" + std::to_string(line_of("scfgfu")) + ": field 'scfgfu': unknown force unit 'dN'"),
             std::string::npos)
       << unknown;
@@ -143,12 +152,14 @@ TEST(RdtCalibration, UnknownOrContradictoryUnitsAreRefused) {
   EXPECT_NE(contradiction.find("field 'scfgfu': 'lbf' disagrees with 'cfgfu' = 2 (N)"), std::string::npos)
       << contradiction;
 
-  const std::string code =
-      error_of([] { (void)parse_netft_xml(page_with({{"scfgtu", nullptr}, {"cfgtu", "9"}}), "p.xml"); });
+  const std::string code = error_of([] {
+    (void)parse_netft_xml(page_with({{"scfgtu", nullptr}, {"cfgtu", "9"}}), "p.xml");
+  });
   EXPECT_NE(code.find("field 'cfgtu': unknown torque unit code '9'"), std::string::npos) << code;
 
-  const std::string none = error_of(
-      [] { (void)parse_netft_xml(page_with({{"scfgtu", nullptr}, {"cfgtu", nullptr}}), "p.xml"); });
+  const std::string none = error_of([] {
+    (void)parse_netft_xml(page_with({{"scfgtu", nullptr}, {"cfgtu", nullptr}}), "p.xml");
+  });
   EXPECT_NE(none.find("field 'scfgtu': missing"), std::string::npos) << none;
 }
 
@@ -156,12 +167,12 @@ TEST(RdtCalibration, MalformedPagesAndFilesAreNamed) {
   const std::string broken = error_of([] { (void)parse_netft_xml("<netft>\n<cfgcpf>1</cfgcpf>\n<cfgcpt>", "b.xml"); });
   EXPECT_EQ(broken.rfind("b.xml:", 0), 0u) << broken;
   EXPECT_NE(broken.find("not well-formed XML"), std::string::npos) << broken;
-  const std::string twice = error_of([] {
-    (void)parse_netft_xml("<netft>\n<cfgcpf>1</cfgcpf>\n<cfgcpf>2</cfgcpf>\n</netft>", "t.xml");
-  });
+  const std::string twice =
+      error_of([] { (void)parse_netft_xml("<netft>\n<cfgcpf>1</cfgcpf>\n<cfgcpf>2</cfgcpf>\n</netft>", "t.xml"); });
   EXPECT_NE(twice.find("t.xml:3: field 'cfgcpf' given twice (also on line 2)"), std::string::npos) << twice;
   const std::string file = error_of([] { (void)load_netft_xml("/nonexistent/netftapi2.xml"); });
-  EXPECT_NE(file.find("/nonexistent/netftapi2.xml: cannot read the sensor calibration page"), std::string::npos) << file;
+  EXPECT_NE(file.find("/nonexistent/netftapi2.xml: cannot read the sensor calibration page"), std::string::npos)
+      << file;
   const std::string rate = error_of([] { (void)parse_netft_xml(page_with({{"comrdtrate", "-7000"}}), "r.xml"); });
   EXPECT_NE(rate.find("field 'comrdtrate'"), std::string::npos) << rate;
   const std::string buffer = error_of([] { (void)parse_netft_xml(page_with({{"comrdtbsiz", "41"}}), "r.xml"); });
@@ -184,7 +195,8 @@ TEST(RdtCalibration, TheRateComesFromThePageOrTheOptionAndBothMustAgree) {
   EXPECT_EQ(resolve_rdt_calibration(o, "").rate_hz, 1000.0);
   o.rate_hz = 7000.0;
   const std::string clash = error_of([&] { (void)resolve_rdt_calibration(o, ""); });
-  EXPECT_NE(clash.find("--rdt-rate-hz 7000 disagrees with the sensor's comrdtrate 1000 Hz"), std::string::npos) << clash;
+  EXPECT_NE(clash.find("--rdt-rate-hz 7000 disagrees with the sensor's comrdtrate 1000 Hz"), std::string::npos)
+      << clash;
 
   // A page without the rate needs the option.
   const std::string path = ::testing::TempDir() + "/norate_netftapi2.xml";

@@ -3,6 +3,8 @@
 // at 7 kHz read at 250 Hz, buffered datagrams, loss, duplicates, reorder, faulty records, a stall, a
 // sensor that never answers, a stolen stream, a sensor restart, stop, a reader that fell behind,
 // sequence wrap, the requests' bytes, and an allocation-free cycle.
+#include "deflex/sensors/rdt_force_source.hpp"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -11,7 +13,6 @@
 #include <vector>
 
 #include "deflex/model/errors.hpp"
-#include "deflex/sensors/rdt_force_source.hpp"
 #include "deflex/transport/clock.hpp"
 #include "deflex/transport/memory_network.hpp"
 #include "sensors/rdt_test_sensor.hpp"
@@ -31,8 +32,8 @@ struct Bench {
   explicit Bench(double rate_hz, RdtStreamSettings settings = {}, RdtCalibration calibration = {})
       : sensor(network, make_datagram_address("10.0.0.2", 49152), rate_hz),
         mine(network.add_endpoint(make_datagram_address("10.0.0.1", 5000))),
-        source(mine, clock, sensor.address(), calibration.counts_per_force > 0 ? calibration : test_calibration(rate_hz),
-               settings) {}
+        source(mine, clock, sensor.address(),
+               calibration.counts_per_force > 0 ? calibration : test_calibration(rate_hz), settings) {}
 
   // Runs `seconds` of cycles of `period_s`: the clock moves, the sensor sends what is due, the
   // source is drained as a compensator drains it (until it returns false).
@@ -194,7 +195,7 @@ TEST(RdtForceSource, AStolenStreamIsTakenBackAndCounted) {
   DatagramAddress from;
   int stolen = 0;
   while (thief.receive(buf.data(), buf.size(), from) >= 0) ++stolen;
-  EXPECT_GT(stolen, 50);  // the sensor answered the last requester
+  EXPECT_GT(stolen, 50);                               // the sensor answered the last requester
   EXPECT_EQ(b.sensor.target, b.mine.local_address());  // and we asked it back
   EXPECT_EQ(b.source.counters().re_requests, 1u);
   EXPECT_EQ(b.source.counters().sequence_restarts, 0u);  // the restart at 1 was our own request's

@@ -6,18 +6,16 @@
 // never depends on timing: the counts are compared with the stand-in's own, and where real time
 // decides how often something happens (re-requests) only "at least once" is asserted.
 #include <gtest/gtest.h>
-
 #include <netinet/in.h>
 #include <sys/socket.h>
 
 #include <chrono>
-#include <memory>
 #include <cmath>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "cross/cli_child.hpp"
 #include "deflex/model/errors.hpp"
@@ -83,10 +81,10 @@ void read_until(RdtUdpForceSource& source, std::vector<ForceSample>& got, double
 }
 
 TEST(RdtStandin, CalibrationFromItsPageAndEveryFaultCountedAsItReports) {
-  Standin sensor({"--rate", "1000", "--force-unit", "lbf", "--counts-per-force", "100", "--torque-unit", "lbf-in",
-                  "--counts-per-torque", "1000", "--wrench", "10,0,-20,5,0,0", "--max-records", "2000",
-                  "--drop-every", "50", "--duplicate-every", "70", "--reorder-every", "97", "--saturate-every",
-                  "101", "--status-every", "103"});
+  Standin sensor({"--rate",          "1000",   "--force-unit",        "lbf",  "--counts-per-force", "100",
+                  "--torque-unit",   "lbf-in", "--counts-per-torque", "1000", "--wrench",           "10,0,-20,5,0,0",
+                  "--max-records",   "2000",   "--drop-every",        "50",   "--duplicate-every",  "70",
+                  "--reorder-every", "97",     "--saturate-every",    "101",  "--status-every",     "103"});
   ASSERT_GT(sensor.rdt_port, 0);
   RdtCalibrationOptions options;
   options.spec = sensor.page();
@@ -169,8 +167,8 @@ TEST(RdtStandin, AStallAndAStolenStreamAreRecoveredFrom) {
   const std::uint64_t before = source.source().counters().re_requests;
   const std::size_t had = got.size();
   read_until(source, got, 10.0, [&] {
-    return source.source().counters().re_requests > before &&
-           source.source().state() == RdtStreamState::kStreaming && got.size() > had + 500;
+    return source.source().counters().re_requests > before && source.source().state() == RdtStreamState::kStreaming &&
+           got.size() > had + 500;
   });
   unsigned char buf[64];
   const long stolen = ::recv(thief, buf, sizeof buf, MSG_DONTWAIT);
@@ -239,7 +237,8 @@ TEST(RdtStandin, ASensorThatNeverAnswersIsAClearErrorAtStart) {
   RdtUdpForceSource source(make_datagram_address("127.0.0.1", port), cal, settings, "127.0.0.1");
   const std::string e = test::error_of([&] { source.start(); });
   ::close(probe);
-  EXPECT_NE(e.find("rdt sensor 127.0.0.1:" + std::to_string(port) + ": no record within 0.3 s"), std::string::npos) << e;
+  EXPECT_NE(e.find("rdt sensor 127.0.0.1:" + std::to_string(port) + ": no record within 0.3 s"), std::string::npos)
+      << e;
   EXPECT_EQ(source.source().state(), RdtStreamState::kNoAnswer);
 }
 

@@ -19,7 +19,7 @@ namespace deflex::test {
 
 /// A calibration for tests: `counts_per_force` counts a newton, `counts_per_torque` a newton-metre.
 inline RdtCalibration test_rdt_calibration(double rate_hz, double counts_per_force = 1000000.0,
-                                          double counts_per_torque = 100000.0) {
+                                           double counts_per_torque = 100000.0) {
   RdtCalibration c;
   c.source = "test";
   c.counts_per_force = counts_per_force;
@@ -39,13 +39,13 @@ class RdtTestSensor {
   std::function<std::array<std::int32_t, 6>(std::uint64_t)> counts_of = [](std::uint64_t) {
     return std::array<std::int32_t, 6>{1000000, -2000000, 3000000, 40000, -50000, 60000};
   };
-  int buffer = 10;             // records a datagram in buffered mode
-  std::uint32_t ft_step = 1;   // ft_sequence counts a record (internal rate / RDT rate)
-  std::uint32_t ft_start = 0;  // ft_sequence at power-up
+  int buffer = 10;              // records a datagram in buffered mode
+  std::uint32_t ft_step = 1;    // ft_sequence counts a record (internal rate / RDT rate)
+  std::uint32_t ft_start = 0;   // ft_sequence at power-up
   std::uint32_t rdt_start = 1;  // the manuals: 1 (a test may start near the wrap)
   // Faults, by the index of the record among all records produced for a client (0, 1, ...).
   std::set<std::uint64_t> drop, duplicate, swap_with_next, saturate;
-  std::set<std::uint64_t> flag;           // status word set
+  std::set<std::uint64_t> flag;  // status word set
   std::uint32_t status_word = 0x00010000;
   bool quiet = false;  // the network is cut: records and requests are lost
 

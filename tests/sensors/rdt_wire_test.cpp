@@ -45,8 +45,8 @@ TEST(RdtWire, RequestDecodingRefusesAWrongHeaderOrSize) {
   ASSERT_TRUE(decode_rdt_request(bytes.data(), 8, r));
   EXPECT_EQ(r.command, 0x0082);
   EXPECT_EQ(r.sample_count, 2u);
-  EXPECT_FALSE(decode_rdt_request(bytes.data(), 9, r));  // one byte too many
-  EXPECT_FALSE(decode_rdt_request(bytes.data(), 7, r));  // one too few
+  EXPECT_FALSE(decode_rdt_request(bytes.data(), 9, r));                                        // one byte too many
+  EXPECT_FALSE(decode_rdt_request(bytes.data(), 7, r));                                        // one too few
   const std::array<unsigned char, 8> swapped{0x34, 0x12, 0x02, 0x00, 0x00, 0x00, 0x00, 0x00};  // little-endian
   EXPECT_FALSE(decode_rdt_request(swapped.data(), 8, r));
   EXPECT_EQ(r.header, 0x3412);
@@ -105,7 +105,8 @@ TEST(RdtWire, BufferedDatagramsHoldOneToFortyWholeRecords) {
 TEST(RdtWire, RecordsOfABufferedDatagramFollowEachOtherAcrossTheWrap) {
   // Three records back to back, rdt_sequence 0xFFFFFFFE, 0xFFFFFFFF, 0 (the wrap), by hand.
   std::vector<unsigned char> d(3 * 36, 0);
-  const std::array<std::array<unsigned char, 4>, 3> seq{{{0xFF, 0xFF, 0xFF, 0xFE}, {0xFF, 0xFF, 0xFF, 0xFF}, {0, 0, 0, 0}}};
+  const std::array<std::array<unsigned char, 4>, 3> seq{
+      {{0xFF, 0xFF, 0xFF, 0xFE}, {0xFF, 0xFF, 0xFF, 0xFF}, {0, 0, 0, 0}}};
   for (std::size_t i = 0; i < 3; ++i) {
     for (std::size_t b = 0; b < 4; ++b) d[i * 36 + b] = seq[i][b];
     d[i * 36 + 15] = static_cast<unsigned char>(i + 1);  // Fx = 1, 2, 3

@@ -1,13 +1,14 @@
 // The software tare: mean and standard deviation over the window against values worked out by hand,
 // refusal on motion and on faulty samples, the payload's weight at the tare pose, and the tare inside
 // the RDT source (nothing handed on while it collects or after it was refused).
+#include "deflex/sensors/wrench_tare.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
 #include "deflex/sensors/rdt_force_source.hpp"
-#include "deflex/sensors/wrench_tare.hpp"
 #include "deflex/transport/clock.hpp"
 #include "deflex/transport/memory_network.hpp"
 #include "sensors/rdt_test_sensor.hpp"

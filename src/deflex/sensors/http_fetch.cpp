@@ -2,13 +2,12 @@
 #include "deflex/sensors/http_fetch.hpp"
 
 #include <curl/curl.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
 #include <memory>
 #include <mutex>
-
-#include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
 
@@ -66,7 +65,8 @@ std::string http_get_text(const std::string& url, double timeout_s, std::size_t 
   curl_easy_setopt(curl.get(), CURLOPT_WRITEDATA, &body);
   const CURLcode rc = curl_easy_perform(curl.get());
   if (body.too_large) {
-    throw Error(fmt::format("{}: the reply is larger than {} bytes (not a sensor's configuration page?)", url, max_bytes));
+    throw Error(
+        fmt::format("{}: the reply is larger than {} bytes (not a sensor's configuration page?)", url, max_bytes));
   }
   if (rc != CURLE_OK) {
     throw Error(fmt::format("{}: {} ({})", url, error[0] != '\0' ? error : curl_easy_strerror(rc),

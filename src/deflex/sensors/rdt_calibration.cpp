@@ -3,14 +3,13 @@
 // reader), for its line numbers in every message.
 #include "deflex/sensors/rdt_calibration.hpp"
 
+#include <fmt/format.h>
 #include <tinyxml.h>
 
 #include <array>
 #include <cctype>
 #include <cmath>
 #include <utility>
-
-#include <fmt/format.h>
 
 #include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
@@ -26,9 +25,9 @@ namespace {
 constexpr double kLbfN = 0.45359237 * 9.80665;
 constexpr double kKgfN = 9.80665;
 struct UnitEntry {
-  const char* name;   // as the manuals write it
-  const char* key;    // lower case, separators removed
-  double si;          // N or Nm of one unit
+  const char* name;  // as the manuals write it
+  const char* key;   // lower case, separators removed
+  double si;         // N or Nm of one unit
 };
 constexpr std::array<UnitEntry, 6> kForceUnits{{{"lbf", "lbf", kLbfN},
                                                 {"N", "n", 1.0},
@@ -136,15 +135,16 @@ class Page {
     if (coded.present && !coded.text.empty()) {
       const auto code = parse_int64(coded.text);
       if (!code || *code < 1 || *code > static_cast<std::int64_t>(N)) {
-        fail(coded, code_field, fmt::format("unknown {} unit code '{}' (the manual's codes: 1..{} = {})", kind,
-                                            coded.text, N, names(table)));
+        fail(coded, code_field,
+             fmt::format("unknown {} unit code '{}' (the manual's codes: 1..{} = {})", kind, coded.text, N,
+                         names(table)));
       }
       from_code = table[static_cast<std::size_t>(*code - 1)].name;
     }
     if (!named.present || named.text.empty()) {
       if (from_code.empty()) {
-        fail(named, name_field, fmt::format("missing: the {} unit the counts are in (and no '{}' code either)", kind,
-                                            code_field));
+        fail(named, name_field,
+             fmt::format("missing: the {} unit the counts are in (and no '{}' code either)", kind, code_field));
       }
       return from_code;
     }
@@ -153,8 +153,9 @@ class Page {
       fail(named, name_field, fmt::format("unknown {} unit '{}' (known: {})", kind, named.text, names(table)));
     }
     if (!from_code.empty() && lookup(table, from_code) != si) {
-      fail(named, name_field, fmt::format("'{}' disagrees with '{}' = {} ({}) on line {}", named.text, code_field,
-                                          coded.text, from_code, coded.line));
+      fail(named, name_field,
+           fmt::format("'{}' disagrees with '{}' = {} ({}) on line {}", named.text, code_field, coded.text, from_code,
+                       coded.line));
     }
     return named.text;
   }
@@ -227,8 +228,8 @@ RdtCalibration parse_netft_xml(const std::string& text, const std::string& origi
   c.internal_rate_hz = page.optional_number("runrate", "the internal sample rate (Hz)");
   const double buffer = page.optional_number("comrdtbsiz", "the RDT buffer size (records)");
   if (buffer != std::floor(buffer) || buffer > 40.0) {
-    page.fail(page.field("comrdtbsiz"), "comrdtbsiz", fmt::format("the RDT buffer size must be 1..40 records, not {}",
-                                                                  number_text(buffer)));
+    page.fail(page.field("comrdtbsiz"), "comrdtbsiz",
+              fmt::format("the RDT buffer size must be 1..40 records, not {}", number_text(buffer)));
   }
   c.buffer_records = static_cast<int>(buffer);
   const Field product = page.field("prodname");
@@ -253,9 +254,10 @@ RdtCalibration onrobot_hex_calibration(double rate_hz) {
   const double n = 1000.0 / rate_hz;
   if (!(rate_hz > 0.0) || !std::isfinite(rate_hz) || std::abs(n - std::round(n)) > 1e-6 * n || std::round(n) < 1.0 ||
       std::round(n) > 65535.0) {
-    throw InputError(fmt::format("profile onrobot-hex: rate {} Hz is not one the Compute Box streams at "
-                                 "(1000 / n Hz for a whole n: 1000, 500, 250, 200, 125, 100 ...)",
-                                 number_text(rate_hz)));
+    throw InputError(
+        fmt::format("profile onrobot-hex: rate {} Hz is not one the Compute Box streams at "
+                    "(1000 / n Hz for a whole n: 1000, 500, 250, 200, 125, 100 ...)",
+                    number_text(rate_hz)));
   }
   RdtCalibration c;
   c.source = "profile onrobot-hex";
@@ -273,11 +275,14 @@ RdtCalibration resolve_rdt_calibration(const RdtCalibrationOptions& options, con
       "sensor (fetch http://HOST/netftapi2.xml), FILE.xml (a saved netftapi2.xml), http://URL, onrobot-hex, "
       "or counts:counts_per_force=C,counts_per_torque=C,force_unit=U,torque_unit=U";
   if (spec.empty()) {
-    throw InputError("an rdt force source needs the sensor's calibration (counts per unit are never assumed): "
-                     "give --rdt-calibration " + choices);
+    throw InputError(
+        "an rdt force source needs the sensor's calibration (counts per unit are never assumed): "
+        "give --rdt-calibration " +
+        choices);
   }
   if (options.rate_hz != 0.0 && (!(options.rate_hz > 0.0) || !std::isfinite(options.rate_hz))) {
-    throw InputError(fmt::format("--rdt-rate-hz: must be a positive number of Hz, not {}", number_text(options.rate_hz)));
+    throw InputError(
+        fmt::format("--rdt-rate-hz: must be a positive number of Hz, not {}", number_text(options.rate_hz)));
   }
   RdtCalibration c;
   if (spec == "onrobot-hex") {
@@ -303,9 +308,10 @@ RdtCalibration resolve_rdt_calibration(const RdtCalibrationOptions& options, con
     }
     if (options.rate_hz > 0.0) {
       if (c.rate_hz > 0.0 && !same_rate(c.rate_hz, options.rate_hz)) {
-        throw InputError(fmt::format("--rdt-rate-hz {} disagrees with the sensor's comrdtrate {} Hz in {}: the "
-                                     "page is the sensor's own setting; change the setting or the option",
-                                     number_text(options.rate_hz), number_text(c.rate_hz), c.source));
+        throw InputError(
+            fmt::format("--rdt-rate-hz {} disagrees with the sensor's comrdtrate {} Hz in {}: the "
+                        "page is the sensor's own setting; change the setting or the option",
+                        number_text(options.rate_hz), number_text(c.rate_hz), c.source));
       }
       c.rate_hz = options.rate_hz;
     }

@@ -21,16 +21,16 @@ namespace deflex {
 [[nodiscard]] std::string torque_unit_of_code(int code);
 
 struct RdtCalibration {
-  std::string source = "<none>";     ///< where it came from (file, URL, "options", "profile onrobot-hex")
-  std::string sensor_name;           ///< the product and serial the page names, or the profile's name
-  double counts_per_force = 0.0;     ///< counts per `force_unit` (cfgcpf)
-  double counts_per_torque = 0.0;    ///< counts per `torque_unit` (cfgcpt)
-  std::string force_unit = "N";      ///< as the sensor names it (scfgfu)
-  std::string torque_unit = "Nm";    ///< (scfgtu)
-  double rate_hz = 0.0;              ///< records a second the sensor streams (comrdtrate); 0: not known yet
-  int buffer_records = 0;            ///< records a datagram in buffered mode (comrdtbsiz); 0: not stated
-  double internal_rate_hz = 0.0;     ///< the sensor's own sampling rate (runrate), for the log; 0: not stated
-  bool onrobot = false;              ///< OnRobot Compute Box: the rate is set by command 0x0082 at start
+  std::string source = "<none>";   ///< where it came from (file, URL, "options", "profile onrobot-hex")
+  std::string sensor_name;         ///< the product and serial the page names, or the profile's name
+  double counts_per_force = 0.0;   ///< counts per `force_unit` (cfgcpf)
+  double counts_per_torque = 0.0;  ///< counts per `torque_unit` (cfgcpt)
+  std::string force_unit = "N";    ///< as the sensor names it (scfgfu)
+  std::string torque_unit = "Nm";  ///< (scfgtu)
+  double rate_hz = 0.0;            ///< records a second the sensor streams (comrdtrate); 0: not known yet
+  int buffer_records = 0;          ///< records a datagram in buffered mode (comrdtbsiz); 0: not stated
+  double internal_rate_hz = 0.0;   ///< the sensor's own sampling rate (runrate), for the log; 0: not stated
+  bool onrobot = false;            ///< OnRobot Compute Box: the rate is set by command 0x0082 at start
 
   /// Throws InputError naming `source` and the field when a count is missing or not positive, a unit
   /// is unknown, or the rate is not known or not positive.

@@ -1,11 +1,11 @@
 // Force samples from an RDT sensor (see rdt_force_source.hpp).
 #include "deflex/sensors/rdt_force_source.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
 #include "deflex/model/parse_number.hpp"
@@ -72,8 +72,8 @@ RdtForceSource::RdtForceSource(DatagramTransport& transport, const Clock& clock,
   settings_.validate();
   force_n_per_count_ = calibration_.force_n_per_count();
   torque_nm_per_count_ = calibration_.torque_nm_per_count();
-  stall_timeout_s_ = settings_.stall_timeout_s > 0.0 ? settings_.stall_timeout_s
-                                                      : std::max(0.1, 10.0 / calibration_.rate_hz);
+  stall_timeout_s_ =
+      settings_.stall_timeout_s > 0.0 ? settings_.stall_timeout_s : std::max(0.1, 10.0 / calibration_.rate_hz);
   const auto capacity = static_cast<std::size_t>(std::ceil(settings_.queue_s * calibration_.rate_hz));
   ring_.resize(std::max<std::size_t>(2 * kRdtMaxRecordsPerDatagram, capacity));
   buffer_.resize(kRdtMaxDatagramBytes + 1);
@@ -256,7 +256,8 @@ bool RdtForceSource::advance_time(std::uint32_t ft_sequence, std::int64_t rdt_st
   const std::uint32_t step = std::max<std::uint32_t>(ft_step_, 1u);
   if (forward < 0x80000000u) {
     if (ft_step_ == 0 && rdt_step > 0) {
-      ft_step_ = std::max<std::uint32_t>(1u, static_cast<std::uint32_t>(forward / static_cast<std::uint64_t>(rdt_step)));
+      ft_step_ =
+          std::max<std::uint32_t>(1u, static_cast<std::uint32_t>(forward / static_cast<std::uint64_t>(rdt_step)));
     }
     if (rdt_step <= 0 && ft_step_ > 0 && forward > ft_step_) {
       // A new stream: rdt_sequence started again and cannot tell the gap; the sensor's own counter can.
@@ -409,8 +410,9 @@ const TareResult& RdtUdpForceSource::tare(const TareSettings& settings) {
   }
   const TareResult& r = source_.tare_result();
   if (r.state == TareState::kCollecting) {
-    throw Error(fmt::format("rdt sensor {}: tare: only {} of {} samples in {} s (stream {})", to_string(source_.sensor()),
-                            r.samples + r.faulty, r.samples_wanted, number_text(limit_s), to_string(source_.state())));
+    throw Error(fmt::format("rdt sensor {}: tare: only {} of {} samples in {} s (stream {})",
+                            to_string(source_.sensor()), r.samples + r.faulty, r.samples_wanted, number_text(limit_s),
+                            to_string(source_.state())));
   }
   if (r.state == TareState::kRejected) {
     throw InputError(fmt::format("rdt sensor {}: {}", to_string(source_.sensor()), describe(r, settings)));

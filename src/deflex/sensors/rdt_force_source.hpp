@@ -42,7 +42,7 @@
 namespace deflex {
 
 struct RdtStreamSettings {
-  bool buffered = false;         ///< request buffered streaming (0x0003: up to 40 records a datagram) instead of 0x0002
+  bool buffered = false;  ///< request buffered streaming (0x0003: up to 40 records a datagram) instead of 0x0002
   double answer_timeout_s = 1.0;  ///< no record this long after the first request: kNoAnswer
   double stall_timeout_s = 0.0;   ///< no record this long while streaming: request again; 0: max(0.1 s, 10 records)
   double retry_min_s = 0.1;       ///< first wait between requests while stalled (s), doubling ...
@@ -63,28 +63,28 @@ enum class RdtStreamState {
 
 /// Everything the source counts (ForceSourceStats is the part every source shares).
 struct RdtCounters {
-  std::uint64_t datagrams = 0;       ///< datagrams read from the sensor's address
-  std::uint64_t records = 0;         ///< records in well-formed datagrams
-  std::uint64_t accepted = 0;        ///< samples handed on
-  std::uint64_t malformed = 0;       ///< datagrams not a whole number of 1..40 records (wrong size)
-  std::uint64_t foreign = 0;         ///< datagrams from another address (ignored)
-  std::uint64_t lost = 0;            ///< records the rdt_sequence says were sent and never arrived
-  std::uint64_t duplicates = 0;      ///< a record (or an ft sample) seen before: dropped
-  std::uint64_t out_of_order = 0;    ///< a record older than one handed on: dropped
-  std::uint64_t far_ahead = 0;       ///< a record far ahead of the stream (a stray, or a jump not yet confirmed): dropped
-  std::uint64_t faulty = 0;          ///< samples handed on invalid: status bit set or saturated
-  std::uint64_t saturated = 0;       ///< of those, counts at the int32 limits
-  std::uint64_t dropped_behind = 0;  ///< records dropped because the reader fell more than queue_s behind
-  std::uint64_t held_by_tare = 0;    ///< samples the tare took (collecting) or held back (refused): not handed on
-  std::uint64_t requests = 0;        ///< stream requests sent (the first one included)
-  std::uint64_t re_requests = 0;     ///< of those, sent because the stream stopped or never came
-  std::uint64_t sequence_restarts = 0;  ///< the rdt_sequence restarted without our request (another client's request, a jump)
-  std::uint64_t ft_restarts = 0;     ///< ft_sequence went back (the sensor restarted)
+  std::uint64_t datagrams = 0;          ///< datagrams read from the sensor's address
+  std::uint64_t records = 0;            ///< records in well-formed datagrams
+  std::uint64_t accepted = 0;           ///< samples handed on
+  std::uint64_t malformed = 0;          ///< datagrams not a whole number of 1..40 records (wrong size)
+  std::uint64_t foreign = 0;            ///< datagrams from another address (ignored)
+  std::uint64_t lost = 0;               ///< records the rdt_sequence says were sent and never arrived
+  std::uint64_t duplicates = 0;         ///< a record (or an ft sample) seen before: dropped
+  std::uint64_t out_of_order = 0;       ///< a record older than one handed on: dropped
+  std::uint64_t far_ahead = 0;          ///< far ahead of the stream (a stray, a jump not yet confirmed): dropped
+  std::uint64_t faulty = 0;             ///< samples handed on invalid: status bit set or saturated
+  std::uint64_t saturated = 0;          ///< of those, counts at the int32 limits
+  std::uint64_t dropped_behind = 0;     ///< records dropped because the reader fell more than queue_s behind
+  std::uint64_t held_by_tare = 0;       ///< samples the tare took (collecting) or held back (refused): not handed on
+  std::uint64_t requests = 0;           ///< stream requests sent (the first one included)
+  std::uint64_t re_requests = 0;        ///< of those, sent because the stream stopped or never came
+  std::uint64_t sequence_restarts = 0;  ///< rdt_sequence restarted, not at our request (another client, a jump)
+  std::uint64_t ft_restarts = 0;        ///< ft_sequence went back (the sensor restarted)
   /// Samples the sensor measured (by ft_sequence) while its stream was not ours: between the last
   /// record before a new stream and the first after it (a stall, another client, a stop)
   std::uint64_t unseen = 0;
-  std::uint64_t send_failures = 0;   ///< requests the transport could not send
-  std::uint32_t last_status = 0;     ///< the last non-zero status word seen (0: none)
+  std::uint64_t send_failures = 0;  ///< requests the transport could not send
+  std::uint32_t last_status = 0;    ///< the last non-zero status word seen (0: none)
 };
 
 /// An RDT sensor over any datagram transport: UDP on a cell, the in-memory network in tests and

@@ -1,10 +1,10 @@
 // The software tare of a force source (see wrench_tare.hpp).
 #include "deflex/sensors/wrench_tare.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
 #include "deflex/model/parse_number.hpp"
@@ -47,21 +47,22 @@ std::string describe(const TareResult& r, const TareSettings& s) {
   const double std_t = r.std_sensor.tail<3>().maxCoeff();
   switch (r.state) {
     case TareState::kOff: return "tare: off";
-    case TareState::kCollecting:
-      return fmt::format("tare: collecting, {} of {} samples", r.samples, r.samples_wanted);
+    case TareState::kCollecting: return fmt::format("tare: collecting, {} of {} samples", r.samples, r.samples_wanted);
     case TareState::kDone:
       return fmt::format("tare done: {} samples over {} s, offset {}, standard deviation at most {:.3f} N, {:.4f} Nm",
                          r.samples, number_text(s.window_s), axes(r.offset_sensor), std_f, std_t);
     case TareState::kRejected:
       if (r.faulty > 0) {
-        return fmt::format("tare refused: {} of the {} samples in the window were faulty (sensor status or "
-                           "saturation); check the sensor before taring",
-                           r.faulty, r.samples + r.faulty);
+        return fmt::format(
+            "tare refused: {} of the {} samples in the window were faulty (sensor status or "
+            "saturation); check the sensor before taring",
+            r.faulty, r.samples + r.faulty);
       }
-      return fmt::format("tare refused: the reading moved during the {} s window (standard deviation {} against "
-                         "the limits {} N, {} Nm): hold the arm still, stop the tool, and tare again",
-                         number_text(s.window_s), axes(r.std_sensor), number_text(s.max_std_force_n),
-                         number_text(s.max_std_torque_nm));
+      return fmt::format(
+          "tare refused: the reading moved during the {} s window (standard deviation {} against "
+          "the limits {} N, {} Nm): hold the arm still, stop the tool, and tare again",
+          number_text(s.window_s), axes(r.std_sensor), number_text(s.max_std_force_n),
+          number_text(s.max_std_torque_nm));
   }
   return "tare: ?";
 }
@@ -77,7 +78,8 @@ Vector6 payload_wrench_sensor(double mass_kg, const Vector3& cog_sensor_m, const
 void WrenchTare::start(const TareSettings& settings, double rate_hz) {
   settings.validate();
   if (!(rate_hz > 0.0) || !std::isfinite(rate_hz)) {
-    throw InputError(fmt::format("tare: the sample rate must be a positive number of Hz, not {}", number_text(rate_hz)));
+    throw InputError(
+        fmt::format("tare: the sample rate must be a positive number of Hz, not {}", number_text(rate_hz)));
   }
   settings_ = settings;
   result_ = TareResult{};

@@ -23,8 +23,8 @@
 namespace deflex {
 
 struct TareSettings {
-  double window_s = 0.5;         ///< how long the arm is held still (s)
-  double max_std_force_n = 0.5;  ///< largest standard deviation of any force axis over the window (N)
+  double window_s = 0.5;            ///< how long the arm is held still (s)
+  double max_std_force_n = 0.5;     ///< largest standard deviation of any force axis over the window (N)
   double max_std_torque_nm = 0.05;  ///< same for the torque axes (Nm)
   /// What the sensor should read at the tare pose with no process force (N, Nm, sensor frame): the
   /// payload's weight there. Zero: the tare takes out everything it reads.
@@ -43,9 +43,9 @@ enum class TareState {
 
 struct TareResult {
   TareState state = TareState::kOff;
-  int samples = 0;            ///< samples averaged so far
-  int samples_wanted = 0;     ///< window x rate
-  int faulty = 0;             ///< invalid samples seen in the window (any: rejected)
+  int samples = 0;                          ///< samples averaged so far
+  int samples_wanted = 0;                   ///< window x rate
+  int faulty = 0;                           ///< invalid samples seen in the window (any: rejected)
   Vector6 mean_sensor = Vector6::Zero();    ///< N, Nm
   Vector6 std_sensor = Vector6::Zero();     ///< standard deviation per axis, N, Nm
   Vector6 offset_sensor = Vector6::Zero();  ///< mean - expected: subtracted from every sample
@@ -57,8 +57,8 @@ struct TareResult {
 /// The payload's weight as the sensor reads it (N, Nm, sensor frame, moment about the sensor origin):
 /// force m sensor_R_base g, moment c x that force (c: centre of gravity, sensor frame). The inverse of
 /// the pipeline's gravity compensation, for `TareSettings::expected_wrench_sensor`.
-[[nodiscard]] Vector6 payload_wrench_sensor(double mass_kg, const Vector3& cog_sensor_m, const Vector3& gravity_base_m_s2,
-                                            const Matrix3& base_R_sensor);
+[[nodiscard]] Vector6 payload_wrench_sensor(double mass_kg, const Vector3& cog_sensor_m,
+                                            const Vector3& gravity_base_m_s2, const Matrix3& base_R_sensor);
 
 /// The tare's state machine and running statistics (Welford's, so a long window stays exact).
 /// Never allocates; add() and apply() never throw.

@@ -32,8 +32,9 @@ enum class RdtCommand : std::uint16_t {
   kStartRealTime = 0x0002,    ///< one record a datagram (Axia: 0x0001 single block, 0x0002 accepted)
   kStartBuffered = 0x0003,    ///< several records a datagram (Axia: multi-block)
   kSetSoftwareBias = 0x0042,  ///< the sensor's own bias; OnRobot: sample_count 255 on, 0 off
-  kOnRobotFilter = 0x0081,    ///< OnRobot only: sample_count 0 none, 1 = 500 Hz, 2 = 150, 3 = 50, 4 = 15, 5 = 5, 6 = 1.5 Hz
-  kOnRobotRate = 0x0082,      ///< OnRobot only: output rate 1000 / sample_count Hz
+  /// OnRobot only: low-pass filter, sample_count 0 none, 1 = 500 Hz, 2 = 150, 3 = 50, 4 = 15, 5 = 5, 6 = 1.5 Hz
+  kOnRobotFilter = 0x0081,
+  kOnRobotRate = 0x0082,  ///< OnRobot only: output rate 1000 / sample_count Hz
 };
 
 struct RdtRequest {
@@ -44,9 +45,9 @@ struct RdtRequest {
 
 /// One record as it stands on the wire (counts, not yet scaled).
 struct RdtRecord {
-  std::uint32_t rdt_sequence = 0;  ///< 1 for the first record of each request, +1 a record
-  std::uint32_t ft_sequence = 0;   ///< the sensor's own sample counter since power-up (not reset by a request)
-  std::uint32_t status = 0;        ///< 0: healthy; any set bit: a condition the sensor reports
+  std::uint32_t rdt_sequence = 0;        ///< 1 for the first record of each request, +1 a record
+  std::uint32_t ft_sequence = 0;         ///< the sensor's own sample counter since power-up (not reset by a request)
+  std::uint32_t status = 0;              ///< 0: healthy; any set bit: a condition the sensor reports
   std::array<std::int32_t, 6> counts{};  ///< Fx Fy Fz Tx Ty Tz
 };
 
