@@ -57,6 +57,9 @@ std::string http_get_text(const std::string& url, double timeout_s, std::size_t 
   curl_easy_setopt(curl.get(), CURLOPT_TIMEOUT_MS, timeout_ms);
   curl_easy_setopt(curl.get(), CURLOPT_CONNECTTIMEOUT_MS, timeout_ms);
   curl_easy_setopt(curl.get(), CURLOPT_NOSIGNAL, 1L);  // no SIGALRM for the timeout: safe beside other threads
+  // A sensor sits on the cell's own network: a proxy from the environment (http_proxy) would send the
+  // request where the sensor is not.
+  curl_easy_setopt(curl.get(), CURLOPT_NOPROXY, "*");
   curl_easy_setopt(curl.get(), CURLOPT_FOLLOWLOCATION, 1L);
   curl_easy_setopt(curl.get(), CURLOPT_MAXREDIRS, 3L);
   // A sensor's configuration is plain HTTP on the cell's network; nothing else is asked for.

@@ -1,7 +1,7 @@
 // Reading one small text document over HTTP (a sensor's configuration page, such as an ATI Net F/T's
 // netftapi2.xml). Set-up time only: it blocks, allocates and throws. Built on libcurl (Debian's
-// libcurl4-openssl-dev), not on a request written by hand: redirects, chunked replies, proxies from
-// the environment and timeouts are its business, and it is maintained.
+// libcurl4-openssl-dev), not on a request written by hand: redirects, chunked replies and timeouts
+// are its business, and it is maintained. Proxies are bypassed: a sensor is on the cell's network.
 #pragma once
 
 #include <cstddef>
