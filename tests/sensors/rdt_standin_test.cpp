@@ -61,12 +61,12 @@ struct Standin {
 
 /// A source on the stand-in, its calibration fetched from the stand-in's page, started.
 std::unique_ptr<RdtUdpForceSource> connect(const Standin& sensor, const RdtStreamSettings& settings = {}) {
-  RdtCalibrationOptions options;
-  options.spec = sensor.page();
-  auto source = std::make_unique<RdtUdpForceSource>(sensor.address(), resolve_rdt_calibration(options, "127.0.0.1"),
-                                                    settings, "127.0.0.1");
-  source->start();
-  return source;
+  RdtSourceOptions options;
+  options.endpoint = "127.0.0.1:" + std::to_string(sensor.rdt_port);
+  options.calibration.spec = sensor.page();
+  options.stream = settings;
+  options.bind_address = "127.0.0.1";
+  return open_rdt_force_source(options);
 }
 
 /// Reads until `done` or `limit_s` of wall time, into `got`.
@@ -240,6 +240,16 @@ TEST(RdtStandin, ASensorThatNeverAnswersIsAClearErrorAtStart) {
   EXPECT_NE(e.find("rdt sensor 127.0.0.1:" + std::to_string(port) + ": no record within 0.3 s"), std::string::npos)
       << e;
   EXPECT_EQ(source.source().state(), RdtStreamState::kNoAnswer);
+}
+
+TEST(RdtStandin, AnRdtSourceWithoutACalibrationDoesNotStart) {
+  RdtSourceOptions options;
+  options.endpoint = "127.0.0.1";
+  const std::string e = test::error_of([&] { (void)open_rdt_force_source(options); });
+  EXPECT_NE(e.find("an rdt force source needs the sensor's calibration"), std::string::npos) << e;
+  options.endpoint = "127.0.0.1:99999";
+  EXPECT_NE(test::error_of([&] { (void)open_rdt_force_source(options); }).find("port must be 1..65535"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -420,4 +420,13 @@ const TareResult& RdtUdpForceSource::tare(const TareSettings& settings) {
   return r;
 }
 
+std::unique_ptr<RdtUdpForceSource> open_rdt_force_source(const RdtSourceOptions& options) {
+  const DatagramAddress sensor = parse_rdt_endpoint(options.endpoint);
+  const std::string host = options.endpoint.substr(0, options.endpoint.rfind(':'));
+  auto source = std::make_unique<RdtUdpForceSource>(sensor, resolve_rdt_calibration(options.calibration, host),
+                                                    options.stream, options.bind_address);
+  source->start();
+  return source;
+}
+
 }  // namespace deflex

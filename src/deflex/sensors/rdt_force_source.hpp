@@ -27,6 +27,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -217,5 +218,19 @@ class RdtUdpForceSource final : public ForceSource {
   SteadyClock clock_;
   RdtForceSource source_;
 };
+
+/// Everything a command line gives for `--force-source rdt:HOST[:PORT]`.
+struct RdtSourceOptions {
+  std::string endpoint;               ///< "HOST[:PORT]", the part after "rdt:"
+  RdtCalibrationOptions calibration;  ///< --rdt-calibration, --rdt-rate-hz
+  RdtStreamSettings stream;           ///< --rdt-buffered and the timeouts
+  std::string bind_address = "0.0.0.0";
+};
+
+/// Resolves the calibration (fetching the sensor's page for "sensor"), opens the socket and starts
+/// the stream, waiting for its first record. Throws InputError (options, calibration), ModelError (a
+/// bad page) or Error (no answer, socket). The tare is the caller's next step (it needs the arm's
+/// pose for the payload's weight).
+[[nodiscard]] std::unique_ptr<RdtUdpForceSource> open_rdt_force_source(const RdtSourceOptions& options);
 
 }  // namespace deflex
