@@ -8,6 +8,8 @@ packages=(
   protobuf-compiler libprotobuf-dev liburdfdom-dev libtinyxml-dev
   libgtest-dev libgmock-dev libbenchmark-dev liborocos-kdl-dev libboost-dev
   libspdlog-dev libxml2-dev
+  # libcurl: an RDT force sensor's calibration page (netftapi2.xml) fetched from the sensor over HTTP
+  libcurl4-openssl-dev
   python3 python3-dev python3-numpy python3-pytest pybind11-dev
 )
 missing=()

@@ -20,6 +20,7 @@
 #include "deflex/model/robot_io.hpp"
 #include "deflex/runtime/session.hpp"
 #include "deflex/sensors/force_source_spec.hpp"
+#include "deflex/sensors/wrench_tare.hpp"
 #include "deflex/wire/egm_codec.hpp"
 
 namespace deflex::cli {
@@ -63,6 +64,10 @@ struct Opts {
   std::string sentype = "ImFree";
   double rsi_correction_latency_ms = 0.0;
   int rsi_max_document_bytes = 4096, rsi_timeout = 100;
+  // RDT force sensors and the tare.
+  std::string rdt_calibration, tare_pose_deg;
+  double rdt_rate_hz = 0.0, tare_window_s = 0.5, tare_max_std_n = 0.5, tare_max_std_nm = 0.05;
+  bool rdt_buffered = false, tare = false;
   // Simple message.
   std::string byte_order = "little";
   int buffer_depth = 2, max_failures = 3, max_frame_bytes = 1024;
@@ -170,6 +175,40 @@ void add_link_options(CLI::App& sub, Opts& o) {
                  "simple-message: a controller that takes points slower than the program's cycle may fall this far "
                  "behind the program, s, before the motion is stopped (exit code 8)")
       ->capture_default_str();
+}
+
+void add_sensor_options(CLI::App& sub, Opts& o) {
+  sub.add_option("--rdt-calibration", o.rdt_calibration,
+                 "rdt: counts to N and Nm: sensor (its netftapi2.xml over HTTP), FILE.xml (a saved page), http://URL, "
+                 "onrobot-hex, or counts:counts_per_force=C,counts_per_torque=C,force_unit=U,torque_unit=U");
+  sub.add_option("--rdt-rate-hz", o.rdt_rate_hz,
+                 "rdt: the sensor's RDT rate, Hz (default: its page's comrdtrate; required for counts:, OnRobot 1000/n)");
+  sub.add_flag("--rdt-buffered", o.rdt_buffered, "rdt: buffered streaming (several records a datagram)");
+  sub.add_flag("--tare", o.tare,
+               "rdt: take the sensor's offset at start, arm still, over --tare-window-s (refused when it moves); "
+               "the sensor configuration's bias must then be zero");
+  sub.add_option("--tare-window-s", o.tare_window_s, "With --tare: the averaging window, s")->capture_default_str();
+  sub.add_option("--tare-max-std-N", o.tare_max_std_n,
+                 "With --tare: the largest standard deviation of a force axis over the window, N")
+      ->capture_default_str();
+  sub.add_option("--tare-max-std-Nm", o.tare_max_std_nm,
+                 "With --tare: the largest standard deviation of a torque axis over the window, Nm")
+      ->capture_default_str();
+  sub.add_option("--tare-pose-deg", o.tare_pose_deg,
+                 "With --tare and a payload: the joints the arm holds during the tare, deg (default for streaming "
+                 "links: the program's start), so that the payload's weight stays in the reading");
+}
+
+void check_sensor_options(const CLI::App& sub, const Opts& o) {
+  const bool rdt = o.force_source.rfind("rdt:", 0) == 0;
+  for (const char* name : {"--rdt-calibration", "--rdt-rate-hz", "--rdt-buffered", "--tare"}) {
+    if (!rdt && sub.get_option(name)->count() > 0) {
+      throw InputError(fmt::format("option {}: applies to --force-source rdt:HOST[:PORT]", name));
+    }
+  }
+  for (const char* name : {"--tare-window-s", "--tare-max-std-N", "--tare-max-std-Nm", "--tare-pose-deg"}) {
+    if (!o.tare && sub.get_option(name)->count() > 0) throw InputError(fmt::format("option {}: applies with --tare", name));
+  }
 }
 
 void check_link_options(const CLI::App& sub, LinkKind kind) {
@@ -302,20 +341,72 @@ runtime::SessionConfig session_config(const Opts& o, const CLI::App& sub) {
   return c;
 }
 
+// --tare: the sensor's offset, averaged with the arm still, the payload's weight at the tare pose left
+// in the reading (the pipeline's gravity compensation takes it out at every pose).
+void tare_sensor(const Opts& o, const RobotModel& model, const SensorConfig& sensor, const JointTrajectory* program,
+                 const OpenedForceSource& force, spdlog::logger& log) {
+  if (sensor.bias_sensor.cwiseAbs().maxCoeff() > 0.0) {
+    throw InputError(fmt::format(
+        "option --tare: the sensor configuration {} gives a bias too ({:.3f} {:.3f} {:.3f} N ...): the offset would be "
+        "taken out twice; set its bias to zero or leave --tare out",
+        sensor.source, sensor.bias_sensor[0], sensor.bias_sensor[1], sensor.bias_sensor[2]));
+  }
+  TareSettings ts;
+  ts.window_s = o.tare_window_s;
+  ts.max_std_force_n = o.tare_max_std_n;
+  ts.max_std_torque_nm = o.tare_max_std_nm;
+  std::string pose_text = "no payload in the sensor configuration: the tare takes out all it reads";
+  if (sensor.payload_mass_kg > 0.0) {
+    JointVector q;
+    if (!o.tare_pose_deg.empty()) {
+      q = parse_joints_deg(o.tare_pose_deg, model, "--tare-pose-deg");
+      pose_text = "the payload's weight at --tare-pose-deg kept in the reading";
+    } else if (program != nullptr) {
+      q = program->points().front();
+      pose_text = "the payload's weight at the program's start kept in the reading";
+    } else {
+      throw InputError(
+          "option --tare-pose-deg: the sensor configuration has a payload, and this link streams no program: give the "
+          "joints the arm holds during the tare, so that its weight is not taken out as an offset");
+    }
+    Workspace ws(model);
+    forward_kinematics(model, ws, q);
+    const Matrix3 base_R_sensor = ws.base_T_flange.linear() * sensor.flange_T_sensor.linear();
+    ts.expected_wrench_sensor =
+        payload_wrench_sensor(sensor.payload_mass_kg, sensor.payload_cog_sensor_m, sensor.gravity_base_m_s2, base_R_sensor);
+  }
+  log.info("tare: hold the arm still for {:g} s ({})", ts.window_s, pose_text);
+  log.info("tare: {}", describe(force.rdt->tare(ts), ts));
+}
+
 void run_online(const Opts& o, const CLI::App& sub, int& exit_code) {
   const runtime::SessionConfig config = session_config(o, sub);
   const runtime::LinkKindInfo& info = runtime::link_kind(config.link);
   const RobotModel model = load_cli_robot("online", o.robot);
-  const SensorConfig sensor = sensor_or_default(o.sensor);
+  SensorConfig sensor = sensor_or_default(o.sensor);
   std::unique_ptr<ForceModel> force_model;
   if (!o.force_model.empty()) force_model = parse_force_spec(o.force_model);
   std::shared_ptr<const JointTrajectory> program;
   if (!o.program.empty()) program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o.program, model));
+  check_sensor_options(sub, o);
   const auto log = make_field_logger("online", o.log_options);
   ForceSourceOptions fo;
   fo.loop = o.loop;
   fo.bind_address = o.bind;
+  fo.rdt_calibration.spec = o.rdt_calibration;
+  fo.rdt_calibration.rate_hz = o.rdt_rate_hz;
+  fo.rdt_stream.buffered = o.rdt_buffered;
   const OpenedForceSource force = open_force_source(o.force_source, fo);
+  if (force.sample_rate_hz > 0.0 && std::abs(force.sample_rate_hz - sensor.sample_rate_hz) > 1e-9) {
+    // The filter is designed for the rate the samples come at: the sensor's own.
+    if (!o.sensor.empty()) {
+      log->info("the force source streams at {:g} Hz: the low-pass filter is designed for it (the sensor file says {:g} "
+                "Hz)",
+                force.sample_rate_hz, sensor.sample_rate_hz);
+    }
+    sensor.sample_rate_hz = force.sample_rate_hz;
+  }
+  if (o.tare) tare_sensor(o, model, sensor, program.get(), force, *log);
   SteadyClock clock;
   runtime::Session session(config, model, sensor, program, force_model.get(), force.source.get(), clock, {},
                            [log](runtime::LogLevel level, const std::string& text) {
@@ -362,6 +453,8 @@ void run_online(const Opts& o, const CLI::App& sub, int& exit_code) {
     print_json(doc);
   }
   exit_code = summary.exit_code;
+  // A session that ended as planned but whose cycle log could not be written failed all the same.
+  if (!summary.output_error.empty() && exit_code == 0) exit_code = 1;
 }
 
 void setup_online(CLI::App& sub, int& exit_code) {
@@ -433,6 +526,7 @@ void setup_online(CLI::App& sub, int& exit_code) {
   sub.add_option("--rt-cpu", o->rt_cpu, "With --realtime: the CPU to pin the loop to (an isolated core)");
   sub.add_flag("--rt-no-mlock", o->rt_no_mlock, "With --realtime: do not lock the process's memory");
   add_link_options(sub, *o);
+  add_sensor_options(sub, *o);
   sub.callback([o, &sub, &exit_code] { run_online(*o, sub, exit_code); });
 }
 

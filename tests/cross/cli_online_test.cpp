@@ -176,7 +176,8 @@ TEST(CliOnline, BadOptionsAndProgramsAreRefusedBeforeAnythingRuns) {
   expect("--link egm-joint --program " + program_path + " --strategy hybrid", "needs a force model");
   expect("--link egm-joint --program " + program_path + " --strategy guess", "strategy 'guess'");
   expect("--link egm-path --path-corr-frame world", "world");
-  expect("--link egm-joint --program " + program_path + " --fault-dump /nonexistent/dir/dump.csv", "fault dump");
+  expect("--link egm-joint --program " + program_path + " --fault-dump /nonexistent/dir/dump.csv",
+         "option --fault-dump '/nonexistent/dir/dump.csv': the folder '/nonexistent/dir' does not exist");
   // Programs the robot cannot follow, named by file, line and joint.
   const auto write = [&](const std::string& name, const std::string& text) {
     const std::string p = dir + "/" + name;

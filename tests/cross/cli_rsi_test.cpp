@@ -234,7 +234,7 @@ TEST(CliRsi, BadOptionsAreRefusedNamingTheOption) {
   expect(base + "--link rsi --rsi-port 0 --rsi-max-document-bytes 10", "--rsi-max-document-bytes");
   expect(base + "--link rsi --rsi-port 0 --log-level loud", "--log-level");
   expect(base + "--link rsi --rsi-port 0 --log-file /nonexistent/dir/field.log", "/nonexistent/dir/field.log");
-  expect(base + "--link rsi --rsi-port 0 --fault-dump /nonexistent/dir/dump.csv", "fault dump");
+  expect(base + "--link rsi --rsi-port 0 --fault-dump /nonexistent/dir/dump.csv", "option --fault-dump");
   const std::string setup = "controller-setup -o " + ::testing::TempDir() + " ";
   expect(setup + "--link fanuc --sensor-ip 10.0.0.2", "--link");
   expect(setup + "--link rsi --sensor-ip 0.0.0.0", "--sensor-ip");

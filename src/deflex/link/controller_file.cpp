@@ -2,11 +2,11 @@
 #include "deflex/link/controller_file.hpp"
 
 #include <cctype>
-#include <fstream>
 
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
+#include "deflex/model/output_file.hpp"
 
 namespace deflex {
 
@@ -26,13 +26,14 @@ bool plain_identifier(const std::string& s, std::size_t max_length) {
 }
 
 void write_controller_files(const std::vector<ControllerFile>& files, const std::string& directory) {
+  // The files of one link belong together: they appear all or none, and a failure leaves what was in
+  // the folder as it was (model/output_file.hpp).
+  OutputTransaction transaction;
   for (const ControllerFile& f : files) {
     const std::string path = directory.empty() ? f.name : directory + "/" + f.name;
-    std::ofstream out(path, std::ios::binary);
-    out << f.text;
-    out.close();
-    if (!out) throw Error(fmt::format("{}: cannot write", path));
+    transaction.add(path, "controller file").write(f.text);
   }
+  transaction.commit();
 }
 
 }  // namespace deflex

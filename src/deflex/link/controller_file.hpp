@@ -20,7 +20,9 @@ struct ControllerFile {
 /// True for a name RAPID and KRL both take: a letter, then letters, digits or '_', 1..max_length long.
 [[nodiscard]] bool plain_identifier(const std::string& s, std::size_t max_length);
 
-/// Writes each file into `directory` (which must exist). Throws Error naming the file it cannot write.
+/// Writes the files into `directory` (which must exist), all or none, never destroying what was there
+/// on a failure (model/output_file.hpp). Throws InputError for a path that cannot be an output and
+/// OutputError naming the file it cannot write.
 void write_controller_files(const std::vector<ControllerFile>& files, const std::string& directory);
 
 }  // namespace deflex

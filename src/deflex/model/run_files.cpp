@@ -87,6 +87,9 @@ void record_output_file(const FileId& id, const std::string& path, const std::st
                                  what, path, in->path));
   }
   if (const Entry* other = find(r.outputs, id)) {
+    // The same output written again (a fault dump rewritten at each episode) is that output's own
+    // business; two outputs naming one file would lose one of them.
+    if (other->what == what) return;
     throw InputError(fmt::format("{} '{}' and {} '{}' are the same file: give each output its own name", other->what,
                                  other->path, what, path));
   }

@@ -33,7 +33,8 @@ struct FileId {
 void record_input_file(const FileId& id, const std::string& path);
 
 /// Notes an output file that exists already (`what` names it: "option -o"); throws InputError naming
-/// both when this run reads it or another output is the same file.
+/// both when this run reads it or another output (another `what`) is the same file. The same output
+/// written again (a fault dump, rewritten at each fault episode) is not refused.
 void record_output_file(const FileId& id, const std::string& path, const std::string& what);
 
 }  // namespace deflex

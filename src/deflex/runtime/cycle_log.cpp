@@ -1,9 +1,7 @@
 // The cycle log's CSV (see cycle_log.hpp).
 #include "deflex/runtime/cycle_log.hpp"
 
-#include <cerrno>
 #include <cmath>
-#include <cstring>
 
 #include <fmt/format.h>
 
@@ -67,39 +65,31 @@ void append_cycle_row(std::string& out, const SessionEntry& e, int joints) {
                  c.step_limited);
 }
 
-CycleLogFile::CycleLogFile(const std::string& path, int joints) : path_(path), joints_(joints) {
-  file_ = std::fopen(path.c_str(), "w");
-  if (file_ == nullptr) {
-    throw Error(fmt::format("{}: cannot write the cycle log ({})", path, std::strerror(errno)));
-  }
-  buffer_.resize(1 << 20);
-  std::setvbuf(file_, buffer_.data(), _IOFBF, buffer_.size());
-  const std::string header = cycle_log_header(joints);
-  failed_ = std::fputs(header.c_str(), file_) < 0;
+CycleLogFile::CycleLogFile(const std::string& path, int joints) : file_(path, "option --log"), joints_(joints) {
+  file_.write(cycle_log_header(joints));
   row_.reserve(4096);
 }
 
-CycleLogFile::~CycleLogFile() {
-  if (file_ != nullptr) std::fclose(file_);
-}
-
 void CycleLogFile::write(const SessionEntry& e) {
-  if (file_ == nullptr || e.kind != SessionEntry::Kind::kCycle) return;
+  if (closed_ || e.kind != SessionEntry::Kind::kCycle) return;
   row_.clear();
   append_cycle_row(row_, e, joints_);
-  if (std::fwrite(row_.data(), 1, row_.size(), file_) != row_.size()) failed_ = true;
+  file_.write(row_);
   ++rows_;
 }
 
 void CycleLogFile::close() {
-  if (file_ == nullptr) return;
-  const bool flushed = std::fflush(file_) == 0 && std::ferror(file_) == 0;
-  const int err = errno;
-  const bool closed = std::fclose(file_) == 0;
-  file_ = nullptr;
-  if (failed_ || !flushed || !closed) {
-    throw Error(fmt::format("{}: writing the cycle log failed ({})", path_, std::strerror(err)));
-  }
+  if (closed_) return;
+  closed_ = true;
+  file_.commit();
+}
+
+void write_fault_dump(const std::string& path, const std::string& text) {
+  write_output_file(path, text, "option --fault-dump");
+}
+
+void check_fault_dump_path(const std::string& path) {
+  const OutputFile probe(path, "option --fault-dump");  // uncommitted: its temporary file goes with it
 }
 
 }  // namespace deflex::runtime

@@ -7,10 +7,10 @@
 // counts. Written on the reporter's thread, never on the loop's.
 #pragma once
 
-#include <cstdio>
 #include <string>
 #include <vector>
 
+#include "deflex/model/output_file.hpp"
 #include "deflex/runtime/record_queue.hpp"
 
 namespace deflex::runtime {
@@ -20,29 +20,33 @@ namespace deflex::runtime {
 /// One row (with its newline).
 void append_cycle_row(std::string& out, const SessionEntry& e, int joints);
 
+/// The cycle log as an output of deflex (model/output_file.hpp): written into a temporary file beside
+/// the path and put in place when the session ends (whatever ended it: the log is the record of what
+/// happened), never truncating the path before then; a session that dies leaves the path as it was.
 class CycleLogFile {
  public:
-  /// Opens `path` for writing now, so an unwritable path is an error at the session's start, and
-  /// writes the header. Throws Error naming the path.
+  /// Prepares `path` now, so a path that cannot be an output is an error at the session's start, and
+  /// writes the header. Throws InputError naming the option and the path.
   CycleLogFile(const std::string& path, int joints);
-  ~CycleLogFile();
-  CycleLogFile(const CycleLogFile&) = delete;
-  CycleLogFile& operator=(const CycleLogFile&) = delete;
 
   void write(const SessionEntry& e);
-  /// Flushes and closes; throws Error naming the path when any write failed (a full disk).
+  /// Puts the log in place; throws OutputError naming the path when a write failed (a full disk).
   void close();
-  [[nodiscard]] const std::string& path() const { return path_; }
+  [[nodiscard]] const std::string& path() const { return file_.path(); }
   [[nodiscard]] std::uint64_t rows() const { return rows_; }
 
  private:
-  std::string path_;
-  std::FILE* file_ = nullptr;
+  OutputFile file_;
   int joints_;
   std::string row_;
-  std::vector<char> buffer_;
   std::uint64_t rows_ = 0;
-  bool failed_ = false;
+  bool closed_ = false;
 };
+
+/// `text` as the fault dump at `path`, put in place at once (a temporary file renamed over the
+/// previous dump). Throws InputError or OutputError naming the path.
+void write_fault_dump(const std::string& path, const std::string& text);
+/// Refuses now a dump path that could not be written later (InputError naming it); leaves no trace.
+void check_fault_dump_path(const std::string& path);
 
 }  // namespace deflex::runtime

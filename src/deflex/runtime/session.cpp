@@ -339,6 +339,7 @@ void Session::build_summary() {
     s.program_behind_s = reporter_->program_behind_s();
   }
   if (program_) s.program_time_s = l.last_cycle().program_time_s - program_->start_time_s();
+  if (reporter_) s.output_error = reporter_->log_error();
 
   const bool tcp = s.limits.form == CommandForm::kTcpOffset;
   const std::string invariants =

@@ -94,6 +94,7 @@ struct SessionSummary {
   std::uint64_t late_answers = 0;
   double program_time_s = 0.0;   ///< streaming links: where the program was at the end (its own axis)
   double program_behind_s = 0.0; ///< how far behind real time the program ran
+  std::string output_error;      ///< the cycle log could not be written ("" when it was, or none was asked)
   std::string text;              ///< the summary as lines for a person
   nlohmann::json json;           ///< the same for a program
 };

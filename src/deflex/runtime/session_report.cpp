@@ -33,12 +33,8 @@ double Histogram::quantile(double q) const {
 
 SessionReporter::SessionReporter(ReportSetup setup) : setup_(std::move(setup)) {
   if (!setup_.log_path.empty()) log_ = std::make_unique<CycleLogFile>(setup_.log_path, setup_.joints);
-  if (!setup_.dump_path.empty()) {
-    // Checked now: an unwritable path must not end a run at its first fault.
-    std::FILE* probe = std::fopen(setup_.dump_path.c_str(), "a");
-    if (probe == nullptr) throw Error(fmt::format("{}: cannot write the fault dump", setup_.dump_path));
-    std::fclose(probe);
-  }
+  // Checked now: a path that cannot be written must not end a run at its first fault.
+  if (!setup_.dump_path.empty()) check_fault_dump_path(setup_.dump_path);
   SessionEntry blank;
   blank.record.q_nominal = blank.record.q_blend = blank.record.q_feedback = blank.record.q_command =
       blank.record.dtheta = JointVector::Zero(setup_.joints);
@@ -159,17 +155,13 @@ void SessionReporter::begin_episode(const SessionEntry& e) {
 
 void SessionReporter::write_dump(const std::string& why) {
   if (setup_.dump_path.empty()) return;
-  std::FILE* f = std::fopen(setup_.dump_path.c_str(), "w");
-  if (f == nullptr) {
-    log(LogLevel::kError, fmt::format("{}: {}: cannot write the fault dump", why, setup_.dump_path));
-    return;
-  }
   std::string text = cycle_log_header(setup_.joints);
   const std::size_t first = (ring_head_ + ring_.size() - ring_count_) % ring_.size();
   for (std::size_t k = 0; k < ring_count_; ++k) append_cycle_row(text, ring_[(first + k) % ring_.size()], setup_.joints);
-  const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  if (std::fclose(f) != 0 || !ok) {
-    log(LogLevel::kError, fmt::format("{}: {}: writing the fault dump failed", why, setup_.dump_path));
+  try {
+    write_fault_dump(setup_.dump_path, text);
+  } catch (const Error& e) {
+    log(LogLevel::kError, fmt::format("{}: {}", why, e.what()));
     return;
   }
   log(LogLevel::kWarn, fmt::format("{}: the last {} cycles written to {}", why, ring_count_, setup_.dump_path));

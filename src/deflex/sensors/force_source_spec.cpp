@@ -10,7 +10,10 @@
 
 namespace deflex {
 
-const char* force_source_kinds() { return "udp:PORT (deflex's force datagram) or csv:FILE (a recorded replay)"; }
+const char* force_source_kinds() {
+  return "udp:PORT (deflex's force datagram), csv:FILE (a recorded replay) or rdt:HOST[:PORT] (an ATI, Schunk or "
+         "OnRobot sensor in its own RDT protocol; needs --rdt-calibration)";
+}
 
 namespace {
 
@@ -38,6 +41,22 @@ OpenedForceSource open_force_source(const std::string& spec, const ForceSourceOp
   if (kind == "csv" && !arg.empty()) {
     auto src = std::make_unique<CsvForceReplay>(arg, options.loop);
     out.description = fmt::format("CSV replay of {} ({} samples{})", arg, src->size(), options.loop ? ", looped" : "");
+    out.source = std::move(src);
+    return out;
+  }
+  if (kind == "rdt" && !arg.empty()) {
+    RdtSourceOptions o;
+    o.endpoint = arg;
+    o.calibration = options.rdt_calibration;
+    o.stream = options.rdt_stream;
+    o.bind_address = options.rdt_bind_address;
+    auto src = open_rdt_force_source(o);
+    const RdtForceSource& s = src->source();
+    const RdtCalibration& c = s.calibration();
+    out.sample_rate_hz = s.sample_rate_hz();
+    out.description = fmt::format("RDT sensor at {}, {} streaming: {}", arg,
+                                  options.rdt_stream.buffered ? "buffered" : "real-time", c.describe());
+    out.rdt = src.get();
     out.source = std::move(src);
     return out;
   }
