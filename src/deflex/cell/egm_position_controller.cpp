@@ -76,8 +76,12 @@ const JointVector& EgmPositionGuidanceController::tick(double t_s) {
   return position_;
 }
 
-void EgmPositionGuidanceController::restart(bool reset_reference) {
+void EgmPositionGuidanceController::restart(double t_s, bool reset_reference) {
   seqno_ = 0;
+  stopped_ = streaming_after_stop_ = false;
+  robot_.mci_state = 3;
+  last_answer_s_ = t_s;
+  next_send_s_ = t_s;
   if (reset_reference) {
     target_ = filtered_target_ = have_encoders_ ? encoders_ : position_;
     speed_ref_.setZero();

@@ -46,10 +46,10 @@ class EgmPositionGuidanceController final : public RobotController {
   /// The target the controller follows now (rad): the sensor's last one.
   [[nodiscard]] const JointVector& target() const { return target_; }
 
-  /// A new EGM session from the next message on: the sequence number starts again at 1; with
-  /// `reset_reference` the reference is where the arm is now (a new EGMRunJoint), else the one it
+  /// A new EGM session at t_s (EGMRunJoint called again, after a timeout too): the sequence number
+  /// starts again at 1; with `reset_reference` the reference is where the arm is now, else the one it
   /// followed stays.
-  void restart(bool reset_reference);
+  void restart(double t_s, bool reset_reference);
   /// EGM ends with `mci_state` (2 STOPPED, 1 ERROR): targets are no longer taken, the arm holds, the
   /// controller keeps streaming its state.
   void end_session(int mci_state);

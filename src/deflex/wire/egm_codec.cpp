@@ -288,7 +288,12 @@ std::size_t EgmCodec::encode_robot(const EgmRobotMessage& msg, unsigned char* ou
   }
   m.mutable_motorstate()->set_state(msg.motor_state == 2 ? abb::egm::EgmMotorState::MOTORS_OFF
                                                          : abb::egm::EgmMotorState::MOTORS_ON);
-  m.mutable_mcistate()->set_state(abb::egm::EgmMCIState::MCI_RUNNING);
+  // The controller's EGM state as the stand-in gives it (running unless it says otherwise).
+  m.mutable_mcistate()->set_state(msg.mci_state == 1   ? abb::egm::EgmMCIState::MCI_ERROR
+                                  : msg.mci_state == 2 ? abb::egm::EgmMCIState::MCI_STOPPED
+                                                       : abb::egm::EgmMCIState::MCI_RUNNING);
+  m.mutable_rapidexecstate()->set_state(msg.rapid_exec_state == 1 ? abb::egm::EgmRapidCtrlExecState::RAPID_STOPPED
+                                                                  : abb::egm::EgmRapidCtrlExecState::RAPID_RUNNING);
   m.set_mciconvergencemet(msg.mci_convergence_met);
   const std::size_t n = m.ByteSizeLong();
   if (n > capacity || !m.SerializeToArray(out, static_cast<int>(capacity))) {

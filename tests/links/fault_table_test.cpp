@@ -1,0 +1,405 @@
+// The fault table of docs/online.md ("Faults and exit codes"), row by row, for each link it applies
+// to, against stand-ins that behave as the real controllers do (fault_bench.hpp): silences of any
+// length, restarts with and without silence, a stalled deflex, a controller that stops, a stale
+// force, a slow consumer. In every test the two invariants are checked on what went on the wire:
+// every command within the bound of the nominal deflex held, and no step between two commands above
+// the per-cycle limit the test computes itself; and every stop has a named reason and its exit code.
+#include <gtest/gtest.h>
+
+#include "links/fault_bench.hpp"
+
+namespace deflex {
+namespace {
+
+using runtime::LinkKind;
+using runtime::StopReason;
+using test::FaultBench;
+
+JointVector pose_deg(double a, double b, double c, double d, double e, double f) {
+  JointVector q(6);
+  q << a, b, c, d, e, f;
+  return q * (kPi / 180.0);
+}
+
+const JointVector kStart = pose_deg(0, 20, 10, 0, 60, 0);
+
+// A 20 s sweep: moving all the time, a few degrees a second on the big joints (a 50 mm/s TCP path).
+std::shared_ptr<const JointTrajectory> sweep(double seconds = 20.0) {
+  return test::sweep_program(test::bench_robot(), kStart, pose_deg(20, -8, 12, 25, -15, 40), seconds);
+}
+
+// Every command the controller received is one deflex sent (in order), and what it says is what the
+// record says was sent.
+void expect_wire_is_what_was_sent(FaultBench& b) {
+  b.session->service();
+  std::vector<const LinkCycleRecord*> sent;
+  for (const LinkCycleRecord& r : b.session->collected()) {
+    if (r.replied) sent.push_back(&r);
+  }
+  std::size_t at = 0;
+  for (const test::WireCommand& c : b.tap.commands) {
+    bool found = false;
+    for (; at < sent.size() && !found; ++at) {
+      const LinkCycleRecord& r = *sent[at];
+      if (b.kind == LinkKind::kEgmJoint) {
+        found = (r.q_command - c.joints).cwiseAbs().maxCoeff() < 1e-12;
+      } else if (b.kind == LinkKind::kRsi) {
+        found = ((r.q_command - r.q_nominal) - c.joints).cwiseAbs().maxCoeff() < 1e-9;
+      } else {
+        found = true;  // path correction's offsets are in the tool frame: checked by norm below
+      }
+    }
+    ASSERT_TRUE(found) << "a command on the wire that deflex never recorded sending";
+  }
+}
+
+void expect_invariants(FaultBench& b, const char* what) {
+  EXPECT_LE(b.worst_step_fraction(), 1.0) << what << ": a step on the wire beyond the per-cycle limit";
+  EXPECT_LE(b.worst_bound_fraction(), 1.0) << what << ": a command beyond the bound of the nominal";
+  expect_wire_is_what_was_sent(b);
+}
+
+// ---- egm-joint: silence, stalled deflex, restarts, controller stops, stale force ----------------
+
+TEST(FaultTable, EgmJointOutagesOfAnyLengthNeverStepTheTargetAndTheProgramWaits) {
+  for (const double outage : {0.02, 0.1, 0.3, 0.45, 0.9}) {
+    FaultBench b(LinkKind::kEgmJoint, sweep());
+    b.run_for(3.0);
+    const double program_before = b.session->link().last_cycle().program_time_s;
+    const std::size_t wire_before = b.tap.commands.size();
+    b.network.add_outage(b.t_s, b.t_s + outage);
+    b.run_for(outage + 2.0);
+    ASSERT_FALSE(b.session->ended()) << outage << " s: " << b.session->finish().reason_text;
+    expect_invariants(b, "outage");
+    // The program never ran ahead of what the controller took: it went on where it stopped.
+    b.session->service();
+    const auto& records = b.session->collected();
+    double after = -1.0;
+    for (const LinkCycleRecord& r : records) {
+      if (r.replied && r.program_time_s > program_before + 1e-9) {
+        after = r.program_time_s;
+        break;
+      }
+    }
+    EXPECT_NEAR(after, program_before + 0.004, 1e-9) << outage << " s";
+    // The TCP: the controller's targets around the outage moved by a normal step only (the 22.8 mm of
+    // the old program clock is what this guards).
+    Workspace ws(b.robot);
+    const Vector3 p0 = tcp_pose(b.robot, ws, b.tap.commands[wire_before - 1].joints).translation();
+    const Vector3 p1 = tcp_pose(b.robot, ws, b.tap.commands[wire_before].joints).translation();
+    EXPECT_LT((p1 - p0).norm(), 0.5e-3) << outage << " s: the first target after the outage steps the TCP";
+    if (outage > 0.05) {
+      EXPECT_GE(b.session->link().counters().silences, 1u);
+      EXPECT_NEAR(b.session->link().counters().longest_silence_s, outage, 0.01) << outage;
+    }
+    EXPECT_EQ(b.session->link().counters().guard_trips, 0u);
+  }
+}
+
+TEST(FaultTable, EgmJointAStalledDeflexNeverStepsTheTargetAfterwards) {
+  for (const double stall : {0.05, 0.3, 0.45}) {
+    FaultBench b(LinkKind::kEgmJoint, sweep());
+    b.run_for(3.0);
+    b.deflex_running = false;  // the controller goes on (its messages queue up), deflex does not read
+    b.run_for(stall);
+    b.deflex_running = true;
+    b.run_for(2.0);
+    ASSERT_FALSE(b.session->ended());
+    expect_invariants(b, "stall");
+    EXPECT_GT(b.session->link().counters().superseded, 0u);  // the queued messages: only the newest answered
+    EXPECT_FALSE(b.egm->counters().timed_out);
+  }
+}
+
+TEST(FaultTable, EgmJointARestartAfterASilenceAppliesTheCorrectionOnce) {
+  FaultBench b(LinkKind::kEgmJoint, sweep());
+  b.run_for(3.0);
+  const JointVector dtheta = b.session->link().last_cycle().dtheta;
+  ASSERT_GT(dtheta.cwiseAbs().maxCoeff(), 1e-5);
+  // 1.2 s of silence: the controller's EGM times out (1 s) and the arm holds where it is, some way
+  // behind deflex's last target (its dead time); then EGMRunJoint again, its reference where the arm
+  // is, its sequence from 1.
+  b.network.add_outage(b.t_s, b.t_s + 1.2);
+  b.run_for(1.7);
+  ASSERT_TRUE(b.egm->counters().timed_out);
+  const std::size_t before = b.tap.commands.size();
+  b.egm->restart(b.t_s, true);
+  b.run_for(3.0);
+  ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
+  EXPECT_EQ(b.session->link().counters().restarts, 1u);
+  // On the wire: within each session no step above the limit, and the new session's first command is
+  // where the controller's new reference is (the arm), not a step from it.
+  EXPECT_LE(b.worst_step_fraction(before + 1), 1.0);
+  EXPECT_LE(b.worst_bound_fraction(), 1.0);
+  b.session->service();
+  JointVector q(6);
+  bool after = false;
+  for (const LinkCycleRecord& r : b.session->collected()) {
+    if (r.session_start && r.sequence == 1) {
+      after = true;
+      // The first command is the reference the controller holds (the arm, which holds), less the
+      // correction's own change this cycle (at most its rate bound): the blend is that reference less
+      // the program less the correction, so the correction counts once.
+      const double one_step = b.config.online.max_correction_rate_rad_s * b.config.online.period_s + 1e-9;
+      EXPECT_LE((r.q_command - r.q_feedback).cwiseAbs().maxCoeff(), one_step);
+      b.program->sample(r.program_time_s, q);
+      EXPECT_LE((r.q_blend - (r.q_feedback - (q - r.dtheta))).cwiseAbs().maxCoeff(), one_step);
+    }
+    // After the ramp-in (1 s) the command is the program less the correction, exactly.
+    if (after && r.replied && r.program_time_s > 3.0 + 1.05) {
+      b.program->sample(r.program_time_s, q);
+      EXPECT_LT((r.q_command - (q - r.dtheta)).cwiseAbs().maxCoeff(), 1e-12);
+    }
+  }
+  EXPECT_TRUE(after);
+}
+
+TEST(FaultTable, EgmJointARestartWithoutSilenceKeepsTheStreamAndNeverSteps) {
+  for (const bool reset_reference : {false, true}) {
+    FaultBench b(LinkKind::kEgmJoint, sweep());
+    b.run_for(3.0);
+    const std::size_t at = b.tap.commands.size();
+    b.egm->restart(b.t_s, reset_reference);  // the sequence starts again, the arm moving
+    b.run_for(3.0);
+    ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
+    EXPECT_EQ(b.session->link().counters().restarts, 1u);
+    if (!reset_reference) {
+      expect_invariants(b, "restart without silence");
+      continue;
+    }
+    // A reset reference: the controller holds the arm's (lagging) position now, not deflex's last
+    // target. The stream goes on from what the controller holds: the first command after the restart
+    // steps by at most the limit from the reference it reported, and from then on by at most it.
+    EXPECT_LE(b.worst_step_fraction(at + 1), 1.0);
+    EXPECT_LE(b.worst_bound_fraction(), 1.0);
+    b.session->service();
+    for (const LinkCycleRecord& r : b.session->collected()) {
+      if (!r.session_start || !r.replied || r.sequence > 16) continue;
+      EXPECT_LE(((r.q_command - r.q_feedback).cwiseAbs().array() / b.joint_step_limit().array()).maxCoeff(), 40.0)
+          << "the first command after a reset is where the controller's reference is, near the arm";
+    }
+  }
+}
+
+TEST(FaultTable, EgmJointAControllerThatStopsEndsTheSessionWithItsReason) {
+  {  // EGM ended before the program's end: exit 6, named, at the next message
+    FaultBench b(LinkKind::kEgmJoint, sweep());
+    b.run_for(2.0);
+    b.egm->end_session(2);
+    const double t0 = b.t_s;
+    b.run_for(1.0);
+    ASSERT_TRUE(b.session->ended());
+    const runtime::SessionSummary& s = b.session->finish();
+    EXPECT_EQ(s.reason, StopReason::kControllerStopped);
+    EXPECT_EQ(s.exit_code, 6);
+    EXPECT_NE(s.reason_text.find("ended EGM (mciState STOPPED)"), std::string::npos) << s.reason_text;
+    EXPECT_LE(b.t_s - t0, 0.0121);  // within three 4 ms cycles
+    expect_invariants(b, "EGM ended");
+  }
+  {  // the motors off (an emergency stop): exit 6
+    FaultBench b(LinkKind::kEgmJoint, sweep());
+    b.run_for(2.0);
+    b.egm->motors_off();
+    b.run_for(1.0);
+    const runtime::SessionSummary& s = b.session->finish();
+    EXPECT_EQ(s.exit_code, 6);
+    EXPECT_NE(s.reason_text.find("motors off"), std::string::npos) << s.reason_text;
+  }
+  {  // EGM ended after the program's end: the planned end, exit 0
+    FaultBench b(LinkKind::kEgmJoint, sweep(2.0));
+    b.run_for(3.5);
+    ASSERT_EQ(b.session->link().state(), LinkState::kFinished);
+    b.egm->end_session(2);
+    b.run_for(0.1);
+    const runtime::SessionSummary& s = b.session->finish();
+    EXPECT_EQ(s.reason, StopReason::kProgramEnd);
+    EXPECT_EQ(s.exit_code, 0);
+  }
+  {  // silent for longer than the stop silence (3 s): exit 5, within a cycle of it
+    FaultBench b(LinkKind::kEgmJoint, sweep());
+    b.run_for(2.0);
+    b.network.add_outage(b.t_s, b.t_s + 10.0);
+    const double t0 = b.t_s;
+    b.run_for(5.0);
+    ASSERT_TRUE(b.session->ended());
+    const runtime::SessionSummary& s = b.session->finish();
+    EXPECT_EQ(s.reason, StopReason::kControllerSilent);
+    EXPECT_EQ(s.exit_code, 5);
+    EXPECT_NEAR(b.t_s - t0, 3.0, 0.01);
+    EXPECT_NE(s.reason_text.find("no usable message from the controller for 3.0"), std::string::npos) << s.reason_text;
+  }
+}
+
+TEST(FaultTable, EgmJointAStaleForceRampsTheCorrectionOutAtTheRateBound) {
+  FaultBench b(LinkKind::kEgmJoint, sweep());
+  b.run_for(3.0);
+  const double before = b.session->link().last_cycle().dtheta.cwiseAbs().maxCoeff();
+  b.force.on = false;
+  b.run_for(1.0);
+  expect_invariants(b, "stale force");
+  b.session->service();
+  int ramp = 0;
+  double previous = before;
+  for (const LinkCycleRecord& r : b.session->collected()) {
+    if (r.status != CycleStatus::kStaleForce) continue;
+    const double now = r.dtheta.cwiseAbs().maxCoeff();
+    EXPECT_LE(previous - now, b.config.online.max_correction_rate_rad_s * 0.004 * (1 + 1e-9) + 1e-15);
+    if (now > 0.0) ++ramp;
+    previous = now;
+  }
+  EXPECT_EQ(previous, 0.0);
+  EXPECT_GE(ramp, 2);  // a ramp over cycles, not a step
+}
+
+// ---- egm-path: silence, restart, stale force, the controller's end ---------------------------------
+
+TEST(FaultTable, EgmPathAStaleForceRampsTheOffsetOutOverSeveralAnswers) {
+  FaultBench b(LinkKind::kEgmPath, sweep());
+  b.run_for(4.0);
+  const double offset = b.tap.commands.back().offset_m.norm();
+  ASSERT_GT(offset, 2e-4);
+  const std::size_t at = b.tap.commands.size();
+  b.force.on = false;
+  b.run_for(2.0);
+  expect_invariants(b, "stale force");
+  // Zero at the end, reached over at least |offset| / (TCP rate x period) answers: a ramp.
+  std::size_t answers = 0;
+  for (std::size_t k = at; k < b.tap.commands.size() && b.tap.commands[k].offset_m.norm() > 1e-9; ++k) ++answers;
+  EXPECT_EQ(b.tap.commands.back().offset_m.norm(), 0.0);
+  EXPECT_GE(static_cast<double>(answers) + 1.0,
+            offset / (b.config.online.max_tcp_rate_m_s * b.config.online.period_s));
+  EXPECT_GE(answers, 2u);
+}
+
+TEST(FaultTable, EgmPathOutagesAndARestartNeverStepTheOffset) {
+  FaultBench b(LinkKind::kEgmPath, sweep());
+  b.run_for(3.0);
+  b.network.add_outage(b.t_s, b.t_s + 0.45);
+  b.run_for(2.0);
+  b.deflex_running = false;
+  b.run_for(0.3);
+  b.deflex_running = true;
+  b.run_for(1.0);
+  b.path->restart();  // a new EGMActMove: its correction from zero
+  b.run_for(2.0);
+  ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
+  expect_invariants(b, "egm-path faults");
+  EXPECT_EQ(b.session->link().counters().restarts, 1u);
+}
+
+TEST(FaultTable, EgmPathTheControllersEndIsPlannedAndSilenceIsNot) {
+  {
+    FaultBench b(LinkKind::kEgmPath, sweep());
+    b.run_for(1.0);
+    b.network.add_outage(b.t_s, b.t_s + 10.0);
+    b.run_for(4.0);
+    EXPECT_EQ(b.session->finish().exit_code, 5);
+  }
+  {
+    FaultBench b(LinkKind::kEgmPath, sweep(), [](runtime::SessionConfig& c, auto&) { c.end_on_silence = true; });
+    b.run_for(1.0);
+    b.network.add_outage(b.t_s, b.t_s + 10.0);
+    b.run_for(4.0);
+    const runtime::SessionSummary& s = b.session->finish();
+    EXPECT_EQ(s.exit_code, 0) << s.reason_text;
+    EXPECT_EQ(s.reason, StopReason::kProgramEnd);
+  }
+}
+
+// ---- rsi: outage, stalled deflex (the Timeout), restart, stale force ------------------------------
+
+TEST(FaultTable, RsiAnOutageShorterThanTheTimeoutIsRiddenThrough) {
+  FaultBench b(LinkKind::kRsi, sweep());
+  b.run_for(2.0);
+  b.network.add_outage(b.t_s, b.t_s + 0.2);  // 50 cycles late: below the Timeout of 100
+  b.run_for(2.0);
+  ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
+  EXPECT_TRUE(b.rsi->running());
+  expect_invariants(b, "rsi outage");
+  // The controller counted the cycles it got no answer in: 50, less the one in flight when it ended.
+  EXPECT_NEAR(static_cast<double>(b.session->link().counters().controller_late), 50.0, 1.0);
+}
+
+TEST(FaultTable, RsiStoppedOnItsTimeoutByAStalledDeflexIsNamedWithinTwoCycles) {
+  FaultBench b(LinkKind::kRsi, sweep());
+  b.run_for(2.0);
+  b.deflex_running = false;
+  b.run_for(0.6);  // 150 cycles unanswered: RSI stops at its 100th late answer
+  ASSERT_FALSE(b.rsi->running());
+  const double stopped_at = b.t_s;
+  b.deflex_running = true;
+  b.run_for(1.0);
+  ASSERT_TRUE(b.session->ended());
+  const runtime::SessionSummary& s = b.session->finish();
+  EXPECT_EQ(s.reason, StopReason::kControllerStopped);
+  EXPECT_EQ(s.exit_code, 6);
+  EXPECT_NE(s.reason_text.find("RSI stopped: the controller's late count reached its Timeout of 100"), std::string::npos)
+      << s.reason_text;
+  EXPECT_LE(b.t_s - stopped_at, 0.0121);
+  expect_invariants(b, "rsi timeout");
+}
+
+TEST(FaultTable, RsiARestartStartsTheCorrectionFromZeroAndNothingSteps) {
+  FaultBench b(LinkKind::kRsi, sweep());
+  b.run_for(2.0);
+  ASSERT_GT(b.tap.commands.back().joints.cwiseAbs().maxCoeff(), 1e-5);
+  b.rsi->pause(b.t_s, b.t_s + 0.3);  // RSI_OFF ...
+  b.run_for(0.3);
+  b.rsi->restart();  // ... and RSI_ON: a new session, its AXISCORR from zero
+  const std::size_t at = b.tap.commands.size();
+  b.run_for(2.0);
+  ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
+  EXPECT_EQ(b.session->link().counters().restarts, 1u);
+  // The first answer of the new session steps from zero (what AXISCORR applies), by at most the limit.
+  ASSERT_GT(b.tap.commands.size(), at);
+  EXPECT_LE((b.tap.commands[at].joints.cwiseAbs().array() / b.joint_step_limit().array()).maxCoeff(), 1.0);
+  EXPECT_LE(b.worst_step_fraction(at + 1), 1.0);
+  EXPECT_LE(b.worst_bound_fraction(), 1.0);
+  EXPECT_EQ(b.rsi->counters().clamped, 0u);
+}
+
+TEST(FaultTable, RsiAStaleForceRampsAtTheRateBound) {
+  FaultBench b(LinkKind::kRsi, sweep());
+  b.run_for(2.0);
+  b.force.on = false;
+  b.run_for(1.0);
+  expect_invariants(b, "rsi stale");
+  EXPECT_EQ(b.tap.commands.back().joints.cwiseAbs().maxCoeff(), 0.0);
+}
+
+// ---- simple message: a slow consumer, a stale force ------------------------------------------------
+
+TEST(FaultTable, SimpleMessageASlowControllerIsReportedAndStoppedPastTheLimit) {
+  FaultBench b(LinkKind::kSimpleMessage, sweep(), [](runtime::SessionConfig&, cell::SimpleMessageServerConfig& s) {
+    s.read_period_s = 0.15;  // the robot program takes a point every 150 ms; the program's cycle is 100 ms
+  });
+  b.run_for(20.0);
+  ASSERT_TRUE(b.session->ended());
+  const runtime::SessionSummary& s = b.session->finish();
+  EXPECT_EQ(s.reason, StopReason::kTooSlow);
+  EXPECT_EQ(s.exit_code, 8);
+  EXPECT_NE(s.reason_text.find("behind the program's 100 ms a point (limit 2.00 s)"), std::string::npos)
+      << s.reason_text;
+  // It ran at two thirds of the program's speed until then: 2 s behind after some 6 s.
+  EXPECT_NEAR(b.t_s, 6.0, 0.6);
+  EXPECT_NE(s.text.find("behind its schedule"), std::string::npos);
+  for (int k = 0; k < 100; ++k) {  // the server reads what is left; deflex flushes its STOP_TRAJECTORY
+    b.clock.set(b.t_s += 0.004);
+    b.controller->tick(b.t_s);
+    (void)b.session->link().poll(0.0);
+  }
+  EXPECT_EQ(b.server->counters().stops, 1u);  // the motion stopped with STOP_TRAJECTORY
+  expect_invariants(b, "slow consumer");
+}
+
+TEST(FaultTable, SimpleMessageAStaleForceRampsAtTheRateBound) {
+  FaultBench b(LinkKind::kSimpleMessage, sweep());
+  b.run_for(3.0);
+  b.force.on = false;
+  b.run_for(2.0);
+  ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
+  expect_invariants(b, "simple message stale");
+}
+
+}  // namespace
+}  // namespace deflex
