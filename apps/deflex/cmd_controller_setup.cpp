@@ -3,6 +3,7 @@
 // config, the RSI context and the KRL lines for KUKA RSI), from the same options and defaults as
 // `deflex online` (ports, period, bounds, SENTYPE), so the controller's side agrees with deflex's.
 #include <filesystem>
+#include <limits>
 #include <iostream>
 #include <memory>
 
@@ -12,6 +13,7 @@
 #include "command.hpp"
 #include "deflex/egm/egm_controller_setup.hpp"
 #include "deflex/model/errors.hpp"
+#include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/rsi/rsi_controller_setup.hpp"
 #include "deflex/rsi/rsi_link.hpp"
 
@@ -21,11 +23,14 @@ namespace {
 void setup_controller_setup(CLI::App& sub, int& exit_code) {
   struct Opts {
     std::string link, sensor_ip, output_dir = ".", sentype = "ImFree", context = "deflex_rsi", device = "DEFLEX",
-                                  egm_config = "default", module = "DeflexEgm", path_frame = "tool", tool = "tool0";
+                                  egm_config = "default", module = "DeflexEgm", path_frame = "tool", tool = "tool0",
+                                  program, robot;
     int egm_port = 6510, rsi_port = 49152, rsi_timeout = 100, rsi_precision = 4;
-    double period_ms = 0.0, max_joint_deg = 0.5, max_tcp_mm = 5.0, ramp_in_s = 1.0, comm_timeout_s = 1.0,
-           lowpass_hz = 20.0, convergence_deg = 0.1, cond_time_s = 10.0, max_pos_deviation_deg = 1000.0,
-           max_speed_deviation_deg_s = 1000.0, monitor_factor = 1.2;
+    double period_ms = 0.0, max_joint_deg = 0.5, max_tcp_mm = 5.0, ramp_in_s = 1.0,
+           comm_timeout_s = std::numeric_limits<double>::quiet_NaN(), lowpass_hz = 20.0, convergence_deg = 0.1,
+           cond_time_s = 10.0, max_pos_deviation_deg = std::numeric_limits<double>::quiet_NaN(),
+           max_speed_deviation_deg_s = std::numeric_limits<double>::quiet_NaN(), monitor_factor = 1.2,
+           max_rate_deg_s = 3.0, stop_silence_s = 3.0;
     bool json = false;
   };
   auto o = std::make_shared<Opts>();
@@ -57,16 +62,25 @@ void setup_controller_setup(CLI::App& sub, int& exit_code) {
       ->capture_default_str();
   sub.add_option("--module", o->module, "EGM: the RAPID module's name")->capture_default_str();
   sub.add_option("--tool", o->tool, "EGM: the tooldata the program moves with")->capture_default_str();
-  sub.add_option("--comm-timeout-s", o->comm_timeout_s, "EGM: EGMSetupUC \\CommTimeout, s")->capture_default_str();
+  sub.add_option("--comm-timeout-s", o->comm_timeout_s,
+                 "EGM: EGMSetupUC \\CommTimeout, s (default: --stop-silence-s, deflex's own)");
+  sub.add_option("--stop-silence-s", o->stop_silence_s, "EGM: deflex online --stop-silence-s")->capture_default_str();
+  sub.add_option("--max-rate-deg-s", o->max_rate_deg_s, "egm-joint: deflex online --max-rate-deg-s")
+      ->capture_default_str();
+  sub.add_option("--program", o->program,
+                 "egm-joint: deflex online --program: its peak joint speeds make \\MaxSpeedDeviation and "
+                 "\\MaxPosDeviation tight (without it the robot's speed limits stand in)");
+  sub.add_option("--robot", o->robot, "Robot file (its joint speed limits); default: the built-in IRB 6700");
   sub.add_option("--lowpass-hz", o->lowpass_hz, "egm-joint: EGMActJoint \\LpFilter, Hz")->capture_default_str();
   sub.add_option("--convergence-deg", o->convergence_deg, "egm-joint: the joints' convergence condition, deg")
       ->capture_default_str();
   sub.add_option("--cond-time-s", o->cond_time_s, "egm-joint: EGMRunJoint \\CondTime, s")->capture_default_str();
-  sub.add_option("--max-pos-deviation-deg", o->max_pos_deviation_deg, "egm-joint: EGMActJoint \\MaxPosDeviation, deg")
-      ->capture_default_str();
+  sub.add_option("--max-pos-deviation-deg", o->max_pos_deviation_deg,
+                 "egm-joint: EGMActJoint \\MaxPosDeviation, deg (default: derived from deflex's bound, start tolerance "
+                 "and the program's speed)");
   sub.add_option("--max-speed-deviation-deg-s", o->max_speed_deviation_deg_s,
-                 "egm-joint: EGMActJoint \\MaxSpeedDeviation, deg/s")
-      ->capture_default_str();
+                 "egm-joint: EGMActJoint \\MaxSpeedDeviation, deg/s (default: 1.25 x the fastest deflex's command may "
+                 "move)");
   sub.add_option("--context", o->context, "rsi: base name of the files and the KRL program")->capture_default_str();
   sub.add_option("--rsi-timeout", o->rsi_timeout, "rsi: ETHERNET Timeout, late answers before RSI stops")
       ->capture_default_str();
@@ -101,10 +115,25 @@ void setup_controller_setup(CLI::App& sub, int& exit_code) {
       e.cond_time_s = o->cond_time_s;
       e.max_pos_deviation_deg = o->max_pos_deviation_deg;
       e.max_speed_deviation_deg_s = o->max_speed_deviation_deg_s;
+      e.max_rate_deg_s = o->max_rate_deg_s;
+      e.stop_silence_s = o->stop_silence_s;
+      const RobotModel model = load_cli_robot("controller-setup", o->robot);
+      if (model.has_max_speed()) {
+        for (int j = 0; j < model.dof(); ++j) e.robot_max_speed_deg_s.push_back(rad_to_deg(model.max_speed()[j]));
+      }
+      if (!o->program.empty()) {
+        if (e.path_correction) throw InputError("option --program: egm-path corrects the controller's own program");
+        const JointTrajectory program = JointTrajectory::read_csv(o->program, model);
+        for (int j = 0; j < program.dof(); ++j) e.program_peak_speed_deg_s.push_back(rad_to_deg(program.peak_speed()[j]));
+      }
       e.path_frame = o->path_frame;
       e.tool = o->tool;
       files = egm_controller_setup(e);
     } else if (o->link == "rsi") {
+      if (!o->program.empty() || !o->robot.empty()) {
+        throw InputError("options --program, --robot: apply to --link egm-joint and egm-path (the RSI limits come from "
+                         "--max-joint-correction-deg)");
+      }
       RsiSetupOptions r;
       r.sensor_ip = o->sensor_ip;
       r.port = port(o->rsi_port, "--rsi-port");

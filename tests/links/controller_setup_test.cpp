@@ -6,6 +6,7 @@
 // arguments against deflex's port, period, ramp-in and device. Options that cannot work are refused
 // with the option named.
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -367,6 +368,40 @@ TEST(ControllerSetup, OptionsThatCannotWorkAreRefusedNamingTheOption) {
   e = egm_options(false);
   e.max_pos_deviation_deg = 0.1;
   refuses(e, "--max-pos-deviation-deg");
+  e = egm_options(false);
+  e.program_peak_speed_deg_s = {10, 10, 10, 10, 10, 10};
+  e.max_speed_deviation_deg_s = 5.0;  // slower than the program itself
+  refuses(e, "--max-speed-deviation-deg-s");
+}
+
+TEST(ControllerSetup, EgmSupervisionIsDerivedTightFromDeflexsOwnLimits) {
+  // A program whose fastest joint moves at 2 deg/s, deflex's default bound, rate and ramp-in.
+  EgmSetupOptions o = egm_options(false);
+  o.max_joint_correction_deg = 0.5;
+  o.ramp_in_s = 1.0;
+  o.max_rate_deg_s = 3.0;
+  o.program_peak_speed_deg_s = {2.0, 1.5, 1.0, 0.5, 1.0, 2.0};
+  const EgmSupervision s = egm_supervision(o);
+  // The fastest deflex's command may move: the program's 2, the blend's 1.5 x 1 deg / 1 s, the rate's 3.
+  EXPECT_DOUBLE_EQ(s.fastest_command_deg_s, 2.0 + 1.5 + 3.0);
+  EXPECT_EQ(s.max_speed_deviation_deg_s, std::ceil(1.25 * 6.5));
+  EXPECT_DOUBLE_EQ(s.max_pos_deviation_deg, 0.5 + 1.0 + 2.0 * 0.1);
+  EXPECT_EQ(s.comm_timeout_s, o.stop_silence_s);
+  // The jump of a program clock that ran on through a 0.45 s silence (1.13 deg in one 4 ms cycle, the
+  // measured defect) is far beyond what the controller now admits: it would stop EGM.
+  EXPECT_GT(1.13 / 0.004, 10.0 * s.max_speed_deviation_deg_s);
+  // The module carries the values.
+  const RapidCall act = call(read_rapid(file(egm_controller_setup(o), ".mod").text), "EGMActJoint");
+  EXPECT_EQ(std::stod(act.optional.at("MaxSpeedDeviation")), s.max_speed_deviation_deg_s);
+  EXPECT_EQ(std::stod(act.optional.at("MaxPosDeviation")), s.max_pos_deviation_deg);
+  const RapidCall setup = call(read_rapid(file(egm_controller_setup(o), ".mod").text), "EGMSetupUC");
+  EXPECT_EQ(std::stod(setup.optional.at("CommTimeout")), 3.0);
+  // Without a program, the robot's speed limits stand in: looser, and the module says so.
+  o.program_peak_speed_deg_s.clear();
+  o.robot_max_speed_deg_s = {100, 90, 90, 190, 140, 235};
+  const EgmSupervision loose = egm_supervision(o);
+  EXPECT_GT(loose.max_speed_deviation_deg_s, 235.0);
+  EXPECT_NE(file(egm_controller_setup(o), ".mod").text.find("the robot's joint speed limits"), std::string::npos);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 // EGMRunJoint's \CondTime, \RampInTime, \PosCorrGain, EGMActMove's sensor frame and \SampleRate).
 #include "deflex/egm/egm_controller_setup.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -50,24 +51,63 @@ void EgmSetupOptions::validate() const {
   }
   positive(max_joint_correction_deg, 10.0, "--max-joint-correction-deg");
   positive(max_tcp_correction_mm, 1000.0, "--max-tcp-correction-mm");
-  positive(comm_timeout_s, 3600.0, "--comm-timeout-s");
+  if (!std::isnan(comm_timeout_s)) positive(comm_timeout_s, 3600.0, "--comm-timeout-s");
+  positive(stop_silence_s, 3600.0, "--stop-silence-s");
+  positive(max_rate_deg_s, 1e5, "--max-rate-deg-s");
+  positive(start_tolerance_deg, 10.0, "the start tolerance");
+  positive(follow_lag_s, 10.0, "the follow lag");
   positive(lowpass_hz, 1000.0, "--lowpass-hz");
   positive(ramp_in_s, 60.0, "--ramp-in-s");
   positive(convergence_deg, 180.0, "--convergence-deg");
   positive(cond_time_s, 3600.0, "--cond-time-s");
-  positive(max_pos_deviation_deg, 1000.0, "--max-pos-deviation-deg");
-  positive(max_speed_deviation_deg_s, 10000.0, "--max-speed-deviation-deg-s");
-  if (max_pos_deviation_deg < max_joint_correction_deg) {
+  if (!std::isnan(max_pos_deviation_deg)) positive(max_pos_deviation_deg, 1000.0, "--max-pos-deviation-deg");
+  if (!std::isnan(max_speed_deviation_deg_s)) {
+    positive(max_speed_deviation_deg_s, 10000.0, "--max-speed-deviation-deg-s");
+  }
+  if (!std::isnan(max_pos_deviation_deg) && max_pos_deviation_deg < max_joint_correction_deg) {
     throw InputError("option --max-pos-deviation-deg: smaller than deflex's own --max-joint-correction-deg, so the "
                      "controller would stop EGM on a correction deflex allows");
+  }
+  for (const auto* list : {&program_peak_speed_deg_s, &robot_max_speed_deg_s}) {
+    for (double v : *list) {
+      if (!std::isfinite(v) || v < 0.0) throw InputError("controller setup: joint speeds must be finite and >= 0 deg/s");
+    }
   }
   if (path_frame != "tool" && path_frame != "flange" && path_frame != "path") {
     throw InputError(fmt::format("option --path-corr-frame: '{}' is not tool, flange or path", path_frame));
   }
 }
 
+EgmSupervision egm_supervision(const EgmSetupOptions& o) {
+  EgmSupervision s;
+  const std::vector<double>& speeds =
+      !o.program_peak_speed_deg_s.empty() ? o.program_peak_speed_deg_s : o.robot_max_speed_deg_s;
+  s.basis = !o.program_peak_speed_deg_s.empty() ? "the program's peak joint speeds"
+            : !o.robot_max_speed_deg_s.empty() ? "the robot's joint speed limits (give --program for tighter values)"
+                                               : "a 250 deg/s joint speed (give --program or --robot for tighter values)";
+  double fastest_program = speeds.empty() ? 250.0 : 0.0;
+  for (double v : speeds) fastest_program = std::max(fastest_program, v);
+  const double blend = o.ramp_in_s > 0.0 ? 1.5 * o.start_tolerance_deg / o.ramp_in_s : 0.0;
+  s.fastest_command_deg_s = fastest_program + blend + o.max_rate_deg_s;
+  // Rounded up to what RAPID is given (0.01 deg, 1 deg/s), never below what deflex may send.
+  const double derived_speed = std::ceil(1.25 * s.fastest_command_deg_s);
+  const double derived_pos =
+      std::ceil((o.max_joint_correction_deg + o.start_tolerance_deg + fastest_program * o.follow_lag_s) * 100.0) / 100.0;
+  s.max_speed_deviation_deg_s = std::isnan(o.max_speed_deviation_deg_s) ? derived_speed : o.max_speed_deviation_deg_s;
+  s.max_pos_deviation_deg = std::isnan(o.max_pos_deviation_deg) ? derived_pos : o.max_pos_deviation_deg;
+  s.comm_timeout_s = std::isnan(o.comm_timeout_s) ? o.stop_silence_s : o.comm_timeout_s;
+  if (!o.path_correction && s.max_speed_deviation_deg_s < s.fastest_command_deg_s) {
+    throw InputError(fmt::format(
+        "option --max-speed-deviation-deg-s: {} deg/s is below the {:.1f} deg/s deflex's command may move ({}, the "
+        "ramp-in and the correction's rate), so the controller would stop EGM on a command deflex allows",
+        plain_number(s.max_speed_deviation_deg_s), s.fastest_command_deg_s, s.basis));
+  }
+  return s;
+}
+
 std::vector<ControllerFile> egm_controller_setup(const EgmSetupOptions& o) {
   o.validate();
+  const EgmSupervision sup = egm_supervision(o);
   const std::string link = o.path_correction ? "egm-path" : "egm-joint";
   std::string mod = fmt::format(
       "MODULE {module}\n"
@@ -94,6 +134,9 @@ std::vector<ControllerFile> egm_controller_setup(const EgmSetupOptions& o) {
         "  ! holds the program's last point when the program ends.\n"
         "  LOCAL CONST egm_minmax deflex_converged:=[{neg},{pos}];\n"
         "\n"
+        "  ! Supervision from deflex's own limits ({basis}): deflex's command moves at most {fastest} deg/s\n"
+        "  ! and stays within {joint} deg of its nominal, so the controller stops EGM beyond {maxspeed} deg/s or\n"
+        "  ! {maxpos} deg from the arm; it gives up on a silent deflex after {timeout} s, as deflex gives up on it.\n"
         "  ! Position guidance: deflex streams the program. Call with the arm at the program's start (within 1 deg).\n"
         "  PROC deflex_egm_joint()\n"
         "    EGMReset deflex_egm_id;\n"
@@ -106,10 +149,12 @@ std::vector<ControllerFile> egm_controller_setup(const EgmSetupOptions& o) {
         "  ENDPROC\n",
         fmt::arg("neg", plain_number(-o.convergence_deg)), fmt::arg("pos", plain_number(o.convergence_deg)),
         fmt::arg("config", o.egm_config), fmt::arg("device", o.device),
-        fmt::arg("timeout", plain_number(o.comm_timeout_s)),
+        fmt::arg("timeout", plain_number(sup.comm_timeout_s)), fmt::arg("basis", sup.basis),
+        fmt::arg("fastest", plain_number(std::round(sup.fastest_command_deg_s * 10.0) / 10.0)),
+        fmt::arg("joint", plain_number(o.max_joint_correction_deg)),
         fmt::arg("tool", o.tool), fmt::arg("conditions", conditions), fmt::arg("lp", plain_number(o.lowpass_hz)),
-        fmt::arg("period", plain_number(o.period_ms)), fmt::arg("maxpos", plain_number(o.max_pos_deviation_deg)),
-        fmt::arg("maxspeed", plain_number(o.max_speed_deviation_deg_s)), fmt::arg("joints", joints),
+        fmt::arg("period", plain_number(o.period_ms)), fmt::arg("maxpos", plain_number(sup.max_pos_deviation_deg)),
+        fmt::arg("maxspeed", plain_number(sup.max_speed_deviation_deg_s)), fmt::arg("joints", joints),
         fmt::arg("cond", plain_number(o.cond_time_s)), fmt::arg("ramp", plain_number(o.ramp_in_s)));
   } else {
     // The frame EGMActMove is given is the frame deflex expresses its offsets in.
@@ -146,7 +191,7 @@ std::vector<ControllerFile> egm_controller_setup(const EgmSetupOptions& o) {
         "  !   deflex_egm_path_end;\n",
         fmt::arg("period", plain_number(o.period_ms)), fmt::arg("frame_note", frame_note),
         fmt::arg("config", o.egm_config),
-        fmt::arg("device", o.device), fmt::arg("timeout", plain_number(o.comm_timeout_s)), fmt::arg("frame", frame),
+        fmt::arg("device", o.device), fmt::arg("timeout", plain_number(sup.comm_timeout_s)), fmt::arg("frame", frame),
         fmt::arg("tool", o.tool));
   }
   mod += "ENDMODULE\n";

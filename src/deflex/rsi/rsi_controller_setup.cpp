@@ -56,8 +56,9 @@ std::vector<ControllerFile> rsi_controller_setup(const RsiSetupOptions& o) {
   const std::string ethernet_file = o.context + "_ethernet.xml";
   const std::string context_file = o.context + ".rsi.xml";
   const std::string command = fmt::format(
-      "deflex online --link rsi --bind {} --rsi-port {} --rsi-sentype {} --period-ms {} --max-joint-correction-deg {}",
-      o.sensor_ip, o.port, o.sentype, plain_number(o.period_ms), plain_number(o.max_joint_correction_deg));
+      "deflex online --link rsi --bind {} --rsi-port {} --rsi-sentype {} --period-ms {} --max-joint-correction-deg {} "
+      "--rsi-timeout {}",
+      o.sensor_ip, o.port, o.sentype, plain_number(o.period_ms), plain_number(o.max_joint_correction_deg), o.timeout);
 
   std::string receive;
   for (int a = 1; a <= o.axes; ++a) {
