@@ -1,5 +1,5 @@
 // The parts of the deflex Python module, one function a part of the library (model, identify,
-// offline, evaluate, online, study), each in its own file; module.cpp calls them in this order.
+// offline, evaluate, online, study, runtime), each in its own file; module.cpp calls them in this order.
 #pragma once
 
 #include <memory>
@@ -29,5 +29,6 @@ void bind_offline(py::module_& m);
 void bind_evaluate(py::module_& m);
 void bind_online(py::module_& m);
 void bind_study(py::module_& m);
+void bind_runtime(py::module_& m);
 
 }  // namespace deflex::python

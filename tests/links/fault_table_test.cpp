@@ -37,7 +37,7 @@ void expect_wire_is_what_was_sent(FaultBench& b) {
     if (r.replied) sent.push_back(&r);
   }
   std::size_t at = 0;
-  for (const test::WireCommand& c : b.tap.commands) {
+  for (const standin::WireCommand& c : b.wire()) {
     bool found = false;
     for (; at < sent.size() && !found; ++at) {
       const LinkCycleRecord& r = *sent[at];
@@ -66,8 +66,8 @@ TEST(FaultTable, EgmJointOutagesOfAnyLengthNeverStepTheTargetAndTheProgramWaits)
     FaultBench b(LinkKind::kEgmJoint, sweep());
     b.run_for(3.0);
     const double program_before = b.session->link().last_cycle().program_time_s;
-    const std::size_t wire_before = b.tap.commands.size();
-    b.network.add_outage(b.t_s, b.t_s + outage);
+    const std::size_t wire_before = b.wire().size();
+    b.standin->outage(outage);
     b.run_for(outage + 2.0);
     ASSERT_FALSE(b.session->ended()) << outage << " s: " << b.session->finish().reason_text;
     expect_invariants(b, "outage");
@@ -85,8 +85,8 @@ TEST(FaultTable, EgmJointOutagesOfAnyLengthNeverStepTheTargetAndTheProgramWaits)
     // The TCP: the controller's targets around the outage moved by a normal step only (the 22.8 mm of
     // the old program clock is what this guards).
     Workspace ws(b.robot);
-    const Vector3 p0 = tcp_pose(b.robot, ws, b.tap.commands[wire_before - 1].joints).translation();
-    const Vector3 p1 = tcp_pose(b.robot, ws, b.tap.commands[wire_before].joints).translation();
+    const Vector3 p0 = tcp_pose(b.robot, ws, b.wire()[wire_before - 1].joints).translation();
+    const Vector3 p1 = tcp_pose(b.robot, ws, b.wire()[wire_before].joints).translation();
     EXPECT_LT((p1 - p0).norm(), 0.5e-3) << outage << " s: the first target after the outage steps the TCP";
     if (outage > 0.05) {
       EXPECT_GE(b.session->link().counters().silences, 1u);
@@ -100,14 +100,14 @@ TEST(FaultTable, EgmJointAStalledDeflexNeverStepsTheTargetAfterwards) {
   for (const double stall : {0.05, 0.3, 0.45}) {
     FaultBench b(LinkKind::kEgmJoint, sweep());
     b.run_for(3.0);
-    b.deflex_running = false;  // the controller goes on (its messages queue up), deflex does not read
+    b.standin->stall(true);  // the controller goes on (its messages queue up), deflex does not read
     b.run_for(stall);
-    b.deflex_running = true;
+    b.standin->stall(false);
     b.run_for(2.0);
     ASSERT_FALSE(b.session->ended());
     expect_invariants(b, "stall");
     EXPECT_GT(b.session->link().counters().superseded, 0u);  // the queued messages: only the newest answered
-    EXPECT_FALSE(b.egm->counters().timed_out);
+    EXPECT_FALSE(b.standin->egm()->counters().timed_out);
   }
 }
 
@@ -119,11 +119,11 @@ TEST(FaultTable, EgmJointARestartAfterASilenceAppliesTheCorrectionOnce) {
   // 1.2 s of silence: the controller's EGM times out (1 s) and the arm holds where it is, some way
   // behind deflex's last target (its dead time); then EGMRunJoint again, its reference where the arm
   // is, its sequence from 1.
-  b.network.add_outage(b.t_s, b.t_s + 1.2);
+  b.standin->outage(1.2);
   b.run_for(1.7);
-  ASSERT_TRUE(b.egm->counters().timed_out);
-  const std::size_t before = b.tap.commands.size();
-  b.egm->restart(b.t_s, true);
+  ASSERT_TRUE(b.standin->egm()->counters().timed_out);
+  const std::size_t before = b.wire().size();
+  b.standin->restart(true);
   b.run_for(3.0);
   ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
   EXPECT_EQ(b.session->link().counters().restarts, 1u);
@@ -158,8 +158,8 @@ TEST(FaultTable, EgmJointARestartWithoutSilenceKeepsTheStreamAndNeverSteps) {
   for (const bool reset_reference : {false, true}) {
     FaultBench b(LinkKind::kEgmJoint, sweep());
     b.run_for(3.0);
-    const std::size_t at = b.tap.commands.size();
-    b.egm->restart(b.t_s, reset_reference);  // the sequence starts again, the arm moving
+    const std::size_t at = b.wire().size();
+    b.standin->restart(reset_reference);  // the sequence starts again, the arm moving
     b.run_for(3.0);
     ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
     EXPECT_EQ(b.session->link().counters().restarts, 1u);
@@ -185,21 +185,21 @@ TEST(FaultTable, EgmJointAControllerThatStopsEndsTheSessionWithItsReason) {
   {  // EGM ended before the program's end: exit 6, named, at the next message
     FaultBench b(LinkKind::kEgmJoint, sweep());
     b.run_for(2.0);
-    b.egm->end_session(2);
-    const double t0 = b.t_s;
+    b.standin->end_session(2);
+    const double t0 = b.t_s();
     b.run_for(1.0);
     ASSERT_TRUE(b.session->ended());
     const runtime::SessionSummary& s = b.session->finish();
     EXPECT_EQ(s.reason, StopReason::kControllerStopped);
     EXPECT_EQ(s.exit_code, 6);
     EXPECT_NE(s.reason_text.find("ended EGM (mciState STOPPED)"), std::string::npos) << s.reason_text;
-    EXPECT_LE(b.t_s - t0, 0.0121);  // within three 4 ms cycles
+    EXPECT_LE(b.t_s() - t0, 0.0121);  // within three 4 ms cycles
     expect_invariants(b, "EGM ended");
   }
   {  // the motors off (an emergency stop): exit 6
     FaultBench b(LinkKind::kEgmJoint, sweep());
     b.run_for(2.0);
-    b.egm->motors_off();
+    b.standin->motors_off();
     b.run_for(1.0);
     const runtime::SessionSummary& s = b.session->finish();
     EXPECT_EQ(s.exit_code, 6);
@@ -209,7 +209,7 @@ TEST(FaultTable, EgmJointAControllerThatStopsEndsTheSessionWithItsReason) {
     FaultBench b(LinkKind::kEgmJoint, sweep(2.0));
     b.run_for(3.5);
     ASSERT_EQ(b.session->link().state(), LinkState::kFinished);
-    b.egm->end_session(2);
+    b.standin->end_session(2);
     b.run_for(0.1);
     const runtime::SessionSummary& s = b.session->finish();
     EXPECT_EQ(s.reason, StopReason::kProgramEnd);
@@ -218,14 +218,14 @@ TEST(FaultTable, EgmJointAControllerThatStopsEndsTheSessionWithItsReason) {
   {  // silent for longer than the stop silence (3 s): exit 5, within a cycle of it
     FaultBench b(LinkKind::kEgmJoint, sweep());
     b.run_for(2.0);
-    b.network.add_outage(b.t_s, b.t_s + 10.0);
-    const double t0 = b.t_s;
+    b.standin->outage(10.0);
+    const double t0 = b.t_s();
     b.run_for(5.0);
     ASSERT_TRUE(b.session->ended());
     const runtime::SessionSummary& s = b.session->finish();
     EXPECT_EQ(s.reason, StopReason::kControllerSilent);
     EXPECT_EQ(s.exit_code, 5);
-    EXPECT_NEAR(b.t_s - t0, 3.0, 0.01);
+    EXPECT_NEAR(b.t_s() - t0, 3.0, 0.01);
     EXPECT_NE(s.reason_text.find("no usable message from the controller for 3.0"), std::string::npos) << s.reason_text;
   }
 }
@@ -234,7 +234,7 @@ TEST(FaultTable, EgmJointAStaleForceRampsTheCorrectionOutAtTheRateBound) {
   FaultBench b(LinkKind::kEgmJoint, sweep());
   b.run_for(3.0);
   const double before = b.session->link().last_cycle().dtheta.cwiseAbs().maxCoeff();
-  b.force.on = false;
+  b.standin->sensor_silent(true);
   b.run_for(1.0);
   expect_invariants(b, "stale force");
   b.session->service();
@@ -256,16 +256,16 @@ TEST(FaultTable, EgmJointAStaleForceRampsTheCorrectionOutAtTheRateBound) {
 TEST(FaultTable, EgmPathAStaleForceRampsTheOffsetOutOverSeveralAnswers) {
   FaultBench b(LinkKind::kEgmPath, sweep());
   b.run_for(4.0);
-  const double offset = b.tap.commands.back().offset_m.norm();
+  const double offset = b.wire().back().offset_m.norm();
   ASSERT_GT(offset, 2e-4);
-  const std::size_t at = b.tap.commands.size();
-  b.force.on = false;
+  const std::size_t at = b.wire().size();
+  b.standin->sensor_silent(true);
   b.run_for(2.0);
   expect_invariants(b, "stale force");
   // Zero at the end, reached over at least |offset| / (TCP rate x period) answers: a ramp.
   std::size_t answers = 0;
-  for (std::size_t k = at; k < b.tap.commands.size() && b.tap.commands[k].offset_m.norm() > 1e-9; ++k) ++answers;
-  EXPECT_EQ(b.tap.commands.back().offset_m.norm(), 0.0);
+  for (std::size_t k = at; k < b.wire().size() && b.wire()[k].offset_m.norm() > 1e-9; ++k) ++answers;
+  EXPECT_EQ(b.wire().back().offset_m.norm(), 0.0);
   EXPECT_GE(static_cast<double>(answers) + 1.0,
             offset / (b.config.online.max_tcp_rate_m_s * b.config.online.period_s));
   EXPECT_GE(answers, 2u);
@@ -274,13 +274,13 @@ TEST(FaultTable, EgmPathAStaleForceRampsTheOffsetOutOverSeveralAnswers) {
 TEST(FaultTable, EgmPathOutagesAndARestartNeverStepTheOffset) {
   FaultBench b(LinkKind::kEgmPath, sweep());
   b.run_for(3.0);
-  b.network.add_outage(b.t_s, b.t_s + 0.45);
+  b.standin->outage(0.45);
   b.run_for(2.0);
-  b.deflex_running = false;
+  b.standin->stall(true);
   b.run_for(0.3);
-  b.deflex_running = true;
+  b.standin->stall(false);
   b.run_for(1.0);
-  b.path->restart();  // a new EGMActMove: its correction from zero
+  b.standin->restart();  // a new EGMActMove: its correction from zero
   b.run_for(2.0);
   ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
   expect_invariants(b, "egm-path faults");
@@ -291,14 +291,15 @@ TEST(FaultTable, EgmPathTheControllersEndIsPlannedAndSilenceIsNot) {
   {
     FaultBench b(LinkKind::kEgmPath, sweep());
     b.run_for(1.0);
-    b.network.add_outage(b.t_s, b.t_s + 10.0);
+    b.standin->outage(10.0);
     b.run_for(4.0);
     EXPECT_EQ(b.session->finish().exit_code, 5);
   }
   {
-    FaultBench b(LinkKind::kEgmPath, sweep(), [](runtime::SessionConfig& c, auto&) { c.end_on_silence = true; });
+    FaultBench b(LinkKind::kEgmPath, sweep(),
+                 [](runtime::SessionConfig& c, standin::StandInConfig&) { c.end_on_silence = true; });
     b.run_for(1.0);
-    b.network.add_outage(b.t_s, b.t_s + 10.0);
+    b.standin->outage(10.0);
     b.run_for(4.0);
     const runtime::SessionSummary& s = b.session->finish();
     EXPECT_EQ(s.exit_code, 0) << s.reason_text;
@@ -311,10 +312,10 @@ TEST(FaultTable, EgmPathTheControllersEndIsPlannedAndSilenceIsNot) {
 TEST(FaultTable, RsiAnOutageShorterThanTheTimeoutIsRiddenThrough) {
   FaultBench b(LinkKind::kRsi, sweep());
   b.run_for(2.0);
-  b.network.add_outage(b.t_s, b.t_s + 0.2);  // 50 cycles late: below the Timeout of 100
+  b.standin->outage(0.2);  // 50 cycles late: below the Timeout of 100
   b.run_for(2.0);
   ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
-  EXPECT_TRUE(b.rsi->running());
+  EXPECT_TRUE(b.standin->rsi()->running());
   expect_invariants(b, "rsi outage");
   // The controller counted the cycles it got no answer in: 50, less the one in flight when it ended.
   EXPECT_NEAR(static_cast<double>(b.session->link().counters().controller_late), 50.0, 1.0);
@@ -323,11 +324,11 @@ TEST(FaultTable, RsiAnOutageShorterThanTheTimeoutIsRiddenThrough) {
 TEST(FaultTable, RsiStoppedOnItsTimeoutByAStalledDeflexIsNamedWithinTwoCycles) {
   FaultBench b(LinkKind::kRsi, sweep());
   b.run_for(2.0);
-  b.deflex_running = false;
+  b.standin->stall(true);
   b.run_for(0.6);  // 150 cycles unanswered: RSI stops at its 100th late answer
-  ASSERT_FALSE(b.rsi->running());
-  const double stopped_at = b.t_s;
-  b.deflex_running = true;
+  ASSERT_FALSE(b.standin->rsi()->running());
+  const double stopped_at = b.t_s();
+  b.standin->stall(false);
   b.run_for(1.0);
   ASSERT_TRUE(b.session->ended());
   const runtime::SessionSummary& s = b.session->finish();
@@ -335,43 +336,43 @@ TEST(FaultTable, RsiStoppedOnItsTimeoutByAStalledDeflexIsNamedWithinTwoCycles) {
   EXPECT_EQ(s.exit_code, 6);
   EXPECT_NE(s.reason_text.find("RSI stopped: the controller's late count reached its Timeout of 100"), std::string::npos)
       << s.reason_text;
-  EXPECT_LE(b.t_s - stopped_at, 0.0121);
+  EXPECT_LE(b.t_s() - stopped_at, 0.0121);
   expect_invariants(b, "rsi timeout");
 }
 
 TEST(FaultTable, RsiARestartStartsTheCorrectionFromZeroAndNothingSteps) {
   FaultBench b(LinkKind::kRsi, sweep());
   b.run_for(2.0);
-  ASSERT_GT(b.tap.commands.back().joints.cwiseAbs().maxCoeff(), 1e-5);
-  b.rsi->pause(b.t_s, b.t_s + 0.3);  // RSI_OFF ...
-  b.run_for(0.3);
-  b.rsi->restart();  // ... and RSI_ON: a new session, its AXISCORR from zero
-  const std::size_t at = b.tap.commands.size();
+  ASSERT_GT(b.wire().back().joints.cwiseAbs().maxCoeff(), 1e-5);
+  b.standin->restart(true, 0.3);  // RSI_OFF for 0.3 s and RSI_ON: a new session, its AXISCORR from zero
+  const std::size_t at = b.wire().size();
   b.run_for(2.0);
   ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
   EXPECT_EQ(b.session->link().counters().restarts, 1u);
-  // The first answer of the new session steps from zero (what AXISCORR applies), by at most the limit.
-  ASSERT_GT(b.tap.commands.size(), at);
-  EXPECT_LE((b.tap.commands[at].joints.cwiseAbs().array() / b.joint_step_limit().array()).maxCoeff(), 1.0);
+  // The first answer of the new session steps from zero (what AXISCORR applies), by at most the limit,
+  // and is far from the correction the last session ended with.
+  ASSERT_GT(b.wire().size(), at);
+  EXPECT_LE((b.wire()[at].joints.cwiseAbs().array() / b.joint_step_limit().array()).maxCoeff(), 1.0);
+  EXPECT_LT(b.wire()[at].joints.cwiseAbs().maxCoeff(), 0.5 * b.wire()[at - 1].joints.cwiseAbs().maxCoeff());
   EXPECT_LE(b.worst_step_fraction(at + 1), 1.0);
   EXPECT_LE(b.worst_bound_fraction(), 1.0);
-  EXPECT_EQ(b.rsi->counters().clamped, 0u);
+  EXPECT_EQ(b.standin->rsi()->counters().clamped, 0u);
 }
 
 TEST(FaultTable, RsiAStaleForceRampsAtTheRateBound) {
   FaultBench b(LinkKind::kRsi, sweep());
   b.run_for(2.0);
-  b.force.on = false;
+  b.standin->sensor_silent(true);
   b.run_for(1.0);
   expect_invariants(b, "rsi stale");
-  EXPECT_EQ(b.tap.commands.back().joints.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(b.wire().back().joints.cwiseAbs().maxCoeff(), 0.0);
 }
 
 // ---- simple message: a slow consumer, a stale force ------------------------------------------------
 
 TEST(FaultTable, SimpleMessageASlowControllerIsReportedAndStoppedPastTheLimit) {
-  FaultBench b(LinkKind::kSimpleMessage, sweep(), [](runtime::SessionConfig&, cell::SimpleMessageServerConfig& s) {
-    s.read_period_s = 0.15;  // the robot program takes a point every 150 ms; the program's cycle is 100 ms
+  FaultBench b(LinkKind::kSimpleMessage, sweep(), [](runtime::SessionConfig&, standin::StandInConfig& s) {
+    s.server.read_period_s = 0.15;  // the robot program takes a point every 150 ms; the program's cycle is 100 ms
   });
   b.run_for(20.0);
   ASSERT_TRUE(b.session->ended());
@@ -381,21 +382,20 @@ TEST(FaultTable, SimpleMessageASlowControllerIsReportedAndStoppedPastTheLimit) {
   EXPECT_NE(s.reason_text.find("behind the program's 100 ms a point (limit 2.00 s)"), std::string::npos)
       << s.reason_text;
   // It ran at two thirds of the program's speed until then: 2 s behind after some 6 s.
-  EXPECT_NEAR(b.t_s, 6.0, 0.6);
+  EXPECT_NEAR(b.t_s(), 6.0, 0.6);
   EXPECT_NE(s.text.find("behind its schedule"), std::string::npos);
   for (int k = 0; k < 100; ++k) {  // the server reads what is left; deflex flushes its STOP_TRAJECTORY
-    b.clock.set(b.t_s += 0.004);
-    b.controller->tick(b.t_s);
+    b.standin->tick();
     (void)b.session->link().poll(0.0);
   }
-  EXPECT_EQ(b.server->counters().stops, 1u);  // the motion stopped with STOP_TRAJECTORY
+  EXPECT_EQ(b.standin->server()->counters().stops, 1u);  // the motion stopped with STOP_TRAJECTORY
   expect_invariants(b, "slow consumer");
 }
 
 TEST(FaultTable, SimpleMessageAStaleForceRampsAtTheRateBound) {
   FaultBench b(LinkKind::kSimpleMessage, sweep());
   b.run_for(3.0);
-  b.force.on = false;
+  b.standin->sensor_silent(true);
   b.run_for(2.0);
   ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
   expect_invariants(b, "simple message stale");
