@@ -100,11 +100,7 @@ struct FaultBench {
       return ((a - b).cwiseAbs().array() / limit.array()).maxCoeff();
     };
     std::vector<JointVector> commands;
-    if (kind == runtime::LinkKind::kSimpleMessage) {
-      commands = standin->points_taken();
-    } else {
-      for (const auto& c : wire()) commands.push_back(c.joints);
-    }
+    for (const auto& c : wire()) commands.push_back(c.joints);
     for (std::size_t k = std::max<std::size_t>(first, 1); k < commands.size(); ++k) {
       worst = std::max(worst, step(commands[k], commands[k - 1]));
     }

@@ -124,6 +124,7 @@ void SimpleMessageServer::serve_motion(double t_s) {
       ++counters_.accepted;
       last_target_ = target;
       last_sequence_ = p.sequence;
+      if (config_.record_points) accepted_points_.push_back({t_s, target});
       reply(f.header, sm::kReplySuccess, p);
     }
   }

@@ -35,6 +35,7 @@ struct SimpleMessageServerConfig {
   double state_period_s = 0.1;       ///< ROS_stateServer's update_rate
   bool publish_status = true;        ///< a ROBOT_STATUS after each JOINT_POSITION, as ROS_stateServer does
   bool reply_with_data = false;      ///< ABB: header-only replies; industrial_core servers echo the point
+  bool record_points = false;        ///< keep every accepted point with its time (stand-ins check the wire with it)
   std::size_t max_frame_bytes = simple_message::kDefaultMaxFrameBytes;
   JointMoveConfig motion;            ///< the motion task's MoveAbsJ with its zone
   /// The server task reads the motion connection at most once this often (0: every tick): a slow
@@ -79,6 +80,13 @@ class SimpleMessageServer final : public RobotController {
   /// The last point accepted (rad), and its sequence number (-1 before the first).
   [[nodiscard]] const JointVector& last_target() const { return last_target_; }
   [[nodiscard]] std::int32_t last_sequence() const { return last_sequence_; }
+  /// With record_points: every point accepted, in order, with the time it was taken (s) and its joints
+  /// as the wire carried them (rad).
+  struct AcceptedPoint {
+    double t_s;
+    JointVector q;
+  };
+  [[nodiscard]] const std::vector<AcceptedPoint>& accepted_points() const { return accepted_points_; }
 
  private:
   void serve_motion(double t_s);
@@ -98,6 +106,7 @@ class SimpleMessageServer final : public RobotController {
   double next_read_s_ = 0.0;
   bool estopped_ = false;
   JointVector q_, last_target_;
+  std::vector<AcceptedPoint> accepted_points_;
   std::int32_t last_sequence_ = -1;
 };
 

@@ -120,6 +120,7 @@ StandInSession::StandInSession(const runtime::SessionConfig& config, const Robot
     case runtime::LinkKind::kSimpleMessage: {
       cell::SimpleMessageServerConfig sc = standin.server;
       sc.byte_order = config_.simple_message.byte_order;
+      sc.record_points = true;
       auto c = std::make_unique<cell::SimpleMessageServer>(sc, robot, program_->points().front(), motion_.server(),
                                                           state_.server());
       server_ = c.get();
@@ -158,8 +159,14 @@ void StandInSession::tick() {
   t_s_ += tick_s;
   clock_.set(t_s_);
   arm_ = controller_->tick(t_s_);
-  if (server_ != nullptr && server_->last_sequence() >= static_cast<std::int32_t>(points_.size())) {
-    points_.push_back(server_->last_target());
+  if (server_ != nullptr) {
+    // Every point the server took, as the wire carried it (float32 radians).
+    for (std::size_t i = wire_.size(); i < server_->accepted_points().size(); ++i) {
+      WireCommand c;
+      c.t_s = server_->accepted_points()[i].t_s;
+      c.joints = server_->accepted_points()[i].q;
+      wire_.push_back(c);
+    }
   }
   sensor_.set(arm_, standin_.force_base_n);
   if (t_s_ + 1e-12 >= next_sample_s_) {

@@ -23,7 +23,8 @@
 
 namespace deflex::standin {
 
-/// What the controller received from deflex, in order, decoded with the wire's own codec.
+/// What the controller received from deflex, in order, decoded with the wire's own codec (simple message:
+/// every point the server took, as the frame carried it).
 struct WireCommand {
   double t_s = 0.0;                    ///< when the controller read it
   JointVector joints;                  ///< absolute joints (egm-joint, simple message) or the joint offset (rsi), rad
@@ -95,8 +96,6 @@ class StandInSession {
 
   [[nodiscard]] runtime::Session& session() { return *session_; }
   [[nodiscard]] const std::vector<WireCommand>& wire() const { return wire_; }
-  /// Simple message: every point the server took, in order (rad).
-  [[nodiscard]] const std::vector<JointVector>& points_taken() const { return points_; }
   [[nodiscard]] double time_s() const { return t_s_; }
   [[nodiscard]] const JointVector& arm() const { return arm_; }
   [[nodiscard]] runtime::LinkKind link() const { return kind_; }
@@ -133,7 +132,6 @@ class StandInSession {
   cell::RsiController* rsi_ = nullptr;
   cell::SimpleMessageServer* server_ = nullptr;
   std::vector<WireCommand> wire_;
-  std::vector<JointVector> points_;
   double t_s_ = 0.0;
   double next_sample_s_ = 0.0;
   bool stalled_ = false;
