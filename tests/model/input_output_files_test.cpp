@@ -309,5 +309,28 @@ TEST(RunFiles, AnOutputThatIsAnInputIsRefusedWhicheverComesFirst) {
   EXPECT_EQ(slurp(s.at("m.csv")), "rewritten\n");
 }
 
+TEST(RunFiles, AFileReadToBeRewrittenIsItsOutputAndStillNoOtherRunsInput) {
+  const Scratch s;
+  s.write("poses.csv", "a,b\n1,2\n");
+  fs::create_symlink("poses.csv", s.dir / "link.csv");
+  {
+    const RunFilesScope run;
+    const std::string text = read_file_to_update(s.at("poses.csv"), InputKind::kCsvTable, "option --record");
+    OutputFile out(s.at("link.csv"), "option --record");  // the same output: allowed
+    out.write(text + "3,4\n");
+    // The same file as an input, or as another output, is still refused.
+    const std::string msg = error_of([&] { (void)read_input_file(s.at("poses.csv"), InputKind::kCsvTable); });
+    EXPECT_NE(msg.find("the same file"), std::string::npos) << msg;
+    EXPECT_THROW(OutputFile(s.at("poses.csv"), "option -o"), InputError);
+    out.commit();
+  }
+  EXPECT_EQ(slurp(s.at("poses.csv")), "a,b\n1,2\n3,4\n");
+  {
+    const RunFilesScope run;
+    (void)read_input_file(s.at("poses.csv"), InputKind::kCsvTable);  // an input first: no update of it
+    EXPECT_THROW((void)read_file_to_update(s.at("link.csv"), InputKind::kCsvTable, "option --record"), InputError);
+  }
+}
+
 }  // namespace
 }  // namespace deflex

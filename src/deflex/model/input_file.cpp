@@ -68,7 +68,7 @@ const InputKindInfo& input_kind_info(InputKind kind) {
   return kConfig;
 }
 
-InputFile::InputFile(const std::string& path, InputKind kind) : path_(path), kind_(kind) {
+InputFile::InputFile(const std::string& path, InputKind kind, const std::string& updated_as) : path_(path), kind_(kind) {
   const InputKindInfo& info = input_kind_info(kind);
   if (path.empty()) {
     refuse("<empty path>", fmt::format("no file name given for the {}", info.what));
@@ -91,7 +91,12 @@ InputFile::InputFile(const std::string& path, InputKind kind) : path_(path), kin
     check_stat(path, info, st);
     ::fcntl(fd_, F_SETFL, ::fcntl(fd_, F_GETFL) & ~O_NONBLOCK);
     size_ = static_cast<std::uint64_t>(st.st_size);
-    record_input_file({static_cast<std::uint64_t>(st.st_dev), static_cast<std::uint64_t>(st.st_ino)}, path);
+    const FileId id{static_cast<std::uint64_t>(st.st_dev), static_cast<std::uint64_t>(st.st_ino)};
+    if (updated_as.empty()) {
+      record_input_file(id, path);
+    } else {
+      record_output_file(id, path, updated_as);
+    }
   } catch (...) {
     ::close(fd_);
     throw;
@@ -141,14 +146,25 @@ std::string InputFile::read_all() {
   return text;
 }
 
-std::string read_input_file(const std::string& path, InputKind kind) {
-  InputFile file(path, kind);
+namespace {
+std::string read_text(InputFile& file) {
   std::string text = file.read_all();
   // A UTF-8 byte order mark (Excel and some editors write one) is not part of the content.
   if (text.rfind("\xEF\xBB\xBF", 0) == 0) {
     text.erase(0, 3);
   }
   return text;
+}
+}  // namespace
+
+std::string read_input_file(const std::string& path, InputKind kind) {
+  InputFile file(path, kind);
+  return read_text(file);
+}
+
+std::string read_file_to_update(const std::string& path, InputKind kind, const std::string& what) {
+  InputFile file(path, kind, what);
+  return read_text(file);
 }
 
 }  // namespace deflex

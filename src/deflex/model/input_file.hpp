@@ -39,7 +39,10 @@ struct InputKindInfo {
 /// than the limit, or is a file this run writes (InputError, see run_files.hpp).
 class InputFile {
  public:
-  InputFile(const std::string& path, InputKind kind);
+  /// `updated_as`: the file is read to be rewritten whole by this run's output of that name (a row
+  /// added to a poses CSV); it is then recorded as that output, not as an input, so the output may
+  /// replace it while any other use of it as an input or output is still refused.
+  InputFile(const std::string& path, InputKind kind, const std::string& updated_as = "");
   ~InputFile();
   InputFile(const InputFile&) = delete;
   InputFile& operator=(const InputFile&) = delete;
@@ -64,5 +67,7 @@ class InputFile {
 
 /// The whole text of a file of `kind` (InputFile's rules); a leading UTF-8 byte order mark is dropped.
 [[nodiscard]] std::string read_input_file(const std::string& path, InputKind kind);
+/// The same, for a file this run rewrites whole as its output `what` (InputFile's `updated_as`).
+[[nodiscard]] std::string read_file_to_update(const std::string& path, InputKind kind, const std::string& what);
 
 }  // namespace deflex

@@ -11,7 +11,6 @@
 #include <cmath>
 #include <utility>
 
-#include "deflex/model/csv_table.hpp"
 #include "deflex/model/input_file.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/model/parse_number.hpp"
