@@ -26,14 +26,14 @@ inline std::string slurp(const std::filesystem::path& p) {
   return ss.str();
 }
 
-/// `args` is appended to the program path as shell words (quote them yourself).
-inline CliRun run_cli(const std::string& args) {
+/// Runs `command` with sh (quote its words yourself), capturing its exit code, stdout and stderr.
+inline CliRun run_shell(const std::string& command) {
   static int counter = 0;
   const auto dir = std::filesystem::temp_directory_path();
   const std::string tag = std::to_string(::getpid()) + "_" + std::to_string(counter++);
   const auto out = dir / ("deflex_cli_out_" + tag);
   const auto err = dir / ("deflex_cli_err_" + tag);
-  const std::string cmd = std::string(DEFLEX_CLI) + " " + args + " >" + out.string() + " 2>" + err.string() + " </dev/null";
+  const std::string cmd = command + " >" + out.string() + " 2>" + err.string() + " </dev/null";
   const int status = std::system(cmd.c_str());
   CliRun r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -43,5 +43,8 @@ inline CliRun run_cli(const std::string& args) {
   std::filesystem::remove(err);
   return r;
 }
+
+/// `args` is appended to the program path as shell words (quote them yourself).
+inline CliRun run_cli(const std::string& args) { return run_shell(std::string(DEFLEX_CLI) + " " + args); }
 
 }  // namespace deflex::test

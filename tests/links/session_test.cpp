@@ -1,0 +1,144 @@
+// The runtime session itself: its loop allocates nothing with every report on (the cycle log, the
+// fault dump, a log sink: all on the reporter's side of a lock-free ring); options that cannot work
+// are refused before anything runs, naming the option; the exit codes are the documented table
+// (docs/online.md, "Faults and exit codes", read here from the file).
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include <gtest/gtest.h>
+
+#include "deflex/cell/egm_position_controller.hpp"
+#include "deflex/model/errors.hpp"
+#include "deflex/runtime/session.hpp"
+#include "links/link_harness.hpp"
+#include "support/allocation_guard.hpp"
+#include "support/error_of.hpp"
+
+namespace deflex {
+namespace {
+
+namespace fs = std::filesystem;
+
+JointVector pose_deg(double a, double b, double c, double d, double e, double f) {
+  JointVector q(6);
+  q << a, b, c, d, e, f;
+  return q * (kPi / 180.0);
+}
+
+TEST(Session, ThePollDoesNotAllocateWithTheLogTheDumpAndASinkOn) {
+  const RobotModel robot = test::bench_robot();
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  const auto program = test::sweep_program(robot, q0, pose_deg(8, -3, 4, 10, -5, 12), 10.0);
+  ManualClock clock;
+  MemoryNetwork network(clock);
+  MemoryTransport& deflex_port = network.add_endpoint(test::kSensorAddress, 0.0002);
+  MemoryTransport& controller_port = network.add_endpoint(test::kControllerAddress, 0.0002);
+  const std::string dir = ::testing::TempDir() + "/session_alloc";
+  fs::create_directories(dir);
+  runtime::SessionConfig c;
+  c.link = runtime::LinkKind::kEgmJoint;
+  c.online = test::bench_online();
+  c.log_path = dir + "/log.csv";
+  c.fault_dump_path = dir + "/dump.csv";
+  c.status_interval_s = 0.1;
+  std::size_t lines = 0;
+  test::ConstantForce force;
+  force.reading = test::reading_at(robot, q0, Vector3(0, 0, -500));
+  runtime::Session session(c, robot, test::bench_sensor(), program, nullptr, &force, clock, {&deflex_port},
+                           [&lines](runtime::LogLevel, const std::string&) { ++lines; });
+  cell::ControllerConfig cc;
+  cell::EgmPositionGuidanceController controller(cc, q0, controller_port, test::kSensorAddress);
+  double t = 0.0;
+  const auto tick = [&](bool guarded) {
+    t += 0.004;
+    clock.set(t);
+    controller.tick(t);
+    clock.set(t + 0.0002);
+    std::size_t allocations = 0;
+    {
+      std::optional<test::AllocationGuard> guard;
+      if (guarded) guard.emplace();
+      while (session.poll(0.0) != LinkPollResult::kIdle) {
+      }
+      if (guard) allocations = guard->allocations();
+    }
+    session.service();  // the reporter's work, outside the loop
+    return allocations;
+  };
+  for (int k = 0; k < 300; ++k) tick(false);  // warm: every buffer at its size
+  std::size_t allocations = 0;
+  for (int k = 0; k < 500; ++k) allocations += tick(true);
+  EXPECT_EQ(allocations, 0u);
+  const runtime::SessionSummary& s = session.finish();
+  EXPECT_EQ(s.exit_code, 0);
+  EXPECT_EQ(s.log_dropped, 0u);
+  EXPECT_GT(lines, 10u);  // status lines reached the sink
+  std::ifstream log(c.log_path);
+  std::size_t rows = 0;
+  for (std::string line; std::getline(log, line);) ++rows;
+  EXPECT_EQ(rows, 1 + s.cycles);  // the header and every cycle
+}
+
+TEST(Session, OptionsThatCannotWorkAreRefusedNamingThem) {
+  const RobotModel robot = test::bench_robot();
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  const auto program = test::hold_program(robot, q0, 10.0);
+  ManualClock clock;
+  MemoryNetwork network(clock);
+  MemoryTransport& port = network.add_endpoint(test::kSensorAddress, 0.0);
+  const auto refuse = [&](runtime::SessionConfig c, std::shared_ptr<const JointTrajectory> p,
+                          const std::string& fragment) {
+    const std::string e = test::error_of(
+        [&] { runtime::Session s(c, robot, test::bench_sensor(), p, nullptr, nullptr, clock, {&port}); });
+    EXPECT_NE(e.find(fragment), std::string::npos) << e;
+  };
+  runtime::SessionConfig c;
+  c.online = test::bench_online();
+  c.online.period_s = 0.1;
+  c.online.max_correction_rate_rad_s = 0.2;  // 0.02 rad a cycle, beyond the 0.01 rad bound
+  refuse(c, program, "rate bound allows 1.146 deg a cycle");
+  c.online = test::bench_online();
+  c.online.max_tcp_rate_m_s = 5.0;  // 20 mm a cycle, beyond the 5 mm bound
+  refuse(c, program, "TCP rate bound allows 20 mm a cycle");
+  c.online = test::bench_online();
+  refuse(c, nullptr, "option --program: egm-joint streams a nominal program");
+  c.link = runtime::LinkKind::kRsi;
+  refuse(c, program, "option --program: rsi corrects the controller's own program");
+  c.link = runtime::LinkKind::kEgmJoint;
+  c.stop_silence_s = -1.0;
+  refuse(c, program, "stop silence must be > 0 s");
+  c.stop_silence_s.reset();
+  c.realtime.enabled = true;
+  c.realtime.priority = 0;
+  refuse(c, program, "option --rt-priority: SCHED_FIFO priorities are 1..99");
+  c.realtime = {};
+  c.log_path = "/nonexistent/dir/log.csv";
+  refuse(c, program, "option --log '/nonexistent/dir/log.csv'");
+}
+
+TEST(Session, TheExitCodesAreTheDocumentedTable) {
+  // docs/online.md: "| 6 | controller-stopped | ..." rows.
+  std::ifstream doc(std::string(DEFLEX_SOURCE_DIR) + "/docs/online.md");
+  const std::regex row(R"(^\| (\d) \| `([a-z-]+)`)");
+  std::map<std::string, int> documented;
+  for (std::string line; std::getline(doc, line);) {
+    std::smatch m;
+    if (std::regex_search(line, m, row)) documented[m[2]] = std::stoi(m[1]);
+  }
+  for (int r = 1; r <= 9; ++r) {
+    const auto reason = static_cast<runtime::StopReason>(r);
+    ASSERT_TRUE(documented.count(runtime::to_string(reason))) << runtime::to_string(reason) << " is not in the table";
+    EXPECT_EQ(documented[runtime::to_string(reason)], runtime::exit_code(reason)) << runtime::to_string(reason);
+  }
+  // Only the planned ends exit 0.
+  for (int r = 1; r <= 9; ++r) {
+    const auto reason = static_cast<runtime::StopReason>(r);
+    const bool planned = reason == runtime::StopReason::kProgramEnd || reason == runtime::StopReason::kUserStop ||
+                         reason == runtime::StopReason::kDuration;
+    EXPECT_EQ(runtime::exit_code(reason) == 0, planned) << runtime::to_string(reason);
+  }
+}
+
+}  // namespace
+}  // namespace deflex
