@@ -14,6 +14,8 @@
 #include <thread>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "cross/cli_runner.hpp"
 
 namespace deflex::test {
@@ -83,6 +85,20 @@ void run_in_real_time(Controller& controller, double seconds) {
     next += std::chrono::milliseconds(4);
     std::this_thread::sleep_until(next);
   }
+}
+
+/// The recorded force replay the online tests stream (examples/online/force_replay.csv).
+inline const std::string kForceReplay = std::string(DEFLEX_SOURCE_DIR) + "/examples/online/force_replay.csv";
+
+/// `deflex offline --nominal-trajectory` of the paper's circle (r 129.9 mm about (1800, 0, 900) mm) at
+/// `speed_mm_s` after `hold_s` at rest, into DIR/nominal.csv; returns its path.
+inline std::string nominal_program(const std::string& dir, double speed_mm_s = 30.0, double hold_s = 0.5) {
+  const std::string path = dir + "/nominal.csv";
+  const auto r = run_cli("offline --circle \"centre_mm=1800;0;900,radius_mm=129.9,points=81\" --force "
+                         "\"ldbb:phi_deg=30,force_N=400\" --speed-mm-s " + std::to_string(speed_mm_s) +
+                         " --hold-start-s " + std::to_string(hold_s) + " --nominal-trajectory " + path);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return path;
 }
 
 }  // namespace deflex::test

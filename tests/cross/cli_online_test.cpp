@@ -39,21 +39,13 @@ using test::spawn;
 int egm_port_of(const Child& c) { return test::port_of(c, "EGM on 127.0.0.1:"); }
 
 const std::string kDeflex = DEFLEX_CLI;
-const std::string kReplay = std::string(DEFLEX_SOURCE_DIR) + "/examples/online/force_replay.csv";
+const std::string& kReplay = test::kForceReplay;
 
-std::string nominal_program(const std::string& dir) {
-  const std::string path = dir + "/nominal.csv";
-  const auto r = test::run_cli("offline --circle \"centre_mm=1800;0;900,radius_mm=129.9,points=81\" --force "
-                               "\"ldbb:phi_deg=30,force_N=400\" --speed-mm-s 30 --hold-start-s 0.5 "
-                               "--nominal-trajectory " + path);
-  EXPECT_EQ(r.exit_code, 0) << r.err;
-  return path;
-}
 
 TEST(CliOnline, EgmJointStreamsTheProgramWithinTheBoundOfIt) {
   const std::string dir = ::testing::TempDir() + "/cli_online_joint";
   fs::create_directories(dir);
-  const std::string program_path = nominal_program(dir);
+  const std::string program_path = test::nominal_program(dir);
   const RobotModel robot = builtin_irb6700();
   const JointTrajectory program = JointTrajectory::read_csv(program_path, robot);
   const std::string log = dir + "/log.csv";
@@ -101,7 +93,7 @@ TEST(CliOnline, EgmJointStreamsTheProgramWithinTheBoundOfIt) {
 TEST(CliOnline, EgmJointRefusesAStartAwayFromTheProgramAndNamesTheJoint) {
   const std::string dir = ::testing::TempDir() + "/cli_online_refuse";
   fs::create_directories(dir);
-  const std::string program_path = nominal_program(dir);
+  const std::string program_path = test::nominal_program(dir);
   const RobotModel robot = builtin_irb6700();
   const JointTrajectory program = JointTrajectory::read_csv(program_path, robot);
   Child deflex;
@@ -129,7 +121,7 @@ TEST(CliOnline, EgmJointRefusesAStartAwayFromTheProgramAndNamesTheJoint) {
 TEST(CliOnline, EgmPathAnswersTheControllersOwnProgramWithAbsoluteOffsets) {
   const std::string dir = ::testing::TempDir() + "/cli_online_path";
   fs::create_directories(dir);
-  const std::string program_path = nominal_program(dir);
+  const std::string program_path = test::nominal_program(dir);
   const RobotModel robot = builtin_irb6700();
   auto program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(program_path, robot));
   Child deflex;
@@ -156,7 +148,7 @@ TEST(CliOnline, EgmPathAnswersTheControllersOwnProgramWithAbsoluteOffsets) {
 TEST(CliOnline, BadOptionsAndProgramsAreRefusedBeforeAnythingRuns) {
   const std::string dir = ::testing::TempDir() + "/cli_online_bad";
   fs::create_directories(dir);
-  const std::string program_path = nominal_program(dir);
+  const std::string program_path = test::nominal_program(dir);
   const std::string base = "online --egm-port 0 --force-source csv:" + kReplay + " ";
   const auto expect = [&](const std::string& args, const std::string& fragment) {
     const auto r = test::run_cli(base + args);

@@ -119,12 +119,7 @@ TEST(CliRdt, OnlineOverRdtAgainstTheEgmStandIn) {
   const std::string dir = ::testing::TempDir() + "/cli_rdt_online";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const std::string program_path = dir + "/nominal.csv";
-  ASSERT_EQ(test::run_cli("offline --circle \"centre_mm=1800;0;900,radius_mm=129.9,points=81\" --force "
-                          "\"ldbb:phi_deg=30,force_N=400\" --speed-mm-s 50 --hold-start-s 0.2 --nominal-trajectory " +
-                          program_path)
-                .exit_code,
-            0);
+  const std::string program_path = test::nominal_program(dir, 50.0, 0.2);
   const RobotModel robot = builtin_irb6700();
   const JointTrajectory program = JointTrajectory::read_csv(program_path, robot);
   Vector6 wrench;

@@ -32,7 +32,7 @@ namespace fs = std::filesystem;
 using test::Child;
 
 const std::string kDeflex = DEFLEX_CLI;
-const std::string kReplay = std::string(DEFLEX_SOURCE_DIR) + "/examples/online/force_replay.csv";
+const std::string& kReplay = test::kForceReplay;
 
 std::shared_ptr<const JointTrajectory> hold(const RobotModel& robot, double seconds) {
   JointVector q(6);

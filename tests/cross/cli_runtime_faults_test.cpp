@@ -30,16 +30,8 @@ namespace fs = std::filesystem;
 using test::Child;
 
 const std::string kDeflex = DEFLEX_CLI;
-const std::string kReplay = std::string(DEFLEX_SOURCE_DIR) + "/examples/online/force_replay.csv";
+const std::string& kReplay = test::kForceReplay;
 
-std::string nominal_program(const std::string& dir) {
-  const std::string path = dir + "/nominal.csv";
-  const auto r = test::run_cli("offline --circle \"centre_mm=1800;0;900,radius_mm=129.9,points=81\" --force "
-                               "\"ldbb:phi_deg=30,force_N=400\" --speed-mm-s 50 --hold-start-s 0.2 "
-                               "--nominal-trajectory " + path);
-  EXPECT_EQ(r.exit_code, 0) << r.err;
-  return path;
-}
 
 // Ticks `controller` in real time every 4 ms for `seconds`; `at(t)` is called before each tick.
 template <class Controller, class Hook>
@@ -59,7 +51,7 @@ void run_with(Controller& controller, double seconds, Hook at) {
 TEST(CliRuntimeFaults, AStoppedAndContinuedProcessNeverStepsTheTarget) {
   const std::string dir = ::testing::TempDir() + "/cli_sigstop";
   fs::create_directories(dir);
-  const std::string program_path = nominal_program(dir);
+  const std::string program_path = test::nominal_program(dir, 50.0, 0.2);
   const RobotModel robot = builtin_irb6700();
   const JointTrajectory program = JointTrajectory::read_csv(program_path, robot);
   const std::string log = dir + "/log.csv";
@@ -153,7 +145,7 @@ TEST(CliRuntimeFaults, AStoppedRsiControllerEndsTheRunWithANonZeroCodeNamingIt) 
 TEST(CliRuntimeFaults, RealTimeTheSystemRefusesIsExitTwoNamingThePermission) {
   const std::string dir = ::testing::TempDir() + "/cli_realtime";
   fs::create_directories(dir);
-  const std::string program_path = nominal_program(dir);
+  const std::string program_path = test::nominal_program(dir, 50.0, 0.2);
   // Without CAP_SYS_NICE and with a real-time priority limit of 0 (root keeps the capability unless
   // it is taken out of the bounding set).
   const std::string drop = ::geteuid() == 0 ? "setpriv --bounding-set=-sys_nice,-ipc_lock " : "prlimit --rtprio=0 ";

@@ -15,7 +15,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cross/cli_runner.hpp"
+#include "cross/cli_child.hpp"
 #include "deflex/cell/simple_message_server.hpp"
 #include "deflex/model/csv_table.hpp"
 #include "deflex/model/robot_io.hpp"
@@ -29,7 +29,7 @@ namespace {
 namespace fs = std::filesystem;
 
 const std::string kDeflex = DEFLEX_CLI;
-const std::string kReplay = std::string(DEFLEX_SOURCE_DIR) + "/examples/online/force_replay.csv";
+const std::string& kReplay = test::kForceReplay;
 
 // deflex running in a child process, its stderr in a file.
 struct Deflex {
@@ -120,14 +120,6 @@ std::string temp_dir(const std::string& name) {
   return dir;
 }
 
-std::string nominal_program(const std::string& dir) {
-  const std::string path = dir + "/nominal.csv";
-  const auto r = test::run_cli("offline --circle \"centre_mm=1800;0;900,radius_mm=129.9,points=81\" --force "
-                               "\"ldbb:phi_deg=30,force_N=400\" --speed-mm-s 30 --hold-start-s 0.5 "
-                               "--nominal-trajectory " + path);
-  EXPECT_EQ(r.exit_code, 0) << r.err;
-  return path;
-}
 
 std::vector<std::string> join(std::vector<std::string> a, const std::vector<std::string>& b) {
   a.insert(a.end(), b.begin(), b.end());
@@ -136,7 +128,7 @@ std::vector<std::string> join(std::vector<std::string> a, const std::vector<std:
 
 TEST(CliSimpleMessage, StreamsTheProgramWithinTheBoundAndCtrlCStopsTheArm) {
   const std::string dir = temp_dir("cli_sm_stream");
-  const std::string program_path = nominal_program(dir);
+  const std::string program_path = test::nominal_program(dir);
   const RobotModel robot = builtin_irb6700();
   const JointTrajectory program = JointTrajectory::read_csv(program_path, robot);
   const std::string log = dir + "/log.csv";
@@ -184,7 +176,7 @@ TEST(CliSimpleMessage, StreamsTheProgramWithinTheBoundAndCtrlCStopsTheArm) {
 
 TEST(CliSimpleMessage, RefusesAStartAwayFromTheProgramAndSendsNothing) {
   const std::string dir = temp_dir("cli_sm_refuse");
-  const std::string program_path = nominal_program(dir);
+  const std::string program_path = test::nominal_program(dir);
   const RobotModel robot = builtin_irb6700();
   const JointTrajectory program = JointTrajectory::read_csv(program_path, robot);
   Controller c;
@@ -206,7 +198,7 @@ TEST(CliSimpleMessage, RefusesAStartAwayFromTheProgramAndSendsNothing) {
 
 TEST(CliSimpleMessage, ALostConnectionStopsWithExitCodeSixAndSaysWhich) {
   const std::string dir = temp_dir("cli_sm_lost");
-  const std::string program_path = nominal_program(dir);
+  const std::string program_path = test::nominal_program(dir);
   const RobotModel robot = builtin_irb6700();
   const JointTrajectory program = JointTrajectory::read_csv(program_path, robot);
   Controller c;
@@ -231,7 +223,7 @@ TEST(CliSimpleMessage, ALostConnectionStopsWithExitCodeSixAndSaysWhich) {
 
 TEST(CliSimpleMessage, AFrameThatCannotBeOneIsBadInputAndNamed) {
   const std::string dir = temp_dir("cli_sm_bad");
-  const std::string program_path = nominal_program(dir);
+  const std::string program_path = test::nominal_program(dir);
   Controller c;
   Deflex deflex(join({"online", "--link", "simple-message", "--program", program_path, "--period-ms", "100",
                       "--force-source", "csv:" + kReplay, "--loop"},
@@ -249,7 +241,7 @@ TEST(CliSimpleMessage, AFrameThatCannotBeOneIsBadInputAndNamed) {
 
 TEST(CliSimpleMessage, BadOptionsAreRefusedBeforeAnythingConnects) {
   const std::string dir = temp_dir("cli_sm_options");
-  const std::string program_path = nominal_program(dir);
+  const std::string program_path = test::nominal_program(dir);
   const std::string base = "online --link simple-message --force-source csv:" + kReplay + " --program " + program_path;
   const auto expect = [](const std::string& args, const std::string& fragment) {
     const auto r = test::run_cli(args);

@@ -156,15 +156,7 @@ LinkPollResult EgmJointLink::poll(double timeout_s) noexcept {
   rq.arrival = receiver_.arrival();
   const LinkCycle::Verdict verdict = cycle_.run(rq);
   const auto compute = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_read).count(); };
-  if (verdict == LinkCycle::Verdict::kInvalid) {
-    cycle_.not_sent(compute());
-    return LinkPollResult::kNotAnswered;
-  }
-  if (verdict == LinkCycle::Verdict::kGuard) {
-    cycle_.not_sent(compute());
-    stop_link(LinkStopCause::kSafety, "%s", cycle_.guard_message());
-    return announce_terminal();
-  }
+  if (verdict != LinkCycle::Verdict::kSend) return cycle_not_passed(verdict, compute());
   const JointVector& command = cycle_.joint_command();
   reply_.seqno = ++reply_seq_;
   reply_.tm_ms = egm_time_stamp_ms(now);

@@ -198,21 +198,13 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
   rq.arrival = receiver_.arrival();
   const LinkCycle::Verdict verdict = cycle_.run(rq);
   const auto compute = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_read).count(); };
-  if (verdict == LinkCycle::Verdict::kInvalid) {
-    cycle_.not_sent(compute());
-    return LinkPollResult::kNotAnswered;
-  }
+  if (verdict != LinkCycle::Verdict::kSend) return cycle_not_passed(verdict, compute());
   // The rotation the model predicts, which this mode cannot correct.
   jacobian(model, ws_, target_, EndPoint::kTcp, jac_);
   const double rotation = (jac_.bottomRows<3>() * cycle_.output().dtheta).norm();
   cycle_.note_uncorrected_rotation(rotation);
   max_rotation_rad_ = std::max(max_rotation_rad_, rotation);
   if (rotation > config_.rotation_warning_rad) ++rotation_warnings_;
-  if (verdict == LinkCycle::Verdict::kGuard) {
-    cycle_.not_sent(compute());
-    stop_link(LinkStopCause::kSafety, "%s", cycle_.guard_message());
-    return announce_terminal();
-  }
   const Vector3& correction = cycle_.tcp_offset_m();
   reply_.seqno = ++reply_seq_;
   reply_.tm_ms = egm_time_stamp_ms(now);

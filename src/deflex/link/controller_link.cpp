@@ -117,6 +117,13 @@ bool ControllerLink::apply_silence_rules(double now) noexcept {
   return true;
 }
 
+LinkPollResult ControllerLink::cycle_not_passed(LinkCycle::Verdict verdict, double compute_s) noexcept {
+  cycle_.not_sent(compute_s);
+  if (verdict != LinkCycle::Verdict::kGuard) return LinkPollResult::kNotAnswered;
+  stop_link(LinkStopCause::kSafety, "%s", cycle_.guard_message());
+  return announce_terminal();
+}
+
 LinkPollResult ControllerLink::announce_terminal() noexcept {
   if (announced_) return LinkPollResult::kIdle;
   announced_ = true;

@@ -132,6 +132,10 @@ class ControllerLink {
   bool apply_silence_rules(double now) noexcept;
   /// The terminal states: kRefused / kStopped returned once, then kIdle.
   LinkPollResult announce_terminal() noexcept;
+  /// A cycle whose command did not pass (`verdict` not kSend): recorded as not sent; kInvalid (the
+  /// compensator refused the input) is left unanswered, kGuard (the final guard refused the command)
+  /// stops the link for safety. Returns the poll's result.
+  LinkPollResult cycle_not_passed(LinkCycle::Verdict verdict, double compute_s) noexcept;
   /// Whether the session so far ended healthy enough for a silence to be its planned end (links that
   /// correct the controller's program; RSI: its late count below the Timeout).
   [[nodiscard]] virtual bool silence_is_planned_end() const { return rules_.end_on_silence; }

@@ -235,15 +235,7 @@ LinkPollResult RsiLink::poll(double timeout_s) noexcept {
   rq.arrival = arrival_;
   const LinkCycle::Verdict verdict = cycle_.run(rq);
   const auto compute = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_read).count(); };
-  if (verdict == LinkCycle::Verdict::kInvalid) {
-    cycle_.not_sent(compute());
-    return LinkPollResult::kNotAnswered;
-  }
-  if (verdict == LinkCycle::Verdict::kGuard) {
-    cycle_.not_sent(compute());
-    stop_link(LinkStopCause::kSafety, "%s", cycle_.guard_message());
-    return announce_terminal();
-  }
+  if (verdict != LinkCycle::Verdict::kSend) return cycle_not_passed(verdict, compute());
   reply_.ipoc = m.ipoc;
   const JointVector& ak = cycle_.joint_command();  // the whole offset, rounded as the answer carries it
   for (int i = 0; i < ak.size(); ++i) reply_.correction_deg[i] = rad_to_deg(ak[i]);
