@@ -21,6 +21,7 @@
 #include "deflex/cell/egm_position_controller.hpp"
 #include "deflex/model/csv_table.hpp"
 #include "deflex/model/kinematics.hpp"
+#include "deflex/model/types.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/transport/udp_transport.hpp"
@@ -161,6 +162,34 @@ TEST(CliRdt, OnlineOverRdtAgainstTheEgmStandIn) {
     ++checked;
   }
   EXPECT_GT(checked, 100);
+  // The invariants as for every source, read off the log: every command within the 0.5 deg bound of
+  // the nominal it was sent for (the program plus the ramp-in blend), and no step between consecutive
+  // commands above the per-cycle limit computed here (the program's peak speed sampled every 0.5 ms,
+  // the blend's 1.5 x 1 deg over 1 s, the correction's 3 deg/s, over 4 ms).
+  JointVector peak = JointVector::Zero(6), a(6), b(6);
+  program.sample(program.start_time_s(), a);
+  for (double t = program.start_time_s() + 0.0005; t <= program.end_time_s(); t += 0.0005) {
+    program.sample(t, b);
+    peak = peak.cwiseMax((b - a).cwiseAbs() / 0.0005);
+    a = b;
+  }
+  const JointVector limit_deg = (0.004 * (peak * 1.001).array() + 0.004 * deg_to_rad(1.5 + 3.0)) * (180.0 / kPi);
+  double worst_bound = 0.0, worst_step = 0.0;
+  for (std::size_t r = 0; r < table.rows(); ++r) {
+    if (table.at(r, "replied") == 0.0) continue;
+    for (int j = 1; j <= 6; ++j) {
+      const std::string n = std::to_string(j) + "_deg";
+      worst_bound = std::max(worst_bound, std::abs(table.at(r, "q_command" + n) - table.at(r, "q_nominal" + n) -
+                                                   table.at(r, "q_blend" + n)));
+      if (r > 0 && table.at(r - 1, "replied") != 0.0) {
+        worst_step = std::max(worst_step, std::abs(table.at(r, "q_command" + n) - table.at(r - 1, "q_command" + n)) /
+                                              limit_deg[j - 1]);
+      }
+    }
+  }
+  EXPECT_LE(worst_bound, 0.5 + 1e-6);
+  EXPECT_GT(worst_bound, 0.005);  // the sensor's force was compensated
+  EXPECT_LE(worst_step, 1.0);
 }
 
 }  // namespace
