@@ -12,6 +12,10 @@
 
 namespace deflex::cli {
 
+/// The --robot option's help where a robot file is optional.
+inline constexpr const char* kRobotHelp =
+    "Robot file (.yaml deflex format or .urdf); default: the built-in ABB IRB 6700-300/2.70";
+
 /// "1, 2.5,3" -> {1, 2.5, 3}. Throws InputError naming `option` on a bad number, NaN/inf, a value
 /// outside `range` (input_ranges.hpp), or when `expected` (if non-zero) does not match the count.
 std::vector<double> parse_numbers(const std::string& text, const std::string& option, std::size_t expected = 0,

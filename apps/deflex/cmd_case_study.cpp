@@ -22,7 +22,7 @@
 namespace deflex::cli {
 namespace {
 
-struct Opts {
+struct CaseStudyOpts {
   std::string case_file, out_dir = "case-study-out", traces_dir;
   long long seed = -1;
   int seeds = 0;
@@ -111,7 +111,7 @@ std::vector<std::string> honest_notes(const study::CaseConfig& config, const Stu
   return notes;
 }
 
-void run(const Opts& o, int& exit_code) {
+void run(const CaseStudyOpts& o, int& exit_code) {
   study::CaseConfig config = o.case_file.empty() ? study::paper_case() : study::load_case(o.case_file);
   // The report's folder before the study runs, so a path that cannot be one fails at once.
   std::error_code folder_error;
@@ -218,7 +218,7 @@ void run(const Opts& o, int& exit_code) {
 }
 
 void setup(CLI::App& sub, int& exit_code) {
-  auto o = std::make_shared<Opts>();
+  auto o = std::make_shared<CaseStudyOpts>();
   sub.add_option("--case", o->case_file, "Case file (YAML, see data/cases/paper.yaml); default: the paper's case");
   sub.add_option("--seed", o->seed, "Seed of every random effect (default: the case file's)");
   sub.add_option("--out", o->out_dir,

@@ -19,7 +19,7 @@ namespace deflex::cli {
 namespace {
 
 // Required: fitting the built-in IRB 6700 to another arm's data gives confident nonsense (J5 negative).
-const char* const kRobotHelp =
+const char* const kDataRobotHelp =
     "Robot file (.yaml deflex format or .urdf) whose kinematics, tool and WAP the data were taken with; required "
     "('builtin' names the built-in ABB IRB 6700-300/2.70 with no tool: WAP and TCP at the flange centre)";
 
@@ -60,7 +60,7 @@ void setup_identify(CLI::App& sub, int& exit_code) {
     double rotation_scale_m = 1.0, max_rel = 0.5;
   };
   auto o = std::make_shared<Opts>();
-  sub.add_option("--robot", o->robot, kRobotHelp)->required();
+  sub.add_option("--robot", o->robot, kDataRobotHelp)->required();
   sub.add_option("--data", o->data,
                  "Measurement CSV: q1_deg..q6_deg, fx_N,fy_N,fz_N, mx_Nm,my_Nm,mz_Nm (at the WAP, base frame), "
                  "dx_mm,dy_mm,dz_mm (TCP, loaded minus unloaded, base frame); optional drx_rad,dry_rad,drz_rad, weight")
@@ -215,7 +215,7 @@ void setup_plan(CLI::App& sub, int& exit_code) {
     bool json = false;
   };
   auto o = std::make_shared<Opts>();
-  sub.add_option("--robot", o->robot, kRobotHelp)->required();
+  sub.add_option("--robot", o->robot, kDataRobotHelp)->required();
   sub.add_option("--region-mm", o->region,
                  "Box of TCP positions to calibrate in, base frame: \"xmin,xmax,ymin,ymax,zmin,zmax\" (mm)")
       ->required();

@@ -23,7 +23,6 @@
 namespace deflex::cli {
 namespace {
 
-const char* const kRobotHelp = "Robot file (.yaml deflex format or .urdf); default: the built-in ABB IRB 6700-300/2.70";
 
 SensorConfig sensor_or_default(const std::string& path) {
   if (path.empty()) {
@@ -34,7 +33,7 @@ SensorConfig sensor_or_default(const std::string& path) {
   return load_sensor_config(path);
 }
 
-struct Opts {
+struct PayloadOpts {
   std::string robot, sensor, data, out;
   bool json = false;
   // Recording a pose from a sensor.
@@ -89,7 +88,7 @@ std::string existing_poses(const std::string& path, const std::string& header, i
 // when the arm or the tool moves, as the tare is), added as one row to --record's poses CSV. The file
 // is rewritten whole through a temporary file and renamed into place: a failed recording leaves it
 // as it was.
-void record_pose(const Opts& o, int& exit_code) {
+void record_pose(const PayloadOpts& o, int& exit_code) {
   const RobotModel model = load_cli_robot("identify-payload", o.robot);
   const SensorConfig sensor = sensor_or_default(o.sensor);
   const JointVector q = parse_joints_deg(o.joints_deg, model, "--joints-deg");
@@ -186,7 +185,7 @@ void record_pose(const Opts& o, int& exit_code) {
   exit_code = 0;
 }
 
-void identify(const Opts& o, int& exit_code) {
+void identify(const PayloadOpts& o, int& exit_code) {
   OutputFile out(o.out, "option -o");  // prepared first: the file written is never one read
   SensorConfig sensor = sensor_or_default(o.sensor);
   const RobotModel model = load_cli_robot("identify-payload", o.robot);
@@ -241,7 +240,7 @@ void identify(const Opts& o, int& exit_code) {
 }
 
 void setup_identify_payload(CLI::App& sub, int& exit_code) {
-  auto o = std::make_shared<Opts>();
+  auto o = std::make_shared<PayloadOpts>();
   sub.add_option("--data", o->data,
                  "CSV of static poses: fx_N,fy_N,fz_N[,mx_Nm,my_Nm,mz_Nm] raw readings and the orientation as "
                  "qw,qx,qy,qz (base_R_sensor) or q1_deg..q6_deg (needs the robot and the sensor mount)");

@@ -15,7 +15,6 @@
 namespace deflex::cli {
 namespace {
 
-const char* const kRobotHelp = "Robot file (.yaml deflex format or .urdf); default: the built-in ABB IRB 6700-300/2.70";
 
 nlohmann::json pose_json(const Pose& p) {
   const Eigen::Quaterniond q(p.linear());

@@ -28,7 +28,7 @@
 namespace deflex::cli {
 namespace {
 
-struct Opts {
+struct OfflineOpts {
   std::string robot, stiffness, circle, line, path_csv, orientation = "0,0,1,0", config, seed, csv_out, rapid_out;
   std::string trajectory_out, nominal_trajectory_out;
   double hold_start_s = 0.0;
@@ -88,7 +88,7 @@ nlohmann::json program_json(const RobotModel& model, const ProgramCompensation& 
 
 /// --program-in: an existing RAPID or KRL program compensated target by target. The outputs are
 /// prepared before the program is read, so an output that is an input is refused first.
-void run_program(const Opts& o, int& exit_code) {
+void run_program(const OfflineOpts& o, int& exit_code) {
   if (o.program_out.empty()) {
     throw InputError("option --program-in needs --program-out FILE (the input is never overwritten)");
   }
@@ -135,7 +135,7 @@ void run_program(const Opts& o, int& exit_code) {
 }
 
 /// The pose source of --circle, --line or --path, and its description for the outputs.
-std::unique_ptr<PoseSource> make_pose_source(const Opts& o, ForceSpecContext& context, std::string& path_text) {
+std::unique_ptr<PoseSource> make_pose_source(const OfflineOpts& o, ForceSpecContext& context, std::string& path_text) {
   if (!o.path_csv.empty()) {
     if (o.orientation_given) {
       std::cerr << "deflex offline: warning: --orientation-wxyz is ignored: the path file gives the orientation\n";
@@ -163,7 +163,7 @@ std::unique_ptr<PoseSource> make_pose_source(const Opts& o, ForceSpecContext& co
 }
 
 /// The first point's IK request from --config and --seed-deg.
-IkRequest first_ik_request(const Opts& o, const RobotModel& model) {
+IkRequest first_ik_request(const OfflineOpts& o, const RobotModel& model) {
   IkRequest first;
   if (!o.config.empty()) {
     const auto c = parse_numbers(o.config, "--config", 4);
@@ -187,7 +187,7 @@ IkRequest first_ik_request(const Opts& o, const RobotModel& model) {
   return first;
 }
 
-RapidOptions rapid_options(const Opts& o) {
+RapidOptions rapid_options(const OfflineOpts& o) {
   RapidOptions rapid;
   if (o.motion == "absj") {
     rapid.motion = RapidMotion::kMoveAbsJ;
@@ -239,7 +239,7 @@ std::vector<std::string> run_labels(const std::vector<std::unique_ptr<ForceModel
 }
 
 /// Every output of every run, prepared before the robot and the path are read.
-void prepare_outputs(const Opts& o, std::vector<Run>& runs, OutputTransaction& outputs, OutputFile*& nominal) {
+void prepare_outputs(const OfflineOpts& o, std::vector<Run>& runs, OutputTransaction& outputs, OutputFile*& nominal) {
   const bool several = runs.size() > 1;
   const auto name = [&](const std::string& path, const Run& r) { return several ? suffixed(path, r.label) : path; };
   for (Run& r : runs) {
@@ -258,7 +258,7 @@ void prepare_outputs(const Opts& o, std::vector<Run>& runs, OutputTransaction& o
   }
 }
 
-void check_path_options(const Opts& o) {
+void check_path_options(const OfflineOpts& o) {
   if (!o.program_out.empty() || !o.tooldata.empty() || !o.wobjdata.empty()) {
     throw InputError("options --program-out, --tooldata and --wobjdata go with --program-in");
   }
@@ -279,7 +279,7 @@ void check_path_options(const Opts& o) {
 /// The one pass over the path: a pose, its IK, then every load's compensation and CSV row. Only
 /// what an output needs whole is kept (a RAPID module's points, a trajectory's poses and joints), so
 /// a path written to CSV alone streams in memory independent of its length.
-void compensate_along(const Opts& o, const RobotModel& model, PoseSource& source, PathIkSolver& ik,
+void compensate_along(const OfflineOpts& o, const RobotModel& model, PoseSource& source, PathIkSolver& ik,
                       std::vector<Run>& runs, std::vector<Pose>& poses, std::vector<JointVector>& q_nominal) {
   const bool trajectories = !o.trajectory_out.empty() || !o.nominal_trajectory_out.empty();
   for (Run& r : runs) {
@@ -330,7 +330,7 @@ void compensate_along(const Opts& o, const RobotModel& model, PoseSource& source
 }
 
 /// The summary (text or JSON) once every output is in place.
-void report_offline(const Opts& o, const RobotModel& model, const std::string& path_text,
+void report_offline(const OfflineOpts& o, const RobotModel& model, const std::string& path_text,
                     const ArmConfiguration& configuration, const std::vector<Run>& runs, const OutputFile* nominal,
                     double nominal_s) {
   if (nominal != nullptr) {
@@ -382,7 +382,7 @@ void report_offline(const Opts& o, const RobotModel& model, const std::string& p
   }
 }
 
-void run(const Opts& o, int& exit_code) {
+void run(const OfflineOpts& o, int& exit_code) {
   if (o.forces.empty()) {
     throw InputError("give a force model: --force ldbb:...|constant:...|tool:...|table:FILE.csv");
   }
@@ -465,7 +465,7 @@ void run(const Opts& o, int& exit_code) {
 }
 
 void setup_offline(CLI::App& sub, int& exit_code) {
-  auto o = std::make_shared<Opts>();
+  auto o = std::make_shared<OfflineOpts>();
   sub.add_option("--robot", o->robot,
                  "Robot file (.yaml deflex format or .urdf) with joint stiffness; default: the built-in ABB IRB 6700");
   sub.add_option("--stiffness-Nm-per-rad", o->stiffness, kStiffnessHelp);

@@ -28,7 +28,6 @@ namespace {
 
 using runtime::LinkKind;
 
-const char* const kRobotHelp = "Robot file (.yaml deflex format or .urdf); default: the built-in ABB IRB 6700-300/2.70";
 
 std::atomic<bool> g_stop{false};
 extern "C" void on_stop_signal(int /*signal*/) { g_stop.store(true); }
@@ -42,7 +41,7 @@ SensorConfig sensor_or_default(const std::string& path) {
   return load_sensor_config(path);
 }
 
-struct Opts {
+struct OnlineOpts {
   std::string link, robot, sensor, force_source, program, strategy = "online", force_model, log, fault_dump,
       jacobian_at = "nominal";
   double period_ms = 0.0, max_joint_deg = 0.5, max_tcp_mm = 5.0, max_rate_deg_s = 3.0, max_tcp_rate_mm_s = 5.0,
@@ -111,7 +110,7 @@ const std::vector<LinkOption>& link_options() {
   return options;
 }
 
-void add_link_options(CLI::App& sub, Opts& o) {
+void add_link_options(CLI::App& sub, OnlineOpts& o) {
   sub.add_option("--egm-port", o.egm_port, "EGM: UDP port the controller's EGM messages arrive on (ABB examples: 6510)");
   sub.add_option("--ramp-in-s", o.ramp_in_s,
                  "egm-joint, simple-message: blend from where the controller is to the program over this time, s")
@@ -177,7 +176,7 @@ void add_link_options(CLI::App& sub, Opts& o) {
       ->capture_default_str();
 }
 
-void add_sensor_options(CLI::App& sub, Opts& o) {
+void add_sensor_options(CLI::App& sub, OnlineOpts& o) {
   sub.add_option("--rdt-calibration", o.rdt_calibration,
                  "rdt: counts to N and Nm: sensor (its netftapi2.xml over HTTP), FILE.xml (a saved page), http://URL, "
                  "onrobot-hex, or counts:counts_per_force=C,counts_per_torque=C,force_unit=U,torque_unit=U");
@@ -199,7 +198,7 @@ void add_sensor_options(CLI::App& sub, Opts& o) {
                  "links: the program's start), so that the payload's weight stays in the reading");
 }
 
-void check_sensor_options(const CLI::App& sub, const Opts& o) {
+void check_sensor_options(const CLI::App& sub, const OnlineOpts& o) {
   const bool rdt = o.force_source.rfind("rdt:", 0) == 0;
   for (const char* name : {"--rdt-calibration", "--rdt-rate-hz", "--rdt-buffered", "--tare"}) {
     if (!rdt && sub.get_option(name)->count() > 0) {
@@ -222,7 +221,7 @@ void check_link_options(const CLI::App& sub, LinkKind kind) {
   }
 }
 
-runtime::SessionConfig session_config(const Opts& o, const CLI::App& sub) {
+runtime::SessionConfig session_config(const OnlineOpts& o, const CLI::App& sub) {
   runtime::SessionConfig c;
   c.link = runtime::parse_link_kind(o.link);
   check_link_options(sub, c.link);
@@ -343,7 +342,7 @@ runtime::SessionConfig session_config(const Opts& o, const CLI::App& sub) {
 
 // --tare: the sensor's offset, averaged with the arm still, the payload's weight at the tare pose left
 // in the reading (the pipeline's gravity compensation takes it out at every pose).
-void tare_sensor(const Opts& o, const RobotModel& model, const SensorConfig& sensor, const JointTrajectory* program,
+void tare_sensor(const OnlineOpts& o, const RobotModel& model, const SensorConfig& sensor, const JointTrajectory* program,
                  const OpenedForceSource& force, spdlog::logger& log) {
   if (sensor.bias_sensor.cwiseAbs().maxCoeff() > 0.0) {
     throw InputError(fmt::format(
@@ -379,7 +378,7 @@ void tare_sensor(const Opts& o, const RobotModel& model, const SensorConfig& sen
   log.info("tare: {}", describe(force.rdt->tare(ts), ts));
 }
 
-void run_online(const Opts& o, const CLI::App& sub, int& exit_code) {
+void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
   const runtime::SessionConfig config = session_config(o, sub);
   const runtime::LinkKindInfo& info = runtime::link_kind(config.link);
   const RobotModel model = load_cli_robot("online", o.robot);
@@ -458,7 +457,7 @@ void run_online(const Opts& o, const CLI::App& sub, int& exit_code) {
 }
 
 void setup_online(CLI::App& sub, int& exit_code) {
-  auto o = std::make_shared<Opts>();
+  auto o = std::make_shared<OnlineOpts>();
   std::string link_help = "Controller link:";
   for (const runtime::LinkKindInfo& k : runtime::link_kinds()) link_help += fmt::format(" {} ({});", k.name, k.help);
   sub.add_option("--link", o->link, link_help)->required();

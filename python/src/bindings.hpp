@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 
+#include <nlohmann/json_fwd.hpp>
 #include <pybind11/pybind11.h>
 
 #include "deflex/model/arm_configuration.hpp"
@@ -21,6 +22,9 @@ using RobotHolder = std::shared_ptr<RobotModel>;
 /// ABB confdata (cf1, cf4, cf6, cfx) as a tuple, and from a Python sequence (None: not given).
 py::tuple configuration_tuple(const ArmConfiguration& c);
 std::optional<ArmConfiguration> arm_configuration_arg(const py::object& c);
+
+/// A JSON document as the Python objects json.loads makes of it (dict, list, str, float, ...).
+py::object json_to_python(const nlohmann::json& doc);
 
 void bind_errors(py::module_& m);
 void bind_model(py::module_& m);

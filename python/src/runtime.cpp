@@ -24,7 +24,6 @@ namespace deflex::python {
 using namespace pybind11::literals;
 namespace {
 
-py::object json_to_python(const nlohmann::json& doc) { return py::module_::import("json").attr("loads")(doc.dump()); }
 
 // One setting: its name, and how a Python value sets it in the session's configuration.
 using Setter = std::function<void(runtime::SessionConfig&, const py::handle&)>;

@@ -11,11 +11,11 @@
 
 namespace deflex::python {
 using namespace pybind11::literals;
-namespace {
-
 py::object json_to_python(const nlohmann::json& doc) {
   return py::module_::import("json").attr("loads")(doc.dump());
 }
+
+namespace {
 
 py::list links_to_python(const std::vector<study::LinkSummary>& links) {
   py::list out;

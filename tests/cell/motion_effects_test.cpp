@@ -18,13 +18,13 @@
 namespace deflex::cell {
 namespace {
 
-CellConfig bare_cell() {
+CellConfig effects_cell() {
   CellConfig c;
   c.robot.gravity_torque_nm = {0, 9000, 3500, 0, 60, 0};
   return c;
 }
 
-JointVector test_pose() {
+JointVector effects_pose() {
   JointVector q(6);
   q << 0.1, deg_to_rad(25.0), deg_to_rad(5.0), 0.2, deg_to_rad(55.0), -0.3;
   return q;
@@ -43,11 +43,11 @@ Matrix3 structural_compliance(const TrueRobot& robot, Workspace& ws) {
 }
 
 TEST(TrueRobot, UpperArmBendingIsReciprocalPositiveAndGoesWithOneOverEI) {
-  CellConfig c = bare_cell();
+  CellConfig c = effects_cell();
   c.robot.upper_arm_ei_nm2 = 4e7;
   const TrueRobot robot(c, false, 7);
   Workspace ws(robot.true_model());
-  forward_kinematics(robot.true_model(), ws, test_pose());
+  forward_kinematics(robot.true_model(), ws, effects_pose());
   const Matrix3 C = structural_compliance(robot, ws);
   // Maxwell-Betti: a linear elastic structure's compliance is symmetric, and it stores energy under
   // any force that bends it (positive semi-definite).
@@ -60,23 +60,23 @@ TEST(TrueRobot, UpperArmBendingIsReciprocalPositiveAndGoesWithOneOverEI) {
   soft.robot.upper_arm_ei_nm2 = 2e7;
   const TrueRobot soft_robot(soft, false, 7);
   Workspace ws2(soft_robot.true_model());
-  forward_kinematics(soft_robot.true_model(), ws2, test_pose());
+  forward_kinematics(soft_robot.true_model(), ws2, effects_pose());
   EXPECT_NEAR((structural_compliance(soft_robot, ws2) - 2.0 * C).norm(), 0.0, 1e-9 * C.norm());
   // EI 0 stands for a rigid arm: nothing added.
-  CellConfig rigid = bare_cell();
+  CellConfig rigid = effects_cell();
   const TrueRobot rigid_robot(rigid, false, 7);
   Workspace ws3(rigid_robot.true_model());
-  forward_kinematics(rigid_robot.true_model(), ws3, test_pose());
+  forward_kinematics(rigid_robot.true_model(), ws3, effects_pose());
   EXPECT_EQ(structural_compliance(rigid_robot, ws3).norm(), 0.0);
 }
 
 TEST(TrueRobot, FoundationTiltMovesTheTcpByTheMomentAboutTheBase) {
-  CellConfig c = bare_cell();
+  CellConfig c = effects_cell();
   const double k = 3e-10;  // rad/Nm
   c.robot.base_tilt_compliance_rad_per_nm = k;
   const TrueRobot robot(c, false, 7);
   Workspace ws(robot.true_model());
-  forward_kinematics(robot.true_model(), ws, test_pose());
+  forward_kinematics(robot.true_model(), ws, effects_pose());
   const Vector3 p = ws.base_T_tcp.translation();
   // A vertical force F at the TCP, at horizontal distance r and height h from the base origin: the
   // foundation tilts by k F r about the horizontal axis across the arm, which lowers the TCP by
@@ -97,7 +97,7 @@ TEST(TrueRobot, FoundationTiltMovesTheTcpByTheMomentAboutTheBase) {
 Vector3 moving_deflection(const TrueRobot& robot, const JointVector& speed, const Wrench& w) {
   Workspace ws(robot.true_model());
   const double dt = 0.004;
-  JointVector q = test_pose();
+  JointVector q = effects_pose();
   TrueRobotState loaded = robot.initial_state(q), unloaded = robot.initial_state(q);
   Vector3 d = Vector3::Zero();
   for (int i = 1; i <= 5; ++i) {
@@ -110,7 +110,7 @@ Vector3 moving_deflection(const TrueRobot& robot, const JointVector& speed, cons
 }
 
 TEST(TrueRobot, MovingJointsDeflectLessAndMoreWithTheirTorque) {
-  CellConfig c = bare_cell();
+  CellConfig c = effects_cell();
   c.robot.lost_motion_rad.clear();  // lost motion would add its own direction-dependent offset
   const TrueRobot still(c, false, 7);
   c.robot.speed_stiffening = 0.10;
@@ -129,14 +129,14 @@ TEST(TrueRobot, MovingJointsDeflectLessAndMoreWithTheirTorque) {
   EXPECT_NEAR((moving_deflection(stiffening, zero, w) - d_still).norm(), 0.0, 1e-12);
   // Direction asymmetry: moving with the torque of every joint yields (1 + a), against it (1 - a);
   // the mean of the two is the still arm's.
-  CellConfig a = bare_cell();
+  CellConfig a = effects_cell();
   a.robot.lost_motion_rad.clear();
   a.robot.direction_asymmetry = 0.08;
   a.robot.speed_ref_rad_s = 1e-4;
   const TrueRobot asym(a, false, 7);
   Workspace ws(asym.true_model());
   Jacobian J(6, 6);
-  jacobian(asym.true_model(), ws, test_pose(), EndPoint::kTcp, J);
+  jacobian(asym.true_model(), ws, effects_pose(), EndPoint::kTcp, J);
   const JointVector tau = J.transpose() * w;
   const JointVector with = 0.05 * tau.cwiseSign();
   const Vector3 d_with = moving_deflection(asym, with, w);
@@ -146,13 +146,13 @@ TEST(TrueRobot, MovingJointsDeflectLessAndMoreWithTheirTorque) {
 }
 
 TEST(TrueRobot, ServoFollowingErrorAndItsYieldToAChangingTorque) {
-  CellConfig c = bare_cell();
+  CellConfig c = effects_cell();
   c.robot.lost_motion_rad.clear();
   c.robot.servo_following_s = 0.008;
   const TrueRobot robot(c, false, 7);
   Workspace ws(robot.true_model());
   const double dt = 0.004;
-  JointVector q = test_pose();
+  JointVector q = effects_pose();
   TrueRobotState s = robot.initial_state(q);
   const JointVector v = JointVector::Constant(6, 0.1);
   for (int i = 0; i < 3; ++i) {
@@ -164,14 +164,14 @@ TEST(TrueRobot, ServoFollowingErrorAndItsYieldToAChangingTorque) {
 
   // The yield: a process torque that steps on yields f C dtau more at first, decaying with the
   // integral action's time constant: after n ticks the integrator holds 1 - exp(-n dt / T_i) of it.
-  CellConfig y = bare_cell();
+  CellConfig y = effects_cell();
   y.robot.lost_motion_rad.clear();
   const TrueRobot rigid_servo(y, false, 7);
   const double f = 0.2, Ti = 0.1;
   y.robot.servo_compliance_fraction = f;
   y.robot.servo_integral_s = Ti;
   const TrueRobot yielding(y, false, 7);
-  const JointVector q0 = test_pose();
+  const JointVector q0 = effects_pose();
   TrueRobotState sy = yielding.initial_state(q0), sr = rigid_servo.initial_state(q0);
   Workspace wy(yielding.true_model()), wr(rigid_servo.true_model());
   (void)yielding.solve(wy, q0, Wrench::Zero(), sy, dt);  // unloaded: the integrator holds no torque

@@ -16,7 +16,7 @@ namespace {
 
 using test::Bytes;
 
-JointVector start() {
+JointVector server_start() {
   JointVector q(6);
   q << 0.1, 0.4, 0.2, 0.0, 0.9, 0.0;
   return q;
@@ -43,7 +43,7 @@ struct Client {
   explicit Client(bool big_endian, std::size_t buffer = 4) : big(big_endian) {
     config.byte_order = big ? simple_message::ByteOrder::kBig : simple_message::ByteOrder::kLittle;
     config.buffer_points = buffer;
-    server = std::make_unique<SimpleMessageServer>(config, robot, start(), motion.server(), state.server());
+    server = std::make_unique<SimpleMessageServer>(config, robot, server_start(), motion.server(), state.server());
   }
   void send(const Bytes& b) { ASSERT_EQ(motion.client().write(b.data(), b.size()), static_cast<long>(b.size())); }
   // One 4 ms servo tick, then read what reached the client.
@@ -67,7 +67,7 @@ struct Client {
 TEST(SimpleMessageServer, AcceptsPointsWithHeaderOnlySuccessRepliesAndRunsThem) {
   for (bool big : {false, true}) {
     Client c(big);
-    JointVector target = start();
+    JointVector target = server_start();
     target[0] += 0.01;
     c.send(test::hand_traj_pt(big, 2, 0, 0, floats(target), 0.0f, 0.1f));
     c.tick();
@@ -91,7 +91,7 @@ TEST(SimpleMessageServer, AFullBufferAnswersFailureAndTakesNothing) {
   for (bool big : {false, true}) {
     Client c(big, 2);
     for (int k = 0; k < 3; ++k) {
-      JointVector target = start();
+      JointVector target = server_start();
       target[0] += 0.01 * (k + 1);
       c.send(test::hand_traj_pt(big, 2, 0, k, floats(target), 0.0f, 0.1f));
     }
@@ -109,7 +109,7 @@ TEST(SimpleMessageServer, AFullBufferAnswersFailureAndTakesNothing) {
 TEST(SimpleMessageServer, StopTrajectoryStopsTheArmAndEmptiesTheBuffer) {
   Client c(false);
   for (int k = 0; k < 4; ++k) {
-    JointVector target = start();
+    JointVector target = server_start();
     target[0] += 0.02 * (k + 1);
     c.send(test::hand_traj_pt(false, 2, 0, k, floats(target), 0.0f, 0.1f));
   }
@@ -125,7 +125,7 @@ TEST(SimpleMessageServer, StopTrajectoryStopsTheArmAndEmptiesTheBuffer) {
   for (int k = 0; k < 50; ++k) c.tick();
   EXPECT_TRUE(c.server->motion().at_rest());
   const double held = c.server->motion().position()[0];
-  EXPECT_LT(held, start()[0] + 0.08 - 1e-3);  // it never reached the last point
+  EXPECT_LT(held, server_start()[0] + 0.08 - 1e-3);  // it never reached the last point
   for (int k = 0; k < 50; ++k) c.tick();
   EXPECT_EQ(c.server->motion().position()[0], held);
 }
@@ -163,7 +163,7 @@ TEST(SimpleMessageServer, PublishesJointPositionAndStatusEveryTenthOfASecond) {
         ASSERT_EQ(f.data.size(), 44u);
         EXPECT_EQ(f.i32(big, 0), 0);  // ROS_stateServer's sequence is 0
         for (std::size_t j = 0; j < 6; ++j) {
-          EXPECT_EQ(f.f32(big, 1 + j), static_cast<float>(start()[static_cast<int>(j)]));
+          EXPECT_EQ(f.f32(big, 1 + j), static_cast<float>(server_start()[static_cast<int>(j)]));
         }
         for (std::size_t j = 6; j < 10; ++j) EXPECT_EQ(f.f32(big, 1 + j), 0.0f);
       } else if (f.type == 13) {
@@ -182,12 +182,12 @@ TEST(SimpleMessageServer, PublishesJointPositionAndStatusEveryTenthOfASecond) {
 
 TEST(SimpleMessageServer, AnOutOfRangePointIsRefusedAndStopsTheMotion) {
   Client c(false);
-  JointVector target = start();
+  JointVector target = server_start();
   target[0] += 0.05;
   c.send(test::hand_traj_pt(false, 2, 0, 0, floats(target), 0.0f, 0.1f));
   for (int k = 0; k < 30; ++k) c.tick();
   EXPECT_FALSE(c.server->motion().at_rest());
-  JointVector wild = start();
+  JointVector wild = server_start();
   wild[2] = c.robot.upper_limits()[2] + 0.1;
   c.send(test::hand_traj_pt(false, 2, 0, 1, floats(wild), 0.0f, 0.1f));
   c.send(test::hand_traj_pt(false, 2, 0, 2, floats(target), 0.0f, -1.0f));  // a negative duration
@@ -210,7 +210,7 @@ TEST(SimpleMessageServer, AnEmergencyStopIsReportedAndEveryPointRefused) {
     if (f.type == 13) saw = saw || f.i32(true, 1) == 1;
   }
   EXPECT_TRUE(saw);
-  c.send(test::hand_traj_pt(true, 2, 0, 0, floats(start()), 0.0f, 0.1f));
+  c.send(test::hand_traj_pt(true, 2, 0, 0, floats(server_start()), 0.0f, 0.1f));
   c.tick();
   const auto r = c.replies();
   ASSERT_EQ(r.size(), 1u);
@@ -220,8 +220,8 @@ TEST(SimpleMessageServer, AnEmergencyStopIsReportedAndEveryPointRefused) {
 TEST(SimpleMessageServer, IndustrialCoreStyleRepliesEchoThePoint) {
   Client c(false);
   c.config.reply_with_data = true;
-  c.server = std::make_unique<SimpleMessageServer>(c.config, c.robot, start(), c.motion.server(), c.state.server());
-  c.send(test::hand_traj_pt(false, 2, 0, 41, floats(start()), 0.0f, 0.1f));
+  c.server = std::make_unique<SimpleMessageServer>(c.config, c.robot, server_start(), c.motion.server(), c.state.server());
+  c.send(test::hand_traj_pt(false, 2, 0, 41, floats(server_start()), 0.0f, 0.1f));
   c.tick();
   const auto r = c.replies();
   ASSERT_EQ(r.size(), 1u);

@@ -87,6 +87,9 @@ void run_in_real_time(Controller& controller, double seconds) {
   }
 }
 
+/// The command-line program under test.
+inline const std::string kDeflex = DEFLEX_CLI;
+
 /// The recorded force replay the online tests stream (examples/online/force_replay.csv).
 inline const std::string kForceReplay = std::string(DEFLEX_SOURCE_DIR) + "/examples/online/force_replay.csv";
 

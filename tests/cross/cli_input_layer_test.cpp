@@ -16,7 +16,7 @@ namespace deflex::test {
 namespace {
 
 namespace fs = std::filesystem;
-const std::string kSrc = DEFLEX_SOURCE_DIR;
+const std::string kSourceDir = DEFLEX_SOURCE_DIR;
 
 fs::path scratch(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("deflex_input_" + std::to_string(::getpid()) + "_" + name);
@@ -34,12 +34,12 @@ std::string replace_all(std::string s, const std::string& from, const std::strin
 
 TEST(CliInput, WrenchTableWithByteOrderMarkOrCrLinesMeansTheSame) {
   const fs::path d = scratch("bom");
-  const std::string table = slurp(kSrc + "/examples/offline/square_wrench.csv");
+  const std::string table = slurp(kSourceDir + "/examples/offline/square_wrench.csv");
   std::ofstream(d / "bom.csv", std::ios::binary) << "\xEF\xBB\xBF" << table;
   std::ofstream(d / "cr.csv", std::ios::binary) << replace_all(table, "\n", "\r");
   std::ofstream(d / "crlf.csv", std::ios::binary) << replace_all(table, "\n", "\r\n");
-  const std::string path = " --path " + kSrc + "/examples/offline/square_path.csv --force table:";
-  const auto plain = run_cli("offline" + path + kSrc + "/examples/offline/square_wrench.csv -o " + (d / "plain.out").string());
+  const std::string path = " --path " + kSourceDir + "/examples/offline/square_path.csv --force table:";
+  const auto plain = run_cli("offline" + path + kSourceDir + "/examples/offline/square_wrench.csv -o " + (d / "plain.out").string());
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
   for (const char* name : {"bom", "cr", "crlf"}) {
     const auto r = run_cli("offline" + path + (d / (std::string(name) + ".csv")).string() + " -o " +
@@ -61,7 +61,7 @@ TEST(CliInput, WrenchTableWithByteOrderMarkOrCrLinesMeansTheSame) {
 
 TEST(CliInput, RobotFileWithQuotesAndBackslashesReadsBack) {
   const fs::path d = scratch("quotes");
-  std::string robot = slurp(kSrc + "/examples/robots/kuka_kr210_r2700.yaml");
+  std::string robot = slurp(kSourceDir + "/examples/robots/kuka_kr210_r2700.yaml");
   robot = replace_all(robot, "name: \"KUKA KR 210 R2700-class (approximate)\"", "name: 'KR 210 \"test\" C:\\cell\\1'");
   std::ofstream(d / "in.yaml") << robot;
   const auto printed = run_cli("robot --robot " + (d / "in.yaml").string());
@@ -94,7 +94,7 @@ TEST(CliInput, PlanCalibrationSaysWhatToChangeWhenTheTcpIsOnTheLastAxis) {
 
 TEST(CliInput, IdentifyFromOneRowIdentifiesNothing) {
   const fs::path d = scratch("one_row");
-  std::ifstream in(kSrc + "/examples/identify/kr210_synthetic_measurements.csv");
+  std::ifstream in(kSourceDir + "/examples/identify/kr210_synthetic_measurements.csv");
   std::string text, line;
   int data_rows = 0;
   while (std::getline(in, line) && data_rows < 1) {
@@ -102,7 +102,7 @@ TEST(CliInput, IdentifyFromOneRowIdentifiesNothing) {
     data_rows += (line.empty() || line[0] == '#' || line.rfind("q1_deg", 0) == 0) ? 0 : 1;
   }
   std::ofstream(d / "one.csv") << text;
-  const auto r = run_cli("identify --robot " + kSrc + "/examples/robots/kuka_kr210_r2700.yaml --data " +
+  const auto r = run_cli("identify --robot " + kSourceDir + "/examples/robots/kuka_kr210_r2700.yaml --data " +
                          (d / "one.csv").string() + " --write-robot " + (d / "out.yaml").string());
   EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
   EXPECT_NE(r.err.find("no joint can be identified"), std::string::npos) << r.err;

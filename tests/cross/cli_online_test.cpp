@@ -38,8 +38,7 @@ using test::spawn;
 // The EGM port deflex bound, from its start-up line.
 int egm_port_of(const Child& c) { return test::port_of(c, "EGM on 127.0.0.1:"); }
 
-const std::string kDeflex = DEFLEX_CLI;
-const std::string& kReplay = test::kForceReplay;
+using test::kDeflex;
 
 
 TEST(CliOnline, EgmJointStreamsTheProgramWithinTheBoundOfIt) {
@@ -52,7 +51,7 @@ TEST(CliOnline, EgmJointStreamsTheProgramWithinTheBoundOfIt) {
   Child deflex;
   spawn(deflex,
         {kDeflex, "online", "--link", "egm-joint", "--program", program_path, "--egm-port", "0", "--force-source",
-         "csv:" + kReplay, "--loop", "--log", log, "--max-joint-correction-deg", "0.5", "--status-interval-s", "0.5"},
+         "csv:" + test::kForceReplay, "--loop", "--log", log, "--max-joint-correction-deg", "0.5", "--status-interval-s", "0.5"},
         dir + "/stderr.txt");
   const int port = egm_port_of(deflex);
   ASSERT_GT(port, 0) << test::slurp(deflex.stderr_path);
@@ -99,7 +98,7 @@ TEST(CliOnline, EgmJointRefusesAStartAwayFromTheProgramAndNamesTheJoint) {
   Child deflex;
   spawn(deflex,
         {kDeflex, "online", "--link", "egm-joint", "--program", program_path, "--egm-port", "0", "--force-source",
-         "csv:" + kReplay, "--loop"},
+         "csv:" + test::kForceReplay, "--loop"},
         dir + "/stderr.txt");
   const int port = egm_port_of(deflex);
   ASSERT_GT(port, 0);
@@ -127,7 +126,7 @@ TEST(CliOnline, EgmPathAnswersTheControllersOwnProgramWithAbsoluteOffsets) {
   Child deflex;
   spawn(deflex,
         {kDeflex, "online", "--link", "egm-path", "--period-ms", "24", "--egm-port", "0", "--force-source",
-         "csv:" + kReplay, "--loop", "--path-corr-frame", "tool"},
+         "csv:" + test::kForceReplay, "--loop", "--path-corr-frame", "tool"},
         dir + "/stderr.txt");
   const int port = egm_port_of(deflex);
   ASSERT_GT(port, 0) << test::slurp(deflex.stderr_path);
@@ -149,7 +148,7 @@ TEST(CliOnline, BadOptionsAndProgramsAreRefusedBeforeAnythingRuns) {
   const std::string dir = ::testing::TempDir() + "/cli_online_bad";
   fs::create_directories(dir);
   const std::string program_path = test::nominal_program(dir);
-  const std::string base = "online --egm-port 0 --force-source csv:" + kReplay + " ";
+  const std::string base = "online --egm-port 0 --force-source csv:" + test::kForceReplay + " ";
   const auto expect = [&](const std::string& args, const std::string& fragment) {
     const auto r = test::run_cli(base + args);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
@@ -157,7 +156,7 @@ TEST(CliOnline, BadOptionsAndProgramsAreRefusedBeforeAnythingRuns) {
   };
   expect("--link fanuc", "--link");
   {
-    const auto r = test::run_cli("online --link egm-path --force-source csv:" + kReplay);
+    const auto r = test::run_cli("online --link egm-path --force-source csv:" + test::kForceReplay);
     EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_NE(r.err.find("--egm-port"), std::string::npos) << r.err;
   }

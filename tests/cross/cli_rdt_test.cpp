@@ -32,7 +32,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::Child;
 
-const std::string kDeflex = DEFLEX_CLI;
+using test::kDeflex;
 const std::string kStandin = std::string(DEFLEX_SOURCE_DIR) + "/examples/online/rdt_sensor_standin.py";
 constexpr double kLbfInN = 4.4482216152605;       // 1 lbf in N
 constexpr double kLbfInInNm = 0.1129848290276167;  // 1 lbf-in in Nm

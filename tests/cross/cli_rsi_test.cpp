@@ -31,8 +31,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::Child;
 
-const std::string kDeflex = DEFLEX_CLI;
-const std::string& kReplay = test::kForceReplay;
+using test::kDeflex;
 
 std::shared_ptr<const JointTrajectory> hold(const RobotModel& robot, double seconds) {
   JointVector q(6);
@@ -70,7 +69,7 @@ TEST(CliRsi, CompensatesAgainstTheControllerSetUpFromTheGeneratedFiles) {
   Child deflex;
   test::spawn(deflex,
               {kDeflex, "online", "--link", "rsi", "--rsi-port", "0", "--rsi-sentype", "Deflex",
-               "--max-joint-correction-deg", "0.2", "--force-source", "csv:" + kReplay, "--loop", "--log",
+               "--max-joint-correction-deg", "0.2", "--force-source", "csv:" + test::kForceReplay, "--loop", "--log",
                dir + "/cycles.csv", "--log-file", dir + "/field.log", "--status-interval-s", "0.5", "--json"},
               dir + "/stderr.txt", dir + "/stdout.json");
   const int port = test::port_of(deflex, "RSI on 127.0.0.1:");
@@ -189,7 +188,7 @@ TEST(CliRsi, HundredThousandEgmPacketsMissingARequiredFieldGiveCountersNotLines)
   fs::create_directories(dir);
   Child deflex;
   test::spawn(deflex,
-              {kDeflex, "online", "--link", "egm-path", "--egm-port", "0", "--force-source", "csv:" + kReplay,
+              {kDeflex, "online", "--link", "egm-path", "--egm-port", "0", "--force-source", "csv:" + test::kForceReplay,
                "--loop", "--json", "--status-interval-s", "0.5"},
               dir + "/stderr.txt", dir + "/stdout.json");
   const int port = test::port_of(deflex, "EGM on 127.0.0.1:");
@@ -221,7 +220,7 @@ TEST(CliRsi, HundredThousandEgmPacketsMissingARequiredFieldGiveCountersNotLines)
 }
 
 TEST(CliRsi, BadOptionsAreRefusedNamingTheOption) {
-  const std::string base = "online --force-source csv:" + kReplay + " ";
+  const std::string base = "online --force-source csv:" + test::kForceReplay + " ";
   const auto expect = [](const std::string& args, const std::string& fragment) {
     const auto r = test::run_cli(args);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;

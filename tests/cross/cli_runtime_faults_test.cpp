@@ -29,8 +29,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::Child;
 
-const std::string kDeflex = DEFLEX_CLI;
-const std::string& kReplay = test::kForceReplay;
+using test::kDeflex;
 
 
 // Ticks `controller` in real time every 4 ms for `seconds`; `at(t)` is called before each tick.
@@ -58,7 +57,7 @@ TEST(CliRuntimeFaults, AStoppedAndContinuedProcessNeverStepsTheTarget) {
   Child deflex;
   test::spawn(deflex,
               {kDeflex, "online", "--link", "egm-joint", "--program", program_path, "--egm-port", "0",
-               "--force-source", "csv:" + kReplay, "--loop", "--log", log},
+               "--force-source", "csv:" + test::kForceReplay, "--loop", "--log", log},
               dir + "/stderr.txt");
   const int port = test::port_of(deflex, "EGM on 127.0.0.1:");
   ASSERT_GT(port, 0) << test::slurp(deflex.stderr_path);
@@ -114,7 +113,7 @@ TEST(CliRuntimeFaults, AStoppedRsiControllerEndsTheRunWithANonZeroCodeNamingIt) 
   fs::create_directories(dir);
   Child deflex;
   test::spawn(deflex,
-              {kDeflex, "online", "--link", "rsi", "--rsi-port", "0", "--force-source", "csv:" + kReplay, "--loop",
+              {kDeflex, "online", "--link", "rsi", "--rsi-port", "0", "--force-source", "csv:" + test::kForceReplay, "--loop",
                "--json"},
               dir + "/stderr.txt", dir + "/stdout.json");
   const int port = test::port_of(deflex, "RSI on 127.0.0.1:");
@@ -152,13 +151,13 @@ TEST(CliRuntimeFaults, RealTimeTheSystemRefusesIsExitTwoNamingThePermission) {
   if (std::system(("command -v " + drop.substr(0, drop.find(' ')) + " >/dev/null").c_str()) != 0) {
     GTEST_SKIP() << "no " << drop << "on this machine";
   }
-  const auto r = test::run_shell(drop + kDeflex + " online --link egm-joint --egm-port 0 --force-source csv:" + kReplay +
+  const auto r = test::run_shell(drop + kDeflex + " online --link egm-joint --egm-port 0 --force-source csv:" + test::kForceReplay +
                                  " --program " + program_path + " --realtime --duration-s 1");
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("option --realtime: the system refused SCHED_FIFO priority 80"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("CAP_SYS_NICE"), std::string::npos) << r.err;
   // Options for real time without it are refused too, naming them.
-  const auto o = test::run_cli("online --link egm-joint --egm-port 0 --force-source csv:" + kReplay + " --program " +
+  const auto o = test::run_cli("online --link egm-joint --egm-port 0 --force-source csv:" + test::kForceReplay + " --program " +
                                program_path + " --rt-cpu 1");
   EXPECT_EQ(o.exit_code, 2);
   EXPECT_NE(o.err.find("apply with --realtime"), std::string::npos) << o.err;

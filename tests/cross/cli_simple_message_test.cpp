@@ -28,8 +28,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kDeflex = DEFLEX_CLI;
-const std::string& kReplay = test::kForceReplay;
+using test::kDeflex;
 
 // deflex running in a child process, its stderr in a file.
 struct Deflex {
@@ -134,7 +133,7 @@ TEST(CliSimpleMessage, StreamsTheProgramWithinTheBoundAndCtrlCStopsTheArm) {
   const std::string log = dir + "/log.csv";
   Controller c;
   Deflex deflex(join({"online", "--link", "simple-message", "--program", program_path, "--period-ms", "100",
-                      "--force-source", "csv:" + kReplay, "--loop", "--log", log, "--status-interval-s", "0.5"},
+                      "--force-source", "csv:" + test::kForceReplay, "--loop", "--log", log, "--status-interval-s", "0.5"},
                      c.ports()),
                 dir + "/stderr.txt");
   ASSERT_TRUE(c.accept()) << deflex.err();
@@ -181,7 +180,7 @@ TEST(CliSimpleMessage, RefusesAStartAwayFromTheProgramAndSendsNothing) {
   const JointTrajectory program = JointTrajectory::read_csv(program_path, robot);
   Controller c;
   Deflex deflex(join({"online", "--link", "simple-message", "--program", program_path, "--period-ms", "100",
-                      "--force-source", "csv:" + kReplay, "--loop"},
+                      "--force-source", "csv:" + test::kForceReplay, "--loop"},
                      c.ports()),
                 dir + "/stderr.txt");
   ASSERT_TRUE(c.accept()) << deflex.err();
@@ -203,7 +202,7 @@ TEST(CliSimpleMessage, ALostConnectionStopsWithExitCodeSixAndSaysWhich) {
   const JointTrajectory program = JointTrajectory::read_csv(program_path, robot);
   Controller c;
   Deflex deflex(join({"online", "--link", "simple-message", "--program", program_path, "--period-ms", "100",
-                      "--force-source", "csv:" + kReplay, "--loop", "--fault-dump", dir + "/dump.csv"},
+                      "--force-source", "csv:" + test::kForceReplay, "--loop", "--fault-dump", dir + "/dump.csv"},
                      c.ports()),
                 dir + "/stderr.txt");
   ASSERT_TRUE(c.accept()) << deflex.err();
@@ -226,7 +225,7 @@ TEST(CliSimpleMessage, AFrameThatCannotBeOneIsBadInputAndNamed) {
   const std::string program_path = test::nominal_program(dir);
   Controller c;
   Deflex deflex(join({"online", "--link", "simple-message", "--program", program_path, "--period-ms", "100",
-                      "--force-source", "csv:" + kReplay, "--loop"},
+                      "--force-source", "csv:" + test::kForceReplay, "--loop"},
                      c.ports()),
                 dir + "/stderr.txt");
   ASSERT_TRUE(c.accept()) << deflex.err();
@@ -242,7 +241,7 @@ TEST(CliSimpleMessage, AFrameThatCannotBeOneIsBadInputAndNamed) {
 TEST(CliSimpleMessage, BadOptionsAreRefusedBeforeAnythingConnects) {
   const std::string dir = temp_dir("cli_sm_options");
   const std::string program_path = test::nominal_program(dir);
-  const std::string base = "online --link simple-message --force-source csv:" + kReplay + " --program " + program_path;
+  const std::string base = "online --link simple-message --force-source csv:" + test::kForceReplay + " --program " + program_path;
   const auto expect = [](const std::string& args, const std::string& fragment) {
     const auto r = test::run_cli(args);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
@@ -257,7 +256,7 @@ TEST(CliSimpleMessage, BadOptionsAreRefusedBeforeAnythingConnects) {
   expect(base + " --robot-host 127.0.0.1 --period-ms 100 --buffer-depth 0", "option --buffer-depth");
   expect(base + " --robot-host 127.0.0.1 --period-ms 100 --motion-port 70000", "option --motion-port");
   expect(base + " --robot-host 127.0.0.1 --period-ms 100 --reply-timeout-s 0", "option --reply-timeout-s");
-  expect("online --link simple-message --force-source csv:" + kReplay + " --robot-host 127.0.0.1 --period-ms 100",
+  expect("online --link simple-message --force-source csv:" + test::kForceReplay + " --robot-host 127.0.0.1 --period-ms 100",
          "--program");
   // Nobody listening: the error names the address and port.
   auto gone = std::make_unique<TcpListener>("127.0.0.1", 0);

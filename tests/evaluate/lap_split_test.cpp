@@ -11,7 +11,7 @@
 namespace deflex {
 namespace {
 
-const Vector3 kCentre(1.6, -0.1, 0.8);
+const Vector3 kLapCentre(1.6, -0.1, 0.8);
 
 TrackerTrace concat(const std::vector<TrackerTrace>& parts) {
   TrackerTrace out;
@@ -28,8 +28,8 @@ TEST(LapSplit, ThreeAnticlockwiseThenThreeClockwise) {
   // one gets the closing sample).
   const int n = 2000;
   const TrackerTrace t = test::with_noise(
-      concat({test::circle(0.1, kCentre, 3 * n, 3.0, false), test::closed_circle(0.1, kCentre, n, true),
-              test::circle(0.1, kCentre, 2 * n, 2.0, true, 2.0 * kPi / n * 0.0)}),
+      concat({test::circle(0.1, kLapCentre, 3 * n, 3.0, false), test::closed_circle(0.1, kLapCentre, n, true),
+              test::circle(0.1, kLapCentre, 2 * n, 2.0, true, 2.0 * kPi / n * 0.0)}),
       5e-6, 3);
   const LapSplit s = split_laps(t);
   ASSERT_EQ(s.laps.size(), 6u);
@@ -45,8 +45,8 @@ TEST(LapSplit, ThreeAnticlockwiseThenThreeClockwise) {
 TEST(LapSplit, AlternatingDirectionsAndAPartialPiece) {
   // CW, CCW, CW laps, then a quarter turn: 3 laps and one dropped piece.
   const int n = 1000;
-  const TrackerTrace t = concat({test::closed_circle(0.1, kCentre, n, true), test::closed_circle(0.1, kCentre, n, false),
-                                 test::closed_circle(0.1, kCentre, n, true), test::circle(0.1, kCentre, n / 4, 0.25)});
+  const TrackerTrace t = concat({test::closed_circle(0.1, kLapCentre, n, true), test::closed_circle(0.1, kLapCentre, n, false),
+                                 test::closed_circle(0.1, kLapCentre, n, true), test::circle(0.1, kLapCentre, n / 4, 0.25)});
   const LapSplit s = split_laps(t);
   EXPECT_EQ(s.laps.size(), 3u);
   EXPECT_EQ(s.dropped_partial, 1);
@@ -58,11 +58,11 @@ TEST(LapSplit, SplitLapsGiveIsoRepeatability) {
   const int n = 1500;
   std::vector<TrackerTrace> parts;
   for (const double h : {0.1e-3, 0.2e-3, 0.3e-3}) {
-    parts.push_back(test::shifted(test::closed_circle(0.1, kCentre, n, h > 0.15e-3), Vector3(0, 0, h)));
+    parts.push_back(test::shifted(test::closed_circle(0.1, kLapCentre, n, h > 0.15e-3), Vector3(0, 0, h)));
   }
   const LapSplit s = split_laps(concat(parts));
   ASSERT_EQ(s.laps.size(), 3u);
-  const Iso9283Path iso = iso9283_path(s.laps, test::closed_circle(0.1, kCentre, 4000));
+  const Iso9283Path iso = iso9283_path(s.laps, test::closed_circle(0.1, kLapCentre, 4000));
   const double l_bar = 0.2e-3 / 3.0;
   const double s_l = std::sqrt((2.0 * (0.1e-3 - l_bar) * (0.1e-3 - l_bar) + l_bar * l_bar) / 2.0);
   EXPECT_NEAR(iso.repeatability_m, l_bar + 3.0 * s_l, 2e-6);  // lap ends carry the neighbour's lift
@@ -73,12 +73,12 @@ TEST(LapSplit, PlaneOfATiltedCircle) {
   const Eigen::AngleAxisd tilt(0.3, Vector3::UnitY());
   TrackerTrace t = test::circle(0.1, Vector3::Zero(), 500);  // uniform samples: the centroid is the centre
   for (auto& s : t) {
-    s.p_m = kCentre + tilt * s.p_m;
+    s.p_m = kLapCentre + tilt * s.p_m;
   }
   const PathPlane pl = best_fit_plane(t);
   EXPECT_NEAR(std::abs(pl.normal.dot(tilt * Vector3::UnitZ())), 1.0, 1e-12);
   EXPECT_GE(pl.normal.z(), 0.0);
-  EXPECT_NEAR((pl.centroid_m - kCentre).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((pl.centroid_m - kLapCentre).norm(), 0.0, 1e-12);
   EXPECT_NEAR(pl.u.dot(pl.normal), 0.0, 1e-12);
   EXPECT_NEAR(pl.u.cross(pl.v).dot(pl.normal), 1.0, 1e-12);
   EXPECT_GT(pl.u.x(), 0.9);  // follows the base x

@@ -22,7 +22,7 @@
 namespace deflex {
 namespace {
 
-RobotModel kr210() { return load_robot(std::string(DEFLEX_SOURCE_DIR) + "/examples/robots/kuka_kr210_r2700.yaml"); }
+RobotModel kr210_model() { return load_robot(std::string(DEFLEX_SOURCE_DIR) + "/examples/robots/kuka_kr210_r2700.yaml"); }
 
 // A random configuration inside the limits (wrist joints within +-150 deg) and away from
 // singularities, so every joint moves the TCP.
@@ -117,7 +117,7 @@ RobotModel modified_dh_arm_off_axis_tool() {
 }
 
 TEST(IdentifyStiffness, NoiseFreeDataRecoverTheStiffnessTo1e9) {
-  for (const RobotModel& model : {kr210(), modified_dh_arm_off_axis_tool()}) {
+  for (const RobotModel& model : {kr210_model(), modified_dh_arm_off_axis_tool()}) {
     const JointVector k_true = model.stiffness();
     for (bool orientation : {false, true}) {
       const auto data = kdl_linear_data(model, k_true, 60, true, orientation, 7);
@@ -141,7 +141,7 @@ TEST(IdentifyStiffness, NoisyDataRecoverWithinTheReportedStandardErrors) {
   // the generator handles that through the core's WAP Jacobian, the identification through its own.
   Pose wap = Pose::Identity();
   wap.translation() = Vector3(0.06, 0.0, 0.35);
-  const RobotModel truth = kr210().with_tool(kr210().description().flange_T_tcp, wap);
+  const RobotModel truth = kr210_model().with_tool(kr210_model().description().flange_T_tcp, wap);
   const JointVector k_true = truth.stiffness();
   const double noise = 10e-6;
   double sum_z2 = 0.0;
@@ -168,7 +168,7 @@ TEST(IdentifyStiffness, NoisyDataRecoverWithinTheReportedStandardErrors) {
 }
 
 TEST(IdentifyStiffness, TukeyReweightingRejectsInjectedOutliers) {
-  const RobotModel truth = kr210();
+  const RobotModel truth = kr210_model();
   const JointVector k_true = truth.stiffness();
   auto data = deflected_data(truth, 200, 10e-6, 42);
   // Ten gross errors (a reflector lost and re-seated, a wrong load): 0.3..2 mm added to one axis.
@@ -232,7 +232,7 @@ TEST(IdentifyStiffness, JointNeverTurnedByTheLoadsIsFlaggedNotGivenANumber) {
 }
 
 TEST(IdentifyStiffness, OneConfigurationAndOneLoadDirectionLeaveJointsCollinear) {
-  const RobotModel model = kr210();
+  const RobotModel model = kr210_model();
   auto data = kdl_linear_data(model, model.stiffness(), 1, true, false, 5);
   const StiffnessMeasurement first = data.front();
   for (int i = 1; i < 10; ++i) {
@@ -261,7 +261,7 @@ TEST(IdentifyStiffness, OneConfigurationAndOneLoadDirectionLeaveJointsCollinear)
 }
 
 TEST(IdentifyStiffness, FixedJointsAreHeldAndTheRestRecovered) {
-  const RobotModel model = kr210();
+  const RobotModel model = kr210_model();
   const JointVector k_true = model.stiffness();
   const auto data = kdl_linear_data(model, k_true, 40, true, false, 9);
   IdentificationOptions opt;
@@ -280,7 +280,7 @@ TEST(IdentifyStiffness, FixedJointsAreHeldAndTheRestRecovered) {
 }
 
 TEST(IdentifyStiffness, AWeightOfTwoCountsLikeTheMeasurementTakenTwice) {
-  const RobotModel truth = kr210();
+  const RobotModel truth = kr210_model();
   auto data = deflected_data(truth, 40, 20e-6, 21);
   auto doubled = data;
   for (std::size_t i = 0; i < data.size(); i += 3) {
@@ -297,7 +297,7 @@ TEST(IdentifyStiffness, AWeightOfTwoCountsLikeTheMeasurementTakenTwice) {
 }
 
 TEST(IdentifyStiffness, RegressorBlockIsTheTcpMotionPerUnitComplianceAndDoesNotAllocate) {
-  const RobotModel model = kr210();
+  const RobotModel model = kr210_model();
   Workspace ws(model);
   std::mt19937 rng(2);
   const JointVector q = random_configuration(model, rng);
@@ -314,7 +314,7 @@ TEST(IdentifyStiffness, RegressorBlockIsTheTcpMotionPerUnitComplianceAndDoesNotA
 }
 
 TEST(IdentifyStiffness, BadInputIsAnErrorNamingTheMeasurement) {
-  const RobotModel model = kr210();
+  const RobotModel model = kr210_model();
   auto data = kdl_linear_data(model, model.stiffness(), 5, true, false, 1);
   data[2].q.resize(5);
   data[2].line = 17;
@@ -345,7 +345,7 @@ namespace {
 // least-squares solve of the whole stacked system, built here from KDL's Jacobian (the compliances
 // are positive, so the c >= 0 bound is inactive and NNLS is least squares).
 TEST(IdentifyStiffness, TheSlabwiseSolveEqualsADenseSolveOfTheWholeStack) {
-  const RobotModel model = kr210();
+  const RobotModel model = kr210_model();
   const JointVector k_true = model.stiffness();
   auto data = kdl_linear_data(model, k_true, 3000, true, false, 99);
   const auto with_rotation = kdl_linear_data(model, k_true, 500, true, true, 98);
@@ -415,7 +415,7 @@ namespace {
 // must be the in-memory one bit for bit, through fixed joints (rows rewritten in place), 3- and
 // 6-row measurements across chunk boundaries, and the robust re-weighting with outliers.
 TEST(IdentifyStiffness, RowsKeptInAScratchFileGiveTheSameEstimateBitForBit) {
-  const RobotModel truth = kr210();
+  const RobotModel truth = kr210_model();
   std::vector<StiffnessMeasurement> data = deflected_data(truth, 60000, 20e-6, 41);
   std::mt19937 rng(43);
   for (std::size_t i = 0; i < data.size(); ++i) {
@@ -472,7 +472,7 @@ TEST(IdentifyStiffness, RowsKeptInAScratchFileGiveTheSameEstimateBitForBit) {
 // With nowhere to write the scratch file the identification stops with an error naming the
 // directory and what to do, not a crash or a partial result.
 TEST(IdentifyStiffness, AScratchFileThatCannotBeMadeIsAnErrorNamingTheDirectory) {
-  const RobotModel truth = kr210();
+  const RobotModel truth = kr210_model();
   const std::vector<StiffnessMeasurement> data = deflected_data(truth, 25000, 20e-6, 5);
   const char* old = std::getenv("TMPDIR");
   const std::string saved = old != nullptr ? old : "";

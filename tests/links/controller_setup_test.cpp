@@ -166,7 +166,7 @@ TEST(ControllerSetup, EgmJointModuleIsWellFormedAndAgreesWithDeflex) {
   EXPECT_TRUE(setup.optional.count("Joint"));
   const RapidCall act = call(m, "EGMActJoint");
   EXPECT_EQ(act.optional.at("SampleRate"), "4");
-  for (int j = 1; j <= 6; ++j) EXPECT_EQ(act.optional.at("J" + std::to_string(j)), "deflex_converged");
+  for (int j = 1; j <= 6; ++j) EXPECT_EQ(act.optional.at(std::string("J") + std::to_string(j)), "deflex_converged");
   EXPECT_GE(std::stod(act.optional.at("MaxPosDeviation")), 0.3);
   const RapidCall run = call(m, "EGMRunJoint");
   EXPECT_EQ(run.optional.at("RampInTime"), "2.5");

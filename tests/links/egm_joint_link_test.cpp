@@ -4,6 +4,8 @@
 // the link exists to avoid (answering "planned minus correction") does walk away on this stand-in.
 #include <gtest/gtest.h>
 
+#include "support/poses.hpp"
+
 #include "links/link_harness.hpp"
 #include "support/allocation_guard.hpp"
 
@@ -12,11 +14,7 @@ namespace {
 
 using test::JointBench;
 
-JointVector pose_deg(double a, double b, double c, double d, double e, double f) {
-  JointVector q(6);
-  q << a, b, c, d, e, f;
-  return q * (kPi / 180.0);
-}
+using test::pose_deg;
 
 TEST(EgmJointLink, ConstantForceConvergesWithinTheBoundAndNeverDriftsOver100000Cycles) {
   const JointVector q0 = pose_deg(5, 25, -5, 20, 35, -15);

@@ -5,6 +5,8 @@
 // increments instead walks away on this stand-in.
 #include <gtest/gtest.h>
 
+#include "support/poses.hpp"
+
 #include "links/link_harness.hpp"
 #include "support/allocation_guard.hpp"
 
@@ -13,11 +15,7 @@ namespace {
 
 using test::PathBench;
 
-JointVector pose_deg(double a, double b, double c, double d, double e, double f) {
-  JointVector q(6);
-  q << a, b, c, d, e, f;
-  return q * (kPi / 180.0);
-}
+using test::pose_deg;
 
 TEST(EgmPathLink, ConstantForceGivesAConstantAbsoluteOffsetOver100000Cycles) {
   const JointVector q0 = pose_deg(5, 25, -5, 20, 35, -15);

@@ -6,6 +6,8 @@
 // the per-cycle limit the test computes itself; and every stop has a named reason and its exit code.
 #include <gtest/gtest.h>
 
+#include "support/poses.hpp"
+
 #include "links/fault_bench.hpp"
 
 namespace deflex {
@@ -15,11 +17,7 @@ using runtime::LinkKind;
 using runtime::StopReason;
 using test::FaultBench;
 
-JointVector pose_deg(double a, double b, double c, double d, double e, double f) {
-  JointVector q(6);
-  q << a, b, c, d, e, f;
-  return q * (kPi / 180.0);
-}
+using test::pose_deg;
 
 const JointVector kStart = pose_deg(0, 20, 10, 0, 60, 0);
 

@@ -7,6 +7,8 @@
 // in-memory network and over UDP.
 #include <gtest/gtest.h>
 
+#include "support/poses.hpp"
+
 #include <string>
 
 #include "deflex/transport/udp_transport.hpp"
@@ -19,11 +21,7 @@ namespace {
 
 using test::RsiBench;
 
-JointVector pose_deg(double a, double b, double c, double d, double e, double f) {
-  JointVector q(6);
-  q << a, b, c, d, e, f;
-  return q * (kPi / 180.0);
-}
+using test::pose_deg;
 
 TEST(RsiLink, ConstantForceGivesAConstantWholeOffsetOver100000Cycles) {
   const JointVector q0 = pose_deg(5, 25, -5, 20, 35, -15);

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/poses.hpp"
+
 #include "deflex/cell/egm_position_controller.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/runtime/session.hpp"
@@ -20,11 +22,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-JointVector pose_deg(double a, double b, double c, double d, double e, double f) {
-  JointVector q(6);
-  q << a, b, c, d, e, f;
-  return q * (kPi / 180.0);
-}
+using test::pose_deg;
 
 TEST(Session, ThePollDoesNotAllocateWithTheLogTheDumpAndASinkOn) {
   const RobotModel robot = test::bench_robot();

@@ -10,6 +10,8 @@
 // point; both byte orders; the cycle does not allocate.
 #include <gtest/gtest.h>
 
+#include "support/poses.hpp"
+
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -24,11 +26,7 @@ namespace {
 using test::SimpleMessageBench;
 using test::ScriptedSimpleMessage;
 
-JointVector pose_deg(double a, double b, double c, double d, double e, double f) {
-  JointVector q(6);
-  q << a, b, c, d, e, f;
-  return q * (kPi / 180.0);
-}
+using test::pose_deg;
 
 double as_float(double v) { return static_cast<double>(static_cast<float>(v)); }
 

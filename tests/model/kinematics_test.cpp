@@ -14,7 +14,7 @@
 namespace deflex {
 namespace {
 
-JointVector random_q(const RobotModel& m, std::mt19937_64& rng) {
+JointVector random_joints(const RobotModel& m, std::mt19937_64& rng) {
   JointVector q(m.dof());
   for (int i = 0; i < m.dof(); ++i) {
     const double lo = std::max(m.lower_limits()[i], -kPi);
@@ -33,7 +33,7 @@ void expect_fk_and_jacobian_match_kdl(const RobotModel& model, int samples) {
   Jacobian J;
   std::mt19937_64 rng(42);
   for (int s = 0; s < samples; ++s) {
-    const JointVector q = random_q(model, rng);
+    const JointVector q = random_joints(model, rng);
     KDL::JntArray kq(static_cast<unsigned>(model.dof()));
     for (int i = 0; i < model.dof(); ++i) {
       kq(static_cast<unsigned>(i)) = q[i];
@@ -91,7 +91,7 @@ TEST(Kinematics, JacobianMatchesFiniteDifferencesOfFk) {
     Jacobian J;
     std::mt19937_64 rng(7);
     for (int s = 0; s < 100; ++s) {
-      const JointVector q = random_q(model, rng);
+      const JointVector q = random_joints(model, rng);
       jacobian(model, ws, q, EndPoint::kTcp, J);
       const Pose T0 = ws.base_T_tcp;
       const double h = 1e-6;

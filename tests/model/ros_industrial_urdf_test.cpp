@@ -18,7 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string fixture(const std::string& name) {
+std::string urdf_fixture(const std::string& name) {
   return std::string(DEFLEX_SOURCE_DIR) + "/examples/robots/ros-industrial/" + name;
 }
 
@@ -45,7 +45,7 @@ std::string joined(const std::vector<std::string>& v) {
 
 TEST(RosIndustrialUrdf, EachLoadsBareAsBaseLinkToTool0) {
   for (const Fixture& f : kFixtures) {
-    const RobotModel m = load_robot(fixture(f.file));
+    const RobotModel m = load_robot(urdf_fixture(f.file));
     EXPECT_EQ(m.dof(), 6) << f.file;
     EXPECT_FALSE(m.has_stiffness()) << f.file;
     EXPECT_EQ(m.description().urdf_base_link, "base_link") << f.file;
@@ -64,8 +64,8 @@ TEST(RosIndustrialUrdf, EachLoadsBareAsBaseLinkToTool0) {
 TEST(RosIndustrialUrdf, ForwardKinematicsAgreesWithAnIndependentUrdfReading) {
   std::mt19937_64 rng(13);
   for (const Fixture& f : kFixtures) {
-    const RobotModel m = load_robot(fixture(f.file));
-    const auto chain = test::reference_chain(fixture(f.file), "base_link", "tool0");
+    const RobotModel m = load_robot(urdf_fixture(f.file));
+    const auto chain = test::reference_chain(urdf_fixture(f.file), "base_link", "tool0");
     Workspace ws(m);
     for (int s = 0; s < 200; ++s) {
       JointVector q(6);
@@ -84,12 +84,12 @@ TEST(RosIndustrialUrdf, ForwardKinematicsAgreesWithAnIndependentUrdfReading) {
 
 TEST(RosIndustrialUrdf, PublishedJointLimitsAndSpeedsComeThrough) {
   // abb_irb6700_support: joint 2 from -65 to 85 deg, joint 6 at 190 deg/s.
-  const RobotModel abb = load_robot(fixture("abb_irb6700_235_265.urdf"));
+  const RobotModel abb = load_robot(urdf_fixture("abb_irb6700_235_265.urdf"));
   EXPECT_NEAR(rad_to_deg(abb.lower_limits()[1]), -65.0, 1e-12);
   EXPECT_NEAR(rad_to_deg(abb.upper_limits()[1]), 85.0, 1e-12);
   EXPECT_NEAR(rad_to_deg(abb.max_speed()[5]), 190.0, 1e-12);
   // kuka_kr210_support: A2 from -140 to -5 deg.
-  const RobotModel kuka = load_robot(fixture("kuka_kr210_r3100_2.urdf"));
+  const RobotModel kuka = load_robot(urdf_fixture("kuka_kr210_r3100_2.urdf"));
   EXPECT_NEAR(rad_to_deg(kuka.lower_limits()[1]), -140.0, 1e-12);
   EXPECT_NEAR(rad_to_deg(kuka.upper_limits()[1]), -5.0, 1e-12);
 }
@@ -97,13 +97,13 @@ TEST(RosIndustrialUrdf, PublishedJointLimitsAndSpeedsComeThrough) {
 TEST(RosIndustrialUrdf, NamedEndsInAYamlOverlayOverrideTheConvention) {
   const std::string yaml = (fs::temp_directory_path() / ("deflex_ri_" + std::to_string(::getpid()) + ".yaml")).string();
   std::ofstream(yaml) << "deflex_robot: 1\nunits: {length: m, angle: deg}\nkinematics: {convention: urdf, file: "
-                      << fixture("kuka_kr120r2500pro.urdf")
+                      << urdf_fixture("kuka_kr120r2500pro.urdf")
                       << ", tip_link: flange}\njoint_stiffness_Nm_per_rad: [1e6, 1e6, 1e6, 1e5, 1e5, 1e5]\n";
   const RobotModel m = load_robot(yaml);
   EXPECT_EQ(m.description().urdf_tip_link, "flange");
   EXPECT_TRUE(m.has_stiffness());
   Workspace ws(m);
-  const auto chain = test::reference_chain(fixture("kuka_kr120r2500pro.urdf"), "base_link", "flange");
+  const auto chain = test::reference_chain(urdf_fixture("kuka_kr120r2500pro.urdf"), "base_link", "flange");
   const std::vector<double> qv{0.1, -1.2, 1.4, 0.3, -0.5, 0.7};
   JointVector q(6);
   for (int i = 0; i < 6; ++i) {

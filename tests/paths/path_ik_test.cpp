@@ -12,13 +12,13 @@
 namespace deflex {
 namespace {
 
-const Eigen::Quaterniond kDown(0.0, 0.0, 1.0, 0.0);
+const Eigen::Quaterniond kToolDown(0.0, 0.0, 1.0, 0.0);
 
 using test::error_of;
 
 TEST(PathIk, DefaultCircleRoundTripsThroughFkWithOneConfiguration) {
   const RobotModel model = builtin_irb6700();
-  const auto poses = sample_circle(default_circle(), kDown);
+  const auto poses = sample_circle(default_circle(), kToolDown);
   const JointPath path = solve_path_ik(model, poses, IkRequest{});
   ASSERT_EQ(path.q.size(), poses.size());
   Workspace ws(model);
@@ -39,7 +39,7 @@ TEST(PathIk, DefaultCircleRoundTripsThroughFkWithOneConfiguration) {
 
 TEST(PathIk, RequestedConfigurationIsKept) {
   const RobotModel model = builtin_irb6700();
-  const auto poses = sample_circle(default_circle(), kDown);
+  const auto poses = sample_circle(default_circle(), kToolDown);
   Workspace ws(model);
   // Every configuration the first point allows; each must be kept along the whole circle.
   const auto all = all_ik_solutions(model, ws, poses[0]);
@@ -64,7 +64,7 @@ TEST(PathIk, RequestedConfigurationIsKept) {
 
 TEST(PathIk, UnreachablePointIsNamed) {
   const RobotModel model = builtin_irb6700();
-  auto poses = sample_circle(default_circle(), kDown);
+  auto poses = sample_circle(default_circle(), kToolDown);
   poses[7].translation() = Vector3(4.0, 0.0, 1.0);  // beyond the 2.7 m reach
   const std::string m = error_of([&] { (void)solve_path_ik(model, poses, IkRequest{}); });
   EXPECT_NE(m.find("path point 7: unreachable"), std::string::npos) << m;

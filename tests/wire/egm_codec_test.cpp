@@ -8,25 +8,15 @@
 #include <gtest/gtest.h>
 
 #include "deflex/wire/egm_codec.hpp"
+#include "wire/protobuf_bytes.hpp"
 
 namespace deflex {
 namespace {
 
-using Bytes = std::vector<unsigned char>;
-
-void varint(Bytes& b, std::uint64_t v) {
-  while (v >= 0x80) {
-    b.push_back(static_cast<unsigned char>(v | 0x80));
-    v >>= 7;
-  }
-  b.push_back(static_cast<unsigned char>(v));
-}
+using test::Bytes;
+using test::len_field;
+using test::varint;
 void tag(Bytes& b, int field, int wire) { varint(b, static_cast<std::uint64_t>(field << 3 | wire)); }
-void len_field(Bytes& b, int field, const Bytes& body) {
-  tag(b, field, 2);
-  varint(b, body.size());
-  b.insert(b.end(), body.begin(), body.end());
-}
 void fixed64(Bytes& b, double v) {
   unsigned char raw[8];
   std::memcpy(raw, &v, 8);

@@ -3,7 +3,22 @@
 
 #include <cmath>
 
+#include "deflex/evaluate/path_metrics.hpp"
+
 namespace deflex {
+
+double PaperRow::mean_compensation() const {
+  double sum = 0.0;
+  int n = 0;
+  for (const auto& [v, c] : c_mm) {
+    const double comp = compensation_ratio(uc_mm, c);
+    if (std::isfinite(comp)) {
+      sum += comp;
+      ++n;
+    }
+  }
+  return n > 0 ? sum / n : kNaN;
+}
 
 const PaperRow* PaperTable::row_for(double load_N, double tolerance_N) const {
   for (const auto& r : rows) {

@@ -14,6 +14,9 @@ struct PaperRow {
   double load_N = 0.0;
   double uc_mm = 0.0;
   std::map<int, double> c_mm;
+  /// 1 - C/UC, the mean over the row's speeds (its UC is already their mean): the paper's own way of
+  /// quoting compensation. NaN when no speed has a finite ratio.
+  [[nodiscard]] double mean_compensation() const;
 };
 
 struct PaperTable {

@@ -3,6 +3,7 @@
 // seeds), Markdown and CSV.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <map>
@@ -88,6 +89,9 @@ struct StudyResult {
   std::uint64_t seed = 0;                ///< the first seed
   std::vector<std::uint64_t> seeds;      ///< every seed the figures are over (empty: just `seed`)
   double wall_time_s = 0.0;              ///< optional, 0 = not reported
+
+  /// How many seeds the figures are over (at least 1: `seed` alone when `seeds` is empty).
+  [[nodiscard]] std::size_t seed_count() const { return std::max<std::size_t>(1, seeds.size()); }
 };
 
 /// {"setups":[{"setup":"offline","description":..,"loads":[{"load_N":125,"uc_mm":{"10":..,"30":..,"50":..},

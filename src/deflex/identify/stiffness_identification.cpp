@@ -32,7 +32,6 @@ void stiffness_regressor(const RobotModel& model, Workspace& ws, const JointVect
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Wilson-Hilferty approximation of the chi-square quantile with k degrees of freedom at the
 // standard normal quantile z; good to a few percent for k >= 1, enough to set robust thresholds.
@@ -67,6 +66,11 @@ std::string joint_list(const std::vector<int>& joints) {
   }
   return fmt::format("{}", fmt::join(s, ", "));
 }
+
+}  // namespace
+
+// Not in the anonymous namespace: StiffnessIdentifier::RowStoreHolder (declared in the header) holds one.
+namespace identify_detail {
 
 // The stacked problem in compact form: per measurement its 3 (or 6) rows [A_i | b_i], already
 // multiplied by sqrt(weight) (rotation rows also by rotation_scale_m), in chunks of 64k rows so that
@@ -168,6 +172,12 @@ class RowStore {
   SpillFile spill_{"identification rows"};
   mutable std::vector<double> buffer_;  // one chunk read back from the scratch file
 };
+
+}  // namespace identify_detail
+
+namespace {
+
+using identify_detail::RowStore;
 
 using RowBlock = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
 

@@ -1,6 +1,8 @@
 // Vocabulary types shared by all of deflex. SI units throughout: m, rad, N, Nm, s.
 #pragma once
 
+#include <limits>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -33,6 +35,8 @@ using Wrench = Vector6;
 using Displacement = Vector6;
 
 inline constexpr double kPi = 3.14159265358979323846;
+/// A quiet NaN: "no value" in a field that has none (a skipped row, an unmeasured figure).
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 inline constexpr double deg_to_rad(double deg) { return deg * kPi / 180.0; }
 inline constexpr double rad_to_deg(double rad) { return rad * 180.0 / kPi; }
 

@@ -16,7 +16,6 @@
 namespace deflex {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 const char* const kCss = R"(
 body { font-family: Helvetica, Arial, sans-serif; color: #222; max-width: 1060px; margin: 24px auto; padding: 0 16px; line-height: 1.45; }
@@ -46,8 +45,6 @@ std::string esc(const std::string& s) { return xml_escape(s); }
 
 std::string mm(double v) { return std::isfinite(v) ? fmt::format("{:.3f}", v) : "n/a"; }
 
-std::size_t seed_count(const StudyResult& study) { return std::max<std::size_t>(1, study.seeds.size()); }
-
 // "0.152 ±0.012" with the spread small and grey; just the mean for one seed.
 std::string mm_spread(const Spread& s) {
   if (s.n <= 1) {
@@ -74,20 +71,6 @@ std::string with_paper(const std::string& ours, double paper_value, int decimals
     return ours;
   }
   return fmt::format("{} <span class=\"paper\">({:.{}f})</span>", ours, paper_value, decimals);
-}
-
-// 1 - C/UC of the paper's row, the mean over its speeds (its UC is already their mean).
-double paper_compensation(const PaperRow& r) {
-  double sum = 0.0;
-  int n = 0;
-  for (const auto& [v, c] : r.c_mm) {
-    const double comp = compensation_ratio(r.uc_mm, c);
-    if (std::isfinite(comp)) {
-      sum += comp;
-      ++n;
-    }
-  }
-  return n > 0 ? sum / n : kNaN;
 }
 
 std::string seeds_text(const StudyResult& study) {
@@ -181,7 +164,7 @@ std::string results_tables(const StudyResult& study) {
       "mean over the speeds, as in the paper. Compensation = 1 - C/UC: ours with UC at the same speed, the paper's "
       "with its mean UC. \"UC vs paper\" is green within 25% and \"C vs paper\" (C averaged over the speeds) within "
       "35%: the fidelity targets.</p>\n",
-      seeds_text(study), seed_count(study) > 1 ? ", &#177; the sample standard deviation over the seeds" : "");
+      seeds_text(study), study.seed_count() > 1 ? ", &#177; the sample standard deviation over the seeds" : "");
   return h;
 }
 
@@ -236,7 +219,7 @@ std::string compensation_table(const StudyResult& study) {
   const PaperFigures paper = paper_reference();
   const std::vector<int> speeds = study_speeds_mm_s(study);
   std::string h = "<table>\n<tr><th class=\"l\">setup</th><th>load</th><th>ours, mean over the speeds</th>";
-  if (seed_count(study) > 1) {
+  if (study.seed_count() > 1) {
     h += "<th>seeds: min to max</th>";
   }
   for (const int v : speeds) {
@@ -254,7 +237,7 @@ std::string compensation_table(const StudyResult& study) {
       Spread comp = l.compensation_spread();
       h += fmt::format("<tr><td class=\"l\">{}</td><td>{:g} N</td><td>{}</td>", esc(s.setup), l.load_N,
                        percent_spread(comp));
-      if (seed_count(study) > 1) {
+      if (study.seed_count() > 1) {
         h += fmt::format("<td>{} to {}</td>", percent_text(comp.min), percent_text(comp.max));
       }
       for (const int v : speeds) {
@@ -266,7 +249,7 @@ std::string compensation_table(const StudyResult& study) {
           per_speed += fmt::format("{}{}", i == 0 ? "" : " / ",
                                    percent_text(compensation_ratio(pr->uc_mm, value_at_speed(pr->c_mm, speeds[i]))));
         }
-        h += fmt::format("<td>{}</td><td class=\"l\">{}</td>", percent_text(paper_compensation(*pr)), per_speed);
+        h += fmt::format("<td>{}</td><td class=\"l\">{}</td>", percent_text(pr->mean_compensation()), per_speed);
       } else {
         h += "<td>-</td><td class=\"l\">-</td>";
       }
@@ -383,7 +366,7 @@ bool any_setup(const StudyResult& study, bool with_paper) {
 
 std::string figures_html(const StudyResult& study) {
   auto whiskers_of = [&](const char* what) {
-    return seed_count(study) > 1 ? fmt::format("{}: the mean over {}; whiskers: the range (min to max) over the seeds.",
+    return study.seed_count() > 1 ? fmt::format("{}: the mean over {}; whiskers: the range (min to max) over the seeds.",
                                                what, seeds_text(study))
                                  : std::string("One seed: no whiskers.");
   };
@@ -477,7 +460,7 @@ std::string html_report(const ReportContent& content) {
     h += "<p class=\"caption\">Beyond the paper's 10-50 mm/s (shaded): how each strategy's compensation holds up "
          "as the TCP speed grows and the compensation cycle and delay start to matter. The time-synchronous panel "
          "shows the lag the nearest-point metric does not see. " +
-         std::string(seed_count(study) > 1 ? "Points: the mean over the seeds; whiskers: min to max over them. "
+         std::string(study.seed_count() > 1 ? "Points: the mean over the seeds; whiskers: min to max over them. "
                                            : "") +
          "Each panel's range is fitted to its data; points at one speed are drawn side by side.</p>\n";
   }

@@ -21,7 +21,6 @@ using svg::Canvas;
 using svg::kMinFont;
 using svg::Scale;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 TrackerTrace finite_only(const TrackerTrace& t) {
   TrackerTrace out;

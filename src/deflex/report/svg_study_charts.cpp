@@ -18,7 +18,6 @@ using svg::Canvas;
 using svg::kMinFont;
 using svg::Scale;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 bool selected(const std::string& setup, SetupSelection which) {
   switch (which) {
@@ -29,27 +28,9 @@ bool selected(const std::string& setup, SetupSelection which) {
   return true;
 }
 
-// Number of seeds a study's figures are over (1 when it lists none).
-std::size_t seed_count(const StudyResult& study) { return std::max<std::size_t>(1, study.seeds.size()); }
-
 std::string whisker_note(const StudyResult& study) {
-  const std::size_t n = seed_count(study);
+  const std::size_t n = study.seed_count();
   return n > 1 ? fmt::format("whiskers: min to max over {} seeds", n) : "one seed: no whiskers";
-}
-
-// Mean over the speeds of 1 - C/UC, with the paper's UC (its mean over the speeds): the paper's
-// own way of quoting compensation.
-double paper_compensation(const PaperRow& r) {
-  double sum = 0.0;
-  int n = 0;
-  for (const auto& [v, c] : r.c_mm) {
-    const double comp = compensation_ratio(r.uc_mm, c);
-    if (std::isfinite(comp)) {
-      sum += comp;
-      ++n;
-    }
-  }
-  return n > 0 ? sum / n : kNaN;
 }
 
 // A bar from the baseline up to `value` (nothing for NaN), with attributes a reader (or a test) can
@@ -283,7 +264,7 @@ std::string svg_compensation(const StudyResult& study) {
     const double paper_w = ours_w * 0.6;
     const double x0 = xc - (with_paper ? ours_w + 1.5 + paper_w : ours_w) / 2.0;
     Spread s = l.compensation_spread();
-    const double pc = with_paper ? paper_compensation(*groups[g].paper) : kNaN;
+    const double pc = with_paper ? groups[g].paper->mean_compensation() : kNaN;
     const std::string& setup = study.setups[groups[g].setup].setup;
     c.group_begin(fmt::format("{} {:g} N: compensation {}{}", setup, l.load_N, spread_text(s, 100.0, "%", 0),
                               std::isfinite(pc) ? fmt::format("; the paper's {:.0f}%", pc * 100.0) : ""));
