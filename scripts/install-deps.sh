@@ -4,6 +4,8 @@
 set -euo pipefail
 packages=(
   build-essential cmake pkg-config
+  # ninja: scripts/sanitize.sh builds with it (it compiles a module's tests while other modules build)
+  ninja-build
   libeigen3-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev
   protobuf-compiler libprotobuf-dev liburdfdom-dev libtinyxml-dev
   libgtest-dev libgmock-dev libbenchmark-dev liborocos-kdl-dev libboost-dev
