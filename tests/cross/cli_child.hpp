@@ -17,6 +17,8 @@
 #include <gtest/gtest.h>
 
 #include "cross/cli_runner.hpp"
+#include "deflex/paths/joint_trajectory.hpp"
+#include "support/sampled_speed.hpp"
 
 namespace deflex::test {
 
@@ -85,6 +87,15 @@ void run_in_real_time(Controller& controller, double seconds) {
     next += std::chrono::milliseconds(4);
     std::this_thread::sleep_until(next);
   }
+}
+
+/// The per-cycle step limit of `deflex online` as these tests run it (4 ms cycle, the default
+/// 1 s ramp-in with its 1.5 x 1 deg blend, a 3 deg/s correction rate), deg a joint, computed here: the
+/// program's peak speed sampled every 0.5 ms (0.1 % margin), the blend's and the correction's rates,
+/// over one cycle.
+inline JointVector cli_step_limit_deg(const JointTrajectory& program) {
+  const JointVector peak = sampled_peak_speed(program);
+  return (0.004 * (peak * 1.001).array() + 0.004 * deg_to_rad(1.5 + 3.0)) * (180.0 / kPi);
 }
 
 /// The command-line program under test.

@@ -164,16 +164,10 @@ TEST(CliRdt, OnlineOverRdtAgainstTheEgmStandIn) {
   EXPECT_GT(checked, 100);
   // The invariants as for every source, read off the log: every command within the 0.5 deg bound of
   // the nominal it was sent for (the program plus the ramp-in blend), and no step between consecutive
-  // commands above the per-cycle limit computed here (the program's peak speed sampled every 0.5 ms,
-  // the blend's 1.5 x 1 deg over 1 s, the correction's 3 deg/s, over 4 ms).
-  JointVector peak = JointVector::Zero(6), a(6), b(6);
-  program.sample(program.start_time_s(), a);
-  for (double t = program.start_time_s() + 0.0005; t <= program.end_time_s(); t += 0.0005) {
-    program.sample(t, b);
-    peak = peak.cwiseMax((b - a).cwiseAbs() / 0.0005);
-    a = b;
-  }
-  const JointVector limit_deg = (0.004 * (peak * 1.001).array() + 0.004 * deg_to_rad(1.5 + 3.0)) * (180.0 / kPi);
+  // commands above the per-cycle limit the test computes (test::cli_step_limit_deg: the program's
+  // peak speed sampled every 0.5 ms, the blend's 1.5 x 1 deg over 1 s, the correction's 3 deg/s, over
+  // 4 ms).
+  const JointVector limit_deg = test::cli_step_limit_deg(program);
   double worst_bound = 0.0, worst_step = 0.0;
   for (std::size_t r = 0; r < table.rows(); ++r) {
     if (table.at(r, "replied") == 0.0) continue;

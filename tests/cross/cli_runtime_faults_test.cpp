@@ -83,14 +83,7 @@ TEST(CliRuntimeFaults, AStoppedAndContinuedProcessNeverStepsTheTarget) {
   ASSERT_GT(table.rows(), 400u);
   // The per-cycle limit, computed here: the program's peak speed (sampled every 0.5 ms), the ramp-in
   // blend's (1.5 x 1 deg over 1 s), the correction's rate (3 deg/s), over 4 ms.
-  JointVector peak = JointVector::Zero(6), a(6), b(6);
-  program.sample(program.start_time_s(), a);
-  for (double t = program.start_time_s() + 0.0005; t <= program.end_time_s(); t += 0.0005) {
-    program.sample(t, b);
-    peak = peak.cwiseMax((b - a).cwiseAbs() / 0.0005);
-    a = b;
-  }
-  const JointVector limit_deg = (0.004 * (peak * 1.001).array() + 0.004 * deg_to_rad(1.5 + 3.0)) * (180.0 / kPi);
+  const JointVector limit_deg = test::cli_step_limit_deg(program);
   double worst = 0.0, longest_gap = 0.0, largest_program_step = 0.0;
   for (std::size_t r = 1; r < table.rows(); ++r) {
     if (table.at(r, "replied") == 0.0 || table.at(r - 1, "replied") == 0.0) continue;
