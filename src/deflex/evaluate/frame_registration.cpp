@@ -1,0 +1,217 @@
+// Tracker-to-base registration (see frame_registration.hpp).
+#include "deflex/evaluate/frame_registration.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+#include <fmt/format.h>
+
+#include "deflex/model/errors.hpp"
+#include "deflex/model/yaml_fields.hpp"
+
+namespace deflex {
+namespace {
+
+bool finite_all(const std::vector<Vector3>& v) {
+  return std::all_of(v.begin(), v.end(), [](const Vector3& p) { return p.allFinite(); });
+}
+
+}  // namespace
+
+CircleFit fit_circle(const std::vector<Vector3>& points, const std::string& what) {
+  if (points.size() < 5) {
+    throw InputError(fmt::format("{}: {} point(s); a circle fit needs at least 5", what, points.size()));
+  }
+  if (!finite_all(points)) throw InputError(fmt::format("{}: a point is not finite", what));
+  Vector3 centroid = Vector3::Zero();
+  for (const auto& p : points) centroid += p;
+  centroid /= static_cast<double>(points.size());
+  Matrix3 cov = Matrix3::Zero();
+  for (const auto& p : points) cov += (p - centroid) * (p - centroid).transpose();
+  const Eigen::SelfAdjointEigenSolver<Matrix3> eig(cov);  // eigenvalues ascending
+  const Vector3 sv = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  if (!(sv[1] > 1e-3 * sv[2])) {
+    throw InputError(fmt::format("{}: the points lie on a line, not on a circle", what));
+  }
+  Vector3 normal = eig.eigenvectors().col(0);
+  const Vector3 u = eig.eigenvectors().col(2);
+  const Vector3 v = normal.cross(u);
+  // Algebraic (Kasa) fit in the plane: x^2 + y^2 = 2 a x + 2 b y + c.
+  const auto n = static_cast<Eigen::Index>(points.size());
+  Eigen::MatrixXd A(n, 3);
+  Eigen::VectorXd rhs(n);
+  std::vector<Eigen::Vector2d> xy(points.size());
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Vector3 d = points[static_cast<std::size_t>(i)] - centroid;
+    xy[static_cast<std::size_t>(i)] = {d.dot(u), d.dot(v)};
+    A.row(i) << 2 * d.dot(u), 2 * d.dot(v), 1.0;
+    rhs[i] = d.dot(u) * d.dot(u) + d.dot(v) * d.dot(v);
+  }
+  const Eigen::Vector3d abc = A.colPivHouseholderQr().solve(rhs);
+  Eigen::Vector2d c(abc[0], abc[1]);
+  double r = std::sqrt(std::max(0.0, abc[2] + c.squaredNorm()));
+  // Gauss-Newton on the geometric distances |p - c| - r (the algebraic fit is biased on short arcs).
+  for (int it = 0; it < 20; ++it) {
+    Eigen::MatrixXd J(n, 3);
+    Eigen::VectorXd res(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Vector2d d = xy[static_cast<std::size_t>(i)] - c;
+      const double dist = std::max(d.norm(), 1e-12);
+      res[i] = dist - r;
+      J.row(i) << -d.x() / dist, -d.y() / dist, -1.0;
+    }
+    const Eigen::Vector3d step = J.colPivHouseholderQr().solve(-res);
+    c += step.head<2>();
+    r += step[2];
+    if (step.norm() < 1e-12) break;
+  }
+  CircleFit fit;
+  fit.points = points.size();
+  fit.radius_m = r;
+  double ss = 0.0, swept = 0.0, turned = 0.0;
+  double min_a = 0.0, max_a = 0.0;
+  for (std::size_t i = 0; i < xy.size(); ++i) {
+    const double e = (xy[i] - c).norm() - r;
+    ss += e * e;
+    if (i > 0) {
+      const Eigen::Vector2d a = xy[i - 1] - c, b = xy[i] - c;
+      const double da = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+      swept += a.x() * b.y() - a.y() * b.x();
+      turned += da;
+      min_a = std::min(min_a, turned);
+      max_a = std::max(max_a, turned);
+    }
+  }
+  fit.rms_m = std::sqrt(ss / static_cast<double>(xy.size()));
+  fit.arc_rad = std::min(2 * kPi, max_a - min_a);
+  if (fit.arc_rad < 20.0 * kPi / 180.0) {
+    throw InputError(fmt::format("{}: the points span {:.1f} degrees of arc; at least 20 are needed for a centre and "
+                                 "axis worth registering with",
+                                 what, fit.arc_rad * 180.0 / kPi));
+  }
+  if (swept < 0.0) normal = -normal;  // right-hand rule along the direction of travel
+  fit.axis = normal;
+  fit.centre_m = centroid + c.x() * u + c.y() * v;
+  return fit;
+}
+
+FrameRegistration register_frames(const RegistrationInput& in) {
+  if (in.tracker_m.size() != in.base_m.size()) {
+    throw InputError(fmt::format("registration: {} tracker point(s) and {} base point(s): they must pair up",
+                                 in.tracker_m.size(), in.base_m.size()));
+  }
+  if (in.tracker_circles.size() != in.base_circles.size()) {
+    throw InputError(fmt::format("registration: {} tracker circle(s) and {} base circle(s): they must pair up",
+                                 in.tracker_circles.size(), in.base_circles.size()));
+  }
+  if (!finite_all(in.tracker_m) || !finite_all(in.base_m)) throw InputError("registration: a point is not finite");
+  const std::size_t np = in.tracker_m.size(), nc = in.tracker_circles.size();
+  if (np + nc == 0 || (nc == 0 && np < 3)) {
+    throw InputError(fmt::format("registration: {} point pair(s) and no circle: at least 3 points off one line are "
+                                 "needed (or circles)",
+                                 np));
+  }
+  // Every point feature: the measured points and the circles' centres.
+  std::vector<Vector3> a = in.tracker_m, b = in.base_m;
+  std::vector<std::string> names(np);
+  for (std::size_t i = 0; i < np; ++i) names[i] = i < in.names.size() ? in.names[i] : fmt::format("point {}", i + 1);
+  for (std::size_t k = 0; k < nc; ++k) {
+    a.push_back(in.tracker_circles[k].centre_m);
+    b.push_back(in.base_circles[k].centre_m);
+    names.push_back(fmt::format("circle {} centre", k + 1));
+  }
+  Vector3 ca = Vector3::Zero(), cb = Vector3::Zero();
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ca += a[i];
+    cb += b[i];
+  }
+  ca /= static_cast<double>(a.size());
+  cb /= static_cast<double>(b.size());
+  Matrix3 S = Matrix3::Zero();  // sum of a' b'^T
+  Eigen::Matrix<double, 3, Eigen::Dynamic> spread(3, static_cast<Eigen::Index>(a.size() + nc));
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    S += (a[i] - ca) * (b[i] - cb).transpose();
+    spread.col(static_cast<Eigen::Index>(i)) = a[i] - ca;
+  }
+  for (std::size_t k = 0; k < nc; ++k) {
+    const double w = in.tracker_circles[k].radius_m * in.base_circles[k].radius_m;
+    S += w * in.tracker_circles[k].axis * in.base_circles[k].axis.transpose();
+    spread.col(static_cast<Eigen::Index>(a.size() + k)) = std::sqrt(w) * in.tracker_circles[k].axis;
+  }
+  // The rotation is fixed only if the features span at least two directions.
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(spread);
+  const auto sv = svd.singularValues();
+  if (sv.size() < 2 || !(sv[1] > 1e-3 * sv[0])) {
+    throw InputError(
+        "registration: the points lie on one line (and no circle axis leaves it): the rotation about that line is "
+        "not fixed; measure a point off the line");
+  }
+  Eigen::Matrix4d N;
+  const double sxx = S(0, 0), sxy = S(0, 1), sxz = S(0, 2), syx = S(1, 0), syy = S(1, 1), syz = S(1, 2);
+  const double szx = S(2, 0), szy = S(2, 1), szz = S(2, 2);
+  N << sxx + syy + szz, syz - szy, szx - sxz, sxy - syx,  //
+      syz - szy, sxx - syy - szz, sxy + syx, szx + sxz,   //
+      szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy,  //
+      sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eig(N);
+  const Eigen::Vector4d q = eig.eigenvectors().col(3);  // largest eigenvalue last
+  const Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
+  FrameRegistration out;
+  out.base_T_tracker.linear() = quat.normalized().toRotationMatrix();
+  out.base_T_tracker.translation() = cb - out.base_T_tracker.linear() * ca;
+  double ss = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double d = (out.base_T_tracker * a[i] - b[i]).norm();
+    out.residuals.push_back({names[i], d});
+    ss += d * d;
+    out.max_m = std::max(out.max_m, d);
+  }
+  out.rms_m = std::sqrt(ss / static_cast<double>(a.size()));
+  for (std::size_t k = 0; k < nc; ++k) {
+    const Vector3 ra = out.base_T_tracker.linear() * in.tracker_circles[k].axis;
+    out.circle_axis_error_rad.push_back(std::acos(std::clamp(ra.dot(in.base_circles[k].axis), -1.0, 1.0)));
+  }
+  out.points = np;
+  out.circles = nc;
+  return out;
+}
+
+void write_tracker_frame(const TrackerFrame& f, OutputFile& out) {
+  const Eigen::Quaterniond q(f.base_T_tracker.linear());
+  const Vector3 t = f.base_T_tracker.translation();
+  std::string text =
+      "# deflex tracker frame: p_base = base_T_tracker * p_tracker (position in m, unit quaternion w x y z).\n"
+      "# Written by deflex register; read by deflex evaluate --tracker-frame.\n";
+  text += fmt::format("tracker_frame: {}\n", yaml::scalar_text(f.tracker_frame));
+  text += "base_T_tracker:\n";
+  text += fmt::format("  position: [{:.9f}, {:.9f}, {:.9f}]\n", t.x(), t.y(), t.z());
+  text += fmt::format("  quaternion_wxyz: [{:.15f}, {:.15f}, {:.15f}, {:.15f}]\n", q.w(), q.x(), q.y(), q.z());
+  text += "registration:\n";
+  text += fmt::format("  points: {}\n  circles: {}\n", f.points, f.circles);
+  if (std::isfinite(f.rms_m)) text += fmt::format("  rms_mm: {:.6f}\n  max_mm: {:.6f}\n", f.rms_m * 1e3, f.max_m * 1e3);
+  out.write(text);
+}
+
+TrackerFrame read_tracker_frame(const std::string& path) {
+  const yaml::Field root = yaml::Field::load_file(path);
+  root.only_keys({"tracker_frame", "base_T_tracker", "registration"});
+  TrackerFrame f;
+  f.tracker_frame = root.get("tracker_frame", std::string());
+  f.base_T_tracker = yaml::parse_pose(root.at("base_T_tracker"), 1.0, 1.0);
+  if (!root.at("base_T_tracker").has("quaternion_wxyz") && !root.at("base_T_tracker").has("rpy")) {
+    root.at("base_T_tracker").fail("no rotation (quaternion_wxyz): a tracker frame is never only a translation");
+  }
+  if (root.has("registration")) {
+    const yaml::Field r = root.at("registration");
+    r.only_keys({"points", "circles", "rms_mm", "max_mm"});
+    f.points = static_cast<std::size_t>(std::max(0, r.get("points", 0)));
+    f.circles = static_cast<std::size_t>(std::max(0, r.get("circles", 0)));
+    if (r.has("rms_mm")) f.rms_m = r.at("rms_mm").as_double() * 1e-3;
+    if (r.has("max_mm")) f.max_m = r.at("max_mm").as_double() * 1e-3;
+  }
+  return f;
+}
+
+}  // namespace deflex

@@ -1,0 +1,82 @@
+// The tracker-to-robot-base transform: from points measured in both frames (closed-form least squares,
+// Horn's unit-quaternion method), optionally with circles (a joint turned alone, or the TCP on a
+// commanded circle) whose centre and axis are known in both frames; and its small YAML file.
+//
+// B. K. P. Horn, "Closed-form solution of absolute orientation using unit quaternions", J. Opt. Soc.
+// Am. A 4(4), 1987: the rotation is the eigenvector of the largest eigenvalue of a symmetric 4x4
+// matrix built from the centred points' cross-covariance; the translation follows from the centroids.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "deflex/model/output_file.hpp"
+#include "deflex/model/types.hpp"
+
+namespace deflex {
+
+/// A circle fitted to points measured in order along it: its centre (m), its axis (unit, oriented by
+/// the right-hand rule along the direction of travel), its radius (m), the RMS distance of the points
+/// from it (m) and the angle the points span (rad).
+struct CircleFit {
+  Vector3 centre_m = Vector3::Zero();
+  Vector3 axis = Vector3::UnitZ();
+  double radius_m = 0.0;
+  double rms_m = 0.0;
+  double arc_rad = 0.0;
+  std::size_t points = 0;
+};
+
+/// Fits a circle (plane of best fit, then the circle in that plane by algebraic least squares refined
+/// by Gauss-Newton on the geometric distances). Throws InputError (`what` names the points) for fewer
+/// than 5 points, points on a line, or an arc of less than 20 degrees (its centre is then too poorly
+/// determined to register a frame with).
+CircleFit fit_circle(const std::vector<Vector3>& points_m, const std::string& what);
+
+/// The measurements a registration is computed from: points paired by index (tracker frame, base
+/// frame; `names` optional, for messages), and circles paired by index.
+struct RegistrationInput {
+  std::vector<Vector3> tracker_m, base_m;
+  std::vector<std::string> names;
+  std::vector<CircleFit> tracker_circles, base_circles;
+};
+
+struct RegistrationResidual {
+  std::string name;
+  double distance_m = 0.0;  ///< |base_T_tracker * tracker - base|
+};
+
+struct FrameRegistration {
+  Pose base_T_tracker = Pose::Identity();  ///< p_base = base_T_tracker * p_tracker
+  std::vector<RegistrationResidual> residuals;  ///< one per point, then one per circle centre
+  std::vector<double> circle_axis_error_rad;    ///< angle between each rotated tracker axis and its base axis
+  double rms_m = 0.0;
+  double max_m = 0.0;
+  std::size_t points = 0;
+  std::size_t circles = 0;
+};
+
+/// Least-squares rigid transform (rotation and translation, no scale) from the tracker frame to the
+/// base frame. A circle counts as its centre (a point) and its axis (a direction, weighted by the
+/// radius squared: as much as two points a radius apart along it). Throws InputError when the
+/// measurements cannot fix the transform: fewer than 3 points and no circle, points all on one line
+/// (their spread across the line under 1/1000 of their spread along it) with no circle axis off that
+/// line, sizes that do not match, or values that are not finite.
+FrameRegistration register_frames(const RegistrationInput& input);
+
+/// The transform and what it came from, as written to and read from a frame YAML file.
+struct TrackerFrame {
+  Pose base_T_tracker = Pose::Identity();
+  std::string tracker_frame;  ///< the tracker's working frame name, "" when not known
+  double rms_m = kNaN;
+  double max_m = kNaN;
+  std::size_t points = 0, circles = 0;
+};
+
+/// Writes the frame file (position in m, quaternion w x y z, the registration's figures as comments and
+/// fields). Throws OutputError when a write fails.
+void write_tracker_frame(const TrackerFrame& frame, OutputFile& out);
+/// Reads it. Throws ModelError naming the file, line and field.
+TrackerFrame read_tracker_frame(const std::string& path);
+
+}  // namespace deflex

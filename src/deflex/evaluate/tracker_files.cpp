@@ -1,0 +1,600 @@
+// Tracker files: SA ASCII exports and plain CSV (see tracker_files.hpp).
+#include "deflex/evaluate/tracker_files.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <optional>
+#include <string_view>
+
+#include <fmt/format.h>
+
+#include "deflex/model/csv_table.hpp"
+#include "deflex/model/errors.hpp"
+#include "deflex/model/input_file.hpp"
+#include "deflex/model/parse_number.hpp"
+
+namespace deflex {
+namespace {
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return out;
+}
+
+// Metres per unit of a length unit name, or nullopt.
+std::optional<double> length_scale(const std::string& unit) {
+  if (unit == "mm") return 1e-3;
+  if (unit == "m") return 1.0;
+  if (unit == "cm") return 1e-2;
+  if (unit == "in") return 0.0254;
+  if (unit == "ft") return 0.3048;
+  return std::nullopt;
+}
+
+// The canonical name of a unit word from a header ("Millimeters" -> "mm"), or "".
+std::string length_word(const std::string& w) {
+  if (w == "mm" || w == "millimeter" || w == "millimeters" || w == "millimetre" || w == "millimetres") return "mm";
+  if (w == "m" || w == "meter" || w == "meters" || w == "metre" || w == "metres") return "m";
+  if (w == "cm" || w == "centimeter" || w == "centimeters" || w == "centimetre" || w == "centimetres") return "cm";
+  if (w == "in" || w == "inch" || w == "inches") return "in";
+  if (w == "ft" || w == "foot" || w == "feet") return "ft";
+  return "";
+}
+std::string angle_word(const std::string& w) {
+  if (w == "deg" || w == "degree" || w == "degrees") return "deg";
+  if (w == "rad" || w == "radian" || w == "radians") return "rad";
+  return "";
+}
+
+std::vector<std::string> words_of(std::string_view text) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : text) {
+    if (std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_') {
+      cur += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    } else if (!cur.empty()) {
+      out.push_back(cur);
+      cur.clear();
+    }
+  }
+  if (!cur.empty()) out.push_back(cur);
+  return out;
+}
+
+std::string after_colon(std::string_view text) {
+  const auto colon = text.find(':');
+  return std::string(trim_view(colon == std::string_view::npos ? text : text.substr(colon + 1)));
+}
+
+// --- Time stamps: seconds, or a calendar date and time of day. ---
+
+bool all_digits(std::string_view s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
+// "2026/11/25" or "2026-11-25" -> days since 1970-01-01 (proleptic Gregorian), nullopt otherwise.
+std::optional<long> date_days(std::string_view s) {
+  if (s.size() < 8 || s.size() > 10) return std::nullopt;
+  const char sep = s[4];
+  if (sep != '/' && sep != '-') return std::nullopt;
+  const auto second = s.find(sep, 5);
+  if (second == std::string_view::npos) return std::nullopt;
+  const std::string_view ys = s.substr(0, 4), ms = s.substr(5, second - 5), ds = s.substr(second + 1);
+  if (!all_digits(ys) || !all_digits(ms) || !all_digits(ds) || ms.size() > 2 || ds.size() > 2) return std::nullopt;
+  long y = std::stol(std::string(ys));
+  const long m = std::stol(std::string(ms));
+  const long d = std::stol(std::string(ds));
+  if (m < 1 || m > 12 || d < 1 || d > 31) return std::nullopt;
+  // Days from the civil date (H. Hinnant's well-known algorithm, written from its description).
+  y -= m <= 2 ? 1 : 0;
+  const long era = (y >= 0 ? y : y - 399) / 400;
+  const long yoe = y - era * 400;
+  const long doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
+  const long doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+  return era * 146097 + doe - 719468;
+}
+
+// "10:31:02.123" -> seconds into the day.
+std::optional<double> time_of_day(std::string_view s) {
+  const auto c1 = s.find(':');
+  if (c1 == std::string_view::npos) return std::nullopt;
+  const auto c2 = s.find(':', c1 + 1);
+  if (c2 == std::string_view::npos) return std::nullopt;
+  const std::string_view hs = s.substr(0, c1), ms = s.substr(c1 + 1, c2 - c1 - 1), ss = s.substr(c2 + 1);
+  if (!all_digits(hs) || !all_digits(ms) || hs.size() > 2 || ms.size() != 2) return std::nullopt;
+  const auto sec = parse_double(ss);
+  if (!sec || ss.empty() || ss[0] < '0' || ss[0] > '9') return std::nullopt;
+  const long h = std::stol(std::string(hs));
+  const long mi = std::stol(std::string(ms));
+  if (h > 23 || mi > 59 || *sec < 0.0 || *sec >= 61.0) return std::nullopt;
+  return static_cast<double>(h * 3600 + mi * 60) + *sec;
+}
+
+// A date and time ("2026/11/25 10:31:02.5", "2026-11-25T10:31:02.5") -> seconds since 1970.
+std::optional<double> date_time(std::string_view s) {
+  auto split = s.find_first_of(" T");
+  if (split == std::string_view::npos) return std::nullopt;
+  const auto days = date_days(s.substr(0, split));
+  const auto tod = time_of_day(trim_view(s.substr(split + 1)));
+  if (!days || !tod) return std::nullopt;
+  return static_cast<double>(*days) * 86400.0 + *tod;
+}
+
+// A line's fields: comma separated when it holds a comma, else blank separated; a date followed by a
+// time of day is one field.
+std::vector<std::string> fields_of(std::string_view line) {
+  std::vector<std::string> raw;
+  if (line.find(',') != std::string_view::npos) {
+    std::size_t start = 0;
+    while (true) {
+      const auto comma = line.find(',', start);
+      raw.emplace_back(trim_view(line.substr(start, comma == std::string_view::npos ? line.npos : comma - start)));
+      if (comma == std::string_view::npos) break;
+      start = comma + 1;
+    }
+    return raw;
+  }
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    if (i >= line.size()) break;
+    std::size_t j = i;
+    while (j < line.size() && line[j] != ' ' && line[j] != '\t') ++j;
+    raw.emplace_back(line.substr(i, j - i));
+    i = j;
+  }
+  std::vector<std::string> out;
+  for (std::size_t k = 0; k < raw.size(); ++k) {
+    if (k + 1 < raw.size() && date_days(raw[k]) && time_of_day(raw[k + 1])) {
+      out.push_back(raw[k] + " " + raw[k + 1]);
+      ++k;
+    } else {
+      out.push_back(raw[k]);
+    }
+  }
+  return out;
+}
+
+// --- SA column layouts. ---
+
+enum class Col { kName, kX, kY, kZ, kR, kAzimuth, kZenith, kElevation, kTime, kIgnored };
+
+struct Layout {
+  std::vector<Col> cols;
+  std::vector<std::string> names;  // as given, for messages
+  std::string coordinates;         // "cartesian", "cylindrical", "spherical"
+};
+
+std::optional<Col> column_kind(const std::string& w) {
+  if (w == "collection" || w == "group" || w == "target" || w == "name" || w == "point") return Col::kName;
+  if (w == "x") return Col::kX;
+  if (w == "y") return Col::kY;
+  if (w == "z") return Col::kZ;
+  if (w == "r" || w == "d" || w == "distance" || w == "radius") return Col::kR;
+  if (w == "theta" || w == "az" || w == "azimuth") return Col::kAzimuth;
+  if (w == "phi" || w == "zenith" || w == "zen") return Col::kZenith;
+  if (w == "el" || w == "elevation") return Col::kElevation;
+  if (w == "time" || w == "t" || w == "timestamp" || w == "time_stamp") return Col::kTime;
+  if (w == "ux" || w == "uy" || w == "uz" || w == "u" || w == "tol" || w == "tolerance" || w == "uncertainty" ||
+      w == "skip" || w == "comment") {
+    return Col::kIgnored;
+  }
+  return std::nullopt;
+}
+
+[[noreturn]] void fail_at(const std::string& source, int line, const std::string& message) {
+  if (line > 0) throw DataError(fmt::format("{}:{}: {}", source, line, message));
+  throw DataError(fmt::format("{}: {}", source, message));
+}
+
+Layout parse_layout(const std::string& text, const std::string& source, int line, const char* where) {
+  Layout l;
+  for (const auto& w : words_of(text)) {
+    const auto kind = column_kind(w);
+    if (!kind) {
+      fail_at(source, line,
+              fmt::format("{}: unknown column '{}' (names: collection group target, x y z, r theta z, r theta phi "
+                          "or r az el, time, and ux uy uz tol skip for columns to leave out)",
+                          where, w));
+    }
+    l.cols.push_back(*kind);
+    l.names.push_back(w);
+  }
+  auto count = [&](Col c) { return std::count(l.cols.begin(), l.cols.end(), c); };
+  const auto nx = count(Col::kX), ny = count(Col::kY), nz = count(Col::kZ), nr = count(Col::kR);
+  const auto na = count(Col::kAzimuth), nzen = count(Col::kZenith), nel = count(Col::kElevation);
+  if (nx == 1 && ny == 1 && nz == 1 && nr + na + nzen + nel == 0) {
+    l.coordinates = "cartesian";
+  } else if (nr == 1 && na == 1 && nz == 1 && nx + ny + nzen + nel == 0) {
+    l.coordinates = "cylindrical";
+  } else if (nr == 1 && na == 1 && nzen + nel == 1 && nx + ny + nz == 0) {
+    l.coordinates = "spherical";
+  } else {
+    fail_at(source, line,
+            fmt::format("{} '{}' name no single coordinate system: give x y z (Cartesian), r theta z (cylindrical) "
+                        "or r theta phi / r az el (spherical), once each",
+                        where, text));
+  }
+  if (count(Col::kTime) > 1 || count(Col::kName) > 3) {
+    fail_at(source, line, fmt::format("{} '{}': at most three name columns and one time column", where, text));
+  }
+  return l;
+}
+
+struct Header {
+  std::string version, frame, coordinates, length_unit, angle_unit, columns;
+  int coordinates_line = 0, columns_line = 0, frame_line = 0, unit_line = 0;
+};
+
+void read_comment(std::string_view body, int line, const std::string& source, Header& h) {
+  const std::string low = lower(body);
+  if (low.find("column") != std::string::npos) {
+    h.columns = after_colon(body);
+    h.columns_line = line;
+    return;
+  }
+  if (low.find("version") != std::string::npos) {
+    h.version = after_colon(body);
+  }
+  if (low.find("frame") != std::string::npos && h.frame.empty()) {
+    std::string f = after_colon(body);
+    if (f.empty() || f == std::string(trim_view(body))) {
+      const auto at = low.find("frame");
+      f = std::string(trim_view(body.substr(at + 5)));
+    }
+    h.frame = f;
+    h.frame_line = line;
+  }
+  for (const char* system : {"cartesian", "cylindrical", "spherical"}) {
+    if (low.find(system) == std::string::npos) continue;
+    if (!h.coordinates.empty() && h.coordinates != system) {
+      fail_at(source, line,
+              fmt::format("mixed coordinate types: this comment names {} coordinates, line {} named {}", system,
+                          h.coordinates_line, h.coordinates));
+    }
+    h.coordinates = system;
+    h.coordinates_line = line;
+  }
+  if (low.find("unit") != std::string::npos) {
+    for (const auto& w : words_of(after_colon(body))) {
+      if (const auto lw = length_word(w); !lw.empty()) {
+        if (!h.length_unit.empty() && h.length_unit != lw) {
+          fail_at(source, line, fmt::format("two length units in the header ({} and {})", h.length_unit, lw));
+        }
+        h.length_unit = lw;
+        h.unit_line = line;
+      } else if (const auto aw = angle_word(w); !aw.empty()) {
+        h.angle_unit = aw;
+      }
+    }
+  }
+}
+
+bool is_number(const std::string& s) { return parse_double(s).has_value(); }
+
+// The layout of a file that declares none: up to three text names, then x y z and, optionally, a
+// calendar time stamp. Anything else could be read two ways and is refused.
+Layout inferred_layout(const std::vector<std::string>& f, const std::string& source, int line) {
+  Layout l;
+  l.coordinates = "cartesian";
+  std::size_t k = 0;
+  while (k < f.size() && !is_number(f[k]) && !date_time(f[k])) {
+    l.cols.push_back(Col::kName);
+    ++k;
+  }
+  const std::size_t numbers = f.size() - k;
+  const bool dated = numbers >= 1 && date_time(f.back()).has_value();
+  if (l.cols.size() <= 3 && numbers == (dated ? 4U : 3U)) {
+    for (Col c : {Col::kX, Col::kY, Col::kZ}) l.cols.push_back(c);
+    if (dated) l.cols.push_back(Col::kTime);
+    return l;
+  }
+  fail_at(source, line,
+          fmt::format("{} field(s) after {} name(s) and no '// Columns:' comment saying what they are: give the "
+                      "columns with --sa-columns (e.g. \"target x y z time\"); only 'names, x y z' is read without",
+                      numbers, l.cols.size()));
+}
+
+Vector3 to_cartesian(const Layout& l, const std::array<double, 4>& v, double length, double angle) {
+  // v: [x or r, y or azimuth, z or zenith/elevation, unused]
+  if (l.coordinates == "cartesian") return Vector3(v[0], v[1], v[2]) * length;
+  if (l.coordinates == "cylindrical") {
+    const double r = v[0] * length, a = v[1] * angle;
+    return {r * std::cos(a), r * std::sin(a), v[2] * length};
+  }
+  const bool elevation = std::find(l.cols.begin(), l.cols.end(), Col::kElevation) != l.cols.end();
+  const double r = v[0] * length, a = v[1] * angle;
+  const double polar = elevation ? kPi / 2 - v[2] * angle : v[2] * angle;
+  return {r * std::sin(polar) * std::cos(a), r * std::sin(polar) * std::sin(a), r * std::cos(polar)};
+}
+
+TrackerFile parse_sa(const std::string& text, const std::string& source, const TrackerReadOptions& options) {
+  TrackerFile out;
+  out.source = source;
+  out.format = "sa";
+  Header h;
+  std::optional<Layout> layout;
+  std::size_t expected_fields = 0;
+  int first_data_line = 0;
+  double length = 0.0, angle = 0.0;
+  int line_no = 0;
+  std::size_t pos = 0;
+  auto settle_layout = [&](const std::vector<std::string>& f, int line) {
+    if (!options.columns.empty()) {
+      layout = parse_layout(options.columns, source, 0, "option --sa-columns");
+    } else if (!h.columns.empty()) {
+      layout = parse_layout(h.columns, source, h.columns_line, "the '// Columns:' comment");
+    } else {
+      layout = inferred_layout(f, source, line);
+    }
+    if (!h.coordinates.empty() && h.coordinates != layout->coordinates) {
+      fail_at(source, line,
+              fmt::format("mixed coordinate types: the header (line {}) says {} coordinates, the columns are {}",
+                          h.coordinates_line, h.coordinates, layout->coordinates));
+    }
+    // The length unit: from the header or the option, never guessed; both must agree.
+    if (!options.length_unit.empty() && !length_scale(options.length_unit)) {
+      throw InputError(fmt::format("option --tracker-units: '{}' is not one of mm, m, cm, in, ft", options.length_unit));
+    }
+    if (!h.length_unit.empty() && !options.length_unit.empty() && h.length_unit != options.length_unit) {
+      fail_at(source, h.unit_line,
+              fmt::format("the header says {} and --tracker-units says {}: which is it?", h.length_unit,
+                          options.length_unit));
+    }
+    out.length_unit = !h.length_unit.empty() ? h.length_unit : options.length_unit;
+    out.unit_from = !h.length_unit.empty() ? "header" : "option";
+    if (out.length_unit.empty()) {
+      fail_at(source, 0,
+              "the header names no length unit (no '// Units: Millimeters' comment): give the file's unit with "
+              "--tracker-units mm|m|cm|in|ft");
+    }
+    length = *length_scale(out.length_unit);
+    if (layout->coordinates != "cartesian") {
+      std::string au = !h.angle_unit.empty() ? h.angle_unit : options.angle_unit;
+      if (!h.angle_unit.empty() && !options.angle_unit.empty() && h.angle_unit != options.angle_unit) {
+        fail_at(source, h.unit_line,
+                fmt::format("the header says {} and --tracker-angle-units says {}", h.angle_unit, options.angle_unit));
+      }
+      if (au.empty()) {
+        fail_at(source, 0,
+                fmt::format("{} coordinates and no angle unit in the header: give --tracker-angle-units deg|rad",
+                            layout->coordinates));
+      }
+      if (au != "deg" && au != "rad") {
+        throw InputError(fmt::format("option --tracker-angle-units: '{}' is not deg or rad", au));
+      }
+      angle = au == "deg" ? kPi / 180.0 : 1.0;
+    }
+    out.coordinates = layout->coordinates;
+    out.has_time = std::find(layout->cols.begin(), layout->cols.end(), Col::kTime) != layout->cols.end();
+    out.has_names = std::find(layout->cols.begin(), layout->cols.end(), Col::kName) != layout->cols.end();
+    expected_fields = layout->cols.size();
+    first_data_line = line;
+    if (!options.expect_frame.empty() && !h.frame.empty() && h.frame != options.expect_frame) {
+      fail_at(source, h.frame_line,
+              fmt::format("the working frame is '{}', not the expected '{}' (the points would be in another frame)",
+                          h.frame, options.expect_frame));
+    }
+  };
+
+  while (pos <= text.size()) {
+    auto end = text.find('\n', pos);
+    if (end == std::string::npos) end = text.size();
+    std::string_view raw(text.data() + pos, end - pos);
+    pos = end + 1;
+    ++line_no;
+    if (!raw.empty() && raw.back() == '\r') raw.remove_suffix(1);
+    const std::string_view line = trim_view(raw);
+    if (line.empty()) {
+      if (end == text.size()) break;
+      continue;
+    }
+    if (line.rfind("//", 0) == 0) {
+      if (layout) fail_at(source, line_no, "a '//' comment after the first point (two exports run together?)");
+      read_comment(line.substr(2), line_no, source, h);
+      continue;
+    }
+    const std::vector<std::string> f = fields_of(line);
+    if (!layout) settle_layout(f, line_no);
+    if (f.size() != expected_fields) {
+      fail_at(source, line_no,
+              fmt::format("{} field(s) where the layout ({}) has {} (line {} had {})", f.size(),
+                          options.columns.empty() && h.columns.empty() ? "inferred from the first point" : "declared",
+                          expected_fields, first_data_line, expected_fields));
+    }
+    TrackerPoint p;
+    p.line = line_no;
+    std::array<double, 4> v{kNaN, kNaN, kNaN, 0.0};
+    for (std::size_t k = 0; k < f.size(); ++k) {
+      const Col c = layout->cols[k];
+      const std::string col_name = k < layout->names.size() ? layout->names[k] : fmt::format("field {}", k + 1);
+      if (c == Col::kName) {
+        if (f[k].empty()) fail_at(source, line_no, fmt::format("field {} (a name) is empty", k + 1));
+        p.name += (p.name.empty() ? "" : "::") + f[k];
+        continue;
+      }
+      if (c == Col::kIgnored) continue;
+      if (c == Col::kTime) {
+        if (const auto dt = date_time(f[k])) {
+          p.t_s = *dt;
+          continue;
+        }
+      }
+      const auto value = parse_double(f[k]);
+      if (!value) {
+        fail_at(source, line_no,
+                fmt::format("field {} ({}): {}", k + 1, col_name,
+                            c == Col::kTime ? fmt::format("'{}' is neither seconds nor a date and time", f[k])
+                                            : not_a_number(f[k])));
+      }
+      switch (c) {
+        case Col::kX:
+        case Col::kR: v[0] = *value; break;
+        case Col::kY:
+        case Col::kAzimuth: v[1] = *value; break;
+        case Col::kZ:
+          if (layout->coordinates == "cartesian" || layout->coordinates == "cylindrical") v[2] = *value;
+          break;
+        case Col::kZenith:
+        case Col::kElevation: v[2] = *value; break;
+        case Col::kTime: p.t_s = *value; break;
+        default: break;
+      }
+    }
+    p.p_m = to_cartesian(*layout, v, length, angle);
+    if (!p.p_m.allFinite() || p.p_m.norm() > 1e4) {
+      fail_at(source, line_no, "the point is not a finite position within 10 km of the frame's origin (wrong unit?)");
+    }
+    out.points.push_back(std::move(p));
+    if (end == text.size()) break;
+  }
+  if (out.points.empty()) fail_at(source, 0, "no points (only comments or blank lines)");
+  out.frame = h.frame;
+  out.version = h.version;
+  return out;
+}
+
+TrackerFile parse_csv(const std::string& text, const std::string& source, const TrackerReadOptions& options) {
+  const CsvTable table = CsvTable::parse(text, source);
+  TrackerFile out;
+  out.source = source;
+  out.format = "csv";
+  out.coordinates = "cartesian";
+  out.unit_from = "column names";
+  const bool mm = table.has("x_mm") || table.has("y_mm") || table.has("z_mm");
+  const bool m = table.has("x_m") || table.has("y_m") || table.has("z_m");
+  if (mm && m) throw DataError(fmt::format("{}: both x_mm-style and x_m-style columns: keep one unit", source));
+  if (!mm && !m) {
+    std::string have;
+    for (const auto& c : table.columns()) have += (have.empty() ? "" : ", ") + c;
+    throw DataError(fmt::format("{}: no position columns with a unit in their name: give x_mm,y_mm,z_mm or "
+                                "x_m,y_m,z_m (have: {})",
+                                source, have));
+  }
+  const std::string suffix = mm ? "_mm" : "_m";
+  table.require({"x" + suffix, "y" + suffix, "z" + suffix});
+  out.length_unit = mm ? "mm" : "m";
+  if (!options.length_unit.empty() && options.length_unit != out.length_unit) {
+    throw DataError(fmt::format("{}: the columns are in {} and --tracker-units says {}", source, out.length_unit,
+                                options.length_unit));
+  }
+  const double scale = mm ? 1e-3 : 1.0;
+  const std::size_t cx = table.column("x" + suffix), cy = table.column("y" + suffix), cz = table.column("z" + suffix);
+  out.has_time = table.has("t_s");
+  const std::size_t ct = out.has_time ? table.column("t_s") : 0;
+  if (table.rows() == 0) throw DataError(fmt::format("{}: no samples (only a header row)", source));
+  out.points.reserve(table.rows());
+  for (std::size_t r = 0; r < table.rows(); ++r) {
+    TrackerPoint p;
+    p.line = table.line_of(r);
+    p.t_s = out.has_time ? table.at(r, ct) : kNaN;
+    p.p_m = Vector3(table.at(r, cx), table.at(r, cy), table.at(r, cz)) * scale;
+    out.points.push_back(std::move(p));
+  }
+  return out;
+}
+
+bool looks_like_csv(const std::string& text) {
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    auto end = text.find('\n', pos);
+    if (end == std::string::npos) end = text.size();
+    const std::string_view line = trim_view(std::string_view(text).substr(pos, end - pos));
+    pos = end + 1;
+    if (line.empty() || line[0] == '#') continue;
+    if (line.rfind("//", 0) == 0) return false;
+    for (const auto& cell : fields_of(line)) {
+      if (cell == "t_s" || cell == "x_mm" || cell == "x_m" || cell == "y_mm" || cell == "y_m") return true;
+    }
+    return false;
+  }
+  return false;
+}
+
+}  // namespace
+
+TrackerFile parse_tracker_file(const std::string& text, const std::string& source, const TrackerReadOptions& options) {
+  std::string body = text;
+  if (body.rfind("\xEF\xBB\xBF", 0) == 0) body.erase(0, 3);
+  TrackerFile f = looks_like_csv(body) ? parse_csv(body, source, options) : parse_sa(body, source, options);
+  if (!options.expect_frame.empty() && f.frame.empty() && f.format == "sa") {
+    // A file that names no frame cannot be checked against the expected one; say so rather than pass.
+    throw DataError(fmt::format("{}: the header names no working frame, and '{}' was expected (export with the SA "
+                                "version and frame comments, or leave out --expect-frame)",
+                                source, options.expect_frame));
+  }
+  return f;
+}
+
+TrackerFile read_tracker_file(const std::string& path, const TrackerReadOptions& options) {
+  return parse_tracker_file(read_input_file(path, InputKind::kCsvTable), path, options);
+}
+
+TrackerTrace timed_trace(const TrackerFile& file, const std::string& what) {
+  if (!file.has_time) {
+    throw DataError(fmt::format("{}: {} needs time stamps and the points have none{}", file.source, what,
+                                file.format == "sa" ? " (export with time stamps, or name a time column)"
+                                                    : " (no t_s column)"));
+  }
+  TrackerTrace trace;
+  trace.reserve(file.points.size());
+  for (std::size_t i = 0; i < file.points.size(); ++i) {
+    const TrackerPoint& p = file.points[i];
+    if (!std::isfinite(p.t_s)) {
+      throw DataError(fmt::format("{}:{}: {} needs a time stamp on every point", file.source, p.line, what));
+    }
+    if (i > 0 && !(p.t_s > file.points[i - 1].t_s)) {
+      throw DataError(fmt::format("{}:{}: time stamp {} s {} line {}'s ({} s): {} needs increasing stamps",
+                                  file.source, p.line, number_text(p.t_s),
+                                  p.t_s == file.points[i - 1].t_s ? "repeats" : "goes back from",
+                                  file.points[i - 1].line, number_text(file.points[i - 1].t_s), what));
+    }
+    trace.push_back({p.t_s, p.p_m});
+  }
+  return trace;
+}
+
+TrackerTrace untimed_trace(const TrackerFile& file) {
+  TrackerTrace trace;
+  trace.reserve(file.points.size());
+  for (const auto& p : file.points) trace.push_back({std::isfinite(p.t_s) ? p.t_s : 0.0, p.p_m});
+  return trace;
+}
+
+void write_sa_export(const TrackerTrace& trace, OutputFile& out, const SaExportOptions& o) {
+  const char* sep = o.comma ? "," : " ";
+  std::string text;
+  text += "// SA Version: written by deflex (Spatial Analyzer ASCII point export layout)\n";
+  text += fmt::format("// Working Frame: {}\n", o.frame);
+  text += "// Units: Millimeters\n";
+  text += "// Coordinate System: Cartesian\n";
+  text += fmt::format("// Columns: Collection{0}Group{0}Target{0}X{0}Y{0}Z{1}\n", sep, o.time ? fmt::format("{}Time", sep) : "");
+  out.write(text);
+  std::string line;
+  for (std::size_t i = 0; i < trace.size(); ++i) {
+    line.clear();
+    const Vector3 mm = trace[i].p_m * 1e3;
+    fmt::format_to(std::back_inserter(line), "{1}{0}{2}{0}P{3:06d}", sep, o.collection, o.group, i + 1);
+    for (int k = 0; k < 3; ++k) {
+      if (o.scientific) {
+        fmt::format_to(std::back_inserter(line), "{}{:.16e}", sep, mm[k]);
+      } else {
+        fmt::format_to(std::back_inserter(line), "{}{:.6f}", sep, mm[k]);
+      }
+    }
+    if (o.time) fmt::format_to(std::back_inserter(line), "{}{:.6f}", sep, trace[i].t_s);
+    line += '\n';
+    out.write(line);
+  }
+}
+
+void write_sa_export(const TrackerTrace& trace, const std::string& path, const SaExportOptions& options) {
+  OutputFile out(path, "tracker export");
+  write_sa_export(trace, out, options);
+  out.commit();
+}
+
+}  // namespace deflex
