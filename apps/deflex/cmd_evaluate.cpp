@@ -1,28 +1,83 @@
 // `deflex evaluate`: the paper's mean deformation and ISO 9283 path figures from tracker files.
 #include <algorithm>
 #include <iostream>
+#include <cmath>
 #include <memory>
 
 #include <fmt/format.h>
 
 #include "cli_util.hpp"
 #include "command.hpp"
+#include "tracker_options.hpp"
+#include "deflex/evaluate/commanded_path.hpp"
+#include "deflex/evaluate/frame_registration.hpp"
 #include "deflex/evaluate/iso9283_path.hpp"
 #include "deflex/evaluate/lap_split.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
+#include "deflex/evaluate/time_alignment.hpp"
+#include "deflex/evaluate/tracker_files.hpp"
 #include "deflex/evaluate/tracker_trace.hpp"
 #include "deflex/model/errors.hpp"
 
 namespace deflex::cli {
+
+void add_tracker_format_options(CLI::App& sub, TrackerReadOptions& o) {
+  sub.add_option("--tracker-units", o.length_unit,
+                 "Length unit of Spatial Analyzer exports whose header names none: mm, m, cm, in or ft (never "
+                 "guessed; an error when the header names another)");
+  sub.add_option("--tracker-angle-units", o.angle_unit,
+                 "Angle unit (deg or rad) of cylindrical or spherical SA exports whose header names none");
+  sub.add_option("--sa-columns", o.columns,
+                 "The SA export's columns when its header does not say, e.g. \"target x y z time\" or "
+                 "\"collection group target r theta phi\" (docs/evaluation.md)");
+  sub.add_option("--expect-frame", o.expect_frame,
+                 "The working frame the SA exports must name in their header (another name is an error)");
+}
+
 namespace {
 
+// How tracker files are read: their format options, the tracker frame, and the commanded path the
+// runs are put on the program's clock with.
+struct Reading {
+  TrackerReadOptions options;
+  bool have_frame = false;
+  TrackerFrame frame;
+  bool align = false;
+  CommandedPath commanded;
+  TimeAlignmentOptions alignment;
+};
+
+// One tracker file as a trace in the base frame: on the program's clock when aligning (its alignment
+// appended to `alignments`), else with its own stamps.
+TrackerTrace read_run(const std::string& path, const Reading& r, std::vector<std::pair<std::string, TimeAlignment>>& alignments) {
+  const TrackerFile file = read_tracker_file(path, r.options);
+  TrackerTrace t = r.align ? timed_trace(file, "--align-to") : untimed_trace(file);
+  if (r.have_frame) {
+    for (auto& s : t) s.p_m = r.frame.base_T_tracker * s.p_m;
+  }
+  if (r.align) {
+    TimeAlignment a;
+    try {
+      a = align_time(t, r.commanded.trace, r.alignment);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: {}", path, e.what()));
+    }
+    alignments.emplace_back(path, a);
+    t = to_program_time(t, a);
+  }
+  return t;
+}
+
 // Each file is one run, or with --split-laps each lap of a closed path in a file is one run.
-// `names` gets each run's file (and lap), for messages about a run.
+// `names` gets each run's file (and lap), for messages about a run; `whole` each file's trace.
 std::vector<TrackerTrace> read_all(const std::vector<std::string>& paths, bool split, const char* what,
-                                   std::vector<std::string>& names) {
+                                   std::vector<std::string>& names, const Reading& reading,
+                                   std::vector<std::pair<std::string, TimeAlignment>>& alignments,
+                                   std::vector<TrackerTrace>& whole) {
   std::vector<TrackerTrace> out;
   for (const auto& p : paths) {
-    TrackerTrace t = read_tracker_csv(p);
+    TrackerTrace t = read_run(p, reading, alignments);
+    whole.push_back(t);
     if (!split) {
       out.push_back(std::move(t));
       names.push_back(p);
@@ -90,25 +145,74 @@ std::string iso_text(const std::string& what, const Iso9283Path& iso) {
   return out + "\n";
 }
 
+std::string alignment_text(const std::string& path, const TimeAlignment& a) {
+  std::string out = fmt::format("  {}: offset {:+.4f} s", path, a.offset_s);
+  out += std::isfinite(a.offset_std_s) ? fmt::format(" +- {:.4f} s", a.offset_std_s) : " (uncertainty n/a: too few moving blocks)";
+  if (a.drift != 0.0) out += fmt::format(", drift {:+.2f} ppm", a.drift * 1e6);
+  out += fmt::format(", RMS from the command {:.4f} mm, {} samples ({:.0f} % moving)\n", a.rms_m * 1e3, a.samples,
+                     a.moving_fraction * 100);
+  return out;
+}
+
+struct EvaluateOpts {
+  std::vector<std::string> unloaded, loaded;
+  std::string commanded, tracker_frame, align_to, robot;
+  int points = 81;
+  double max_offset_mm = 10.0, search_s = 0.0, clock_offset_s = kNaN;
+  bool json = false, split = false, mean_reference = false, fit_drift = false;
+  TrackerReadOptions read;
+};
+
+Reading make_reading(const EvaluateOpts& o) {
+  Reading r;
+  r.options = o.read;
+  if (!o.tracker_frame.empty()) {
+    r.have_frame = true;
+    r.frame = read_tracker_frame(o.tracker_frame);
+    // The frame file says which tracker frame it maps from: a tracker file in another frame is refused.
+    if (r.options.expect_frame.empty()) r.options.expect_frame = r.frame.tracker_frame;
+  }
+  if (!o.align_to.empty()) {
+    r.align = true;
+    std::unique_ptr<RobotModel> model;
+    if (!o.robot.empty()) model = std::make_unique<RobotModel>(load_cli_robot("evaluate", o.robot));
+    r.commanded = read_commanded_path(o.align_to, model.get());
+    r.alignment.search_s = o.search_s;
+    r.alignment.fit_drift = o.fit_drift;
+  } else if (o.fit_drift || o.search_s > 0.0 || std::isfinite(o.clock_offset_s)) {
+    throw InputError("options --fit-drift, --search-s and --clock-offset-s need --align-to");
+  }
+  return r;
+}
+
 void setup_evaluate(CLI::App& sub, int& exit_code) {
-  struct Opts {
-    std::vector<std::string> unloaded, loaded;
-    std::string commanded;
-    int points = 81;
-    double max_offset_mm = 10.0;
-    bool json = false, split = false, mean_reference = false;
-  };
-  auto o = std::make_shared<Opts>();
+  auto o = std::make_shared<EvaluateOpts>();
   sub.add_option("--unloaded", o->unloaded,
-                 "Tracker CSV (t_s,x_mm,y_mm,z_mm) of the unloaded path; repeat the option for several laps/runs")
+                 "Tracker file of the unloaded path: CSV (t_s,x_mm,y_mm,z_mm or x_m...) or a Spatial Analyzer ASCII "
+                 "export; repeat the option for several laps/runs")
       ->required();
   sub.add_option("--loaded", o->loaded,
-                 "Tracker CSV of the loaded path (uncompensated or compensated); repeat for several laps/runs "
+                 "Tracker file of the loaded path (uncompensated or compensated); repeat for several laps/runs "
                  "(each file is one run for ISO 9283 repeatability)")
       ->required();
   sub.add_option("--commanded", o->commanded,
-                 "CSV of the commanded path (same columns; t_s may be 0): ISO 9283 accuracy is then taken against "
-                 "it instead of the first unloaded run");
+                 "CSV of the commanded path (t_s,x_mm,y_mm,z_mm, base frame; t_s may be 0): ISO 9283 accuracy is then "
+                 "taken against it instead of the first unloaded run");
+  sub.add_option("--tracker-frame", o->tracker_frame,
+                 "Frame file from deflex register: the tracker files are in the tracker's frame and are moved into "
+                 "the robot's base frame with it");
+  sub.add_option("--align-to", o->align_to,
+                 "The commanded trajectory with its times (a Cartesian CSV t_s,x_mm,..., a joint trajectory "
+                 "t_s,q1_deg,... or deflex online's --log, the joint forms with --robot): each tracker file is put "
+                 "on its clock, and the time-synchronous error is printed");
+  sub.add_option("--robot", o->robot, "Robot file for a joint trajectory or cycle log given to --align-to");
+  sub.add_option("--search-s", o->search_s,
+                 "--align-to: search offsets within this many s of 0 (default: every offset that overlaps half a run)");
+  sub.add_flag("--fit-drift", o->fit_drift, "--align-to: also fit the clocks' rate difference (ppm)");
+  sub.add_option("--clock-offset-s", o->clock_offset_s,
+                 "--align-to: program time minus tracker time when known from a shared trigger; the lag of each run "
+                 "behind its command is then printed (without it a constant lag is part of the clock offset)");
+  add_tracker_format_options(sub, o->read);
   sub.add_option("--evaluation-points", o->points,
                  "ISO 9283: planes normal to the path, 1..100000 (default 81, the paper's)");
   sub.add_option("--max-offset-mm", o->max_offset_mm,
@@ -125,10 +229,16 @@ void setup_evaluate(CLI::App& sub, int& exit_code) {
     if (!(o->max_offset_mm > 0.0)) {
       throw InputError("option --max-offset-mm: must be a positive number of mm");
     }
+    if (!o->robot.empty() && o->align_to.empty()) throw InputError("option --robot: only used with --align-to");
+    const Reading reading = make_reading(*o);
     std::vector<std::string> unloaded_names;
     std::vector<std::string> loaded_names;
-    const std::vector<TrackerTrace> unloaded = read_all(o->unloaded, o->split, "unloaded", unloaded_names);
-    const std::vector<TrackerTrace> loaded = read_all(o->loaded, o->split, "loaded", loaded_names);
+    std::vector<std::pair<std::string, TimeAlignment>> alignments;
+    std::vector<TrackerTrace> unloaded_whole, loaded_whole;
+    const std::vector<TrackerTrace> unloaded =
+        read_all(o->unloaded, o->split, "unloaded", unloaded_names, reading, alignments, unloaded_whole);
+    const std::vector<TrackerTrace> loaded =
+        read_all(o->loaded, o->split, "loaded", loaded_names, reading, alignments, loaded_whole);
     std::vector<TrackerTrace> distance_reference;
     if (o->mean_reference) {
       TrackerTrace all;
@@ -155,6 +265,16 @@ void setup_evaluate(CLI::App& sub, int& exit_code) {
     if (have_commanded) {
       iso_unloaded = iso_of(unloaded, unloaded_names, reference, ref_file, o->points, o->max_offset_mm * 1e-3);
     }
+    // On the program's clock: the study's time-synchronous error (loaded against unloaded at the same
+    // program time) and each run against its command.
+    PathDeviationStats sync;
+    std::vector<PathDeviationStats> to_command;
+    if (reading.align) {
+      sync = time_synchronous_deviation(loaded_whole.front(), unloaded_whole.front());
+      for (const auto* group : {&unloaded_whole, &loaded_whole}) {
+        for (const auto& t : *group) to_command.push_back(time_synchronous_deviation(t, reading.commanded.trace));
+      }
+    }
     if (o->json) {
       nlohmann::json doc{{"mean_deformation_mm", dev.mean_m * 1e3},
                          {"distance_to", o->mean_reference ? "mean of the unloaded laps" : "unloaded samples"},
@@ -167,8 +287,31 @@ void setup_evaluate(CLI::App& sub, int& exit_code) {
       if (have_commanded) {
         doc["iso9283_unloaded"] = iso_json(iso_unloaded, ref_name);
       }
+      if (reading.have_frame) doc["tracker_frame"] = o->tracker_frame;
+      if (reading.align) {
+        nlohmann::json runs = nlohmann::json::array();
+        for (std::size_t k = 0; k < alignments.size(); ++k) {
+          const auto& [path, a] = alignments[k];
+          nlohmann::json run{{"file", path},
+                             {"offset_s", a.offset_s},
+                             {"offset_std_s", std::isfinite(a.offset_std_s) ? nlohmann::json(a.offset_std_s) : nlohmann::json(nullptr)},
+                             {"drift_ppm", a.drift * 1e6},
+                             {"rms_from_command_mm", a.rms_m * 1e3},
+                             {"samples", a.samples},
+                             {"synchronous_error_to_command_mm", to_command[k].mean_m * 1e3}};
+          if (std::isfinite(o->clock_offset_s)) run["lag_s"] = o->clock_offset_s - a.offset_s;
+          runs.push_back(run);
+        }
+        doc["alignment"] = {{"commanded", o->align_to}, {"commanded_kind", reading.commanded.kind}, {"runs", runs}};
+        doc["time_synchronous_mm"] = {{"mean", sync.mean_m * 1e3}, {"max", sync.max_m * 1e3},
+                                      {"rms", sync.rms_m * 1e3}, {"samples", sync.samples}};
+      }
       print_json(doc);
     } else {
+      if (reading.have_frame) {
+        std::cout << fmt::format("Tracker files moved into the base frame with {} (registration RMS {:.4f} mm)\n",
+                                 o->tracker_frame, reading.frame.rms_m * 1e3);
+      }
       std::cout << fmt::format(
           "Distance of the loaded path from {} ({} loaded points, {} run{}; {} unloaded points, {} "
           "run{}):\n  mean (the paper's mean deformation) {:.4f} mm\n  max {:.4f} mm   RMS {:.4f} mm   std {:.4f} mm\n",
@@ -177,6 +320,21 @@ void setup_evaluate(CLI::App& sub, int& exit_code) {
       std::cout << iso_text(fmt::format("ISO 9283 (loaded runs against the {} path)", ref_name), iso_loaded);
       if (have_commanded) {
         std::cout << iso_text("ISO 9283 (unloaded runs against the commanded path)", iso_unloaded);
+      }
+      if (reading.align) {
+        std::cout << fmt::format("Clock alignment with {} ({}): program time = tracker time + offset\n", o->align_to,
+                                 reading.commanded.kind);
+        for (std::size_t k = 0; k < alignments.size(); ++k) {
+          std::cout << alignment_text(alignments[k].first, alignments[k].second);
+          if (std::isfinite(o->clock_offset_s)) {
+            std::cout << fmt::format("    lag behind the command {:+.4f} s (with --clock-offset-s {})\n",
+                                     o->clock_offset_s - alignments[k].second.offset_s, o->clock_offset_s);
+          }
+        }
+        std::cout << fmt::format(
+            "Time-synchronous error (loaded against unloaded at the same program time, first files): mean {:.4f} mm, "
+            "max {:.4f} mm, RMS {:.4f} mm, {} samples\n",
+            sync.mean_m * 1e3, sync.max_m * 1e3, sync.rms_m * 1e3, sync.samples);
       }
     }
     exit_code = 0;

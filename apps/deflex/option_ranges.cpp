@@ -24,7 +24,7 @@ bool ends_with(std::string_view s, std::string_view suffix) {
 // The range of a numeric option, by its long name. Exact names first (where the unit alone is too
 // wide: a period of 1e-9 ms would spin, a count of 1e9 poses would never end), then unit suffixes.
 InputRange option_range(const std::string& name, bool integer) {
-  static const std::array<std::pair<std::string_view, InputRange>, 11> kByName{{
+  static const std::array<std::pair<std::string_view, InputRange>, 12> kByName{{
       {"--period-ms", range::kPeriodMs},
       {"--threads", {"thread count", "", 0.0, 256.0}},
       {"--seeds", {"seed count", "", 1.0, 1000.0}},
@@ -36,6 +36,7 @@ InputRange option_range(const std::string& name, bool integer) {
       {"--max-relative-std-error", {"relative standard error", "", 1e-6, 1e3}},
       {"--rsi-monitor-factor", {"factor", "", 0.0, 1000.0}},
       {"--rotation-scale-m", {"length", "m", 1e-6, 100.0}},
+      {"--clock-offset-s", range::kTimeS},  // a clock difference: either sign
   }};
   for (const auto& [n, r] : kByName) {
     if (name == n) {

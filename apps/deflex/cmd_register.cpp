@@ -1,0 +1,168 @@
+// `deflex register`: the tracker-to-base transform from points (and circles) measured in both frames.
+#include <iostream>
+#include <map>
+#include <memory>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "cli_util.hpp"
+#include "command.hpp"
+#include "deflex/evaluate/frame_registration.hpp"
+#include "deflex/evaluate/tracker_files.hpp"
+#include "deflex/model/errors.hpp"
+#include "deflex/model/output_file.hpp"
+#include "tracker_options.hpp"
+
+namespace deflex::cli {
+namespace {
+
+struct RegisterOpts {
+  std::string tracker, base, out;
+  std::vector<std::string> tracker_circles, base_circles;
+  bool json = false;
+  TrackerReadOptions read;
+};
+
+// Pairs the points: by name when both files name them (every name in both, nothing left over), else by
+// order (equal counts).
+void pair_points(const TrackerFile& t, const TrackerFile& b, RegistrationInput& in) {
+  if (t.has_names && b.has_names) {
+    std::map<std::string, Vector3> base;
+    for (const auto& p : b.points) {
+      if (!base.emplace(p.name, p.p_m).second) {
+        throw DataError(fmt::format("{}:{}: point '{}' named twice", b.source, p.line, p.name));
+      }
+    }
+    std::set<std::string> seen;
+    for (const auto& p : t.points) {
+      if (!seen.insert(p.name).second) throw DataError(fmt::format("{}:{}: point '{}' named twice", t.source, p.line, p.name));
+      const auto it = base.find(p.name);
+      if (it == base.end()) {
+        throw DataError(fmt::format("{}:{}: point '{}' is not in {} (pairs are made by name)", t.source, p.line, p.name,
+                                    b.source));
+      }
+      in.tracker_m.push_back(p.p_m);
+      in.base_m.push_back(it->second);
+      in.names.push_back(p.name);
+    }
+    for (const auto& p : b.points) {
+      if (seen.count(p.name) == 0) {
+        throw DataError(fmt::format("{}:{}: point '{}' is not in {} (pairs are made by name)", b.source, p.line, p.name,
+                                    t.source));
+      }
+    }
+    return;
+  }
+  if (t.points.size() != b.points.size()) {
+    throw DataError(fmt::format("{} has {} point(s) and {} has {}: without names on both sides they pair by order and "
+                                "must be as many",
+                                t.source, t.points.size(), b.source, b.points.size()));
+  }
+  for (std::size_t i = 0; i < t.points.size(); ++i) {
+    in.tracker_m.push_back(t.points[i].p_m);
+    in.base_m.push_back(b.points[i].p_m);
+    in.names.push_back(t.has_names ? t.points[i].name : fmt::format("point {} (line {})", i + 1, t.points[i].line));
+  }
+}
+
+CircleFit circle_of(const std::string& path, const TrackerReadOptions& read) {
+  const TrackerFile f = read_tracker_file(path, read);
+  std::vector<Vector3> pts;
+  for (const auto& p : f.points) pts.push_back(p.p_m);
+  return fit_circle(pts, path);
+}
+
+void setup_register(CLI::App& sub, int& exit_code) {
+  auto o = std::make_shared<RegisterOpts>();
+  sub.add_option("--tracker", o->tracker,
+                 "Points measured by the tracker, in its frame (SA export or CSV x_mm,y_mm,z_mm); named points pair "
+                 "with --base by name, unnamed ones by order");
+  sub.add_option("--base", o->base, "The same points in the robot's base frame (SA export or CSV)");
+  sub.add_option("--tracker-circle", o->tracker_circles,
+                 "Points measured in order along a circle (a joint turned alone, or the TCP on a commanded circle); "
+                 "repeat for several circles");
+  sub.add_option("--base-circle", o->base_circles,
+                 "The same circle in the base frame, in the same direction of travel (e.g. the commanded path); one "
+                 "per --tracker-circle, in the same order");
+  sub.add_option("-o,--out", o->out, "Frame file to write (YAML), for deflex evaluate --tracker-frame")->required();
+  add_tracker_format_options(sub, o->read);
+  sub.add_flag("--json", o->json, "Print one JSON document on stdout");
+  sub.callback([o, &exit_code] {
+    if (o->tracker.empty() != o->base.empty()) throw InputError("options --tracker and --base: give both or neither");
+    if (o->tracker_circles.size() != o->base_circles.size()) {
+      throw InputError(fmt::format("{} --tracker-circle and {} --base-circle: one base circle per tracker circle",
+                                   o->tracker_circles.size(), o->base_circles.size()));
+    }
+    OutputFile out(o->out, "option --out");
+    RegistrationInput in;
+    std::string tracker_frame;
+    TrackerReadOptions base_read = o->read;
+    base_read.expect_frame.clear();  // the base files are in the robot's frame, whatever they call it
+    if (!o->tracker.empty()) {
+      const TrackerFile t = read_tracker_file(o->tracker, o->read);
+      const TrackerFile b = read_tracker_file(o->base, base_read);
+      tracker_frame = t.frame;
+      pair_points(t, b, in);
+    }
+    for (std::size_t k = 0; k < o->tracker_circles.size(); ++k) {
+      in.tracker_circles.push_back(circle_of(o->tracker_circles[k], o->read));
+      in.base_circles.push_back(circle_of(o->base_circles[k], base_read));
+    }
+    const FrameRegistration r = register_frames(in);
+    TrackerFrame frame;
+    frame.base_T_tracker = r.base_T_tracker;
+    frame.tracker_frame = tracker_frame;
+    frame.rms_m = r.rms_m;
+    frame.max_m = r.max_m;
+    frame.points = r.points;
+    frame.circles = r.circles;
+    write_tracker_frame(frame, out);
+    out.commit();
+    const Eigen::Quaterniond q(r.base_T_tracker.linear());
+    const Vector3 t = r.base_T_tracker.translation();
+    if (o->json) {
+      nlohmann::json residuals = nlohmann::json::array();
+      for (const auto& e : r.residuals) residuals.push_back({{"name", e.name}, {"distance_mm", e.distance_m * 1e3}});
+      nlohmann::json circles = nlohmann::json::array();
+      for (std::size_t k = 0; k < r.circles; ++k) {
+        circles.push_back({{"tracker_radius_mm", in.tracker_circles[k].radius_m * 1e3},
+                           {"base_radius_mm", in.base_circles[k].radius_m * 1e3},
+                           {"tracker_fit_rms_mm", in.tracker_circles[k].rms_m * 1e3},
+                           {"axis_error_mrad", r.circle_axis_error_rad[k] * 1e3}});
+      }
+      print_json({{"frame_file", o->out},
+                  {"tracker_frame", tracker_frame},
+                  {"position_mm", {t.x() * 1e3, t.y() * 1e3, t.z() * 1e3}},
+                  {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}},
+                  {"rms_mm", r.rms_m * 1e3},
+                  {"max_mm", r.max_m * 1e3},
+                  {"residuals", residuals},
+                  {"circles", circles}});
+    } else {
+      std::cout << fmt::format("Tracker frame{} -> robot base: {} point pair(s), {} circle(s)\n",
+                               tracker_frame.empty() ? "" : fmt::format(" '{}'", tracker_frame), r.points, r.circles);
+      std::cout << fmt::format("  position {:.4f}, {:.4f}, {:.4f} mm; quaternion w x y z {:.9f}, {:.9f}, {:.9f}, {:.9f}\n",
+                               t.x() * 1e3, t.y() * 1e3, t.z() * 1e3, q.w(), q.x(), q.y(), q.z());
+      std::cout << "  residual per point, mm:\n";
+      for (const auto& e : r.residuals) std::cout << fmt::format("    {:<28} {:.4f}\n", e.name, e.distance_m * 1e3);
+      for (std::size_t k = 0; k < r.circles; ++k) {
+        std::cout << fmt::format("  circle {}: radius {:.4f} mm measured, {:.4f} mm in the base frame; fit RMS {:.4f} mm; "
+                                 "axis {:.3f} mrad off after the transform\n",
+                                 k + 1, in.tracker_circles[k].radius_m * 1e3, in.base_circles[k].radius_m * 1e3,
+                                 in.tracker_circles[k].rms_m * 1e3, r.circle_axis_error_rad[k] * 1e3);
+      }
+      std::cout << fmt::format("  RMS {:.4f} mm, max {:.4f} mm; written to {}\n", r.rms_m * 1e3, r.max_m * 1e3, o->out);
+    }
+    exit_code = 0;
+  });
+}
+
+}  // namespace
+
+DEFLEX_COMMAND("register",
+               "The tracker-to-robot-base transform from points (and circles) measured in both frames, for "
+               "deflex evaluate --tracker-frame: residual per point in mm",
+               setup_register, 61);
+
+}  // namespace deflex::cli
