@@ -13,6 +13,7 @@
 #include "cli_util.hpp"
 #include "command.hpp"
 #include "deflex/study/case_study.hpp"
+#include "deflex/evaluate/tracker_files.hpp"
 #include "deflex/evaluate/study_tables.hpp"
 #include "deflex/evaluate/tracker_trace.hpp"
 #include "deflex/model/errors.hpp"
@@ -136,9 +137,17 @@ void run(const CaseStudyOpts& o, int& exit_code) {
     if (ec) throw Error(fmt::format("{}: cannot create the directory: {}", o.traces_dir, ec.message()));
     options.trace_sink = [&](const std::string& name, const TrackerTrace& trace) {
       const std::string path = (std::filesystem::path(o.traces_dir) / (name + ".csv")).string();
+      // The same run as a Spatial Analyzer ASCII export, as a tracker session leaves it (the simulated
+      // tracker measures in the robot's base frame, so that is the working frame it names).
+      const std::string sa_path = (std::filesystem::path(o.traces_dir) / (name + ".sa.txt")).string();
+      SaExportOptions sa;
+      sa.frame = "Robot Base";
+      sa.group = name;
       const std::lock_guard lock(trace_mutex);
       write_tracker_csv(trace, outputs.add(path, "option --write-traces"));
+      write_sa_export(trace, outputs.add(sa_path, "option --write-traces"), sa);
       traces_written.push_back(path);
+      traces_written.push_back(sa_path);
     };
   }
   const int seeds = o.seeds > 0 ? o.seeds : config.seeds;
@@ -227,7 +236,8 @@ void setup(CLI::App& sub, int& exit_code) {
                  "Seeds to run, from --seed up: each its own cell and runs; the tables give mean and spread "
                  "(default: the case file's protocol.seeds; 1..1000)");
   sub.add_option("--write-traces", o->traces_dir,
-                 "Directory for the simulated tracker CSVs of the first seed at the error budget's speed and each "
+                 "Directory for the simulated tracker runs (CSV and Spatial Analyzer export, .sa.txt) of the first seed at "
+                 "the error budget's speed and each "
                  "setup's highest load (unloaded, UC and C), to try `deflex evaluate` on");
   sub.add_option("--threads", o->threads, "Worker threads, 0..256 (default 0: one per hardware thread)");
   sub.add_flag("--json", o->json, "Print only the JSON document of the results on stdout");
