@@ -6,12 +6,24 @@
 
 #include "arrays.hpp"
 #include "bindings.hpp"
+#include "deflex/evaluate/frame_registration.hpp"
 #include "deflex/evaluate/iso9283_path.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
+#include "deflex/evaluate/time_alignment.hpp"
+#include "deflex/evaluate/tracker_files.hpp"
 
 namespace deflex::python {
 using namespace pybind11::literals;
 namespace {
+
+// (N, 3) points in m.
+std::vector<Vector3> points_of(const py::handle& obj, const char* name) {
+  const TrackerTrace t = tracker_trace(obj, name);
+  std::vector<Vector3> out;
+  out.reserve(t.size());
+  for (const auto& s : t) out.push_back(s.p_m);
+  return out;
+}
 
 std::vector<TrackerTrace> traces(const py::handle& list, const char* name) {
   std::vector<TrackerTrace> out;
@@ -95,6 +107,91 @@ void bind_evaluate(py::module_& m) {
       "ISO 9283 path accuracy and repeatability of repeated runs (a list of traces) against the commanded or "
       "unloaded reference.");
   m.def("compensation_ratio", &compensation_ratio, "uc"_a, "c"_a, "1 - C/UC (NaN when UC is not positive).");
+
+  // Tracker sessions: SA exports and unit-named CSV, registration, time alignment (docs/evaluation.md).
+  m.def(
+      "read_tracker_file",
+      [](const py::object& path, const std::string& length_unit, const std::string& angle_unit,
+         const std::string& columns, const std::string& expect_frame) {
+        TrackerReadOptions o{length_unit, angle_unit, columns, expect_frame};
+        const TrackerFile f = read_tracker_file(py::str(path).cast<std::string>(), o);
+        Array a = new_array({static_cast<py::ssize_t>(f.points.size()), 4});
+        auto v = a.mutable_unchecked<2>();
+        py::list names;
+        for (std::size_t i = 0; i < f.points.size(); ++i) {
+          const auto& p = f.points[i];
+          v(static_cast<py::ssize_t>(i), 0) = p.t_s;
+          for (int k = 0; k < 3; ++k) v(static_cast<py::ssize_t>(i), k + 1) = p.p_m[k];
+          names.append(p.name);
+        }
+        py::dict d;
+        d["points"] = a;
+        d["names"] = names;
+        d["frame"] = f.frame;
+        d["format"] = f.format;
+        d["coordinates"] = f.coordinates;
+        d["length_unit"] = f.length_unit;
+        d["has_time"] = f.has_time;
+        return d;
+      },
+      "path"_a, "length_unit"_a = "", "angle_unit"_a = "", "columns"_a = "", "expect_frame"_a = "",
+      "A Spatial Analyzer ASCII export or a CSV with the unit in its header (x_mm or x_m): a dict with 'points' "
+      "(N, 4) [t_s (NaN without stamps), x_m, y_m, z_m] in the file's frame, 'names', 'frame', 'format', "
+      "'coordinates', 'length_unit', 'has_time'. Units are never guessed: give length_unit when the header names "
+      "none.");
+  m.def(
+      "write_sa_export",
+      [](const py::object& path, const py::handle& trace, const std::string& frame) {
+        SaExportOptions o;
+        o.frame = frame;
+        write_sa_export(tracker_trace(trace, "trace"), py::str(path).cast<std::string>(), o);
+      },
+      "path"_a, "trace"_a, "frame"_a = "Robot Base",
+      "Writes an (N, 4) trace [t_s, x_m, y_m, z_m] as a Spatial Analyzer ASCII export (mm, named working frame).");
+  m.def(
+      "register_frames",
+      [](const py::handle& tracker_points, const py::handle& base_points) {
+        RegistrationInput in;
+        in.tracker_m = points_of(tracker_points, "tracker_points");
+        in.base_m = points_of(base_points, "base_points");
+        const FrameRegistration r = register_frames(in);
+        std::vector<double> res;
+        for (const auto& e : r.residuals) res.push_back(e.distance_m);
+        py::dict d;
+        d["base_T_tracker"] = from_pose(r.base_T_tracker);
+        d["rms_m"] = r.rms_m;
+        d["max_m"] = r.max_m;
+        d["residuals_m"] = from_vector(res);
+        return d;
+      },
+      "tracker_points"_a, "base_points"_a,
+      "The tracker-to-base transform (4x4, p_base = T p_tracker) from paired (N, 3) points in m, by Horn's closed "
+      "form, with the residual of each point; refuses fewer than 3 points or points on a line.");
+  m.def(
+      "align_time",
+      [](const py::handle& measured, const py::handle& commanded, bool fit_drift, double search_s, double centre_s) {
+        const TrackerTrace mt = tracker_trace(measured, "measured"), ct = tracker_trace(commanded, "commanded");
+        TimeAlignmentOptions o;
+        o.fit_drift = fit_drift;
+        o.search_s = search_s;
+        o.centre_s = centre_s;
+        TimeAlignment a;
+        {
+          py::gil_scoped_release release;
+          a = align_time(mt, ct, o);
+        }
+        py::dict d;
+        d["offset_s"] = a.offset_s;
+        d["offset_std_s"] = a.offset_std_s;
+        d["drift"] = a.drift;
+        d["reference_t_s"] = a.reference_t_s;
+        d["rms_m"] = a.rms_m;
+        d["samples"] = a.samples;
+        return d;
+      },
+      "measured"_a, "commanded"_a, "fit_drift"_a = false, "search_s"_a = 0.0, "centre_s"_a = 0.0,
+      "The clock offset (program time = tracker time + offset_s [+ drift (t - reference_t_s)]) that best puts the "
+      "measured (N, 4) trace on the commanded one, with its uncertainty from the spread over the run's blocks.");
 }
 
 }  // namespace deflex::python
