@@ -24,35 +24,60 @@ struct RegisterOpts {
   TrackerReadOptions read;
 };
 
-// Pairs the points: by name when both files name them (every name in both, nothing left over), else by
-// order (equal counts).
+// The target's own name: the last part of "Collection::Group::Target".
+std::string target_of(const std::string& name) {
+  const auto at = name.rfind("::");
+  return at == std::string::npos ? name : name.substr(at + 2);
+}
+
+// Pairs by the key `key_of` gives each point: every key once on each side, and the same keys on both.
+// Returns false (and pairs nothing) when the key sets differ; throws for a repeated key.
+bool pair_by(const TrackerFile& t, const TrackerFile& b, std::string (*key_of)(const std::string&),
+             RegistrationInput& in) {
+  std::map<std::string, const TrackerPoint*> base, tracker;
+  for (const auto* f : {&b, &t}) {
+    auto& into = f == &b ? base : tracker;
+    for (const auto& p : f->points) {
+      if (!into.emplace(key_of(p.name), &p).second) {
+        throw DataError(fmt::format("{}:{}: point '{}' named twice", f->source, p.line, key_of(p.name)));
+      }
+    }
+  }
+  for (const auto& [key, p] : tracker) {
+    if (base.count(key) == 0) return false;
+  }
+  if (base.size() != tracker.size()) return false;
+  for (const auto& p : t.points) {
+    in.tracker_m.push_back(p.p_m);
+    in.base_m.push_back(base.at(key_of(p.name))->p_m);
+    in.names.push_back(key_of(p.name));
+  }
+  return true;
+}
+
+std::string whole_name(const std::string& name) { return name; }
+
+// Pairs the points: by name when both files name them (the whole name, else the target's own name:
+// "Job::Reference::REF1" pairs with "REF1"), else by order (equal counts).
 void pair_points(const TrackerFile& t, const TrackerFile& b, RegistrationInput& in) {
   if (t.has_names && b.has_names) {
-    std::map<std::string, Vector3> base;
-    for (const auto& p : b.points) {
-      if (!base.emplace(p.name, p.p_m).second) {
-        throw DataError(fmt::format("{}:{}: point '{}' named twice", b.source, p.line, p.name));
-      }
-    }
-    std::set<std::string> seen;
+    if (pair_by(t, b, whole_name, in) || pair_by(t, b, target_of, in)) return;
+    std::set<std::string> base;
+    for (const auto& p : b.points) base.insert(target_of(p.name));
     for (const auto& p : t.points) {
-      if (!seen.insert(p.name).second) throw DataError(fmt::format("{}:{}: point '{}' named twice", t.source, p.line, p.name));
-      const auto it = base.find(p.name);
-      if (it == base.end()) {
-        throw DataError(fmt::format("{}:{}: point '{}' is not in {} (pairs are made by name)", t.source, p.line, p.name,
-                                    b.source));
+      if (base.count(target_of(p.name)) == 0) {
+        throw DataError(fmt::format("{}:{}: point '{}' is not in {} (pairs are made by name)", t.source, p.line,
+                                    p.name, b.source));
       }
-      in.tracker_m.push_back(p.p_m);
-      in.base_m.push_back(it->second);
-      in.names.push_back(p.name);
+      base.erase(target_of(p.name));
     }
+    const std::string left = *base.begin();
     for (const auto& p : b.points) {
-      if (seen.count(p.name) == 0) {
-        throw DataError(fmt::format("{}:{}: point '{}' is not in {} (pairs are made by name)", b.source, p.line, p.name,
-                                    t.source));
+      if (target_of(p.name) == left) {
+        throw DataError(fmt::format("{}:{}: point '{}' is not in {} (pairs are made by name)", b.source, p.line,
+                                    p.name, t.source));
       }
     }
-    return;
   }
   if (t.points.size() != b.points.size()) {
     throw DataError(fmt::format("{} has {} point(s) and {} has {}: without names on both sides they pair by order and "
