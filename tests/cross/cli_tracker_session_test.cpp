@@ -23,15 +23,15 @@ using test::run_cli;
 
 const std::string kExamples = std::string(DEFLEX_SOURCE_DIR) + "/examples/evaluate/";
 
-struct Session {
+struct TrackerSession {
   fs::path dir = fs::temp_directory_path() / ("deflex_tracker_session_" + std::to_string(::getpid()));
   Pose base_T_tracker = Pose::Identity();
-  Session() {
+  TrackerSession() {
     fs::create_directories(dir);
     base_T_tracker.linear() = Eigen::AngleAxisd(-2.1, Vector3(0.1, 0.2, 1.0).normalized()).toRotationMatrix();
     base_T_tracker.translation() = Vector3(4.1, -2.3, 0.35);
   }
-  ~Session() { fs::remove_all(dir); }
+  ~TrackerSession() { fs::remove_all(dir); }
   // A base-frame CSV of the examples as an SA export in the tracker's frame (metres), stamped on a
   // clock `clock_s` ahead of the file's, 3 um noise.
   std::string export_run(const std::string& name, double clock_s, std::uint32_t seed) const {
@@ -59,7 +59,7 @@ struct Session {
 };
 
 TEST(CliTrackerSession, RegisteredAndAlignedRunsGiveTheBaseFrameFigures) {
-  Session s;
+  TrackerSession s;
   // Six named points measured in both frames (tracker in m, base in mm), 5 um noise on the tracker side.
   std::string base = "// Working Frame: Robot Base\n// Units: Millimeters\n";
   const std::vector<Vector3> pts{{1.5, -0.5, 0.5}, {2.2, -0.4, 0.7}, {1.8, 0.6, 0.4},
@@ -102,7 +102,7 @@ TEST(CliTrackerSession, RegisteredAndAlignedRunsGiveTheBaseFrameFigures) {
 }
 
 TEST(CliTrackerSession, BadFilesExitTwoNamingFileAndLine) {
-  Session s;
+  TrackerSession s;
   s.write("nounit.txt", "// Working Frame: T\nP1 1 2 3\nP2 1 2 3\n");
   s.write("ok.txt", "// Working Frame: T\n// Units: mm\n// Columns: target x y z time\nP1 1 2 3 0\nP2 1 2 3 0\n");
   s.write("line.txt", "// Units: mm\nA 0 0 0\nB 1 1 1\nC 2 2 2\n");

@@ -13,7 +13,7 @@
 namespace deflex {
 namespace {
 
-std::string error_of(const std::string& text, const TrackerReadOptions& o = {}) {
+std::string file_error_of(const std::string& text, const TrackerReadOptions& o = {}) {
   try {
     parse_tracker_file(text, "session.txt", o);
   } catch (const Error& e) {
@@ -145,33 +145,33 @@ TEST(TrackerFileCsv, MetresOrMillimetresNamedInTheHeader) {
 
 TEST(TrackerFileErrors, EachNamesTheFileAndLine) {
   // No unit anywhere.
-  EXPECT_NE(error_of("P1 1 2 3\n").find("names no length unit"), std::string::npos);
-  EXPECT_NE(error_of("t_s,x,y,z\n0,1,2,3\n").find("no position columns with a unit"), std::string::npos);
+  EXPECT_NE(file_error_of("P1 1 2 3\n").find("names no length unit"), std::string::npos);
+  EXPECT_NE(file_error_of("t_s,x,y,z\n0,1,2,3\n").find("no position columns with a unit"), std::string::npos);
   // The header and the option disagree.
   TrackerReadOptions inch;
   inch.length_unit = "in";
-  EXPECT_NE(error_of("// Units: Millimeters\nP1 1 2 3\n", inch).find("session.txt:1: the header says mm"),
+  EXPECT_NE(file_error_of("// Units: Millimeters\nP1 1 2 3\n", inch).find("session.txt:1: the header says mm"),
             std::string::npos);
   // Mixed coordinate types: the header says one, the columns another; or two in the header.
-  EXPECT_NE(error_of("// Units: mm\n// Coordinate System: Cylindrical\nP1 1 2 3\n").find("mixed coordinate types"),
+  EXPECT_NE(file_error_of("// Units: mm\n// Coordinate System: Cylindrical\nP1 1 2 3\n").find("mixed coordinate types"),
             std::string::npos);
-  EXPECT_NE(error_of("// Units: mm\n// Cartesian\n// Spherical\nP1 1 2 3\n").find("session.txt:3: mixed coordinate"),
+  EXPECT_NE(file_error_of("// Units: mm\n// Cartesian\n// Spherical\nP1 1 2 3\n").find("session.txt:3: mixed coordinate"),
             std::string::npos);
   // Another working frame than expected, or none named.
   TrackerReadOptions frame;
   frame.expect_frame = "Tracker";
-  EXPECT_NE(error_of("// Working Frame: World\n// Units: mm\nP1 1 2 3\n", frame)
+  EXPECT_NE(file_error_of("// Working Frame: World\n// Units: mm\nP1 1 2 3\n", frame)
                 .find("session.txt:1: the working frame is 'World', not the expected 'Tracker'"),
             std::string::npos);
-  EXPECT_NE(error_of("// Units: mm\nP1 1 2 3\n", frame).find("names no working frame"), std::string::npos);
+  EXPECT_NE(file_error_of("// Units: mm\nP1 1 2 3\n", frame).find("names no working frame"), std::string::npos);
   // A line with another layout, a bad number, an ambiguous layout, an unknown column.
-  EXPECT_NE(error_of("// Units: mm\nP1 1 2 3\nP2 1 2\n").find("session.txt:3: 3 field(s)"), std::string::npos);
-  EXPECT_NE(error_of("// Units: mm\nP1 1 2 3\nP2 1 nan 3\n").find("session.txt:3: field 3"), std::string::npos);
-  EXPECT_NE(error_of("// Units: mm\n1 2 3 4\n").find("--sa-columns"), std::string::npos);
-  EXPECT_NE(error_of("// Units: mm\n// Columns: Target X Y Q\nP1 1 2 3\n").find("unknown column 'q'"),
+  EXPECT_NE(file_error_of("// Units: mm\nP1 1 2 3\nP2 1 2\n").find("session.txt:3: 3 field(s)"), std::string::npos);
+  EXPECT_NE(file_error_of("// Units: mm\nP1 1 2 3\nP2 1 nan 3\n").find("session.txt:3: field 3"), std::string::npos);
+  EXPECT_NE(file_error_of("// Units: mm\n1 2 3 4\n").find("--sa-columns"), std::string::npos);
+  EXPECT_NE(file_error_of("// Units: mm\n// Columns: Target X Y Q\nP1 1 2 3\n").find("unknown column 'q'"),
             std::string::npos);
-  EXPECT_NE(error_of("// Units: mm\n").find("no points"), std::string::npos);
-  EXPECT_NE(error_of("// Units: mm\nP1 1 2 3\n// Units: m\nP2 1 2 3\n").find("session.txt:3"), std::string::npos);
+  EXPECT_NE(file_error_of("// Units: mm\n").find("no points"), std::string::npos);
+  EXPECT_NE(file_error_of("// Units: mm\nP1 1 2 3\n// Units: m\nP2 1 2 3\n").find("session.txt:3"), std::string::npos);
 }
 
 TEST(TrackerFileErrors, TimeBasedWorkNeedsIncreasingStamps) {

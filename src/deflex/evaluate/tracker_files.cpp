@@ -273,7 +273,7 @@ void read_comment(std::string_view body, int line, const std::string& source, He
   }
 }
 
-bool is_number(const std::string& s) { return parse_double(s).has_value(); }
+bool is_sa_number(const std::string& s) { return parse_double(s).has_value(); }
 
 // The layout of a file that declares none: up to three text names, then x y z and, optionally, a
 // calendar time stamp. Anything else could be read two ways and is refused.
@@ -281,7 +281,7 @@ Layout inferred_layout(const std::vector<std::string>& f, const std::string& sou
   Layout l;
   l.coordinates = "cartesian";
   std::size_t k = 0;
-  while (k < f.size() && !is_number(f[k]) && !date_time(f[k])) {
+  while (k < f.size() && !is_sa_number(f[k]) && !date_time(f[k])) {
     l.cols.push_back(Col::kName);
     ++k;
   }
