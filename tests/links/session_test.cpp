@@ -24,7 +24,7 @@ namespace fs = std::filesystem;
 
 using test::pose_deg;
 
-TEST(Session, ThePollDoesNotAllocateWithTheLogTheDumpAndASinkOn) {
+TEST(Session, ThePollDoesNotAllocateWithTheLogTheDumpASinkAndTheMonitorOn) {
   const RobotModel robot = test::bench_robot();
   const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
   const auto program = test::sweep_program(robot, q0, pose_deg(8, -3, 4, 10, -5, 12), 10.0);
@@ -40,6 +40,7 @@ TEST(Session, ThePollDoesNotAllocateWithTheLogTheDumpAndASinkOn) {
   c.log_path = dir + "/log.csv";
   c.fault_dump_path = dir + "/dump.csv";
   c.status_interval_s = 0.1;
+  c.monitor = true;  // the live page's feed: filled by the reporter, never by the loop
   std::size_t lines = 0;
   test::ConstantForce force;
   force.reading = test::reading_at(robot, q0, Vector3(0, 0, -500));
@@ -73,9 +74,12 @@ TEST(Session, ThePollDoesNotAllocateWithTheLogTheDumpAndASinkOn) {
   EXPECT_EQ(s.log_dropped, 0u);
   EXPECT_GT(lines, 10u);  // status lines reached the sink
   std::ifstream log(c.log_path);
-  std::size_t rows = 0;
-  for (std::string line; std::getline(log, line);) ++rows;
+  std::size_t rows = 0, comments = 0;
+  for (std::string line; std::getline(log, line);) (line.rfind('#', 0) == 0 ? comments : rows) += 1;
   EXPECT_EQ(rows, 1 + s.cycles);  // the header and every cycle
+  EXPECT_EQ(comments, 1u);        // the link and its bounds, for deflex monitor --log
+  ASSERT_TRUE(session.monitor_feed());
+  EXPECT_EQ(session.monitor_feed()->rows_added(), s.cycles);  // every cycle reached the page's feed
 }
 
 TEST(Session, OptionsThatCannotWorkAreRefusedNamingThem) {

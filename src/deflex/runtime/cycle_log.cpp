@@ -65,7 +65,9 @@ void append_cycle_row(std::string& out, const SessionEntry& e, int joints) {
                  c.step_limited);
 }
 
-CycleLogFile::CycleLogFile(const std::string& path, int joints) : file_(path, "option --log"), joints_(joints) {
+CycleLogFile::CycleLogFile(const std::string& path, int joints, const std::string& comment)
+    : file_(path, "option --log"), joints_(joints) {
+  if (!comment.empty()) file_.write("# " + comment + "\n");
   file_.write(cycle_log_header(joints));
   row_.reserve(4096);
 }

@@ -26,8 +26,9 @@ void append_cycle_row(std::string& out, const SessionEntry& e, int joints);
 class CycleLogFile {
  public:
   /// Prepares `path` now, so a path that cannot be an output is an error at the session's start, and
-  /// writes the header. Throws InputError naming the option and the path.
-  CycleLogFile(const std::string& path, int joints);
+  /// writes the header, after `comment` as a '#' line when given (the link and its bounds, which
+  /// `deflex monitor --log` draws). Throws InputError naming the option and the path.
+  CycleLogFile(const std::string& path, int joints, const std::string& comment = "");
 
   void write(const SessionEntry& e);
   /// Puts the log in place; throws OutputError naming the path when a write failed (a full disk).

@@ -30,6 +30,9 @@ void check_config(const SessionConfig& c, const LinkKindInfo& kind, const JointT
   };
   non_negative(c.duration_s, "--duration-s");
   non_negative(c.status_interval_s, "--status-interval-s");
+  if (c.monitor && !(c.monitor_window_s >= 1.0 && c.monitor_window_s <= 3600.0)) {
+    throw InputError(fmt::format("option --monitor-window-s: 1..3600 s (got {})", c.monitor_window_s));
+  }
   if (!std::isfinite(c.fault_quiet_s) || !(c.fault_quiet_s > 0.0)) {
     throw InputError("session: the fault episode's quiet time must be > 0 s");
   }
@@ -61,7 +64,7 @@ Session::Session(const SessionConfig& config, const RobotModel& robot, const Sen
   open_link(endpoints, force, std::move(program));
 
   reporting_ = !config_.log_path.empty() || !config_.fault_dump_path.empty() || static_cast<bool>(sink_) ||
-               config_.collect_cycles;
+               config_.collect_cycles || config_.monitor;
   entry_.record = link_->history().blank();
   if (reporting_) {
     ReportSetup setup;
@@ -81,6 +84,17 @@ Session::Session(const SessionConfig& config, const RobotModel& robot, const Sen
     setup.status_interval_s = config_.status_interval_s > 0.0 ? config_.status_interval_s : 1e300;
     setup.collect = config_.collect_cycles;
     setup.sink = sink_;
+    if (config_.monitor) {
+      MonitorSetup ms;
+      ms.link = info.name;
+      ms.joints = robot.dof();
+      ms.joint_bound_deg = rad_to_deg(setup.limits.joint_bound_rad);
+      ms.tcp_bound_mm = setup.limits.tcp_bound_m * 1e3;
+      ms.program_duration_s = setup.program_duration_s;
+      ms.window_s = config_.monitor_window_s;
+      monitor_ = std::make_shared<MonitorFeed>(ms);
+      setup.monitor = monitor_;
+    }
     reporter_ = std::make_unique<SessionReporter>(std::move(setup));
     queue_ = std::make_unique<SpscRing<SessionEntry>>(config_.queue_entries, entry_);
   }

@@ -65,6 +65,8 @@ struct SessionConfig {
   double fault_quiet_s = 1.0;            ///< a fault episode ends after this long without a fault
   std::size_t queue_entries = 8192;      ///< the loop-to-reporter ring (32 s of 4 ms cycles)
   bool collect_cycles = false;           ///< keep every cycle in memory (Python's cycle log)
+  bool monitor = false;                  ///< feed the live monitor page (monitor_feed() gives its data)
+  double monitor_window_s = 30.0;        ///< the history the page keeps and shows
   RealtimeOptions realtime;
 };
 
@@ -145,6 +147,8 @@ class Session {
   /// The cycles kept (collect_cycles), oldest first; read after finish() or between service() calls.
   [[nodiscard]] const std::vector<LinkCycleRecord>& collected() const;
   [[nodiscard]] const SessionReporter* reporter() const { return reporter_.get(); }
+  /// The live monitor's data (null unless config.monitor): filled by the reporter, read by a server.
+  [[nodiscard]] std::shared_ptr<MonitorFeed> monitor_feed() const { return monitor_; }
 
  private:
   void open_link(const SessionEndpoints& endpoints, ForceSource* force, std::shared_ptr<const JointTrajectory> program);
@@ -174,6 +178,7 @@ class Session {
   SessionEntry entry_;
   std::atomic<std::uint64_t> dropped_{0};
   std::unique_ptr<SessionReporter> reporter_;
+  std::shared_ptr<MonitorFeed> monitor_;
   std::thread reporter_thread_;
   std::atomic<bool> reporter_stop_{false};
   bool started_ = false, finished_ = false;

@@ -32,7 +32,15 @@ double Histogram::quantile(double q) const {
 }
 
 SessionReporter::SessionReporter(ReportSetup setup) : setup_(std::move(setup)) {
-  if (!setup_.log_path.empty()) log_ = std::make_unique<CycleLogFile>(setup_.log_path, setup_.joints);
+  if (!setup_.log_path.empty()) {
+    // The link and its bounds as a comment line: what `deflex monitor --log` needs to draw them.
+    const std::string comment =
+        fmt::format("deflex cycle log: link={} joints={} period_ms={:.6g} joint_bound_deg={:.9g} tcp_bound_mm={:.9g} "
+                    "program_duration_s={:.9g}",
+                    setup_.link_name, setup_.joints, setup_.period_s * 1e3, rad_to_deg(setup_.limits.joint_bound_rad),
+                    setup_.limits.tcp_bound_m * 1e3, setup_.program_duration_s);
+    log_ = std::make_unique<CycleLogFile>(setup_.log_path, setup_.joints, comment);
+  }
   // Checked now: a path that cannot be written must not end a run at its first fault.
   if (!setup_.dump_path.empty()) check_fault_dump_path(setup_.dump_path);
   SessionEntry blank;
@@ -52,6 +60,10 @@ void SessionReporter::consume(const SessionEntry& e) {
     next_status_s_ = e.t_s + setup_.status_interval_s;
   }
   if (e.kind == SessionEntry::Kind::kCycle) on_cycle(e);
+  if (setup_.monitor) {
+    setup_.monitor->add(e);
+    if (!have_last_ || last_.state != e.state) setup_.monitor->set_state(to_string(e.state));
+  }
   last_ = e;
   have_last_ = true;
 }
@@ -168,6 +180,7 @@ void SessionReporter::write_dump(const std::string& why) {
 }
 
 void SessionReporter::end(double now_s, StopReason reason, const std::string& reason_text) {
+  if (setup_.monitor) setup_.monitor->set_state("ended", reason_text);
   if (in_episode_) {
     in_episode_ = false;
     log(LogLevel::kInfo, fmt::format("fault episode {} ended with the session: {} faulted cycles over {:.2f} s",

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "deflex/runtime/cycle_log.hpp"
+#include "deflex/runtime/monitor_feed.hpp"
 #include "deflex/runtime/stop_reason.hpp"
 
 namespace deflex::runtime {
@@ -55,6 +56,7 @@ struct ReportSetup {
   double status_interval_s = 1.0;
   bool collect = false;        ///< keep every cycle's record (Python's cycle log)
   LogSink sink;
+  std::shared_ptr<MonitorFeed> monitor;  ///< the live page's data (null: no monitor)
 };
 
 class SessionReporter {
