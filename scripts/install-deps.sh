@@ -12,6 +12,10 @@ packages=(
   libspdlog-dev libxml2-dev
   # libcurl: an RDT force sensor's calibration page (netftapi2.xml) fetched from the sensor over HTTP
   libcurl4-openssl-dev
+  # cpp-httplib: the live monitor page's server (deflex online --monitor, deflex monitor)
+  libcpp-httplib-dev
+  # chromium: the tests open the monitor page in headless Chromium and read what it shows
+  chromium
   python3 python3-dev python3-numpy python3-pytest pybind11-dev
 )
 missing=()

@@ -4,16 +4,20 @@
 // the status, the summary) and prints what it says; the exit code is the session's stop reason's
 // (docs/online.md, "Faults and exit codes").
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <thread>
 
 #include <fmt/format.h>
 
 #include "cli_util.hpp"
 #include "command.hpp"
+#include "deflex/monitor/cycle_log_reader.hpp"
+#include "deflex/monitor/monitor_server.hpp"
 #include "field_log.hpp"
 #include "deflex/force/force_spec.hpp"
 #include "deflex/model/errors.hpp"
@@ -48,6 +52,10 @@ struct OnlineOpts {
          watchdog_ms = 50.0;
   double end_silence_s = 2.0, stop_silence_s = 0.0, duration_s = 0.0, status_s = 1.0;
   bool loop = false, json = false, end_on_silence = false;
+  // The live monitor page.
+  std::string monitor;
+  bool monitor_remote = false, log_report = false;
+  double monitor_window_s = 30.0, monitor_linger_s = 0.0;
   // Real time.
   bool realtime = false, rt_no_mlock = false;
   int rt_priority = 80, rt_cpu = -1;
@@ -270,6 +278,8 @@ runtime::SessionConfig session_config(const OnlineOpts& o, const CLI::App& sub) 
   c.status_interval_s = o.status_s;
   c.log_path = o.log;
   c.fault_dump_path = o.fault_dump;
+  c.monitor = !o.monitor.empty();
+  c.monitor_window_s = o.monitor_window_s;
   c.realtime.enabled = o.realtime;
   c.realtime.priority = o.rt_priority;
   c.realtime.cpu = o.rt_cpu;
@@ -378,7 +388,19 @@ void tare_sensor(const OnlineOpts& o, const RobotModel& model, const SensorConfi
   log.info("tare: {}", describe(force.rdt->tare(ts), ts));
 }
 
+// Where --log-report writes: beside the log, .html for its .csv.
+std::string log_report_path(const std::string& log) {
+  const std::string csv = ".csv";
+  if (log.size() > csv.size() && log.compare(log.size() - csv.size(), csv.size(), csv) == 0) {
+    return log.substr(0, log.size() - csv.size()) + ".html";
+  }
+  return log + ".html";
+}
+
 void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
+  if (o.log_report && o.log.empty()) throw InputError("option --log-report: needs --log (the report draws the log)");
+  if (!o.monitor.empty()) (void)monitor::parse_monitor_address(o.monitor, o.monitor_remote, "--monitor");
+  if (o.monitor_remote && o.monitor.empty()) throw InputError("option --monitor-remote: only with --monitor");
   const runtime::SessionConfig config = session_config(o, sub);
   const runtime::LinkKindInfo& info = runtime::link_kind(config.link);
   const RobotModel model = load_cli_robot("online", o.robot);
@@ -415,6 +437,14 @@ void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
                                case runtime::LogLevel::kError: log->error("{}", text); break;
                              }
                            });
+  // The monitor binds before anything is answered: a port in use is an error now, not mid-session.
+  std::unique_ptr<monitor::MonitorServer> monitor_server;
+  if (config.monitor) {
+    monitor_server = std::make_unique<monitor::MonitorServer>(
+        session.monitor_feed(), monitor::parse_monitor_address(o.monitor, o.monitor_remote, "--monitor"));
+    log->info("monitor on {} (the last {:g} s of the session, 10 updates a second)", monitor_server->url(),
+              o.monitor_window_s);
+  }
   if (info.streams_program && !model.has_max_speed()) {
     log->warn("the robot file gives no joint speed limits, so the program's speeds were not checked (add max_speed "
               "to the robot file)");
@@ -454,6 +484,17 @@ void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
   exit_code = summary.exit_code;
   // A session that ended as planned but whose cycle log could not be written failed all the same.
   if (!summary.output_error.empty() && exit_code == 0) exit_code = 1;
+  if (o.log_report && summary.output_error.empty()) {
+    const std::string report = log_report_path(o.log);
+    write_output_file(report, monitor::monitor_report(*monitor::read_cycle_log_feed(o.log),
+                                                      fmt::format("deflex online: {} ({})", o.log, summary.reason_text)),
+                      "option --log-report");
+    log->info("the session's charts: {}", report);
+  }
+  if (monitor_server && o.monitor_linger_s > 0.0) {
+    log->info("monitor: the page stays up {:g} s more (--monitor-linger-s)", o.monitor_linger_s);
+    std::this_thread::sleep_for(std::chrono::duration<double>(o.monitor_linger_s));
+  }
 }
 
 void setup_online(CLI::App& sub, int& exit_code) {
@@ -508,6 +549,18 @@ void setup_online(CLI::App& sub, int& exit_code) {
                "egm-path, rsi: a silence longer than --stop-silence-s after a healthy session is the planned end (the "
                "program's EGMStop or RSI_OFF): exit 0 instead of 5");
   sub.add_option("--log", o->log, "CSV log of every cycle (written off the loop's thread)");
+  sub.add_flag("--log-report", o->log_report,
+               "At the end, write the monitor's charts of the whole --log beside it (LOG with .html for .csv): a "
+               "static page for a commissioning report");
+  sub.add_option("--monitor", o->monitor,
+                 "Serve a live page of the session at [ADDR:]PORT (default address 127.0.0.1; port 0 = any free one): "
+                 "forces, corrections against their bounds, link health, 10 updates a second");
+  sub.add_flag("--monitor-remote", o->monitor_remote,
+               "Allow --monitor on an address other hosts can reach (the page shows the cell's data)");
+  sub.add_option("--monitor-window-s", o->monitor_window_s, "The history the live page keeps, s (1..3600)")
+      ->capture_default_str();
+  sub.add_option("--monitor-linger-s", o->monitor_linger_s,
+                 "Keep the live page up this long after the session ended, so its stop reason can be read, s");
   sub.add_option("--fault-dump", o->fault_dump,
                  "CSV the last cycles are written to, once per fault episode and at a stop for a fault (checked for "
                  "writability at start)");
