@@ -13,7 +13,7 @@ mkdir -p "$out"
     --nominal-trajectory "$out/nominal.csv" > "$out/offline.txt"
 port=$(( 20000 + $$ % 20000 ))
 "$deflex" online --link egm-joint --program "$out/nominal.csv" --egm-port $port \
-    --force-source "csv:$here/force_replay.csv" --loop --log "$out/online.csv" --duration-s 6 \
+    --force-source "csv:$here/force_replay.csv" --loop --log "$out/online.csv" --log-report --duration-s 6 \
     --status-interval-s 1 2> "$out/online.txt" &
 pid=$!
 sleep 0.5
