@@ -1,7 +1,11 @@
 #!/usr/bin/env bash
 # Installs what deflex needs to build and test, from Debian 12's packages only. Safe to run again:
 # apt-get skips what is already installed. Run as root (or with sudo available).
+#   scripts/install-deps.sh           what the build and the main job need
+#   scripts/install-deps.sh --tests   and what only the tests use (headless Chromium, about 100 MB)
 set -euo pipefail
+tests=0
+if [ "${1:-}" = "--tests" ]; then tests=1; fi
 packages=(
   build-essential cmake pkg-config
   # ninja: scripts/sanitize.sh builds with it (it compiles a module's tests while other modules build)
@@ -14,10 +18,10 @@ packages=(
   libcurl4-openssl-dev
   # cpp-httplib: the live monitor page's server (deflex online --monitor, deflex monitor)
   libcpp-httplib-dev
-  # chromium: the tests open the monitor page in headless Chromium and read what it shows
-  chromium
   python3 python3-dev python3-numpy python3-pytest pybind11-dev
 )
+# chromium: the tests open the live monitor page in headless Chromium and read what it shows
+if [ "$tests" -eq 1 ]; then packages+=(chromium); fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
