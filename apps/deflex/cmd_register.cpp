@@ -134,7 +134,16 @@ void setup_register(CLI::App& sub, int& exit_code) {
       in.tracker_circles.push_back(circle_of(o->tracker_circles[k], o->read));
       in.base_circles.push_back(circle_of(o->base_circles[k], base_read));
     }
-    const FrameRegistration r = register_frames(in);
+    FrameRegistration r;
+    try {
+      r = register_frames(in);
+    } catch (const InputError& e) {
+      std::string files = o->tracker.empty() ? "" : o->tracker + " and " + o->base;
+      for (std::size_t k = 0; k < o->tracker_circles.size(); ++k) {
+        files += (files.empty() ? "" : ", ") + o->tracker_circles[k] + " and " + o->base_circles[k];
+      }
+      throw InputError(fmt::format("{}: {}", files, e.what()));
+    }
     TrackerFrame frame;
     frame.base_T_tracker = r.base_T_tracker;
     frame.tracker_frame = tracker_frame;

@@ -21,7 +21,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::run_cli;
 
-const std::string kExamples = std::string(DEFLEX_SOURCE_DIR) + "/examples/evaluate/";
+const std::string kTrackerExamples = std::string(DEFLEX_SOURCE_DIR) + "/examples/evaluate/";
 
 struct TrackerSession {
   fs::path dir = fs::temp_directory_path() / ("deflex_tracker_session_" + std::to_string(::getpid()));
@@ -35,7 +35,7 @@ struct TrackerSession {
   // A base-frame CSV of the examples as an SA export in the tracker's frame (metres), stamped on a
   // clock `clock_s` ahead of the file's, 3 um noise.
   std::string export_run(const std::string& name, double clock_s, std::uint32_t seed) const {
-    std::ifstream in(kExamples + name);
+    std::ifstream in(kTrackerExamples + name);
     std::string line;
     std::getline(in, line);
     const fs::path out_path = dir / (name + ".txt");
@@ -84,11 +84,11 @@ TEST(CliTrackerSession, RegisteredAndAlignedRunsGiveTheBaseFrameFigures) {
 
   const std::string unloaded = s.export_run("unloaded.csv", 812.25, 1);
   const std::string loaded = s.export_run("loaded_uc.csv", 903.5, 2);
-  const auto base_run = run_cli("evaluate --split-laps --json --unloaded " + kExamples + "unloaded.csv --loaded " +
-                                kExamples + "loaded_uc.csv");
+  const auto base_run = run_cli("evaluate --split-laps --json --unloaded " + kTrackerExamples + "unloaded.csv --loaded " +
+                                kTrackerExamples + "loaded_uc.csv");
   ASSERT_EQ(base_run.exit_code, 0) << base_run.err;
   const auto tracker_run = run_cli("evaluate --split-laps --json --tracker-frame " + s.path("frame.yaml") +
-                                   " --unloaded " + unloaded + " --loaded " + loaded + " --align-to " + kExamples +
+                                   " --unloaded " + unloaded + " --loaded " + loaded + " --align-to " + kTrackerExamples +
                                    "unloaded.csv");
   ASSERT_EQ(tracker_run.exit_code, 0) << tracker_run.err;
   const auto b = nlohmann::json::parse(base_run.out), t = nlohmann::json::parse(tracker_run.out);
@@ -115,7 +115,7 @@ TEST(CliTrackerSession, BadFilesExitTwoNamingFileAndLine) {
                  "nounit.txt: the header names no length unit");
   // Duplicate time stamps where a time-based metric is asked for.
   expect_refused(run_cli("evaluate --unloaded " + s.path("ok.txt") + " --loaded " + s.path("ok.txt") + " --align-to " +
-                         kExamples + "unloaded.csv"),
+                         kTrackerExamples + "unloaded.csv"),
                  "ok.txt:5: time stamp 0 s repeats line 4's");
   // A frame file for another tracker frame.
   expect_refused(run_cli("evaluate --unloaded " + s.path("ok.txt") + " --loaded " + s.path("ok.txt") +
@@ -124,7 +124,7 @@ TEST(CliTrackerSession, BadFilesExitTwoNamingFileAndLine) {
   // Collinear registration points.
   expect_refused(run_cli("register --tracker " + s.path("line.txt") + " --base " + s.path("line.txt") + " -o " +
                          s.path("out.yaml")),
-                 "on one line");
+                 "line.txt: registration: the points lie on one line");
   EXPECT_FALSE(fs::exists(s.path("out.yaml")));
 }
 

@@ -20,10 +20,11 @@ class Commanded {
   explicit Commanded(const TrackerTrace& c) : c_(c) {}
   [[nodiscard]] double start() const { return c_.front().t_s; }
   [[nodiscard]] double end() const { return c_.back().t_s; }
-  void reset() { k_ = 0; }
+  void reset() { fresh_ = true; }
   // Position and velocity at t (inside the span).
   void at(double t, Vector3& p, Vector3& v) {
-    if (k_ + 1 >= c_.size() || c_[k_].t_s > t) {
+    if (fresh_ || k_ + 1 >= c_.size() || c_[k_].t_s > t) {  // a new pass starts with a binary search
+      fresh_ = false;
       k_ = static_cast<std::size_t>(std::upper_bound(c_.begin(), c_.end(), t,
                                                      [](double x, const TrackerSample& s) { return x < s.t_s; }) -
                                     c_.begin());
@@ -40,6 +41,7 @@ class Commanded {
  private:
   const TrackerTrace& c_;
   std::size_t k_ = 0;
+  bool fresh_ = true;
 };
 
 struct Model {
