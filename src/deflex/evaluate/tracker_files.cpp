@@ -497,7 +497,10 @@ TrackerFile parse_csv(const std::string& text, const std::string& source, const 
   return out;
 }
 
-bool looks_like_csv(const std::string& text) {
+// CSV when the first line (after '#' comments) names a unit-named column (split at commas, semicolons,
+// tabs or blanks, so a CSV with the wrong separator still reaches the CSV reader and its message);
+// an SA export when it is a '//' comment; otherwise by the file's extension (.csv: CSV).
+bool looks_like_csv(const std::string& text, const std::string& source) {
   std::size_t pos = 0;
   while (pos < text.size()) {
     auto end = text.find('\n', pos);
@@ -506,12 +509,20 @@ bool looks_like_csv(const std::string& text) {
     pos = end + 1;
     if (line.empty() || line[0] == '#') continue;
     if (line.rfind("//", 0) == 0) return false;
-    for (const auto& cell : fields_of(line)) {
-      if (cell == "t_s" || cell == "x_mm" || cell == "x_m" || cell == "y_mm" || cell == "y_m") return true;
+    std::string cell;
+    for (std::size_t i = 0; i <= line.size(); ++i) {
+      const char ch = i < line.size() ? line[i] : ',';
+      if (ch == ',' || ch == ';' || ch == '\t' || ch == ' ') {
+        if (cell == "t_s" || cell == "x_mm" || cell == "x_m" || cell == "y_mm" || cell == "y_m") return true;
+        cell.clear();
+      } else {
+        cell += ch;
+      }
     }
-    return false;
+    break;
   }
-  return false;
+  const std::string ext = ".csv";
+  return source.size() >= ext.size() && lower(source.substr(source.size() - ext.size())) == ext;
 }
 
 }  // namespace
@@ -519,7 +530,8 @@ bool looks_like_csv(const std::string& text) {
 TrackerFile parse_tracker_file(const std::string& text, const std::string& source, const TrackerReadOptions& options) {
   std::string body = text;
   if (body.rfind("\xEF\xBB\xBF", 0) == 0) body.erase(0, 3);
-  TrackerFile f = looks_like_csv(body) ? parse_csv(body, source, options) : parse_sa(body, source, options);
+  TrackerFile f =
+      looks_like_csv(body, source) ? parse_csv(body, source, options) : parse_sa(body, source, options);
   if (!options.expect_frame.empty() && f.frame.empty() && f.format == "sa") {
     // A file that names no frame cannot be checked against the expected one; say so rather than pass.
     throw DataError(fmt::format("{}: the header names no working frame, and '{}' was expected (export with the SA "

@@ -34,7 +34,7 @@ std::shared_ptr<runtime::MonitorFeed> read_cycle_log_feed(const std::string& pat
   runtime::MonitorSetup setup;
   setup.recorded = true;
   setup.source = path;
-  setup.link = "(not in the log)";
+  setup.link = "recorded log";
   std::map<std::string, std::size_t> col;
   std::vector<std::string> header;
   std::shared_ptr<runtime::MonitorFeed> feed;
@@ -59,31 +59,7 @@ std::shared_ptr<runtime::MonitorFeed> read_cycle_log_feed(const std::string& pat
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (trim_view(line).empty()) continue;
-    if (line[0] == '#') {
-      const std::string_view body = trim_view(line.substr(1));
-      if (body.rfind("deflex cycle log:", 0) != 0) continue;
-      std::size_t p = 17;
-      while (p < body.size()) {
-        while (p < body.size() && body[p] == ' ') ++p;
-        const auto sp = body.find(' ', p);
-        const std::string_view kv = body.substr(p, sp == std::string_view::npos ? body.npos : sp - p);
-        p = sp == std::string_view::npos ? body.size() : sp;
-        const auto eq = kv.find('=');
-        if (eq == std::string_view::npos) continue;
-        const std::string key(kv.substr(0, eq));
-        const std::string_view value = kv.substr(eq + 1);
-        if (key == "link") {
-          setup.link = std::string(value);
-          continue;
-        }
-        const auto v = parse_double(value);
-        if (!v) throw DataError(fmt::format("{}:{}: '{}' is not a number", path, line_no, kv));
-        if (key == "joint_bound_deg") setup.joint_bound_deg = *v;
-        if (key == "tcp_bound_mm") setup.tcp_bound_mm = *v;
-        if (key == "program_duration_s") setup.program_duration_s = *v;
-      }
-      continue;
-    }
+    if (line[0] == '#') continue;
     const auto cells = cells_of(line);
     if (header.empty()) {
       for (std::size_t i = 0; i < cells.size(); ++i) {
@@ -120,7 +96,6 @@ std::shared_ptr<runtime::MonitorFeed> read_cycle_log_feed(const std::string& pat
       c.clate = need("controller_late");
       c.sil = need("silences");
       c.guard = need("guard_trips");
-      feed = std::make_shared<runtime::MonitorFeed>(setup);
       continue;
     }
     if (cells.size() != header.size()) {
@@ -140,6 +115,14 @@ std::shared_ptr<runtime::MonitorFeed> read_cycle_log_feed(const std::string& pat
       }
       return static_cast<std::uint64_t>(v);
     };
+    if (!feed) {
+      // The bounds are in every row of a log written since they were added (older logs: not drawn).
+      if (col.count("joint_bound_deg") != 0) setup.joint_bound_deg = value(col.at("joint_bound_deg"));
+      if (col.count("tcp_bound_mm") != 0) setup.tcp_bound_mm = value(col.at("tcp_bound_mm"));
+      if (!std::isfinite(setup.joint_bound_deg)) setup.joint_bound_deg = 0.0;
+      if (!std::isfinite(setup.tcp_bound_mm)) setup.tcp_bound_mm = 0.0;
+      feed = std::make_shared<runtime::MonitorFeed>(setup);
+    }
     runtime::MonitorRow r;
     r.t_s = value(c.t);
     if (!std::isfinite(r.t_s)) throw DataError(fmt::format("{}:{}: column 't_s': a cycle without a time", path, line_no));
@@ -170,8 +153,8 @@ std::shared_ptr<runtime::MonitorFeed> read_cycle_log_feed(const std::string& pat
     r.guard_trips = count(c.guard);
     feed->add(r);
   }
-  if (!feed) throw DataError(fmt::format("{}: no header row: not a deflex cycle log", path));
-  if (feed->rows_added() == 0) throw DataError(fmt::format("{}: no cycles (only the header)", path));
+  if (header.empty()) throw DataError(fmt::format("{}: no header row: not a deflex cycle log", path));
+  if (!feed || feed->rows_added() == 0) throw DataError(fmt::format("{}: no cycles (only the header)", path));
   feed->set_state("recorded", "");
   return feed;
 }

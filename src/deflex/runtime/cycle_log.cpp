@@ -17,7 +17,7 @@ std::string cycle_log_header(int joints) {
   h += ",corr_x_mm,corr_y_mm,corr_z_mm,rot_uncorrected_mrad,fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,meas_fx_N,meas_fy_N,"
        "meas_fz_N,deviation_deg,deviation_mm,step_deg,step_mm,delay_ms,compute_us,answer_ms,stamp_ms,"
        "arrival_delay_ms,jitter_ms,missed_before,duplicates,superseded,rejected,restarts,late,controller_late,silences,"
-       "guard_trips,step_limited_total\n";
+       "guard_trips,step_limited_total,joint_bound_deg,tcp_bound_mm\n";
   return h;
 }
 
@@ -38,7 +38,7 @@ void general(std::string& out, double v) {
 }
 }  // namespace
 
-void append_cycle_row(std::string& out, const SessionEntry& e, int joints) {
+void append_cycle_row(std::string& out, const SessionEntry& e, int joints, const CycleLogBounds& bounds) {
   const LinkCycleRecord& r = e.record;
   const LinkCounters& c = e.counters;
   fmt::format_to(std::back_inserter(out), "{:.6f},{:.9f},{},{},{},{},{}", r.t_s, r.program_time_s, r.sequence,
@@ -60,14 +60,16 @@ void append_cycle_row(std::string& out, const SessionEntry& e, int joints) {
   number(out, r.arrival.stamp_s * 1e3, 0);
   number(out, r.arrival.arrival_delay_s * 1e3, 3);
   number(out, r.arrival.jitter_s * 1e3, 3);
-  fmt::format_to(std::back_inserter(out), ",{},{},{},{},{},{},{},{},{},{}\n", r.arrival.missed_before, c.duplicate,
+  fmt::format_to(std::back_inserter(out), ",{},{},{},{},{},{},{},{},{},{}", r.arrival.missed_before, c.duplicate,
                  c.superseded, c.rejected(), c.restarts, c.late, c.controller_late, c.silences, c.guard_trips,
                  c.step_limited);
+  general(out, bounds.joint_deg);
+  general(out, bounds.tcp_mm);
+  out += '\n';
 }
 
-CycleLogFile::CycleLogFile(const std::string& path, int joints, const std::string& comment)
-    : file_(path, "option --log"), joints_(joints) {
-  if (!comment.empty()) file_.write("# " + comment + "\n");
+CycleLogFile::CycleLogFile(const std::string& path, int joints, const CycleLogBounds& bounds)
+    : file_(path, "option --log"), joints_(joints), bounds_(bounds) {
   file_.write(cycle_log_header(joints));
   row_.reserve(4096);
 }
@@ -75,7 +77,7 @@ CycleLogFile::CycleLogFile(const std::string& path, int joints, const std::strin
 void CycleLogFile::write(const SessionEntry& e) {
   if (closed_ || e.kind != SessionEntry::Kind::kCycle) return;
   row_.clear();
-  append_cycle_row(row_, e, joints_);
+  append_cycle_row(row_, e, joints_, bounds_);
   file_.write(row_);
   ++rows_;
 }

@@ -15,10 +15,17 @@
 
 namespace deflex::runtime {
 
+/// The bounds a session's commands were held to, in every row (the last two columns, joint_bound_deg
+/// and tcp_bound_mm), so a log read back on its own (`deflex monitor --log`) draws them.
+struct CycleLogBounds {
+  double joint_deg = 0.0;
+  double tcp_mm = 0.0;
+};
+
 /// The header line (with its newline) for a robot of `joints` joints.
 [[nodiscard]] std::string cycle_log_header(int joints);
 /// One row (with its newline).
-void append_cycle_row(std::string& out, const SessionEntry& e, int joints);
+void append_cycle_row(std::string& out, const SessionEntry& e, int joints, const CycleLogBounds& bounds);
 
 /// The cycle log as an output of deflex (model/output_file.hpp): written into a temporary file beside
 /// the path and put in place when the session ends (whatever ended it: the log is the record of what
@@ -26,9 +33,8 @@ void append_cycle_row(std::string& out, const SessionEntry& e, int joints);
 class CycleLogFile {
  public:
   /// Prepares `path` now, so a path that cannot be an output is an error at the session's start, and
-  /// writes the header, after `comment` as a '#' line when given (the link and its bounds, which
-  /// `deflex monitor --log` draws). Throws InputError naming the option and the path.
-  CycleLogFile(const std::string& path, int joints, const std::string& comment = "");
+  /// writes the header. Throws InputError naming the option and the path.
+  CycleLogFile(const std::string& path, int joints, const CycleLogBounds& bounds);
 
   void write(const SessionEntry& e);
   /// Puts the log in place; throws OutputError naming the path when a write failed (a full disk).
@@ -39,6 +45,7 @@ class CycleLogFile {
  private:
   OutputFile file_;
   int joints_;
+  CycleLogBounds bounds_;
   std::string row_;
   std::uint64_t rows_ = 0;
   bool closed_ = false;

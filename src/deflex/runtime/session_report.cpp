@@ -32,15 +32,7 @@ double Histogram::quantile(double q) const {
 }
 
 SessionReporter::SessionReporter(ReportSetup setup) : setup_(std::move(setup)) {
-  if (!setup_.log_path.empty()) {
-    // The link and its bounds as a comment line: what `deflex monitor --log` needs to draw them.
-    const std::string comment =
-        fmt::format("deflex cycle log: link={} joints={} period_ms={:.6g} joint_bound_deg={:.9g} tcp_bound_mm={:.9g} "
-                    "program_duration_s={:.9g}",
-                    setup_.link_name, setup_.joints, setup_.period_s * 1e3, rad_to_deg(setup_.limits.joint_bound_rad),
-                    setup_.limits.tcp_bound_m * 1e3, setup_.program_duration_s);
-    log_ = std::make_unique<CycleLogFile>(setup_.log_path, setup_.joints, comment);
-  }
+  if (!setup_.log_path.empty()) log_ = std::make_unique<CycleLogFile>(setup_.log_path, setup_.joints, bounds());
   // Checked now: a path that cannot be written must not end a run at its first fault.
   if (!setup_.dump_path.empty()) check_fault_dump_path(setup_.dump_path);
   SessionEntry blank;
@@ -169,7 +161,7 @@ void SessionReporter::write_dump(const std::string& why) {
   if (setup_.dump_path.empty()) return;
   std::string text = cycle_log_header(setup_.joints);
   const std::size_t first = (ring_head_ + ring_.size() - ring_count_) % ring_.size();
-  for (std::size_t k = 0; k < ring_count_; ++k) append_cycle_row(text, ring_[(first + k) % ring_.size()], setup_.joints);
+  for (std::size_t k = 0; k < ring_count_; ++k) append_cycle_row(text, ring_[(first + k) % ring_.size()], setup_.joints, bounds());
   try {
     write_fault_dump(setup_.dump_path, text);
   } catch (const Error& e) {

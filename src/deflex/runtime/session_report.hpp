@@ -92,6 +92,9 @@ class SessionReporter {
 
  private:
   void log(LogLevel level, const std::string& text) const;
+  [[nodiscard]] CycleLogBounds bounds() const {
+    return {rad_to_deg(setup_.limits.joint_bound_rad), setup_.limits.tcp_bound_m * 1e3};
+  }
   void on_cycle(const SessionEntry& e);
   void begin_episode(const SessionEntry& e);
   void write_dump(const std::string& why);
