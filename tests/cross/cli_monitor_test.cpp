@@ -22,7 +22,9 @@
 #include "cross/cli_runner.hpp"
 #include "deflex/cell/egm_position_controller.hpp"
 #include "deflex/model/csv_table.hpp"
+#include "deflex/model/errors.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/monitor/monitor_server.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/transport/udp_transport.hpp"
 
@@ -330,6 +332,28 @@ TEST(CliMonitor, BadAddressesPortsAndLogsExitTwo) {
   EXPECT_NE(r.err.find("cut.csv:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("truncated"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(run.dir + "/x.html"));
+}
+
+TEST(MonitorServer, StartsAndStopsAtOnceAndParsesItsAddress) {
+  runtime::MonitorSetup setup;
+  setup.link = "egm-joint";
+  const auto feed = std::make_shared<runtime::MonitorFeed>(setup);
+  for (int k = 0; k < 20; ++k) {  // a server destroyed right after it was made never hangs its owner
+    monitor::MonitorServer server(feed, {"127.0.0.1", 0});
+    EXPECT_GT(server.port(), 0);
+  }
+  monitor::MonitorServer server(feed, {"127.0.0.1", 0});
+  EXPECT_NE(http_request(server.port(), "GET /data").find("\"link\":\"egm-joint\""), std::string::npos);
+  const auto a = monitor::parse_monitor_address("8080", false, "--monitor");
+  EXPECT_EQ(a.host, "127.0.0.1");
+  EXPECT_EQ(a.port, 8080);
+  EXPECT_EQ(monitor::parse_monitor_address("127.0.0.2:0", false, "--monitor").host, "127.0.0.2");
+  EXPECT_EQ(monitor::parse_monitor_address("192.168.1.5:9000", true, "--monitor").port, 9000);
+  EXPECT_THROW(monitor::parse_monitor_address("192.168.1.5:9000", false, "--monitor"), InputError);
+  EXPECT_THROW(monitor::parse_monitor_address(":80", false, "--monitor"), InputError);
+  EXPECT_THROW(monitor::parse_monitor_address("80x", false, "--monitor"), InputError);
+  // An address that is not this host's cannot be bound: refused at once.
+  EXPECT_THROW(monitor::MonitorServer(feed, {"192.0.2.1", 0}), InputError);
 }
 
 }  // namespace

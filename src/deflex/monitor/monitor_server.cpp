@@ -3,6 +3,9 @@
 
 #include <arpa/inet.h>
 
+#include <chrono>
+#include <thread>
+
 #include <fmt/format.h>
 #include <httplib.h>
 
@@ -87,6 +90,8 @@ MonitorServer::MonitorServer(std::shared_ptr<const runtime::MonitorFeed> feed, c
                                  host, address.port));
   }
   thread_ = std::thread([this] { server_->listen_after_bind(); });
+  // Until the server runs, stop() would not reach it (and the destructor's join would wait forever).
+  for (int i = 0; i < 2000 && !server_->is_running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
 }
 
 MonitorServer::~MonitorServer() {
