@@ -69,7 +69,8 @@ TrackerTrace read_run(const std::string& path, const Reading& r, std::vector<std
 }
 
 // Each file is one run, or with --split-laps each lap of a closed path in a file is one run.
-// `names` gets each run's file (and lap), for messages about a run; `whole` each file's trace.
+// `names` gets each run's file (and lap), for messages about a run; `whole` each file's trace when
+// aligning.
 std::vector<TrackerTrace> read_all(const std::vector<std::string>& paths, bool split, const char* what,
                                    std::vector<std::string>& names, const Reading& reading,
                                    std::vector<std::pair<std::string, TimeAlignment>>& alignments,
@@ -77,7 +78,7 @@ std::vector<TrackerTrace> read_all(const std::vector<std::string>& paths, bool s
   std::vector<TrackerTrace> out;
   for (const auto& p : paths) {
     TrackerTrace t = read_run(p, reading, alignments);
-    whole.push_back(t);
+    if (reading.align) whole.push_back(t);  // the time-synchronous figures need each file whole
     if (!split) {
       out.push_back(std::move(t));
       names.push_back(p);

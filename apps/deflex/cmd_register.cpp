@@ -71,9 +71,8 @@ void pair_points(const TrackerFile& t, const TrackerFile& b, RegistrationInput& 
       }
       base.erase(target_of(p.name));
     }
-    const std::string left = *base.begin();
     for (const auto& p : b.points) {
-      if (target_of(p.name) == left) {
+      if (base.count(target_of(p.name)) != 0) {
         throw DataError(fmt::format("{}:{}: point '{}' is not in {} (pairs are made by name)", b.source, p.line,
                                     p.name, t.source));
       }

@@ -128,13 +128,7 @@ std::optional<double> date_time(std::string_view s) {
 std::vector<std::string> fields_of(std::string_view line) {
   std::vector<std::string> raw;
   if (line.find(',') != std::string_view::npos) {
-    std::size_t start = 0;
-    while (true) {
-      const auto comma = line.find(',', start);
-      raw.emplace_back(trim_view(line.substr(start, comma == std::string_view::npos ? line.npos : comma - start)));
-      if (comma == std::string_view::npos) break;
-      start = comma + 1;
-    }
+    for_each_csv_cell(line, [&raw](std::string_view cell) { raw.emplace_back(cell); });
     return raw;
   }
   std::size_t i = 0;

@@ -33,22 +33,6 @@ std::string_view trim(std::string_view s) {
   return s.substr(b, e - b + 1);
 }
 
-/// Calls f(cell) for every comma-separated cell of `line`, trimmed (a trailing comma gives an empty
-/// last cell, as a spreadsheet means it).
-template <typename F>
-void for_each_cell(std::string_view line, F&& f) {
-  std::size_t start = 0;
-  while (true) {
-    const auto comma = line.find(',', start);
-    if (comma == std::string_view::npos) {
-      f(trim(line.substr(start)));
-      return;
-    }
-    f(trim(line.substr(start, comma - start)));
-    start = comma + 1;
-  }
-}
-
 // A header cell written quoted by a spreadsheet ("x_mm") names the column x_mm.
 std::string_view unquote(std::string_view cell) {
   if (cell.size() >= 2 && cell.front() == '"' && cell.back() == '"') {
@@ -140,7 +124,7 @@ void CsvReader::read_header() {
       }
     }
     std::size_t i = 0;
-    for_each_cell(tl, [&](std::string_view cell) {
+    for_each_csv_cell(tl, [&](std::string_view cell) {
       ++i;
       const std::string_view name = unquote(cell);
       if (name.empty()) {
@@ -166,7 +150,7 @@ void CsvReader::read_header() {
 void CsvReader::parse_row(std::string_view line) {
   std::size_t i = 0;
   const std::size_t width = columns_.size();
-  for_each_cell(line, [&](std::string_view cell) {
+  for_each_csv_cell(line, [&](std::string_view cell) {
     if (i >= width) {
       ++i;
       return;  // counted, reported below

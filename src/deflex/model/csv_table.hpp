@@ -118,6 +118,28 @@ class CsvTable {
   std::vector<int> lines_;
 };
 
+/// Calls f(cell) for every comma-separated cell of `line`, trimmed of spaces and tabs (a trailing comma
+/// gives an empty last cell, as a spreadsheet means it). The one splitter of every deflex reader of
+/// comma-separated lines.
+template <typename F>
+void for_each_csv_cell(std::string_view line, F&& f) {
+  const auto trimmed = [](std::string_view s) {
+    const auto b = s.find_first_not_of(" \t");
+    if (b == std::string_view::npos) return std::string_view();
+    return s.substr(b, s.find_last_not_of(" \t") - b + 1);
+  };
+  std::size_t start = 0;
+  while (true) {
+    const auto comma = line.find(',', start);
+    if (comma == std::string_view::npos) {
+      f(trimmed(line.substr(start)));
+      return;
+    }
+    f(trimmed(line.substr(start, comma - start)));
+    start = comma + 1;
+  }
+}
+
 /// A text cell for a CSV file: quoted (RFC 4180, inner quotes doubled) when it holds a comma, a
 /// quote, a line break or blanks at its ends; as it is otherwise.
 [[nodiscard]] std::string csv_text_cell(const std::string& text);

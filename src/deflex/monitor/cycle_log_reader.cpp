@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/model/input_file.hpp"
 #include "deflex/model/parse_number.hpp"
@@ -17,13 +18,7 @@ namespace {
 
 std::vector<std::string_view> cells_of(std::string_view line) {
   std::vector<std::string_view> out;
-  std::size_t start = 0;
-  while (true) {
-    const auto comma = line.find(',', start);
-    out.push_back(trim_view(line.substr(start, comma == std::string_view::npos ? line.npos : comma - start)));
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
-  }
+  for_each_csv_cell(line, [&out](std::string_view cell) { out.push_back(cell); });
   return out;
 }
 
