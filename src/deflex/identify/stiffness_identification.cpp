@@ -448,11 +448,13 @@ StiffnessEstimate StiffnessIdentifier::solve() {
     if (model.has_stiffness()) {
       const double k = model.stiffness()[j];
       move_to_rhs(j, 1.0 / k);
-      est.warnings.push_back(fmt::format("joint {}: held at the robot file's {:.4g} Nm/rad while the others were fitted",
+      est.warnings.push_back(fmt::format("joint {}: not identified (NaN in the estimate); the others were fitted "
+                                         "with it held at the robot file's {:.4g} Nm/rad",
                                          j + 1, k));
     } else {
       est.warnings.push_back(fmt::format(
-          "joint {}: taken as rigid while the others were fitted (the robot file gives no stiffness to hold it at)",
+          "joint {}: not identified (NaN in the estimate); the others were fitted with it taken as rigid (the robot "
+          "file gives no stiffness to hold it at)",
           j + 1));
     }
   }

@@ -110,6 +110,9 @@ class OnlineCompensator {
   [[nodiscard]] const Wrench& wrench_slope() const { return slope_; }
 
   [[nodiscard]] const CompensatorCounters& counters() const { return counters_; }
+  /// Samples the queue holds before push_force() drops the oldest, and the samples it holds now.
+  [[nodiscard]] int queue_capacity() const { return queue_capacity_; }
+  [[nodiscard]] int queued() const { return queue_count_; }
   [[nodiscard]] const RobotModel& model() const { return model_; }
   [[nodiscard]] const OnlineConfig& config() const { return config_; }
   [[nodiscard]] const ForcePipeline& pipeline() const { return pipeline_; }
