@@ -200,12 +200,22 @@ TrackerTrace tracker_trace(const py::handle& obj, const char* name) {
   for (std::size_t i = 0; i < t.size(); ++i) {
     t[i].t_s = timed ? *d++ : static_cast<double>(i);
     t[i].p_m = Vector3(d[0], d[1], d[2]);
+    if (t[i].p_m.cwiseAbs().maxCoeff() > range::kLengthM.max) {
+      throw InputError(fmt::format("argument {}: row {}: a position of {:g} is beyond {:g} m: positions are in m (a "
+                                   "trace in mm divided by 1000)",
+                                   name, i, t[i].p_m.cwiseAbs().maxCoeff(), range::kLengthM.max));
+    }
     d += 3;
   }
   return t;
 }
 
 Array new_array(std::vector<py::ssize_t> shape) { return Array(std::move(shape)); }
+
+Array frozen(Array a) {
+  a.attr("setflags")(py::arg("write") = false);
+  return a;
+}
 
 Array from_vector(const Eigen::Ref<const Eigen::VectorXd>& v) {
   Array out = new_array({v.size()});

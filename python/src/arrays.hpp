@@ -3,12 +3,15 @@
 // deflex.InputError (a ValueError) naming the argument and the shape expected, never a crash.
 #pragma once
 
+#include <filesystem>
 #include <initializer_list>
 #include <string>
 #include <vector>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include "deflex/evaluate/tracker_trace.hpp"
 #include "deflex/model/input_ranges.hpp"
@@ -20,6 +23,47 @@ namespace py = pybind11;
 
 /// C-contiguous float64: what every array argument becomes and every array result is.
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+/// An argument taken as any Python object and checked by the functions below, named in signatures,
+/// docstrings and the .pyi stubs by `Tag::name` (e.g. numpy.typing.ArrayLike) rather than `handle`.
+template <typename Tag>
+struct Arg {
+  py::object obj;
+  operator py::handle() const { return obj; }  // NOLINT: passed on to the checks below
+  [[nodiscard]] bool is_none() const { return obj.is_none(); }
+};
+struct ArrayLikeTag {
+  static constexpr auto name = py::detail::const_name("numpy.typing.ArrayLike");
+};
+struct PathOrPosesTag {
+  static constexpr auto name = py::detail::const_name("typing.Union[Circle, numpy.typing.ArrayLike]");
+};
+struct ForceTag {
+  static constexpr auto name = py::detail::const_name("typing.Union[str, numpy.typing.ArrayLike]");
+};
+struct ConfigurationTag {
+  static constexpr auto name = py::detail::const_name("typing.Optional[typing.Tuple[int, int, int, int]]");
+};
+struct DataTag {
+  static constexpr auto name = py::detail::const_name("typing.Union[str, os.PathLike, numpy.typing.ArrayLike, None]");
+};
+/// A data file's path, or the first of the arrays that stand for it.
+using DataArg = Arg<DataTag>;
+/// ABB confdata (cf1, cf4, cf6, cfx) or None.
+using ConfigurationArg = Arg<ConfigurationTag>;
+/// Numbers: a sequence or an array (checked by to_array and the shape functions below).
+using ArrayLike = Arg<ArrayLikeTag>;
+/// A path: a Circle, or (N, 4, 4) poses.
+using PathOrPoses = Arg<PathOrPosesTag>;
+/// A force: a spec string as `deflex offline --force` takes it, or wrenches.
+using ForceArg = Arg<ForceTag>;
+/// A file path: str or any os.PathLike (pathlib.Path), as the C++ library's string.
+using PathArg = std::filesystem::path;
+[[nodiscard]] inline std::string path_text(const PathArg& p) { return p.string(); }
+
+/// The array made read-only: what every array property returns, so that an edit in place
+/// (`circle.centre_m[2] = 0.9`) raises ValueError instead of changing a copy the object never sees.
+Array frozen(Array a);
 
 /// Any sequence or array of real numbers (float, int, uint dtypes) as C-contiguous float64, with
 /// `ndim` dimensions (0: any). Throws InputError "argument NAME: ..." otherwise.
@@ -108,11 +152,12 @@ Array poses_of(const std::vector<T>& items, Pose T::*field) {
   return out;
 }
 
-/// A read-write property of a fixed-size vector member (Vector3, Vector6), checked on assignment.
+/// A read-write property of a fixed-size vector member (Vector3, Vector6), checked on assignment;
+/// the array it returns is read-only (assign the whole vector to change it).
 template <typename T, typename Vec>
 void vector_property(py::class_<T>& c, const char* name, Vec T::*field, const char* doc = "") {
   c.def_property(
-      name, [field](const T& t) { return from_vector(t.*field); },
+      name, [field](const T& t) { return frozen(from_vector(t.*field)); },
       [field, name](T& t, const py::handle& v) {
         t.*field = Eigen::Map<const Vec>(vector_array(v, name, Vec::RowsAtCompileTime).data());
       },
@@ -123,8 +168,24 @@ void vector_property(py::class_<T>& c, const char* name, Vec T::*field, const ch
 template <typename T>
 void pose_property(py::class_<T>& c, const char* name, Pose T::*field, const char* doc = "") {
   c.def_property(
-      name, [field](const T& t) { return from_pose(t.*field); },
+      name, [field](const T& t) { return frozen(from_pose(t.*field)); },
       [field, name](T& t, const py::handle& v) { t.*field = pose(v, name); }, doc);
 }
 
 }  // namespace deflex::python
+
+namespace pybind11::detail {
+/// Takes any object (None too: the function decides what None means) and keeps it for the checks.
+template <typename Tag>
+struct type_caster<deflex::python::Arg<Tag>> {
+  PYBIND11_TYPE_CASTER(deflex::python::Arg<Tag>, Tag::name);
+  bool load(handle src, bool /*convert*/) {
+    if (!src) return false;
+    value.obj = reinterpret_borrow<object>(src);
+    return true;
+  }
+  static handle cast(const deflex::python::Arg<Tag>& a, return_value_policy /*policy*/, handle /*parent*/) {
+    return a.obj.inc_ref();
+  }
+};
+}  // namespace pybind11::detail

@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <optional>
+#include <string>
 
 #include <nlohmann/json_fwd.hpp>
 #include <pybind11/pybind11.h>
@@ -21,7 +22,13 @@ using RobotHolder = std::shared_ptr<RobotModel>;
 
 /// ABB confdata (cf1, cf4, cf6, cfx) as a tuple, and from a Python sequence (None: not given).
 py::tuple configuration_tuple(const ArmConfiguration& c);
-std::optional<ArmConfiguration> arm_configuration_arg(const py::object& c);
+std::optional<ArmConfiguration> arm_configuration_arg(const py::handle& c);
+
+/// Where a wrench's moment is taken, from a `moment_about` argument: "wap" (false) or "tcp" (true).
+bool moment_about_tcp(const std::string& about);
+/// A wrench with its moment about the WAP: moved there from the TCP when `about_tcp`
+/// (M_wap = M_tcp + (p_tcp - p_wap) x F), as given otherwise.
+Wrench wrench_about_wap(const Pose& base_T_tcp, const Pose& base_T_wap, const Wrench& w, bool about_tcp);
 
 /// A JSON document as the Python objects json.loads makes of it (dict, list, str, float, ...).
 py::object json_to_python(const nlohmann::json& doc);

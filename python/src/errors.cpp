@@ -3,6 +3,8 @@
 // InputError; InputError is also a ValueError, since it means a bad argument (bad arrays included).
 #include <Python.h>
 
+#include <new>
+
 #include "bindings.hpp"
 #include "deflex/model/errors.hpp"
 
@@ -43,6 +45,16 @@ void bind_errors(py::module_& m) {
     } catch (const ModelError& e) {
       PyErr_SetString(g_model_error, e.what());
     } catch (const Error& e) {
+      PyErr_SetString(g_error, e.what());
+    } catch (const py::builtin_exception&) {
+      throw;  // pybind11's own (IndexError, StopIteration, TypeError, ...): its translator raises them
+    } catch (const py::error_already_set&) {
+      throw;
+    } catch (const std::bad_alloc&) {
+      throw;  // MemoryError
+    } catch (const std::exception& e) {
+      // Anything else the library or the standard library throws (a file system error, an Eigen
+      // size check) is still a deflex.Error, never a bare RuntimeError.
       PyErr_SetString(g_error, e.what());
     }
   });

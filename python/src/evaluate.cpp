@@ -60,11 +60,11 @@ void bind_evaluate(py::module_& m) {
                            s.accuracy_m, s.repeatability_m, s.evaluation_points, s.runs);
       });
 
-  m.def("read_tracker_csv", [](const std::string& path) { return from_trace(read_tracker_csv(path)); }, "path"_a,
+  m.def("read_tracker_csv", [](const PathArg& path) { return from_trace(read_tracker_csv(path_text(path))); }, "path"_a,
         "A tracker CSV (t_s,x_mm,y_mm,z_mm) as an (N, 4) array [t_s, x_m, y_m, z_m].");
   m.def(
       "mean_distance_to_path_m",
-      [](const py::handle& loaded, const py::handle& reference) {
+      [](const ArrayLike& loaded, const ArrayLike& reference) {
         const TrackerTrace l = tracker_trace(loaded, "loaded"), r = tracker_trace(reference, "reference");
         py::gil_scoped_release release;
         return mean_distance_to_path_m(l, r);
@@ -73,8 +73,8 @@ void bind_evaluate(py::module_& m) {
       "The paper's figure of merit: mean distance (m) of the loaded points from the reference polyline.");
   m.def(
       "path_deviation",
-      [](const py::handle& loaded, const py::handle& reference) {
-        if (py::isinstance<py::list>(loaded) || py::isinstance<py::tuple>(loaded)) {
+      [](const ArrayLike& loaded, const ArrayLike& reference) {
+        if (py::isinstance<py::list>(loaded.obj) || py::isinstance<py::tuple>(loaded.obj)) {
           const auto l = traces(loaded, "loaded"), r = traces(reference, "reference");
           py::gil_scoped_release release;
           return path_deviation(l, r);
@@ -88,7 +88,7 @@ void bind_evaluate(py::module_& m) {
       "traces for several laps (each reference lap its own polyline).");
   m.def(
       "time_synchronous_deviation",
-      [](const py::handle& loaded, const py::handle& reference) {
+      [](const ArrayLike& loaded, const ArrayLike& reference) {
         const TrackerTrace l = tracker_trace(loaded, "loaded"), r = tracker_trace(reference, "reference");
         return time_synchronous_deviation(l, r);
       },
@@ -97,7 +97,7 @@ void bind_evaluate(py::module_& m) {
       "start): sees lag along the path.");
   m.def(
       "iso9283_path",
-      [](const py::handle& runs, const py::handle& reference, int evaluation_points, double max_offset_m) {
+      [](const ArrayLike& runs, const ArrayLike& reference, int evaluation_points, double max_offset_m) {
         const auto r = traces(runs, "runs");
         const TrackerTrace ref = tracker_trace(reference, "reference");
         py::gil_scoped_release release;
@@ -111,10 +111,10 @@ void bind_evaluate(py::module_& m) {
   // Tracker sessions: SA exports and unit-named CSV, registration, time alignment (docs/evaluation.md).
   m.def(
       "read_tracker_file",
-      [](const py::object& path, const std::string& length_unit, const std::string& angle_unit,
+      [](const PathArg& path, const std::string& length_unit, const std::string& angle_unit,
          const std::string& columns, const std::string& expect_frame) {
         TrackerReadOptions o{length_unit, angle_unit, columns, expect_frame};
-        const TrackerFile f = read_tracker_file(py::str(path).cast<std::string>(), o);
+        const TrackerFile f = read_tracker_file(path_text(path), o);
         Array a = new_array({static_cast<py::ssize_t>(f.points.size()), 4});
         auto v = a.mutable_unchecked<2>();
         py::list names;
@@ -141,16 +141,16 @@ void bind_evaluate(py::module_& m) {
       "none.");
   m.def(
       "write_sa_export",
-      [](const py::object& path, const py::handle& trace, const std::string& frame) {
+      [](const PathArg& path, const ArrayLike& trace, const std::string& frame) {
         SaExportOptions o;
         o.frame = frame;
-        write_sa_export(tracker_trace(trace, "trace"), py::str(path).cast<std::string>(), o);
+        write_sa_export(tracker_trace(trace, "trace"), path_text(path), o);
       },
       "path"_a, "trace"_a, "frame"_a = "Robot Base",
       "Writes an (N, 4) trace [t_s, x_m, y_m, z_m] as a Spatial Analyzer ASCII export (mm, named working frame).");
   m.def(
       "register_frames",
-      [](const py::handle& tracker_points, const py::handle& base_points) {
+      [](const ArrayLike& tracker_points, const ArrayLike& base_points) {
         RegistrationInput in;
         in.tracker_m = points_of(tracker_points, "tracker_points");
         in.base_m = points_of(base_points, "base_points");
@@ -169,7 +169,7 @@ void bind_evaluate(py::module_& m) {
       "form, with the residual of each point; refuses fewer than 3 points or points on a line.");
   m.def(
       "align_time",
-      [](const py::handle& measured, const py::handle& commanded, bool fit_drift, double search_s, double centre_s) {
+      [](const ArrayLike& measured, const ArrayLike& commanded, bool fit_drift, double search_s, double centre_s) {
         const TrackerTrace mt = tracker_trace(measured, "measured"), ct = tracker_trace(commanded, "commanded");
         TimeAlignmentOptions o;
         o.fit_drift = fit_drift;

@@ -1,5 +1,8 @@
 // Stiffness identification (from arrays or the measurement CSV) and calibration planning.
+#include <cmath>
+
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <pybind11/stl.h>
 
 #include "arrays.hpp"
@@ -68,11 +71,11 @@ py::dict measurements_to_dict(const std::vector<StiffnessMeasurement>& data) {
 void bind_identify(py::module_& m) {
   py::class_<StiffnessEstimate>(m, "StiffnessEstimate",
                                 "Identified joint stiffness (Nm/rad) with standard errors and identifiability flags.")
-      .def_property_readonly("stiffness_nm_per_rad", [](const StiffnessEstimate& e) { return from_vector(e.stiffness_nm_per_rad); })
-      .def_property_readonly("std_error_nm_per_rad", [](const StiffnessEstimate& e) { return from_vector(e.std_error_nm_per_rad); })
-      .def_property_readonly("compliance_rad_per_nm", [](const StiffnessEstimate& e) { return from_vector(e.compliance_rad_per_nm); })
+      .def_property_readonly("stiffness_nm_per_rad", [](const StiffnessEstimate& e) { return frozen(from_vector(e.stiffness_nm_per_rad)); })
+      .def_property_readonly("std_error_nm_per_rad", [](const StiffnessEstimate& e) { return frozen(from_vector(e.std_error_nm_per_rad)); })
+      .def_property_readonly("compliance_rad_per_nm", [](const StiffnessEstimate& e) { return frozen(from_vector(e.compliance_rad_per_nm)); })
       .def_property_readonly("compliance_std_error_rad_per_nm",
-                             [](const StiffnessEstimate& e) { return from_vector(e.compliance_std_error_rad_per_nm); })
+                             [](const StiffnessEstimate& e) { return frozen(from_vector(e.compliance_std_error_rad_per_nm)); })
       .def_readonly("residual_rms_m", &StiffnessEstimate::residual_rms_m)
       .def_readonly("residual_max_m", &StiffnessEstimate::residual_max_m)
       .def_readonly("residual_rms_rad", &StiffnessEstimate::residual_rms_rad)
@@ -81,48 +84,74 @@ void bind_identify(py::module_& m) {
       .def_readonly("unidentifiable_joints", &StiffnessEstimate::unidentifiable_joints, "1-based joint numbers")
       .def_readonly("fixed_joints", &StiffnessEstimate::fixed_joints, "1-based joint numbers")
       .def_readonly("warnings", &StiffnessEstimate::warnings)
-      .def_property_readonly("robust_weights", [](const StiffnessEstimate& e) { return from_vector(e.robust_weights); })
+      .def_property_readonly("robust_weights", [](const StiffnessEstimate& e) { return frozen(from_vector(e.robust_weights)); })
       .def_readonly("rejected_measurements", &StiffnessEstimate::rejected_measurements, "0-based indices")
       .def_readonly("measurements", &StiffnessEstimate::measurements)
       .def_readonly("iterations", &StiffnessEstimate::iterations)
       .def("__repr__", [](const StiffnessEstimate& e) {
-        return fmt::format("StiffnessEstimate(stiffness_nm_per_rad={}, condition_number={:.3g}, warnings={})",
-                           py::repr(from_vector(e.stiffness_nm_per_rad)).cast<std::string>(), e.condition_number,
-                           e.warnings.size());
+        std::string s = fmt::format("StiffnessEstimate(stiffness_nm_per_rad={}, condition_number={:.3g}",
+                                    py::repr(from_vector(e.stiffness_nm_per_rad)).cast<std::string>(), e.condition_number);
+        std::vector<int> nan, poor;
+        for (const int j : e.unidentifiable_joints) {
+          (std::isnan(e.stiffness_nm_per_rad[j - 1]) ? nan : poor).push_back(j);
+        }
+        if (!nan.empty()) s += fmt::format(", not identified (NaN): joints {}", fmt::join(nan, ", "));
+        if (!poor.empty()) s += fmt::format(", poorly identified (shown, not to be used): joints {}", fmt::join(poor, ", "));
+        return s + fmt::format(", {} warnings)", e.warnings.size());
       });
 
   m.def("read_stiffness_measurements",
-        [](const std::string& path) { return measurements_to_dict(read_stiffness_measurements(path)); }, "path"_a,
+        [](const PathArg& path) { return measurements_to_dict(read_stiffness_measurements(path_text(path))); }, "path"_a,
         "The measurement CSV (docs/identify.md) as arrays in SI units: q (m, dof) rad, wrench (m, 6) N/Nm, dp (m, 3) "
         "m, drot (m, 3) rad or None, weight (m,), line (file line of each row).");
 
   m.def(
       "identify_stiffness",
-      [](const RobotModel& model, const py::object& data, const py::object& q, const py::object& wrench,
-         const py::object& dp, const py::object& drot, const py::object& weight, const py::object& fixed, bool robust,
-         double rotation_scale_m, double max_relative_std_error) {
+      [](const RobotModel& model, const DataArg& data, const std::optional<ArrayLike>& wrench_pos,
+         const std::optional<ArrayLike>& dp_pos, const std::optional<ArrayLike>& q_kw, const std::optional<ArrayLike>& drot, const std::optional<ArrayLike>& weight, const py::object& fixed,
+         bool robust, double rotation_scale_m, double max_relative_std_error) {
         std::vector<StiffnessMeasurement> measurements;
-        if (!data.is_none()) {
-          if (!q.is_none() || !wrench.is_none() || !dp.is_none()) {
+        const auto given = [](const std::optional<ArrayLike>& a) { return a && !a->is_none(); };
+        const bool is_file = py::isinstance<py::str>(data.obj) || py::hasattr(data.obj, "__fspath__");
+        if (is_file) {
+          if (given(q_kw) || given(wrench_pos) || given(dp_pos)) {
             throw InputError("identify_stiffness: give either data (a CSV path) or the arrays q, wrench, dp, not both");
           }
-          measurements = read_stiffness_measurements(data.cast<std::string>());
+          measurements = read_stiffness_measurements(data.obj.cast<PathArg>().string());
         } else {
-          measurements = measurements_from_arrays(model, q, wrench, dp, drot, weight);
+          // Arrays: by keyword, or positionally as (robot, q, wrench, dp).
+          if (!data.is_none() && given(q_kw)) throw InputError("identify_stiffness: q given twice (positionally and as q=)");
+          const py::object none = py::none();
+          const py::object q = !data.is_none() ? data.obj : given(q_kw) ? q_kw->obj : none;
+          const py::object w = given(wrench_pos) ? wrench_pos->obj : none;
+          const py::object dp = given(dp_pos) ? dp_pos->obj : none;
+          if (q.is_none() || w.is_none() || dp.is_none()) {
+            throw InputError("identify_stiffness: give the measurement CSV's path, or the arrays q (m, dof) rad, wrench "
+                             "(m, 6) N/Nm and dp (m, 3) m");
+          }
+          measurements = measurements_from_arrays(model, q, w, dp, given(drot) ? drot->obj : none,
+                                                  given(weight) ? weight->obj : none);
         }
         IdentificationOptions options;
         options.robust = robust;
         options.rotation_scale_m = rotation_scale_m;
         options.max_relative_std_error = max_relative_std_error;
-        if (!fixed.is_none()) options.fixed_stiffness_nm_per_rad = fixed.cast<std::vector<std::optional<double>>>();
+        if (!fixed.is_none()) {
+          try {
+            options.fixed_stiffness_nm_per_rad = fixed.cast<std::vector<std::optional<double>>>();
+          } catch (const py::cast_error&) {
+            throw InputError("argument fixed_stiffness_nm_per_rad: one entry a joint, a number (Nm/rad) or None");
+          }
+        }
         py::gil_scoped_release release;
         return identify_stiffness(model, measurements, options);
       },
-      "robot"_a, "data"_a = py::none(), py::kw_only(), "q"_a = py::none(), "wrench"_a = py::none(), "dp"_a = py::none(),
-      "drot"_a = py::none(), "weight"_a = py::none(), "fixed_stiffness_nm_per_rad"_a = py::none(), "robust"_a = true,
-      "rotation_scale_m"_a = 1.0, "max_relative_std_error"_a = 0.5,
-      "Joint stiffness from measured TCP deflections: data is the measurement CSV's path, or give arrays q (m, dof) "
-      "rad, wrench (m, 6) N/Nm (base frame, at the WAP), dp (m, 3) m, optional drot (m, 3) rad and weight (m,). "
+      "robot"_a, "data"_a = py::none(), "wrench"_a = py::none(), "dp"_a = py::none(), py::kw_only(), "q"_a = py::none(), "drot"_a = py::none(), "weight"_a = py::none(),
+      "fixed_stiffness_nm_per_rad"_a = py::none(), "robust"_a = true, "rotation_scale_m"_a = 1.0,
+      "max_relative_std_error"_a = 0.5,
+      "Joint stiffness from measured TCP deflections: data is the measurement CSV's path (str or os.PathLike), or "
+      "the arrays q (m, dof) rad, wrench (m, 6) N/Nm (base frame, moment about the WAP) and dp (m, 3) m, positionally "
+      "(robot, q, wrench, dp) or by keyword; optional drot (m, 3) rad and weight (m,). "
       "fixed_stiffness_nm_per_rad: one entry a joint, a value to hold or None to estimate.");
 
   py::class_<CalibrationPlan>(m, "CalibrationPlan", "Poses and loads of a compliance-calibration experiment.")
@@ -149,13 +178,13 @@ void bind_identify(py::module_& m) {
       .def_readonly("candidate_poses", &CalibrationPlan::candidate_poses)
       .def_readonly("reachable_poses", &CalibrationPlan::reachable_poses)
       .def_readonly("warnings", &CalibrationPlan::warnings)
-      .def("write_csv", [](const CalibrationPlan& p, const std::string& path) { write_calibration_plan(path, p); },
+      .def("write_csv", [](const CalibrationPlan& p, const PathArg& path) { write_calibration_plan(path_text(path), p); },
            "path"_a, "The plan as the operator's CSV (the same as deflex plan-calibration -o).");
 
   m.def(
       "plan_calibration",
-      [](const RobotModel& model, const py::handle& region_min, const py::handle& region_max, double load_n, int poses,
-         int loads_per_pose, double lever_m, const py::handle& orientation, int grid_per_axis, double noise_m) {
+      [](const RobotModel& model, const ArrayLike& region_min, const ArrayLike& region_max, double load_n, int poses,
+         int loads_per_pose, double lever_m, const ArrayLike& orientation, int grid_per_axis, double noise_m) {
         CalibrationPlanOptions o;
         o.region_min_m = vector3(region_min, "region_min_m");
         o.region_max_m = vector3(region_max, "region_max_m");
