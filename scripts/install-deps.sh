@@ -19,9 +19,13 @@ packages=(
   # cpp-httplib: the live monitor page's server (deflex online --monitor, deflex monitor)
   libcpp-httplib-dev
   python3 python3-dev python3-numpy python3-pytest pybind11-dev
+  # mypy's stubgen: the Python module's .pyi stubs (typed signatures for editors and type checkers)
+  python3-mypy
 )
-# chromium: the tests open the live monitor page in headless Chromium and read what it shows
-if [ "$tests" -eq 1 ]; then packages+=(chromium); fi
+# chromium: the tests open the live monitor page in headless Chromium and read what it shows;
+# python3-yaml: the Python tests give the case study a case as a dict read from the case file;
+# python3-venv: the Python module is installed into and tested in a second interpreter (a venv)
+if [ "$tests" -eq 1 ]; then packages+=(chromium python3-yaml python3-venv); fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

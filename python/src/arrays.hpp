@@ -45,8 +45,18 @@ struct ConfigurationTag {
   static constexpr auto name = py::detail::const_name("typing.Optional[typing.Tuple[int, int, int, int]]");
 };
 struct DataTag {
-  static constexpr auto name = py::detail::const_name("typing.Union[str, os.PathLike, numpy.typing.ArrayLike, None]");
+  static constexpr auto name = py::detail::const_name("typing.Union[str, os.PathLike, numpy.typing.ArrayLike]");
 };
+struct CaseTag {
+  static constexpr auto name = py::detail::const_name("typing.Union[str, os.PathLike, dict]");
+};
+/// A case: a case file's path or a dict of its keys (None: the paper's case).
+using CaseArg = Arg<CaseTag>;
+struct OptionalFloatsTag {
+  static constexpr auto name = py::detail::const_name("typing.Sequence[typing.Optional[float]]");
+};
+/// One entry a joint: a number or None.
+using OptionalFloats = Arg<OptionalFloatsTag>;
 /// A data file's path, or the first of the arrays that stand for it.
 using DataArg = Arg<DataTag>;
 /// ABB confdata (cf1, cf4, cf6, cfx) or None.

@@ -108,7 +108,7 @@ void bind_identify(py::module_& m) {
   m.def(
       "identify_stiffness",
       [](const RobotModel& model, const DataArg& data, const std::optional<ArrayLike>& wrench_pos,
-         const std::optional<ArrayLike>& dp_pos, const std::optional<ArrayLike>& q_kw, const std::optional<ArrayLike>& drot, const std::optional<ArrayLike>& weight, const py::object& fixed,
+         const std::optional<ArrayLike>& dp_pos, const std::optional<ArrayLike>& q_kw, const std::optional<ArrayLike>& drot, const std::optional<ArrayLike>& weight, const OptionalFloats& fixed,
          bool robust, double rotation_scale_m, double max_relative_std_error) {
         std::vector<StiffnessMeasurement> measurements;
         const auto given = [](const std::optional<ArrayLike>& a) { return a && !a->is_none(); };
@@ -138,7 +138,7 @@ void bind_identify(py::module_& m) {
         options.max_relative_std_error = max_relative_std_error;
         if (!fixed.is_none()) {
           try {
-            options.fixed_stiffness_nm_per_rad = fixed.cast<std::vector<std::optional<double>>>();
+            options.fixed_stiffness_nm_per_rad = fixed.obj.cast<std::vector<std::optional<double>>>();
           } catch (const py::cast_error&) {
             throw InputError("argument fixed_stiffness_nm_per_rad: one entry a joint, a number (Nm/rad) or None");
           }
@@ -146,7 +146,7 @@ void bind_identify(py::module_& m) {
         py::gil_scoped_release release;
         return identify_stiffness(model, measurements, options);
       },
-      "robot"_a, "data"_a = py::none(), "wrench"_a = py::none(), "dp"_a = py::none(), py::kw_only(), "q"_a = py::none(), "drot"_a = py::none(), "weight"_a = py::none(),
+      "robot"_a, "data"_a = py::none(), "wrench"_a = py::none(), "dp"_a = py::none(), "q"_a = py::none(), "drot"_a = py::none(), "weight"_a = py::none(),
       "fixed_stiffness_nm_per_rad"_a = py::none(), "robust"_a = true, "rotation_scale_m"_a = 1.0,
       "max_relative_std_error"_a = 0.5,
       "Joint stiffness from measured TCP deflections: data is the measurement CSV's path (str or os.PathLike), or "

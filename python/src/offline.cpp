@@ -420,6 +420,51 @@ void bind_offline(py::module_& m) {
           },
           "path"_a, "robot"_a, "speed_mm_s"_a = 10.0, "hold_start_s"_a = 0.0, "nominal"_a = false, "comment"_a = "",
           "joint_trajectory() as the CSV `t_s,q1_deg,...` deflex online --program reads.")
+      .def(py::pickle(
+          [](const OfflineResult& r) {
+            py::list points;
+            for (const OfflinePoint& p : r.points) {
+              points.append(py::make_tuple(from_vector(p.q_desired), from_vector(p.q_command), from_pose(p.tcp_desired),
+                                           from_pose(p.tcp_command), configuration_tuple(p.configuration_command),
+                                           from_vector(Eigen::VectorXd(p.wrench_base)),
+                                           from_vector(Eigen::VectorXd(p.predicted_deflection)),
+                                           from_vector(Eigen::VectorXd(p.predicted_residual))));
+            }
+            return py::make_tuple(points, r.point_count, r.max_deflection_m, r.mean_deflection_m, r.max_deflection_rad,
+                                  r.max_residual_m, r.max_residual_rad, r.max_correction_m, r.max_joint_correction_rad,
+                                  r.robot_name, r.stiffness_note, r.force_description, r.predicted);
+          },
+          [](const py::tuple& t) {
+            if (t.size() != 13) throw InputError("deflex.OfflineResult: not a pickled OfflineResult");
+            OfflineResult r;
+            for (const py::handle item : t[0].cast<py::list>()) {
+              const auto p = item.cast<py::tuple>();
+              OfflinePoint pt;
+              const Array qd = p[0].cast<Array>(), qc = p[1].cast<Array>();
+              pt.q_desired = Eigen::Map<const Eigen::VectorXd>(qd.data(), qd.size());
+              pt.q_command = Eigen::Map<const Eigen::VectorXd>(qc.data(), qc.size());
+              pt.tcp_desired = pose(p[2], "tcp_desired");
+              pt.tcp_command = pose(p[3], "tcp_command");
+              pt.configuration_command = *arm_configuration_arg(p[4]);
+              pt.wrench_base = vector6(p[5], "wrench");
+              pt.predicted_deflection = vector6(p[6], "predicted_deflection");
+              pt.predicted_residual = vector6(p[7], "predicted_residual");
+              r.points.push_back(std::move(pt));
+            }
+            r.point_count = t[1].cast<std::size_t>();
+            r.max_deflection_m = t[2].cast<double>();
+            r.mean_deflection_m = t[3].cast<double>();
+            r.max_deflection_rad = t[4].cast<double>();
+            r.max_residual_m = t[5].cast<double>();
+            r.max_residual_rad = t[6].cast<double>();
+            r.max_correction_m = t[7].cast<double>();
+            r.max_joint_correction_rad = t[8].cast<double>();
+            r.robot_name = t[9].cast<std::string>();
+            r.stiffness_note = t[10].cast<std::string>();
+            r.force_description = t[11].cast<std::string>();
+            r.predicted = t[12].cast<bool>();
+            return r;
+          }))
       .def("__repr__", [](const OfflineResult& r) {
         return fmt::format("<deflex.OfflineResult {} points, force: {}, max deflection {:.4f} mm, max residual {:.2e} mm>",
                            r.point_count, r.force_description, r.max_deflection_m * 1e3, r.max_residual_m * 1e3);

@@ -303,7 +303,7 @@ void bind_runtime(py::module_& m) {
       .def("motors_off", &standin::StandInSession::motors_off, "An emergency stop.")
       .def("sensor_silent", &standin::StandInSession::sensor_silent, "silent"_a, "The force sensor stops or comes back.")
       .def(
-          "set_force", [](standin::StandInSession& s, const py::handle& f) { s.set_force(vector3(f, "force_base_N")); },
+          "set_force", [](standin::StandInSession& s, const ArrayLike& f) { s.set_force(vector3(f, "force_base_N")); },
           "force_base_N"_a)
       .def_property_readonly("time_s", &standin::StandInSession::time_s)
       .def_property_readonly("ended", [](standin::StandInSession& s) { return s.session().ended(); })

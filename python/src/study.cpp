@@ -106,9 +106,10 @@ void bind_study(py::module_& m) {
 
   m.def(
       "run_case_study",
-      [](const py::object& case_arg, int seeds, std::optional<long long> seed, bool quick, bool speed_sweep,
+      [](const CaseArg& case_in, int seeds, std::optional<long long> seed, bool quick, bool speed_sweep,
          bool error_budget, int threads, bool traces) {
         CaseStudyRun run;
+        const py::object& case_arg = case_in.obj;
         if (case_arg.is_none() || (py::isinstance<py::str>(case_arg) && case_arg.cast<std::string>().empty())) {
           run.config = study::paper_case();
           run.case_text = study::paper_case_yaml();
