@@ -8,9 +8,8 @@ Each block below is a notebook cell. Units: m, rad, N, Nm (mm only in printed fi
 import pathlib
 import sys
 
+import deflex  # first: on an interpreter without NumPy its message says what to do
 import numpy as np
-
-import deflex
 
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent.parent

@@ -17,9 +17,8 @@ import csv
 import pathlib
 import sys
 
+import deflex  # first: on an interpreter without NumPy its message says what to do
 import numpy as np
-
-import deflex
 
 out_dir = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".")
 out_dir.mkdir(parents=True, exist_ok=True)
