@@ -236,14 +236,25 @@ std::vector<IkResult> ik_solutions(const RobotModel& r, Workspace& ws, const Pos
   return all;
 }
 
-IkRequest ik_request(const RobotModel& r, const std::optional<ArrayLike>& seed, const Array* seeds, py::ssize_t i) {
+/// The request for pose i: its own seed from `seeds` (N, dof), or the one seed for all (or none).
+IkRequest ik_request(const RobotModel& r, const std::optional<JointVector>& seed, const Array* seeds, py::ssize_t i) {
   IkRequest req;
   if (seeds != nullptr) {
     req.seed = Eigen::Map<const Eigen::VectorXd>(seeds->data() + i * r.dof(), r.dof());
-  } else if (seed && !seed->is_none()) {
-    req.seed = joint_vector(*seed, "seed", r.dof());
+  } else {
+    req.seed = seed;
   }
   return req;
+}
+
+/// One seed (dof,) for every pose, read while the GIL is held; none when absent or one a pose.
+std::optional<JointVector> one_seed(const RobotModel& r, const std::optional<ArrayLike>& seed, bool batch) {
+  if (!seed || seed->is_none()) return std::nullopt;
+  if (batch) {
+    const py::array a = py::array::ensure(seed->obj);
+    if (a && a.ndim() == 2) return std::nullopt;  // one a pose: seed_rows()
+  }
+  return joint_vector(*seed, "seed", r.dof());
 }
 
 /// Seeds (dof,) for every pose or (N, dof) one a pose; null when one seed (or none) serves all.
@@ -267,16 +278,17 @@ bool is_pose_batch(const py::handle& obj) {
 py::object ik(const RobotModel& r, const ArrayLike& target, const std::optional<ArrayLike>& seed) {
   if (!is_pose_batch(target)) {
     Workspace ws(r);
-    return py::cast(ik_solutions(r, ws, pose(target, "pose"), ik_request(r, seed, nullptr, 0)));
+    return py::cast(ik_solutions(r, ws, pose(target, "pose"), ik_request(r, one_seed(r, seed, false), nullptr, 0)));
   }
   const std::vector<Pose> p = poses(target, "pose");
   const std::optional<Array> seeds = seed_rows(r, seed, static_cast<py::ssize_t>(p.size()));
+  const std::optional<JointVector> common = one_seed(r, seed, true);
   std::vector<std::vector<IkResult>> out(p.size());
   {
     py::gil_scoped_release release;
     Workspace ws(r);
     for (std::size_t i = 0; i < p.size(); ++i) {
-      out[i] = ik_solutions(r, ws, p[i], ik_request(r, seed, seeds ? &*seeds : nullptr, static_cast<py::ssize_t>(i)));
+      out[i] = ik_solutions(r, ws, p[i], ik_request(r, common, seeds ? &*seeds : nullptr, static_cast<py::ssize_t>(i)));
     }
   }
   return py::cast(out);
@@ -286,19 +298,20 @@ py::object inverse_kinematics_of(const RobotModel& r, const ArrayLike& target, c
                                   const std::optional<ArrayLike>& seed) {
   const std::optional<ArmConfiguration> conf = arm_configuration_arg(configuration);
   if (!is_pose_batch(target)) {
-    IkRequest req = ik_request(r, seed, nullptr, 0);
+    IkRequest req = ik_request(r, one_seed(r, seed, false), nullptr, 0);
     req.configuration = conf;
     Workspace ws(r);
     return py::cast(inverse_kinematics(r, ws, pose(target, "pose"), req));
   }
   const std::vector<Pose> p = poses(target, "pose");
   const std::optional<Array> seeds = seed_rows(r, seed, static_cast<py::ssize_t>(p.size()));
+  const std::optional<JointVector> common = one_seed(r, seed, true);
   std::vector<IkResult> out(p.size());
   {
     py::gil_scoped_release release;
     Workspace ws(r);
     for (std::size_t i = 0; i < p.size(); ++i) {
-      IkRequest req = ik_request(r, seed, seeds ? &*seeds : nullptr, static_cast<py::ssize_t>(i));
+      IkRequest req = ik_request(r, common, seeds ? &*seeds : nullptr, static_cast<py::ssize_t>(i));
       req.configuration = conf;
       out[i] = inverse_kinematics(r, ws, p[i], req);
     }

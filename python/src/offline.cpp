@@ -108,14 +108,16 @@ std::vector<Pose> path_poses(const py::handle& path, const py::handle& orientati
 
 py::ssize_t dof_of(const OfflineResult& r) { return r.points.empty() ? 0 : r.points.front().q_desired.size(); }
 
-/// Every load of `forces` compensated along the path: one OfflineResult each.
-std::vector<OfflineResult> compensate_all(const RobotModel& model, const PathOrPoses& path, const ForceArg& force,
-                                          const ConfigurationArg& configuration, const std::optional<ArrayLike>& seed,
-                                          const ArrayLike& orientation, bool predict, const std::string& about) {
+/// Every load of `force` compensated along the path: one OfflineResult each. With `list_is_loads`
+/// a list or tuple is one load an item; otherwise a nested list is a wrench table (N, 6).
+std::vector<OfflineResult> compensate_each(const RobotModel& model, const PathOrPoses& path, const ForceArg& force,
+                                           const ConfigurationArg& configuration, const std::optional<ArrayLike>& seed,
+                                           const ArrayLike& orientation, bool predict, const std::string& about,
+                                           bool list_is_loads) {
   ForceSpecContext context;
   const std::vector<Pose> p = path_poses(path, orientation, context);
   std::vector<std::unique_ptr<ForceModel>> forces;
-  if (py::isinstance<py::list>(force.obj) || py::isinstance<py::tuple>(force.obj)) {
+  if (list_is_loads && (py::isinstance<py::list>(force.obj) || py::isinstance<py::tuple>(force.obj))) {
     // A list of loads: spec strings or wrench arrays, one load each (a list of six numbers is one wrench).
     const py::sequence seq = force.obj;
     const bool one_wrench =
@@ -474,7 +476,8 @@ void bind_offline(py::module_& m) {
       "compensate_path",
       [](const RobotModel& model, const PathOrPoses& path, const ForceArg& force, const ConfigurationArg& configuration,
          const std::optional<ArrayLike>& seed, const ArrayLike& orientation, bool predict, const std::string& about) {
-        std::vector<OfflineResult> all = compensate_all(model, path, force, configuration, seed, orientation, predict, about);
+        std::vector<OfflineResult> all =
+            compensate_each(model, path, force, configuration, seed, orientation, predict, about, false);
         if (all.size() != 1) {
           throw InputError(fmt::format("argument force: describes {} loads; compensate_path takes one (compensate_loads "
                                        "gives one result a load)",
@@ -489,7 +492,13 @@ void bind_offline(py::module_& m) {
       "'ldbb:phi_deg=30,force_N=400' with a Circle, 'constant:fz_N=-500'; a spec's moments are about the TCP), or one "
       "wrench (6,) or one a point (N, 6) (N, Nm; base frame, moment about the WAP, or the TCP with "
       "moment_about='tcp').");
-  m.def("compensate_loads", &compensate_all, "robot"_a, "path"_a, "force"_a, "configuration"_a = py::none(),
+  m.def(
+      "compensate_loads",
+      [](const RobotModel& model, const PathOrPoses& path, const ForceArg& force, const ConfigurationArg& configuration,
+         const std::optional<ArrayLike>& seed, const ArrayLike& orientation, bool predict, const std::string& about) {
+        return compensate_each(model, path, force, configuration, seed, orientation, predict, about, true);
+      },
+      "robot"_a, "path"_a, "force"_a, "configuration"_a = py::none(),
         "seed"_a = py::none(), "orientation_wxyz"_a = std::vector<double>{0.0, 0.0, 1.0, 0.0}, "predict"_a = true,
         "moment_about"_a = "wap",
         "compensate_path for several loads on one path (one IK): a spec with several force_N values "

@@ -174,7 +174,10 @@ def test_batches_equal_the_loop_and_threads_do_not_change_the_result():
     assert len(per_pose) == 5
     for i, sols in enumerate(per_pose):
         np.testing.assert_allclose(sols[0].q, qs[i], atol=1e-7)
+    one_seed = robot.ik(poses, seed=qs[0])  # one seed (dof,) for every pose
+    np.testing.assert_allclose(one_seed[0][0].q, qs[0], atol=1e-7)
     one_each = robot.inverse_kinematics(poses, seed=qs[:5])
+    np.testing.assert_allclose(np.array([r.q for r in robot.inverse_kinematics(poses, seed=qs[0])])[0], qs[0], atol=1e-7)
     np.testing.assert_allclose(np.array([r.q for r in one_each]), qs[:5], atol=1e-7)
     with pytest.raises(deflex.InputError, match="threads"):
         robot.fk(qs, threads=-1)

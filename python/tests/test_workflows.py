@@ -69,6 +69,11 @@ def test_several_loads_and_their_files_match_the_cli(tmp_path):
     with pytest.raises(deflex.InputError):
         deflex.write_joint_trajectory(tmp_path / "bad.csv", robot, t, bad_q)
     assert not (tmp_path / "bad.csv").exists()
+    # A list gives one load an item to compensate_loads; to compensate_path a nested list is a table.
+    mixed = deflex.compensate_loads(robot, deflex.Circle(points=5), ["constant:fz_N=-300", [0, 0, -300, 0, 0, 0]])
+    np.testing.assert_allclose(mixed[0].q_command, mixed[1].q_command, atol=1e-12)
+    table = deflex.compensate_path(robot, deflex.Circle(points=5), [[0, 0, -300, 0, 0, 0]] * 5)
+    np.testing.assert_allclose(table.q_command, mixed[0].q_command, atol=1e-12)
     # Results pickle (e.g. to a worker process) with every point.
     copy = pickle.loads(pickle.dumps(results[1]))
     np.testing.assert_array_equal(copy.q_command, results[1].q_command)
