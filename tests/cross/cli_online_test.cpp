@@ -70,8 +70,11 @@ TEST(CliOnline, EgmJointStreamsTheProgramWithinTheBoundOfIt) {
   ASSERT_GT(table.rows(), 200u);
   const std::size_t last = table.rows() - 1;
   EXPECT_GT(table.at(last, "program_t_s") - table.at(0, "program_t_s"), 1.0);
+  // Not ahead of the link's clock by more than one 4 ms cycle: the first and last rows' stamps carry the
+  // scheduling jitter of a loaded machine (0.13 ms seen in a full ctest run beside a build), while a
+  // program clock running ahead would gain a cycle every few cycles.
   EXPECT_LE(table.at(last, "program_t_s") - table.at(0, "program_t_s"),
-            table.at(last, "t_s") - table.at(0, "t_s") + 1e-6);
+            table.at(last, "t_s") - table.at(0, "t_s") + 0.004);
   double worst_nominal = 0.0, worst_command = 0.0, largest = 0.0;
   JointVector q(6);
   for (std::size_t r = 0; r < table.rows(); ++r) {
