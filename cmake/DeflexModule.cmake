@@ -2,7 +2,17 @@
 # Builds src/deflex/NAME/*.cpp into the static library deflex_NAME (nothing if the folder has no
 # sources yet), and tests/NAME/*_test.cpp into the test program deflex_NAME_tests. Adding a file
 # to a module needs no edit here: new files are found at configure time (CONFIGURE_DEPENDS).
+# Each module is also the target deflex::NAME, in the build tree (an alias) and in the installed
+# package (find_package(deflex COMPONENTS NAME), cmake/deflexConfig.cmake.in): it passes on C++20
+# and its include path, and records what a consumer's CMake must find for it (deflex_module_requires).
 set(DEFLEX_MODULE_TARGETS "" CACHE INTERNAL "")
+set(DEFLEX_MODULE_NAMES "" CACHE INTERNAL "")
+
+# deflex_module_requires(NAME CODE...): CMake code the installed package's config runs for a consumer
+# that uses module NAME (find_dependency(...) of what the module links), one call a line.
+function(deflex_module_requires name)
+  set_property(GLOBAL APPEND PROPERTY DEFLEX_REQUIRES_${name} ${ARGN})
+endfunction()
 
 function(deflex_module name)
   cmake_parse_arguments(ARG "" "" "DEPENDS" ${ARGN})
@@ -13,18 +23,33 @@ function(deflex_module name)
   endif()
   set(target deflex_${name})
   add_library(${target} STATIC ${sources})
-  target_include_directories(${target} PUBLIC ${PROJECT_SOURCE_DIR}/src ${PROJECT_BINARY_DIR}/generated)
-  target_link_libraries(${target} PUBLIC Eigen3::Eigen fmt::fmt PRIVATE deflex_warnings)
+  add_library(deflex::${name} ALIAS ${target})
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${name})
+  target_include_directories(
+    ${target} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src> $<BUILD_INTERFACE:${PROJECT_BINARY_DIR}/generated>
+                     $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+  target_compile_features(${target} PUBLIC cxx_std_20)
+  target_link_libraries(${target} PUBLIC Eigen3::Eigen fmt::fmt)
+  target_compile_options(${target} PRIVATE ${DEFLEX_WARNING_FLAGS})
+  deflex_module_requires(${name} "find_dependency(Eigen3 3.4 NO_MODULE)" "find_dependency(fmt)")
+  set(deps "")
   foreach(dep IN LISTS ARG_DEPENDS)
     if(TARGET deflex_${dep})
       target_link_libraries(${target} PUBLIC deflex_${dep})
+      list(APPEND deps ${dep})
     endif()
   endforeach()
+  set_property(GLOBAL PROPERTY DEFLEX_DEPENDS_${name} ${deps})
+  install(TARGETS ${target} EXPORT deflexTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  # The module's public headers; those under detail/ are its own and are not installed.
+  file(GLOB headers CONFIGURE_DEPENDS ${dir}/*.hpp)
+  install(FILES ${headers} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/deflex/${name})
   # Per-module extras (generated sources, extra packages) live beside the module's sources.
   if(EXISTS ${dir}/module.cmake)
     include(${dir}/module.cmake)
   endif()
   set(DEFLEX_MODULE_TARGETS ${DEFLEX_MODULE_TARGETS} ${target} CACHE INTERNAL "")
+  set(DEFLEX_MODULE_NAMES ${DEFLEX_MODULE_NAMES} ${name} CACHE INTERNAL "")
 endfunction()
 
 # deflex_embed_text(TARGET FILE SYMBOL)
@@ -39,4 +64,30 @@ function(deflex_embed_text target file symbol)
   file(CONFIGURE OUTPUT ${out} @ONLY CONTENT
     "// Generated from ${file} by deflex_embed_text (cmake/DeflexModule.cmake).\nnamespace deflex { extern const char* const ${symbol}; const char* const ${symbol} = R\"deflexembed(@text@)deflexembed\"; }\n")
   target_sources(${target} PRIVATE ${out})
+endfunction()
+
+# deflex_check_private_headers(): a module's detail/ headers are its own. Any file of another module,
+# the program, the Python module, the examples or the benchmarks that includes one fails the
+# configure, naming the file and the header (tests may include them: they test the module itself).
+function(deflex_check_private_headers)
+  file(GLOB_RECURSE files CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/deflex/*.hpp ${PROJECT_SOURCE_DIR}/src/deflex/*.cpp
+       ${PROJECT_SOURCE_DIR}/apps/*.cpp ${PROJECT_SOURCE_DIR}/apps/*.hpp ${PROJECT_SOURCE_DIR}/python/src/*.cpp
+       ${PROJECT_SOURCE_DIR}/python/src/*.hpp ${PROJECT_SOURCE_DIR}/examples/*.cpp ${PROJECT_SOURCE_DIR}/bench/*.cpp)
+  set(violations "")
+  foreach(f IN LISTS files)
+    file(STRINGS ${f} lines REGEX "#include \"deflex/[a-z_]+/detail/")
+    foreach(line IN LISTS lines)
+      string(REGEX MATCH "deflex/([a-z_]+)/detail/[a-z_0-9.]+" header "${line}")
+      set(owner ${CMAKE_MATCH_1})
+      if(NOT f MATCHES "/src/deflex/${owner}/")
+        file(RELATIVE_PATH rel ${PROJECT_SOURCE_DIR} ${f})
+        list(APPEND violations "${rel} includes ${header}")
+      endif()
+    endforeach()
+  endforeach()
+  if(violations)
+    list(JOIN violations "\n  " text)
+    message(FATAL_ERROR "private headers used outside their module (move what is shared to the module's "
+                        "public headers):\n  ${text}")
+  endif()
 endfunction()

@@ -15,7 +15,7 @@
 #include "deflex/model/robot_io.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/paths/path_ik.hpp"
-#include "deflex/paths/pose_path_csv.hpp"
+#include "deflex/paths/detail/pose_path_csv.hpp"
 
 namespace deflex {
 namespace {

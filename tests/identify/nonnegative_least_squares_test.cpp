@@ -5,7 +5,7 @@
 #include <Eigen/QR>
 #include <gtest/gtest.h>
 
-#include "deflex/identify/nonnegative_least_squares.hpp"
+#include "deflex/identify/detail/nonnegative_least_squares.hpp"
 
 namespace deflex {
 namespace {

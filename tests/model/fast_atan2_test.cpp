@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/fast_atan2.hpp"
+#include "deflex/model/detail/fast_atan2.hpp"
 
 namespace deflex {
 namespace {

@@ -10,7 +10,7 @@
 #include "deflex/model/input_ranges.hpp"
 #include "deflex/model/nearest_name.hpp"
 #include "deflex/model/parse_number.hpp"
-#include "deflex/model/utf8_text.hpp"
+#include "deflex/model/detail/utf8_text.hpp"
 #include "deflex/model/yaml_fields.hpp"
 #include "support/error_of.hpp"
 

@@ -9,7 +9,7 @@
 
 #include "deflex/model/errors.hpp"
 #include "deflex/model/robot_io.hpp"
-#include "deflex/model/urdf_tree.hpp"
+#include "deflex/model/detail/urdf_tree.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex {

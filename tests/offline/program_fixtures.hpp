@@ -9,8 +9,8 @@
 
 #include "deflex/force/constant_wrench_model.hpp"
 #include "deflex/model/robot_io.hpp"
-#include "deflex/offline/krl_program.hpp"
-#include "deflex/offline/rapid_program.hpp"
+#include "deflex/offline/detail/krl_program.hpp"
+#include "deflex/offline/detail/rapid_program.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex::program_fixtures {

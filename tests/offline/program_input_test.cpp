@@ -11,10 +11,10 @@
 #include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
 #include "deflex/model/robot_io.hpp"
-#include "deflex/offline/krl_program.hpp"
+#include "deflex/offline/detail/krl_program.hpp"
 #include "deflex/offline/program_compensation.hpp"
-#include "deflex/offline/program_text.hpp"
-#include "deflex/offline/rapid_program.hpp"
+#include "deflex/offline/detail/program_text.hpp"
+#include "deflex/offline/detail/rapid_program.hpp"
 #include "offline/program_fixtures.hpp"
 #include "support/error_of.hpp"
 

@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/offline/quaternion_sign.hpp"
+#include "deflex/offline/detail/quaternion_sign.hpp"
 
 namespace deflex {
 namespace {

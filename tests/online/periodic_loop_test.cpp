@@ -6,7 +6,7 @@
 
 #include "deflex/model/errors.hpp"
 #include "deflex/model/robot_io.hpp"
-#include "deflex/online/periodic_loop.hpp"
+#include "deflex/online/detail/periodic_loop.hpp"
 #include "support/allocation_guard.hpp"
 
 namespace deflex {

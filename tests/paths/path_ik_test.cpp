@@ -6,7 +6,7 @@
 #include "deflex/model/robot_io.hpp"
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/path_spec.hpp"
-#include "deflex/paths/pose_path_csv.hpp"
+#include "deflex/paths/detail/pose_path_csv.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex {

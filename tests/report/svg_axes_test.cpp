@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/report/svg_canvas.hpp"
+#include "deflex/report/detail/svg_canvas.hpp"
 
 namespace deflex {
 namespace {

@@ -11,8 +11,8 @@
 #include <gtest/gtest.h>
 
 #include "deflex/model/errors.hpp"
-#include "deflex/sensors/csv_force_replay.hpp"
-#include "deflex/sensors/udp_force_source.hpp"
+#include "deflex/sensors/detail/csv_force_replay.hpp"
+#include "deflex/sensors/detail/udp_force_source.hpp"
 #include "support/allocation_guard.hpp"
 
 namespace deflex {

@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/online/force_pipeline.hpp"
-#include "deflex/sensors/csv_force_replay.hpp"
+#include "deflex/sensors/detail/csv_force_replay.hpp"
 
 namespace deflex {
 namespace {

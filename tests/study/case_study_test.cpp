@@ -9,7 +9,7 @@
 
 #include <cmath>
 
-#include "deflex/study/simulated_run.hpp"
+#include "deflex/study/detail/simulated_run.hpp"
 
 #include <filesystem>
 #include <fstream>

@@ -9,7 +9,7 @@
 
 #include "deflex/evaluate/time_alignment.hpp"
 #include "deflex/model/kinematics.hpp"
-#include "deflex/study/simulated_run.hpp"
+#include "deflex/study/detail/simulated_run.hpp"
 
 namespace deflex::study {
 namespace {

@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/wire/rsi_xml.hpp"
-#include "deflex/wire/xml_scanner.hpp"
+#include "deflex/wire/detail/xml_scanner.hpp"
 #include "support/allocation_guard.hpp"
 #include "wire/libxml2_reader.hpp"
 

@@ -1,5 +1,5 @@
 // Lawson-Hanson active-set NNLS.
-#include "deflex/identify/nonnegative_least_squares.hpp"
+#include "deflex/identify/detail/nonnegative_least_squares.hpp"
 
 #include <Eigen/QR>
 

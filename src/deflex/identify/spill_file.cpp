@@ -1,5 +1,5 @@
 // Scratch file for the identification's rows beyond its memory budget.
-#include "deflex/identify/spill_file.hpp"
+#include "deflex/identify/detail/spill_file.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>

@@ -12,8 +12,8 @@
 #include <Eigen/SVD>
 #include <fmt/format.h>
 
-#include "deflex/identify/nonnegative_least_squares.hpp"
-#include "deflex/identify/spill_file.hpp"
+#include "deflex/identify/detail/nonnegative_least_squares.hpp"
+#include "deflex/identify/detail/spill_file.hpp"
 #include "deflex/model/errors.hpp"
 
 namespace deflex {

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "deflex/model/fast_atan2.hpp"
+#include "deflex/model/detail/fast_atan2.hpp"
 #include "deflex/model/robot_model.hpp"
 
 namespace deflex {

@@ -14,7 +14,7 @@
 #include "deflex/model/input_file.hpp"
 #include "deflex/model/input_ranges.hpp"
 #include "deflex/model/output_file.hpp"
-#include "deflex/model/urdf_tree.hpp"
+#include "deflex/model/detail/urdf_tree.hpp"
 #include "deflex/model/yaml_fields.hpp"
 
 namespace deflex {

@@ -1,6 +1,6 @@
 // URDF tree structure with line numbers (TinyXML) and the choice of the serial chain, in time linear
 // in the number of links and joints.
-#include "deflex/model/urdf_tree.hpp"
+#include "deflex/model/detail/urdf_tree.hpp"
 
 #include <algorithm>
 #include <sstream>
@@ -11,7 +11,7 @@
 #include "deflex/model/errors.hpp"
 #include "deflex/model/input_ranges.hpp"
 #include "deflex/model/parse_number.hpp"
-#include "deflex/model/utf8_text.hpp"
+#include "deflex/model/detail/utf8_text.hpp"
 
 namespace deflex {
 namespace {

@@ -13,7 +13,7 @@
 #include "deflex/model/errors.hpp"
 #include "deflex/model/nearest_name.hpp"
 #include "deflex/model/parse_number.hpp"
-#include "deflex/model/utf8_text.hpp"
+#include "deflex/model/detail/utf8_text.hpp"
 
 namespace deflex::yaml {
 

@@ -1,5 +1,5 @@
 // KRL files, aggregates and frames.
-#include "deflex/offline/krl_aggregate.hpp"
+#include "deflex/offline/detail/krl_aggregate.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
-#include "deflex/offline/program_text.hpp"
+#include "deflex/offline/detail/program_text.hpp"
 
 namespace deflex {
 

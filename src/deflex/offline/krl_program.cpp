@@ -5,7 +5,7 @@
 // of another type stop it with the file, the line and the name. Only points whose value is known
 // only when the program runs (or that live in $config.dat, or motions deflex does not compensate)
 // are listed and left unchanged.
-#include "deflex/offline/krl_program.hpp"
+#include "deflex/offline/detail/krl_program.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,10 +18,10 @@
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
-#include "deflex/offline/krl_aggregate.hpp"
-#include "deflex/offline/program_targets.hpp"
-#include "deflex/offline/program_text.hpp"
-#include "deflex/offline/program_write_back.hpp"
+#include "deflex/offline/detail/krl_aggregate.hpp"
+#include "deflex/offline/detail/program_targets.hpp"
+#include "deflex/offline/detail/program_text.hpp"
+#include "deflex/offline/detail/program_write_back.hpp"
 
 namespace deflex {
 namespace {

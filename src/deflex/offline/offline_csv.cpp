@@ -7,7 +7,7 @@
 
 #include "deflex/model/csv_table.hpp"
 #include "deflex/model/errors.hpp"
-#include "deflex/offline/quaternion_sign.hpp"
+#include "deflex/offline/detail/quaternion_sign.hpp"
 
 namespace deflex {
 namespace {

@@ -10,9 +10,9 @@
 #include "deflex/model/errors.hpp"
 #include "deflex/model/input_file.hpp"
 #include "deflex/model/output_file.hpp"
-#include "deflex/offline/krl_program.hpp"
-#include "deflex/offline/rapid_program.hpp"
-#include "deflex/offline/program_text.hpp"
+#include "deflex/offline/detail/krl_program.hpp"
+#include "deflex/offline/detail/rapid_program.hpp"
+#include "deflex/offline/detail/program_text.hpp"
 
 namespace deflex {
 namespace {

@@ -1,6 +1,6 @@
 // Compensation of resolved program targets, one compensate_path() call per use so the program path
 // computes exactly what the path path computes.
-#include "deflex/offline/program_targets.hpp"
+#include "deflex/offline/detail/program_targets.hpp"
 
 #include <map>
 #include <memory>

@@ -1,5 +1,5 @@
 // Byte-exact program edits and the small text helpers the program readers share.
-#include "deflex/offline/program_text.hpp"
+#include "deflex/offline/detail/program_text.hpp"
 
 #include <algorithm>
 #include <cctype>

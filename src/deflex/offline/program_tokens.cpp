@@ -1,5 +1,5 @@
 // RAPID and KRL lexers.
-#include "deflex/offline/program_tokens.hpp"
+#include "deflex/offline/detail/program_tokens.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
-#include "deflex/offline/program_text.hpp"
+#include "deflex/offline/detail/program_text.hpp"
 
 namespace deflex {
 namespace {

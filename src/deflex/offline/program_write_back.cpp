@@ -1,11 +1,11 @@
 // The write-back plan shared by the RAPID and KRL writers.
-#include "deflex/offline/program_write_back.hpp"
+#include "deflex/offline/detail/program_write_back.hpp"
 
 #include <algorithm>
 
 #include <fmt/format.h>
 
-#include "deflex/offline/program_text.hpp"
+#include "deflex/offline/detail/program_text.hpp"
 
 namespace deflex {
 

@@ -1,5 +1,5 @@
 // Sign choice of output quaternions.
-#include "deflex/offline/quaternion_sign.hpp"
+#include "deflex/offline/detail/quaternion_sign.hpp"
 
 #include <cmath>
 

@@ -10,7 +10,7 @@
 
 #include "deflex/model/errors.hpp"
 #include "deflex/model/output_file.hpp"
-#include "deflex/offline/quaternion_sign.hpp"
+#include "deflex/offline/detail/quaternion_sign.hpp"
 
 namespace deflex {
 namespace {

@@ -3,7 +3,7 @@
 // only targets whose value is known only when the program runs (or that live in another module, or
 // that deflex does not compensate) are listed and left unchanged. Data are looked up the way RAPID
 // scopes them: a routine's own data first, then the module's.
-#include "deflex/offline/rapid_program.hpp"
+#include "deflex/offline/detail/rapid_program.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,11 +15,11 @@
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
-#include "deflex/offline/program_targets.hpp"
-#include "deflex/offline/program_text.hpp"
-#include "deflex/offline/program_write_back.hpp"
-#include "deflex/offline/quaternion_sign.hpp"
-#include "deflex/offline/rapid_values.hpp"
+#include "deflex/offline/detail/program_targets.hpp"
+#include "deflex/offline/detail/program_text.hpp"
+#include "deflex/offline/detail/program_write_back.hpp"
+#include "deflex/offline/detail/quaternion_sign.hpp"
+#include "deflex/offline/detail/rapid_values.hpp"
 
 namespace deflex {
 namespace {

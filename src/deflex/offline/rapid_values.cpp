@@ -1,5 +1,5 @@
 // RAPID literal values and the layouts of the data types the program reader takes.
-#include "deflex/offline/rapid_values.hpp"
+#include "deflex/offline/detail/rapid_values.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
-#include "deflex/offline/program_text.hpp"
+#include "deflex/offline/detail/program_text.hpp"
 
 namespace deflex {
 

@@ -1,5 +1,5 @@
 // Fixed-period online loop (see periodic_loop.hpp).
-#include "deflex/online/periodic_loop.hpp"
+#include "deflex/online/detail/periodic_loop.hpp"
 
 #include <chrono>
 #include <cmath>

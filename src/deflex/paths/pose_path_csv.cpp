@@ -1,5 +1,5 @@
 // CSV reader for TCP pose paths.
-#include "deflex/paths/pose_path_csv.hpp"
+#include "deflex/paths/detail/pose_path_csv.hpp"
 
 #include "deflex/paths/pose_source.hpp"
 

@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 
 #include "deflex/model/errors.hpp"
-#include "deflex/paths/pose_path_csv.hpp"
+#include "deflex/paths/detail/pose_path_csv.hpp"
 
 namespace deflex {
 

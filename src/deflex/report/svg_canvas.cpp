@@ -1,5 +1,5 @@
 // A minimal SVG builder for the report's charts.
-#include "deflex/report/svg_canvas.hpp"
+#include "deflex/report/detail/svg_canvas.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // Parts the report's charts share.
-#include "deflex/report/svg_chart_parts.hpp"
+#include "deflex/report/detail/svg_chart_parts.hpp"
 
 #include <algorithm>
 #include <cmath>

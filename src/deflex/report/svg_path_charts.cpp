@@ -10,8 +10,8 @@
 
 #include "deflex/evaluate/lap_split.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
-#include "deflex/report/svg_canvas.hpp"
-#include "deflex/report/svg_chart_parts.hpp"
+#include "deflex/report/detail/svg_canvas.hpp"
+#include "deflex/report/detail/svg_chart_parts.hpp"
 #include "deflex/report/svg_charts.hpp"
 
 namespace deflex {

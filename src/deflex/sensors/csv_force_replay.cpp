@@ -1,5 +1,5 @@
 // CSV force replay (see csv_force_replay.hpp).
-#include "deflex/sensors/csv_force_replay.hpp"
+#include "deflex/sensors/detail/csv_force_replay.hpp"
 
 #include <fmt/format.h>
 

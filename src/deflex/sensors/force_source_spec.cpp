@@ -5,8 +5,8 @@
 
 #include "deflex/model/errors.hpp"
 #include "deflex/model/parse_number.hpp"
-#include "deflex/sensors/csv_force_replay.hpp"
-#include "deflex/sensors/udp_force_source.hpp"
+#include "deflex/sensors/detail/csv_force_replay.hpp"
+#include "deflex/sensors/detail/udp_force_source.hpp"
 
 namespace deflex {
 

@@ -1,5 +1,5 @@
 // One HTTP GET through libcurl (see http_fetch.hpp).
-#include "deflex/sensors/http_fetch.hpp"
+#include "deflex/sensors/detail/http_fetch.hpp"
 
 #include <curl/curl.h>
 #include <fmt/format.h>

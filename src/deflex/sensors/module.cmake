@@ -4,3 +4,5 @@ find_package(PkgConfig REQUIRED)
 pkg_check_modules(TINYXML REQUIRED IMPORTED_TARGET tinyxml)
 find_package(CURL REQUIRED)
 target_link_libraries(${target} PRIVATE PkgConfig::TINYXML CURL::libcurl)
+deflex_module_requires(sensors "find_dependency(PkgConfig)" "pkg_check_modules(TINYXML REQUIRED IMPORTED_TARGET tinyxml)"
+                       "find_dependency(CURL)")

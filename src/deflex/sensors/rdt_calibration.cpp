@@ -15,7 +15,7 @@
 #include "deflex/model/errors.hpp"
 #include "deflex/model/parse_number.hpp"
 #include "deflex/paths/key_value_spec.hpp"
-#include "deflex/sensors/http_fetch.hpp"
+#include "deflex/sensors/detail/http_fetch.hpp"
 
 namespace deflex {
 namespace {

@@ -21,7 +21,7 @@
 #include "deflex/evaluate/tracker_trace.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
 #include "deflex/model/errors.hpp"
-#include "deflex/study/simulated_run.hpp"
+#include "deflex/study/detail/simulated_run.hpp"
 
 namespace deflex::study {
 namespace {

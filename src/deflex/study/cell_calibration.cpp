@@ -1,5 +1,5 @@
 // The compliance calibration experiment on the simulated cell (see cell_calibration.hpp).
-#include "deflex/study/cell_calibration.hpp"
+#include "deflex/study/detail/cell_calibration.hpp"
 
 #include <fmt/format.h>
 
@@ -17,7 +17,7 @@
 #include "deflex/paths/circle_path.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/paths/path_ik.hpp"
-#include "deflex/study/simulated_run.hpp"
+#include "deflex/study/detail/simulated_run.hpp"
 
 namespace deflex::study {
 namespace {

@@ -3,3 +3,4 @@
 deflex_embed_text(${target} data/cases/paper.yaml kPaperCaseYaml)
 find_package(Threads REQUIRED)
 target_link_libraries(${target} PUBLIC Threads::Threads)
+deflex_module_requires(study "find_dependency(Threads)")

@@ -1,5 +1,5 @@
 // One protocol run on the simulated cell (see simulated_run.hpp).
-#include "deflex/study/simulated_run.hpp"
+#include "deflex/study/detail/simulated_run.hpp"
 
 #include <fmt/format.h>
 

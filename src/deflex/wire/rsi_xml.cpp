@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "deflex/wire/xml_scanner.hpp"
+#include "deflex/wire/detail/xml_scanner.hpp"
 
 namespace deflex {
 

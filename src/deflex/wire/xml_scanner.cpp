@@ -1,5 +1,5 @@
 // The strict XML subset scanner (see xml_scanner.hpp). Grammar references are to XML 1.0 (5th ed.).
-#include "deflex/wire/xml_scanner.hpp"
+#include "deflex/wire/detail/xml_scanner.hpp"
 
 namespace deflex {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "deflex/offline/program_tokens.hpp"
+#include "deflex/offline/detail/program_tokens.hpp"
 
 namespace deflex {
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "deflex/model/types.hpp"
-#include "deflex/offline/program_tokens.hpp"
+#include "deflex/offline/detail/program_tokens.hpp"
 
 namespace deflex {
 

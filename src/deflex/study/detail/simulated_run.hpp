@@ -17,7 +17,7 @@
 #include "deflex/online/sensor_config.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/paths/path_ik.hpp"
-#include "deflex/study/cell_calibration.hpp"
+#include "deflex/study/detail/cell_calibration.hpp"
 #include "deflex/study/case_config.hpp"
 
 namespace deflex::study {

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "deflex/report/svg_canvas.hpp"
+#include "deflex/report/detail/svg_canvas.hpp"
 
 namespace deflex::svg {
 
