@@ -6,8 +6,11 @@
 #   scripts/python-module.sh                      the python3 first on PATH
 #   scripts/python-module.sh --python PY          that interpreter (e.g. ~/venv/bin/python)
 #   options: --build-dir DIR   where to build (default build-python/<the interpreter's ABI tag>)
-#            --from-build DIR  install the module an existing build made, when it was built for the
-#                              same ABI (a venv of the interpreter that build used); no compiling
+#            --from-build DIR  use an existing deflex build (its library and CMake package): install
+#                              its module when it was built for the same ABI (a venv of the
+#                              interpreter that build used: no compiling), else compile only the
+#                              module against that build (about a minute)
+#            --rebuild         with --from-build: compile the module even when the ABI matches
 #            --no-install      build only
 #
 # What the interpreter needs: NumPy (PY -m pip install numpy; conda install numpy; Debian:
@@ -19,14 +22,16 @@ cd "$(dirname "$0")/.."
 python=python3
 build_dir=""
 from_build=""
+rebuild=0
 install=1
 while [ $# -gt 0 ]; do
   case "$1" in
     --python) python="$2"; shift 2 ;;
     --build-dir) build_dir="$2"; shift 2 ;;
     --from-build) from_build="$2"; shift 2 ;;
+    --rebuild) rebuild=1; shift ;;
     --no-install) install=0; shift ;;
-    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "python-module: unknown option '$1' (--help)" >&2; exit 2 ;;
   esac
 done
@@ -48,11 +53,18 @@ soabi=$("$exe" -c 'import sysconfig; print(sysconfig.get_config_var("SOABI") or 
 site=$("$exe" -c 'import sysconfig; print(sysconfig.get_paths()["platlib"])')
 say "interpreter $exe (Python $version, $soabi); installs into $site"
 
-if [ -n "$from_build" ]; then
+if [ -n "$from_build" ] && [ "$rebuild" -eq 0 ] && ls "$from_build"/python/deflex/_deflex."$soabi".so >/dev/null 2>&1; then
   module_dir="$from_build/python/deflex"
-  ls "$module_dir"/_deflex."$soabi".so >/dev/null 2>&1 ||
-    fail "$from_build holds no module for $soabi (it has: $(ls "$module_dir"/_deflex.*.so 2>/dev/null | xargs -r -n1 basename | tr '\n' ' ')); build one: drop --from-build"
   say "using the module $from_build built for the same ABI"
+elif [ -n "$from_build" ]; then
+  [ -f "$from_build/deflexConfig.cmake" ] ||
+    fail "$from_build is no deflex build (no deflexConfig.cmake): build deflex there first (README), or drop --from-build"
+  build_dir=${build_dir:-build-python/$soabi}
+  say "compiling the module for $soabi in $build_dir against the library of $from_build"
+  cmake -S python -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -Ddeflex_DIR="$(cd "$from_build" && pwd)" \
+    -DPython3_EXECUTABLE="$exe" >/dev/null
+  cmake --build "$build_dir" -j"$(nproc)" --target deflex_python
+  module_dir="$build_dir/python/deflex"
 else
   build_dir=${build_dir:-build-python/$soabi}
   say "building in $build_dir"

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# The module in a second interpreter, as a user with a venv has it: scripts/python-module.sh installs
-# the build's module into a fresh venv of the build's python3 (PyPI is out of reach here, so the venv
-# sees the system's NumPy through --system-site-packages), and the paper's workflow example runs under
-# that venv's python alone (no PYTHONPATH), from another folder. A venv without NumPy is refused by
+# The module in a second interpreter, as a user with a venv has it: scripts/python-module.sh compiles
+# the module for a fresh venv's python against this build's library (its CMake package, no library
+# rebuilt) and installs it into the venv (PyPI is out of reach here, so the venv sees the system's
+# NumPy through --system-site-packages), and the paper's workflow example runs under that venv's
+# python alone (no PYTHONPATH), from another folder. A venv without NumPy is refused by
 # the script with the command that fixes it, and importing deflex there says the same.
 #   second_interpreter.sh PYTHON3 SOURCE_DIR BUILD_DIR WORK_DIR
 set -euo pipefail
@@ -10,7 +11,9 @@ python3=$1 source_dir=$2 build_dir=$3 work=$4
 rm -rf "$work" && mkdir -p "$work"
 unset PYTHONPATH
 "$python3" -m venv --system-site-packages "$work/venv"
-"$source_dir/scripts/python-module.sh" --python "$work/venv/bin/python" --from-build "$build_dir"
+"$source_dir/scripts/python-module.sh" --python "$work/venv/bin/python" --from-build "$build_dir" --rebuild \
+  --build-dir "$work/module-build"
+test -f "$work/module-build/python/deflex/_deflex.pyi"  # compiled here, stubs and all
 site=$("$work/venv/bin/python" -c 'import sysconfig; print(sysconfig.get_paths()["platlib"])')
 test -f "$site/deflex/__init__.py"
 (cd "$work" && PYTHONDONTWRITEBYTECODE=1 "$work/venv/bin/python" -c \
@@ -18,7 +21,7 @@ test -f "$site/deflex/__init__.py"
 mkdir -p "$work/out"
 (cd "$work/out" && PYTHONDONTWRITEBYTECODE=1 "$work/venv/bin/python" "$source_dir/examples/python/03_paper_workflow.py" .)
 test -s "$work/out/paper_workflow.csv"
-# Installed again over its own earlier install: replaced, not refused.
+# Installed again over its own earlier install (the build's own module this time): replaced, not refused.
 "$source_dir/scripts/python-module.sh" --python "$work/venv/bin/python" --from-build "$build_dir" >/dev/null
 # An interpreter without NumPy: refused by name, and nothing installed.
 "$python3" -m venv "$work/bare"
