@@ -72,6 +72,10 @@ class PathCompensator {
  public:
   /// Throws InputError when the robot has no joint stiffness.
   PathCompensator(const RobotModel& model, const ForceModel& force, const OfflineOptions& options = {});
+  /// The compensator keeps references to the model and the force model (docs/architecture.md,
+  /// "Ownership"): a temporary of either would dangle, so it does not compile.
+  PathCompensator(RobotModel&& model, const ForceModel& force, const OfflineOptions& options = {}) = delete;
+  PathCompensator(const RobotModel& model, ForceModel&& force, const OfflineOptions& options = {}) = delete;
   /// Compensates path point `index` (0-based, in order) with joints `q_desired` and pose `tcp_desired`.
   /// The reference stays valid until the next call.
   const OfflinePoint& compensate(std::size_t index, const JointVector& q_desired, const Pose& tcp_desired);

@@ -37,6 +37,8 @@ class OnlineStrategy {
   /// predictive when given. Throws InputError when hybrid has none, or when the model cannot give a
   /// wrench from a pose alone (a path-indexed table).
   OnlineStrategy(const RobotModel& model, StrategyKind kind, const ForceModel* force_model);
+  /// The strategy keeps a reference to the model: a temporary would dangle, so it does not compile.
+  OnlineStrategy(RobotModel&& model, StrategyKind kind, const ForceModel* force_model) = delete;
 
   /// Fills in.wrench_offset_base and in.wrench_lead_s for one cycle. `q_feedback`: where the arm is
   /// (the pose the measured force belongs to); `q_target`: the configuration the command is for;

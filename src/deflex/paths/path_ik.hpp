@@ -42,6 +42,8 @@ struct PathIkOptions {
 class PathIkSolver {
  public:
   PathIkSolver(const RobotModel& model, const IkRequest& first, const PathIkOptions& options = {});
+  /// The solver keeps a reference to the model: a temporary would dangle, so it does not compile.
+  PathIkSolver(RobotModel&& model, const IkRequest& first, const PathIkOptions& options = {}) = delete;
   /// Joint values of the next path point (its 0-based index is points() before the call).
   const JointVector& next(const Pose& base_T_tcp);
   [[nodiscard]] std::size_t points() const { return index_; }
