@@ -7,6 +7,9 @@ namespace deflex {
 
 void joint_deflection(const RobotModel& model, Workspace& ws, const JointVector& q, const Wrench& wrench_base,
                       JointVector& dtheta, const ComplianceOptions& options) {
+  if (!model.has_stiffness()) [[unlikely]] {
+    (void)model.stiffness();  // throws ModelError naming the robot file that gives none
+  }
   const JointVector& c = model.compliance();
   jacobian(model, ws, q, EndPoint::kWap, ws.jacobian);
   const JointVector tau = ws.jacobian.transpose() * wrench_base;  // joint torques, Nm
@@ -36,6 +39,9 @@ Displacement tcp_deflection(const RobotModel& model, Workspace& ws, const JointV
 }
 
 Matrix6 cartesian_compliance(const RobotModel& model, Workspace& ws, const JointVector& q) {
+  if (!model.has_stiffness()) [[unlikely]] {
+    (void)model.stiffness();  // throws ModelError naming the robot file that gives none
+  }
   jacobian(model, ws, q, EndPoint::kWap, ws.jacobian);
   const JointVector& c = model.compliance();
   return ws.jacobian * c.asDiagonal() * ws.jacobian.transpose();

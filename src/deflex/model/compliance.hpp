@@ -22,7 +22,9 @@ struct ComplianceOptions {
 
 /// Joint deflection dtheta (rad) under wrench W (N, Nm; base frame, moment about the WAP) with J
 /// evaluated at q itself: the form for a configuration the arm actually takes (online use, and the
-/// exact form for compensation). Runs FK at q. Requires model.has_stiffness().
+/// exact form for compensation). Runs FK at q. Throws ModelError, in Release too, when the robot has
+/// no stiffness (a bare URDF), and InputError as forward_kinematics() does; every call below that
+/// deflects (and cartesian_compliance) goes through it.
 void joint_deflection(const RobotModel& model, Workspace& ws, const JointVector& q, const Wrench& wrench_base,
                       JointVector& dtheta, const ComplianceOptions& options = {});
 

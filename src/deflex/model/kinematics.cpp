@@ -3,7 +3,23 @@
 
 #include <cmath>
 
+#include <fmt/format.h>
+
+#include "deflex/model/errors.hpp"
+
 namespace deflex {
+namespace {
+
+[[noreturn, gnu::cold]] void wrong_size(const RobotModel& model, const Workspace& ws, const JointVector& q) {
+  if (ws.dof != model.dof()) {
+    throw InputError(fmt::format("forward_kinematics: the workspace was made for a robot of {} joints, {} has {}",
+                                 ws.dof, model.name(), model.dof()));
+  }
+  throw InputError(fmt::format("forward_kinematics: {} joint values for {}, which has {} joints", q.size(),
+                               model.name(), model.dof()));
+}
+
+}  // namespace
 
 Workspace::Workspace(const RobotModel& model) : dof(model.dof()) {
   q = JointVector::Zero(dof);
@@ -11,6 +27,9 @@ Workspace::Workspace(const RobotModel& model) : dof(model.dof()) {
 }
 
 void forward_kinematics(const RobotModel& model, Workspace& ws, const JointVector& q) {
+  if (q.size() != model.dof() || ws.dof != model.dof()) [[unlikely]] {
+    wrong_size(model, ws, q);
+  }
   const RobotDescription& d = model.description();
   const int n = model.dof();
   ws.q = q;

@@ -24,7 +24,9 @@ struct Workspace {
 };
 
 /// Computes every joint frame and the flange, TCP and WAP poses at q (rad), in the robot base
-/// frame. Precondition: q.size() == model.dof() and finite (checked by callers at the edge).
+/// frame. Throws InputError, in Release too, when q does not have one value a joint, or the workspace
+/// was made for another robot (a cold branch: the real-time cycle checks its inputs before, and gives
+/// a status, so it never reaches it). Finite values are the callers' to check at the edge.
 void forward_kinematics(const RobotModel& model, Workspace& ws, const JointVector& q);
 
 /// Geometric Jacobian of the point `point_base` (m, base frame) rigidly attached to the last link,
