@@ -144,7 +144,7 @@ TEST(CsvReader, AMissingFileIsNamed) {
     CsvReader reader(temp_path("does_not_exist.csv"));
     FAIL();
   } catch (const DataError& e) {
-    EXPECT_NE(std::string(e.what()).find("does_not_exist.csv: cannot read the data file"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("does_not_exist.csv: the data file does not exist"), std::string::npos);
   }
 }
 

@@ -93,7 +93,11 @@ TEST(InputFile, RefusesFifosDevicesAndFoldersWithoutBlocking) {
             std::string::npos);
   EXPECT_NE(error_of([&] { (void)read_input_file(s.dir.string(), InputKind::kCsvTable); }).find("directory"),
             std::string::npos);
-  EXPECT_NE(error_of([&] { (void)read_input_file(s.at("none.csv"), InputKind::kCsvTable); }).find("cannot read"),
+  // A missing file, and a missing folder on its way, are said as such.
+  EXPECT_NE(error_of([&] { (void)read_input_file(s.at("none.csv"), InputKind::kCsvTable); }).find("does not exist"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { (void)read_input_file(s.at("no-folder/none.csv"), InputKind::kCsvTable); })
+                .find("does not exist: there is no folder"),
             std::string::npos);
 }
 

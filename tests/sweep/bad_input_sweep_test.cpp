@@ -158,7 +158,7 @@ void add_csv_cases(const CsvKind& k, std::vector<BadInput>& cases) {
   cases.push_back({k.kind + "_empty_file", replace_all(k.command, "{F}", "{D}/" + file), {{file, ""}},
                    {"{D}/" + file, "no header row"}});
   cases.push_back({k.kind + "_missing_file", replace_all(k.command, "{F}", "{D}/no-such-" + file), {},
-                   {"{D}/no-such-" + file, "cannot read"}});
+                   {"{D}/no-such-" + file, "does not exist"}});
   cases.push_back({k.kind + "_directory", replace_all(k.command, "{F}", "{D}"), {}, {"{D}", "directory"}});
   if (k.strict_columns) {
     // A misspelt extra column ("fx_Nx") beside the real ones, a 0 in every row for it.
@@ -203,7 +203,7 @@ void add_yaml_cases(const YamlKind& k, std::vector<BadInput>& cases) {
   cases.push_back({k.kind + "_syntax", cmd, {{file, k.base + "\n  - [unclosed\n"}}, {"{D}/" + file + ":", "YAML"}});
   cases.push_back({k.kind + "_empty", cmd, {{file, ""}}, {"{D}/" + file}});
   cases.push_back({k.kind + "_missing", replace_all(k.command, "{F}", "{D}/no-such.yaml"), {},
-                   {"{D}/no-such.yaml", "cannot read"}});
+                   {"{D}/no-such.yaml", "does not exist"}});
 }
 
 std::string tracker_csv(double z_mm) {

@@ -1,6 +1,8 @@
 // Input files: regular files within their kind's size limit, opened without blocking.
 #include "deflex/model/input_file.hpp"
 
+#include <filesystem>
+
 #include <cerrno>
 #include <cstring>
 
@@ -76,7 +78,17 @@ InputFile::InputFile(const std::string& path, InputKind kind, const std::string&
   // stat first: a device is never opened (opening some has side effects), a FIFO never waited on.
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
-    refuse(path, fmt::format("cannot read the {}: {}", info.what, std::strerror(errno)));
+    const int err = errno;
+    if (err == ENOENT) {
+      // Say which part is missing: the file, or a folder on its way.
+      const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+      std::error_code ec;
+      if (!parent.empty() && !std::filesystem::is_directory(parent, ec)) {
+        refuse(path, fmt::format("the {} does not exist: there is no folder '{}'", info.what, parent.string()));
+      }
+      refuse(path, fmt::format("the {} does not exist", info.what));
+    }
+    refuse(path, fmt::format("cannot read the {}: {}", info.what, std::strerror(err)));
   }
   check_stat(path, info, st);
   fd_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
