@@ -24,20 +24,28 @@ packages=(
 )
 # chromium: the tests open the live monitor page in headless Chromium and read what it shows;
 # python3-yaml: the Python tests give the case study a case as a dict read from the case file;
-# python3-venv: the Python module is installed into and tested in a second interpreter (a venv)
-if [ "$tests" -eq 1 ]; then packages+=(chromium python3-yaml python3-venv); fi
+# python3-venv: the Python module is installed into and tested in a second interpreter (a venv);
+# locales: a comma-decimal locale (de_DE.UTF-8, generated below) for the test that numbers parse the same
+# whatever the process locale (it skips, saying so, where the locale is missing)
+if [ "$tests" -eq 1 ]; then packages+=(chromium python3-yaml python3-venv locales); fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-if [ ${#missing[@]} -eq 0 ]; then
-  echo "install-deps: all ${#packages[@]} packages present" >&2
-  exit 0
-fi
 sudo=""
 if [ "$(id -u)" -ne 0 ]; then sudo=sudo; fi
-echo "install-deps: installing ${missing[*]}" >&2
-export DEBIAN_FRONTEND=noninteractive
-$sudo apt-get update -qq
-$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-echo "install-deps: done" >&2
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present" >&2
+else
+  echo "install-deps: installing ${missing[*]}" >&2
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -qq
+  $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  echo "install-deps: done" >&2
+fi
+if [ "$tests" -eq 1 ] && ! locale -a 2>/dev/null | grep -qi '^de_DE\.utf-\?8$'; then
+  echo "install-deps: generating the de_DE.UTF-8 locale (a test parses numbers under it)" >&2
+  $sudo sed -i 's/^# *\(de_DE.UTF-8 UTF-8\)/\1/' /etc/locale.gen
+  grep -q '^de_DE.UTF-8 UTF-8' /etc/locale.gen || echo 'de_DE.UTF-8 UTF-8' | $sudo tee -a /etc/locale.gen >/dev/null
+  $sudo locale-gen >/dev/null
+fi
