@@ -112,28 +112,11 @@ void setup_identify(CLI::App& sub, int& exit_code) {
     const auto n = static_cast<std::size_t>(model.dof());
 
     if (!o->write_robot.empty()) {
-      std::vector<double> k(n);
-      std::vector<std::string> kept;
-      for (std::size_t j = 0; j < n; ++j) {
-        const bool flagged = std::find(est.unidentifiable_joints.begin(), est.unidentifiable_joints.end(),
-                                       static_cast<int>(j) + 1) != est.unidentifiable_joints.end();
-        if (std::isfinite(est.stiffness_nm_per_rad[j]) && !flagged) {
-          k[j] = est.stiffness_nm_per_rad[j];
-        } else if (model.has_stiffness()) {
-          k[j] = model.stiffness()[static_cast<Eigen::Index>(j)];
-          kept.push_back(std::to_string(j + 1));
-        } else {
-          throw InputError(fmt::format("--write-robot: joint {} is not identified and the robot file gives no value "
-                                       "to keep; nothing written",
-                                       j + 1));
-        }
+      try {
+        robot_out->write(robot_to_yaml(identified_robot(model, est, o->data)));
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("--write-robot: {}; nothing written", e.what()));
       }
-      std::string note = fmt::format("identified by deflex identify from {} ({} measurements, residual RMS {:.4f} mm)",
-                                     o->data, est.measurements, est.residual_rms_m * 1e3);
-      if (!kept.empty()) {
-        note += fmt::format("; joints {} kept from the previous file", fmt::join(kept, ", "));
-      }
-      robot_out->write(robot_to_yaml(model.with_stiffness(k, note)));
     }
     outputs.commit();
     if (robot_out != nullptr) {

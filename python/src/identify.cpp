@@ -154,6 +154,15 @@ void bind_identify(py::module_& m) {
       "(robot, q, wrench, dp) or by keyword; optional drot (m, 3) rad and weight (m,). "
       "fixed_stiffness_nm_per_rad: one entry a joint, a value to hold or None to estimate.");
 
+  m.def(
+      "identified_robot",
+      [](const RobotModel& model, const StiffnessEstimate& estimate, const std::string& data_name) {
+        return std::make_shared<RobotModel>(identified_robot(model, estimate, data_name));
+      },
+      "robot"_a, "estimate"_a, "data_name"_a = "<arrays>",
+      "The robot with its identified stiffness, as `deflex identify --write-robot` writes it: a joint the estimate "
+      "did not identify keeps the robot file's value (the note says which); InputError when it has none to keep.");
+
   py::class_<CalibrationPlan>(m, "CalibrationPlan", "Poses and loads of a compliance-calibration experiment.")
       .def_property_readonly("pose", [](const CalibrationPlan& p) {
         std::vector<int> v;

@@ -199,3 +199,24 @@ def test_joint_frames_against_finite_differences_and_the_flange():
     np.testing.assert_array_equal(urdf.fk(q, point=name), urdf.fk(q, point="joint3"))
     with pytest.raises(deflex.InputError, match="joint7"):
         robot.fk(q, point="joint7")
+
+
+def test_the_identified_robot_is_the_one_the_cli_writes(tmp_path):
+    robot_file = SOURCE_DIR / "examples" / "robots" / "kuka_kr210_r2700.yaml"
+    data = SOURCE_DIR / "examples" / "identify" / "kr210_synthetic_measurements.csv"
+    run_cli("identify", "--robot", robot_file, "--data", data, "--write-robot", tmp_path / "identified.yaml")
+    written = deflex.Robot.from_file(tmp_path / "identified.yaml")
+    robot = deflex.Robot.from_file(robot_file)
+    mine = deflex.identified_robot(robot, deflex.identify_stiffness(robot, data), str(data))
+    np.testing.assert_allclose(mine.stiffness, written.stiffness, rtol=1e-9)
+    assert mine.to_yaml() == written.to_yaml()
+    # A joint not identified keeps the file's value, and the note says so.
+    d = deflex.read_stiffness_measurements(data)
+    partial = deflex.identify_stiffness(robot, q=d["q"][:1], wrench=d["wrench"][:1], dp=d["dp"][:1], robust=False,
+                                        fixed_stiffness_nm_per_rad=[None, None, None, None, 3.5e5, 2e5])
+    merged = deflex.identified_robot(robot, partial)
+    assert merged.stiffness[0] == robot.stiffness[0] and merged.stiffness[3] == robot.stiffness[3]
+    assert "joints 1, 2, 4 kept from the previous file" in merged.to_yaml()
+    bare = deflex.Robot.from_file(SOURCE_DIR / "examples" / "robots" / "ros-industrial" / "kuka_kr120r2500pro.urdf")
+    with pytest.raises(deflex.InputError, match="joint 1 is not identified"):
+        deflex.identified_robot(bare, partial)

@@ -670,4 +670,33 @@ StiffnessEstimate StiffnessIdentifier::solve() {
   return est;
 }
 
+RobotModel identified_robot(const RobotModel& model, const StiffnessEstimate& estimate, const std::string& data_name) {
+  const auto n = static_cast<std::size_t>(model.dof());
+  if (estimate.stiffness_nm_per_rad.size() != n) {
+    throw InputError(fmt::format("identified_robot: the estimate has {} joints, {} has {}",
+                                 estimate.stiffness_nm_per_rad.size(), model.name(), n));
+  }
+  std::vector<double> k(n);
+  std::vector<std::string> kept;
+  for (std::size_t j = 0; j < n; ++j) {
+    const bool flagged = std::find(estimate.unidentifiable_joints.begin(), estimate.unidentifiable_joints.end(),
+                                   static_cast<int>(j) + 1) != estimate.unidentifiable_joints.end();
+    const double value = estimate.stiffness_nm_per_rad[j];
+    if (std::isfinite(value) && !flagged) {
+      k[j] = value;
+    } else if (model.has_stiffness()) {
+      k[j] = model.stiffness()[static_cast<Eigen::Index>(j)];
+      kept.push_back(std::to_string(j + 1));
+    } else {
+      throw InputError(fmt::format("joint {} is not identified and the robot file gives no value to keep", j + 1));
+    }
+  }
+  std::string note = fmt::format("identified by deflex identify from {} ({} measurements, residual RMS {:.4f} mm)",
+                                 data_name, estimate.measurements, estimate.residual_rms_m * 1e3);
+  if (!kept.empty()) {
+    note += fmt::format("; joints {} kept from the previous file", fmt::join(kept, ", "));
+  }
+  return model.with_stiffness(k, note);
+}
+
 }  // namespace deflex

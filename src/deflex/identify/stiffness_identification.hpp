@@ -122,4 +122,12 @@ class StiffnessIdentifier {
 void stiffness_regressor(const RobotModel& model, Workspace& ws, const JointVector& q, const Wrench& wrench_base,
                          Jacobian& block);
 
+/// The robot with its identified stiffness, as `deflex identify --write-robot` writes it: each joint
+/// the estimate identified takes its value; a joint it did not (NaN, or listed unidentifiable) keeps
+/// the robot file's, and the note says which ("joints 4, 6 kept from the previous file"). Throws
+/// InputError naming the joint when one is not identified and the robot file gives no value to keep.
+/// `data_name` names the measurements in the note.
+[[nodiscard]] RobotModel identified_robot(const RobotModel& model, const StiffnessEstimate& estimate,
+                                          const std::string& data_name);
+
 }  // namespace deflex
