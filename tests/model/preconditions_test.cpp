@@ -9,22 +9,13 @@
 #include "deflex/model/errors.hpp"
 #include "deflex/model/kinematics.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "support/error_of.hpp"
 
 namespace deflex {
 namespace {
 
 RobotModel bare_urdf() {
   return load_robot(std::string(DEFLEX_SOURCE_DIR) + "/examples/robots/ros-industrial/kuka_kr120r2500pro.urdf");
-}
-
-template <typename F>
-std::string precondition_error(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
 }
 
 TEST(Preconditions, DeflectionWithoutStiffnessIsRefused) {
@@ -40,7 +31,7 @@ TEST(Preconditions, DeflectionWithoutStiffnessIsRefused) {
   EXPECT_THROW((void)cartesian_compliance(robot, ws, q), ModelError);
   EXPECT_THROW(compensated_configuration(robot, ws, q, w, q_cmd), ModelError);
   EXPECT_THROW((void)deflected_configuration(robot, ws, q, w, q_actual), ModelError);
-  EXPECT_NE(precondition_error([&] { joint_deflection(robot, ws, q, w, dtheta); }).find("kuka_kr120r2500pro.urdf"),
+  EXPECT_NE(test::error_of([&] { joint_deflection(robot, ws, q, w, dtheta); }).find("kuka_kr120r2500pro.urdf"),
             std::string::npos);
 }
 
@@ -57,7 +48,7 @@ TEST(Preconditions, JointValuesOfTheWrongCountAreRefused) {
   Wrench w = Wrench::Zero();
   JointVector dtheta;
   EXPECT_THROW(joint_deflection(robot, ws, five, w, dtheta), InputError);
-  EXPECT_NE(precondition_error([&] { forward_kinematics(robot, ws, five); }).find("5 joint values"), std::string::npos);
+  EXPECT_NE(test::error_of([&] { forward_kinematics(robot, ws, five); }).find("5 joint values"), std::string::npos);
 }
 
 TEST(Preconditions, AWorkspaceOfAnotherRobotIsRefused) {
@@ -70,7 +61,7 @@ TEST(Preconditions, AWorkspaceOfAnotherRobotIsRefused) {
   const RobotModel five(d);
   Workspace ws_five(five);
   const JointVector q = JointVector::Constant(6, 0.1);
-  EXPECT_NE(precondition_error([&] { forward_kinematics(six, ws_five, q); }).find("workspace was made for a robot of 5 joints"),
+  EXPECT_NE(test::error_of([&] { forward_kinematics(six, ws_five, q); }).find("workspace was made for a robot of 5 joints"),
             std::string::npos);
 }
 
