@@ -117,8 +117,16 @@ void run(const CaseStudyOpts& o, int& exit_code) {
           "\nError budget, {} {:.0f} N at {:.0f} mm/s (seed {}, the table's runs, {} laps each): C = {:.3f} mm with "
           "every effect (UC {:.3f} mm)\n",
           b.setup, b.load_N, b.speed_mm_s, b.seed, b.laps, b.residual_mm_all, b.uc_mm);
+      // Columns as wide as their longest entry, so a long size never runs into the figures.
+      std::size_t effect_w = 6, size_w = 4;
       for (const auto& e : b.entries) {
-        std::cout << fmt::format("  {:<48} {:<44} C without it {:.3f} mm ({:+.0f}% of C)\n", e.effect, e.size,
+        effect_w = std::max(effect_w, e.effect.size());
+        size_w = std::max(size_w, e.size.size());
+      }
+      std::cout << fmt::format("  {:<{}}  {:<{}}  {:>18}  {:>7}\n", "effect", effect_w, "size", size_w,
+                               "C without it (mm)", "share");
+      for (const auto& e : b.entries) {
+        std::cout << fmt::format("  {:<{}}  {:<{}}  {:>18.3f}  {:>+6.0f}%\n", e.effect, effect_w, e.size, size_w,
                                  e.residual_mm_without_it, 100.0 * e.share_of_residual);
       }
     }

@@ -28,6 +28,7 @@ th, td { border: 1px solid #d0d0d0; padding: 4px 10px; text-align: right; white-
 th { white-space: normal; }
 th { background: #eef2f7; }
 td.l, th.l { text-align: left; }
+td.l { white-space: normal; min-width: 6em; }
 .paper { color: #777; font-size: 12px; }
 .sd { color: #555; font-size: 12px; }
 .good { color: #2e7d32; } .bad { color: #c62828; }
