@@ -88,6 +88,38 @@ void bind_identify(py::module_& m) {
       .def_readonly("rejected_measurements", &StiffnessEstimate::rejected_measurements, "0-based indices")
       .def_readonly("measurements", &StiffnessEstimate::measurements)
       .def_readonly("iterations", &StiffnessEstimate::iterations)
+      .def(py::pickle(
+          [](const StiffnessEstimate& e) {
+            return py::make_tuple(e.stiffness_nm_per_rad, e.std_error_nm_per_rad, e.compliance_rad_per_nm,
+                                  e.compliance_std_error_rad_per_nm,
+                                  py::make_tuple(e.residual_rms_m, e.residual_max_m, e.residual_rms_rad, e.sigma_m,
+                                                 e.condition_number),
+                                  e.unidentifiable_joints, e.fixed_joints, e.warnings, e.robust_weights,
+                                  e.rejected_measurements, e.rejected_lines, e.measurements, e.iterations);
+          },
+          [](const py::tuple& t) {
+            if (t.size() != 13) throw InputError("deflex.StiffnessEstimate: not a pickled StiffnessEstimate");
+            StiffnessEstimate e;
+            e.stiffness_nm_per_rad = t[0].cast<std::vector<double>>();
+            e.std_error_nm_per_rad = t[1].cast<std::vector<double>>();
+            e.compliance_rad_per_nm = t[2].cast<std::vector<double>>();
+            e.compliance_std_error_rad_per_nm = t[3].cast<std::vector<double>>();
+            const auto f = t[4].cast<py::tuple>();
+            e.residual_rms_m = f[0].cast<double>();
+            e.residual_max_m = f[1].cast<double>();
+            e.residual_rms_rad = f[2].cast<double>();
+            e.sigma_m = f[3].cast<double>();
+            e.condition_number = f[4].cast<double>();
+            e.unidentifiable_joints = t[5].cast<std::vector<int>>();
+            e.fixed_joints = t[6].cast<std::vector<int>>();
+            e.warnings = t[7].cast<std::vector<std::string>>();
+            e.robust_weights = t[8].cast<std::vector<double>>();
+            e.rejected_measurements = t[9].cast<std::vector<int>>();
+            e.rejected_lines = t[10].cast<std::vector<int>>();
+            e.measurements = t[11].cast<int>();
+            e.iterations = t[12].cast<int>();
+            return e;
+          }))
       .def("__repr__", [](const StiffnessEstimate& e) {
         std::string s = fmt::format("StiffnessEstimate(stiffness_nm_per_rad={}, condition_number={:.3g}",
                                     py::repr(from_vector(e.stiffness_nm_per_rad)).cast<std::string>(), e.condition_number);

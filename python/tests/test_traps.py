@@ -212,6 +212,13 @@ def test_robots_and_results_pickle_and_cross_processes():
     ik2 = pickle.loads(pickle.dumps(ik))
     np.testing.assert_array_equal(ik2.q, ik.q)
     assert ik2.configuration == ik.configuration and ik2.status == ik.status
+    est = deflex.identify_stiffness(deflex.Robot.from_file(KR210),
+                                    SOURCE_DIR / "examples" / "identify" / "kr210_synthetic_measurements.csv")
+    est2 = pickle.loads(pickle.dumps(est))
+    np.testing.assert_array_equal(est2.stiffness_nm_per_rad, est.stiffness_nm_per_rad)
+    np.testing.assert_array_equal(est2.robust_weights, est.robust_weights)
+    assert (est2.warnings, est2.measurements, est2.condition_number) == (est.warnings, est.measurements,
+                                                                         est.condition_number)
     c = pickle.loads(pickle.dumps(deflex.Circle(radius_m=0.2, points=17)))
     assert c.radius_m == 0.2 and c.points == 17
     with multiprocessing.get_context("spawn").Pool(2) as pool:
