@@ -10,6 +10,7 @@
 #include <pybind11/pybind11.h>
 
 #include "deflex/model/arm_configuration.hpp"
+#include "deflex/model/kinematics.hpp"
 #include "deflex/model/robot_model.hpp"
 
 namespace deflex::python {
@@ -26,9 +27,10 @@ std::optional<ArmConfiguration> arm_configuration_arg(const py::handle& c);
 
 /// Where a wrench's moment is taken, from a `moment_about` argument: "wap" (false) or "tcp" (true).
 bool moment_about_tcp(const std::string& about);
-/// A wrench with its moment about the WAP: moved there from the TCP when `about_tcp`
-/// (M_wap = M_tcp + (p_tcp - p_wap) x F), as given otherwise.
-Wrench wrench_about_wap(const Pose& base_T_tcp, const Pose& base_T_wap, const Wrench& w, bool about_tcp);
+/// The wrench of row `row` of `wrenches` ((6,) for every row when not `per_row`, else (N, 6)) with its
+/// moment about the WAP at q, moved there from the TCP when `about_tcp` (FK at q into `ws`).
+Wrench wrench_at_wap(const RobotModel& model, Workspace& ws, const JointVector& q, const double* wrenches,
+                     bool per_row, std::ptrdiff_t row, bool about_tcp);
 
 /// A JSON document as the Python objects json.loads makes of it (dict, list, str, float, ...).
 py::object json_to_python(const nlohmann::json& doc);

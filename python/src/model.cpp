@@ -23,12 +23,12 @@ bool moment_about_tcp(const std::string& about) {
   throw InputError(fmt::format("argument moment_about: '{}' is neither wap nor tcp", about));
 }
 
-Wrench wrench_about_wap(const Pose& base_T_tcp, const Pose& base_T_wap, const Wrench& w, bool about_tcp) {
+Wrench wrench_at_wap(const RobotModel& model, Workspace& ws, const JointVector& q, const double* wrenches,
+                     bool per_row, std::ptrdiff_t row, bool about_tcp) {
+  const Wrench w = Eigen::Map<const Wrench>(wrenches + (per_row ? 6 * row : 0));
   if (!about_tcp) return w;
-  Wrench out = w;
-  // M_wap = M_tcp + (p_tcp - p_wap) x F
-  out.tail<3>() += (base_T_tcp.translation() - base_T_wap.translation()).cross(Vector3(w.head<3>()));
-  return out;
+  forward_kinematics(model, ws, q);
+  return moment_moved(w, ws.base_T_tcp.translation(), ws.base_T_wap.translation());
 }
 
 namespace {
@@ -169,11 +169,7 @@ Deflection deflect(const RobotModel& model, const ArrayLike& q_obj, const ArrayL
   ComplianceOptions options;
   options.complementary_stiffness = complementary;
   for_each_row(model, q.data(), rows, threads, [&](Workspace& ws, std::ptrdiff_t i, const JointVector& qi) {
-    Wrench wi = Eigen::Map<const Wrench>(wd + (w_batch ? 6 * i : 0));
-    if (about_tcp) {
-      forward_kinematics(model, ws, qi);
-      wi = wrench_about_wap(ws.base_T_tcp, ws.base_T_wap, wi, true);
-    }
+    const Wrench wi = wrench_at_wap(model, ws, qi, wd, w_batch, i, about_tcp);
     JointVector dtheta(dof);
     Eigen::Map<Displacement>(dx + 6 * i) = tcp_deflection(model, ws, qi, wi, dtheta, options);
     Eigen::Map<Eigen::VectorXd>(dt + i * dof, dof) = dtheta;
@@ -196,11 +192,7 @@ Array configurations_under(const RobotModel& model, const ArrayLike& q_obj, cons
   const double* wd = w.data();
   std::vector<char> failed(static_cast<std::size_t>(rows), 0);
   for_each_row(model, q.data(), rows, threads, [&](Workspace& ws, std::ptrdiff_t i, const JointVector& qi) {
-    Wrench wi = Eigen::Map<const Wrench>(wd + (w_batch ? 6 * i : 0));
-    if (about_tcp) {
-      forward_kinematics(model, ws, qi);
-      wi = wrench_about_wap(ws.base_T_tcp, ws.base_T_wap, wi, true);
-    }
+    const Wrench wi = wrench_at_wap(model, ws, qi, wd, w_batch, i, about_tcp);
     JointVector r(dof);
     if (deflected) {
       failed[static_cast<std::size_t>(i)] = deflected_configuration(model, ws, qi, wi, r) != DeflectionStatus::kConverged;
@@ -236,39 +228,41 @@ std::vector<IkResult> ik_solutions(const RobotModel& r, Workspace& ws, const Pos
   return all;
 }
 
-/// The request for pose i: its own seed from `seeds` (N, dof), or the one seed for all (or none).
-IkRequest ik_request(const RobotModel& r, const std::optional<JointVector>& seed, const Array* seeds, py::ssize_t i) {
-  IkRequest req;
-  if (seeds != nullptr) {
-    req.seed = Eigen::Map<const Eigen::VectorXd>(seeds->data() + i * r.dof(), r.dof());
-  } else {
-    req.seed = seed;
-  }
-  return req;
-}
+/// The seeds of an IK call, read while the GIL is held: none, one (dof,) for every pose, or one a
+/// pose (N, dof) when `poses` > 0 (a batch of poses).
+struct Seeds {
+  std::optional<JointVector> one;
+  std::optional<Array> rows;
 
-/// One seed (dof,) for every pose, read while the GIL is held; none when absent or one a pose.
-std::optional<JointVector> one_seed(const RobotModel& r, const std::optional<ArrayLike>& seed, bool batch) {
-  if (!seed || seed->is_none()) return std::nullopt;
-  if (batch) {
-    const py::array a = py::array::ensure(seed->obj);
-    if (a && a.ndim() == 2) return std::nullopt;  // one a pose: seed_rows()
+  Seeds(const RobotModel& r, const std::optional<ArrayLike>& seed, py::ssize_t poses) {
+    if (!seed || seed->is_none()) return;
+    if (poses == 0) {
+      one = joint_vector(*seed, "seed", r.dof());
+      return;
+    }
+    bool batch = false;
+    Array s = joint_rows(*seed, "seed", r.dof(), batch);
+    if (!batch) {
+      one = Eigen::Map<const Eigen::VectorXd>(s.data(), r.dof());
+    } else if (s.shape(0) != poses) {
+      throw InputError(fmt::format("argument seed: expected shape ({},) or ({}, {}) (one seed a pose), got ({}, {})",
+                                   r.dof(), poses, r.dof(), s.shape(0), r.dof()));
+    } else {
+      rows = std::move(s);
+    }
   }
-  return joint_vector(*seed, "seed", r.dof());
-}
 
-/// Seeds (dof,) for every pose or (N, dof) one a pose; null when one seed (or none) serves all.
-std::optional<Array> seed_rows(const RobotModel& r, const std::optional<ArrayLike>& seed, py::ssize_t poses) {
-  if (!seed || seed->is_none()) return std::nullopt;
-  bool batch = false;
-  Array s = joint_rows(*seed, "seed", r.dof(), batch);
-  if (!batch) return std::nullopt;
-  if (s.shape(0) != poses) {
-    throw InputError(fmt::format("argument seed: expected shape ({},) or ({}, {}) (one seed a pose), got ({}, {})",
-                                 r.dof(), poses, r.dof(), s.shape(0), r.dof()));
+  /// The request for pose i (no Python call: safe without the GIL).
+  [[nodiscard]] IkRequest request(int dof, py::ssize_t i) const {
+    IkRequest req;
+    if (rows) {
+      req.seed = Eigen::Map<const Eigen::VectorXd>(rows->data() + i * dof, dof);
+    } else {
+      req.seed = one;
+    }
+    return req;
   }
-  return s;
-}
+};
 
 bool is_pose_batch(const py::handle& obj) {
   const py::array a = py::array::ensure(obj);
@@ -278,17 +272,16 @@ bool is_pose_batch(const py::handle& obj) {
 py::object ik(const RobotModel& r, const ArrayLike& target, const std::optional<ArrayLike>& seed) {
   if (!is_pose_batch(target)) {
     Workspace ws(r);
-    return py::cast(ik_solutions(r, ws, pose(target, "pose"), ik_request(r, one_seed(r, seed, false), nullptr, 0)));
+    return py::cast(ik_solutions(r, ws, pose(target, "pose"), Seeds(r, seed, 0).request(r.dof(), 0)));
   }
   const std::vector<Pose> p = poses(target, "pose");
-  const std::optional<Array> seeds = seed_rows(r, seed, static_cast<py::ssize_t>(p.size()));
-  const std::optional<JointVector> common = one_seed(r, seed, true);
+  const Seeds seeds(r, seed, static_cast<py::ssize_t>(p.size()));
   std::vector<std::vector<IkResult>> out(p.size());
   {
     py::gil_scoped_release release;
     Workspace ws(r);
     for (std::size_t i = 0; i < p.size(); ++i) {
-      out[i] = ik_solutions(r, ws, p[i], ik_request(r, common, seeds ? &*seeds : nullptr, static_cast<py::ssize_t>(i)));
+      out[i] = ik_solutions(r, ws, p[i], seeds.request(r.dof(), static_cast<py::ssize_t>(i)));
     }
   }
   return py::cast(out);
@@ -298,20 +291,19 @@ py::object inverse_kinematics_of(const RobotModel& r, const ArrayLike& target, c
                                   const std::optional<ArrayLike>& seed) {
   const std::optional<ArmConfiguration> conf = arm_configuration_arg(configuration);
   if (!is_pose_batch(target)) {
-    IkRequest req = ik_request(r, one_seed(r, seed, false), nullptr, 0);
+    IkRequest req = Seeds(r, seed, 0).request(r.dof(), 0);
     req.configuration = conf;
     Workspace ws(r);
     return py::cast(inverse_kinematics(r, ws, pose(target, "pose"), req));
   }
   const std::vector<Pose> p = poses(target, "pose");
-  const std::optional<Array> seeds = seed_rows(r, seed, static_cast<py::ssize_t>(p.size()));
-  const std::optional<JointVector> common = one_seed(r, seed, true);
+  const Seeds seeds(r, seed, static_cast<py::ssize_t>(p.size()));
   std::vector<IkResult> out(p.size());
   {
     py::gil_scoped_release release;
     Workspace ws(r);
     for (std::size_t i = 0; i < p.size(); ++i) {
-      IkRequest req = ik_request(r, common, seeds ? &*seeds : nullptr, static_cast<py::ssize_t>(i));
+      IkRequest req = seeds.request(r.dof(), static_cast<py::ssize_t>(i));
       req.configuration = conf;
       out[i] = inverse_kinematics(r, ws, p[i], req);
     }

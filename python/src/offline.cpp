@@ -26,8 +26,8 @@ using namespace pybind11::literals;
 namespace {
 
 /// Wrenches given from Python (one, or one a path point), base frame, with their moment about the
-/// WAP or the TCP; handed to the compensation as every ForceModel gives them, about the TCP
-/// (M_tcp = M_wap + (p_wap - p_tcp) x F at each pose), which moves it back to the WAP exactly.
+/// WAP or the TCP; handed to the compensation as every ForceModel gives them, about the TCP (moved
+/// from the WAP at each pose), which moves it back to the WAP exactly.
 class ArrayWrenchModel final : public ForceModel {
  public:
   ArrayWrenchModel(std::vector<Wrench> wrenches, bool table, const Pose& tcp_T_wap, bool about_tcp)
@@ -36,12 +36,9 @@ class ArrayWrenchModel final : public ForceModel {
     if (table_ && index >= wrenches_.size()) {
       throw InputError(fmt::format("force: the wrench array has {} rows, no row for path point {}", wrenches_.size(), index));
     }
-    Wrench w = wrenches_[table_ ? index : 0];
-    if (!about_tcp_) {
-      const Vector3 r = base_T_tcp.linear() * tcp_T_wap_.translation();  // p_wap - p_tcp, base frame
-      w.tail<3>() += r.cross(Vector3(w.head<3>()));
-    }
-    return w;
+    const Wrench& w = wrenches_[table_ ? index : 0];
+    if (about_tcp_) return w;
+    return moment_moved(w, (base_T_tcp * tcp_T_wap_).translation(), base_T_tcp.translation());
   }
   [[nodiscard]] std::string describe() const override {
     const char* about = about_tcp_ ? "TCP" : "WAP";
@@ -329,10 +326,7 @@ void bind_offline(py::module_& m) {
           const auto* ldbb = dynamic_cast<const LdbbForceModel*>(f.get());
           for (std::size_t i = 0; i < p.size(); ++i) {
             Wrench wi = f->wrench_at(i, p[i]);  // moment about the TCP, as every force model gives it
-            if (!about_tcp) {
-              const Pose base_T_wap = p[i] * t_w;
-              wi = wrench_about_wap(p[i], base_T_wap, wi, true);
-            }
+            if (!about_tcp) wi = moment_moved(wi, p[i].translation(), (p[i] * t_w).translation());
             Eigen::Map<Wrench>(w.mutable_data() + 6 * i) = wi;
             length.mutable_data()[i] = ldbb != nullptr ? ldbb->bar_length_m(p[i]) : std::nan("");
             incline.mutable_data()[i] = ldbb != nullptr ? ldbb->inclination_rad(p[i]) : std::nan("");

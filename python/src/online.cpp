@@ -131,7 +131,8 @@ void bind_online(py::module_& m) {
               if (about_tcp) {
                 Workspace ws(c.model());
                 forward_kinematics(c.model(), ws, in.q_planned);
-                in.wrench_offset_base = wrench_about_wap(ws.base_T_tcp, ws.base_T_wap, in.wrench_offset_base, true);
+                in.wrench_offset_base =
+                    moment_moved(in.wrench_offset_base, ws.base_T_tcp.translation(), ws.base_T_wap.translation());
               }
             }
             in.wrench_lead_s = wrench_lead_s;

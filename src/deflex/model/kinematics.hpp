@@ -51,4 +51,13 @@ void jacobian(const RobotModel& model, Workspace& ws, const JointVector& q, EndP
 /// Applies a small base-frame displacement [dp; drot] to a pose (exact rotation via angle-axis).
 [[nodiscard]] Pose apply_displacement(const Pose& pose, const Displacement& d);
 
+/// The same wrench [F; M] (base frame) with its moment taken about another point: M_to = M_from +
+/// (p_from - p_to) x F, points in the base frame (m). Force models give the moment about the TCP,
+/// the compliance model takes it about the WAP. Never allocates.
+[[nodiscard]] inline Wrench moment_moved(const Wrench& w, const Vector3& from_m, const Vector3& to_m) {
+  Wrench out = w;
+  out.tail<3>() += (from_m - to_m).cross(Vector3(w.head<3>()));
+  return out;
+}
+
 }  // namespace deflex

@@ -58,10 +58,9 @@ const OfflinePoint& PathCompensator::compensate(std::size_t i, const JointVector
   }
   pt.wrench_base = wrench_tcp;
   if (!model.wap_is_tcp()) {
-    // Moment about the WAP of a force acting at the TCP: M_wap = M_tcp + (p_tcp - p_wap) x F.
+    // The force acts at the TCP; the model takes its moment about the WAP.
     forward_kinematics(model, ws, pt.q_desired);
-    pt.wrench_base.tail<3>() +=
-        (ws.base_T_tcp.translation() - ws.base_T_wap.translation()).cross(Vector3(wrench_tcp.head<3>()));
+    pt.wrench_base = moment_moved(wrench_tcp, ws.base_T_tcp.translation(), ws.base_T_wap.translation());
   }
 
   compensated_configuration(model, ws, pt.q_desired, pt.wrench_base, pt.q_command, dtheta_desired_);

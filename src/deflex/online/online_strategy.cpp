@@ -50,8 +50,7 @@ bool OnlineStrategy::model_wrench_at(const JointVector& q, Wrench& out) noexcept
     return false;
   }
   // Force models give the moment about the TCP; the compensator works at the WAP.
-  out = at_tcp;
-  out.tail<3>() += (ws_.base_T_tcp.translation() - ws_.base_T_wap.translation()).cross(at_tcp.head<3>());
+  out = moment_moved(at_tcp, ws_.base_T_tcp.translation(), ws_.base_T_wap.translation());
   return true;
 }
 
