@@ -10,8 +10,8 @@
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
-#include "deflex/model/csv_table.hpp"
-#include "deflex/model/format_number.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/format_number.hpp"
 
 namespace {
 

@@ -19,6 +19,7 @@
 #include "deflex/model/robot_io.hpp"
 #include "deflex/transport/memory_stream.hpp"
 #include "deflex/transport/tcp_stream.hpp"
+#include "deflex/online/online_strategy.hpp"
 
 // GCC sees the replacement operator new (malloc) and delete (free) of this file inlined into the same
 // translation unit and calls them mismatched; they are the standard replacement pair.

@@ -8,9 +8,9 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/input_ranges.hpp"
-#include "deflex/model/parse_number.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/input_ranges.hpp"
+#include "deflex/text/parse_number.hpp"
 #include "deflex/model/robot_io.hpp"
 
 namespace deflex::cli {

@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "deflex/model/input_ranges.hpp"
+#include "deflex/text/input_ranges.hpp"
 #include "deflex/model/robot_model.hpp"
 
 namespace deflex::cli {

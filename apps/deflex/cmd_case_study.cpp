@@ -12,13 +12,13 @@
 
 #include "cli_util.hpp"
 #include "command.hpp"
-#include "deflex/study/case_report.hpp"
+#include "deflex/report/case_report.hpp"
 #include "deflex/study/case_study.hpp"
 #include "deflex/evaluate/tracker_files.hpp"
-#include "deflex/evaluate/study_tables.hpp"
-#include "deflex/evaluate/tracker_trace.hpp"
-#include "deflex/model/errors.hpp"
-#include "deflex/model/output_file.hpp"
+#include "deflex/study/study_tables.hpp"
+#include "deflex/model/tracker_trace.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/output_file.hpp"
 #include "deflex/report/html_report.hpp"
 
 namespace deflex::cli {

@@ -11,8 +11,8 @@
 #include "deflex/identify/calibration_planner.hpp"
 #include "deflex/identify/calibration_simulation.hpp"
 #include "deflex/identify/stiffness_identification.hpp"
-#include "deflex/model/errors.hpp"
-#include "deflex/model/output_file.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/output_file.hpp"
 #include "deflex/model/robot_io.hpp"
 
 namespace deflex::cli {

@@ -8,7 +8,7 @@
 #include "cli_util.hpp"
 #include "command.hpp"
 #include "deflex/model/compliance.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
 #include "deflex/model/robot_io.hpp"
 

@@ -10,8 +10,8 @@
 #include <fmt/format.h>
 
 #include "command.hpp"
-#include "deflex/model/errors.hpp"
-#include "deflex/model/output_file.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/output_file.hpp"
 #include "deflex/monitor/cycle_log_reader.hpp"
 #include "deflex/monitor/monitor_server.hpp"
 

@@ -10,8 +10,8 @@
 #include "command.hpp"
 #include "deflex/evaluate/frame_registration.hpp"
 #include "deflex/evaluate/tracker_files.hpp"
-#include "deflex/model/errors.hpp"
-#include "deflex/model/output_file.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/output_file.hpp"
 #include "tracker_options.hpp"
 
 namespace deflex::cli {

@@ -13,9 +13,9 @@
 
 #include "command.hpp"
 #include "option_ranges.hpp"
-#include "deflex/model/errors.hpp"
-#include "deflex/model/output_file.hpp"
-#include "deflex/model/run_files.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/output_file.hpp"
+#include "deflex/text/run_files.hpp"
 
 namespace deflex::cli {
 

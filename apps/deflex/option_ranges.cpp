@@ -10,9 +10,9 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/input_ranges.hpp"
-#include "deflex/model/nearest_name.hpp"
-#include "deflex/model/parse_number.hpp"
+#include "deflex/text/input_ranges.hpp"
+#include "deflex/text/nearest_name.hpp"
+#include "deflex/text/parse_number.hpp"
 
 namespace deflex::cli {
 namespace {

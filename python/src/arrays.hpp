@@ -13,8 +13,8 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
-#include "deflex/evaluate/tracker_trace.hpp"
-#include "deflex/model/input_ranges.hpp"
+#include "deflex/model/tracker_trace.hpp"
+#include "deflex/text/input_ranges.hpp"
 #include "deflex/model/types.hpp"
 
 namespace deflex::python {

@@ -6,7 +6,7 @@
 #include <new>
 
 #include "bindings.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::python {
 namespace {

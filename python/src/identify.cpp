@@ -10,7 +10,7 @@
 #include "deflex/identify/calibration_planner.hpp"
 #include "deflex/identify/stiffness_identification.hpp"
 #include "deflex/identify/stiffness_measurements.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::python {
 using namespace pybind11::literals;

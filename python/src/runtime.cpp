@@ -15,7 +15,7 @@
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "deflex/force/force_spec.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/runtime/session.hpp"
 #include "deflex/sensors/force_source_spec.hpp"
 #include "deflex/standin/standin_session.hpp"

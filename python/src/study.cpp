@@ -9,12 +9,12 @@
 
 #include "arrays.hpp"
 #include "bindings.hpp"
-#include "deflex/evaluate/study_tables.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/study/study_tables.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/evaluate/tracker_files.hpp"
-#include "deflex/model/output_file.hpp"
+#include "deflex/text/output_file.hpp"
 #include "deflex/report/html_report.hpp"
-#include "deflex/study/case_report.hpp"
+#include "deflex/report/case_report.hpp"
 #include "deflex/study/case_study.hpp"
 
 namespace deflex::python {

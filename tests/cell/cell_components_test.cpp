@@ -10,7 +10,7 @@
 #include "deflex/cell/ldbb_device.hpp"
 #include "deflex/cell/true_robot.hpp"
 #include "deflex/model/compliance.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::cell {
 namespace {

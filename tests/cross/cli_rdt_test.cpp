@@ -19,7 +19,7 @@
 
 #include "cross/cli_child.hpp"
 #include "deflex/cell/egm_position_controller.hpp"
-#include "deflex/model/csv_table.hpp"
+#include "deflex/text/csv_table.hpp"
 #include "deflex/model/kinematics.hpp"
 #include "deflex/model/types.hpp"
 #include "deflex/model/robot_io.hpp"

@@ -11,7 +11,7 @@
 
 #include "cli_runner.hpp"
 #include "deflex/force/constant_wrench_model.hpp"
-#include "deflex/model/csv_table.hpp"
+#include "deflex/text/csv_table.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/paths/path_ik.hpp"

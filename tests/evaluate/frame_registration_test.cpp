@@ -12,7 +12,7 @@
 #include "deflex/evaluate/lap_split.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
 #include "deflex/evaluate/tracker_files.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {

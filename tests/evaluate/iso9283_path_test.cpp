@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/evaluate/iso9283_path.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "synthetic_paths.hpp"
 
 namespace deflex {

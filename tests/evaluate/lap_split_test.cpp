@@ -5,7 +5,7 @@
 
 #include "deflex/evaluate/iso9283_path.hpp"
 #include "deflex/evaluate/lap_split.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "synthetic_paths.hpp"
 
 namespace deflex {

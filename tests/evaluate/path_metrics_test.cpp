@@ -9,7 +9,7 @@
 
 #include "deflex/evaluate/lap_split.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "synthetic_paths.hpp"
 
 namespace deflex {

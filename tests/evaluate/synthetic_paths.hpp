@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include "deflex/evaluate/tracker_trace.hpp"
+#include "deflex/model/tracker_trace.hpp"
 
 namespace deflex::test {
 

@@ -10,8 +10,8 @@
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/force/tool_wrench_model.hpp"
 #include "deflex/force/wrench_table_model.hpp"
-#include "deflex/model/csv_table.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/paths/path_spec.hpp"
 #include "support/error_of.hpp"
 

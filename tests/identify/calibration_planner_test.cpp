@@ -15,8 +15,8 @@
 #include "deflex/identify/calibration_simulation.hpp"
 #include "deflex/identify/stiffness_identification.hpp"
 #include "deflex/model/compliance.hpp"
-#include "deflex/model/csv_table.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
 #include "deflex/model/robot_io.hpp"
 

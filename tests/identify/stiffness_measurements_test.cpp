@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/identify/stiffness_measurements.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {

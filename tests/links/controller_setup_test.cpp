@@ -17,7 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/egm/egm_controller_setup.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/rsi/rsi_controller_setup.hpp"
 #include "wire/libxml2_reader.hpp"
 

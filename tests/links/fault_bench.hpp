@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "deflex/standin/standin_session.hpp"
+#include "deflex/online/online_strategy.hpp"
 #include "links/link_harness.hpp"
 #include "support/sampled_speed.hpp"
 

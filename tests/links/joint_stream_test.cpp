@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/link/joint_stream.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 
 namespace deflex {

@@ -15,6 +15,7 @@
 #include "deflex/model/robot_io.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/transport/memory_network.hpp"
+#include "deflex/online/online_strategy.hpp"
 #include "online/fd_jacobian.hpp"
 
 namespace deflex::test {

@@ -11,6 +11,7 @@
 
 #include "deflex/cell/rsi_controller.hpp"
 #include "deflex/rsi/rsi_link.hpp"
+#include "deflex/online/online_strategy.hpp"
 #include "links/link_harness.hpp"
 
 namespace deflex::test {

@@ -11,7 +11,7 @@
 #include "support/poses.hpp"
 
 #include "deflex/cell/egm_position_controller.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/runtime/session.hpp"
 #include "links/link_harness.hpp"
 #include "support/allocation_guard.hpp"

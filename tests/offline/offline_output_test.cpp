@@ -7,8 +7,8 @@
 #include <gtest/gtest.h>
 
 #include "deflex/force/ldbb_force_model.hpp"
-#include "deflex/model/csv_table.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/offline/offline_csv.hpp"
 #include "deflex/offline/offline_summary.hpp"

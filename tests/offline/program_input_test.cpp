@@ -8,8 +8,8 @@
 
 #include "deflex/force/constant_wrench_model.hpp"
 #include "deflex/force/wrench_table_model.hpp"
-#include "deflex/model/csv_table.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/offline/detail/krl_program.hpp"
 #include "deflex/offline/program_compensation.hpp"

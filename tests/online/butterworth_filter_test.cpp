@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/online/butterworth_filter.hpp"
 #include "support/allocation_guard.hpp"
 

@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/online/force_pipeline.hpp"
 #include "support/allocation_guard.hpp"
 

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/online/online_compensator.hpp"
 #include "online/fd_jacobian.hpp"

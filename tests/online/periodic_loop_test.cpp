@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/online/detail/periodic_loop.hpp"
 #include "support/allocation_guard.hpp"

@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/paths/circle_path.hpp"
 #include "deflex/paths/line_path.hpp"
 #include "deflex/paths/path_spec.hpp"

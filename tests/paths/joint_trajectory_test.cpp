@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "support/allocation_guard.hpp"

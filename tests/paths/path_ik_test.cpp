@@ -2,7 +2,7 @@
 // path CSV reader.
 #include <gtest/gtest.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/path_spec.hpp"

@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/evaluate/tracker_trace.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/model/tracker_trace.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/report/html_report.hpp"
 #include "svg_scan.hpp"
 #include "synthetic_study.hpp"

@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/sensors/detail/csv_force_replay.hpp"
 #include "deflex/sensors/detail/udp_force_source.hpp"
 #include "support/allocation_guard.hpp"

@@ -11,7 +11,7 @@
 #include <string>
 #include <utility>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex {

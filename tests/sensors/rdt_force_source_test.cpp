@@ -12,7 +12,7 @@
 #include <memory>
 #include <vector>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/transport/clock.hpp"
 #include "deflex/transport/memory_network.hpp"
 #include "sensors/rdt_test_sensor.hpp"

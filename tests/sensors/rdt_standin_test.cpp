@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "cross/cli_child.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/sensors/rdt_force_source.hpp"
 #include "deflex/wire/rdt.hpp"
 #include "sensors/rdt_test_sensor.hpp"

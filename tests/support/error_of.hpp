@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::test {
 

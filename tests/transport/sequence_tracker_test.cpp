@@ -4,7 +4,7 @@
 // 32-bit wrap, 64-bit IPOC time stamps, and the rules' own validation.
 #include <gtest/gtest.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/transport/sequence_tracker.hpp"
 
 namespace deflex {

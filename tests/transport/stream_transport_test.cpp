@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/transport/memory_stream.hpp"
 #include "deflex/transport/tcp_stream.hpp"
 #include "support/allocation_guard.hpp"

@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 #include "deflex/transport/memory_network.hpp"
 #include "deflex/transport/udp_transport.hpp"

@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/wire/simple_message.hpp"
 #include "deflex/wire/simple_message_stream.hpp"
 #include "support/allocation_guard.hpp"

@@ -9,7 +9,7 @@
 #include <boost/random/normal_distribution.hpp>
 
 #include "deflex/cell/cell_config.hpp"
-#include "deflex/evaluate/tracker_trace.hpp"
+#include "deflex/model/tracker_trace.hpp"
 
 namespace deflex::cell {
 

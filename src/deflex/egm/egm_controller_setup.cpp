@@ -10,7 +10,7 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/transport/datagram_transport.hpp"
 
 namespace deflex {

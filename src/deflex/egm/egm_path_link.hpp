@@ -13,6 +13,7 @@
 #pragma once
 
 #include "deflex/egm/egm_receiver.hpp"
+#include "deflex/model/kinematics.hpp"
 #include "deflex/link/controller_link.hpp"
 #include "deflex/online/delay_estimator.hpp"
 

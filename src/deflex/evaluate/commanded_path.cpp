@@ -3,8 +3,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/csv_table.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/model/kinematics.hpp"
 
 namespace deflex {

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "deflex/evaluate/tracker_trace.hpp"
+#include "deflex/model/tracker_trace.hpp"
 #include "deflex/model/robot_model.hpp"
 
 namespace deflex {

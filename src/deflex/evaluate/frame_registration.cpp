@@ -8,8 +8,8 @@
 #include <Eigen/SVD>
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/yaml_fields.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/yaml_fields.hpp"
 
 namespace deflex {
 namespace {

@@ -9,7 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 

@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "deflex/evaluate/tracker_trace.hpp"
+#include "deflex/model/tracker_trace.hpp"
 
 namespace deflex {
 

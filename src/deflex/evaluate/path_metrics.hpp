@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "deflex/evaluate/tracker_trace.hpp"
+#include "deflex/model/tracker_trace.hpp"
 
 namespace deflex {
 

@@ -6,7 +6,7 @@
 
 #include <cstddef>
 
-#include "deflex/evaluate/tracker_trace.hpp"
+#include "deflex/model/tracker_trace.hpp"
 
 namespace deflex {
 

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "deflex/evaluate/tracker_trace.hpp"
-#include "deflex/model/output_file.hpp"
+#include "deflex/model/tracker_trace.hpp"
+#include "deflex/text/output_file.hpp"
 #include "deflex/model/types.hpp"
 
 namespace deflex {

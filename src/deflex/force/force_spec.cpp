@@ -9,7 +9,7 @@
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/force/tool_wrench_model.hpp"
 #include "deflex/force/wrench_table_model.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/paths/key_value_spec.hpp"
 
 namespace deflex {

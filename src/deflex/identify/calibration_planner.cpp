@@ -11,9 +11,9 @@
 #include <fmt/format.h>
 
 #include "deflex/identify/stiffness_identification.hpp"
-#include "deflex/model/csv_table.hpp"
-#include "deflex/model/errors.hpp"
-#include "deflex/model/input_ranges.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/input_ranges.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
 
 namespace deflex {

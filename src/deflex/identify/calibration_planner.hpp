@@ -8,7 +8,7 @@
 
 #include <Eigen/Geometry>
 
-#include "deflex/model/output_file.hpp"
+#include "deflex/text/output_file.hpp"
 #include "deflex/model/robot_model.hpp"
 
 namespace deflex {

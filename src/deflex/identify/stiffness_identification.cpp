@@ -14,7 +14,7 @@
 
 #include "deflex/identify/detail/nonnegative_least_squares.hpp"
 #include "deflex/identify/detail/spill_file.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 

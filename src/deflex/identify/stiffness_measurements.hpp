@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "deflex/model/output_file.hpp"
+#include "deflex/text/output_file.hpp"
 #include "deflex/model/types.hpp"
 
 namespace deflex {

@@ -5,8 +5,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/output_file.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/output_file.hpp"
 
 namespace deflex {
 

@@ -9,7 +9,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/online/online_strategy.hpp"
 
 namespace deflex {
 

@@ -26,9 +26,14 @@
 #include "deflex/link/joint_stream.hpp"
 #include "deflex/link/link_history.hpp"
 #include "deflex/link/link_record.hpp"
-#include "deflex/online/online_strategy.hpp"
+#include "deflex/online/cycle_types.hpp"
+#include "deflex/online/force_sample.hpp"
 
 namespace deflex {
+
+// The cycle drives these by reference; their headers are the .cpp files' business.
+class OnlineCompensator;
+class OnlineStrategy;
 
 /// What a link sends the controller, and so what its command is measured against.
 enum class CommandForm : int {

@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-#include "deflex/online/online_compensator.hpp"
+#include "deflex/online/cycle_types.hpp"
 
 namespace deflex {
 

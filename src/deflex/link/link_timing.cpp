@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 

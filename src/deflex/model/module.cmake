@@ -1,7 +1,7 @@
-# Model module extras: compile the built-in robot file in, and link the YAML and URDF parsers.
+# Model module extras: compile the built-in robot file in, and link the URDF parser (YAML comes with text/).
 deflex_embed_text(${target} data/robots/abb_irb6700_300_270.yaml kBuiltinIrb6700Yaml)
-target_link_libraries(${target} PUBLIC yaml-cpp PRIVATE urdfdom::urdfdom_model)
-deflex_module_requires(model "find_dependency(yaml-cpp)" "find_dependency(urdfdom CONFIG)")
+target_link_libraries(${target} PRIVATE urdfdom::urdfdom_model)
+deflex_module_requires(model "find_dependency(urdfdom CONFIG)")
 # TinyXML (a dependency of urdfdom, Debian's libtinyxml-dev) reads the URDF tree with line numbers.
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(TINYXML REQUIRED IMPORTED_TARGET tinyxml)

@@ -9,13 +9,13 @@
 #include <fmt/format.h>
 #include <urdf_parser/urdf_parser.h>
 
-#include "deflex/model/csv_table.hpp"
-#include "deflex/model/errors.hpp"
-#include "deflex/model/input_file.hpp"
-#include "deflex/model/input_ranges.hpp"
-#include "deflex/model/output_file.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/input_file.hpp"
+#include "deflex/text/input_ranges.hpp"
+#include "deflex/text/output_file.hpp"
 #include "deflex/model/detail/urdf_tree.hpp"
-#include "deflex/model/yaml_fields.hpp"
+#include "deflex/text/yaml_fields.hpp"
 
 namespace deflex {
 

@@ -8,10 +8,10 @@
 #include <fmt/format.h>
 #include <tinyxml.h>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/input_ranges.hpp"
-#include "deflex/model/parse_number.hpp"
-#include "deflex/model/detail/utf8_text.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/input_ranges.hpp"
+#include "deflex/text/parse_number.hpp"
+#include "deflex/text/utf8_text.hpp"
 
 namespace deflex {
 namespace {

@@ -8,10 +8,10 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/csv_table.hpp"
-#include "deflex/model/errors.hpp"
-#include "deflex/model/input_file.hpp"
-#include "deflex/model/parse_number.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/input_file.hpp"
+#include "deflex/text/parse_number.hpp"
 
 namespace deflex::monitor {
 namespace {

@@ -9,8 +9,8 @@
 #include <fmt/format.h>
 #include <httplib.h>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/parse_number.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/parse_number.hpp"
 
 namespace deflex {
 extern const char* const kMonitorPageHtml;

@@ -17,7 +17,7 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/offline/detail/krl_aggregate.hpp"
 #include "deflex/offline/detail/program_targets.hpp"
 #include "deflex/offline/detail/program_text.hpp"

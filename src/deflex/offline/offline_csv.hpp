@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "deflex/model/csv_table.hpp"
+#include "deflex/text/csv_table.hpp"
 #include "deflex/offline/compensate_path.hpp"
 
 namespace deflex {

@@ -7,9 +7,9 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/input_file.hpp"
-#include "deflex/model/output_file.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/input_file.hpp"
+#include "deflex/text/output_file.hpp"
 #include "deflex/offline/detail/krl_program.hpp"
 #include "deflex/offline/detail/rapid_program.hpp"
 #include "deflex/offline/detail/program_text.hpp"

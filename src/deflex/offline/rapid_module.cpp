@@ -8,8 +8,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/output_file.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/output_file.hpp"
 #include "deflex/offline/detail/quaternion_sign.hpp"
 
 namespace deflex {

@@ -14,7 +14,7 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/offline/detail/program_targets.hpp"
 #include "deflex/offline/detail/program_text.hpp"
 #include "deflex/offline/detail/program_write_back.hpp"

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <thread>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 

@@ -5,9 +5,9 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/input_ranges.hpp"
-#include "deflex/model/yaml_fields.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/input_ranges.hpp"
+#include "deflex/text/yaml_fields.hpp"
 
 namespace deflex {
 

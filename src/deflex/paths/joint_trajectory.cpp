@@ -8,9 +8,9 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/csv_table.hpp"
-#include "deflex/model/errors.hpp"
-#include "deflex/model/output_file.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/output_file.hpp"
 
 namespace deflex {
 namespace {

@@ -7,10 +7,10 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/input_ranges.hpp"
-#include "deflex/model/nearest_name.hpp"
-#include "deflex/model/parse_number.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/input_ranges.hpp"
+#include "deflex/text/nearest_name.hpp"
+#include "deflex/text/parse_number.hpp"
 
 namespace deflex {
 

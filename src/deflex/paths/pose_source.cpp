@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/paths/detail/pose_path_csv.hpp"
 
 namespace deflex {

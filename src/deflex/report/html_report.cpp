@@ -9,9 +9,9 @@
 
 #include <fmt/format.h>
 
-#include "deflex/evaluate/paper_figures.hpp"
+#include "deflex/study/paper_figures.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "deflex/evaluate/study_tables.hpp"
-#include "deflex/evaluate/error_budget.hpp"
+#include "deflex/study/study_tables.hpp"
+#include "deflex/study/error_budget.hpp"
 #include "deflex/report/svg_charts.hpp"
 
 namespace deflex {

@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/parse_number.hpp"
+#include "deflex/text/parse_number.hpp"
 
 #include "deflex/report/svg_charts.hpp"
 

@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/transport/datagram_transport.hpp"
 #include "deflex/wire/rsi_xml.hpp"
 

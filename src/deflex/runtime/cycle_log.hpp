@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "deflex/model/output_file.hpp"
+#include "deflex/text/output_file.hpp"
 #include "deflex/runtime/record_queue.hpp"
 
 namespace deflex::runtime {

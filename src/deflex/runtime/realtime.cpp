@@ -11,7 +11,7 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::runtime {
 

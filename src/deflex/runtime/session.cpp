@@ -6,9 +6,10 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/transport/tcp_stream.hpp"
 #include "deflex/transport/udp_transport.hpp"
+#include "deflex/online/online_strategy.hpp"
 
 namespace deflex::runtime {
 

@@ -25,6 +25,7 @@
 
 #include "deflex/egm/egm_joint_link.hpp"
 #include "deflex/egm/egm_path_link.hpp"
+#include "deflex/online/online_strategy.hpp"
 #include "deflex/rsi/rsi_link.hpp"
 #include "deflex/runtime/link_table.hpp"
 #include "deflex/runtime/realtime.hpp"

@@ -3,8 +3,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/parse_number.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/parse_number.hpp"
 #include "deflex/sensors/detail/csv_force_replay.hpp"
 #include "deflex/sensors/detail/udp_force_source.hpp"
 

@@ -9,7 +9,7 @@
 #include <memory>
 #include <mutex>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {

@@ -11,9 +11,9 @@
 #include <cmath>
 #include <utility>
 
-#include "deflex/model/input_file.hpp"
-#include "deflex/model/errors.hpp"
-#include "deflex/model/parse_number.hpp"
+#include "deflex/text/input_file.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/parse_number.hpp"
 #include "deflex/paths/key_value_spec.hpp"
 #include "deflex/sensors/detail/http_fetch.hpp"
 

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <limits>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/parse_number.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/parse_number.hpp"
 
 namespace deflex {
 namespace {

@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/parse_number.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/parse_number.hpp"
 
 namespace deflex {
 namespace {

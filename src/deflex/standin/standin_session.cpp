@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/wire/egm_codec.hpp"
 #include "deflex/wire/rsi_xml.hpp"
 

@@ -18,9 +18,9 @@
 
 #include "deflex/evaluate/iso9283_path.hpp"
 #include "deflex/evaluate/lap_split.hpp"
-#include "deflex/evaluate/tracker_trace.hpp"
+#include "deflex/model/tracker_trace.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/study/detail/simulated_run.hpp"
 
 namespace deflex::study {

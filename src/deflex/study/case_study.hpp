@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "deflex/study/case_config.hpp"
-#include "deflex/evaluate/study_tables.hpp"
+#include "deflex/study/study_tables.hpp"
 #include "deflex/evaluate/lap_split.hpp"
-#include "deflex/evaluate/tracker_trace.hpp"
+#include "deflex/model/tracker_trace.hpp"
 
 namespace deflex::study {
 

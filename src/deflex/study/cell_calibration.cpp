@@ -12,7 +12,7 @@
 #include "deflex/cell/laser_tracker.hpp"
 #include "deflex/cell/ldbb_device.hpp"
 #include "deflex/cell/path_drift.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/online/force_pipeline.hpp"
 #include "deflex/paths/circle_path.hpp"
 #include "deflex/paths/joint_trajectory.hpp"

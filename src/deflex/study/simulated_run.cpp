@@ -17,7 +17,7 @@
 #include "deflex/cell/simple_message_server.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/model/compliance.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/sensors/datagram_force_source.hpp"
 #include "deflex/online/online_strategy.hpp"

@@ -1,7 +1,7 @@
 // The order of one sender's numbered datagrams (see sequence_tracker.hpp).
 #include "deflex/transport/sequence_tracker.hpp"
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 

@@ -9,7 +9,7 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/parse_number.hpp"
+#include "deflex/text/parse_number.hpp"
 
 namespace deflex {
 

@@ -12,7 +12,7 @@
 
 #include "deflex/cell/force_sensor.hpp"
 #include "deflex/cell/true_robot.hpp"
-#include "deflex/evaluate/tracker_trace.hpp"
+#include "deflex/model/tracker_trace.hpp"
 #include "deflex/link/controller_link.hpp"
 #include "deflex/online/sensor_config.hpp"
 #include "deflex/paths/joint_trajectory.hpp"

@@ -1,5 +1,5 @@
 // The range table's lookups.
-#include "deflex/model/input_ranges.hpp"
+#include "deflex/text/input_ranges.hpp"
 
 #include <array>
 #include <utility>

@@ -1,12 +1,12 @@
 // Laser-tracker traces and their CSV form.
-#include "deflex/evaluate/tracker_trace.hpp"
+#include "deflex/model/tracker_trace.hpp"
 
 #include <array>
 
 #include <fmt/format.h>
 
-#include "deflex/model/csv_table.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {

@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/csv_table.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {

@@ -1,5 +1,5 @@
 // UTF-8 validation (RFC 3629: at most four bytes, no overlong forms, no surrogates).
-#include "deflex/model/detail/utf8_text.hpp"
+#include "deflex/text/utf8_text.hpp"
 
 #include <fmt/format.h>
 

@@ -19,8 +19,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/input_file.hpp"
-#include "deflex/model/output_file.hpp"
+#include "deflex/text/input_file.hpp"
+#include "deflex/text/output_file.hpp"
 
 namespace deflex {
 

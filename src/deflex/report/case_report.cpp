@@ -1,5 +1,5 @@
 // The case study's report content and honest notes (case_report.hpp).
-#include "deflex/study/case_report.hpp"
+#include "deflex/report/case_report.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/evaluate/tracker_trace.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/model/tracker_trace.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {

@@ -1,5 +1,5 @@
 // Input files: regular files within their kind's size limit, opened without blocking.
-#include "deflex/model/input_file.hpp"
+#include "deflex/text/input_file.hpp"
 
 #include <filesystem>
 
@@ -12,8 +12,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/run_files.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/run_files.hpp"
 
 namespace deflex {
 namespace {

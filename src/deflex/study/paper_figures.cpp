@@ -1,5 +1,5 @@
 // Tables 1 and 2 of the reference paper, as published (section 4).
-#include "deflex/evaluate/paper_figures.hpp"
+#include "deflex/study/paper_figures.hpp"
 
 #include <cmath>
 

@@ -1,5 +1,5 @@
 // Locale-independent number parsing (std::from_chars) for every deflex reader.
-#include "deflex/model/parse_number.hpp"
+#include "deflex/text/parse_number.hpp"
 
 #include <cctype>
 #include <charconv>

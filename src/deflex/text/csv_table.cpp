@@ -4,19 +4,19 @@
 // through callbacks and leaves the numbers, the line endings, the header rules and the messages to
 // the caller, which is all this file does; the reader streams with one buffer for the whole file
 // and no string per cell (bench/io_bench measures it).
-#include "deflex/model/csv_table.hpp"
+#include "deflex/text/csv_table.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/format_number.hpp"
-#include "deflex/model/input_file.hpp"
-#include "deflex/model/input_ranges.hpp"
-#include "deflex/model/nearest_name.hpp"
-#include "deflex/model/parse_number.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/format_number.hpp"
+#include "deflex/text/input_file.hpp"
+#include "deflex/text/input_ranges.hpp"
+#include "deflex/text/nearest_name.hpp"
+#include "deflex/text/parse_number.hpp"
 
 namespace deflex {
 namespace {

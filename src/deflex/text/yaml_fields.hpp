@@ -5,11 +5,12 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <yaml-cpp/yaml.h>
 
-#include "deflex/model/input_file.hpp"
-#include "deflex/model/input_ranges.hpp"
-#include "deflex/model/types.hpp"
+#include "deflex/text/input_file.hpp"
+#include "deflex/text/input_ranges.hpp"
 
 namespace deflex::yaml {
 
@@ -46,7 +47,7 @@ class Field {
   [[nodiscard]] bool as_bool() const;
   [[nodiscard]] std::string as_string() const;
   [[nodiscard]] std::vector<double> as_doubles(std::size_t expected_size = 0) const;  ///< 0: any size
-  [[nodiscard]] Vector3 as_vector3() const;
+  [[nodiscard]] Eigen::Vector3d as_vector3() const;
 
   double get(const std::string& key, double fallback) const;
   int get(const std::string& key, int fallback) const;
@@ -77,6 +78,6 @@ class Field {
 /// A pose written as {position: [x, y, z], quaternion_wxyz: [w, x, y, z]} or
 /// {position: [...], rpy: [roll, pitch, yaw]} (fixed-axis X-Y-Z, i.e. R = Rz(yaw) Ry(pitch) Rx(roll)).
 /// `length_scale` converts the file's length unit to m, `angle_scale` its angle unit to rad.
-Pose parse_pose(const Field& f, double length_scale, double angle_scale);
+Eigen::Isometry3d parse_pose(const Field& f, double length_scale, double angle_scale);
 
 }  // namespace deflex::yaml

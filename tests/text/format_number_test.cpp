@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/format_number.hpp"
+#include "deflex/text/format_number.hpp"
 
 namespace deflex {
 namespace {

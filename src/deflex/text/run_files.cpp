@@ -1,6 +1,6 @@
 // The registry behind RunFilesScope: a list per run, under a mutex (the case study writes from its
 // worker threads).
-#include "deflex/model/run_files.hpp"
+#include "deflex/text/run_files.hpp"
 
 #include <mutex>
 #include <stdexcept>
@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {

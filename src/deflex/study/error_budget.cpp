@@ -1,5 +1,5 @@
 // The error budget's arithmetic.
-#include "deflex/evaluate/error_budget.hpp"
+#include "deflex/study/error_budget.hpp"
 
 #include <cmath>
 #include <limits>

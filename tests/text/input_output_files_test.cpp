@@ -18,10 +18,10 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/input_file.hpp"
-#include "deflex/model/output_file.hpp"
-#include "deflex/model/run_files.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/input_file.hpp"
+#include "deflex/text/output_file.hpp"
+#include "deflex/text/run_files.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex {

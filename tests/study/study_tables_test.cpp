@@ -7,8 +7,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "deflex/evaluate/study_tables.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/study/study_tables.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {

@@ -1,5 +1,5 @@
 // YAML field access with file, line and field in every error.
-#include "deflex/model/yaml_fields.hpp"
+#include "deflex/text/yaml_fields.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,11 +9,11 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/input_file.hpp"
-#include "deflex/model/errors.hpp"
-#include "deflex/model/nearest_name.hpp"
-#include "deflex/model/parse_number.hpp"
-#include "deflex/model/detail/utf8_text.hpp"
+#include "deflex/text/input_file.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/nearest_name.hpp"
+#include "deflex/text/parse_number.hpp"
+#include "deflex/text/utf8_text.hpp"
 
 namespace deflex::yaml {
 
@@ -227,7 +227,7 @@ std::vector<double> Field::as_doubles(std::size_t expected_size) const {
   return out;
 }
 
-Vector3 Field::as_vector3() const {
+Eigen::Vector3d Field::as_vector3() const {
   const auto v = as_doubles(3);
   return {v[0], v[1], v[2]};
 }
@@ -252,12 +252,12 @@ void Field::only_keys(const std::vector<std::string>& allowed) const {
   }
 }
 
-Pose parse_pose(const Field& f, double length_scale, double angle_scale) {
+Eigen::Isometry3d parse_pose(const Field& f, double length_scale, double angle_scale) {
   f.only_keys({"position", "quaternion_wxyz", "rpy"});
-  Pose pose = Pose::Identity();
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   if (f.has("position")) {
     const auto p = f.at("position").as_doubles_in(range::kLengthM, 3, length_scale);
-    pose.translation() = Vector3(p[0], p[1], p[2]);
+    pose.translation() = Eigen::Vector3d(p[0], p[1], p[2]);
   }
   if (f.has("quaternion_wxyz") && f.has("rpy")) {
     f.fail("give either quaternion_wxyz or rpy, not both");
@@ -273,9 +273,9 @@ Pose parse_pose(const Field& f, double length_scale, double angle_scale) {
     pose.linear() = quat.normalized().toRotationMatrix();
   } else if (f.has("rpy")) {
     const auto r = f.at("rpy").as_doubles(3);
-    pose.linear() = (Eigen::AngleAxisd(r[2] * angle_scale, Vector3::UnitZ()) *
-                     Eigen::AngleAxisd(r[1] * angle_scale, Vector3::UnitY()) *
-                     Eigen::AngleAxisd(r[0] * angle_scale, Vector3::UnitX()))
+    pose.linear() = (Eigen::AngleAxisd(r[2] * angle_scale, Eigen::Vector3d::UnitZ()) *
+                     Eigen::AngleAxisd(r[1] * angle_scale, Eigen::Vector3d::UnitY()) *
+                     Eigen::AngleAxisd(r[0] * angle_scale, Eigen::Vector3d::UnitX()))
                         .toRotationMatrix();
   }
   return pose;

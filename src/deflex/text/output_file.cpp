@@ -1,6 +1,6 @@
 // Output files: a temporary file beside the target, renamed into place on commit; streams for
 // devices and FIFOs; transactions that put back what they renamed when a later rename fails.
-#include "deflex/model/output_file.hpp"
+#include "deflex/text/output_file.hpp"
 
 #include <atomic>
 #include <cerrno>
@@ -17,8 +17,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/errors.hpp"
-#include "deflex/model/run_files.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/run_files.hpp"
 
 namespace deflex {
 namespace {

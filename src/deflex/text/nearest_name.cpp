@@ -1,5 +1,5 @@
 // Edit-distance suggestions for unknown names.
-#include "deflex/model/nearest_name.hpp"
+#include "deflex/text/nearest_name.hpp"
 
 #include <algorithm>
 #include <cctype>

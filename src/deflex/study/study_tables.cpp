@@ -1,5 +1,5 @@
 // Case-study results as JSON, terminal tables beside the paper's, Markdown and CSV.
-#include "deflex/evaluate/study_tables.hpp"
+#include "deflex/study/study_tables.hpp"
 
 #include <cmath>
 #include <limits>
@@ -7,10 +7,10 @@
 #include <fmt/format.h>
 
 #include "deflex/evaluate/path_metrics.hpp"
-#include "deflex/model/csv_table.hpp"
-#include "deflex/model/errors.hpp"
-#include "deflex/model/output_file.hpp"
-#include "deflex/model/parse_number.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/output_file.hpp"
+#include "deflex/text/parse_number.hpp"
 
 namespace deflex {
 namespace {

@@ -12,8 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "deflex/evaluate/error_budget.hpp"
-#include "deflex/evaluate/paper_figures.hpp"
+#include "deflex/study/error_budget.hpp"
+#include "deflex/study/paper_figures.hpp"
 
 namespace deflex {
 

@@ -5,13 +5,13 @@
 #include <clocale>
 #include <string>
 
-#include "deflex/model/csv_table.hpp"
-#include "deflex/model/errors.hpp"
-#include "deflex/model/input_ranges.hpp"
-#include "deflex/model/nearest_name.hpp"
-#include "deflex/model/parse_number.hpp"
-#include "deflex/model/detail/utf8_text.hpp"
-#include "deflex/model/yaml_fields.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/input_ranges.hpp"
+#include "deflex/text/nearest_name.hpp"
+#include "deflex/text/parse_number.hpp"
+#include "deflex/text/utf8_text.hpp"
+#include "deflex/text/yaml_fields.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex {

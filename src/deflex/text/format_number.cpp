@@ -1,5 +1,5 @@
 // "%.10g" without a big-number algorithm for the common range: see format_number.hpp.
-#include "deflex/model/format_number.hpp"
+#include "deflex/text/format_number.hpp"
 
 #include <charconv>
 #include <cmath>
