@@ -1,7 +1,6 @@
 // `deflex offline`: compensate a planned path for a force model and write the CSV, the RAPID module
 // and a summary (paper, Figure 2).
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -11,12 +10,12 @@
 #include "cli_util.hpp"
 #include "command.hpp"
 #include "deflex/force/force_spec.hpp"
-#include "deflex/force/ldbb_force_model.hpp"
-#include "deflex/model/errors.hpp"
-#include "deflex/model/output_file.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/output_file.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/offline/offline_csv.hpp"
+#include "deflex/offline/offline_job.hpp"
 #include "deflex/offline/offline_summary.hpp"
 #include "deflex/offline/program_compensation.hpp"
 #include "deflex/offline/rapid_module.hpp"
@@ -39,24 +38,6 @@ struct OfflineOpts {
   double speed_mm_s = 10.0;
   bool circle_given = false, orientation_given = false, json = false;
 };
-
-/// "out.csv" + "ldbb_125N_push" -> "out_ldbb_125N_push.csv" (one file per load when several).
-std::string suffixed(const std::string& path, const std::string& label) {
-  const auto slash = path.find_last_of('/');
-  const auto dot = path.find_last_of('.');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) {
-    return path + "_" + label;
-  }
-  return path.substr(0, dot) + "_" + label + path.substr(dot);
-}
-
-std::string identifier_safe(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-  }
-  return out;
-}
 
 nlohmann::json program_json(const RobotModel& model, const ProgramCompensation& result) {
   nlohmann::json targets = nlohmann::json::array();
@@ -189,13 +170,7 @@ IkRequest first_ik_request(const OfflineOpts& o, const RobotModel& model) {
 
 RapidOptions rapid_options(const OfflineOpts& o) {
   RapidOptions rapid;
-  if (o.motion == "absj") {
-    rapid.motion = RapidMotion::kMoveAbsJ;
-  } else if (o.motion == "movel") {
-    rapid.motion = RapidMotion::kMoveL;
-  } else {
-    throw InputError(fmt::format("option --motion: '{}' is neither absj nor movel", o.motion));
-  }
+  rapid.motion = parse_rapid_motion(o.motion, "option --motion");
   rapid.speed_mm_s = o.speed_mm_s;
   rapid.zone = o.zone;
   rapid.tool = o.tool;
@@ -207,41 +182,24 @@ RapidOptions rapid_options(const OfflineOpts& o) {
   return rapid;
 }
 
-/// One load's run: its compensator, its outputs, what its outputs need of the whole path.
+/// One load's run: its force model, its files, and what the job gave it.
 struct Run {
   const ForceModel* force = nullptr;
-  std::unique_ptr<PathCompensator> compensator;
   std::string label;
   std::string module_name;  // of the RAPID module
   OutputFile* csv_file = nullptr;
   OutputFile* rapid_file = nullptr;
   OutputFile* trajectory_file = nullptr;
   std::unique_ptr<OfflineCsvWriter> csv;
-  std::vector<OfflinePoint> points;      // for the RAPID module
-  std::vector<JointVector> q_command;    // for the compensated trajectory
-  const LdbbForceModel* ldbb = nullptr;  // the bar's length and inclination along the path
-  double lmin = HUGE_VAL, lmax = 0.0, pmin = HUGE_VAL, pmax = -HUGE_VAL;
-  OfflineResult summary;
-  std::string trajectory_text;  // "(compensated joint trajectory, 1.234 s at 10 mm/s)"
+  OfflineResult summary;         // with the points when an output needs them whole
+  std::optional<BarRange> bar;   // an LDBB's bar length and inclination along the path
+  std::string trajectory_text;   // "(compensated joint trajectory, 1.234 s at 10 mm/s)"
 };
-
-/// File-name labels of the loads, unique so that no run's file is another's.
-std::vector<std::string> run_labels(const std::vector<std::unique_ptr<ForceModel>>& forces) {
-  std::vector<std::string> labels;
-  for (std::size_t k = 0; k < forces.size(); ++k) {
-    std::string label = identifier_safe(forces[k]->label());
-    if (std::find(labels.begin(), labels.end(), label) != labels.end()) {
-      label += "_" + std::to_string(k + 1);
-    }
-    labels.push_back(label);
-  }
-  return labels;
-}
 
 /// Every output of every run, prepared before the robot and the path are read.
 void prepare_outputs(const OfflineOpts& o, std::vector<Run>& runs, OutputTransaction& outputs, OutputFile*& nominal) {
   const bool several = runs.size() > 1;
-  const auto name = [&](const std::string& path, const Run& r) { return several ? suffixed(path, r.label) : path; };
+  const auto name = [&](const std::string& path, const Run& r) { return several ? path_with_label(path, r.label) : path; };
   for (Run& r : runs) {
     if (!o.csv_out.empty()) {
       r.csv_file = &outputs.add(name(o.csv_out, r), "option -o");
@@ -270,63 +228,29 @@ void check_path_options(const OfflineOpts& o) {
     throw InputError(fmt::format("option --hold-start-s: must be 0..3600 s (got {})", o.hold_start_s));
   }
   const bool trajectories = !o.trajectory_out.empty() || !o.nominal_trajectory_out.empty();
-  if (trajectories && (!std::isfinite(o.speed_mm_s) || !(o.speed_mm_s > 0.0) || o.speed_mm_s > 10000.0)) {
-    throw InputError(fmt::format("option --speed-mm-s: must be a positive TCP speed up to 10000 mm/s (got {})",
-                                 o.speed_mm_s));
-  }
+  if (trajectories) check_trajectory_speed(o.speed_mm_s, "option --speed-mm-s");
 }
 
-/// The one pass over the path: a pose, its IK, then every load's compensation and CSV row. Only
-/// what an output needs whole is kept (a RAPID module's points, a trajectory's poses and joints), so
-/// a path written to CSV alone streams in memory independent of its length.
-void compensate_along(const OfflineOpts& o, const RobotModel& model, PoseSource& source, PathIkSolver& ik,
-                      std::vector<Run>& runs, std::vector<Pose>& poses, std::vector<JointVector>& q_nominal) {
-  const bool trajectories = !o.trajectory_out.empty() || !o.nominal_trajectory_out.empty();
+/// The one pass over the path (offline_job.hpp): each run's CSV streams, and only what an output needs
+/// whole is kept.
+OfflineJobResult compensate_along(const OfflineOpts& o, const RobotModel& model, PoseSource& source,
+                                  std::vector<Run>& runs) {
+  std::vector<OfflineLoad> loads;
   for (Run& r : runs) {
     if (r.csv_file != nullptr) {
       r.csv = std::make_unique<OfflineCsvWriter>(*r.csv_file, model.dof(), model.name(), r.force->describe(), true);
     }
+    loads.push_back({r.force, r.csv.get(), r.rapid_file != nullptr || r.trajectory_file != nullptr});
   }
-  Pose pose;
-  std::size_t i = 0;
-  for (; source.next(pose); ++i) {
-    const JointVector& q = ik.next(pose);
-    if (trajectories || !o.rapid_out.empty()) {
-      check_held_path_points(i);  // these outputs need the whole path
-    }
-    if (trajectories) {
-      poses.push_back(pose);
-      q_nominal.push_back(q);
-    }
-    for (Run& r : runs) {
-      const OfflinePoint& pt = r.compensator->compensate(i, q, pose);
-      if (r.csv) {
-        r.csv->write(i, pt);
-      }
-      if (r.rapid_file != nullptr) {
-        r.points.push_back(pt);
-      }
-      if (r.trajectory_file != nullptr) {
-        r.q_command.push_back(pt.q_command);
-      }
-      if (r.ldbb != nullptr) {
-        const double l = r.ldbb->bar_length_m(pose), phi = r.ldbb->inclination_rad(pose);
-        r.lmin = std::min(r.lmin, l);
-        r.lmax = std::max(r.lmax, l);
-        r.pmin = std::min(r.pmin, phi);
-        r.pmax = std::max(r.pmax, phi);
-      }
-    }
+  OfflineJobOptions options;
+  options.first = first_ik_request(o, model);
+  options.keep_nominal = !o.nominal_trajectory_out.empty();
+  OfflineJobResult job = run_offline_job(model, source, loads, options);
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    runs[k].summary = std::move(job.loads[k]);
+    runs[k].bar = job.bars[k];
   }
-  if (i == 0) {
-    throw InputError("path: no points");
-  }
-  for (Run& r : runs) {
-    r.summary = r.compensator->summary();  // a force table longer than the path fails here
-    if (r.csv) {
-      r.csv->finish();
-    }
-  }
+  return job;
 }
 
 /// The summary (text or JSON) once every output is in place.
@@ -349,11 +273,13 @@ void report_offline(const OfflineOpts& o, const RobotModel& model, const std::st
                        {"max_correction_mm", result.max_correction_m * 1e3},
                        {"max_joint_correction_deg", rad_to_deg(result.max_joint_correction_rad)}};
     std::string extra;
-    if (r.ldbb != nullptr) {
+    if (r.bar) {
+      const BarRange& b = *r.bar;
       extra = fmt::format("LDBB bar: length {:.2f}..{:.2f} mm, inclination to the XY plane {:.2f}..{:.2f} deg\n",
-                          r.lmin * 1e3, r.lmax * 1e3, rad_to_deg(r.pmin), rad_to_deg(r.pmax));
-      run["bar_length_mm"] = {r.lmin * 1e3, r.lmax * 1e3};
-      run["bar_inclination_deg"] = {rad_to_deg(r.pmin), rad_to_deg(r.pmax)};
+                          b.length_min_m * 1e3, b.length_max_m * 1e3, rad_to_deg(b.inclination_min_rad),
+                          rad_to_deg(b.inclination_max_rad));
+      run["bar_length_mm"] = {b.length_min_m * 1e3, b.length_max_m * 1e3};
+      run["bar_inclination_deg"] = {rad_to_deg(b.inclination_min_rad), rad_to_deg(b.inclination_max_rad)};
     }
     if (r.csv_file != nullptr) {
       run["csv"] = r.csv_file->path();
@@ -382,6 +308,66 @@ void report_offline(const OfflineOpts& o, const RobotModel& model, const std::st
   }
 }
 
+/// One run a load: several --force options, or several force_N values in one, give one each.
+std::vector<Run> make_runs(const OfflineOpts& o, const ForceSpecContext& context,
+                           std::vector<std::unique_ptr<ForceModel>>& forces) {
+  for (const std::string& spec : o.forces) {
+    for (auto& m : parse_force_specs(spec, context)) {
+      forces.push_back(std::move(m));
+    }
+  }
+  std::vector<const ForceModel*> models;
+  for (const auto& f : forces) models.push_back(f.get());
+  const std::vector<std::string> labels = offline_load_labels(models);
+  std::vector<Run> runs(forces.size());
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    runs[k].label = labels[k];
+    runs[k].force = models[k];
+  }
+  return runs;
+}
+
+/// The files that need the whole path: the timed joint programs for the streaming links (deflex
+/// online --program; the path at the TCP speed, compensated a load or nominal) and the RAPID modules.
+/// Returns the nominal trajectory's duration (s).
+double write_whole_path_outputs(const OfflineOpts& o, const RobotModel& model, const std::string& path_text,
+                                const OfflineJobResult& job, std::vector<Run>& runs, RapidOptions& rapid,
+                                OutputFile* nominal_file) {
+  const auto write_trajectory = [&](const std::vector<Pose>& poses, const std::vector<JointVector>& q,
+                                    OutputFile& file, const std::string& what) {
+    const JointTrajectory t = trajectory_at_tcp_speed(poses, q, o.speed_mm_s * 1e-3, model, o.hold_start_s);
+    file.write(t.csv_text(fmt::format("deflex offline: {} joint trajectory of {} at {:g} mm/s ({} points, {:.3f} s); "
+                                      "stream it with deflex online --link egm-joint --program {}",
+                                      what, path_text, o.speed_mm_s, t.size(), t.duration_s(), file.path())));
+    return t.duration_s();
+  };
+  const double nominal_s = nominal_file != nullptr
+                               ? write_trajectory(job.poses, job.q_nominal, *nominal_file, "nominal (uncompensated)")
+                               : 0.0;
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    Run& r = runs[k];
+    if (r.trajectory_file != nullptr) {
+      std::vector<Pose> poses;
+      std::vector<JointVector> q;
+      for (const OfflinePoint& pt : r.summary.points) {
+        poses.push_back(pt.tcp_desired);
+        q.push_back(pt.q_command);
+      }
+      r.trajectory_text = fmt::format("(compensated joint trajectory, {:.3f} s at {:g} mm/s)",
+                                      write_trajectory(poses, q, *r.trajectory_file, "compensated"), o.speed_mm_s);
+    }
+    if (r.rapid_file != nullptr) {
+      rapid.module_name = runs.size() > 1 ? o.module + "_" + r.label : o.module;
+      if (rapid.module_name.size() > 32) {
+        rapid.module_name = (o.module + "_" + std::to_string(k + 1)).substr(0, 32);
+      }
+      r.module_name = rapid.module_name;
+      r.rapid_file->write(rapid_module(r.summary, rapid));
+    }
+  }
+  return nominal_s;
+}
+
 void run(const OfflineOpts& o, int& exit_code) {
   if (o.forces.empty()) {
     throw InputError("give a force model: --force ldbb:...|constant:...|tool:...|table:FILE.csv");
@@ -398,21 +384,9 @@ void run(const OfflineOpts& o, int& exit_code) {
   if (o.circle_given) {
     context.circle = parse_circle_spec(o.circle == "default" ? "" : o.circle);
   }
-  // Force models: several --force options, or several force_N values, give one run per load.
   std::vector<std::unique_ptr<ForceModel>> forces;
-  for (const std::string& spec : o.forces) {
-    for (auto& m : parse_force_specs(spec, context)) {
-      forces.push_back(std::move(m));
-    }
-  }
+  std::vector<Run> runs = make_runs(o, context, forces);
   RapidOptions rapid = rapid_options(o);
-  std::vector<Run> runs(forces.size());
-  const std::vector<std::string> labels = run_labels(forces);
-  for (std::size_t k = 0; k < runs.size(); ++k) {
-    runs[k].label = labels[k];
-    runs[k].force = forces[k].get();
-    runs[k].ldbb = dynamic_cast<const LdbbForceModel*>(forces[k].get());
-  }
   OutputTransaction outputs;
   OutputFile* nominal_file = nullptr;
   prepare_outputs(o, runs, outputs, nominal_file);
@@ -421,44 +395,11 @@ void run(const OfflineOpts& o, int& exit_code) {
   require_stiffness(model);  // before any path is solved
   std::string path_text;
   const std::unique_ptr<PoseSource> source = make_pose_source(o, context, path_text);
-  for (std::size_t k = 0; k < runs.size(); ++k) {
-    runs[k].compensator = std::make_unique<PathCompensator>(model, *forces[k]);
-  }
-  PathIkSolver ik(model, first_ik_request(o, model));
-  std::vector<Pose> poses;  // kept only for the trajectories
-  std::vector<JointVector> q_nominal;
-  compensate_along(o, model, *source, ik, runs, poses, q_nominal);
-  const ArmConfiguration& configuration = ik.configuration();
+  const OfflineJobResult job = compensate_along(o, model, *source, runs);
+  const ArmConfiguration& configuration = job.configuration;
   rapid.note = fmt::format("Path: {}; arm configuration [cf1,cf4,cf6,cfx] at the start [{},{},{},{}].", path_text,
                            configuration.cf1, configuration.cf4, configuration.cf6, configuration.cfx);
-
-  // Timed joint programs for the streaming links (deflex online --program): the path at the TCP
-  // speed, compensated (per load) or nominal.
-  const auto write_trajectory = [&](const std::vector<JointVector>& q, OutputFile& file, const std::string& what) {
-    const JointTrajectory t = trajectory_at_tcp_speed(poses, q, o.speed_mm_s * 1e-3, model, o.hold_start_s);
-    file.write(t.csv_text(fmt::format("deflex offline: {} joint trajectory of {} at {:g} mm/s ({} points, {:.3f} s); "
-                                      "stream it with deflex online --link egm-joint --program {}",
-                                      what, path_text, o.speed_mm_s, t.size(), t.duration_s(), file.path())));
-    return t.duration_s();
-  };
-  const double nominal_s =
-      nominal_file != nullptr ? write_trajectory(q_nominal, *nominal_file, "nominal (uncompensated)") : 0.0;
-  for (std::size_t k = 0; k < runs.size(); ++k) {
-    Run& r = runs[k];
-    if (r.trajectory_file != nullptr) {
-      r.trajectory_text = fmt::format("(compensated joint trajectory, {:.3f} s at {:g} mm/s)",
-                                      write_trajectory(r.q_command, *r.trajectory_file, "compensated"), o.speed_mm_s);
-    }
-    if (r.rapid_file != nullptr) {
-      rapid.module_name = runs.size() > 1 ? o.module + "_" + r.label : o.module;
-      if (rapid.module_name.size() > 32) {
-        rapid.module_name = (o.module + "_" + std::to_string(k + 1)).substr(0, 32);
-      }
-      r.module_name = rapid.module_name;
-      r.summary.points = std::move(r.points);
-      r.rapid_file->write(rapid_module(r.summary, rapid));
-    }
-  }
+  const double nominal_s = write_whole_path_outputs(o, model, path_text, job, runs, rapid, nominal_file);
   outputs.commit();  // every file of every load, or none
   report_offline(o, model, path_text, configuration, runs, nominal_file, nominal_s);
   exit_code = 0;

@@ -10,10 +10,11 @@
 #include "deflex/force/constant_wrench_model.hpp"
 #include "deflex/force/force_spec.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/model/kinematics.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/offline/offline_csv.hpp"
+#include "deflex/offline/offline_job.hpp"
 #include "deflex/offline/offline_summary.hpp"
 #include "deflex/offline/program_compensation.hpp"
 #include "deflex/offline/rapid_module.hpp"
@@ -127,26 +128,22 @@ std::vector<OfflineResult> compensate_each(const RobotModel& model, const PathOr
   }
   if (forces.empty()) forces = force_models(model, force, context, about);
   if (forces.empty()) throw InputError("argument force: no load given");
-  const JointPath jp = solve_path_ik(model, p, first_request(model, configuration, seed));
-  OfflineOptions options;
-  options.predict = predict;
-  std::vector<OfflineResult> out;
+  // The job deflex offline runs (offline_job.hpp), every point kept.
+  std::vector<OfflineLoad> loads;
+  for (const auto& f : forces) loads.push_back({f.get(), nullptr, true});
+  OfflineJobOptions options;
+  options.compensation.predict = predict;
+  options.first = first_request(model, configuration, seed);
   py::gil_scoped_release release;
-  for (const auto& f : forces) out.push_back(compensate_path(model, jp, p, *f, options));
-  return out;
+  PoseListSource source(p);
+  return run_offline_job(model, source, loads, options).loads;
 }
 
 RapidOptions rapid_options(const std::string& module, const std::string& motion, double speed_mm_s,
                            const std::string& zone, const std::string& tool, const std::string& wobj,
                            const std::string& note) {
   RapidOptions rapid;
-  if (motion == "absj") {
-    rapid.motion = RapidMotion::kMoveAbsJ;
-  } else if (motion == "movel") {
-    rapid.motion = RapidMotion::kMoveL;
-  } else {
-    throw InputError(fmt::format("argument motion: '{}' is neither absj nor movel", motion));
-  }
+  rapid.motion = parse_rapid_motion(motion, "argument motion");
   rapid.module_name = module;
   rapid.speed_mm_s = speed_mm_s;
   rapid.zone = zone;
@@ -161,9 +158,7 @@ RapidOptions rapid_options(const std::string& module, const std::string& motion,
 JointTrajectory timed(const RobotModel& model, const OfflineResult& r, double speed_mm_s, double hold_start_s,
                       bool nominal) {
   if (r.points.empty()) throw InputError("the result holds no points");
-  if (!std::isfinite(speed_mm_s) || !(speed_mm_s > 0.0) || speed_mm_s > 10000.0) {
-    throw InputError(fmt::format("argument speed_mm_s: must be a positive TCP speed up to 10000 mm/s (got {})", speed_mm_s));
-  }
+  check_trajectory_speed(speed_mm_s, "argument speed_mm_s");
   std::vector<Pose> p;
   std::vector<JointVector> q;
   for (const OfflinePoint& pt : r.points) {

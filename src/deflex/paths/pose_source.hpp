@@ -5,8 +5,9 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
-#include "deflex/model/csv_table.hpp"
+#include "deflex/text/csv_table.hpp"
 #include "deflex/paths/circle_path.hpp"
 #include "deflex/paths/line_path.hpp"
 
@@ -59,6 +60,24 @@ class LinePoseSource final : public PoseSource {
   LinePath line_;
   Eigen::Matrix3d rotation_;
   int index_ = 0;
+};
+
+/// Poses held by the caller, in order. It keeps a reference to them (the ownership rule of
+/// docs/architecture.md), so a temporary vector does not compile.
+class PoseListSource final : public PoseSource {
+ public:
+  explicit PoseListSource(const std::vector<Pose>& poses) : poses_(poses) {}
+  explicit PoseListSource(std::vector<Pose>&& poses) = delete;
+  bool next(Pose& out) override {
+    if (index_ >= poses_.size()) return false;
+    out = poses_[index_++];
+    return true;
+  }
+  [[nodiscard]] std::optional<std::size_t> size() const override { return poses_.size(); }
+
+ private:
+  const std::vector<Pose>& poses_;
+  std::size_t index_ = 0;
 };
 
 /// The poses of read_pose_path_csv(), read a row at a time (columns x_mm,y_mm,z_mm,qw,qx,qy,qz in
