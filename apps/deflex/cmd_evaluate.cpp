@@ -16,8 +16,9 @@
 #include "deflex/evaluate/path_metrics.hpp"
 #include "deflex/evaluate/time_alignment.hpp"
 #include "deflex/evaluate/tracker_files.hpp"
-#include "deflex/evaluate/tracker_trace.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/evaluate/tracker_runs.hpp"
+#include "deflex/model/tracker_trace.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::cli {
 
@@ -35,70 +36,6 @@ void add_tracker_format_options(CLI::App& sub, TrackerReadOptions& o) {
 }
 
 namespace {
-
-// How tracker files are read: their format options, the tracker frame, and the commanded path the
-// runs are put on the program's clock with.
-struct Reading {
-  TrackerReadOptions options;
-  bool have_frame = false;
-  TrackerFrame frame;
-  bool align = false;
-  CommandedPath commanded;
-  TimeAlignmentOptions alignment;
-};
-
-// One tracker file as a trace in the base frame: on the program's clock when aligning (its alignment
-// appended to `alignments`), else with its own stamps.
-TrackerTrace read_run(const std::string& path, const Reading& r, std::vector<std::pair<std::string, TimeAlignment>>& alignments) {
-  const TrackerFile file = read_tracker_file(path, r.options);
-  TrackerTrace t = r.align ? timed_trace(file, "--align-to") : untimed_trace(file);
-  if (r.have_frame) {
-    for (auto& s : t) s.p_m = r.frame.base_T_tracker * s.p_m;
-  }
-  if (r.align) {
-    TimeAlignment a;
-    try {
-      a = align_time(t, r.commanded.trace, r.alignment);
-    } catch (const InputError& e) {
-      throw InputError(fmt::format("{}: {}", path, e.what()));
-    }
-    alignments.emplace_back(path, a);
-    t = to_program_time(t, a);
-  }
-  return t;
-}
-
-// Each file is one run, or with --split-laps each lap of a closed path in a file is one run.
-// `names` gets each run's file (and lap), for messages about a run; `whole` each file's trace when
-// aligning.
-std::vector<TrackerTrace> read_all(const std::vector<std::string>& paths, bool split, const char* what,
-                                   std::vector<std::string>& names, const Reading& reading,
-                                   std::vector<std::pair<std::string, TimeAlignment>>& alignments,
-                                   std::vector<TrackerTrace>& whole) {
-  std::vector<TrackerTrace> out;
-  for (const auto& p : paths) {
-    TrackerTrace t = read_run(p, reading, alignments);
-    if (reading.align) whole.push_back(t);  // the time-synchronous figures need each file whole
-    if (!split) {
-      out.push_back(std::move(t));
-      names.push_back(p);
-      continue;
-    }
-    LapSplit s = split_laps(t);
-    if (s.laps.empty()) {
-      throw InputError(fmt::format("{}: --split-laps found no full lap of a closed path in the {} run", p, what));
-    }
-    std::cerr << fmt::format("deflex evaluate: {}: {} lap{}{}\n", p, s.laps.size(), s.laps.size() == 1 ? "" : "s",
-                             s.dropped_partial > 0 ? fmt::format(" ({} partial piece{} left out)", s.dropped_partial,
-                                                                 s.dropped_partial == 1 ? "" : "s")
-                                                   : "");
-    for (std::size_t k = 0; k < s.laps.size(); ++k) {
-      out.push_back(std::move(s.laps[k]));
-      names.push_back(fmt::format("{} lap {}", p, k + 1));
-    }
-  }
-  return out;
-}
 
 /// ISO 9283 figures of `runs` against `reference`; an error names the files ("run 2" alone would not).
 Iso9283Path iso_of(const std::vector<TrackerTrace>& runs, const std::vector<std::string>& names,
@@ -164,8 +101,9 @@ struct EvaluateOpts {
   TrackerReadOptions read;
 };
 
-Reading make_reading(const EvaluateOpts& o) {
-  Reading r;
+TrackerRunReading make_reading(const EvaluateOpts& o) {
+  TrackerRunReading r;
+  r.split_laps = o.split;
   r.options = o.read;
   if (!o.tracker_frame.empty()) {
     r.have_frame = true;
@@ -231,15 +169,20 @@ void setup_evaluate(CLI::App& sub, int& exit_code) {
       throw InputError("option --max-offset-mm: must be a positive number of mm");
     }
     if (!o->robot.empty() && o->align_to.empty()) throw InputError("option --robot: only used with --align-to");
-    const Reading reading = make_reading(*o);
-    std::vector<std::string> unloaded_names;
-    std::vector<std::string> loaded_names;
-    std::vector<std::pair<std::string, TimeAlignment>> alignments;
-    std::vector<TrackerTrace> unloaded_whole, loaded_whole;
-    const std::vector<TrackerTrace> unloaded =
-        read_all(o->unloaded, o->split, "unloaded", unloaded_names, reading, alignments, unloaded_whole);
-    const std::vector<TrackerTrace> loaded =
-        read_all(o->loaded, o->split, "loaded", loaded_names, reading, alignments, loaded_whole);
+    const TrackerRunReading reading = make_reading(*o);
+    const TrackerRuns unloaded_runs = read_tracker_runs(o->unloaded, reading, "unloaded");
+    const TrackerRuns loaded_runs = read_tracker_runs(o->loaded, reading, "loaded");
+    for (const auto* g : {&unloaded_runs, &loaded_runs}) {
+      for (const std::string& note : g->notes) std::cerr << "deflex evaluate: " << note << "\n";
+    }
+    const std::vector<TrackerTrace>& unloaded = unloaded_runs.runs;
+    const std::vector<TrackerTrace>& loaded = loaded_runs.runs;
+    const std::vector<std::string>& unloaded_names = unloaded_runs.names;
+    const std::vector<std::string>& loaded_names = loaded_runs.names;
+    const std::vector<TrackerTrace>& unloaded_whole = unloaded_runs.whole;
+    const std::vector<TrackerTrace>& loaded_whole = loaded_runs.whole;
+    std::vector<std::pair<std::string, TimeAlignment>> alignments = unloaded_runs.alignments;
+    alignments.insert(alignments.end(), loaded_runs.alignments.begin(), loaded_runs.alignments.end());
     std::vector<TrackerTrace> distance_reference;
     if (o->mean_reference) {
       TrackerTrace all;
