@@ -2,6 +2,7 @@
 // to `deflex online` over that link (a RAPID module and the UdpUc entry for ABB EGM; the Ethernet
 // config, the RSI context and the KRL lines for KUKA RSI), from the same options and defaults as
 // `deflex online` (ports, period, bounds, SENTYPE), so the controller's side agrees with deflex's.
+#include <cmath>
 #include <filesystem>
 #include <limits>
 #include <iostream>
@@ -12,25 +13,31 @@
 #include "cli_util.hpp"
 #include "command.hpp"
 #include "deflex/egm/egm_controller_setup.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/rsi/rsi_controller_setup.hpp"
 #include "deflex/rsi/rsi_link.hpp"
+#include "deflex/runtime/link_table.hpp"
 
 namespace deflex::cli {
 namespace {
 
 void setup_controller_setup(CLI::App& sub, int& exit_code) {
+  // deflex online's defaults, held once (runtime/link_table.hpp): the files agree with a session
+  // started with the same options.
+  static constexpr runtime::SessionOptionDefaults kShared = runtime::kSessionOptionDefaults;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   struct Opts {
-    std::string link, sensor_ip, output_dir = ".", sentype = "ImFree", context = "deflex_rsi", device = "DEFLEX",
-                                  egm_config = "default", module = "DeflexEgm", path_frame = "tool", tool = "tool0",
-                                  program, robot;
-    int egm_port = 6510, rsi_port = 49152, rsi_timeout = 100, rsi_precision = 4;
-    double period_ms = 0.0, max_joint_deg = 0.5, max_tcp_mm = 5.0, ramp_in_s = 1.0,
-           comm_timeout_s = std::numeric_limits<double>::quiet_NaN(), lowpass_hz = 20.0, convergence_deg = 0.1,
-           cond_time_s = 10.0, max_pos_deviation_deg = std::numeric_limits<double>::quiet_NaN(),
-           max_speed_deviation_deg_s = std::numeric_limits<double>::quiet_NaN(), monitor_factor = 1.2,
-           max_rate_deg_s = 3.0, stop_silence_s = 3.0;
+    std::string link, sensor_ip, output_dir = ".", sentype = kShared.rsi_sentype, context = "deflex_rsi",
+                                  device = "DEFLEX", egm_config = "default", module = "DeflexEgm",
+                                  path_frame = kShared.path_frame, tool = "tool0", program, robot;
+    int egm_port = 6510, rsi_port = 49152,  // the ports ABB's and KUKA's examples use
+        rsi_timeout = kShared.rsi_timeout, rsi_precision = 4;
+    double period_ms = 0.0, max_joint_deg = kShared.max_joint_correction_deg,
+           max_tcp_mm = kShared.max_tcp_correction_mm, ramp_in_s = kShared.ramp_in_s, comm_timeout_s = kNaN,
+           lowpass_hz = 20.0, convergence_deg = 0.1, cond_time_s = 10.0, max_pos_deviation_deg = kNaN,
+           max_speed_deviation_deg_s = kNaN, monitor_factor = 1.2, max_rate_deg_s = kShared.max_rate_deg_s,
+           stop_silence_s = kNaN;  // default: the link kind's (runtime/link_table.cpp)
     bool json = false;
   };
   auto o = std::make_shared<Opts>();
@@ -64,7 +71,7 @@ void setup_controller_setup(CLI::App& sub, int& exit_code) {
   sub.add_option("--tool", o->tool, "EGM: the tooldata the program moves with")->capture_default_str();
   sub.add_option("--comm-timeout-s", o->comm_timeout_s,
                  "EGM: EGMSetupUC \\CommTimeout, s (default: --stop-silence-s, deflex's own)");
-  sub.add_option("--stop-silence-s", o->stop_silence_s, "EGM: deflex online --stop-silence-s")->capture_default_str();
+  sub.add_option("--stop-silence-s", o->stop_silence_s, "EGM: deflex online --stop-silence-s (default: the link's, 3)");
   sub.add_option("--max-rate-deg-s", o->max_rate_deg_s, "egm-joint: deflex online --max-rate-deg-s")
       ->capture_default_str();
   sub.add_option("--program", o->program,
@@ -104,7 +111,8 @@ void setup_controller_setup(CLI::App& sub, int& exit_code) {
       e.device = o->device;
       e.egm_config = o->egm_config;
       e.module = o->module;
-      e.period_ms = o->period_ms > 0.0 ? o->period_ms : (e.path_correction ? 48.0 : 4.0);
+      const runtime::LinkKindInfo& kind = runtime::link_kind(runtime::parse_link_kind(o->link));
+      e.period_ms = o->period_ms > 0.0 ? o->period_ms : kind.default_period_s * 1e3;
       if (o->period_ms < 0.0) throw InputError("option --period-ms: must be > 0");
       e.max_joint_correction_deg = o->max_joint_deg;
       e.max_tcp_correction_mm = o->max_tcp_mm;
@@ -116,7 +124,7 @@ void setup_controller_setup(CLI::App& sub, int& exit_code) {
       e.max_pos_deviation_deg = o->max_pos_deviation_deg;
       e.max_speed_deviation_deg_s = o->max_speed_deviation_deg_s;
       e.max_rate_deg_s = o->max_rate_deg_s;
-      e.stop_silence_s = o->stop_silence_s;
+      e.stop_silence_s = std::isnan(o->stop_silence_s) ? kind.default_stop_silence_s : o->stop_silence_s;
       const RobotModel model = load_cli_robot("controller-setup", o->robot);
       if (model.has_max_speed()) {
         for (int j = 0; j < model.dof(); ++j) e.robot_max_speed_deg_s.push_back(rad_to_deg(model.max_speed()[j]));
@@ -139,7 +147,7 @@ void setup_controller_setup(CLI::App& sub, int& exit_code) {
       r.port = port(o->rsi_port, "--rsi-port");
       r.sentype = o->sentype;
       r.context = o->context;
-      r.period_ms = o->period_ms > 0.0 ? o->period_ms : 4.0;
+      r.period_ms = o->period_ms > 0.0 ? o->period_ms : runtime::link_kind(runtime::LinkKind::kRsi).default_period_s * 1e3;
       if (o->period_ms < 0.0) throw InputError("option --period-ms: must be > 0");
       r.max_joint_correction_deg = o->max_joint_deg;
       r.monitor_factor = o->monitor_factor;

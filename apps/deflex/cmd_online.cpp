@@ -20,7 +20,7 @@
 #include "deflex/monitor/monitor_server.hpp"
 #include "field_log.hpp"
 #include "deflex/force/force_spec.hpp"
-#include "deflex/model/errors.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/runtime/session.hpp"
 #include "deflex/sensors/force_source_spec.hpp"
@@ -48,8 +48,10 @@ SensorConfig sensor_or_default(const std::string& path) {
 struct OnlineOpts {
   std::string link, robot, sensor, force_source, program, strategy = "online", force_model, log, fault_dump,
       jacobian_at = "nominal";
-  double period_ms = 0.0, max_joint_deg = 0.5, max_tcp_mm = 5.0, max_rate_deg_s = 3.0, max_tcp_rate_mm_s = 5.0,
-         watchdog_ms = 50.0;
+  // The settings controller-setup writes into the controller's side come from one place.
+  static constexpr runtime::SessionOptionDefaults kShared = runtime::kSessionOptionDefaults;
+  double period_ms = 0.0, max_joint_deg = kShared.max_joint_correction_deg, max_tcp_mm = kShared.max_tcp_correction_mm,
+         max_rate_deg_s = kShared.max_rate_deg_s, max_tcp_rate_mm_s = kShared.max_tcp_rate_mm_s, watchdog_ms = 50.0;
   double end_silence_s = 2.0, stop_silence_s = 0.0, duration_s = 0.0, status_s = 1.0;
   bool loop = false, json = false, end_on_silence = false;
   // The live monitor page.
@@ -64,13 +66,13 @@ struct OnlineOpts {
   int egm_port = -1, rsi_port = -1, motion_port = 11000, state_port = 11002;
   double connect_timeout_s = 5.0;
   // EGM.
-  double ramp_in_s = 1.0, correction_latency_ms = 0.0, rotation_warning_mrad = 0.1;
+  double ramp_in_s = kShared.ramp_in_s, correction_latency_ms = 0.0, rotation_warning_mrad = 0.1;
   bool no_speed_ref = false;
-  std::string path_frame = "tool";
+  std::string path_frame = kShared.path_frame;
   // RSI.
-  std::string sentype = "ImFree";
+  std::string sentype = kShared.rsi_sentype;
   double rsi_correction_latency_ms = 0.0;
-  int rsi_max_document_bytes = 4096, rsi_timeout = 100;
+  int rsi_max_document_bytes = 4096, rsi_timeout = kShared.rsi_timeout;
   // RDT force sensors and the tare.
   std::string rdt_calibration, tare_pose_deg;
   double rdt_rate_hz = 0.0, tare_window_s = 0.5, tare_max_std_n = 0.5, tare_max_std_nm = 0.05;
