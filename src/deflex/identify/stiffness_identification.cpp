@@ -238,6 +238,164 @@ Eigen::JacobiSVD<Eigen::MatrixXd> svd_of(const RowStore& s, const std::vector<in
   return Eigen::JacobiSVD<Eigen::MatrixXd>(t.R.topRows(t.rows), Eigen::ComputeFullV);
 }
 
+// The estimate before anything is known: every joint's values NaN, the measurement count set.
+StiffnessEstimate estimate_without_values(int n, std::size_t measurements) {
+  StiffnessEstimate est;
+  const auto nz = static_cast<std::size_t>(n);
+  est.stiffness_nm_per_rad.assign(nz, kNaN);
+  est.std_error_nm_per_rad.assign(nz, kNaN);
+  est.compliance_rad_per_nm.assign(nz, kNaN);
+  est.compliance_std_error_rad_per_nm.assign(nz, kNaN);
+  est.measurements = static_cast<int>(measurements);
+  return est;
+}
+
+// b -= A.col(j) * c for a joint whose compliance c is known (in place: b is the last column).
+void move_known_compliance_to_rhs(RowStore& s, int j, double c) {
+  const int width = s.width();
+  const int n = width - 1;
+  s.for_each_mutable([&](std::size_t, int rows, double* block) {
+    for (int r = 0; r < rows; ++r) {
+      block[r * width + n] -= block[r * width + j] * c;
+    }
+  });
+}
+
+// Joints held at a known value: their contribution moves to the right-hand side and their given values into
+// the estimate. Returns the joints left to identify.
+std::vector<int> hold_fixed_joints(RowStore& s, const IdentificationOptions& options, StiffnessEstimate& est) {
+  const int n = s.width() - 1;
+  std::vector<int> free_joints;
+  for (int j = 0; j < n; ++j) {
+    const auto ju = static_cast<std::size_t>(j);
+    if (!options.fixed_stiffness_nm_per_rad.empty() && options.fixed_stiffness_nm_per_rad[ju]) {
+      const double k = *options.fixed_stiffness_nm_per_rad[ju];
+      if (!(k > 0.0) || !std::isfinite(k)) {
+        throw InputError(fmt::format("identify_stiffness: fixed stiffness of joint {} must be finite and > 0", j + 1));
+      }
+      move_known_compliance_to_rhs(s, j, 1.0 / k);
+      est.stiffness_nm_per_rad[ju] = k;
+      est.std_error_nm_per_rad[ju] = 0.0;
+      est.compliance_rad_per_nm[ju] = 1.0 / k;
+      est.compliance_std_error_rad_per_nm[ju] = 0.0;
+      est.fixed_joints.push_back(j + 1);
+    } else {
+      free_joints.push_back(j);
+    }
+  }
+  if (free_joints.empty()) {
+    throw InputError("identify_stiffness: every joint is fixed; nothing to identify");
+  }
+  return free_joints;
+}
+
+// The norm of each regressor column over all stored rows (weighted, as stored).
+Eigen::VectorXd regressor_column_norms(const RowStore& s) {
+  const int width = s.width();
+  const int n = width - 1;
+  Eigen::VectorXd col_norm = Eigen::VectorXd::Zero(n);
+  s.for_each([&](std::size_t, int rows, const double* block) {
+    const RowBlock B(block, rows, width);
+    col_norm += B.leftCols(n).colwise().squaredNorm().transpose();
+  });
+  return col_norm.cwiseSqrt();
+}
+
+// Identifiability before fitting, first check: a free joint the loads never turn (or whose turning never moves
+// the measured point) has a (near) zero column; it joins left_out with a warning. Returns the excited joints.
+std::vector<int> excited_joints(const Eigen::VectorXd& col_norm, const std::vector<int>& free_joints,
+                                const IdentificationOptions& options, std::vector<int>& left_out,
+                                std::vector<std::string>& warnings) {
+  const double max_norm = [&] {
+    double v = 0.0;
+    for (int j : free_joints) {
+      v = std::max(v, col_norm[j]);
+    }
+    return v;
+  }();
+  if (!(max_norm > 0.0)) {
+    throw InputError("identify_stiffness: the loads excite no joint (every wrench is zero, or only loads the base)");
+  }
+  std::vector<int> estimated;
+  for (int j : free_joints) {
+    if (col_norm[j] < options.min_relative_excitation * max_norm) {
+      left_out.push_back(j);
+      warnings.push_back(fmt::format(
+          "joint {}: not excited by the data (no load ever turns it, or its turning never moves the measured "
+          "point); its stiffness cannot be identified: add loads with a moment about its axis",
+          j + 1));
+    } else {
+      estimated.push_back(j);
+    }
+  }
+  return estimated;
+}
+
+// Identifiability before fitting, second check: a group of joints whose scaled columns are collinear (or that
+// fewer equations than unknowns leave undetermined) can only be identified as a combination; each such group
+// moves from `estimated` to left_out with a warning, until the rest are well conditioned.
+void drop_collinear_joint_groups(const RowStore& s, const Eigen::VectorXd& col_norm, const std::vector<double>& omega,
+                                 double min_relative_singular_value, std::vector<int>& estimated,
+                                 std::vector<int>& left_out, std::vector<std::string>& warnings) {
+  while (estimated.size() > 1) {
+    const auto svd = svd_of(s, estimated, col_norm, omega);
+    const Eigen::VectorXd sv = svd.singularValues();
+    const Eigen::Index last = sv.size() - 1;
+    // Fewer equations than joints: the SVD has fewer singular values than columns, and V's trailing
+    // columns span a null space the smallest singular value does not show.
+    const bool underdetermined = sv.size() < static_cast<Eigen::Index>(estimated.size());
+    if (!underdetermined && sv[last] >= min_relative_singular_value * sv[0]) {
+      break;
+    }
+    // The joints in the unobservable direction: the smallest singular value's vector or, with fewer
+    // equations than joints, every joint with a component in the null space (V's trailing columns).
+    const Eigen::MatrixXd null_basis =
+        underdetermined ? Eigen::MatrixXd(svd.matrixV().rightCols(svd.matrixV().cols() - sv.size()))
+                        : Eigen::MatrixXd(svd.matrixV().col(last));
+    std::vector<int> group;
+    for (Eigen::Index k = 0; k < null_basis.rows(); ++k) {
+      if (null_basis.row(k).norm() > 0.1) {
+        group.push_back(estimated[static_cast<std::size_t>(k)]);
+      }
+    }
+    warnings.push_back(
+        underdetermined
+            ? fmt::format("joints {}: {} equations for {} unknown compliances; these joints are not determined by "
+                          "the data: add measurements (deflex plan-calibration)",
+                          joint_list(group), sv.size(), estimated.size())
+            : fmt::format(
+                  "joints {}: their effects on the measured displacements are collinear in these data (relative "
+                  "singular value {:.1e}); only a combination is observable, so none of them is identified: add "
+                  "poses or load directions that separate them (deflex plan-calibration)",
+                  joint_list(group), sv[last] / sv[0]));
+    for (int j : group) {
+      left_out.push_back(j);
+      estimated.erase(std::find(estimated.begin(), estimated.end(), j));
+    }
+  }
+}
+
+// A joint left out still deflects: with a value from the robot file it is held there, so the
+// others are not biased; without one it is taken as rigid, which the warning says. Sorts left_out.
+void hold_left_out_joints(RowStore& s, const RobotModel& model, std::vector<int>& left_out,
+                          std::vector<std::string>& warnings) {
+  std::sort(left_out.begin(), left_out.end());
+  for (int j : left_out) {
+    if (model.has_stiffness()) {
+      const double k = model.stiffness()[j];
+      move_known_compliance_to_rhs(s, j, 1.0 / k);
+      warnings.push_back(fmt::format("joint {}: not identified (NaN in the estimate); the others were fitted "
+                                     "with it held at the robot file's {:.4g} Nm/rad",
+                                     j + 1, k));
+    } else {
+      warnings.push_back(fmt::format(
+          "joint {}: not identified (NaN in the estimate); the others were fitted with it taken as rigid (the robot "
+          "file gives no stiffness to hold it at)",
+          j + 1));
+    }
+  }
+}
+
 }  // namespace
 
 StiffnessIdentifier::StiffnessIdentifier(const RobotModel& model, const IdentificationOptions& options)
@@ -330,134 +488,17 @@ StiffnessEstimate StiffnessIdentifier::solve() {
   }
   solved_ = true;
 
-  StiffnessEstimate est;
-  const auto nz = static_cast<std::size_t>(n);
-  est.stiffness_nm_per_rad.assign(nz, kNaN);
-  est.std_error_nm_per_rad.assign(nz, kNaN);
-  est.compliance_rad_per_nm.assign(nz, kNaN);
-  est.compliance_std_error_rad_per_nm.assign(nz, kNaN);
-  est.measurements = static_cast<int>(s.size());
+  StiffnessEstimate est = estimate_without_values(n, s.size());
   const std::size_t m = s.size();
   const int width = s.width();
-
-  // b -= A.col(j) * c for a joint whose compliance c is known (in place: b is the last column).
-  const auto move_to_rhs = [&](int j, double c) {
-    s.for_each_mutable([&](std::size_t, int rows, double* block) {
-      for (int r = 0; r < rows; ++r) {
-        block[r * width + n] -= block[r * width + j] * c;
-      }
-    });
-  };
-
-  // Joints held at a known value: move their contribution to the right-hand side.
-  std::vector<int> free_joints;
-  for (int j = 0; j < n; ++j) {
-    const auto ju = static_cast<std::size_t>(j);
-    if (!options.fixed_stiffness_nm_per_rad.empty() && options.fixed_stiffness_nm_per_rad[ju]) {
-      const double k = *options.fixed_stiffness_nm_per_rad[ju];
-      if (!(k > 0.0) || !std::isfinite(k)) {
-        throw InputError(fmt::format("identify_stiffness: fixed stiffness of joint {} must be finite and > 0", j + 1));
-      }
-      move_to_rhs(j, 1.0 / k);
-      est.stiffness_nm_per_rad[ju] = k;
-      est.std_error_nm_per_rad[ju] = 0.0;
-      est.compliance_rad_per_nm[ju] = 1.0 / k;
-      est.compliance_std_error_rad_per_nm[ju] = 0.0;
-      est.fixed_joints.push_back(j + 1);
-    } else {
-      free_joints.push_back(j);
-    }
-  }
-  if (free_joints.empty()) {
-    throw InputError("identify_stiffness: every joint is fixed; nothing to identify");
-  }
-
-  // Identifiability before fitting: a joint the loads never turn (or whose turning never moves the
-  // measured point) has a zero column; a group of joints whose columns are collinear can only be
-  // identified as a combination. Both are flagged and left out of the fit.
-  Eigen::VectorXd col_norm = Eigen::VectorXd::Zero(n);
-  s.for_each([&](std::size_t, int rows, const double* block) {
-    const RowBlock B(block, rows, width);
-    col_norm += B.leftCols(n).colwise().squaredNorm().transpose();
-  });
-  col_norm = col_norm.cwiseSqrt();
-  const double max_norm = [&] {
-    double v = 0.0;
-    for (int j : free_joints) {
-      v = std::max(v, col_norm[j]);
-    }
-    return v;
-  }();
-  if (!(max_norm > 0.0)) {
-    throw InputError("identify_stiffness: the loads excite no joint (every wrench is zero, or only loads the base)");
-  }
-  std::vector<int> estimated;
+  const std::vector<int> free_joints = hold_fixed_joints(s, options, est);
+  const Eigen::VectorXd col_norm = regressor_column_norms(s);
   std::vector<int> left_out;
-  for (int j : free_joints) {
-    if (col_norm[j] < options.min_relative_excitation * max_norm) {
-      left_out.push_back(j);
-      est.warnings.push_back(fmt::format(
-          "joint {}: not excited by the data (no load ever turns it, or its turning never moves the measured "
-          "point); its stiffness cannot be identified: add loads with a moment about its axis",
-          j + 1));
-    } else {
-      estimated.push_back(j);
-    }
-  }
+  std::vector<int> estimated = excited_joints(col_norm, free_joints, options, left_out, est.warnings);
   std::vector<double> omega(m, 1.0);
-  while (estimated.size() > 1) {
-    const auto svd = svd_of(s, estimated, col_norm, omega);
-    const Eigen::VectorXd sv = svd.singularValues();
-    const Eigen::Index last = sv.size() - 1;
-    // Fewer equations than joints: the SVD has fewer singular values than columns, and V's trailing
-    // columns span a null space the smallest singular value does not show.
-    const bool underdetermined = sv.size() < static_cast<Eigen::Index>(estimated.size());
-    if (!underdetermined && sv[last] >= options.min_relative_singular_value * sv[0]) {
-      break;
-    }
-    // The joints in the unobservable direction: the smallest singular value's vector or, with fewer
-    // equations than joints, every joint with a component in the null space (V's trailing columns).
-    const Eigen::MatrixXd null_basis =
-        underdetermined ? Eigen::MatrixXd(svd.matrixV().rightCols(svd.matrixV().cols() - sv.size()))
-                        : Eigen::MatrixXd(svd.matrixV().col(last));
-    std::vector<int> group;
-    for (Eigen::Index k = 0; k < null_basis.rows(); ++k) {
-      if (null_basis.row(k).norm() > 0.1) {
-        group.push_back(estimated[static_cast<std::size_t>(k)]);
-      }
-    }
-    est.warnings.push_back(
-        underdetermined
-            ? fmt::format("joints {}: {} equations for {} unknown compliances; these joints are not determined by "
-                          "the data: add measurements (deflex plan-calibration)",
-                          joint_list(group), sv.size(), estimated.size())
-            : fmt::format(
-                  "joints {}: their effects on the measured displacements are collinear in these data (relative "
-                  "singular value {:.1e}); only a combination is observable, so none of them is identified: add "
-                  "poses or load directions that separate them (deflex plan-calibration)",
-                  joint_list(group), sv[last] / sv[0]));
-    for (int j : group) {
-      left_out.push_back(j);
-      estimated.erase(std::find(estimated.begin(), estimated.end(), j));
-    }
-  }
-  std::sort(left_out.begin(), left_out.end());
-  // A joint left out still deflects: with a value from the robot file it is held there, so the
-  // others are not biased; without one it is taken as rigid, which the warning says.
-  for (int j : left_out) {
-    if (model.has_stiffness()) {
-      const double k = model.stiffness()[j];
-      move_to_rhs(j, 1.0 / k);
-      est.warnings.push_back(fmt::format("joint {}: not identified (NaN in the estimate); the others were fitted "
-                                         "with it held at the robot file's {:.4g} Nm/rad",
-                                         j + 1, k));
-    } else {
-      est.warnings.push_back(fmt::format(
-          "joint {}: not identified (NaN in the estimate); the others were fitted with it taken as rigid (the robot "
-          "file gives no stiffness to hold it at)",
-          j + 1));
-    }
-  }
+  drop_collinear_joint_groups(s, col_norm, omega, options.min_relative_singular_value, estimated, left_out,
+                              est.warnings);
+  hold_left_out_joints(s, model, left_out, est.warnings);
   if (estimated.empty()) {
     throw InputError(fmt::format("identify_stiffness: no joint can be identified from these data: {}",
                                  fmt::join(est.warnings, "; ")));
