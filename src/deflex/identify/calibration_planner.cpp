@@ -78,27 +78,46 @@ void check_options(const CalibrationPlanOptions& o) {
   }
 }
 
-}  // namespace
-
-CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanOptions& o) {
-  check_options(o);
-  if (!model.has_stiffness()) {
-    throw InputError(fmt::format("plan_calibration: robot '{}' has no joint stiffness; nominal values (even rough "
-                                 "ones) are needed to weigh the joints against each other",
-                                 model.name()));
-  }
-  const int n = model.dof();
-  const JointVector c_nom = model.compliance();
-  Workspace ws(model);
-  CalibrationPlan plan;
-
-  // Candidate loads in the tool's own terms: a force along +-x, +-y, +-z of the base frame, applied
-  // at the WAP or at the end of a lever along +-x or +-y of the tool.
+// The candidate loads at one pose, in the tool's own terms: a force along +-x, +-y, +-z of the base frame,
+// applied at the WAP or at the end of a lever along +-x or +-y of the tool; each with its regressor rows scaled
+// by the nominal compliance. `base_T_wap` is the WAP at cp.q; ws and block are scratch.
+void add_candidate_loads(const RobotModel& model, Workspace& ws, const CalibrationPlanOptions& o,
+                         const JointVector& c_nom, const Pose& base_T_wap, Jacobian& block, CandidatePose& cp) {
   std::vector<Vector3> directions;
   for (int a = 0; a < 3; ++a) {
     directions.push_back(Vector3::Unit(a));
     directions.push_back(-Vector3::Unit(a));
   }
+  std::vector<Vector3> levers = {Vector3::Zero()};
+  if (o.lever_m > 0.0) {
+    for (int a = 0; a < 2; ++a) {
+      levers.push_back(o.lever_m * base_T_wap.linear().col(a));
+      levers.push_back(-o.lever_m * base_T_wap.linear().col(a));
+    }
+  }
+  for (const Vector3& d : directions) {
+    for (const Vector3& r : levers) {
+      if (r.norm() > 0.0 && r.cross(d).norm() < 1e-6 * r.norm()) {
+        continue;  // force along the lever: the same as no lever
+      }
+      Candidate c;
+      c.wrench.head<3>() = o.load_n * d;
+      c.wrench.tail<3>() = r.cross(c.wrench.head<3>());
+      c.load_point = base_T_wap.translation() + r;
+      stiffness_regressor(model, ws, cp.q, c.wrench, block);
+      c.block = block.topRows(3) * c_nom.asDiagonal();
+      cp.loads.push_back(std::move(c));
+    }
+  }
+}
+
+// Every point of the region's grid with every tool spin: the poses IK reaches inside the joint limits, each with
+// its candidate loads. `tried` counts the poses tried.
+std::vector<CandidatePose> reachable_candidate_poses(const RobotModel& model, const CalibrationPlanOptions& o,
+                                                     int& tried) {
+  const int n = model.dof();
+  const JointVector c_nom = model.compliance();
+  Workspace ws(model);
   const Eigen::Quaterniond base_q = o.orientation.normalized();
   const int g = o.grid_per_axis;
   std::vector<CandidatePose> poses;
@@ -110,7 +129,7 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
                                g == 1 ? 0.5 : iz / double(g - 1));
         const Vector3 p = o.region_min_m + ((o.region_max_m - o.region_min_m).array() * t).matrix();
         for (double spin : o.spin_rad) {
-          ++plan.candidate_poses;
+          ++tried;
           Pose target = Pose::Identity();
           target.linear() = (base_q * Eigen::AngleAxisd(spin, Vector3::UnitZ())).toRotationMatrix();
           target.translation() = p;
@@ -123,32 +142,27 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
           forward_kinematics(model, ws, cp.q);
           cp.base_T_tcp = ws.base_T_tcp;
           const Pose base_T_wap = ws.base_T_wap;
-          std::vector<Vector3> levers = {Vector3::Zero()};
-          if (o.lever_m > 0.0) {
-            for (int a = 0; a < 2; ++a) {
-              levers.push_back(o.lever_m * base_T_wap.linear().col(a));
-              levers.push_back(-o.lever_m * base_T_wap.linear().col(a));
-            }
-          }
-          for (const Vector3& d : directions) {
-            for (const Vector3& r : levers) {
-              if (r.norm() > 0.0 && r.cross(d).norm() < 1e-6 * r.norm()) {
-                continue;  // force along the lever: the same as no lever
-              }
-              Candidate c;
-              c.wrench.head<3>() = o.load_n * d;
-              c.wrench.tail<3>() = r.cross(c.wrench.head<3>());
-              c.load_point = base_T_wap.translation() + r;
-              stiffness_regressor(model, ws, cp.q, c.wrench, block);
-              c.block = block.topRows(3) * c_nom.asDiagonal();
-              cp.loads.push_back(std::move(c));
-            }
-          }
+          add_candidate_loads(model, ws, o, c_nom, base_T_wap, block, cp);
           poses.push_back(std::move(cp));
         }
       }
     }
   }
+  return poses;
+}
+
+}  // namespace
+
+CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanOptions& o) {
+  check_options(o);
+  if (!model.has_stiffness()) {
+    throw InputError(fmt::format("plan_calibration: robot '{}' has no joint stiffness; nominal values (even rough "
+                                 "ones) are needed to weigh the joints against each other",
+                                 model.name()));
+  }
+  const int n = model.dof();
+  CalibrationPlan plan;
+  std::vector<CandidatePose> poses = reachable_candidate_poses(model, o, plan.candidate_poses);
   plan.reachable_poses = static_cast<int>(poses.size());
   if (poses.empty()) {
     throw InputError(fmt::format("plan_calibration: no pose of the region is reachable with the requested tool "
