@@ -78,27 +78,46 @@ void check_options(const CalibrationPlanOptions& o) {
   }
 }
 
-}  // namespace
-
-CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanOptions& o) {
-  check_options(o);
-  if (!model.has_stiffness()) {
-    throw InputError(fmt::format("plan_calibration: robot '{}' has no joint stiffness; nominal values (even rough "
-                                 "ones) are needed to weigh the joints against each other",
-                                 model.name()));
-  }
-  const int n = model.dof();
-  const JointVector c_nom = model.compliance();
-  Workspace ws(model);
-  CalibrationPlan plan;
-
-  // Candidate loads in the tool's own terms: a force along +-x, +-y, +-z of the base frame, applied
-  // at the WAP or at the end of a lever along +-x or +-y of the tool.
+// The candidate loads at one pose, in the tool's own terms: a force along +-x, +-y, +-z of the base frame,
+// applied at the WAP or at the end of a lever along +-x or +-y of the tool; each with its regressor rows scaled
+// by the nominal compliance. `base_T_wap` is the WAP at cp.q; ws and block are scratch.
+void add_candidate_loads(const RobotModel& model, Workspace& ws, const CalibrationPlanOptions& o,
+                         const JointVector& c_nom, const Pose& base_T_wap, Jacobian& block, CandidatePose& cp) {
   std::vector<Vector3> directions;
   for (int a = 0; a < 3; ++a) {
     directions.push_back(Vector3::Unit(a));
     directions.push_back(-Vector3::Unit(a));
   }
+  std::vector<Vector3> levers = {Vector3::Zero()};
+  if (o.lever_m > 0.0) {
+    for (int a = 0; a < 2; ++a) {
+      levers.push_back(o.lever_m * base_T_wap.linear().col(a));
+      levers.push_back(-o.lever_m * base_T_wap.linear().col(a));
+    }
+  }
+  for (const Vector3& d : directions) {
+    for (const Vector3& r : levers) {
+      if (r.norm() > 0.0 && r.cross(d).norm() < 1e-6 * r.norm()) {
+        continue;  // force along the lever: the same as no lever
+      }
+      Candidate c;
+      c.wrench.head<3>() = o.load_n * d;
+      c.wrench.tail<3>() = r.cross(c.wrench.head<3>());
+      c.load_point = base_T_wap.translation() + r;
+      stiffness_regressor(model, ws, cp.q, c.wrench, block);
+      c.block = block.topRows(3) * c_nom.asDiagonal();
+      cp.loads.push_back(std::move(c));
+    }
+  }
+}
+
+// Every point of the region's grid with every tool spin: the poses IK reaches inside the joint limits, each with
+// its candidate loads. `tried` counts the poses tried.
+std::vector<CandidatePose> reachable_candidate_poses(const RobotModel& model, const CalibrationPlanOptions& o,
+                                                     int& tried) {
+  const int n = model.dof();
+  const JointVector c_nom = model.compliance();
+  Workspace ws(model);
   const Eigen::Quaterniond base_q = o.orientation.normalized();
   const int g = o.grid_per_axis;
   std::vector<CandidatePose> poses;
@@ -110,7 +129,7 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
                                g == 1 ? 0.5 : iz / double(g - 1));
         const Vector3 p = o.region_min_m + ((o.region_max_m - o.region_min_m).array() * t).matrix();
         for (double spin : o.spin_rad) {
-          ++plan.candidate_poses;
+          ++tried;
           Pose target = Pose::Identity();
           target.linear() = (base_q * Eigen::AngleAxisd(spin, Vector3::UnitZ())).toRotationMatrix();
           target.translation() = p;
@@ -123,136 +142,126 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
           forward_kinematics(model, ws, cp.q);
           cp.base_T_tcp = ws.base_T_tcp;
           const Pose base_T_wap = ws.base_T_wap;
-          std::vector<Vector3> levers = {Vector3::Zero()};
-          if (o.lever_m > 0.0) {
-            for (int a = 0; a < 2; ++a) {
-              levers.push_back(o.lever_m * base_T_wap.linear().col(a));
-              levers.push_back(-o.lever_m * base_T_wap.linear().col(a));
-            }
-          }
-          for (const Vector3& d : directions) {
-            for (const Vector3& r : levers) {
-              if (r.norm() > 0.0 && r.cross(d).norm() < 1e-6 * r.norm()) {
-                continue;  // force along the lever: the same as no lever
-              }
-              Candidate c;
-              c.wrench.head<3>() = o.load_n * d;
-              c.wrench.tail<3>() = r.cross(c.wrench.head<3>());
-              c.load_point = base_T_wap.translation() + r;
-              stiffness_regressor(model, ws, cp.q, c.wrench, block);
-              c.block = block.topRows(3) * c_nom.asDiagonal();
-              cp.loads.push_back(std::move(c));
-            }
-          }
+          add_candidate_loads(model, ws, o, c_nom, base_T_wap, block, cp);
           poses.push_back(std::move(cp));
         }
       }
     }
   }
-  plan.reachable_poses = static_cast<int>(poses.size());
-  if (poses.empty()) {
-    throw InputError(fmt::format("plan_calibration: no pose of the region is reachable with the requested tool "
-                                 "orientation inside the joint limits and away from singularities ({} tried)",
-                                 plan.candidate_poses));
-  }
-  int wanted = o.poses;
-  if (wanted > plan.reachable_poses) {
-    plan.warnings.push_back(fmt::format("only {} reachable poses in the region; the plan uses all of them",
-                                        plan.reachable_poses));
-    wanted = plan.reachable_poses;
-  }
+  return poses;
+}
 
+// The scales of the greedy selection, from the candidates' information.
+struct SelectionScales {
+  double info_scale = 0.0;  // the largest information one candidate load carries
   // Regulariser for the log-determinant while A^T A is singular: tiny against any real information.
-  double info_scale = 0.0;
+  JointMatrix eps;
+  // A joint no candidate can observe would pin the smallest eigenvalue at zero and blind the
+  // criterion to the others: it gets a large constant in the selection only.
+  JointMatrix unobservable_pad;
+};
+
+// The selection's scales for these candidates (n joints).
+SelectionScales selection_scales(const std::vector<CandidatePose>& poses, int n) {
+  SelectionScales sc;
   for (const auto& cp : poses) {
     for (const auto& c : cp.loads) {
-      info_scale = std::max(info_scale, c.block.squaredNorm());
+      sc.info_scale = std::max(sc.info_scale, c.block.squaredNorm());
     }
   }
-  const JointMatrix eps = 1e-9 * info_scale * JointMatrix::Identity(n, n);
-  JointMatrix G = JointMatrix::Zero(n, n);
-  // A joint no candidate can observe would pin the smallest eigenvalue at zero and blind the
-  // criterion to the others: give it a large constant in the selection only.
-  JointMatrix unobservable_pad = JointMatrix::Zero(n, n);
-  {
-    Eigen::VectorXd all_diag = Eigen::VectorXd::Zero(n);
-    for (const auto& cp : poses) {
-      for (const auto& c : cp.loads) {
-        all_diag += c.block.colwise().squaredNorm().transpose();
-      }
-    }
-    for (int j = 0; j < n; ++j) {
-      if (all_diag[j] <= 1e-16 * all_diag.maxCoeff()) {
-        unobservable_pad(j, j) = 1e6 * info_scale;
-      }
+  sc.eps = 1e-9 * sc.info_scale * JointMatrix::Identity(n, n);
+  sc.unobservable_pad = JointMatrix::Zero(n, n);
+  Eigen::VectorXd all_diag = Eigen::VectorXd::Zero(n);
+  for (const auto& cp : poses) {
+    for (const auto& c : cp.loads) {
+      all_diag += c.block.colwise().squaredNorm().transpose();
     }
   }
-  // Picks the best load among candidates; returns {pose, load} or {-1, -1}.
-  struct Scored {
-    int pose, load;
-    double bound;
+  for (int j = 0; j < n; ++j) {
+    if (all_diag[j] <= 1e-16 * all_diag.maxCoeff()) {
+      sc.unobservable_pad(j, j) = 1e6 * sc.info_scale;
+    }
+  }
+  return sc;
+}
+
+// A candidate load (pose and load index) with an upper bound of the smallest eigenvalue it can give.
+struct ScoredLoad {
+  int pose, load;
+  double bound;
+};
+
+// The candidate load that most raises the smallest eigenvalue of the information G (or, while every candidate
+// leaves it ~0, the log-determinant), among the loads of pose `only_pose`, or of every unused pose when it is
+// -1; returns {pose, load} or {-1, -1}.
+std::pair<int, int> best_candidate_load(const std::vector<CandidatePose>& poses, const JointMatrix& G,
+                                        const SelectionScales& sc, int only_pose) {
+  const JointMatrix G0 = G + sc.unobservable_pad;
+  const Eigen::SelfAdjointEigenSolver<JointMatrix> es(G0);
+  const JointVector v0 = es.eigenvectors().col(0);
+  // lambda_min(G0 + B^T B) <= v0^T (G0 + B^T B) v0 = lambda_min(G0) + |B v0|^2: a tight upper
+  // bound that lets most candidates be skipped without an eigenvalue solve.
+  std::vector<ScoredLoad> items;
+  for (int pi = 0; pi < static_cast<int>(poses.size()); ++pi) {
+    const CandidatePose& cp = poses[static_cast<std::size_t>(pi)];
+    if (only_pose >= 0 ? pi != only_pose : cp.used) {
+      continue;
+    }
+    for (int li = 0; li < static_cast<int>(cp.loads.size()); ++li) {
+      const auto& B = cp.loads[static_cast<std::size_t>(li)].block;
+      items.push_back({pi, li, es.eigenvalues()[0] + (B * v0).squaredNorm()});
+    }
+  }
+  const auto block_of = [&](const ScoredLoad& it) -> const auto& {
+    return poses[static_cast<std::size_t>(it.pose)].loads[static_cast<std::size_t>(it.load)].block;
   };
-  auto pick = [&](int only_pose) {
-    const JointMatrix G0 = G + unobservable_pad;
-    const Eigen::SelfAdjointEigenSolver<JointMatrix> es(G0);
-    const JointVector v0 = es.eigenvectors().col(0);
-    // lambda_min(G0 + B^T B) <= v0^T (G0 + B^T B) v0 = lambda_min(G0) + |B v0|^2: a tight upper
-    // bound that lets most candidates be skipped without an eigenvalue solve.
-    std::vector<Scored> items;
-    for (int pi = 0; pi < static_cast<int>(poses.size()); ++pi) {
-      const CandidatePose& cp = poses[static_cast<std::size_t>(pi)];
-      if (only_pose >= 0 ? pi != only_pose : cp.used) {
-        continue;
-      }
-      for (int li = 0; li < static_cast<int>(cp.loads.size()); ++li) {
-        const auto& B = cp.loads[static_cast<std::size_t>(li)].block;
-        items.push_back({pi, li, es.eigenvalues()[0] + (B * v0).squaredNorm()});
-      }
+  // Mirror-image loads score the same up to round-off: keep the first, so plans do not depend
+  // on the compiler's rounding.
+  int best_p = -1, best_l = -1;
+  double best = -std::numeric_limits<double>::infinity();
+  auto consider = [&](const ScoredLoad& it, double score) {
+    if (best_p < 0 || score > best + 1e-9 * std::abs(best)) {
+      best = score;
+      best_p = it.pose;
+      best_l = it.load;
     }
-    const auto block_of = [&](const Scored& it) -> const auto& {
-      return poses[static_cast<std::size_t>(it.pose)].loads[static_cast<std::size_t>(it.load)].block;
-    };
-    // Mirror-image loads score the same up to round-off: keep the first, so plans do not depend
-    // on the compiler's rounding.
-    int best_p = -1, best_l = -1;
-    double best = -std::numeric_limits<double>::infinity();
-    auto consider = [&](const Scored& it, double score) {
-      if (best_p < 0 || score > best + 1e-9 * std::abs(best)) {
-        best = score;
-        best_p = it.pose;
-        best_l = it.load;
-      }
-    };
-    std::vector<Scored> by_bound = items;
-    std::stable_sort(by_bound.begin(), by_bound.end(), [](const Scored& x, const Scored& y) { return x.bound > y.bound; });
-    for (const Scored& it : by_bound) {
-      if (best_p >= 0 && it.bound <= best) {
-        break;  // no remaining candidate can beat the best
-      }
+  };
+  std::vector<ScoredLoad> by_bound = items;
+  std::stable_sort(by_bound.begin(), by_bound.end(),
+                   [](const ScoredLoad& x, const ScoredLoad& y) { return x.bound > y.bound; });
+  for (const ScoredLoad& it : by_bound) {
+    if (best_p >= 0 && it.bound <= best) {
+      break;  // no remaining candidate can beat the best
+    }
+    const auto& B = block_of(it);
+    consider(it, min_eigenvalue(G0 + B.transpose() * B));
+  }
+  // Until the information matrix has full rank every smallest eigenvalue is ~0; then the
+  // log-determinant (D-optimality) spreads the information over the missing directions.
+  if (!(best > 1e-6 * sc.info_scale)) {
+    best_p = -1;
+    for (const ScoredLoad& it : items) {
       const auto& B = block_of(it);
-      consider(it, min_eigenvalue(G0 + B.transpose() * B));
+      consider(it, log_det(G0 + B.transpose() * B + sc.eps));
     }
-    // Until the information matrix has full rank every smallest eigenvalue is ~0; then the
-    // log-determinant (D-optimality) spreads the information over the missing directions.
-    if (!(best > 1e-6 * info_scale)) {
-      best_p = -1;
-      for (const Scored& it : items) {
-        const auto& B = block_of(it);
-        consider(it, log_det(G0 + B.transpose() * B + eps));
-      }
-    }
-    return std::pair<int, int>(best_p, best_l);
-  };
+  }
+  return std::pair<int, int>(best_p, best_l);
+}
+
+// The greedy selection: up to `wanted` poses, each the best unused one, with up to loads_per_pose of its loads,
+// each the best left there; the chosen loads' information is added to G and their points to `points`.
+void choose_calibration_points(std::vector<CandidatePose>& poses, int wanted, int loads_per_pose,
+                               const SelectionScales& sc, JointMatrix& G, std::vector<CalibrationPoint>& points) {
   for (int k = 0; k < wanted; ++k) {
-    auto [pi, li] = pick(-1);
+    auto [pi, li] = best_candidate_load(poses, G, sc, -1);
     if (pi < 0) {
       break;
     }
     CandidatePose& cp = poses[static_cast<std::size_t>(pi)];
     cp.used = true;
-    for (int l = 0; l < o.loads_per_pose && !cp.loads.empty(); ++l) {
+    for (int l = 0; l < loads_per_pose && !cp.loads.empty(); ++l) {
       if (l > 0) {
-        li = pick(pi).second;
+        li = best_candidate_load(poses, G, sc, pi).second;
       }
       const Candidate& c = cp.loads[static_cast<std::size_t>(li)];
       G += c.block.transpose() * c.block;
@@ -263,16 +272,17 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
       pt.wrench_base = c.wrench;
       pt.load_point_base = c.load_point;
       pt.expected_dp_m = c.block.rowwise().sum();  // sum_j c_nom_j * column_j
-      plan.points.push_back(pt);
+      points.push_back(pt);
       cp.loads.erase(cp.loads.begin() + li);
     }
   }
+}
 
-  if (plan.points.empty()) {
-    throw InputError("plan_calibration: no load could be chosen (no candidate has a finite score)");
-  }
-  // Figures of the chosen design. A joint whose column is negligible (no load turns it, or the
-  // TCP lies on its axis) is unobservable; the others are judged on their own.
+// Figures of the chosen design (information G) into plan: the smallest singular value, the condition number and
+// the predicted relative standard errors. A joint whose column is negligible (no load turns it, or the
+// TCP lies on its axis) is unobservable; the others are judged on their own.
+void design_figures(const JointMatrix& G, double noise_m, CalibrationPlan& plan) {
+  const auto n = static_cast<int>(G.rows());
   const Eigen::VectorXd eig = Eigen::SelfAdjointEigenSolver<JointMatrix>(G, Eigen::EigenvaluesOnly).eigenvalues();
   plan.min_singular_value_m = std::sqrt(std::max(0.0, eig[0]));
   const double max_diag = G.diagonal().maxCoeff();
@@ -305,11 +315,15 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
       const Eigen::MatrixXd cov = Go.inverse();
       for (Eigen::Index a = 0; a < no; ++a) {
         plan.predicted_relative_std_error[static_cast<std::size_t>(observable[static_cast<std::size_t>(a)])] =
-            o.noise_m * std::sqrt(cov(a, a));
+            noise_m * std::sqrt(cov(a, a));
       }
     }
   }
-  for (int j = 0; j < n; ++j) {
+}
+
+// A warning for each joint the plan leaves unobservable or predicts worse than 10% (relative standard error).
+void warn_about_weak_joints(double noise_m, CalibrationPlan& plan) {
+  for (int j = 0; j < static_cast<int>(plan.predicted_relative_std_error.size()); ++j) {
     const double r = plan.predicted_relative_std_error[static_cast<std::size_t>(j)];
     if (!std::isfinite(r)) {
       plan.warnings.push_back(fmt::format(
@@ -321,9 +335,44 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
       plan.warnings.push_back(fmt::format(
           "joint {}: predicted relative standard error {:.0f}% with {:.0f} um tracker noise; use more poses, a "
           "larger load, a longer lever or a larger region",
-          j + 1, 100.0 * r, o.noise_m * 1e6));
+          j + 1, 100.0 * r, noise_m * 1e6));
     }
   }
+}
+
+}  // namespace
+
+CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanOptions& o) {
+  check_options(o);
+  if (!model.has_stiffness()) {
+    throw InputError(fmt::format("plan_calibration: robot '{}' has no joint stiffness; nominal values (even rough "
+                                 "ones) are needed to weigh the joints against each other",
+                                 model.name()));
+  }
+  const int n = model.dof();
+  CalibrationPlan plan;
+  std::vector<CandidatePose> poses = reachable_candidate_poses(model, o, plan.candidate_poses);
+  plan.reachable_poses = static_cast<int>(poses.size());
+  if (poses.empty()) {
+    throw InputError(fmt::format("plan_calibration: no pose of the region is reachable with the requested tool "
+                                 "orientation inside the joint limits and away from singularities ({} tried)",
+                                 plan.candidate_poses));
+  }
+  int wanted = o.poses;
+  if (wanted > plan.reachable_poses) {
+    plan.warnings.push_back(fmt::format("only {} reachable poses in the region; the plan uses all of them",
+                                        plan.reachable_poses));
+    wanted = plan.reachable_poses;
+  }
+
+  const SelectionScales scales = selection_scales(poses, n);
+  JointMatrix G = JointMatrix::Zero(n, n);
+  choose_calibration_points(poses, wanted, o.loads_per_pose, scales, G, plan.points);
+  if (plan.points.empty()) {
+    throw InputError("plan_calibration: no load could be chosen (no candidate has a finite score)");
+  }
+  design_figures(G, o.noise_m, plan);
+  warn_about_weak_joints(o.noise_m, plan);
   return plan;
 }
 
