@@ -634,32 +634,68 @@ std::string effect_size(const CaseConfig& c, Effect e) {
   return "";
 }
 
-CaseConfig without_effect(const CaseConfig& config, Effect e) {
-  CaseConfig c = config;
+namespace {
+
+// Switches off `e` in `c` when it is one of the true arm's own effects; false for any other effect.
+bool clear_arm_effect(CaseConfig& c, Effect e) {
+  auto& r = c.cell.robot;
   switch (e) {
     case Effect::kStiffnessMismatch:
       // The overall scale is the robot itself (identification finds it); the per-joint spread is
       // what makes the true ratios between joints differ from the assumed ones.
-      c.cell.robot.stiffness_spread = 0.0;
-      break;
+      r.stiffness_spread = 0.0;
+      return true;
     case Effect::kJointCoupling:
-      c.cell.robot.coupling_23 = 0.0;
-      break;
+      r.coupling_23 = 0.0;
+      return true;
     case Effect::kLinkBending:
-      c.cell.robot.forearm_ei_nm2 = 0.0;
-      c.cell.robot.upper_arm_ei_nm2 = 0.0;
+      r.forearm_ei_nm2 = 0.0;
+      r.upper_arm_ei_nm2 = 0.0;
+      return true;
+    case Effect::kLostMotion:
+      for (double& v : r.lost_motion_rad) v = 0.0;
+      return true;
+    case Effect::kKinematicErrors:
+      r.dh_length_sigma_m = 0.0;
+      r.dh_angle_sigma_rad = 0.0;
+      return true;
+    case Effect::kGearHardening:
+      for (double& v : r.hardening_softening) v = 0.0;
+      return true;
+    case Effect::kBaseCompliance:
+      r.base_tilt_compliance_rad_per_nm = 0.0;
+      return true;
+    case Effect::kMotionStiffness:
+      r.speed_stiffening = 0.0;
+      r.direction_asymmetry = 0.0;
+      return true;
+    case Effect::kServo:
+      r.servo_following_s = 0.0;
+      r.servo_compliance_fraction = 0.0;
+      return true;
+    default:
+      return false;
+  }
+}
+
+// Switches off `e` in `c` when it belongs to the rest of the cell (sensor, LDBB, tracker,
+// controller, calibration, drift); the arm's own effects are clear_arm_effect's.
+void clear_cell_effect(CaseConfig& c, Effect e) {
+  switch (e) {
+    case Effect::kStiffnessMismatch:
+    case Effect::kJointCoupling:
+    case Effect::kLinkBending:
+    case Effect::kLostMotion:
+    case Effect::kKinematicErrors:
+    case Effect::kGearHardening:
+    case Effect::kBaseCompliance:
+    case Effect::kMotionStiffness:
+    case Effect::kServo:
       break;
     case Effect::kSensorCompliance:
       c.cell.sensor.lateral_compliance_m_per_n = 0.0;
       c.cell.sensor.axial_compliance_m_per_n = 0.0;
       c.cell.sensor.rotational_compliance_rad_per_nm = 0.0;
-      break;
-    case Effect::kLostMotion:
-      for (double& v : c.cell.robot.lost_motion_rad) v = 0.0;
-      break;
-    case Effect::kKinematicErrors:
-      c.cell.robot.dh_length_sigma_m = 0.0;
-      c.cell.robot.dh_angle_sigma_rad = 0.0;
       break;
     case Effect::kLdbbForceError:
       c.cell.ldbb.force_bias = 0.0;
@@ -698,23 +734,9 @@ CaseConfig without_effect(const CaseConfig& config, Effect e) {
       c.cell.drift.rotation_rad = 0.0;
       c.cell.drift.wander_m = 0.0;
       break;
-    case Effect::kGearHardening:
-      for (double& v : c.cell.robot.hardening_softening) v = 0.0;
-      break;
     case Effect::kSensorCalibration:
       c.cell.sensor.sensitivity_error = 0.0;
       c.cell.sensor.misalignment_rad = 0.0;
-      break;
-    case Effect::kBaseCompliance:
-      c.cell.robot.base_tilt_compliance_rad_per_nm = 0.0;
-      break;
-    case Effect::kMotionStiffness:
-      c.cell.robot.speed_stiffening = 0.0;
-      c.cell.robot.direction_asymmetry = 0.0;
-      break;
-    case Effect::kServo:
-      c.cell.robot.servo_following_s = 0.0;
-      c.cell.robot.servo_compliance_fraction = 0.0;
       break;
     case Effect::kSensorDrift:
       c.cell.sensor.zero_drift_n = 0.0;
@@ -726,6 +748,13 @@ CaseConfig without_effect(const CaseConfig& config, Effect e) {
       c.cell.ldbb.stick_slip = 0.0;
       break;
   }
+}
+
+}  // namespace
+
+CaseConfig without_effect(const CaseConfig& config, Effect e) {
+  CaseConfig c = config;
+  if (!clear_arm_effect(c, e)) clear_cell_effect(c, e);
   return c;
 }
 
