@@ -7,6 +7,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <optional>
 #include <sstream>
 
 #include "deflex/text/errors.hpp"
@@ -98,153 +100,200 @@ Vector3 CaseConfig::pivot_m() const {
   return circle.center_m - Vector3::UnitZ() * (cell.ldbb.bar_length_m * std::sin(cell.ldbb.inclination_rad));
 }
 
-CaseConfig load_case_text(const std::string& text, const std::string& source) {
-  const yaml::Field root = yaml::Field::load_string(text, source);
-  root.only_keys({"deflex_case", "name", "robot", "seed", "circle", "protocol", "setups", "true_robot", "tool",
-                  "sensor", "ldbb", "tracker", "controller", "online", "calibration", "drift", "error_budget"});
-  if (root.at("deflex_case").as_int() != 1) root.at("deflex_case").fail("unsupported version (expected 1)");
-  CaseConfig c;
-  c.source = source;
-  c.name = root.get("name", std::string("case"));
-  c.cell.robot_file = root.get("robot", std::string());
-  const int seed = root.get("seed", 1);
-  if (seed < 0) root.at("seed").fail("must not be negative");
-  c.seed = static_cast<std::uint64_t>(seed);
+namespace {
 
+// A case file names each number's unit in its key; these convert it to the unit the case keeps.
+double unscaled(double v) { return v; }
+double from_pct(double v) { return v / 100.0; }
+double from_milli(double v) { return v * kMm; }  // mm, ms, mrad
+double from_deg(double v) { return deg_to_rad(v); }
+
+// Reads a number as given, of either sign (positive() and non_negative() read it with a sign).
+double any_sign(const yaml::Field& f) { return f.as_double(); }
+
+// For case_number and case_whole: a key that must be present (no fallback).
+constexpr std::nullopt_t kRequired = std::nullopt;
+
+// Where a number of the case file may lie once in the unit the case keeps (an end is included
+// unless marked open), and the words of its field's error otherwise.
+struct CaseRange {
+  double lo = -HUGE_VAL, hi = HUGE_VAL;
+  bool lo_open = false, hi_open = false;
+  const char* message = "";
+};
+
+CaseRange at_most(double hi, const char* message) { return {-HUGE_VAL, hi, false, false, message}; }
+CaseRange above(double lo, const char* message) { return {lo, HUGE_VAL, true, false, message}; }
+CaseRange within(double lo, double hi, const char* message) { return {lo, hi, false, false, message}; }
+CaseRange inside(double bound, const char* message) { return {-bound, bound, true, true, message}; }
+
+// `value`, read from `key` of `section`, when `range` holds it; else the error naming that field.
+double case_checked(const yaml::Field& section, const char* key, double value, const CaseRange& range) {
+  const bool low_ok = range.lo_open ? value > range.lo : value >= range.lo;
+  const bool high_ok = range.hi_open ? value < range.hi : value <= range.hi;
+  if (!(low_ok && high_ok)) section.at(key).fail(range.message);
+  return value;
+}
+
+// One number of a case file: `key` of `section` read by `read` (or `fallback`, in the file's unit,
+// when the key is absent and may be), converted by `unit`, checked against `range`.
+double case_number(const yaml::Field& section, const char* key, double (*read)(const yaml::Field&),
+                   std::optional<double> fallback, double (*unit)(double), const CaseRange& range = {}) {
+  const double raw = fallback && !section.has(key) ? *fallback : read(section.at(key));
+  return case_checked(section, key, unit(raw), range);
+}
+
+// One whole number of a case file: `key` of `section` (or `fallback` when absent and allowed),
+// within lo..hi, else `message` on the field.
+int case_whole(const yaml::Field& section, const char* key, std::optional<int> fallback, int lo, int hi,
+               const char* message) {
+  const int v = fallback && !section.has(key) ? *fallback : section.at(key).as_int();
+  if (v < lo || v > hi) section.at(key).fail(message);
+  return v;
+}
+
+// The case file's "circle": where the tool goes round, pointing how, through how many points.
+void read_case_circle(const yaml::Field& root, CaseConfig& c) {
   const auto circle = root.at("circle");
   circle.only_keys({"center_mm", "tcp_quaternion_wxyz", "points"});
-  c.circle.points = circle.get("points", 81);
-  if (c.circle.points < 8 || c.circle.points > 100000) circle.at("points").fail("must be 8..100000");
+  c.circle.points = case_whole(circle, "points", 81, 8, 100000, "must be 8..100000");
   c.circle.center_m = circle.at("center_mm").as_vector3() * kMm;
   const auto qv = circle.at("tcp_quaternion_wxyz").as_doubles(4);
   Eigen::Quaterniond quat(qv[0], qv[1], qv[2], qv[3]);
   if (std::abs(quat.norm() - 1.0) > 1e-3) circle.at("tcp_quaternion_wxyz").fail("not a unit quaternion");
   c.circle.tcp_orientation = Pose::Identity();
   c.circle.tcp_orientation.linear() = quat.normalized().toRotationMatrix();
+}
 
+// The case file's "protocol": seeds, laps, speeds and the sweep. Returns the section (the sweep's
+// load is checked against the setups' loads once they are read).
+yaml::Field read_case_protocol(const yaml::Field& root, CaseConfig& c) {
   const auto proto = root.at("protocol");
   proto.only_keys({"laps_cw", "laps_ccw", "speeds_mm_s", "sweep_speeds_mm_s", "sweep_load_N", "seeds"});
-  c.seeds = proto.get("seeds", 1);
-  if (c.seeds < 1 || c.seeds > 1000) proto.at("seeds").fail("must be 1..1000");
+  c.seeds = case_whole(proto, "seeds", 1, 1, 1000, "must be 1..1000");
   c.laps_cw = proto.get("laps_cw", 3);
   c.laps_ccw = proto.get("laps_ccw", 3);
   if (c.laps_cw < 0 || c.laps_ccw < 0 || c.laps_cw + c.laps_ccw == 0) proto.fail("needs at least one lap");
   c.speeds_m_s = speeds(proto.at("speeds_mm_s"));
   if (proto.has("sweep_speeds_mm_s")) c.sweep_speeds_m_s = speeds(proto.at("sweep_speeds_mm_s"));
   c.sweep_load_n = proto.get("sweep_load_N", 650.0);
+  return proto;
+}
 
+// One entry of the case file's "setups"; `others` are the setups before it (names must differ).
+SetupConfig read_case_setup(const yaml::Field& s, const std::vector<SetupConfig>& others) {
+  s.only_keys({"name", "strategy", "link", "sensor", "loads_N", "paper_uc_mm", "paper_c_mm"});
+  SetupConfig sc;
+  sc.name = s.at("name").as_string();
+  sc.strategy = parse_strategy(s.at("strategy"));
+  sc.link = sc.strategy == Strategy::kOffline ? LinkKind::kProgram : LinkKind::kEgmJoint;
+  if (s.has("link")) sc.link = parse_link(s.at("link"));
+  if (sc.strategy == Strategy::kOffline && sc.link != LinkKind::kProgram)
+    s.at("link").fail("the offline strategy runs a program: its link is 'program'");
+  if (sc.strategy != Strategy::kOffline && sc.link == LinkKind::kProgram)
+    s.at("link").fail("an online strategy needs a controller link (egm-joint, egm-path or simple-message)");
+  if (sc.strategy == Strategy::kHybrid && sc.link == LinkKind::kEgmPath)
+    s.at("link").fail("the hybrid strategy streams the offline program: its link is egm-joint or simple-message");
+  sc.sensor_mounted = s.at("sensor").as_bool();
+  if (sc.strategy != Strategy::kOffline && !sc.sensor_mounted)
+    s.at("sensor").fail("online strategies need the sensor");
+  for (const auto& other : others) {
+    if (other.name == sc.name) s.at("name").fail("two setups have this name");
+  }
+  sc.loads_n = s.at("loads_N").as_doubles();
+  for (double l : sc.loads_n) {
+    if (!(l > 0.0)) s.at("loads_N").fail("loads must be positive");
+  }
+  if (s.has("paper_uc_mm")) {
+    sc.paper_uc_mm = s.at("paper_uc_mm").as_doubles(sc.loads_n.size());
+    const auto pc = s.at("paper_c_mm");
+    if (pc.size() != sc.loads_n.size()) pc.fail("one row per load");
+    for (std::size_t k = 0; k < pc.size(); ++k) {
+      const auto row = pc.at(k).as_doubles(3);
+      sc.paper_c_mm.push_back({row[0], row[1], row[2]});
+    }
+  }
+  return sc;
+}
+
+// The case file's "setups", then the protocol's sweep load checked against their loads.
+void read_case_setups(const yaml::Field& root, const yaml::Field& proto, CaseConfig& c) {
   const auto setups = root.at("setups");
   if (!setups.is_sequence() || setups.size() == 0) setups.fail("expected a list of setups");
-  for (std::size_t i = 0; i < setups.size(); ++i) {
-    const auto s = setups.at(i);
-    s.only_keys({"name", "strategy", "link", "sensor", "loads_N", "paper_uc_mm", "paper_c_mm"});
-    SetupConfig sc;
-    sc.name = s.at("name").as_string();
-    sc.strategy = parse_strategy(s.at("strategy"));
-    sc.link = sc.strategy == Strategy::kOffline ? LinkKind::kProgram : LinkKind::kEgmJoint;
-    if (s.has("link")) sc.link = parse_link(s.at("link"));
-    if (sc.strategy == Strategy::kOffline && sc.link != LinkKind::kProgram)
-      s.at("link").fail("the offline strategy runs a program: its link is 'program'");
-    if (sc.strategy != Strategy::kOffline && sc.link == LinkKind::kProgram)
-      s.at("link").fail("an online strategy needs a controller link (egm-joint, egm-path or simple-message)");
-    if (sc.strategy == Strategy::kHybrid && sc.link == LinkKind::kEgmPath)
-      s.at("link").fail("the hybrid strategy streams the offline program: its link is egm-joint or simple-message");
-    sc.sensor_mounted = s.at("sensor").as_bool();
-    if (sc.strategy != Strategy::kOffline && !sc.sensor_mounted)
-      s.at("sensor").fail("online strategies need the sensor");
-    for (const auto& other : c.setups) {
-      if (other.name == sc.name) s.at("name").fail("two setups have this name");
-    }
-    sc.loads_n = s.at("loads_N").as_doubles();
+  for (std::size_t i = 0; i < setups.size(); ++i) c.setups.push_back(read_case_setup(setups.at(i), c.setups));
+  // The sweep runs each setup at its load nearest to sweep_load_N: a value outside every setup's
+  // loads would silently become another load.
+  double lo = HUGE_VAL, hi = 0.0;
+  for (const auto& sc : c.setups) {
     for (double l : sc.loads_n) {
-      if (!(l > 0.0)) s.at("loads_N").fail("loads must be positive");
-    }
-    if (s.has("paper_uc_mm")) {
-      sc.paper_uc_mm = s.at("paper_uc_mm").as_doubles(sc.loads_n.size());
-      const auto pc = s.at("paper_c_mm");
-      if (pc.size() != sc.loads_n.size()) pc.fail("one row per load");
-      for (std::size_t k = 0; k < pc.size(); ++k) {
-        const auto row = pc.at(k).as_doubles(3);
-        sc.paper_c_mm.push_back({row[0], row[1], row[2]});
-      }
-    }
-    c.setups.push_back(sc);
-  }
-  {
-    // The sweep runs each setup at its load nearest to sweep_load_N: a value outside every setup's
-    // loads would silently become another load.
-    double lo = HUGE_VAL, hi = 0.0;
-    for (const auto& sc : c.setups) {
-      for (double l : sc.loads_n) {
-        lo = std::min(lo, l);
-        hi = std::max(hi, l);
-      }
-    }
-    if (c.sweep_load_n < lo || c.sweep_load_n > hi) {
-      (proto.has("sweep_load_N") ? proto.at("sweep_load_N") : proto)
-          .fail(fmt::format("{:g} N is outside the setups' loads ({:g}..{:g} N); the sweep runs each setup at its "
-                            "load nearest to this",
-                            c.sweep_load_n, lo, hi));
+      lo = std::min(lo, l);
+      hi = std::max(hi, l);
     }
   }
+  if (c.sweep_load_n < lo || c.sweep_load_n > hi) {
+    (proto.has("sweep_load_N") ? proto.at("sweep_load_N") : proto)
+        .fail(fmt::format("{:g} N is outside the setups' loads ({:g}..{:g} N); the sweep runs each setup at its "
+                          "load nearest to this",
+                          c.sweep_load_n, lo, hi));
+  }
+}
 
+// The case file's "true_robot": how the simulated arm differs from the model deflex is given.
+void read_case_true_robot(const yaml::Field& root, CaseConfig& c) {
   const auto r = root.at("true_robot");
   r.only_keys({"stiffness_scale", "stiffness_spread_pct", "coupling_23", "forearm_EI_Nm2", "forearm_length_mm",
                "lost_motion_urad", "lost_motion_torque_Nm", "gravity_torque_Nm", "dh_length_sigma_mm",
                "dh_angle_sigma_deg", "hardening_softening", "hardening_torque_Nm", "upper_arm_EI_Nm2",
                "base_tilt_compliance_nrad_per_Nm", "speed_stiffening_pct", "direction_asymmetry_pct",
                "speed_ref_mrad_s", "servo_following_ms", "servo_compliance_pct", "servo_integral_s"});
-  {
-    auto& t = c.cell.robot;
-    t.upper_arm_ei_nm2 = non_negative_or(r, "upper_arm_EI_Nm2", 0.0);
-    t.base_tilt_compliance_rad_per_nm = non_negative_or(r, "base_tilt_compliance_nrad_per_Nm", 0.0) * 1e-9;
-    t.speed_stiffening = non_negative_or(r, "speed_stiffening_pct", 0.0) / 100.0;
-    if (t.speed_stiffening > 0.5) r.at("speed_stiffening_pct").fail("must be within 0..50 %");
-    t.direction_asymmetry = non_negative_or(r, "direction_asymmetry_pct", 0.0) / 100.0;
-    if (t.direction_asymmetry > 0.5) r.at("direction_asymmetry_pct").fail("must be within 0..50 %");
-    t.speed_ref_rad_s = non_negative_or(r, "speed_ref_mrad_s", 10.0) * kMm;
-    if (!(t.speed_ref_rad_s > 0.0)) r.at("speed_ref_mrad_s").fail("must be positive");
-    t.servo_following_s = non_negative_or(r, "servo_following_ms", 0.0) * kMm;
-    if (t.servo_following_s > 0.1) r.at("servo_following_ms").fail("must be within 0..100 ms");
-    t.servo_compliance_fraction = non_negative_or(r, "servo_compliance_pct", 0.0) / 100.0;
-    if (t.servo_compliance_fraction > 1.0) r.at("servo_compliance_pct").fail("must be within 0..100 %");
-    t.servo_integral_s = non_negative_or(r, "servo_integral_s", 0.1);
-    if (!(t.servo_integral_s > 0.0)) r.at("servo_integral_s").fail("must be positive");
-  }
-  c.cell.robot.stiffness_scale = positive(r.at("stiffness_scale"));
-  c.cell.robot.stiffness_spread = non_negative(r.at("stiffness_spread_pct")) / 100.0;
-  c.cell.robot.coupling_23 = r.at("coupling_23").as_double();
-  if (std::abs(c.cell.robot.coupling_23) >= 0.9) r.at("coupling_23").fail("must be within +-0.9");
-  c.cell.robot.forearm_ei_nm2 = non_negative(r.at("forearm_EI_Nm2"));
-  c.cell.robot.forearm_length_m = positive(r.at("forearm_length_mm")) * kMm;
+  auto& t = c.cell.robot;
+  t.upper_arm_ei_nm2 = non_negative_or(r, "upper_arm_EI_Nm2", 0.0);
+  t.base_tilt_compliance_rad_per_nm = non_negative_or(r, "base_tilt_compliance_nrad_per_Nm", 0.0) * 1e-9;
+  t.speed_stiffening =
+      case_number(r, "speed_stiffening_pct", non_negative, 0.0, from_pct, at_most(0.5, "must be within 0..50 %"));
+  t.direction_asymmetry =
+      case_number(r, "direction_asymmetry_pct", non_negative, 0.0, from_pct, at_most(0.5, "must be within 0..50 %"));
+  t.speed_ref_rad_s =
+      case_number(r, "speed_ref_mrad_s", non_negative, 10.0, from_milli, above(0.0, "must be positive"));
+  t.servo_following_s =
+      case_number(r, "servo_following_ms", non_negative, 0.0, from_milli, at_most(0.1, "must be within 0..100 ms"));
+  t.servo_compliance_fraction =
+      case_number(r, "servo_compliance_pct", non_negative, 0.0, from_pct, at_most(1.0, "must be within 0..100 %"));
+  t.servo_integral_s = case_number(r, "servo_integral_s", non_negative, 0.1, unscaled, above(0.0, "must be positive"));
+  t.stiffness_scale = positive(r.at("stiffness_scale"));
+  t.stiffness_spread = non_negative(r.at("stiffness_spread_pct")) / 100.0;
+  t.coupling_23 = case_number(r, "coupling_23", any_sign, kRequired, unscaled, inside(0.9, "must be within +-0.9"));
+  t.forearm_ei_nm2 = non_negative(r.at("forearm_EI_Nm2"));
+  t.forearm_length_m = positive(r.at("forearm_length_mm")) * kMm;
   // Per-joint lists: one entry a joint of the built-in arm (a shorter list would silently leave the
   // last joints without the effect, a longer one would be silently cut).
   const std::size_t per_joint = c.cell.robot_file.empty() ? 6 : 0;
-  c.cell.robot.lost_motion_rad = r.at("lost_motion_urad").as_doubles(per_joint);
-  for (double& v : c.cell.robot.lost_motion_rad) {
+  t.lost_motion_rad = r.at("lost_motion_urad").as_doubles(per_joint);
+  for (double& v : t.lost_motion_rad) {
     if (v < 0) r.at("lost_motion_urad").fail("must not be negative");
     v *= kUm;
   }
-  c.cell.robot.lost_motion_torque_nm = r.at("lost_motion_torque_Nm").as_doubles(c.cell.robot.lost_motion_rad.size());
-  for (double v : c.cell.robot.lost_motion_torque_nm) {
+  t.lost_motion_torque_nm = r.at("lost_motion_torque_Nm").as_doubles(t.lost_motion_rad.size());
+  for (double v : t.lost_motion_torque_nm) {
     if (!(v > 0)) r.at("lost_motion_torque_Nm").fail("must be positive");
   }
-  if (r.has("gravity_torque_Nm")) {
-    c.cell.robot.gravity_torque_nm = r.at("gravity_torque_Nm").as_doubles(c.cell.robot.lost_motion_rad.size());
-  }
-  c.cell.robot.dh_length_sigma_m = non_negative(r.at("dh_length_sigma_mm")) * kMm;
-  c.cell.robot.dh_angle_sigma_rad = deg_to_rad(non_negative(r.at("dh_angle_sigma_deg")));
+  if (r.has("gravity_torque_Nm")) t.gravity_torque_nm = r.at("gravity_torque_Nm").as_doubles(t.lost_motion_rad.size());
+  t.dh_length_sigma_m = non_negative(r.at("dh_length_sigma_mm")) * kMm;
+  t.dh_angle_sigma_rad = deg_to_rad(non_negative(r.at("dh_angle_sigma_deg")));
   if (r.has("hardening_softening") || r.has("hardening_torque_Nm")) {
-    c.cell.robot.hardening_softening = r.at("hardening_softening").as_doubles(per_joint);
-    for (double v : c.cell.robot.hardening_softening) {
+    t.hardening_softening = r.at("hardening_softening").as_doubles(per_joint);
+    for (double v : t.hardening_softening) {
       if (!(v >= 0.0 && v <= 5.0)) r.at("hardening_softening").fail("must be within 0..5");
     }
-    c.cell.robot.hardening_torque_nm = r.at("hardening_torque_Nm").as_doubles(c.cell.robot.hardening_softening.size());
-    for (double v : c.cell.robot.hardening_torque_nm) {
+    t.hardening_torque_nm = r.at("hardening_torque_Nm").as_doubles(t.hardening_softening.size());
+    for (double v : t.hardening_torque_nm) {
       if (!(v > 0)) r.at("hardening_torque_Nm").fail("must be positive");
     }
   }
+}
 
+// The case file's "tool" and "sensor": the end effector and the force sensor it is mounted on.
+void read_case_tool_and_sensor(const yaml::Field& root, CaseConfig& c) {
   const auto t = root.at("tool");
   t.only_keys({"ee_length_mm", "ee_mass_kg", "ee_cog_mm"});
   c.cell.tool.ee_length_m = positive(t.at("ee_length_mm")) * kMm;
@@ -256,61 +305,67 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
                "rotational_compliance_urad_per_Nm", "crosstalk_pct", "crosstalk_calibration_residual_pct", "noise_N",
                "bias_N", "rate_Hz", "gravity_mass_error_pct", "sensitivity_error_pct", "misalignment_deg",
                "daq_latency_ms", "zero_drift_N_per_10min"});
-  c.cell.sensor.zero_drift_n = non_negative_or(s, "zero_drift_N_per_10min", 0.0);
-  if (c.cell.sensor.zero_drift_n > 50.0) s.at("zero_drift_N_per_10min").fail("must be within 0..50 N");
-  c.cell.sensor.height_m = non_negative(s.at("height_mm")) * kMm;
-  c.cell.sensor.lateral_compliance_m_per_n = non_negative(s.at("lateral_compliance_um_per_N")) * kUm;
-  c.cell.sensor.axial_compliance_m_per_n = non_negative(s.at("axial_compliance_um_per_N")) * kUm;
-  c.cell.sensor.rotational_compliance_rad_per_nm = non_negative(s.at("rotational_compliance_urad_per_Nm")) * kUm;
-  c.cell.sensor.crosstalk = non_negative(s.at("crosstalk_pct")) / 100.0;
-  c.cell.sensor.crosstalk_calibration_residual = non_negative(s.at("crosstalk_calibration_residual_pct")) / 100.0;
-  c.cell.sensor.noise_n = non_negative(s.at("noise_N"));
-  c.cell.sensor.bias_n = s.at("bias_N").as_vector3();
-  c.cell.sensor.rate_hz = positive(s.at("rate_Hz"));
+  auto& f = c.cell.sensor;
+  f.zero_drift_n =
+      case_number(s, "zero_drift_N_per_10min", non_negative, 0.0, unscaled, at_most(50.0, "must be within 0..50 N"));
+  f.height_m = non_negative(s.at("height_mm")) * kMm;
+  f.lateral_compliance_m_per_n = non_negative(s.at("lateral_compliance_um_per_N")) * kUm;
+  f.axial_compliance_m_per_n = non_negative(s.at("axial_compliance_um_per_N")) * kUm;
+  f.rotational_compliance_rad_per_nm = non_negative(s.at("rotational_compliance_urad_per_Nm")) * kUm;
+  f.crosstalk = non_negative(s.at("crosstalk_pct")) / 100.0;
+  f.crosstalk_calibration_residual = non_negative(s.at("crosstalk_calibration_residual_pct")) / 100.0;
+  f.noise_n = non_negative(s.at("noise_N"));
+  f.bias_n = s.at("bias_N").as_vector3();
   // The cell simulates every sample: beyond 10 kHz a study takes minutes and gigabytes.
-  if (c.cell.sensor.rate_hz > 10000.0) s.at("rate_Hz").fail("must be at most 10000 Hz (the simulated cell computes every sample)");
-  c.cell.sensor.gravity_mass_error = s.at("gravity_mass_error_pct").as_double() / 100.0;
-  c.cell.sensor.sensitivity_error = s.get("sensitivity_error_pct", 0.0) / 100.0;
-  if (!(c.cell.sensor.sensitivity_error >= 0.0 && c.cell.sensor.sensitivity_error < 0.2))
-    s.at("sensitivity_error_pct").fail("must be within 0..20 %");
-  c.cell.sensor.misalignment_rad = deg_to_rad(s.get("misalignment_deg", 0.0));
-  c.cell.sensor.daq_latency_s = s.get("daq_latency_ms", 0.5) * kMm;
-  if (!(c.cell.sensor.daq_latency_s >= 0.0 && c.cell.sensor.daq_latency_s <= 0.05))
-    s.at("daq_latency_ms").fail("must be within 0..50 ms");
-  if (!(std::abs(c.cell.sensor.misalignment_rad) < deg_to_rad(10.0)))
-    s.at("misalignment_deg").fail("must be within +-10 deg");
+  f.rate_hz = case_number(s, "rate_Hz", positive, kRequired, unscaled,
+                          at_most(10000.0, "must be at most 10000 Hz (the simulated cell computes every sample)"));
+  f.gravity_mass_error = s.at("gravity_mass_error_pct").as_double() / 100.0;
+  f.sensitivity_error = case_number(s, "sensitivity_error_pct", any_sign, 0.0, from_pct,
+                                    {.lo = 0.0, .hi = 0.2, .hi_open = true, .message = "must be within 0..20 %"});
+  f.misalignment_rad = case_number(s, "misalignment_deg", any_sign, 0.0, from_deg);
+  f.daq_latency_s =
+      case_number(s, "daq_latency_ms", any_sign, 0.5, from_milli, within(0.0, 0.05, "must be within 0..50 ms"));
+  case_checked(s, "misalignment_deg", f.misalignment_rad, inside(deg_to_rad(10.0), "must be within +-10 deg"));
+}
 
+// The case file's "ldbb": the loading device (bar, pneumatic force and its errors).
+void read_case_ldbb(const yaml::Field& root, CaseConfig& c) {
   const auto l = root.at("ldbb");
   l.only_keys({"bar_length_mm", "inclination_deg", "push", "time_constant_s", "ripple_pct", "ripple_Hz", "noise_pct",
                "force_bias_pct", "force_bias_recalibrated_pct", "pivot_error_mm", "ball_friction", "ball_radius_mm",
                "settle_s", "stick_slip_pct", "stick_slip_travel_mm"});
-  c.cell.ldbb.force_bias_recalibrated = l.get("force_bias_recalibrated_pct", 0.0) / 100.0;
-  if (std::abs(c.cell.ldbb.force_bias_recalibrated) >= 0.5) l.at("force_bias_recalibrated_pct").fail("must be within +-50 %");
-  c.cell.ldbb.stick_slip = non_negative_or(l, "stick_slip_pct", 0.0) / 100.0;
-  if (c.cell.ldbb.stick_slip > 0.2) l.at("stick_slip_pct").fail("must be within 0..20 %");
-  c.cell.ldbb.stick_slip_travel_m = non_negative_or(l, "stick_slip_travel_mm", 0.5) * kMm;
-  if (!(c.cell.ldbb.stick_slip_travel_m > 0.0)) l.at("stick_slip_travel_mm").fail("must be positive");
-  c.cell.ldbb.bar_length_m = positive(l.at("bar_length_mm")) * kMm;
-  c.cell.ldbb.inclination_rad = deg_to_rad(l.at("inclination_deg").as_double());
-  if (std::abs(c.cell.ldbb.inclination_rad) >= deg_to_rad(89.0)) l.at("inclination_deg").fail("must be within +-89 deg");
-  c.cell.ldbb.push = l.at("push").as_bool();
-  c.cell.ldbb.time_constant_s = positive(l.at("time_constant_s"));
-  c.cell.ldbb.ripple = non_negative(l.at("ripple_pct")) / 100.0;
-  c.cell.ldbb.ripple_hz = positive(l.at("ripple_Hz"));
-  c.cell.ldbb.noise = non_negative(l.at("noise_pct")) / 100.0;
-  c.cell.ldbb.force_bias = l.at("force_bias_pct").as_double() / 100.0;
-  if (std::abs(c.cell.ldbb.force_bias) >= 0.5) l.at("force_bias_pct").fail("must be within +-50 %");
-  c.cell.ldbb.pivot_error_m = l.at("pivot_error_mm").as_vector3() * kMm;
-  c.cell.ldbb.ball_friction = non_negative(l.at("ball_friction"));
-  c.cell.ldbb.ball_radius_m = non_negative(l.at("ball_radius_mm")) * kMm;
-  c.cell.ldbb.settle_s = non_negative(l.at("settle_s"));
+  auto& d = c.cell.ldbb;
+  d.force_bias_recalibrated =
+      case_number(l, "force_bias_recalibrated_pct", any_sign, 0.0, from_pct, inside(0.5, "must be within +-50 %"));
+  d.stick_slip = case_number(l, "stick_slip_pct", non_negative, 0.0, from_pct, at_most(0.2, "must be within 0..20 %"));
+  d.stick_slip_travel_m =
+      case_number(l, "stick_slip_travel_mm", non_negative, 0.5, from_milli, above(0.0, "must be positive"));
+  d.bar_length_m = positive(l.at("bar_length_mm")) * kMm;
+  d.inclination_rad =
+      case_number(l, "inclination_deg", any_sign, kRequired, from_deg,
+                  inside(deg_to_rad(89.0), "must be within +-89 deg"));
+  d.push = l.at("push").as_bool();
+  d.time_constant_s = positive(l.at("time_constant_s"));
+  d.ripple = non_negative(l.at("ripple_pct")) / 100.0;
+  d.ripple_hz = positive(l.at("ripple_Hz"));
+  d.noise = non_negative(l.at("noise_pct")) / 100.0;
+  d.force_bias = case_number(l, "force_bias_pct", any_sign, kRequired, from_pct, inside(0.5, "must be within +-50 %"));
+  d.pivot_error_m = l.at("pivot_error_mm").as_vector3() * kMm;
+  d.ball_friction = non_negative(l.at("ball_friction"));
+  d.ball_radius_m = non_negative(l.at("ball_radius_mm")) * kMm;
+  d.settle_s = non_negative(l.at("settle_s"));
+}
 
+// The case file's "tracker" and "controller": the laser tracker, and the robot controller's servo,
+// network and EGM settings (each setting checked once all are read).
+void read_case_tracker_and_controller(const yaml::Field& root, CaseConfig& c) {
   const auto tr = root.at("tracker");
   tr.only_keys({"noise_um", "rate_Hz"});
   c.cell.tracker.noise_m = non_negative(tr.at("noise_um")) * kUm;
-  c.cell.tracker.rate_hz = positive(tr.at("rate_Hz"));
   // The cell simulates every sample: beyond 10 kHz a study takes minutes and gigabytes.
-  if (c.cell.tracker.rate_hz > 10000.0) tr.at("rate_Hz").fail("must be at most 10000 Hz (the simulated cell computes every sample)");
+  c.cell.tracker.rate_hz =
+      case_number(tr, "rate_Hz", positive, kRequired, unscaled,
+                  at_most(10000.0, "must be at most 10000 Hz (the simulated cell computes every sample)"));
 
   const auto ct = root.at("controller");
   ct.only_keys({"servo_period_ms", "network_latency_ms", "egm_period_ms", "egm_dead_time_ms", "egm_lowpass_Hz",
@@ -330,72 +385,75 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   k.path_corr_frame = ct.at("path_corr_frame").as_string();
   if (k.path_corr_frame != "tool" && k.path_corr_frame != "flange" && k.path_corr_frame != "path")
     ct.at("path_corr_frame").fail("must be tool, flange or path");
-  if (k.servo_period_s > 0.05) ct.at("servo_period_ms").fail("must be at most 50 ms");
+  case_checked(ct, "servo_period_ms", k.servo_period_s, at_most(0.05, "must be at most 50 ms"));
   if (k.egm_period_s < k.servo_period_s) ct.at("egm_period_ms").fail("must not be shorter than the servo period");
   if (k.network_latency_s > 0.5 * k.servo_period_s)
     ct.at("network_latency_ms").fail("must be under half a servo period (the cell's network is local)");
-  if (k.egm_dead_time_s > 1.0) ct.at("egm_dead_time_ms").fail("must be at most 1000 ms");
-  if (k.path_corr_dead_time_s > 1.0) ct.at("path_corr_dead_time_ms").fail("must be at most 1000 ms");
+  case_checked(ct, "egm_dead_time_ms", k.egm_dead_time_s, at_most(1.0, "must be at most 1000 ms"));
+  case_checked(ct, "path_corr_dead_time_ms", k.path_corr_dead_time_s, at_most(1.0, "must be at most 1000 ms"));
+}
 
+// The case file's "online": the online strategies' filter, limits and streaming.
+void read_case_online(const yaml::Field& root, CaseConfig& c) {
   const auto on = root.at("online");
   on.only_keys({"lowpass_Hz", "dead_band_N", "fault_threshold_N", "max_joint_correction_mrad", "max_tcp_correction_mm",
                 "max_rate_mrad_s", "max_tcp_rate_mm_s", "watchdog_ms", "ramp_in_s", "stream_period_ms",
                 "stream_buffer_depth"});
-  c.online.stream_period_s = on.get("stream_period_ms", 100.0) * 1e-3;
-  if (!(c.online.stream_period_s >= 0.02 && c.online.stream_period_s <= 1.0))
-    on.at("stream_period_ms").fail("must be 20..1000 ms");
-  c.online.stream_buffer_depth = on.get("stream_buffer_depth", 2);
-  if (c.online.stream_buffer_depth < 1 || c.online.stream_buffer_depth > 3)
-    on.at("stream_buffer_depth").fail("must be 1..3 (the streaming server holds 4 points)");
-  c.online.lowpass_hz = positive(on.at("lowpass_Hz"));
-  c.online.dead_band_n = non_negative(on.at("dead_band_N"));
-  c.online.fault_threshold_n = positive(on.at("fault_threshold_N"));
-  c.online.max_joint_correction_rad = positive(on.at("max_joint_correction_mrad")) * kMm;
-  c.online.max_tcp_correction_m = positive(on.at("max_tcp_correction_mm")) * kMm;
-  c.online.max_rate_rad_s = positive(on.at("max_rate_mrad_s")) * kMm;
-  c.online.max_tcp_rate_m_s = on.has("max_tcp_rate_mm_s") ? positive(on.at("max_tcp_rate_mm_s")) * kMm : 0.005;
-  c.online.watchdog_s = positive(on.at("watchdog_ms")) * kMm;
-  c.online.ramp_in_s = non_negative(on.at("ramp_in_s"));
+  auto& o = c.online;
+  o.stream_period_s =
+      case_number(on, "stream_period_ms", any_sign, 100.0, from_milli, within(0.02, 1.0, "must be 20..1000 ms"));
+  o.stream_buffer_depth =
+      case_whole(on, "stream_buffer_depth", 2, 1, 3, "must be 1..3 (the streaming server holds 4 points)");
+  o.lowpass_hz = positive(on.at("lowpass_Hz"));
+  o.dead_band_n = non_negative(on.at("dead_band_N"));
+  o.fault_threshold_n = positive(on.at("fault_threshold_N"));
+  o.max_joint_correction_rad = positive(on.at("max_joint_correction_mrad")) * kMm;
+  o.max_tcp_correction_m = positive(on.at("max_tcp_correction_mm")) * kMm;
+  o.max_rate_rad_s = positive(on.at("max_rate_mrad_s")) * kMm;
+  o.max_tcp_rate_m_s = on.has("max_tcp_rate_mm_s") ? positive(on.at("max_tcp_rate_mm_s")) * kMm : 0.005;
+  o.watchdog_s = positive(on.at("watchdog_ms")) * kMm;
+  o.ramp_in_s = non_negative(on.at("ramp_in_s"));
+}
 
+// The case file's "calibration": the moving calibration run that identifies the stiffness.
+void read_case_calibration(const yaml::Field& root, CaseConfig& c) {
   const auto cal = root.at("calibration");
   cal.only_keys({"arcs", "arc_deg", "speed_mm_s", "load_N", "points_per_arc", "window_ms", "ldbb_force_error_pct",
                  "ldbb_force_bias_pct", "force_from"});
-  c.calibration.ldbb_force_bias = cal.get("ldbb_force_bias_pct", 0.0) / 100.0;
-  if (!std::isfinite(c.calibration.ldbb_force_bias) || std::abs(c.calibration.ldbb_force_bias) >= 0.5)
-    cal.at("ldbb_force_bias_pct").fail("must be within +-50 %");
+  auto& b = c.calibration;
+  b.ldbb_force_bias =
+      case_number(cal, "ldbb_force_bias_pct", any_sign, 0.0, from_pct, inside(0.5, "must be within +-50 %"));
   const std::string force_from = cal.get("force_from", std::string("sensor"));
   if (force_from != "sensor" && force_from != "ldbb") cal.at("force_from").fail("must be sensor or ldbb");
-  c.calibration.force_from_sensor = force_from == "sensor";
-  c.calibration.arcs = cal.at("arcs").as_int();
-  if (c.calibration.arcs < 3 || c.calibration.arcs > 60) cal.at("arcs").fail("must be 3..60");
-  c.calibration.arc_rad = deg_to_rad(positive(cal.at("arc_deg")));
-  if (c.calibration.arc_rad > 2.0 * kPi) cal.at("arc_deg").fail("must be at most 360 deg");
-  c.calibration.speed_m_s = positive(cal.at("speed_mm_s")) * kMm;
-  if (c.calibration.speed_m_s > 0.5) cal.at("speed_mm_s").fail("must be at most 500 mm/s (quasi-static)");
-  c.calibration.load_n = positive(cal.at("load_N"));
-  if (c.calibration.load_n > 5000.0) cal.at("load_N").fail("must be at most 5000 N");
-  c.calibration.points_per_arc = cal.at("points_per_arc").as_int();
-  if (c.calibration.points_per_arc < 2 || c.calibration.points_per_arc > 1000)
-    cal.at("points_per_arc").fail("must be 2..1000");
-  c.calibration.window_s = positive(cal.at("window_ms")) * kMm;
-  c.calibration.ldbb_force_error = non_negative(cal.at("ldbb_force_error_pct")) / 100.0;
-  if (c.calibration.ldbb_force_error > 0.5) cal.at("ldbb_force_error_pct").fail("must be within 0..50 %");
+  b.force_from_sensor = force_from == "sensor";
+  b.arcs = case_whole(cal, "arcs", kRequired, 3, 60, "must be 3..60");
+  b.arc_rad = case_number(cal, "arc_deg", positive, kRequired, from_deg, at_most(2.0 * kPi, "must be at most 360 deg"));
+  b.speed_m_s = case_number(cal, "speed_mm_s", positive, kRequired, from_milli,
+                            at_most(0.5, "must be at most 500 mm/s (quasi-static)"));
+  b.load_n = case_number(cal, "load_N", positive, kRequired, unscaled, at_most(5000.0, "must be at most 5000 N"));
+  b.points_per_arc = case_whole(cal, "points_per_arc", kRequired, 2, 1000, "must be 2..1000");
+  b.window_s = positive(cal.at("window_ms")) * kMm;
+  b.ldbb_force_error =
+      case_number(cal, "ldbb_force_error_pct", non_negative, kRequired, from_pct,
+                  at_most(0.5, "must be within 0..50 %"));
+}
 
+// The case file's optional "drift" (of the path between and during runs) and "error_budget".
+void read_case_drift_and_budget(const yaml::Field& root, CaseConfig& c) {
   if (root.has("drift")) {
     const auto d = root.at("drift");
     d.only_keys({"offset_um", "offset_time_s", "rotation_urad", "wander_um", "wander_time_s", "load_offset_um",
                  "load_reference_N"});
-    c.cell.drift.load_offset_m = non_negative_or(d, "load_offset_um", 0.0) * kUm;
-    c.cell.drift.load_reference_n = non_negative_or(d, "load_reference_N", 650.0);
-    if (!(c.cell.drift.load_reference_n > 0.0)) d.at("load_reference_N").fail("must be positive");
-    c.cell.drift.offset_time_s = d.get("offset_time_s", 1200.0);
-    if (!(c.cell.drift.offset_time_s > 0.0)) d.at("offset_time_s").fail("must be positive");
-    c.cell.drift.offset_m = non_negative(d.at("offset_um")) * kUm;
-    c.cell.drift.rotation_rad = non_negative(d.at("rotation_urad")) * kUm;
-    c.cell.drift.wander_m = non_negative(d.at("wander_um")) * kUm;
-    c.cell.drift.wander_time_s = positive(d.at("wander_time_s"));
+    auto& w = c.cell.drift;
+    w.load_offset_m = non_negative_or(d, "load_offset_um", 0.0) * kUm;
+    w.load_reference_n =
+        case_number(d, "load_reference_N", non_negative, 650.0, unscaled, above(0.0, "must be positive"));
+    w.offset_time_s = case_number(d, "offset_time_s", any_sign, 1200.0, unscaled, above(0.0, "must be positive"));
+    w.offset_m = non_negative(d.at("offset_um")) * kUm;
+    w.rotation_rad = non_negative(d.at("rotation_urad")) * kUm;
+    w.wander_m = non_negative(d.at("wander_um")) * kUm;
+    w.wander_time_s = positive(d.at("wander_time_s"));
   }
-
   if (root.has("error_budget")) {
     const auto b = root.at("error_budget");
     b.only_keys({"speed_mm_s", "load_index"});
@@ -407,6 +465,31 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
       }
     }
   }
+}
+
+}  // namespace
+
+CaseConfig load_case_text(const std::string& text, const std::string& source) {
+  const yaml::Field root = yaml::Field::load_string(text, source);
+  root.only_keys({"deflex_case", "name", "robot", "seed", "circle", "protocol", "setups", "true_robot", "tool",
+                  "sensor", "ldbb", "tracker", "controller", "online", "calibration", "drift", "error_budget"});
+  case_whole(root, "deflex_case", kRequired, 1, 1, "unsupported version (expected 1)");
+  CaseConfig c;
+  c.source = source;
+  c.name = root.get("name", std::string("case"));
+  c.cell.robot_file = root.get("robot", std::string());
+  const int seed = case_whole(root, "seed", 1, 0, std::numeric_limits<int>::max(), "must not be negative");
+  c.seed = static_cast<std::uint64_t>(seed);
+  read_case_circle(root, c);
+  const yaml::Field proto = read_case_protocol(root, c);
+  read_case_setups(root, proto, c);
+  read_case_true_robot(root, c);
+  read_case_tool_and_sensor(root, c);
+  read_case_ldbb(root, c);
+  read_case_tracker_and_controller(root, c);
+  read_case_online(root, c);
+  read_case_calibration(root, c);
+  read_case_drift_and_budget(root, c);
   return c;
 }
 
@@ -551,32 +634,68 @@ std::string effect_size(const CaseConfig& c, Effect e) {
   return "";
 }
 
-CaseConfig without_effect(const CaseConfig& config, Effect e) {
-  CaseConfig c = config;
+namespace {
+
+// Switches off `e` in `c` when it is one of the true arm's own effects; false for any other effect.
+bool clear_arm_effect(CaseConfig& c, Effect e) {
+  auto& r = c.cell.robot;
   switch (e) {
     case Effect::kStiffnessMismatch:
       // The overall scale is the robot itself (identification finds it); the per-joint spread is
       // what makes the true ratios between joints differ from the assumed ones.
-      c.cell.robot.stiffness_spread = 0.0;
-      break;
+      r.stiffness_spread = 0.0;
+      return true;
     case Effect::kJointCoupling:
-      c.cell.robot.coupling_23 = 0.0;
-      break;
+      r.coupling_23 = 0.0;
+      return true;
     case Effect::kLinkBending:
-      c.cell.robot.forearm_ei_nm2 = 0.0;
-      c.cell.robot.upper_arm_ei_nm2 = 0.0;
+      r.forearm_ei_nm2 = 0.0;
+      r.upper_arm_ei_nm2 = 0.0;
+      return true;
+    case Effect::kLostMotion:
+      for (double& v : r.lost_motion_rad) v = 0.0;
+      return true;
+    case Effect::kKinematicErrors:
+      r.dh_length_sigma_m = 0.0;
+      r.dh_angle_sigma_rad = 0.0;
+      return true;
+    case Effect::kGearHardening:
+      for (double& v : r.hardening_softening) v = 0.0;
+      return true;
+    case Effect::kBaseCompliance:
+      r.base_tilt_compliance_rad_per_nm = 0.0;
+      return true;
+    case Effect::kMotionStiffness:
+      r.speed_stiffening = 0.0;
+      r.direction_asymmetry = 0.0;
+      return true;
+    case Effect::kServo:
+      r.servo_following_s = 0.0;
+      r.servo_compliance_fraction = 0.0;
+      return true;
+    default:
+      return false;
+  }
+}
+
+// Switches off `e` in `c` when it belongs to the rest of the cell (sensor, LDBB, tracker,
+// controller, calibration, drift); the arm's own effects are clear_arm_effect's.
+void clear_cell_effect(CaseConfig& c, Effect e) {
+  switch (e) {
+    case Effect::kStiffnessMismatch:
+    case Effect::kJointCoupling:
+    case Effect::kLinkBending:
+    case Effect::kLostMotion:
+    case Effect::kKinematicErrors:
+    case Effect::kGearHardening:
+    case Effect::kBaseCompliance:
+    case Effect::kMotionStiffness:
+    case Effect::kServo:
       break;
     case Effect::kSensorCompliance:
       c.cell.sensor.lateral_compliance_m_per_n = 0.0;
       c.cell.sensor.axial_compliance_m_per_n = 0.0;
       c.cell.sensor.rotational_compliance_rad_per_nm = 0.0;
-      break;
-    case Effect::kLostMotion:
-      for (double& v : c.cell.robot.lost_motion_rad) v = 0.0;
-      break;
-    case Effect::kKinematicErrors:
-      c.cell.robot.dh_length_sigma_m = 0.0;
-      c.cell.robot.dh_angle_sigma_rad = 0.0;
       break;
     case Effect::kLdbbForceError:
       c.cell.ldbb.force_bias = 0.0;
@@ -615,23 +734,9 @@ CaseConfig without_effect(const CaseConfig& config, Effect e) {
       c.cell.drift.rotation_rad = 0.0;
       c.cell.drift.wander_m = 0.0;
       break;
-    case Effect::kGearHardening:
-      for (double& v : c.cell.robot.hardening_softening) v = 0.0;
-      break;
     case Effect::kSensorCalibration:
       c.cell.sensor.sensitivity_error = 0.0;
       c.cell.sensor.misalignment_rad = 0.0;
-      break;
-    case Effect::kBaseCompliance:
-      c.cell.robot.base_tilt_compliance_rad_per_nm = 0.0;
-      break;
-    case Effect::kMotionStiffness:
-      c.cell.robot.speed_stiffening = 0.0;
-      c.cell.robot.direction_asymmetry = 0.0;
-      break;
-    case Effect::kServo:
-      c.cell.robot.servo_following_s = 0.0;
-      c.cell.robot.servo_compliance_fraction = 0.0;
       break;
     case Effect::kSensorDrift:
       c.cell.sensor.zero_drift_n = 0.0;
@@ -643,6 +748,13 @@ CaseConfig without_effect(const CaseConfig& config, Effect e) {
       c.cell.ldbb.stick_slip = 0.0;
       break;
   }
+}
+
+}  // namespace
+
+CaseConfig without_effect(const CaseConfig& config, Effect e) {
+  CaseConfig c = config;
+  if (!clear_arm_effect(c, e)) clear_cell_effect(c, e);
   return c;
 }
 
