@@ -215,13 +215,17 @@ std::pair<int, int> best_candidate_load(const std::vector<CandidatePose>& poses,
   const auto block_of = [&](const ScoredLoad& it) -> const auto& {
     return poses[static_cast<std::size_t>(it.pose)].loads[static_cast<std::size_t>(it.load)].block;
   };
-  // Mirror-image loads score the same up to round-off: keep the first, so plans do not depend
-  // on the compiler's rounding.
+  // Mirror-image loads score the same up to round-off: of scores within 1e-9 of each other the
+  // candidate first in the candidate list wins, whichever order they were scored in, so plans do not
+  // depend on the compiler's rounding (which reorders the bounds of a mirror pair).
   int best_p = -1, best_l = -1;
   double best = -std::numeric_limits<double>::infinity();
   auto consider = [&](const ScoredLoad& it, double score) {
-    if (best_p < 0 || score > best + 1e-9 * std::abs(best)) {
-      best = score;
+    const double tol = 1e-9 * std::abs(best);
+    const bool better = best_p < 0 || score > best + tol;
+    const bool tie_earlier = !better && score >= best - tol && std::pair(it.pose, it.load) < std::pair(best_p, best_l);
+    if (better || tie_earlier) {
+      best = better ? score : std::max(best, score);
       best_p = it.pose;
       best_l = it.load;
     }
@@ -230,8 +234,8 @@ std::pair<int, int> best_candidate_load(const std::vector<CandidatePose>& poses,
   std::stable_sort(by_bound.begin(), by_bound.end(),
                    [](const ScoredLoad& x, const ScoredLoad& y) { return x.bound > y.bound; });
   for (const ScoredLoad& it : by_bound) {
-    if (best_p >= 0 && it.bound <= best) {
-      break;  // no remaining candidate can beat the best
+    if (best_p >= 0 && it.bound < best - 1e-9 * std::abs(best)) {
+      break;  // no remaining candidate can beat or tie the best
     }
     const auto& B = block_of(it);
     consider(it, min_eigenvalue(G0 + B.transpose() * B));
