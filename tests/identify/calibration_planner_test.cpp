@@ -19,6 +19,7 @@
 #include "deflex/text/errors.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/model/linear_algebra.hpp"
 
 namespace deflex {
 namespace {
@@ -51,7 +52,7 @@ double min_singular_value(const RobotModel& model, const std::vector<std::pair<J
       A.block(3 * static_cast<Eigen::Index>(i), j, 3, 1) = Jt.col(j).head<3>() * tau * model.compliance()[j];
     }
   }
-  return Eigen::JacobiSVD<Eigen::MatrixXd>(A).singularValues().minCoeff();
+  return singular_values(A).minCoeff();
 }
 
 TEST(CalibrationPlanner, PosesAreReachableInTheRegionAndLoadsAreWhatTheRowsSay) {

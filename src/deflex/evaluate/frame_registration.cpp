@@ -10,6 +10,7 @@
 
 #include "deflex/text/errors.hpp"
 #include "deflex/text/yaml_fields.hpp"
+#include "deflex/model/linear_algebra.hpp"
 
 namespace deflex {
 namespace {
@@ -141,7 +142,7 @@ FrameRegistration register_frames(const RegistrationInput& in) {
     spread.col(static_cast<Eigen::Index>(a.size() + k)) = std::sqrt(w) * in.tracker_circles[k].axis;
   }
   // The rotation is fixed only if the features span at least two directions.
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(spread);
+  const DynamicSvd svd(spread);
   const auto sv = svd.singularValues();
   if (sv.size() < 2 || !(sv[1] > 1e-3 * sv[0])) {
     throw InputError(

@@ -15,6 +15,7 @@
 #include "deflex/identify/detail/nonnegative_least_squares.hpp"
 #include "deflex/identify/detail/spill_file.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/model/linear_algebra.hpp"
 
 namespace deflex {
 
@@ -232,10 +233,10 @@ Triangular blocked_qr(const RowStore& s, const std::vector<int>& cols, const Eig
 }
 
 // Singular values (descending) and right singular vectors of the scaled, weighted columns `cols`.
-Eigen::JacobiSVD<Eigen::MatrixXd> svd_of(const RowStore& s, const std::vector<int>& cols, const Eigen::VectorXd& scale,
+DynamicSvd svd_of(const RowStore& s, const std::vector<int>& cols, const Eigen::VectorXd& scale,
                                          const std::vector<double>& omega) {
   const Triangular t = blocked_qr(s, cols, scale, omega);
-  return Eigen::JacobiSVD<Eigen::MatrixXd>(t.R.topRows(t.rows), Eigen::ComputeFullV);
+  return DynamicSvd(t.R.topRows(t.rows), Eigen::ComputeFullV);
 }
 
 // The estimate before anything is known: every joint's values NaN, the measurement count set.

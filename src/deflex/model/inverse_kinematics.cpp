@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "deflex/model/opw_ik.hpp"
+#include "deflex/model/linear_algebra.hpp"
 
 namespace deflex {
 namespace {
@@ -227,8 +228,7 @@ KukaConfiguration kuka_configuration(const RobotModel& model, Workspace& ws, con
 double jacobian_min_singular_value(const RobotModel& model, Workspace& ws, const JointVector& q) {
   Jacobian J;
   jacobian(model, ws, q, EndPoint::kTcp, J);
-  Eigen::JacobiSVD<Jacobian> svd(J);
-  return svd.singularValues().minCoeff();
+  return singular_values(J).minCoeff();
 }
 
 namespace {

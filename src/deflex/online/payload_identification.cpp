@@ -9,6 +9,7 @@
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/model/kinematics.hpp"
+#include "deflex/model/linear_algebra.hpp"
 
 namespace deflex {
 
@@ -27,7 +28,7 @@ struct Solved {
 };
 
 Solved solve(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const char* what) {
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  DynamicSvd svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
   const auto& s = svd.singularValues();
   Solved r;
   r.condition = s(s.size() - 1) > 0.0 ? s(0) / s(s.size() - 1) : std::numeric_limits<double>::infinity();
