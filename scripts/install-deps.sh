@@ -3,9 +3,17 @@
 # apt-get skips what is already installed. Run as root (or with sudo available).
 #   scripts/install-deps.sh           what the build and the main job need
 #   scripts/install-deps.sh --tests   and what only the tests use (headless Chromium, about 100 MB)
+#   scripts/install-deps.sh --lint    and clang-format and clang-tidy (scripts/lint.sh; CI)
 set -euo pipefail
 tests=0
-if [ "${1:-}" = "--tests" ]; then tests=1; fi
+lint=0
+for arg in "$@"; do
+  case "$arg" in
+    --tests) tests=1 ;;
+    --lint) lint=1 ;;
+    *) echo "install-deps: unknown option $arg (--tests, --lint)" >&2; exit 2 ;;
+  esac
+done
 packages=(
   build-essential cmake pkg-config
   # ninja: scripts/sanitize.sh builds with it (it compiles a module's tests while other modules build)
@@ -28,6 +36,7 @@ packages=(
 # locales: a comma-decimal locale (de_DE.UTF-8, generated below) for the test that numbers parse the same
 # whatever the process locale (it skips, saying so, where the locale is missing)
 if [ "$tests" -eq 1 ]; then packages+=(chromium python3-yaml python3-venv locales); fi
+if [ "$lint" -eq 1 ]; then packages+=(clang-format clang-tidy); fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -33,5 +33,8 @@ struct CommandRegistrar {
 #define DEFLEX_CLI_CONCAT2(a, b) a##b
 #define DEFLEX_CLI_CONCAT(a, b) DEFLEX_CLI_CONCAT2(a, b)
 /// DEFLEX_COMMAND("name", "help", setup [, order]) at namespace scope in a cmd_*.cpp file.
+/// The registrar's name is numbered by __COUNTER__, not __LINE__: in a unity build several cmd_*.cpp
+/// files share one translation unit, and two invocations on the same line would collide (clang counts
+/// a multi-line invocation's line differently from GCC, so one compiler's success proves nothing).
 #define DEFLEX_COMMAND(...) \
-  static const ::deflex::cli::CommandRegistrar DEFLEX_CLI_CONCAT(deflex_command_, __LINE__)(__VA_ARGS__)
+  static const ::deflex::cli::CommandRegistrar DEFLEX_CLI_CONCAT(deflex_command_, __COUNTER__)(__VA_ARGS__)
