@@ -124,165 +124,223 @@ TrackerRunReading make_reading(const EvaluateOpts& o) {
   return r;
 }
 
-void setup_evaluate(CLI::App& sub, int& exit_code) {
-  auto o = std::make_shared<EvaluateOpts>();
-  sub.add_option("--unloaded", o->unloaded,
+/// The options of `deflex evaluate`, in the order --help lists them.
+void add_evaluate_options(CLI::App& sub, EvaluateOpts& o) {
+  sub.add_option("--unloaded", o.unloaded,
                  "Tracker file of the unloaded path: CSV (t_s,x_mm,y_mm,z_mm or x_m...) or a Spatial Analyzer ASCII "
                  "export; repeat the option for several laps/runs")
       ->required();
-  sub.add_option("--loaded", o->loaded,
+  sub.add_option("--loaded", o.loaded,
                  "Tracker file of the loaded path (uncompensated or compensated); repeat for several laps/runs "
                  "(each file is one run for ISO 9283 repeatability)")
       ->required();
-  sub.add_option("--commanded", o->commanded,
+  sub.add_option("--commanded", o.commanded,
                  "CSV of the commanded path (t_s,x_mm,y_mm,z_mm, base frame; t_s may be 0): ISO 9283 accuracy is then "
                  "taken against it instead of the first unloaded run");
-  sub.add_option("--tracker-frame", o->tracker_frame,
+  sub.add_option("--tracker-frame", o.tracker_frame,
                  "Frame file from deflex register: the tracker files are in the tracker's frame and are moved into "
                  "the robot's base frame with it");
-  sub.add_option("--align-to", o->align_to,
+  sub.add_option("--align-to", o.align_to,
                  "The commanded trajectory with its times (a Cartesian CSV t_s,x_mm,..., a joint trajectory "
                  "t_s,q1_deg,... or deflex online's --log, the joint forms with --robot): each tracker file is put "
                  "on its clock, and the time-synchronous error is printed");
-  sub.add_option("--robot", o->robot, "Robot file for a joint trajectory or cycle log given to --align-to");
-  sub.add_option("--search-s", o->search_s,
+  sub.add_option("--robot", o.robot, "Robot file for a joint trajectory or cycle log given to --align-to");
+  sub.add_option("--search-s", o.search_s,
                  "--align-to: search offsets within this many s of 0 (default: every offset that overlaps half a run)");
-  sub.add_flag("--fit-drift", o->fit_drift, "--align-to: also fit the clocks' rate difference (ppm)");
-  sub.add_option("--clock-offset-s", o->clock_offset_s,
+  sub.add_flag("--fit-drift", o.fit_drift, "--align-to: also fit the clocks' rate difference (ppm)");
+  sub.add_option("--clock-offset-s", o.clock_offset_s,
                  "--align-to: program time minus tracker time when known from a shared trigger; the lag of each run "
                  "behind its command is then printed (without it a constant lag is part of the clock offset)");
-  add_tracker_format_options(sub, o->read);
-  sub.add_option("--evaluation-points", o->points,
+  add_tracker_format_options(sub, o.read);
+  sub.add_option("--evaluation-points", o.points,
                  "ISO 9283: planes normal to the path, 1..100000 (default 81, the paper's)");
-  sub.add_option("--max-offset-mm", o->max_offset_mm,
+  sub.add_option("--max-offset-mm", o.max_offset_mm,
                  "ISO 9283: a run crossing a plane farther than this from the path does not count there (default 10)");
-  sub.add_flag("--split-laps", o->split,
+  sub.add_flag("--split-laps", o.split,
                "Split each file of a closed path (a circle) into its laps, each lap one run (a lap ends after a "
                "full turn or where the direction reverses)");
-  sub.add_flag("--mean-reference", o->mean_reference,
+  sub.add_flag("--mean-reference", o.mean_reference,
                "Take the distances to the mean of the unloaded laps (a closed path, binned by angle about its "
                "centre), as deflex case-study does, instead of to the nearest of every unloaded sample: a dense, "
                "noisy reference biases the nearest-point distance low by its own noise");
-  sub.add_flag("--json", o->json, "Print one JSON document on stdout");
-  sub.callback([o, &exit_code] {
-    if (!(o->max_offset_mm > 0.0)) {
-      throw InputError("option --max-offset-mm: must be a positive number of mm");
+  sub.add_flag("--json", o.json, "Print one JSON document on stdout");
+}
+
+/// The tracker files of both groups as read, with the clock alignments of their runs (unloaded first).
+struct EvaluateRuns {
+  TrackerRunReading reading;
+  TrackerRuns unloaded, loaded;
+  std::vector<std::pair<std::string, TimeAlignment>> alignments;
+};
+
+/// Checks the options no file is needed for, then reads every tracker file; the readers' notes go to stderr.
+EvaluateRuns read_evaluate_runs(const EvaluateOpts& o) {
+  if (!(o.max_offset_mm > 0.0)) {
+    throw InputError("option --max-offset-mm: must be a positive number of mm");
+  }
+  if (!o.robot.empty() && o.align_to.empty()) throw InputError("option --robot: only used with --align-to");
+  EvaluateRuns r;
+  r.reading = make_reading(o);
+  r.unloaded = read_tracker_runs(o.unloaded, r.reading, "unloaded");
+  r.loaded = read_tracker_runs(o.loaded, r.reading, "loaded");
+  for (const auto* g : {&r.unloaded, &r.loaded}) {
+    for (const std::string& note : g->notes) std::cerr << "deflex evaluate: " << note << "\n";
+  }
+  r.alignments = r.unloaded.alignments;
+  r.alignments.insert(r.alignments.end(), r.loaded.alignments.begin(), r.loaded.alignments.end());
+  return r;
+}
+
+/// What evaluate prints, from the runs read.
+struct EvaluateFigures {
+  PathDeviationStats dev;       // the loaded runs' distance from the unloaded path (or its mean)
+  bool have_commanded = false;  // ISO 9283 against --commanded, else against the first unloaded run
+  std::string ref_name;
+  Iso9283Path iso_loaded, iso_unloaded;        // iso_unloaded only with --commanded
+  PathDeviationStats sync;                     // when aligned: loaded against unloaded at the same program time
+  std::vector<PathDeviationStats> to_command;  // when aligned: each file against its command, unloaded first
+};
+
+/// With --mean-reference, the mean of the unloaded laps as the one reference path; else none.
+std::vector<TrackerTrace> mean_unloaded_reference(const EvaluateOpts& o, const std::vector<TrackerTrace>& unloaded) {
+  std::vector<TrackerTrace> distance_reference;
+  if (o.mean_reference) {
+    TrackerTrace all;
+    for (const auto& t : unloaded) all.insert(all.end(), t.begin(), t.end());
+    // Bins of about two samples a lap each, at most 3600 (0.1 deg): fewer than that would leave bins
+    // empty on a sparse file (50 Hz), more would average too few laps' samples per bin.
+    const auto per_lap = static_cast<int>(all.size() / std::max<std::size_t>(1, unloaded.size()));
+    distance_reference.push_back(mean_closed_path(all, std::clamp(per_lap / 2, 36, 3600)));
+  }
+  return distance_reference;
+}
+
+/// The distance, ISO 9283 and time-synchronous figures of the runs; a note on a noisy reference goes to stderr.
+EvaluateFigures evaluate_figures(const EvaluateOpts& o, const EvaluateRuns& r) {
+  const std::vector<TrackerTrace>& unloaded = r.unloaded.runs;
+  const std::vector<TrackerTrace>& loaded = r.loaded.runs;
+  EvaluateFigures f;
+  const std::vector<TrackerTrace> distance_reference = mean_unloaded_reference(o, unloaded);
+  if (!o.mean_reference && o.split && unloaded.size() > 1) {
+    std::cerr << "deflex evaluate: note: the nearest-point distance to noisy unloaded laps is biased low by their "
+                 "noise; --mean-reference takes the distance to their mean instead (docs/evaluation.md)\n";
+  }
+  f.dev = path_deviation(loaded, o.mean_reference ? distance_reference : unloaded);
+  // ISO 9283 wants one reference path: the commanded one when given, else the first unloaded run.
+  f.have_commanded = !o.commanded.empty();
+  const TrackerTrace reference = f.have_commanded ? read_tracker_csv(o.commanded) : unloaded.front();
+  f.ref_name = f.have_commanded ? "commanded" : "unloaded (first run)";
+  const std::string ref_file = f.have_commanded ? o.commanded : r.unloaded.names.front();
+  f.iso_loaded = iso_of(loaded, r.loaded.names, reference, ref_file, o.points, o.max_offset_mm * 1e-3);
+  if (f.have_commanded) {
+    f.iso_unloaded = iso_of(unloaded, r.unloaded.names, reference, ref_file, o.points, o.max_offset_mm * 1e-3);
+  }
+  // On the program's clock: the study's time-synchronous error (loaded against unloaded at the same
+  // program time) and each run against its command.
+  if (r.reading.align) {
+    f.sync = time_synchronous_deviation(r.loaded.whole.front(), r.unloaded.whole.front());
+    for (const auto* group : {&r.unloaded.whole, &r.loaded.whole}) {
+      for (const auto& t : *group) f.to_command.push_back(time_synchronous_deviation(t, r.reading.commanded.trace));
     }
-    if (!o->robot.empty() && o->align_to.empty()) throw InputError("option --robot: only used with --align-to");
-    const TrackerRunReading reading = make_reading(*o);
-    const TrackerRuns unloaded_runs = read_tracker_runs(o->unloaded, reading, "unloaded");
-    const TrackerRuns loaded_runs = read_tracker_runs(o->loaded, reading, "loaded");
-    for (const auto* g : {&unloaded_runs, &loaded_runs}) {
-      for (const std::string& note : g->notes) std::cerr << "deflex evaluate: " << note << "\n";
+  }
+  return f;
+}
+
+/// The JSON document of the figures.
+nlohmann::json evaluate_json(const EvaluateOpts& o, const EvaluateRuns& r, const EvaluateFigures& f) {
+  const PathDeviationStats& dev = f.dev;
+  nlohmann::json doc{{"mean_deformation_mm", dev.mean_m * 1e3},
+                     {"distance_to", o.mean_reference ? "mean of the unloaded laps" : "unloaded samples"},
+                     {"max_mm", dev.max_m * 1e3},
+                     {"rms_mm", dev.rms_m * 1e3},
+                     {"std_mm", dev.std_m * 1e3},
+                     {"loaded_samples", dev.samples},
+                     {"unloaded_samples", samples_of(r.unloaded.runs)},
+                     {"iso9283_loaded", iso_json(f.iso_loaded, f.ref_name)}};
+  if (f.have_commanded) {
+    doc["iso9283_unloaded"] = iso_json(f.iso_unloaded, f.ref_name);
+  }
+  if (r.reading.have_frame) doc["tracker_frame"] = o.tracker_frame;
+  if (r.reading.align) {
+    nlohmann::json runs = nlohmann::json::array();
+    for (std::size_t k = 0; k < r.alignments.size(); ++k) {
+      const auto& [path, a] = r.alignments[k];
+      nlohmann::json run{{"file", path},
+                         {"offset_s", a.offset_s},
+                         {"offset_std_s",
+                          std::isfinite(a.offset_std_s) ? nlohmann::json(a.offset_std_s) : nlohmann::json(nullptr)},
+                         {"drift_ppm", a.drift * 1e6},
+                         {"rms_from_command_mm", a.rms_m * 1e3},
+                         {"samples", a.samples},
+                         {"synchronous_error_to_command_mm", f.to_command[k].mean_m * 1e3}};
+      if (std::isfinite(o.clock_offset_s)) run["lag_s"] = o.clock_offset_s - a.offset_s;
+      runs.push_back(run);
     }
-    const std::vector<TrackerTrace>& unloaded = unloaded_runs.runs;
-    const std::vector<TrackerTrace>& loaded = loaded_runs.runs;
-    const std::vector<std::string>& unloaded_names = unloaded_runs.names;
-    const std::vector<std::string>& loaded_names = loaded_runs.names;
-    const std::vector<TrackerTrace>& unloaded_whole = unloaded_runs.whole;
-    const std::vector<TrackerTrace>& loaded_whole = loaded_runs.whole;
-    std::vector<std::pair<std::string, TimeAlignment>> alignments = unloaded_runs.alignments;
-    alignments.insert(alignments.end(), loaded_runs.alignments.begin(), loaded_runs.alignments.end());
-    std::vector<TrackerTrace> distance_reference;
-    if (o->mean_reference) {
-      TrackerTrace all;
-      for (const auto& t : unloaded) all.insert(all.end(), t.begin(), t.end());
-      // Bins of about two samples a lap each, at most 3600 (0.1 deg): fewer than that would leave bins
-      // empty on a sparse file (50 Hz), more would average too few laps' samples per bin.
-      const auto per_lap = static_cast<int>(all.size() / std::max<std::size_t>(1, unloaded.size()));
-      distance_reference.push_back(mean_closed_path(all, std::clamp(per_lap / 2, 36, 3600)));
+    doc["alignment"] = {{"commanded", o.align_to}, {"commanded_kind", r.reading.commanded.kind}, {"runs", runs}};
+    doc["time_synchronous_mm"] = {{"mean", f.sync.mean_m * 1e3}, {"max", f.sync.max_m * 1e3},
+                                  {"rms", f.sync.rms_m * 1e3}, {"samples", f.sync.samples}};
+  }
+  return doc;
+}
+
+/// The clock alignment of each run and the time-synchronous error, as text on stdout.
+void print_evaluate_alignment(const EvaluateOpts& o, const EvaluateRuns& r, const EvaluateFigures& f) {
+  std::cout << fmt::format("Clock alignment with {} ({}): program time = tracker time + offset\n", o.align_to,
+                           r.reading.commanded.kind);
+  for (std::size_t k = 0; k < r.alignments.size(); ++k) {
+    std::cout << alignment_text(r.alignments[k].first, r.alignments[k].second);
+    if (std::isfinite(o.clock_offset_s)) {
+      std::cout << fmt::format("    lag behind the command {:+.4f} s (with --clock-offset-s {})\n",
+                               o.clock_offset_s - r.alignments[k].second.offset_s, o.clock_offset_s);
     }
-    if (!o->mean_reference && o->split && unloaded.size() > 1) {
-      std::cerr << "deflex evaluate: note: the nearest-point distance to noisy unloaded laps is biased low by their "
-                   "noise; --mean-reference takes the distance to their mean instead (docs/evaluation.md)\n";
-    }
-    const PathDeviationStats dev = path_deviation(loaded, o->mean_reference ? distance_reference : unloaded);
-    const std::string distance_to = o->mean_reference ? "the mean of the unloaded laps" : "the unloaded path";
-    // ISO 9283 wants one reference path: the commanded one when given, else the first unloaded run.
-    const bool have_commanded = !o->commanded.empty();
-    const TrackerTrace reference = have_commanded ? read_tracker_csv(o->commanded) : unloaded.front();
-    const std::string ref_name = have_commanded ? "commanded" : "unloaded (first run)";
-    const std::string ref_file = have_commanded ? o->commanded : unloaded_names.front();
-    const Iso9283Path iso_loaded =
-        iso_of(loaded, loaded_names, reference, ref_file, o->points, o->max_offset_mm * 1e-3);
-    Iso9283Path iso_unloaded;
-    if (have_commanded) {
-      iso_unloaded = iso_of(unloaded, unloaded_names, reference, ref_file, o->points, o->max_offset_mm * 1e-3);
-    }
-    // On the program's clock: the study's time-synchronous error (loaded against unloaded at the same
-    // program time) and each run against its command.
-    PathDeviationStats sync;
-    std::vector<PathDeviationStats> to_command;
-    if (reading.align) {
-      sync = time_synchronous_deviation(loaded_whole.front(), unloaded_whole.front());
-      for (const auto* group : {&unloaded_whole, &loaded_whole}) {
-        for (const auto& t : *group) to_command.push_back(time_synchronous_deviation(t, reading.commanded.trace));
-      }
-    }
-    if (o->json) {
-      nlohmann::json doc{{"mean_deformation_mm", dev.mean_m * 1e3},
-                         {"distance_to", o->mean_reference ? "mean of the unloaded laps" : "unloaded samples"},
-                         {"max_mm", dev.max_m * 1e3},
-                         {"rms_mm", dev.rms_m * 1e3},
-                         {"std_mm", dev.std_m * 1e3},
-                         {"loaded_samples", dev.samples},
-                         {"unloaded_samples", samples_of(unloaded)},
-                         {"iso9283_loaded", iso_json(iso_loaded, ref_name)}};
-      if (have_commanded) {
-        doc["iso9283_unloaded"] = iso_json(iso_unloaded, ref_name);
-      }
-      if (reading.have_frame) doc["tracker_frame"] = o->tracker_frame;
-      if (reading.align) {
-        nlohmann::json runs = nlohmann::json::array();
-        for (std::size_t k = 0; k < alignments.size(); ++k) {
-          const auto& [path, a] = alignments[k];
-          nlohmann::json run{{"file", path},
-                             {"offset_s", a.offset_s},
-                             {"offset_std_s", std::isfinite(a.offset_std_s) ? nlohmann::json(a.offset_std_s) : nlohmann::json(nullptr)},
-                             {"drift_ppm", a.drift * 1e6},
-                             {"rms_from_command_mm", a.rms_m * 1e3},
-                             {"samples", a.samples},
-                             {"synchronous_error_to_command_mm", to_command[k].mean_m * 1e3}};
-          if (std::isfinite(o->clock_offset_s)) run["lag_s"] = o->clock_offset_s - a.offset_s;
-          runs.push_back(run);
-        }
-        doc["alignment"] = {{"commanded", o->align_to}, {"commanded_kind", reading.commanded.kind}, {"runs", runs}};
-        doc["time_synchronous_mm"] = {{"mean", sync.mean_m * 1e3}, {"max", sync.max_m * 1e3},
-                                      {"rms", sync.rms_m * 1e3}, {"samples", sync.samples}};
-      }
-      print_json(doc);
-    } else {
-      if (reading.have_frame) {
-        std::cout << fmt::format("Tracker files moved into the base frame with {} (registration RMS {:.4f} mm)\n",
-                                 o->tracker_frame, reading.frame.rms_m * 1e3);
-      }
-      std::cout << fmt::format(
-          "Distance of the loaded path from {} ({} loaded points, {} run{}; {} unloaded points, {} "
-          "run{}):\n  mean (the paper's mean deformation) {:.4f} mm\n  max {:.4f} mm   RMS {:.4f} mm   std {:.4f} mm\n",
-          distance_to, dev.samples, loaded.size(), loaded.size() > 1 ? "s" : "", samples_of(unloaded), unloaded.size(),
-          unloaded.size() > 1 ? "s" : "", dev.mean_m * 1e3, dev.max_m * 1e3, dev.rms_m * 1e3, dev.std_m * 1e3);
-      std::cout << iso_text(fmt::format("ISO 9283 (loaded runs against the {} path)", ref_name), iso_loaded);
-      if (have_commanded) {
-        std::cout << iso_text("ISO 9283 (unloaded runs against the commanded path)", iso_unloaded);
-      }
-      if (reading.align) {
-        std::cout << fmt::format("Clock alignment with {} ({}): program time = tracker time + offset\n", o->align_to,
-                                 reading.commanded.kind);
-        for (std::size_t k = 0; k < alignments.size(); ++k) {
-          std::cout << alignment_text(alignments[k].first, alignments[k].second);
-          if (std::isfinite(o->clock_offset_s)) {
-            std::cout << fmt::format("    lag behind the command {:+.4f} s (with --clock-offset-s {})\n",
-                                     o->clock_offset_s - alignments[k].second.offset_s, o->clock_offset_s);
-          }
-        }
-        std::cout << fmt::format(
-            "Time-synchronous error (loaded against unloaded at the same program time, first files): mean {:.4f} mm, "
-            "max {:.4f} mm, RMS {:.4f} mm, {} samples\n",
-            sync.mean_m * 1e3, sync.max_m * 1e3, sync.rms_m * 1e3, sync.samples);
-      }
-    }
-    exit_code = 0;
-  });
+  }
+  std::cout << fmt::format(
+      "Time-synchronous error (loaded against unloaded at the same program time, first files): mean {:.4f} mm, "
+      "max {:.4f} mm, RMS {:.4f} mm, {} samples\n",
+      f.sync.mean_m * 1e3, f.sync.max_m * 1e3, f.sync.rms_m * 1e3, f.sync.samples);
+}
+
+/// The figures as text on stdout.
+void print_evaluate_text(const EvaluateOpts& o, const EvaluateRuns& r, const EvaluateFigures& f) {
+  const std::vector<TrackerTrace>& unloaded = r.unloaded.runs;
+  const std::vector<TrackerTrace>& loaded = r.loaded.runs;
+  const PathDeviationStats& dev = f.dev;
+  const std::string distance_to = o.mean_reference ? "the mean of the unloaded laps" : "the unloaded path";
+  if (r.reading.have_frame) {
+    std::cout << fmt::format("Tracker files moved into the base frame with {} (registration RMS {:.4f} mm)\n",
+                             o.tracker_frame, r.reading.frame.rms_m * 1e3);
+  }
+  std::cout << fmt::format(
+      "Distance of the loaded path from {} ({} loaded points, {} run{}; {} unloaded points, {} "
+      "run{}):\n  mean (the paper's mean deformation) {:.4f} mm\n  max {:.4f} mm   RMS {:.4f} mm   std {:.4f} mm\n",
+      distance_to, dev.samples, loaded.size(), loaded.size() > 1 ? "s" : "", samples_of(unloaded), unloaded.size(),
+      unloaded.size() > 1 ? "s" : "", dev.mean_m * 1e3, dev.max_m * 1e3, dev.rms_m * 1e3, dev.std_m * 1e3);
+  std::cout << iso_text(fmt::format("ISO 9283 (loaded runs against the {} path)", f.ref_name), f.iso_loaded);
+  if (f.have_commanded) {
+    std::cout << iso_text("ISO 9283 (unloaded runs against the commanded path)", f.iso_unloaded);
+  }
+  if (r.reading.align) {
+    print_evaluate_alignment(o, r, f);
+  }
+}
+
+/// Reads the tracker files, computes the figures and prints them, as JSON with --json.
+void run_evaluate(const EvaluateOpts& o, int& exit_code) {
+  const EvaluateRuns runs = read_evaluate_runs(o);
+  const EvaluateFigures figures = evaluate_figures(o, runs);
+  if (o.json) {
+    print_json(evaluate_json(o, runs, figures));
+  } else {
+    print_evaluate_text(o, runs, figures);
+  }
+  exit_code = 0;
+}
+
+/// Registers the options; the command runs once they parse.
+void setup_evaluate(CLI::App& sub, int& exit_code) {
+  auto o = std::make_shared<EvaluateOpts>();
+  add_evaluate_options(sub, *o);
+  sub.callback([o, &exit_code] { run_evaluate(*o, exit_code); });
 }
 
 }  // namespace

@@ -69,28 +69,256 @@ int abb_cfx(const OpwGeometry& g, double wrist_x_a1, double lower_arm_cross, dou
   return (wrist_x_a1 < 0.0 ? 4 : 0) + (g.sign[1] * lower_arm_cross < 0.0 ? 2 : 0) + (negative_joint(q5) ? 1 : 0);
 }
 
+/// The limits and seed of an OpwJointFit, copied once so the per-joint test reads no pointers.
+struct OpwFitLimits {
+  bool any = false;  // false: no fit, the joints are not computed
+  std::array<double, 6> lo{}, hi{}, ref{};
+};
+
+/// Copies `fit`'s limits and seed (zero without a seed); without `fit`, an empty OpwFitLimits.
+inline OpwFitLimits opw_fit_limits(const OpwJointFit* fit) {
+  OpwFitLimits f;
+  if (fit != nullptr) {
+    f.any = true;
+    for (int i = 0; i < 6; ++i) {
+      f.lo[static_cast<std::size_t>(i)] = fit->lower[i];
+      f.hi[static_cast<std::size_t>(i)] = fit->upper[i];
+      f.ref[static_cast<std::size_t>(i)] = fit->reference != nullptr ? (*fit->reference)[i] : 0.0;
+    }
+  }
+  return f;
+}
+
+/// What every branch of one target shares.
+struct OpwTarget {
+  const OpwGeometry& g;
+  const Matrix3& Re;  // the target's rotation
+  Vector3 w;          // the wrist centre
+  double theta4_when_singular;
+  double near_singular_threshold;
+  OpwFitLimits fit;
+};
+
+/// Joint i of the model for canonical angle theta at the turn the fit asks for; false when no turn fits.
+inline bool opw_fit_joint(const OpwTarget& t, std::size_t i, double theta, double& q) {
+  return !t.fit.any || fit_turn(t.g.sign[i] * (theta - t.g.offset[i]), t.fit.ref[i], t.fit.lo[i], t.fit.hi[i], q);
+}
+
+/// One shoulder: theta1 as (cos, sin) and the planar two-link problem from axis 2 to the wrist centre.
+struct OpwShoulder {
+  double X, c1, s1;   // the wrist centre is at (X, b, z) in the A1 frame
+  double dx, dz, d2;  // from axis 2 to the wrist centre in the arm's plane, and its length squared
+  double cg, sg_abs;  // cos and |sin| of the elbow's gamma
+  double t1;          // set by the caller
+};
+
+/// Shoulder 0 (front) or 1 (back) of the wrist centre, all but theta1; false when the elbow cannot reach it.
+inline bool opw_shoulder(const OpwTarget& t, double rho2, double x_abs, int shoulder, OpwShoulder& s) {
+  const OpwGeometry& g = t.g;
+  const Vector3& w = t.w;
+  // In the A1 frame the wrist centre is at (X, b, z); theta1 turns (X, b) onto (w.x, w.y).
+  s.X = shoulder == 0 ? x_abs : -x_abs;
+  s.c1 = shoulder == 0 ? 1.0 : -1.0;
+  s.s1 = 0.0;
+  if (rho2 > 1e-24) {
+    const double inv = 1.0 / rho2;
+    s.c1 = (s.X * w.x() + g.b * w.y()) * inv;
+    s.s1 = (s.X * w.y() - g.b * w.x()) * inv;
+  }
+  // Planar two-link problem from axis 2 to the wrist centre: d = c2 u(theta2) + k u(theta2 + gamma).
+  s.dx = s.X - g.a1;
+  s.dz = w.z() - g.c1;
+  s.d2 = s.dx * s.dx + s.dz * s.dz;
+  const double C = (s.d2 - g.c2 * g.c2 - g.k * g.k) * g.inv_2_c2_k;
+  if (!(std::abs(C) <= 1.0 + 1e-12)) {
+    return false;
+  }
+  s.cg = std::clamp(C, -1.0, 1.0);
+  s.sg_abs = std::sqrt(1.0 - s.cg * s.cg);
+  return true;
+}
+
+/// One elbow: theta2, theta3 and phi = theta2 + theta3, each as (cos, sin), and the angles theta2, theta3.
+struct OpwElbow {
+  double sg, c2, s2, c3, s3, t2, t3;
+  double cp, sp;  // set by the caller once joints 2 and 3 fit
+};
+
+/// Elbow 0 or 1 (the sign of sin gamma) of shoulder s, all but phi; false when the wrist centre is on axis 2.
+inline bool opw_elbow(const OpwGeometry& g, const OpwShoulder& s, double gamma, int elbow, OpwElbow& e) {
+  e.sg = elbow == 0 ? s.sg_abs : -s.sg_abs;
+  const double ex = g.c2 + g.k * s.cg;
+  const double ey = g.k * e.sg;
+  const double nrm2 = s.d2 * (ex * ex + ey * ey);
+  if (!(nrm2 > 0.0)) {
+    return false;  // wrist centre on axis 2: theta2 undefined
+  }
+  // theta2 = angle(d) - angle(ex, ey); theta3 = gamma - psi; phi = theta2 + theta3.
+  const double inv_nrm = 1.0 / std::sqrt(nrm2);
+  e.c2 = (s.dz * ex + s.dx * ey) * inv_nrm;
+  e.s2 = (s.dx * ex - s.dz * ey) * inv_nrm;
+  e.c3 = s.cg * g.psi_cos + e.sg * g.psi_sin;
+  e.s3 = e.sg * g.psi_cos - s.cg * g.psi_sin;
+  e.t2 = fast_atan2(e.s2, e.c2);
+  e.t3 = (elbow == 0 ? gamma : -gamma) - g.psi;
+  return true;
+}
+
+/// m = (Rz(theta1) Ry(phi))^T Re = Rz(theta4) Ry(theta5) Rz(theta6), row by row.
+inline Matrix3 opw_wrist_rotation(const OpwShoulder& s, const OpwElbow& e, const Matrix3& Re) {
+  const Vector3 rc0(s.c1 * e.cp, s.s1 * e.cp, -e.sp);
+  const Vector3 rc1(-s.s1, s.c1, 0.0);
+  const Vector3 rc2(s.c1 * e.sp, s.s1 * e.sp, e.cp);
+  Matrix3 m;
+  m.row(0) = rc0.transpose() * Re;
+  m.row(1) = rc1.transpose() * Re;
+  m.row(2) = rc2.transpose() * Re;
+  return m;
+}
+
+/// Distance from the wrist centre w of the one the canonical FK puts there, for the check.
+inline double opw_wrist_centre_error(const OpwGeometry& g, const Vector3& w, const OpwShoulder& s, const OpwElbow& e) {
+  const double xa = g.a1 + g.c2 * e.s2 + g.a2 * e.cp + g.c3 * e.sp;
+  const double za = g.c1 + g.c2 * e.c2 - g.a2 * e.sp + g.c3 * e.cp;
+  const double ex0 = s.c1 * xa - s.s1 * g.b - w.x();
+  const double ex1 = s.s1 * xa + s.c1 * g.b - w.y();
+  const double ex2 = za - w.z();
+  return std::sqrt(ex0 * ex0 + ex1 * ex1 + ex2 * ex2);
+}
+
+/// The singularity a branch is near: the wrist centre's X, the elbow's sin gamma, h = |sin theta5|.
+inline Singularity opw_singularity(double X, double sg, double h, double threshold) {
+  if (std::abs(X) < threshold) {
+    return Singularity::kShoulder;
+  }
+  if (std::abs(sg) < threshold) {
+    return Singularity::kElbow;
+  }
+  if (h < threshold) {
+    return Singularity::kWrist;
+  }
+  return Singularity::kNone;
+}
+
+/// One wrist: theta4, theta5 and theta6 as (cos, sin) pairs and as angles.
+struct OpwWrist {
+  double c4, s4, c5, s5, c6, s6;
+  double t4, t5, t6;
+};
+
+/// The first wrist of m, h = |sin theta5|; when exactly singular, theta4 is `theta4_when_singular`.
+inline OpwWrist opw_wrist_angles(const Matrix3& m, double h, bool singular, double theta4_when_singular) {
+  OpwWrist r;
+  if (singular) {
+    r.c4 = std::cos(theta4_when_singular);
+    r.s4 = std::sin(theta4_when_singular);
+    r.c5 = m(2, 2) >= 0.0 ? 1.0 : -1.0;
+    r.s5 = 0.0;
+  } else {
+    // (m22, h) and, below, (c6, s6) are unit pairs up to rounding because m is a rotation, so they
+    // need no normalising: atan2 takes any scale and the FK check would see an error.
+    const double inv_h = 1.0 / h;
+    r.c4 = m(0, 2) * inv_h;
+    r.s4 = m(1, 2) * inv_h;
+    r.c5 = m(2, 2);
+    r.s5 = h;
+  }
+  // theta6 from what remains once theta4 and theta5 are taken out: exact near the wrist
+  // singularity, where theta4 alone is ill-conditioned.
+  const double r00 = r.c4 * m(0, 0) + r.s4 * m(1, 0);
+  const double r10 = -r.s4 * m(0, 0) + r.c4 * m(1, 0);
+  r.c6 = r.c5 * r00 - r.s5 * m(2, 0);
+  r.s6 = r10;
+  r.t4 = fast_atan2(r.s4, r.c4);
+  r.t5 = fast_atan2(r.s5, r.c5);
+  r.t6 = fast_atan2(r.s6, r.c6);
+  return r;
+}
+
+/// Turns a wrist into the other one: Rz(t4 + pi) Ry(-t5) Rz(t6 + pi) is the same rotation.
+inline void opw_flip_wrist(OpwWrist& r) {
+  r.c4 = -r.c4, r.s4 = -r.s4, r.s5 = -r.s5, r.c6 = -r.c6, r.s6 = -r.s6;
+  r.t4 = flip(r.t4), r.t5 = -r.t5, r.t6 = flip(r.t6);
+}
+
+/// Frobenius norm of Rz(theta4) Ry(theta5) Rz(theta6) - m, for the check.
+inline double opw_rotation_error(const OpwWrist& r, const Matrix3& m) {
+  const double e00 = r.c4 * r.c5 * r.c6 - r.s4 * r.s6 - m(0, 0);
+  const double e01 = -r.c4 * r.c5 * r.s6 - r.s4 * r.c6 - m(0, 1);
+  const double e02 = r.c4 * r.s5 - m(0, 2);
+  const double e10 = r.s4 * r.c5 * r.c6 + r.c4 * r.s6 - m(1, 0);
+  const double e11 = -r.s4 * r.c5 * r.s6 + r.c4 * r.c6 - m(1, 1);
+  const double e12 = r.s4 * r.s5 - m(1, 2);
+  const double e20 = -r.s5 * r.c6 - m(2, 0);
+  const double e21 = r.s5 * r.s6 - m(2, 1);
+  const double e22 = r.c5 - m(2, 2);
+  return std::sqrt(e00 * e00 + e01 * e01 + e02 * e02 + e10 * e10 + e11 * e11 + e12 * e12 + e20 * e20 + e21 * e21 +
+                   e22 * e22);
+}
+
+/// Both wrists of one shoulder and elbow (one when exactly singular): joints 4 to 6 fitted, the FK
+/// check, and each branch that passes appended to `out`. `arm_bits` are the branch's shoulder and elbow bits.
+inline void opw_wrist_branches(const OpwTarget& t, const OpwShoulder& s, const OpwElbow& e, const Matrix3& m,
+                               int arm_bits, std::array<double, 6>& q, OpwBranches& out) {
+  const double pos_err = opw_wrist_centre_error(t.g, t.w, s, e);
+  const double h = std::sqrt(m(0, 2) * m(0, 2) + m(1, 2) * m(1, 2));  // |sin theta5|
+  const Singularity sing = opw_singularity(s.X, e.sg, h, t.near_singular_threshold);
+  const bool wrist_singular = h < 1e-12;
+  OpwWrist r = opw_wrist_angles(m, h, wrist_singular, t.theta4_when_singular);
+  double rot_err = 0.0;
+  for (int wrist = 0; wrist < (wrist_singular ? 1 : 2); ++wrist) {
+    if (wrist == 1) {
+      opw_flip_wrist(r);
+    }
+    if (!opw_fit_joint(t, 3, r.t4, q[3]) || !opw_fit_joint(t, 4, r.t5, q[4]) || !opw_fit_joint(t, 5, r.t6, q[5])) {
+      continue;
+    }
+    // Only signs flip between the two wrists, so the check's products are bit for bit the same:
+    // computed once.
+    if (wrist == 0) {
+      rot_err = opw_rotation_error(r, m);
+    }
+    if (!(pos_err < kFkCheck && rot_err < kFkCheck)) {
+      continue;  // the FK is the judge: a branch that does not reproduce the target is dropped
+    }
+    OpwBranch& b = out.branch[static_cast<std::size_t>(out.count++)];
+    b.theta = {s.t1, e.t2, e.t3, r.t4, r.t5, r.t6};
+    b.wrist_x_a1 = s.X;
+    b.lower_arm_cross = e.c2 * s.dx - e.s2 * s.dz;
+    b.branch = static_cast<std::uint8_t>(arm_bits | wrist);
+    b.singularity = sing;
+    b.position_error_m = pos_err;
+    b.orientation_error = rot_err;
+    b.q = q;
+  }
+}
+
+/// Both elbows of shoulder s (whose theta1 fits): joints 2 and 3 fitted, then the wrists.
+inline void opw_elbow_branches(const OpwTarget& t, const OpwShoulder& s, int shoulder, std::array<double, 6>& q,
+                               OpwBranches& out) {
+  const double gamma = fast_atan2(s.sg_abs, s.cg);
+  for (int elbow = 0; elbow < 2; ++elbow) {
+    OpwElbow e;
+    if (!opw_elbow(t.g, s, gamma, elbow, e) || !opw_fit_joint(t, 1, e.t2, q[1]) || !opw_fit_joint(t, 2, e.t3, q[2])) {
+      continue;
+    }
+    e.cp = e.c2 * e.c3 - e.s2 * e.s3;
+    e.sp = e.s2 * e.c3 + e.c2 * e.s3;
+    opw_wrist_branches(t, s, e, opw_wrist_rotation(s, e, t.Re), (shoulder << 2) | (elbow << 1), q, out);
+  }
+}
+
 }  // namespace
 
 void opw_branches(const OpwGeometry& g, const Pose& opw_T_end, double theta4_when_singular,
                   double near_singular_threshold, const OpwJointFit* fit, OpwBranches& out) {
-  // Joint i of the model for canonical angle theta at the turn `fit` asks for; false when no turn
-  // fits. Limits and references copied once, so the per-joint test reads no pointers.
-  std::array<double, 6> lo{}, hi{}, ref{};
-  if (fit != nullptr) {
-    for (int i = 0; i < 6; ++i) {
-      lo[static_cast<std::size_t>(i)] = fit->lower[i];
-      hi[static_cast<std::size_t>(i)] = fit->upper[i];
-      ref[static_cast<std::size_t>(i)] = fit->reference != nullptr ? (*fit->reference)[i] : 0.0;
-    }
-  }
-  const auto fit_joint = [&](std::size_t i, double theta, double& q) {
-    return fit == nullptr || fit_turn(g.sign[i] * (theta - g.offset[i]), ref[i], lo[i], hi[i], q);
-  };
   std::array<double, 6> q{};
   out.count = 0;
   out.reachable = false;
   const Matrix3& Re = opw_T_end.linear();
-  const Vector3 w = opw_T_end.translation() - g.c4 * Re.col(2);
+  const OpwTarget t{g, Re, opw_T_end.translation() - g.c4 * Re.col(2), theta4_when_singular, near_singular_threshold,
+                    opw_fit_limits(fit)};
+  const Vector3& w = t.w;
   const double rho2 = w.x() * w.x() + w.y() * w.y();
   const double x2 = rho2 - g.b * g.b;
   if (x2 < -1e-12) {
@@ -100,142 +328,17 @@ void opw_branches(const OpwGeometry& g, const Pose& opw_T_end, double theta4_whe
   double t1_front = 0.0;
   bool front_done = false;
   for (int shoulder = 0; shoulder < 2; ++shoulder) {
-    // In the A1 frame the wrist centre is at (X, b, z); theta1 turns (X, b) onto (w.x, w.y).
-    const double X = shoulder == 0 ? x_abs : -x_abs;
-    double c1 = shoulder == 0 ? 1.0 : -1.0;
-    double s1 = 0.0;
-    if (rho2 > 1e-24) {
-      const double inv = 1.0 / rho2;
-      c1 = (X * w.x() + g.b * w.y()) * inv;
-      s1 = (X * w.y() - g.b * w.x()) * inv;
-    }
-    // Planar two-link problem from axis 2 to the wrist centre: d = c2 u(theta2) + k u(theta2 + gamma).
-    const double dx = X - g.a1;
-    const double dz = w.z() - g.c1;
-    const double d2 = dx * dx + dz * dz;
-    const double C = (d2 - g.c2 * g.c2 - g.k * g.k) * g.inv_2_c2_k;
-    if (!(std::abs(C) <= 1.0 + 1e-12)) {
+    OpwShoulder s;
+    if (!opw_shoulder(t, rho2, x_abs, shoulder, s)) {
       continue;
     }
     out.reachable = true;
-    const double cg = std::clamp(C, -1.0, 1.0);
-    const double sg_abs = std::sqrt(1.0 - cg * cg);
     // Without a lateral offset the back shoulder is the front one turned by pi.
-    const double t1 = shoulder == 1 && front_done && g.b == 0.0 && rho2 > 1e-24 ? flip(t1_front) : fast_atan2(s1, c1);
-    t1_front = t1;
+    s.t1 = shoulder == 1 && front_done && g.b == 0.0 && rho2 > 1e-24 ? flip(t1_front) : fast_atan2(s.s1, s.c1);
+    t1_front = s.t1;
     front_done = true;
-    if (!fit_joint(0, t1, q[0])) {
-      continue;
-    }
-    const double gamma = fast_atan2(sg_abs, cg);
-    for (int elbow = 0; elbow < 2; ++elbow) {
-      const double sg = elbow == 0 ? sg_abs : -sg_abs;
-      const double ex = g.c2 + g.k * cg;
-      const double ey = g.k * sg;
-      const double nrm2 = d2 * (ex * ex + ey * ey);
-      if (!(nrm2 > 0.0)) {
-        continue;  // wrist centre on axis 2: theta2 undefined
-      }
-      // theta2 = angle(d) - angle(ex, ey); theta3 = gamma - psi; phi = theta2 + theta3.
-      const double inv_nrm = 1.0 / std::sqrt(nrm2);
-      const double c2 = (dz * ex + dx * ey) * inv_nrm;
-      const double s2 = (dx * ex - dz * ey) * inv_nrm;
-      const double c3 = cg * g.psi_cos + sg * g.psi_sin;
-      const double s3 = sg * g.psi_cos - cg * g.psi_sin;
-      const double t2 = fast_atan2(s2, c2);
-      const double t3 = (elbow == 0 ? gamma : -gamma) - g.psi;
-      if (!fit_joint(1, t2, q[1]) || !fit_joint(2, t3, q[2])) {
-        continue;
-      }
-      const double cp = c2 * c3 - s2 * s3;
-      const double sp = s2 * c3 + c2 * s3;
-      // m = (Rz(theta1) Ry(phi))^T Re = Rz(theta4) Ry(theta5) Rz(theta6), row by row.
-      const Vector3 rc0(c1 * cp, s1 * cp, -sp);
-      const Vector3 rc1(-s1, c1, 0.0);
-      const Vector3 rc2(c1 * sp, s1 * sp, cp);
-      Matrix3 m;
-      m.row(0) = rc0.transpose() * Re;
-      m.row(1) = rc1.transpose() * Re;
-      m.row(2) = rc2.transpose() * Re;
-
-      // The wrist centre the canonical FK puts there, for the check.
-      const double xa = g.a1 + g.c2 * s2 + g.a2 * cp + g.c3 * sp;
-      const double za = g.c1 + g.c2 * c2 - g.a2 * sp + g.c3 * cp;
-      const double ex0 = c1 * xa - s1 * g.b - w.x();
-      const double ex1 = s1 * xa + c1 * g.b - w.y();
-      const double ex2 = za - w.z();
-      const double pos_err = std::sqrt(ex0 * ex0 + ex1 * ex1 + ex2 * ex2);
-      const double h = std::sqrt(m(0, 2) * m(0, 2) + m(1, 2) * m(1, 2));  // |sin theta5|
-      Singularity sing = Singularity::kNone;
-      if (std::abs(X) < near_singular_threshold) {
-        sing = Singularity::kShoulder;
-      } else if (std::abs(sg) < near_singular_threshold) {
-        sing = Singularity::kElbow;
-      } else if (h < near_singular_threshold) {
-        sing = Singularity::kWrist;
-      }
-      const bool wrist_singular = h < 1e-12;
-      double c4, s4, c5, s5;
-      if (wrist_singular) {
-        c4 = std::cos(theta4_when_singular);
-        s4 = std::sin(theta4_when_singular);
-        c5 = m(2, 2) >= 0.0 ? 1.0 : -1.0;
-        s5 = 0.0;
-      } else {
-        // (m22, h) and, below, (c6, s6) are unit pairs up to rounding because m is a rotation, so they
-        // need no normalising: atan2 takes any scale and the FK check would see an error.
-        const double inv_h = 1.0 / h;
-        c4 = m(0, 2) * inv_h;
-        s4 = m(1, 2) * inv_h;
-        c5 = m(2, 2);
-        s5 = h;
-      }
-      // theta6 from what remains once theta4 and theta5 are taken out: exact near the wrist
-      // singularity, where theta4 alone is ill-conditioned.
-      const double r00 = c4 * m(0, 0) + s4 * m(1, 0);
-      const double r10 = -s4 * m(0, 0) + c4 * m(1, 0);
-      double c6 = c5 * r00 - s5 * m(2, 0);
-      double s6 = r10;
-      double t4 = fast_atan2(s4, c4);
-      double t5 = fast_atan2(s5, c5);
-      double t6 = fast_atan2(s6, c6);
-      double rot_err = 0.0;
-      for (int wrist = 0; wrist < (wrist_singular ? 1 : 2); ++wrist) {
-        if (wrist == 1) {  // Rz(t4 + pi) Ry(-t5) Rz(t6 + pi) is the same rotation
-          c4 = -c4, s4 = -s4, s5 = -s5, c6 = -c6, s6 = -s6;
-          t4 = flip(t4), t5 = -t5, t6 = flip(t6);
-        }
-        if (!fit_joint(3, t4, q[3]) || !fit_joint(4, t5, q[4]) || !fit_joint(5, t6, q[5])) {
-          continue;
-        }
-        // Only signs flip between the two wrists, so the check's products are bit for bit the same:
-        // computed once.
-        if (wrist == 0) {
-          const double e00 = c4 * c5 * c6 - s4 * s6 - m(0, 0);
-          const double e01 = -c4 * c5 * s6 - s4 * c6 - m(0, 1);
-          const double e02 = c4 * s5 - m(0, 2);
-          const double e10 = s4 * c5 * c6 + c4 * s6 - m(1, 0);
-          const double e11 = -s4 * c5 * s6 + c4 * c6 - m(1, 1);
-          const double e12 = s4 * s5 - m(1, 2);
-          const double e20 = -s5 * c6 - m(2, 0);
-          const double e21 = s5 * s6 - m(2, 1);
-          const double e22 = c5 - m(2, 2);
-          rot_err = std::sqrt(e00 * e00 + e01 * e01 + e02 * e02 + e10 * e10 + e11 * e11 + e12 * e12 + e20 * e20 +
-                              e21 * e21 + e22 * e22);
-        }
-        if (!(pos_err < kFkCheck && rot_err < kFkCheck)) {
-          continue;  // the FK is the judge: a branch that does not reproduce the target is dropped
-        }
-        OpwBranch& b = out.branch[static_cast<std::size_t>(out.count++)];
-        b.theta = {t1, t2, t3, t4, t5, t6};
-        b.wrist_x_a1 = X;
-        b.lower_arm_cross = c2 * dx - s2 * dz;
-        b.branch = static_cast<std::uint8_t>((shoulder << 2) | (elbow << 1) | wrist);
-        b.singularity = sing;
-        b.position_error_m = pos_err;
-        b.orientation_error = rot_err;
-        b.q = q;
-      }
+    if (opw_fit_joint(t, 0, s.t1, q[0])) {
+      opw_elbow_branches(t, s, shoulder, q, out);
     }
   }
 }

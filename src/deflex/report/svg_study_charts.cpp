@@ -287,17 +287,21 @@ std::string svg_compensation(const StudyResult& study) {
   return c.str();
 }
 
-std::string svg_parity(const StudyResult& study) {
-  const PaperFigures paper = paper_reference();
-  struct Point {
-    std::string setup;
-    std::size_t setup_index;
-    double load_N;
-    int speed;  // 0 for UC
-    double paper;
-    Spread ours;
-  };
-  std::vector<Point> points;
+namespace {
+
+/// One figure of the paper's tables beside ours, for the parity plot.
+struct ParityPoint {
+  std::string setup;
+  std::size_t setup_index;
+  double load_N;
+  int speed;  // 0 for UC
+  double paper;
+  Spread ours;
+};
+
+/// Every load of the study the paper's tables have: UC, then C at each of the paper's speeds.
+std::vector<ParityPoint> parity_points(const StudyResult& study, const PaperFigures& paper) {
+  std::vector<ParityPoint> points;
   for (std::size_t si = 0; si < study.setups.size(); ++si) {
     const PaperTable* pt = paper.table_for(study.setups[si].setup);
     if (pt == nullptr) {
@@ -314,86 +318,99 @@ std::string svg_parity(const StudyResult& study) {
       }
     }
   }
-  const double width = svg::kMaxWidth, height = 580.0;
-  const double pl = 96.0, pt = 70.0, ps = 430.0;
-  Canvas c(width, height);
-  c.title("Parity: ours against the paper's Tables 1 and 2");
-  double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
-  for (const auto& p : points) {
-    for (const double v : {p.paper, p.ours.mean, p.ours.min, p.ours.max}) {
-      if (std::isfinite(v) && v > 0.0) {
-        lo = std::min(lo, v);
-        hi = std::max(hi, v);
-      }
-    }
-  }
-  if (!(hi > 0.0)) {
-    c.text(width / 2.0, height / 2.0, "no figure of the paper's to compare with", 14.0, "middle");
-    return c.str();
-  }
+  return points;
+}
+
+/// The parity plot's square (left, top and side, px) and its data range, log scaled alike on both axes.
+struct ParityFrame {
+  double pl, pt, ps;
+  double d0, d1;
+  svg::LogScale xs, ys;
+};
+
+/// The frame at (pl, pt) of side ps for positive values from `lo` to `hi`.
+ParityFrame parity_frame(double lo, double hi, double pl, double pt, double ps) {
   // Ends on 1, 2 or 5 x 10^k with a margin, so every tick is labelled and no point sits on the frame.
   const double d0 = svg::nice_floor(lo / 1.2);
   double d1 = d0;
   while (d1 < hi * 1.2) {
     d1 = svg::nice_floor(d1 * 2.6);  // 1 -> 2 -> 5 -> 10
   }
-  const svg::LogScale xs{d0, d1, pl, pl + ps};
-  const svg::LogScale ys{d0, d1, pt + ps, pt};
-  const auto ticks = svg::log_ticks(d0, d1);
-  for (const double t : ticks) {
+  return {pl, pt, ps, d0, d1, svg::LogScale{d0, d1, pl, pl + ps}, svg::LogScale{d0, d1, pt + ps, pt}};
+}
+
+/// The grid, the ticks, the frame and the axis titles.
+void parity_axes(Canvas& c, const ParityFrame& f) {
+  const double pl = f.pl, pt = f.pt, ps = f.ps;
+  for (const double t : svg::log_ticks(f.d0, f.d1)) {
     const std::string label = fmt::format("{:g}", t);
-    c.line(xs(t), pt, xs(t), pt + ps, "#e3e3e3", 1.0);
-    c.line(pl, ys(t), pl + ps, ys(t), "#e3e3e3", 1.0);
-    c.text(xs(t), pt + ps + 18.0, label, kMinFont, "middle", R"(class="x-tick")");
-    c.text(pl - 6.0, ys(t) + 4.0, label, kMinFont, "end", R"(class="y-tick")");
+    c.line(f.xs(t), pt, f.xs(t), pt + ps, "#e3e3e3", 1.0);
+    c.line(pl, f.ys(t), pl + ps, f.ys(t), "#e3e3e3", 1.0);
+    c.text(f.xs(t), pt + ps + 18.0, label, kMinFont, "middle", R"(class="x-tick")");
+    c.text(pl - 6.0, f.ys(t) + 4.0, label, kMinFont, "end", R"(class="y-tick")");
   }
   c.rect(pl, pt, ps, ps, "none", R"(stroke="#444")");
   c.text(pl + ps / 2.0, pt + ps + 38.0, "the paper's mean distance (mm, log scale)", 12.0, "middle");
   const double ymid = pt + ps / 2.0;
   c.text(pl - 50.0, ymid, "ours, mean over the seeds (mm, log scale)", 12.0, "middle",
          fmt::format(R"svg(transform="rotate(-90 {:.2f} {:.2f})")svg", pl - 50.0, ymid));
-  // The bands, clipped to the plot: +-35% (C's target) shaded, +-25% (UC's) dashed, y = x solid.
+}
+
+/// The bands, clipped to the plot: +-35% (C's target) shaded, +-25% (UC's) dashed, y = x solid.
+void parity_bands(Canvas& c, const ParityFrame& f) {
+  const svg::LogScale& xs = f.xs;
+  const svg::LogScale& ys = f.ys;
   c.raw(fmt::format(R"(<clipPath id="deflex-parity-area"><rect x="{:.2f}" y="{:.2f}" width="{:.2f}" height="{:.2f}"/></clipPath>)"
                     "\n<g clip-path=\"url(#deflex-parity-area)\">\n",
-                    pl, pt, ps, ps));
-  const double e0 = d0 / 2.0, e1 = d1 * 2.0;  // beyond the plot, clipped
+                    f.pl, f.pt, f.ps, f.ps));
+  const double e0 = f.d0 / 2.0, e1 = f.d1 * 2.0;  // beyond the plot, clipped
   c.polygon({xs(e0), ys(e0 * 0.65), xs(e1), ys(e1 * 0.65), xs(e1), ys(e1 * 1.35), xs(e0), ys(e0 * 1.35)}, "#dcefd8");
-  for (const double f : {0.75, 1.25}) {
-    c.line(xs(e0), ys(e0 * f), xs(e1), ys(e1 * f), "#2e7d32", 1.2, R"(stroke-dasharray="5 4")");
+  for (const double k : {0.75, 1.25}) {
+    c.line(xs(e0), ys(e0 * k), xs(e1), ys(e1 * k), "#2e7d32", 1.2, R"(stroke-dasharray="5 4")");
   }
   c.line(xs(e0), ys(e0), xs(e1), ys(e1), "#444", 1.3);
   c.raw("</g>\n");
+}
 
+/// How many of the C and the UC points were drawn, and how many of each are within their target.
+struct ParityCounts {
   int c_in = 0, c_n = 0, uc_in = 0, uc_n = 0;
+};
+
+/// A marker for each point with both values positive (C a dot, UC a square), with its seeds' whisker.
+ParityCounts parity_markers(Canvas& c, const ParityFrame& f, const std::vector<ParityPoint>& points) {
+  ParityCounts n;
   for (const auto& p : points) {
     if (!std::isfinite(p.ours.mean) || !(p.ours.mean > 0.0) || !(p.paper > 0.0)) {
       continue;
     }
     const double ratio = p.ours.mean / p.paper;
     const std::string col = svg::colour(p.setup_index);
-    const double x = xs(p.paper), yv = ys(p.ours.mean);
+    const double x = f.xs(p.paper), yv = f.ys(p.ours.mean);
     const std::string what = p.speed == 0 ? "UC" : fmt::format("C at {} mm/s", p.speed);
     c.group_begin(fmt::format("{} {:g} N, {}: ours {} against the paper's {:.2f} mm ({:+.0f}%)", p.setup, p.load_N,
                               what, spread_text(p.ours, 1.0, " mm", 3), p.paper, (ratio - 1.0) * 100.0));
     if (p.ours.n > 1 && std::isfinite(p.ours.min) && p.ours.min > 0.0) {
-      svg::whisker(c, x, ys(p.ours.min), ys(p.ours.max), col, 5.0);
+      svg::whisker(c, x, f.ys(p.ours.min), f.ys(p.ours.max), col, 5.0);
     }
     const std::string data = fmt::format(R"(data-paper="{:.6g}" data-ours="{:.6g}")", p.paper, p.ours.mean);
     if (p.speed == 0) {
       c.rect(x - 5.0, yv - 5.0, 10.0, 10.0, "white", fmt::format(R"(stroke="{}" stroke-width="2" {})", col, data));
-      ++uc_n;
-      uc_in += std::abs(ratio - 1.0) <= 0.25 ? 1 : 0;
+      ++n.uc_n;
+      n.uc_in += std::abs(ratio - 1.0) <= 0.25 ? 1 : 0;
     } else {
       c.circle(x, yv, 4.5, col, fmt::format(R"(stroke="white" stroke-width="0.8" {})", data));
-      ++c_n;
-      c_in += std::abs(ratio - 1.0) <= 0.35 ? 1 : 0;
+      ++n.c_n;
+      n.c_in += std::abs(ratio - 1.0) <= 0.35 ? 1 : 0;
     }
     c.group_end();
   }
+  return n;
+}
 
-  // Legend and a summary at the right.
-  const double rx = pl + ps + 50.0;
-  double ry = pt + 10.0;
+/// The legend (the setups' colours, the markers, the lines and bands) from (rx, ry) down; ry ends below it.
+void parity_legend(Canvas& c, const StudyResult& study, const std::vector<ParityPoint>& points, double rx,
+                   double& ry) {
   std::map<std::size_t, std::string> setups;
   for (const auto& p : points) {
     setups.emplace(p.setup_index, p.setup);
@@ -415,12 +432,17 @@ std::string svg_parity(const StudyResult& study) {
   svg::legend_entry(c, rx, ry, "dash", "#2e7d32", "25% either side (the target for UC)");
   ry += 20.0;
   c.text(rx, ry, whisker_note(study), 12.0, "start", R"(fill="#444")");
-  ry += 34.0;
+}
+
+/// The counts against the targets and, per setup and load, ours over the paper's (C as the mean over
+/// the speeds, and UC) from (rx, ry) down, as many loads as fit above the chart's `height`.
+void parity_summary(Canvas& c, const StudyResult& study, const PaperFigures& paper, const ParityCounts& n, double rx,
+                    double ry, double height) {
   c.text(rx, ry, "Against the targets", 13.0, "start", R"(font-weight="bold")");
   ry += 20.0;
-  c.text(rx, ry, fmt::format("C per load and speed within 35%: {} of {}", c_in, c_n), 12.0);
+  c.text(rx, ry, fmt::format("C per load and speed within 35%: {} of {}", n.c_in, n.c_n), 12.0);
   ry += 18.0;
-  c.text(rx, ry, fmt::format("UC per load within 25%: {} of {}", uc_in, uc_n), 12.0);
+  c.text(rx, ry, fmt::format("UC per load within 25%: {} of {}", n.uc_in, n.uc_n), 12.0);
   ry += 24.0;
   // Per setup and load: C as the issue judges it (mean over the speeds), and UC.
   c.text(rx, ry, "ours / the paper's, per load:", 12.0, "start", R"(fill="#444")");
@@ -436,16 +458,16 @@ std::string svg_parity(const StudyResult& study) {
         continue;
       }
       double ours = 0.0, theirs = 0.0;
-      int n = 0;
+      int k = 0;
       for (const auto& [v, pc] : pr->c_mm) {
         const double o = value_at_speed(l.c_mm, v);
         if (std::isfinite(o)) {
           ours += o;
           theirs += pc;
-          ++n;
+          ++k;
         }
       }
-      const double c_ratio = n > 0 ? ours / theirs : kNaN;
+      const double c_ratio = k > 0 ? ours / theirs : kNaN;
       const double uc_ratio = l.uc_mean_mm() / pr->uc_mm;
       const bool c_ok = std::abs(c_ratio - 1.0) <= 0.35, uc_ok = std::abs(uc_ratio - 1.0) <= 0.25;
       c.text(rx, ry,
@@ -455,6 +477,39 @@ std::string svg_parity(const StudyResult& study) {
       ry += 18.0;
     }
   }
+}
+
+}  // namespace
+
+std::string svg_parity(const StudyResult& study) {
+  const PaperFigures paper = paper_reference();
+  const std::vector<ParityPoint> points = parity_points(study, paper);
+  const double width = svg::kMaxWidth, height = 580.0;
+  const double pl = 96.0, pt = 70.0, ps = 430.0;
+  Canvas c(width, height);
+  c.title("Parity: ours against the paper's Tables 1 and 2");
+  double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+  for (const auto& p : points) {
+    for (const double v : {p.paper, p.ours.mean, p.ours.min, p.ours.max}) {
+      if (std::isfinite(v) && v > 0.0) {
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+      }
+    }
+  }
+  if (!(hi > 0.0)) {
+    c.text(width / 2.0, height / 2.0, "no figure of the paper's to compare with", 14.0, "middle");
+    return c.str();
+  }
+  const ParityFrame frame = parity_frame(lo, hi, pl, pt, ps);
+  parity_axes(c, frame);
+  parity_bands(c, frame);
+  const ParityCounts counts = parity_markers(c, frame, points);
+  // Legend and a summary at the right.
+  const double rx = pl + ps + 50.0;
+  double ry = pt + 10.0;
+  parity_legend(c, study, points, rx, ry);
+  parity_summary(c, study, paper, counts, rx, ry + 34.0, height);
   return c.str();
 }
 
