@@ -2,6 +2,7 @@
 // OPW parameter sets, every solution against KDL (forward kinematics and its numerical
 // Levenberg-Marquardt solver) over a seeded sweep of seven robots, ABB and KUKA configurations
 // against their geometric definitions, and the hot path's allocations.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -206,6 +207,44 @@ TEST(OpwIk, AgreesWithKdlOnEveryReachablePoseOfASeededSweep) {
     std::printf("%s: %d poses, KDL converged on %d, each on an OPW branch (largest joint difference %.1e rad)\n",
                 r.label.c_str(), samples, kdl_converged, worst_seen);
   }
+}
+
+TEST(OpwIk, TheFkCheckOfABranchDoesNotDependOnTheOtherWristsLimits) {
+  // With q5 limited to [-2, 0] one wrist of most poses leaves the limits; the other must still carry
+  // the orientation error the FK check measured, the same as without the limit (it reported 0 when
+  // the first wrist was the one outside).
+  const RobotModel m = builtin_irb6700();
+  const OpwGeometry& g = *m.opw();
+  JointVector lower = m.lower_limits(), upper = m.upper_limits();
+  upper[4] = 0.0;
+  lower[4] = -2.0;
+  const JointVector all_lower = m.lower_limits(), all_upper = m.upper_limits();
+  const OpwJointFit limited{lower, upper, nullptr}, free{all_lower, all_upper, nullptr};
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Workspace ws(m);
+  int flipped_only = 0;
+  for (int s = 0; s < 400; ++s) {
+    JointVector q(6);
+    for (int j = 0; j < 6; ++j) q[j] = 0.5 * (all_lower[j] + all_upper[j]) + 0.4 * u(rng) * (all_upper[j] - all_lower[j]);
+    const Pose target = tcp_pose(m, ws, q);
+    const Pose canonical = g.opw_T_base * target * g.tcp_T_end;
+    OpwBranches a, b;
+    opw_branches(g, canonical, g.theta(3, q[3]), 1e-2, &limited, a);
+    opw_branches(g, canonical, g.theta(3, q[3]), 1e-2, &free, b);
+    for (int i = 0; i < a.count; ++i) {
+      const OpwBranch& x = a.branch[static_cast<std::size_t>(i)];
+      for (int k = 0; k < b.count; ++k) {
+        const OpwBranch& y = b.branch[static_cast<std::size_t>(k)];
+        if (y.branch != x.branch) continue;
+        EXPECT_EQ(x.orientation_error, y.orientation_error) << "pose " << s << " branch " << int{x.branch};
+        const bool partner_kept = std::any_of(a.branch.begin(), a.branch.begin() + a.count,
+                                              [&](const OpwBranch& z) { return z.branch == (x.branch ^ 1); });
+        if ((x.branch & 1) != 0 && !partner_kept) ++flipped_only;
+      }
+    }
+  }
+  EXPECT_GT(flipped_only, 50) << "too few poses whose only wrist inside the limits is the flipped one";
 }
 
 TEST(OpwIk, UnreachablePosesAreUnreachableForBoth) {

@@ -265,18 +265,16 @@ inline void opw_wrist_branches(const OpwTarget& t, const OpwShoulder& s, const O
   const Singularity sing = opw_singularity(s.X, e.sg, h, t.near_singular_threshold);
   const bool wrist_singular = h < 1e-12;
   OpwWrist r = opw_wrist_angles(m, h, wrist_singular, t.theta4_when_singular);
-  double rot_err = 0.0;
+  // Only signs flip between the two wrists, so the check's products are bit for bit the same:
+  // computed once, before either wrist meets the joint limits (the flipped wrist of a first wrist
+  // outside its limits is checked as well; it used to report 0).
+  const double rot_err = opw_rotation_error(r, m);
   for (int wrist = 0; wrist < (wrist_singular ? 1 : 2); ++wrist) {
     if (wrist == 1) {
       opw_flip_wrist(r);
     }
     if (!opw_fit_joint(t, 3, r.t4, q[3]) || !opw_fit_joint(t, 4, r.t5, q[4]) || !opw_fit_joint(t, 5, r.t6, q[5])) {
       continue;
-    }
-    // Only signs flip between the two wrists, so the check's products are bit for bit the same:
-    // computed once.
-    if (wrist == 0) {
-      rot_err = opw_rotation_error(r, m);
     }
     if (!(pos_err < kFkCheck && rot_err < kFkCheck)) {
       continue;  // the FK is the judge: a branch that does not reproduce the target is dropped
