@@ -48,165 +48,212 @@ struct Pass {
   std::vector<Vector3> force_base;  // the conditioned process force, base frame at the WAP
 };
 
-}  // namespace
-
-CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robot, std::uint64_t seed) {
-  const RobotModel& nominal = robot.nominal_model();
-  if (c.exact_model) {
-    const auto& k = robot.true_model().stiffness();
-    std::vector<double> kv(k.data(), k.data() + k.size());
-    return CellCalibration{nominal.with_stiffness(kv, "exact true stiffness (model-consistent cell)"),
-                           {},
-                           0,
-                           {"exact stiffness given: model-consistent cell"}};
+// What every arc of a setup's calibration shares: the case, the arm and deflex's model of it, today's
+// bar, the force sensor and its sheet, and the arm's state, which carries on from pass to pass.
+struct CalibrationRig {
+  CalibrationRig(const CaseConfig& config, const cell::TrueRobot& arm, std::uint64_t calibration_seed)
+      : c(config),
+        cc(config.cell),
+        cal(config.calibration),
+        robot(arm),
+        nominal(arm.nominal_model()),
+        seed(calibration_seed),
+        ldbb_config(config.cell.ldbb),
+        force_from_sensor(arm.sensor_mounted() && config.calibration.force_from_sensor),
+        sensor(cc.sensor, cc.tool, splitmix(seed ^ 0x5e5ULL), splitmix(c.seed ^ 0x5e5503ULL)),
+        sheet(sensor_config_from_sheet(c, sensor.calibration())),
+        sensor_T_wap(sheet.flange_T_sensor.inverse() * nominal.flange_T_wap()),
+        ws(arm.true_model()),
+        ws_nominal(nominal),
+        dt(cc.controller.servo_period_s),
+        hold_s(std::max(1.5, 5.0 * cc.ldbb.time_constant_s)),
+        seed_q(6) {
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    ldbb_config.force_bias = cal.ldbb_force_bias + cal.ldbb_force_error * normal(rng);
+    seed_q << 0.0, deg_to_rad(20.0), deg_to_rad(10.0), 0.0, deg_to_rad(60.0), 0.0;
   }
-  const cell::CellConfig& cc = c.cell;
-  const CalibrationConfig& cal = c.calibration;
-  const bool sensor_mounted = robot.sensor_mounted();
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> normal(0.0, 1.0);
+
+  const CaseConfig& c;
+  const cell::CellConfig& cc;
+  const CalibrationConfig& cal;
+  const cell::TrueRobot& robot;
+  const RobotModel& nominal;
+  std::uint64_t seed;
   // The LDBB's force against its set-point today (the setup without the sensor knows only the
   // set-point; with the sensor the force is measured and this does not enter the estimate).
-  cell::LdbbConfig ldbb_config = cc.ldbb;
-  ldbb_config.force_bias = cal.ldbb_force_bias + cal.ldbb_force_error * normal(rng);
+  cell::LdbbConfig ldbb_config;
   // Where the calibration's force comes from: the sensor when it is mounted (unless the user
   // chose the LDBB's set-point), else the set-point.
-  const bool force_from_sensor = sensor_mounted && cal.force_from_sensor;
+  bool force_from_sensor;
   // The sensor and what its sheet says (the same physical sensor as in the runs).
-  cell::ForceSensorDaq sensor(cc.sensor, cc.tool, splitmix(seed ^ 0x5e5ULL), splitmix(c.seed ^ 0x5e5503ULL));
-  const deflex::SensorConfig sheet = sensor_config_from_sheet(c, sensor.calibration());
-  const Pose sensor_T_wap = sheet.flange_T_sensor.inverse() * nominal.flange_T_wap();
-
-  Workspace ws(robot.true_model());
-  Workspace ws_nominal(nominal);
+  cell::ForceSensorDaq sensor;
+  deflex::SensorConfig sheet;
+  Pose sensor_T_wap;
+  Workspace ws;
+  Workspace ws_nominal;
   cell::TrueRobotState state;
   bool have_state = false;
-  std::vector<StiffnessMeasurement> data;
-  const double dt = cc.controller.servo_period_s;
-  const double hold_s = std::max(1.5, 5.0 * cc.ldbb.time_constant_s);
-  JointVector seed_q(6);
-  seed_q << 0.0, deg_to_rad(20.0), deg_to_rad(10.0), 0.0, deg_to_rad(60.0), 0.0;
+  double dt;
+  double hold_s;
+  JointVector seed_q;
+};
 
-  for (int k = 0; k < cal.arcs; ++k) {
-    const Arc arc = arc_of(k);
-    const double radius = cc.ldbb.bar_length_m * std::cos(arc.phi_rad);
-    const Vector3 centre = c.circle.center_m + Vector3(0, 0, arc.dz_m);
-    const Vector3 pivot = centre - Vector3::UnitZ() * (cc.ldbb.bar_length_m * std::sin(arc.phi_rad));
-    // The arc's program: poses every ~2 deg at the calibration speed, after a hold for the force.
-    const int n = std::max(8, static_cast<int>(std::ceil(cal.arc_rad / deg_to_rad(2.0)))) + 1;
-    std::vector<Pose> poses;
-    for (int i = 0; i < n; ++i) {
-      const double a = arc.start_rad + cal.arc_rad * i / (n - 1);
-      Pose p = c.circle.tcp_orientation;
-      p.translation() = centre + radius * Vector3(std::cos(a), std::sin(a), 0.0);
-      poses.push_back(p);
-    }
-    IkRequest first;
-    if (nominal.dof() == 6) first.seed = have_state ? state.q_actual : seed_q;
-    const JointPath path = solve_path_ik(nominal, poses, first);
-    const JointTrajectory program = trajectory_at_tcp_speed(poses, path.q, cal.speed_m_s, nominal, hold_s);
+// One arc of the calibration: its geometry, its program, and what its two passes recorded.
+struct CalibrationArc {
+  int index;
+  Arc arc;
+  Vector3 pivot;
+  JointTrajectory program;
+  Pass passes[2];
+  std::optional<cell::PathDrift> unloaded_drift;  // the unloaded pass's drift as it started
+};
 
-    // Two passes over the same program: unloaded, then loaded. Each is its own run (its own drift),
-    // and the joints' lost motion carries on from whatever came before (nothing resets it).
-    Pass passes[2];
-    std::optional<cell::PathDrift> unloaded_drift;
-    for (int loaded = 0; loaded < 2; ++loaded) {
-      const std::uint64_t pass_seed = splitmix(seed ^ (static_cast<std::uint64_t>(k) * 2 + loaded + 1) * 0x9e37ULL);
-      cell::LdbbConfig bar = ldbb_config;
-      bar.push = arc.push;
-      cell::LdbbDevice device(bar, pivot, loaded ? cal.load_n : 0.0, splitmix(pass_seed ^ 1));
-      // The loaded pass follows the unloaded one a pass later: its thermal drift has hardly moved.
-      cell::PathDrift drift = loaded ? cell::PathDrift(cc.drift, splitmix(pass_seed ^ 2), *unloaded_drift,
-                                                       program.end_time_s(), cal.load_n)
-                                     : cell::PathDrift(cc.drift, splitmix(pass_seed ^ 2));
-      if (!loaded) unloaded_drift.emplace(drift);
-      cell::LaserTracker tracker(cc.tracker, splitmix(pass_seed ^ 3), hold_s, program.end_time_s(), 0.0);
-      ForcePipeline pipeline(sheet, sensor_T_wap);
-      JointVector q = program.points().front();
-      if (!have_state) {
-        state = robot.initial_state(q);
-        have_state = true;
-      } else {
-        // The arm moved here unloaded and stood: only the lost motion remembers.
-        const cell::TrueRobotState fresh = robot.initial_state(q);
-        const auto lost_motion = state.lost_motion;
-        state = fresh;
-        state.lost_motion = lost_motion;
-      }
-      Vector3 p_prev = drift.apply(robot.solve(ws, q, Wrench::Zero(), state));
-      Vector3 v_prev = Vector3::Zero();
-      const auto ticks = static_cast<long>(std::ceil(program.end_time_s() / dt));
-      double next_sample = 1.0 / cc.sensor.rate_hz;
-      for (long i = 1; i <= ticks; ++i) {
-        const double t = static_cast<double>(i) * dt;
-        program.sample(t, q);
-        Wrench w = Wrench::Zero();
-        if (loaded) {
-          device.advance(dt);
-          w = device.wrench(p_prev, v_prev);
-        }
-        drift.advance(dt);
-        const Vector3 p = drift.apply(robot.solve(ws, q, w, state, dt));
-        if (force_from_sensor && loaded) {
-          const Matrix3 base_R_flange = ws.base_T_flange.linear();
-          forward_kinematics(nominal, ws_nominal, q);  // the orientation deflex knows (nominal, encoders)
-          const Matrix3 base_R_sensor = ws_nominal.base_T_flange.linear() * sheet.flange_T_sensor.linear();
-          for (; next_sample <= t + 1e-12; next_sample += 1.0 / cc.sensor.rate_hz) {
-            ForceSample fs;
-            fs.t_s = next_sample;
-            fs.wrench_sensor.head<3>() = sensor.sample(w.head<3>(), base_R_flange, next_sample);
-            const ConditionedWrench cw = pipeline.step(fs, base_R_sensor);
-            if (static_cast<int>(cw.status) >= 0) {
-              passes[loaded].force_t.push_back(next_sample);
-              passes[loaded].force_base.push_back(cw.wrench_base.head<3>());
-            }
-          }
-        }
-        tracker.observe(t - dt, p_prev, t, p, passes[loaded].trace);
-        v_prev = (p - p_prev) / dt;
-        p_prev = p;
-      }
-    }
-
-    // Measurements: at points along the arc, the mean of the tracker samples in a window, loaded
-    // minus unloaded at the same times (both passes ran the same program).
-    const double motion_s = program.end_time_s() - hold_s;
-    for (int j = 0; j < cal.points_per_arc; ++j) {
-      const double tj = hold_s + motion_s * (j + 0.5) / cal.points_per_arc;
-      Vector3 sum[2] = {Vector3::Zero(), Vector3::Zero()};
-      int count[2] = {0, 0};
-      for (int pass = 0; pass < 2; ++pass) {
-        for (const auto& s : passes[pass].trace) {
-          if (std::abs(s.t_s - tj) <= 0.5 * cal.window_s) {
-            sum[pass] += s.p_m;
-            ++count[pass];
-          }
-        }
-      }
-      if (count[0] == 0 || count[1] == 0) continue;
-      StiffnessMeasurement m;
-      program.sample(tj, m.q);  // the encoders' reading: the commanded joints
-      m.dp_m = sum[1] / count[1] - sum[0] / count[0];
-      m.wrench_base = Wrench::Zero();
-      if (force_from_sensor) {
-        Vector3 f = Vector3::Zero();
-        int nf = 0;
-        for (std::size_t i = 0; i < passes[1].force_t.size(); ++i) {
-          if (std::abs(passes[1].force_t[i] - tj) <= 0.5 * cal.window_s) {
-            f += passes[1].force_base[i];
-            ++nf;
-          }
-        }
-        if (nf == 0) continue;
-        m.wrench_base.head<3>() = f / nf;
-      } else {
-        // The set-point along the bar as the user places it: nominal pivot, nominal TCP.
-        const Vector3 tcp = tcp_pose(nominal, ws_nominal, m.q).translation();
-        m.wrench_base.head<3>() = (arc.push ? cal.load_n : -cal.load_n) * (tcp - pivot).normalized();
-      }
-      data.push_back(m);
-    }
+// Plans the k-th arc: its bar's pivot and its program, from where the arm stands.
+CalibrationArc plan_calibration_arc(const CalibrationRig& rig, int k) {
+  const CaseConfig& c = rig.c;
+  const cell::CellConfig& cc = rig.cc;
+  const CalibrationConfig& cal = rig.cal;
+  const RobotModel& nominal = rig.nominal;
+  const Arc arc = arc_of(k);
+  const double radius = cc.ldbb.bar_length_m * std::cos(arc.phi_rad);
+  const Vector3 centre = c.circle.center_m + Vector3(0, 0, arc.dz_m);
+  const Vector3 pivot = centre - Vector3::UnitZ() * (cc.ldbb.bar_length_m * std::sin(arc.phi_rad));
+  // The arc's program: poses every ~2 deg at the calibration speed, after a hold for the force.
+  const int n = std::max(8, static_cast<int>(std::ceil(cal.arc_rad / deg_to_rad(2.0)))) + 1;
+  std::vector<Pose> poses;
+  for (int i = 0; i < n; ++i) {
+    const double a = arc.start_rad + cal.arc_rad * i / (n - 1);
+    Pose p = c.circle.tcp_orientation;
+    p.translation() = centre + radius * Vector3(std::cos(a), std::sin(a), 0.0);
+    poses.push_back(p);
   }
+  IkRequest first;
+  if (nominal.dof() == 6) first.seed = rig.have_state ? rig.state.q_actual : rig.seed_q;
+  const JointPath path = solve_path_ik(nominal, poses, first);
+  return CalibrationArc{k, arc, pivot, trajectory_at_tcp_speed(poses, path.q, cal.speed_m_s, nominal, rig.hold_s),
+                        {}, std::nullopt};
+}
+
+// Runs one pass over an arc's program (loaded = 0: unloaded, 1: loaded) and records what the tracker
+// saw and, loaded with the force from the sensor, the conditioned force.
+void run_calibration_pass(CalibrationRig& rig, CalibrationArc& arc, int loaded) {
+  const cell::CellConfig& cc = rig.cc;
+  const CalibrationConfig& cal = rig.cal;
+  const cell::TrueRobot& robot = rig.robot;
+  const JointTrajectory& program = arc.program;
+  const double hold_s = rig.hold_s;
+  const double dt = rig.dt;
+  Workspace& ws = rig.ws;
+  cell::TrueRobotState& state = rig.state;
+  Pass& pass = arc.passes[loaded];
+  const std::uint64_t pass_seed =
+      splitmix(rig.seed ^ (static_cast<std::uint64_t>(arc.index) * 2 + loaded + 1) * 0x9e37ULL);
+  cell::LdbbConfig bar = rig.ldbb_config;
+  bar.push = arc.arc.push;
+  cell::LdbbDevice device(bar, arc.pivot, loaded ? cal.load_n : 0.0, splitmix(pass_seed ^ 1));
+  // The loaded pass follows the unloaded one a pass later: its thermal drift has hardly moved.
+  cell::PathDrift drift = loaded ? cell::PathDrift(cc.drift, splitmix(pass_seed ^ 2), *arc.unloaded_drift,
+                                                   program.end_time_s(), cal.load_n)
+                                 : cell::PathDrift(cc.drift, splitmix(pass_seed ^ 2));
+  if (!loaded) arc.unloaded_drift.emplace(drift);
+  cell::LaserTracker tracker(cc.tracker, splitmix(pass_seed ^ 3), hold_s, program.end_time_s(), 0.0);
+  ForcePipeline pipeline(rig.sheet, rig.sensor_T_wap);
+  JointVector q = program.points().front();
+  if (!rig.have_state) {
+    state = robot.initial_state(q);
+    rig.have_state = true;
+  } else {
+    // The arm moved here unloaded and stood: only the lost motion remembers.
+    const cell::TrueRobotState fresh = robot.initial_state(q);
+    const auto lost_motion = state.lost_motion;
+    state = fresh;
+    state.lost_motion = lost_motion;
+  }
+  Vector3 p_prev = drift.apply(robot.solve(ws, q, Wrench::Zero(), state));
+  Vector3 v_prev = Vector3::Zero();
+  const auto ticks = static_cast<long>(std::ceil(program.end_time_s() / dt));
+  double next_sample = 1.0 / cc.sensor.rate_hz;
+  for (long i = 1; i <= ticks; ++i) {
+    const double t = static_cast<double>(i) * dt;
+    program.sample(t, q);
+    Wrench w = Wrench::Zero();
+    if (loaded) {
+      device.advance(dt);
+      w = device.wrench(p_prev, v_prev);
+    }
+    drift.advance(dt);
+    const Vector3 p = drift.apply(robot.solve(ws, q, w, state, dt));
+    if (rig.force_from_sensor && loaded) {
+      const Matrix3 base_R_flange = ws.base_T_flange.linear();
+      forward_kinematics(rig.nominal, rig.ws_nominal, q);  // the orientation deflex knows (nominal, encoders)
+      const Matrix3 base_R_sensor = rig.ws_nominal.base_T_flange.linear() * rig.sheet.flange_T_sensor.linear();
+      for (; next_sample <= t + 1e-12; next_sample += 1.0 / cc.sensor.rate_hz) {
+        ForceSample fs;
+        fs.t_s = next_sample;
+        fs.wrench_sensor.head<3>() = rig.sensor.sample(w.head<3>(), base_R_flange, next_sample);
+        const ConditionedWrench cw = pipeline.step(fs, base_R_sensor);
+        if (static_cast<int>(cw.status) >= 0) {
+          pass.force_t.push_back(next_sample);
+          pass.force_base.push_back(cw.wrench_base.head<3>());
+        }
+      }
+    }
+    tracker.observe(t - dt, p_prev, t, p, pass.trace);
+    v_prev = (p - p_prev) / dt;
+    p_prev = p;
+  }
+}
+
+// Adds an arc's measurements: at points along the arc, the mean of the tracker samples in a window,
+// loaded minus unloaded at the same times (both passes ran the same program), and the force there.
+void measure_calibration_arc(CalibrationRig& rig, const CalibrationArc& arc, std::vector<StiffnessMeasurement>& data) {
+  const CalibrationConfig& cal = rig.cal;
+  const JointTrajectory& program = arc.program;
+  const Pass* const passes = arc.passes;
+  const double hold_s = rig.hold_s;
+  const double motion_s = program.end_time_s() - hold_s;
+  for (int j = 0; j < cal.points_per_arc; ++j) {
+    const double tj = hold_s + motion_s * (j + 0.5) / cal.points_per_arc;
+    Vector3 sum[2] = {Vector3::Zero(), Vector3::Zero()};
+    int count[2] = {0, 0};
+    for (int pass = 0; pass < 2; ++pass) {
+      for (const auto& s : passes[pass].trace) {
+        if (std::abs(s.t_s - tj) <= 0.5 * cal.window_s) {
+          sum[pass] += s.p_m;
+          ++count[pass];
+        }
+      }
+    }
+    if (count[0] == 0 || count[1] == 0) continue;
+    StiffnessMeasurement m;
+    program.sample(tj, m.q);  // the encoders' reading: the commanded joints
+    m.dp_m = sum[1] / count[1] - sum[0] / count[0];
+    m.wrench_base = Wrench::Zero();
+    if (rig.force_from_sensor) {
+      Vector3 f = Vector3::Zero();
+      int nf = 0;
+      for (std::size_t i = 0; i < passes[1].force_t.size(); ++i) {
+        if (std::abs(passes[1].force_t[i] - tj) <= 0.5 * cal.window_s) {
+          f += passes[1].force_base[i];
+          ++nf;
+        }
+      }
+      if (nf == 0) continue;
+      m.wrench_base.head<3>() = f / nf;
+    } else {
+      // The set-point along the bar as the user places it: nominal pivot, nominal TCP.
+      const Vector3 tcp = tcp_pose(rig.nominal, rig.ws_nominal, m.q).translation();
+      m.wrench_base.head<3>() = (arc.arc.push ? cal.load_n : -cal.load_n) * (tcp - arc.pivot).normalized();
+    }
+    data.push_back(m);
+  }
+}
+
+// Identifies the joint stiffness from the measurements; a joint it cannot identify keeps the
+// assumed value, with a note.
+CellCalibration identify_from_measurements(const CalibrationRig& rig, const std::vector<StiffnessMeasurement>& data) {
+  const RobotModel& nominal = rig.nominal;
   if (data.size() < 6) {
     throw InputError("calibration: fewer than 6 measurements (check the calibration section of the case)");
   }
@@ -229,9 +276,35 @@ CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robo
     out.notes.push_back(w);
   }
   out.identified = nominal.with_stiffness(
-      k, fmt::format("identified on the simulated cell while moving ({} measurements on {} arcs, residual {:.1f} um RMS)",
-                     data.size(), cal.arcs, out.estimate.residual_rms_m * 1e6));
+      k, fmt::format("identified on the simulated cell while moving ({} measurements on {} arcs, "
+                     "residual {:.1f} um RMS)",
+                     data.size(), rig.cal.arcs, out.estimate.residual_rms_m * 1e6));
   return out;
+}
+
+}  // namespace
+
+CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robot, std::uint64_t seed) {
+  if (c.exact_model) {
+    const auto& k = robot.true_model().stiffness();
+    std::vector<double> kv(k.data(), k.data() + k.size());
+    return CellCalibration{robot.nominal_model().with_stiffness(kv, "exact true stiffness (model-consistent cell)"),
+                           {},
+                           0,
+                           {"exact stiffness given: model-consistent cell"}};
+  }
+  CalibrationRig rig(c, robot, seed);
+  std::vector<StiffnessMeasurement> data;
+  for (int k = 0; k < c.calibration.arcs; ++k) {
+    CalibrationArc arc = plan_calibration_arc(rig, k);
+    // Two passes over the same program: unloaded, then loaded. Each is its own run (its own drift),
+    // and the joints' lost motion carries on from whatever came before (nothing resets it).
+    for (int loaded = 0; loaded < 2; ++loaded) {
+      run_calibration_pass(rig, arc, loaded);
+    }
+    measure_calibration_arc(rig, arc, data);
+  }
+  return identify_from_measurements(rig, data);
 }
 
 }  // namespace deflex::study

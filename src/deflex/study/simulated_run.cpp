@@ -166,7 +166,66 @@ deflex::SensorConfig sensor_config_from_sheet(const CaseConfig& config, const ce
   return sc;
 }
 
-RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const RunSpec& spec) {
+namespace {
+
+// What a run is: the case, its setup, the run's spec and what follows from it, the program the
+// controller runs and the run's length in servo ticks.
+struct RunPlan {
+  const CaseConfig& config;
+  const SetupCell& setup;
+  const RunSpec& spec;
+  const cell::TrueRobot& robot;
+  const cell::CellConfig& c;
+  bool loaded;
+  bool compensated;
+  bool linked;
+  std::shared_ptr<const JointTrajectory> program;
+  double settle_s;
+  double run_end_s;
+  double dt;
+  long ticks;
+};
+
+// The cell's network and its three hosts, and the robot program's motion and state connections
+// (simple message), on a clock this simulation advances.
+struct RunNetwork {
+  explicit RunNetwork(const cell::CellConfig& c)
+      : network(clock),
+        controller_port(network.add_endpoint(kController, c.controller.network_latency_s)),
+        deflex_egm_port(network.add_endpoint(kDeflexEgm, c.controller.network_latency_s)),
+        daq_port(network.add_endpoint(kDaq, c.sensor.daq_latency_s)),
+        deflex_force_port(network.add_endpoint(kDeflexForce, 0.0)),
+        motion_stream(clock, c.controller.network_latency_s),
+        state_stream(clock, c.controller.network_latency_s) {}
+
+  ManualClock clock;
+  MemoryNetwork network;
+  MemoryTransport& controller_port;
+  MemoryTransport& deflex_egm_port;
+  MemoryTransport& daq_port;
+  MemoryTransport& deflex_force_port;
+  MemoryStreamPair motion_stream;
+  MemoryStreamPair state_stream;
+};
+
+// deflex's side of a linked run (empty for a run of the robot program): the session and the force
+// model and source it borrows.
+struct DeflexSide {
+  std::unique_ptr<LdbbForceModel> force_model;
+  std::unique_ptr<DatagramForceSource> force_source;
+  std::unique_ptr<runtime::Session> session;
+};
+
+// The cell's instruments on a run: the loading bar, the arm's drift and the laser tracker.
+struct RunInstruments {
+  cell::LdbbDevice ldbb;
+  cell::PathDrift drift;
+  cell::LaserTracker tracker;
+};
+
+// Checks the run and plans it: its program (the offline strategy's compensated one when it has one)
+// and how long the run lasts.
+RunPlan plan_simulated_run(const CaseConfig& config, const SetupCell& setup, const RunSpec& spec) {
   const cell::TrueRobot& robot = *setup.robot;
   const cell::CellConfig& c = config.cell;
   const bool loaded = spec.kind != RunKind::kUnloaded;
@@ -184,92 +243,6 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
   auto program = std::make_shared<const JointTrajectory>(protocol_program(
       setup.circle_poses, configurations, spec.speed_m_s, c.ldbb.settle_s, spec.laps_cw, spec.laps_ccw, identified));
 
-  // The cell's network and its three hosts, on a clock this simulation advances.
-  ManualClock clock;
-  MemoryNetwork network(clock);
-  MemoryTransport& controller_port = network.add_endpoint(kController, c.controller.network_latency_s);
-  MemoryTransport& deflex_egm_port = network.add_endpoint(kDeflexEgm, c.controller.network_latency_s);
-  MemoryTransport& daq_port = network.add_endpoint(kDaq, c.sensor.daq_latency_s);
-  MemoryTransport& deflex_force_port = network.add_endpoint(kDeflexForce, 0.0);
-
-  // The robot program's motion and state connections (simple message), on the same clock.
-  MemoryStreamPair motion_stream(clock, c.controller.network_latency_s);
-  MemoryStreamPair state_stream(clock, c.controller.network_latency_s);
-
-  // The controller.
-  std::unique_ptr<cell::RobotController> controller;
-  switch (spec.link) {
-    case LinkKind::kProgram:
-      controller = std::make_unique<cell::ProgramController>(program);
-      break;
-    case LinkKind::kEgmJoint:
-      controller = std::make_unique<cell::EgmPositionGuidanceController>(c.controller, program->points().front(),
-                                                                          controller_port, kDeflexEgm);
-      break;
-    case LinkKind::kEgmPath:
-      controller = std::make_unique<cell::EgmPathCorrectionController>(c.controller, robot.nominal_model(), program,
-                                                                        controller_port, kDeflexEgm);
-      break;
-    case LinkKind::kSimpleMessage:
-      controller = std::make_unique<cell::SimpleMessageServer>(cell::SimpleMessageServerConfig{}, robot.nominal_model(),
-                                                               program->points().front(), motion_stream.server(),
-                                                               state_stream.server());
-      break;
-  }
-
-  // One physical sensor for the whole case: its crosstalk and true sensitivities come from the case
-  // seed; its noise from the run's.
-  cell::ForceSensorDaq sensor(c.sensor, c.tool, component_seed(spec.seed, Component::kSensor),
-                              splitmix(config.seed ^ 0x5e5503ULL));
-  cell::DaqStream daq(daq_port, kDeflexForce);
-
-  // deflex's side, run as `deflex online` runs it: a session of the runtime on the cell's network, from
-  // the sensor's calibration sheet and identified payload, the identified robot model, the user's
-  // settings, the strategy and the link.
-  std::unique_ptr<LdbbForceModel> force_model;
-  std::unique_ptr<DatagramForceSource> force_source;
-  std::unique_ptr<runtime::Session> session;
-  if (linked) {
-    runtime::SessionConfig sc;
-    sc.link = spec.link == LinkKind::kEgmPath         ? runtime::LinkKind::kEgmPath
-              : spec.link == LinkKind::kSimpleMessage ? runtime::LinkKind::kSimpleMessage
-                                                      : runtime::LinkKind::kEgmJoint;
-    deflex::OnlineConfig& oc = sc.online;
-    oc.period_s = spec.link == LinkKind::kEgmPath         ? c.controller.path_corr_period_s
-                  : spec.link == LinkKind::kSimpleMessage ? config.online.stream_period_s
-                                                          : c.controller.egm_period_s;
-    oc.max_joint_correction_rad = config.online.max_joint_correction_rad;
-    oc.max_tcp_correction_m = config.online.max_tcp_correction_m;
-    oc.max_correction_rate_rad_s = config.online.max_rate_rad_s;
-    oc.max_tcp_rate_m_s = config.online.max_tcp_rate_m_s;
-    oc.watchdog_s = std::max(config.online.watchdog_s, 2.0 * oc.period_s);
-    StrategyKind kind = StrategyKind::kNone;  // the reference runs stream the program uncorrected
-    if (compensated) {
-      kind = spec.strategy == Strategy::kHybrid       ? StrategyKind::kHybrid
-             : spec.strategy == Strategy::kPredictive ? StrategyKind::kPredictive
-                                                      : StrategyKind::kOnline;
-    }
-    sc.strategy = kind;
-    if (kind == StrategyKind::kHybrid || kind == StrategyKind::kPredictive) {
-      // The user's force model: the LDBB with its nominal pivot and set-point force.
-      force_model = std::make_unique<LdbbForceModel>(config.pivot_m(), std::max(spec.load_n, 1.0), c.ldbb.push);
-    }
-    sc.egm_joint.stream.ramp_in_s = config.online.ramp_in_s;
-    sc.simple_message.buffer_depth = config.online.stream_buffer_depth;
-    sc.simple_message.stream.ramp_in_s = config.online.ramp_in_s;
-    sc.egm_path.frame = parse_path_corr_frame(c.controller.path_corr_frame);
-    sc.history_cycles = 16;
-    force_source = std::make_unique<DatagramForceSource>(deflex_force_port);
-    runtime::SessionEndpoints endpoints;
-    endpoints.datagram = &deflex_egm_port;
-    endpoints.motion = &motion_stream.client();
-    endpoints.state = &state_stream.client();
-    session = std::make_unique<runtime::Session>(
-        sc, identified, sensor_config_from_sheet(config, sensor.calibration()),
-        spec.link == LinkKind::kEgmPath ? nullptr : program, force_model.get(), force_source.get(), clock, endpoints);
-  }
-
-  const double settle_s = c.ldbb.settle_s;
   const double motion_end_s = program->end_time_s();
   // The arm follows a streamed program a little late: let the tracker see the motion to its end.
   // (The streaming server runs a buffer of points behind: a second.)
@@ -277,19 +250,167 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
       motion_end_s + (spec.link == LinkKind::kSimpleMessage ? 1.0 : linked ? 0.5 : 0.0);
   const double dt = c.controller.servo_period_s;
   const auto ticks = static_cast<long>(std::ceil(run_end_s / dt));
+  return RunPlan{config, setup, spec, robot, c, loaded, compensated, linked, std::move(program),
+                 c.ldbb.settle_s, run_end_s, dt, ticks};
+}
+
+// The controller the run's link talks to: the robot program itself, EGM position guidance, EGM path
+// correction or the robot program's simple message server.
+std::unique_ptr<cell::RobotController> make_run_controller(const RunPlan& plan, RunNetwork& net) {
+  const cell::CellConfig& c = plan.c;
+  const cell::TrueRobot& robot = plan.robot;
+  const std::shared_ptr<const JointTrajectory>& program = plan.program;
+  std::unique_ptr<cell::RobotController> controller;
+  switch (plan.spec.link) {
+    case LinkKind::kProgram:
+      controller = std::make_unique<cell::ProgramController>(program);
+      break;
+    case LinkKind::kEgmJoint:
+      controller = std::make_unique<cell::EgmPositionGuidanceController>(c.controller, program->points().front(),
+                                                                          net.controller_port, kDeflexEgm);
+      break;
+    case LinkKind::kEgmPath:
+      controller = std::make_unique<cell::EgmPathCorrectionController>(c.controller, robot.nominal_model(), program,
+                                                                        net.controller_port, kDeflexEgm);
+      break;
+    case LinkKind::kSimpleMessage:
+      controller = std::make_unique<cell::SimpleMessageServer>(cell::SimpleMessageServerConfig{}, robot.nominal_model(),
+                                                               program->points().front(), net.motion_stream.server(),
+                                                               net.state_stream.server());
+      break;
+  }
+  return controller;
+}
+
+// deflex's side, run as `deflex online` runs it: a session of the runtime on the cell's network, from
+// the sensor's calibration sheet and identified payload, the identified robot model, the user's
+// settings, the strategy and the link. Empty when the run has no link.
+DeflexSide start_deflex_session(const RunPlan& plan, RunNetwork& net, const cell::ForceSensorDaq& sensor) {
+  DeflexSide side;
+  if (!plan.linked) return side;
+  const CaseConfig& config = plan.config;
+  const cell::CellConfig& c = plan.c;
+  const RunSpec& spec = plan.spec;
+  runtime::SessionConfig sc;
+  sc.link = spec.link == LinkKind::kEgmPath         ? runtime::LinkKind::kEgmPath
+            : spec.link == LinkKind::kSimpleMessage ? runtime::LinkKind::kSimpleMessage
+                                                    : runtime::LinkKind::kEgmJoint;
+  deflex::OnlineConfig& oc = sc.online;
+  oc.period_s = spec.link == LinkKind::kEgmPath         ? c.controller.path_corr_period_s
+                : spec.link == LinkKind::kSimpleMessage ? config.online.stream_period_s
+                                                        : c.controller.egm_period_s;
+  oc.max_joint_correction_rad = config.online.max_joint_correction_rad;
+  oc.max_tcp_correction_m = config.online.max_tcp_correction_m;
+  oc.max_correction_rate_rad_s = config.online.max_rate_rad_s;
+  oc.max_tcp_rate_m_s = config.online.max_tcp_rate_m_s;
+  oc.watchdog_s = std::max(config.online.watchdog_s, 2.0 * oc.period_s);
+  StrategyKind kind = StrategyKind::kNone;  // the reference runs stream the program uncorrected
+  if (plan.compensated) {
+    kind = spec.strategy == Strategy::kHybrid       ? StrategyKind::kHybrid
+           : spec.strategy == Strategy::kPredictive ? StrategyKind::kPredictive
+                                                    : StrategyKind::kOnline;
+  }
+  sc.strategy = kind;
+  if (kind == StrategyKind::kHybrid || kind == StrategyKind::kPredictive) {
+    // The user's force model: the LDBB with its nominal pivot and set-point force.
+    side.force_model = std::make_unique<LdbbForceModel>(config.pivot_m(), std::max(spec.load_n, 1.0), c.ldbb.push);
+  }
+  sc.egm_joint.stream.ramp_in_s = config.online.ramp_in_s;
+  sc.simple_message.buffer_depth = config.online.stream_buffer_depth;
+  sc.simple_message.stream.ramp_in_s = config.online.ramp_in_s;
+  sc.egm_path.frame = parse_path_corr_frame(c.controller.path_corr_frame);
+  sc.history_cycles = 16;
+  side.force_source = std::make_unique<DatagramForceSource>(net.deflex_force_port);
+  runtime::SessionEndpoints endpoints;
+  endpoints.datagram = &net.deflex_egm_port;
+  endpoints.motion = &net.motion_stream.client();
+  endpoints.state = &net.state_stream.client();
+  side.session = std::make_unique<runtime::Session>(
+      sc, plan.setup.calibration.identified, sensor_config_from_sheet(config, sensor.calibration()),
+      spec.link == LinkKind::kEgmPath ? nullptr : plan.program, side.force_model.get(), side.force_source.get(),
+      net.clock, endpoints);
+  return side;
+}
+
+// The run's bar, drift and tracker, each with its own seed from the run's.
+RunInstruments make_run_instruments(const RunPlan& plan) {
+  const cell::CellConfig& c = plan.c;
+  const RunSpec& spec = plan.spec;
   // The bar was serviced and recalibrated before the online tests (paper, section 3): the runs with
   // the sensor mounted see its recalibrated force error, the offline runs its earlier one.
   cell::LdbbConfig bar = c.ldbb;
-  if (robot.sensor_mounted()) bar.force_bias = c.ldbb.force_bias_recalibrated;
-  cell::LdbbDevice ldbb(bar, config.pivot_m(), spec.load_n, component_seed(spec.seed, Component::kLdbb));
-  cell::PathDrift drift(c.drift, component_seed(spec.seed, Component::kDrift), loaded ? spec.load_n : 0.0);
-  cell::LaserTracker tracker(c.tracker, component_seed(spec.seed, Component::kTracker), settle_s, run_end_s, settle_s);
+  if (plan.robot.sensor_mounted()) bar.force_bias = c.ldbb.force_bias_recalibrated;
+  return RunInstruments{
+      cell::LdbbDevice(bar, plan.config.pivot_m(), spec.load_n, component_seed(spec.seed, Component::kLdbb)),
+      cell::PathDrift(c.drift, component_seed(spec.seed, Component::kDrift), plan.loaded ? spec.load_n : 0.0),
+      cell::LaserTracker(c.tracker, component_seed(spec.seed, Component::kTracker), plan.settle_s, plan.run_end_s,
+                         plan.settle_s)};
+}
+
+// A run's whole cell, built in the order the cell comes up: the plan, the network, the controller,
+// the force sensor and its DAQ, deflex's side, then the bar, the drift and the tracker.
+struct SimulatedRun {
+  SimulatedRun(const CaseConfig& config, const SetupCell& setup, const RunSpec& spec)
+      : plan(plan_simulated_run(config, setup, spec)),
+        net(plan.c),
+        controller(make_run_controller(plan, net)),
+        // One physical sensor for the whole case: its crosstalk and true sensitivities come from the
+        // case seed; its noise from the run's.
+        sensor(plan.c.sensor, plan.c.tool, component_seed(spec.seed, Component::kSensor),
+               splitmix(config.seed ^ 0x5e5503ULL)),
+        daq(net.daq_port, kDeflexForce),
+        deflex(start_deflex_session(plan, net, sensor)),
+        instruments(make_run_instruments(plan)) {}
+
+  RunPlan plan;
+  RunNetwork net;
+  std::unique_ptr<cell::RobotController> controller;
+  cell::ForceSensorDaq sensor;
+  cell::DaqStream daq;
+  DeflexSide deflex;
+  RunInstruments instruments;
+};
+
+// Lets deflex answer whatever has reached it by now, counting the controller messages it answered;
+// throws when its session ended with an error.
+void poll_deflex_session(runtime::Session& session, std::uint64_t& link_cycles) {
+  while (!session.ended()) {
+    const LinkPollResult r = session.poll(0.0);
+    if (session.ended() && runtime::exit_code(session.stop_reason()) != 0) {
+      const runtime::SessionSummary& end = session.finish();
+      throw Error(fmt::format("run: deflex's {} session ended: {} ({})", end.link, runtime::to_string(end.reason),
+                              end.reason_text));
+    }
+    if (r == LinkPollResult::kIdle) break;
+    if (r == LinkPollResult::kAnswered) ++link_cycles;
+  }
+}
+
+// Drives the run tick by tick: the controller moves the arm, the bar loads it, drift displaces it,
+// the tracker records it and, on a link, the DAQ streams the force and deflex answers the controller.
+RunOutput drive_simulated_run(SimulatedRun& run) {
+  const RunPlan& plan = run.plan;
+  const cell::TrueRobot& robot = plan.robot;
+  const cell::CellConfig& c = plan.c;
+  const bool loaded = plan.loaded;
+  const bool linked = plan.linked;
+  const double dt = plan.dt;
+  const long ticks = plan.ticks;
+  const double network_latency_s = c.controller.network_latency_s;
+  ManualClock& clock = run.net.clock;
+  cell::RobotController& controller = *run.controller;
+  cell::ForceSensorDaq& sensor = run.sensor;
+  cell::DaqStream& daq = run.daq;
+  runtime::Session* const session = run.deflex.session.get();
+  cell::LdbbDevice& ldbb = run.instruments.ldbb;
+  cell::PathDrift& drift = run.instruments.drift;
+  cell::LaserTracker& tracker = run.instruments.tracker;
 
   RunOutput out;
-  out.simulated_s = run_end_s;
-  out.trace.reserve(static_cast<std::size_t>((run_end_s - settle_s) * c.tracker.rate_hz) + 2);
+  out.simulated_s = plan.run_end_s;
+  out.trace.reserve(static_cast<std::size_t>((plan.run_end_s - plan.settle_s) * c.tracker.rate_hz) + 2);
   Workspace ws(robot.true_model());
-  JointVector q_motor = program->points().front();
+  JointVector q_motor = plan.program->points().front();
   cell::TrueRobotState state = robot.initial_state(q_motor);
   Vector3 p_prev = drift.apply(robot.solve(ws, q_motor, Wrench::Zero(), state));
   Vector3 v_prev = Vector3::Zero();
@@ -299,7 +420,7 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
   for (long k = 1; k <= ticks; ++k) {
     const double t = static_cast<double>(k) * dt;
     clock.set(t);
-    q_motor = controller->tick(t);
+    q_motor = controller.tick(t);
     Wrench w = Wrench::Zero();
     if (loaded) {
       ldbb.advance(dt);
@@ -308,7 +429,7 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
     drift.advance(dt);
     // Drift moves the whole arm (thermal growth, repeatability), so the LDBB sees it too.
     const Vector3 p = drift.apply(robot.solve(ws, q_motor, w, state, dt));
-    controller->encoders(state.q_motor);
+    controller.encoders(state.q_motor);
     if (linked) {
       // The DAQ streams this tick's samples; the EGM message sent this tick reaches deflex after the
       // network's latency, and deflex answers at once (its reply reaches the controller's next tick).
@@ -316,33 +437,36 @@ RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const R
       for (; next_daq <= t + 1e-12; next_daq += daq_period) {
         daq.send(next_daq, sensor.sample(w.head<3>(), base_R_flange, next_daq));
       }
-      clock.set(t + c.controller.network_latency_s);
-      while (!session->ended()) {
-        const LinkPollResult r = session->poll(0.0);
-        if (session->ended() && runtime::exit_code(session->stop_reason()) != 0) {
-          const runtime::SessionSummary& end = session->finish();
-          throw Error(fmt::format("run: deflex's {} session ended: {} ({})", end.link, runtime::to_string(end.reason),
-                                  end.reason_text));
-        }
-        if (r == LinkPollResult::kIdle) break;
-        if (r == LinkPollResult::kAnswered) ++out.link_cycles;
-      }
+      clock.set(t + network_latency_s);
+      poll_deflex_session(*session, out.link_cycles);
     }
     tracker.observe(t - dt, p_prev, t, p, out.trace);
     v_prev = (p - p_prev) / dt;
     p_prev = p;
   }
-  if (linked) {
-    const runtime::SessionSummary& summary = session->finish();
-    out.link_counters = summary.counters;
-    out.measured_delay_s = summary.measured_delay_s;
-    out.max_command_deviation_rad = spec.link == LinkKind::kEgmPath ? 0.0 : summary.stats.max_deviation_rad;
-    out.max_tcp_correction_m = summary.stats.max_deviation_m;
-    const auto* egm = dynamic_cast<const cell::EgmPositionGuidanceController*>(controller.get());
-    if (egm != nullptr && egm->counters().timed_out) {
-      throw Error("run: the simulated controller stopped EGM for lack of answers (a broken setup, not a result)");
-    }
+  return out;
+}
+
+// What deflex's link did over the run, from its session's summary; throws when the simulated
+// controller stopped EGM for lack of answers.
+void summarize_deflex_link(SimulatedRun& run, RunOutput& out) {
+  const runtime::SessionSummary& summary = run.deflex.session->finish();
+  out.link_counters = summary.counters;
+  out.measured_delay_s = summary.measured_delay_s;
+  out.max_command_deviation_rad = run.plan.spec.link == LinkKind::kEgmPath ? 0.0 : summary.stats.max_deviation_rad;
+  out.max_tcp_correction_m = summary.stats.max_deviation_m;
+  const auto* egm = dynamic_cast<const cell::EgmPositionGuidanceController*>(run.controller.get());
+  if (egm != nullptr && egm->counters().timed_out) {
+    throw Error("run: the simulated controller stopped EGM for lack of answers (a broken setup, not a result)");
   }
+}
+
+}  // namespace
+
+RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const RunSpec& spec) {
+  SimulatedRun run(config, setup, spec);
+  RunOutput out = drive_simulated_run(run);
+  if (run.plan.linked) summarize_deflex_link(run, out);
   return out;
 }
 
