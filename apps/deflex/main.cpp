@@ -67,12 +67,8 @@ int check_stdout(const std::string& active, int exit_code) {
   return exit_code == 0 ? 1 : exit_code;
 }
 
-}  // namespace
-
-}  // namespace deflex::cli
-
-int main(int argc, char** argv) {
-  using namespace deflex::cli;
+/// The program. What it throws while setting itself up (before a command runs) reaches main().
+int run_program(int argc, char** argv) {
   hold_closed_standard_streams();
   deflex::remove_temporaries_on_signals();  // Ctrl-C leaves no temporary file beside an output
   CLI::App app{
@@ -112,4 +108,20 @@ int main(int argc, char** argv) {
     return 3;
   }
   return check_stdout(active, exit_code);
+}
+
+}  // namespace
+
+}  // namespace deflex::cli
+
+int main(int argc, char** argv) {
+  // Nothing leaves main as an exception: setting up the commands can still throw (out of memory).
+  try {
+    return deflex::cli::run_program(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "deflex: internal error: %s\n", e.what());
+  } catch (...) {
+    std::fputs("deflex: internal error\n", stderr);
+  }
+  return 3;
 }

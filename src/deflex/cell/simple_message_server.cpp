@@ -33,8 +33,8 @@ SimpleMessageServer::SimpleMessageServer(const SimpleMessageServerConfig& config
       state_(state),
       moves_(config.motion, model, q_start, config.buffer_points),
       reader_(config.byte_order, config.max_frame_bytes),
-      motion_out_(64 * 1024),
-      state_out_(64 * 1024),
+      motion_out_(std::size_t{64} * 1024),
+      state_out_(std::size_t{64} * 1024),
       next_publish_s_(0.0),
       q_(q_start),
       last_target_(q_start) {}

@@ -2,6 +2,7 @@
 #include "deflex/egm/egm_joint_link.hpp"
 
 #include <algorithm>
+#include <utility>
 #include <chrono>
 #include <cmath>
 
@@ -42,7 +43,7 @@ EgmJointLink::EgmJointLink(OnlineCompensator& compensator, OnlineStrategy& strat
       config_(config),
       receiver_(transport, clock, compensator.model(), with_period(config.receiver, compensator.config().period_s),
                 counters_),
-      stream_(nominal, config.stream),
+      stream_(std::move(nominal), config.stream),
       delay_(config.initial_delay_s),
       period_s_(compensator.config().period_s) {
   const int n = compensator.model().dof();

@@ -143,7 +143,7 @@ FrameRegistration register_frames(const RegistrationInput& in) {
   }
   // The rotation is fixed only if the features span at least two directions.
   const DynamicSvd svd(spread);
-  const auto sv = svd.singularValues();
+  const auto& sv = svd.singularValues();
   if (sv.size() < 2 || !(sv[1] > 1e-3 * sv[0])) {
     throw InputError(
         "registration: the points lie on one line (and no circle axis leaves it): the rotation about that line is "

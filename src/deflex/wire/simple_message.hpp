@@ -48,7 +48,7 @@ inline constexpr std::size_t kWireJoints = 10;   ///< joint slots in every joint
 /// 52: sequence, joints, velocity, duration.
 inline constexpr std::size_t kJointTrajPtBytes = 4 + 4 * kWireJoints + 4 + 4;
 inline constexpr std::size_t kJointPositionBytes = 4 + 4 * kWireJoints;         ///< 44: sequence, joints
-inline constexpr std::size_t kRobotStatusBytes = 7 * 4;                         ///< 28: seven int32
+inline constexpr std::size_t kRobotStatusBytes = std::size_t{7} * 4;                        ///< 28: seven int32
 /// industrial_core reads frames into 1024-byte buffers: a longer LENGTH is no simple message deflex
 /// speaks, and on a stream it means the reader is out of step.
 inline constexpr std::size_t kDefaultMaxFrameBytes = 1024;
