@@ -116,7 +116,7 @@ void add_candidate_loads(const RobotModel& model, Workspace& ws, const Calibrati
 std::vector<CandidatePose> reachable_candidate_poses(const RobotModel& model, const CalibrationPlanOptions& o,
                                                      int& tried) {
   const int n = model.dof();
-  const JointVector c_nom = model.compliance();
+  const JointVector& c_nom = model.compliance();
   Workspace ws(model);
   const Eigen::Quaterniond base_q = o.orientation.normalized();
   const int g = o.grid_per_axis;

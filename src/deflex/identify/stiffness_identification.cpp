@@ -88,7 +88,7 @@ class RowStore {
   RowStore(int dof, std::size_t memory_bytes) : width_(dof + 1), memory_budget_(memory_bytes) {}
   // Space for `rows` contiguous rows of the next measurement.
   double* append(int rows) {
-    const std::size_t need = static_cast<std::size_t>(rows * width_);
+    const std::size_t need = static_cast<std::size_t>(rows) * static_cast<std::size_t>(width_);
     if (chunks_.empty() || chunks_.back().values.size() + need > chunk_capacity()) {
       if (!chunks_.empty()) {
         retire(chunks_.back());
@@ -340,7 +340,7 @@ void drop_collinear_joint_groups(const RowStore& s, const Eigen::VectorXd& col_n
                                  std::vector<int>& left_out, std::vector<std::string>& warnings) {
   while (estimated.size() > 1) {
     const auto svd = svd_of(s, estimated, col_norm, omega);
-    const Eigen::VectorXd sv = svd.singularValues();
+    const Eigen::VectorXd& sv = svd.singularValues();
     const Eigen::Index last = sv.size() - 1;
     // Fewer equations than joints: the SVD has fewer singular values than columns, and V's trailing
     // columns span a null space the smallest singular value does not show.
@@ -604,7 +604,7 @@ double residual_variance(const WeightedResidualSums& sums, std::size_t passive_j
 double scaled_condition_number(const RowStore& s, const std::vector<int>& estimated, const Eigen::VectorXd& col_norm,
                                const std::vector<double>& omega) {
   const auto svd = svd_of(s, estimated, col_norm, omega);
-  const Eigen::VectorXd sv = svd.singularValues();
+  const Eigen::VectorXd& sv = svd.singularValues();
   return sv[sv.size() - 1] > 0.0 ? sv[0] / sv[sv.size() - 1] : std::numeric_limits<double>::infinity();
 }
 

@@ -32,7 +32,7 @@ bool is_rapid(const std::string& ext) { return ext == ".MOD" || ext == ".MODX" |
 /// The .dat beside a KRL .src (".dat" or ".DAT"); refused naming it when there is none.
 std::string krl_data_list(const std::string& src) {
   for (const char* ext : {".dat", ".DAT"}) {
-    const std::string dat = fs::path(src).replace_extension(ext).string();
+    std::string dat = fs::path(src).replace_extension(ext).string();
     struct stat st {};
     if (::lstat(dat.c_str(), &st) == 0) {
       return dat;

@@ -134,7 +134,7 @@ JointTrajectory JointTrajectory::read_csv(const std::string& path, const RobotMo
     t.push_back(table.at(r, "t_s"));
     JointVector v(n);
     for (int j = 0; j < n; ++j) {
-      v[j] = deg_to_rad(table.at(r, static_cast<std::size_t>(table.column(expected[static_cast<std::size_t>(j + 1)]))));
+      v[j] = deg_to_rad(table.at(r, static_cast<std::size_t>(table.column(expected[static_cast<std::size_t>(j) + 1]))));
     }
     q.push_back(v);
     lines.push_back(table.line_of(r));

@@ -113,7 +113,7 @@ void whisker(Canvas& c, double x, double y_lo_px, double y_hi_px, const std::str
 }
 
 Range fitted_range(const std::vector<double>& values, bool from_zero, double pad) {
-  double lo = INFINITY, hi = -INFINITY;
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
   for (const double v : values) {
     if (std::isfinite(v)) {
       lo = std::min(lo, v);

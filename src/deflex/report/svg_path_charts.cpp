@@ -56,7 +56,7 @@ std::optional<Reference> reference_of(const PathPlot& plot) {
     return std::nullopt;
   }
   r.plane = best_fit_plane(r.path);
-  double lo_u = INFINITY, hi_u = -INFINITY, lo_v = INFINITY, hi_v = -INFINITY;
+  double lo_u = HUGE_VAL, hi_u = -HUGE_VAL, lo_v = HUGE_VAL, hi_v = -HUGE_VAL;
   for (const auto& s : r.path) {
     const Vector3 d = s.p_m - r.plane.centroid_m;
     lo_u = std::min(lo_u, d.dot(r.plane.u));
@@ -275,7 +275,7 @@ std::string svg_path_plot(const PathPlot& plot) {
 
   // The path in its plane, equal scales, deviations magnified.
   const double pl = 76.0, pt = 130.0, pw = 400.0, ph = 400.0;
-  double lo_u = INFINITY, hi_u = -INFINITY, lo_v = INFINITY, hi_v = -INFINITY;
+  double lo_u = HUGE_VAL, hi_u = -HUGE_VAL, lo_v = HUGE_VAL, hi_v = -HUGE_VAL;
   for (const auto& s : ref->path) {
     const Vector3 d = s.p_m - centroid;
     lo_u = std::min(lo_u, d.dot(u));
@@ -587,7 +587,7 @@ std::string svg_polar_deviation(const PathPlot& plot) {
       if (std::abs(std::remainder(deg - 22.5, 45.0)) > 12.5) {
         continue;  // between the spokes, away from their labels
       }
-      double clearance = INFINITY;
+      double clearance = HUGE_VAL;
       for (const auto& cv : curves) {
         for (std::size_t j = 0; j < kSectors; ++j) {
           const double sector_deg = sector_centre_deg(j);

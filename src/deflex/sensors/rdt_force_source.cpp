@@ -291,7 +291,7 @@ void RdtForceSource::take(const RdtRecord& record) noexcept {
   s.t_s = static_cast<double>(ft_ticks_) / (calibration_.rate_hz * step);
   for (int i = 0; i < 3; ++i) {
     s.wrench_sensor(i) = force_n_per_count_ * record.counts[static_cast<std::size_t>(i)];
-    s.wrench_sensor(i + 3) = torque_nm_per_count_ * record.counts[static_cast<std::size_t>(i + 3)];
+    s.wrench_sensor(i + 3) = torque_nm_per_count_ * record.counts[static_cast<std::size_t>(i) + 3];
   }
   const bool saturated = rdt_counts_saturated(record);
   s.valid = record.status == 0 && !saturated;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 #include <cstdarg>
 #include <array>
 #include <cstdio>
@@ -77,7 +78,7 @@ SimpleMessageLink::SimpleMessageLink(OnlineCompensator& compensator, OnlineStrat
       state_port_(state),
       config_(config),
       period_s_(compensator.config().period_s),
-      stream_(nominal, config.stream),
+      stream_(std::move(nominal), config.stream),
       delay_(std::isnan(config.initial_delay_s) ? config.buffer_depth * compensator.config().period_s
                                                 : config.initial_delay_s,
              (config.buffer_depth + 4) * compensator.config().period_s + 0.5),

@@ -168,7 +168,7 @@ void read_case_circle(const yaml::Field& root, CaseConfig& c) {
 // The case file's "protocol": seeds, laps, speeds and the sweep. Returns the section (the sweep's
 // load is checked against the setups' loads once they are read).
 yaml::Field read_case_protocol(const yaml::Field& root, CaseConfig& c) {
-  const auto proto = root.at("protocol");
+  auto proto = root.at("protocol");
   proto.only_keys({"laps_cw", "laps_ccw", "speeds_mm_s", "sweep_speeds_mm_s", "sweep_load_N", "seeds"});
   c.seeds = case_whole(proto, "seeds", 1, 1, 1000, "must be 1..1000");
   c.laps_cw = proto.get("laps_cw", 3);

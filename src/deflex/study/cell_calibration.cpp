@@ -38,7 +38,8 @@ Arc arc_of(int k) {
                                {deg_to_rad(50), 0.05, false, 4.2},          {deg_to_rad(50), -0.05, true, 1.0},
                                {deg_to_rad(-30), 0.0, true, 3.1},           {deg_to_rad(-30), 0.03, false, 5.2}};
   Arc a = kArcs[k % 6];
-  a.start_rad += 0.37 * (k / 6);
+  const int round = k / 6;  // the round of six arcs
+  a.start_rad += 0.37 * round;
   return a;
 }
 

@@ -26,9 +26,9 @@ char* exact(char* out, double v) noexcept {
 void ten_digits(char* d, std::uint64_t n) noexcept {
   const auto hi = static_cast<unsigned>(n / 100000000U);  // 0..99
   auto lo = static_cast<unsigned>(n % 100000000U);
-  std::memcpy(d, kDigitPairs + 2 * hi, 2);
+  std::memcpy(d, kDigitPairs + std::size_t{2} * hi, 2);
   for (int k = 8; k >= 2; k -= 2) {
-    std::memcpy(d + k, kDigitPairs + 2 * (lo % 100U), 2);
+    std::memcpy(d + k, kDigitPairs + std::size_t{2} * (lo % 100U), 2);
     lo /= 100U;
   }
 }

@@ -295,7 +295,7 @@ std::string OutputFile::keep_previous() const {
     return {};
   }
   for (int attempt = 0; attempt < 100; ++attempt) {
-    const std::string kept = sibling_name(parent_of(target_), base_of(target_), "old");
+    std::string kept = sibling_name(parent_of(target_), base_of(target_), "old");
     if (::link(target_.c_str(), kept.c_str()) == 0) {
       return kept;
     }

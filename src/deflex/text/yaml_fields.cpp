@@ -17,8 +17,8 @@
 
 namespace deflex::yaml {
 
-Field::Field(YAML::Node node, std::string file, std::string path)
-    : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
+Field::Field(const YAML::Node& node, std::string file, std::string path)
+    : node_(node), file_(std::move(file)), path_(std::move(path)) {}
 
 namespace {
 
@@ -65,7 +65,7 @@ void refuse_duplicate_keys(const YAML::Node& node, const std::string& file, cons
       throw ModelError(fmt::format("{}: a key of field '{}': {}", where_of(file, kv.first.Mark()),
                                    path.empty() ? "<document>" : path, *bad));
     }
-    const std::string child = path.empty() ? key : path + "." + key;
+    const std::string child = path.empty() ? key : fmt::format("{}.{}", path, key);
     for (const auto& [k, mark] : seen) {
       if (k == key) {
         throw ModelError(fmt::format("{}: field '{}': key given twice (first at line {}); each key may appear once",

@@ -17,7 +17,7 @@ namespace deflex::yaml {
 /// A YAML node with the file it came from and its dotted path, for error messages.
 class Field {
  public:
-  Field(YAML::Node node, std::string file, std::string path);
+  Field(const YAML::Node& node, std::string file, std::string path);
 
   /// Parses a whole file (input_file.hpp: a regular file within the limit of `kind`); throws ModelError
   /// "FILE: cannot read" or "FILE:LINE: YAML syntax error", and "FILE:LINE:COL: field 'a.b': key given

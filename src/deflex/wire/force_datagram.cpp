@@ -18,7 +18,7 @@ void encode_force_datagram(const ForceDatagram& sample, std::array<unsigned char
   std::memcpy(out.data() + 8, &sample.t_s, 8);
   for (int i = 0; i < 6; ++i) {
     const double v = sample.wrench_sensor[i];
-    std::memcpy(out.data() + 16 + 8 * i, &v, 8);
+    std::memcpy(out.data() + 16 + 8 * static_cast<std::size_t>(i), &v, 8);
   }
 }
 
@@ -30,7 +30,7 @@ bool decode_force_datagram(const unsigned char* data, std::size_t size, ForceDat
   std::memcpy(&out.t_s, data + 8, 8);
   for (int i = 0; i < 6; ++i) {
     double v = 0.0;
-    std::memcpy(&v, data + 16 + 8 * i, 8);
+    std::memcpy(&v, data + 16 + 8 * static_cast<std::size_t>(i), 8);
     out.wrench_sensor[i] = v;
   }
   return true;

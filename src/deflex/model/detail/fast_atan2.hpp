@@ -42,7 +42,9 @@ namespace deflex {
   if (!(den > 0.0) || !(den < HUGE_VAL) || !(num < HUGE_VAL)) {
     return std::atan2(y, x);  // zeros, infinities, NaN
   }
-  const int k = static_cast<int>(num * 16.0 / den + 0.5);
+  // num / den is in [0, 1]: adding 0.5 and truncating rounds to nearest, without lround's library
+  // call in the kinematics kernel.
+  const int k = static_cast<int>(num * 16.0 / den + 0.5);  // NOLINT(bugprone-incorrect-roundings)
   const double c = k * (1.0 / 16.0);
   const double u = (num - c * den) / (den + c * num);
   const double z = u * u;
