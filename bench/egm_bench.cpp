@@ -18,8 +18,8 @@
 #include "deflex/egm/egm_joint_link.hpp"
 #include "deflex/egm/egm_path_link.hpp"
 #include "deflex/model/robot_io.hpp"
-#include "deflex/transport/udp_transport.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/transport/udp_transport.hpp"
 
 // GCC sees the replacement operator new (malloc) and delete (free) of this file inlined into the same
 // translation unit and calls them mismatched; they are the standard replacement pair.

@@ -1,6 +1,6 @@
 // Joint stiffness identification speed: the issue asks for 10,000 measurements in under 50 ms.
-// Data: the built-in IRB6700 with a tool whose TCP is off the flange axis, random poses and loads, the core's exact deflection
-// plus 10 um tracker noise and 1% gross outliers (so the robust loop really iterates).
+// Data: the built-in IRB6700 with a tool whose TCP is off the flange axis, random poses and loads, the core's exact
+// deflection plus 10 um tracker noise and 1% gross outliers (so the robust loop really iterates).
 #include <random>
 
 #include <benchmark/benchmark.h>

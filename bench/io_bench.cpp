@@ -51,8 +51,8 @@ BENCHMARK(BM_CsvWriteRow);
 // configuration integers, forces (N), small deflections (mm, mrad), zeros and rounding noise.
 std::vector<double> offline_like_numbers() {
   std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> deg(-180.0, 180.0), mm(-2500.0, 2500.0), unit(-1.0, 1.0),
-      force(-650.0, 650.0), small(-0.6, 0.6), noise(1e-13, 1e-11);
+  std::uniform_real_distribution<double> deg(-180.0, 180.0), mm(-2500.0, 2500.0), unit(-1.0, 1.0), force(-650.0, 650.0),
+      small(-0.6, 0.6), noise(1e-13, 1e-11);
   std::vector<double> v;
   for (int r = 0; r < 1000; ++r) {
     v.push_back(r);
@@ -87,7 +87,8 @@ void BM_ToCharsG10(benchmark::State& state) {
   char buf[64];
   std::size_t i = 0, bytes = 0;
   for (auto _ : state) {
-    bytes += static_cast<std::size_t>(std::to_chars(buf, buf + sizeof buf, v[i], std::chars_format::general, 10).ptr - buf);
+    bytes +=
+        static_cast<std::size_t>(std::to_chars(buf, buf + sizeof buf, v[i], std::chars_format::general, 10).ptr - buf);
     i = i + 1 == v.size() ? 0 : i + 1;
   }
   benchmark::DoNotOptimize(bytes);

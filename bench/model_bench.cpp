@@ -9,11 +9,11 @@
 #include <kdl/chainiksolverpos_lma.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 
+#include "bench_robot.hpp"
 #include "deflex/model/compliance.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
 #include "deflex/model/opw_ik.hpp"
 #include "deflex/model/robot_io.hpp"
-#include "bench_robot.hpp"
 #include "model/kdl_chain.hpp"
 
 namespace {

@@ -17,9 +17,9 @@
 #include <benchmark/benchmark.h>
 
 #include "deflex/model/robot_io.hpp"
+#include "deflex/online/online_strategy.hpp"
 #include "deflex/rsi/rsi_link.hpp"
 #include "deflex/transport/udp_transport.hpp"
-#include "deflex/online/online_strategy.hpp"
 
 // GCC sees the replacement operator new (malloc) and delete (free) of this file inlined into the same
 // translation unit and calls them mismatched; they are the standard replacement pair.

@@ -15,11 +15,11 @@
 #include <benchmark/benchmark.h>
 
 #include "deflex/cell/simple_message_server.hpp"
-#include "deflex/simple_message/simple_message_link.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/online/online_strategy.hpp"
+#include "deflex/simple_message/simple_message_link.hpp"
 #include "deflex/transport/memory_stream.hpp"
 #include "deflex/transport/tcp_stream.hpp"
-#include "deflex/online/online_strategy.hpp"
 
 // GCC sees the replacement operator new (malloc) and delete (free) of this file inlined into the same
 // translation unit and calls them mismatched; they are the standard replacement pair.

@@ -8,10 +8,10 @@
 
 #include <fmt/format.h>
 
+#include "deflex/model/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/input_ranges.hpp"
 #include "deflex/text/parse_number.hpp"
-#include "deflex/model/robot_io.hpp"
 
 namespace deflex::cli {
 
@@ -26,8 +26,7 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& op
     const std::string t = b == std::string::npos ? "" : item.substr(b, e - b + 1);
     const std::optional<double> v = parse_double(t);
     if (!v) {
-      throw InputError(
-          fmt::format("option {}: {} (value {} of '{}')", option, not_a_number(t), out.size() + 1, text));
+      throw InputError(fmt::format("option {}: {} (value {} of '{}')", option, not_a_number(t), out.size() + 1, text));
     }
     if (const auto bad = range_violation(*v, range)) {
       throw InputError(fmt::format("option {}: value {}: {}", option, out.size() + 1, *bad));
@@ -35,7 +34,8 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& op
     out.push_back(*v);
   }
   if (expected != 0 && out.size() != expected) {
-    throw InputError(fmt::format("option {}: expected {} comma-separated numbers, got {}", option, expected, out.size()));
+    throw InputError(
+        fmt::format("option {}: expected {} comma-separated numbers, got {}", option, expected, out.size()));
   }
   return out;
 }
@@ -86,10 +86,11 @@ RobotModel load_cli_robot(const std::string& command, const std::string& robot_p
 
 void require_stiffness(const RobotModel& model) {
   if (!model.has_stiffness()) {
-    throw InputError(fmt::format("robot '{}' ({}) has no joint stiffness: give it with --stiffness-Nm-per-rad "
-                                 "\"k1,...,k{}\" (Nm/rad) or in a robot file (joint_stiffness_Nm_per_rad, "
-                                 "docs/robot-file.md)",
-                                 model.name(), model.description().source, model.dof()));
+    throw InputError(
+        fmt::format("robot '{}' ({}) has no joint stiffness: give it with --stiffness-Nm-per-rad "
+                    "\"k1,...,k{}\" (Nm/rad) or in a robot file (joint_stiffness_Nm_per_rad, "
+                    "docs/robot-file.md)",
+                    model.name(), model.description().source, model.dof()));
   }
 }
 

@@ -7,8 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "deflex/text/input_ranges.hpp"
 #include "deflex/model/robot_model.hpp"
+#include "deflex/text/input_ranges.hpp"
 
 namespace deflex::cli {
 

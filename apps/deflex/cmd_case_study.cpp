@@ -4,22 +4,22 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <mutex>
 
 #include "cli_util.hpp"
 #include "command.hpp"
-#include "deflex/report/case_report.hpp"
-#include "deflex/study/case_study.hpp"
 #include "deflex/evaluate/tracker_files.hpp"
-#include "deflex/study/study_tables.hpp"
 #include "deflex/model/tracker_trace.hpp"
+#include "deflex/report/case_report.hpp"
+#include "deflex/report/html_report.hpp"
+#include "deflex/study/case_study.hpp"
+#include "deflex/study/study_tables.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/output_file.hpp"
-#include "deflex/report/html_report.hpp"
 
 namespace deflex::cli {
 namespace {
@@ -167,10 +167,11 @@ void setup(CLI::App& sub, int& exit_code) {
   sub.add_option("--seeds", o->seeds,
                  "Seeds to run, from --seed up: each its own cell and runs; the tables give mean and spread "
                  "(default: the case file's protocol.seeds; 1..1000)");
-  sub.add_option("--write-traces", o->traces_dir,
-                 "Directory for the simulated tracker runs (CSV and Spatial Analyzer export, .sa.txt) of the first seed at "
-                 "the error budget's speed and each "
-                 "setup's highest load (unloaded, UC and C), to try `deflex evaluate` on");
+  sub.add_option(
+      "--write-traces", o->traces_dir,
+      "Directory for the simulated tracker runs (CSV and Spatial Analyzer export, .sa.txt) of the first seed at "
+      "the error budget's speed and each "
+      "setup's highest load (unloaded, UC and C), to try `deflex evaluate` on");
   sub.add_option("--threads", o->threads, "Worker threads, 0..256 (default 0: one per hardware thread)");
   sub.add_flag("--json", o->json, "Print only the JSON document of the results on stdout");
   sub.add_flag("--quick", o->quick, "One clockwise and one anticlockwise lap per run instead of the protocol's 3 + 3");

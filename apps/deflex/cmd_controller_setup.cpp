@@ -13,11 +13,11 @@
 #include "command.hpp"
 #include "deflex/egm/egm_controller_setup.hpp"
 #include "deflex/model/types.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/rsi/rsi_controller_setup.hpp"
 #include "deflex/rsi/rsi_link.hpp"
 #include "deflex/runtime/link_table.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::cli {
 namespace {
@@ -27,14 +27,14 @@ struct ControllerSetupOpts {
   // started with the same options.
   static constexpr runtime::SessionOptionDefaults kShared = runtime::kSessionOptionDefaults;
   std::string link, sensor_ip, output_dir = ".", sentype = kShared.rsi_sentype, context = "deflex_rsi",
-      device = "DEFLEX", egm_config = "default", module = "DeflexEgm", path_frame = kShared.path_frame, tool = "tool0",
-      program, robot;
+                               device = "DEFLEX", egm_config = "default", module = "DeflexEgm",
+                               path_frame = kShared.path_frame, tool = "tool0", program, robot;
   int egm_port = 6510, rsi_port = 49152,  // the ports ABB's and KUKA's examples use
       rsi_timeout = kShared.rsi_timeout, rsi_precision = 4;
-  double period_ms = 0.0, max_joint_deg = kShared.max_joint_correction_deg,
-         max_tcp_mm = kShared.max_tcp_correction_mm, ramp_in_s = kShared.ramp_in_s, comm_timeout_s = kNaN,
-         lowpass_hz = 20.0, convergence_deg = 0.1, cond_time_s = 10.0, max_pos_deviation_deg = kNaN,
-         max_speed_deviation_deg_s = kNaN, monitor_factor = 1.2, max_rate_deg_s = kShared.max_rate_deg_s,
+  double period_ms = 0.0, max_joint_deg = kShared.max_joint_correction_deg, max_tcp_mm = kShared.max_tcp_correction_mm,
+         ramp_in_s = kShared.ramp_in_s, comm_timeout_s = kNaN, lowpass_hz = 20.0, convergence_deg = 0.1,
+         cond_time_s = 10.0, max_pos_deviation_deg = kNaN, max_speed_deviation_deg_s = kNaN, monitor_factor = 1.2,
+         max_rate_deg_s = kShared.max_rate_deg_s,
          stop_silence_s = kNaN;  // default: the link kind's (runtime/link_table.cpp)
   bool json = false;
 };
@@ -145,8 +145,9 @@ std::vector<ControllerFile> egm_setup_files(const ControllerSetupOpts& o) {
 /// The files of --link rsi: the Ethernet config, the RSI context and the KRL program.
 std::vector<ControllerFile> rsi_setup_files(const ControllerSetupOpts& o) {
   if (!o.program.empty() || !o.robot.empty()) {
-    throw InputError("options --program, --robot: apply to --link egm-joint and egm-path (the RSI limits come from "
-                     "--max-joint-correction-deg)");
+    throw InputError(
+        "options --program, --robot: apply to --link egm-joint and egm-path (the RSI limits come from "
+        "--max-joint-correction-deg)");
   }
   RsiSetupOptions r;
   r.sensor_ip = o.sensor_ip;

@@ -1,14 +1,13 @@
 // `deflex evaluate`: the paper's mean deformation and ISO 9283 path figures from tracker files.
 #include <algorithm>
-#include <iostream>
 #include <cmath>
+#include <iostream>
 #include <memory>
 
 #include <fmt/format.h>
 
 #include "cli_util.hpp"
 #include "command.hpp"
-#include "tracker_options.hpp"
 #include "deflex/evaluate/commanded_path.hpp"
 #include "deflex/evaluate/frame_registration.hpp"
 #include "deflex/evaluate/iso9283_path.hpp"
@@ -19,6 +18,7 @@
 #include "deflex/evaluate/tracker_runs.hpp"
 #include "deflex/model/tracker_trace.hpp"
 #include "deflex/text/errors.hpp"
+#include "tracker_options.hpp"
 
 namespace deflex::cli {
 
@@ -85,7 +85,8 @@ std::string iso_text(const std::string& what, const Iso9283Path& iso) {
 
 std::string alignment_text(const std::string& path, const TimeAlignment& a) {
   std::string out = fmt::format("  {}: offset {:+.4f} s", path, a.offset_s);
-  out += std::isfinite(a.offset_std_s) ? fmt::format(" +- {:.4f} s", a.offset_std_s) : " (uncertainty n/a: too few moving blocks)";
+  out += std::isfinite(a.offset_std_s) ? fmt::format(" +- {:.4f} s", a.offset_std_s)
+                                       : " (uncertainty n/a: too few moving blocks)";
   if (a.drift != 0.0) out += fmt::format(", drift {:+.2f} ppm", a.drift * 1e6);
   out += fmt::format(", RMS from the command {:.4f} mm, {} samples ({:.0f} % moving)\n", a.rms_m * 1e3, a.samples,
                      a.moving_fraction * 100);
@@ -265,20 +266,22 @@ nlohmann::json evaluate_json(const EvaluateOpts& o, const EvaluateRuns& r, const
     nlohmann::json runs = nlohmann::json::array();
     for (std::size_t k = 0; k < r.alignments.size(); ++k) {
       const auto& [path, a] = r.alignments[k];
-      nlohmann::json run{{"file", path},
-                         {"offset_s", a.offset_s},
-                         {"offset_std_s",
-                          std::isfinite(a.offset_std_s) ? nlohmann::json(a.offset_std_s) : nlohmann::json(nullptr)},
-                         {"drift_ppm", a.drift * 1e6},
-                         {"rms_from_command_mm", a.rms_m * 1e3},
-                         {"samples", a.samples},
-                         {"synchronous_error_to_command_mm", f.to_command[k].mean_m * 1e3}};
+      nlohmann::json run{
+          {"file", path},
+          {"offset_s", a.offset_s},
+          {"offset_std_s", std::isfinite(a.offset_std_s) ? nlohmann::json(a.offset_std_s) : nlohmann::json(nullptr)},
+          {"drift_ppm", a.drift * 1e6},
+          {"rms_from_command_mm", a.rms_m * 1e3},
+          {"samples", a.samples},
+          {"synchronous_error_to_command_mm", f.to_command[k].mean_m * 1e3}};
       if (std::isfinite(o.clock_offset_s)) run["lag_s"] = o.clock_offset_s - a.offset_s;
       runs.push_back(run);
     }
     doc["alignment"] = {{"commanded", o.align_to}, {"commanded_kind", r.reading.commanded.kind}, {"runs", runs}};
-    doc["time_synchronous_mm"] = {{"mean", f.sync.mean_m * 1e3}, {"max", f.sync.max_m * 1e3},
-                                  {"rms", f.sync.rms_m * 1e3}, {"samples", f.sync.samples}};
+    doc["time_synchronous_mm"] = {{"mean", f.sync.mean_m * 1e3},
+                                  {"max", f.sync.max_m * 1e3},
+                                  {"rms", f.sync.rms_m * 1e3},
+                                  {"samples", f.sync.samples}};
   }
   return doc;
 }

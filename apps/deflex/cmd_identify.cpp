@@ -11,9 +11,9 @@
 #include "deflex/identify/calibration_planner.hpp"
 #include "deflex/identify/calibration_simulation.hpp"
 #include "deflex/identify/stiffness_identification.hpp"
+#include "deflex/model/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/output_file.hpp"
-#include "deflex/model/robot_io.hpp"
 
 namespace deflex::cli {
 namespace {
@@ -162,14 +162,14 @@ void setup_identify(CLI::App& sub, int& exit_code) {
         }
         const bool flagged = std::find(est.unidentifiable_joints.begin(), est.unidentifiable_joints.end(),
                                        static_cast<int>(j) + 1) != est.unidentifiable_joints.end();
-        std::cout << fmt::format("{:>5}  {:>14}  {:>16}  {:>9}  {:>16}  {:>12}\n", j + 1,
-                                 std::isfinite(k) && !flagged ? fmt::format("{:.4e}", k)
-                                 : std::isfinite(k)           ? fmt::format("({:.2e})?", k)
-                                                              : "not identified",
-                                 fixed ? "fixed" : (std::isfinite(se) ? fmt::format("{:.3e}", se) : "-"),
-                                 std::isfinite(se) && std::isfinite(k) && !fixed ? fmt::format("{:.2f}%", 100 * se / k)
-                                                                                  : "-",
-                                 std::isfinite(file_k) ? fmt::format("{:.4e}", file_k) : "-", dev);
+        std::cout << fmt::format(
+            "{:>5}  {:>14}  {:>16}  {:>9}  {:>16}  {:>12}\n", j + 1,
+            std::isfinite(k) && !flagged ? fmt::format("{:.4e}", k)
+            : std::isfinite(k)           ? fmt::format("({:.2e})?", k)
+                                         : "not identified",
+            fixed ? "fixed" : (std::isfinite(se) ? fmt::format("{:.3e}", se) : "-"),
+            std::isfinite(se) && std::isfinite(k) && !fixed ? fmt::format("{:.2f}%", 100 * se / k) : "-",
+            std::isfinite(file_k) ? fmt::format("{:.4e}", file_k) : "-", dev);
       }
       std::cout << fmt::format(
           "residual RMS {:.4f} mm (max {:.4f} mm), noise sigma {:.4f} mm, condition number {:.1f}\n"
@@ -217,8 +217,10 @@ void setup_plan(CLI::App& sub, int& exit_code) {
   sub.add_option("--synthetic-measurements", o->synth_out,
                  "Also write what a tracker would measure running the plan on --synthetic-robot (a measurement CSV "
                  "for deflex identify): exact deflection by the core model plus Gaussian noise");
-  sub.add_option("--synthetic-robot", o->synth_robot, "The 'true' robot for --synthetic-measurements (default: --robot)");
-  sub.add_option("--synthetic-noise-mm", o->synth_noise_mm, "Noise per axis of the synthetic measurements (default 0.01)");
+  sub.add_option("--synthetic-robot", o->synth_robot,
+                 "The 'true' robot for --synthetic-measurements (default: --robot)");
+  sub.add_option("--synthetic-noise-mm", o->synth_noise_mm,
+                 "Noise per axis of the synthetic measurements (default 0.01)");
   sub.add_option("--seed", o->seed, "Seed of the synthetic noise (default 1)");
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code] {
@@ -250,8 +252,8 @@ void setup_plan(CLI::App& sub, int& exit_code) {
     opt.spin_rad.clear();
     const std::vector<double> spins = parse_numbers(o->spin, "--spin-deg", 0, range::kAngleDeg);
     if (spins.size() > 360) {
-      throw InputError(fmt::format("option --spin-deg: {} turns; give at most 360 (each multiplies the candidates)",
-                                   spins.size()));
+      throw InputError(
+          fmt::format("option --spin-deg: {} turns; give at most 360 (each multiplies the candidates)", spins.size()));
     }
     for (double s : spins) {
       opt.spin_rad.push_back(deg_to_rad(s));

@@ -11,18 +11,17 @@
 
 #include "cli_util.hpp"
 #include "command.hpp"
-#include "deflex/text/errors.hpp"
-#include "deflex/text/output_file.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/online/payload_identification.hpp"
-#include "deflex/text/input_file.hpp"
 #include "deflex/online/sensor_config.hpp"
 #include "deflex/sensors/force_source_spec.hpp"
 #include "deflex/sensors/wrench_tare.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/input_file.hpp"
+#include "deflex/text/output_file.hpp"
 
 namespace deflex::cli {
 namespace {
-
 
 SensorConfig sensor_or_default(const std::string& path) {
   if (path.empty()) {
@@ -125,23 +124,25 @@ void record_pose(const PayloadOpts& o, int& exit_code) {
       any = true;
     }
     if (std::chrono::steady_clock::now() > deadline) {
-      throw Error(fmt::format("identify-payload: {} gave {} of the {} samples of the window in {:g} s: check the "
-                              "sensor's rate (--rdt-rate-hz, the sensor configuration's sample_rate_hz) and its stream",
-                              force.description, window.result().samples, window.result().samples_wanted,
-                              o.window_s + o.timeout_s));
+      throw Error(fmt::format(
+          "identify-payload: {} gave {} of the {} samples of the window in {:g} s: check the "
+          "sensor's rate (--rdt-rate-hz, the sensor configuration's sample_rate_hz) and its stream",
+          force.description, window.result().samples, window.result().samples_wanted, o.window_s + o.timeout_s));
     }
     if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   const TareResult& r = window.result();
   if (r.state != TareState::kDone) {
     if (r.faulty > 0) {
-      throw InputError(fmt::format("identify-payload: the pose was not recorded: {} of the window's samples were "
-                                   "faulty (flagged by the sensor or saturated)",
-                                   r.faulty));
+      throw InputError(
+          fmt::format("identify-payload: the pose was not recorded: {} of the window's samples were "
+                      "faulty (flagged by the sensor or saturated)",
+                      r.faulty));
     }
     throw InputError(fmt::format(
         "identify-payload: the pose was not recorded: the reading moved during the {:g} s window (standard deviation "
-        "{:.3f} {:.3f} {:.3f} N, {:.4f} {:.4f} {:.4f} Nm; limits {:g} N, {:g} Nm): hold the arm still and stop the tool",
+        "{:.3f} {:.3f} {:.3f} N, {:.4f} {:.4f} {:.4f} Nm; limits {:g} N, {:g} Nm): hold the arm still and stop the "
+        "tool",
         o.window_s, r.std_sensor[0], r.std_sensor[1], r.std_sensor[2], r.std_sensor[3], r.std_sensor[4],
         r.std_sensor[5], o.max_std_n, o.max_std_nm));
   }
@@ -150,9 +151,10 @@ void record_pose(const PayloadOpts& o, int& exit_code) {
   row += fmt::format("{:.6f},{:.6f},{:.6f}", r.mean_sensor[0], r.mean_sensor[1], r.mean_sensor[2]);
   if (moments) row += fmt::format(",{:.7f},{:.7f},{:.7f}", r.mean_sensor[3], r.mean_sensor[4], r.mean_sensor[5]);
   if (previous.empty()) {
-    out.write(fmt::format("# Static poses for deflex identify-payload, recorded from {}: the raw readings (sensor "
-                          "frame, N and Nm) averaged over {:g} s with the arm still\n",
-                          force.description, o.window_s));
+    out.write(
+        fmt::format("# Static poses for deflex identify-payload, recorded from {}: the raw readings (sensor "
+                    "frame, N and Nm) averaged over {:g} s with the arm still\n",
+                    force.description, o.window_s));
     out.write(header + "\n");
   } else {
     out.write(previous);
@@ -175,9 +177,10 @@ void record_pose(const PayloadOpts& o, int& exit_code) {
         moments ? fmt::format(", {:.4f} {:.4f} {:.4f} Nm", r.mean_sensor[3], r.mean_sensor[4], r.mean_sensor[5]) : "",
         r.samples, r.std_sensor.head<3>().maxCoeff());
     if (rows < 6) {
-      std::cout << fmt::format("record {} more (6 or more poses that turn the tool about different axes), then: "
-                               "deflex identify-payload --data {} -o payload.yaml\n",
-                               6 - rows, o.record);
+      std::cout << fmt::format(
+          "record {} more (6 or more poses that turn the tool about different axes), then: "
+          "deflex identify-payload --data {} -o payload.yaml\n",
+          6 - rows, o.record);
     } else {
       std::cout << fmt::format("identify with: deflex identify-payload --data {} -o payload.yaml\n", o.record);
     }
@@ -223,7 +226,8 @@ void identify(const PayloadOpts& o, int& exit_code) {
                 {"output", o.out}});
   } else {
     std::cout << fmt::format(
-        "payload from {} static poses:\n  mass {:.4f} kg\n  centre of gravity (sensor frame) {:.2f} {:.2f} {:.2f} mm{}\n"
+        "payload from {} static poses:\n  mass {:.4f} kg\n  centre of gravity (sensor frame) {:.2f} {:.2f} {:.2f} "
+        "mm{}\n"
         "  force bias {:.3f} {:.3f} {:.3f} N\n",
         e.poses, e.mass_kg, e.cog_sensor_m.x() * 1e3, e.cog_sensor_m.y() * 1e3, e.cog_sensor_m.z() * 1e3,
         e.moments_used ? "" : " (not identified: no moment columns)", e.bias_sensor[0], e.bias_sensor[1],
@@ -244,17 +248,19 @@ void setup_identify_payload(CLI::App& sub, int& exit_code) {
   sub.add_option("--data", o->data,
                  "CSV of static poses: fx_N,fy_N,fz_N[,mx_Nm,my_Nm,mz_Nm] raw readings and the orientation as "
                  "qw,qx,qy,qz (base_R_sensor) or q1_deg..q6_deg (needs the robot and the sensor mount)");
-  sub.add_option("-o,--output", o->out, "Sensor YAML to write: the --sensor-config (or defaults) with the payload and "
-                                        "bias identified");
+  sub.add_option("-o,--output", o->out,
+                 "Sensor YAML to write: the --sensor-config (or defaults) with the payload and "
+                 "bias identified");
   sub.add_option("--robot", o->robot, kRobotHelp);
   sub.add_option("--sensor-config", o->sensor,
                  "Sensor YAML giving the crosstalk matrix and the flange-to-sensor mount (and, when recording, the "
                  "number of components and the sample rate)");
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   // Recording a pose from the sensor itself.
-  sub.add_option("--force-source", o->force_source,
-                 "Record one static pose from this sensor instead of identifying: rdt:HOST[:PORT], udp:PORT or csv:FILE "
-                 "(with --joints-deg and --record)");
+  sub.add_option(
+      "--force-source", o->force_source,
+      "Record one static pose from this sensor instead of identifying: rdt:HOST[:PORT], udp:PORT or csv:FILE "
+      "(with --joints-deg and --record)");
   sub.add_option("--record", o->record,
                  "With --force-source: the poses CSV the pose is added to (created when missing; q1_deg..,fx_N.. "
                  "columns)");
@@ -271,17 +277,20 @@ void setup_identify_payload(CLI::App& sub, int& exit_code) {
                  "With --force-source: how long past the window to wait for its samples, s")
       ->capture_default_str();
   sub.add_option("--bind", o->bind, "udp: the address the port is bound on")->capture_default_str();
-  sub.add_option("--rdt-calibration", o->rdt_calibration,
-                 "rdt: counts to N and Nm: sensor, FILE.xml, http://URL, onrobot-hex or counts:... (docs/rdt-sensors.md)");
+  sub.add_option(
+      "--rdt-calibration", o->rdt_calibration,
+      "rdt: counts to N and Nm: sensor, FILE.xml, http://URL, onrobot-hex or counts:... (docs/rdt-sensors.md)");
   sub.add_option("--rdt-rate-hz", o->rdt_rate_hz, "rdt: the sensor's RDT rate, Hz (default: its page's)");
   sub.add_flag("--rdt-buffered", o->rdt_buffered, "rdt: buffered streaming");
   sub.callback([o, &sub, &exit_code] {
-    const char* const record_only[] = {"--record", "--joints-deg", "--window-s", "--max-std-N", "--max-std-Nm",
-                                       "--timeout-s", "--bind", "--rdt-calibration", "--rdt-rate-hz", "--rdt-buffered"};
+    const char* const record_only[] = {"--record",      "--joints-deg",  "--window-s", "--max-std-N",
+                                       "--max-std-Nm",  "--timeout-s",   "--bind",     "--rdt-calibration",
+                                       "--rdt-rate-hz", "--rdt-buffered"};
     if (!o->force_source.empty()) {
       if (!o->data.empty() || !o->out.empty()) {
-        throw InputError("option --force-source records a pose into --record; identify from the poses in a second "
-                         "call (--data FILE -o payload.yaml)");
+        throw InputError(
+            "option --force-source records a pose into --record; identify from the poses in a second "
+            "call (--data FILE -o payload.yaml)");
       }
       if (o->record.empty()) throw InputError("option --force-source: give --record FILE, the poses CSV to add to");
       if (o->joints_deg.empty()) throw InputError("option --force-source: give --joints-deg, the joints the arm holds");
@@ -289,7 +298,8 @@ void setup_identify_payload(CLI::App& sub, int& exit_code) {
       return;
     }
     for (const char* name : record_only) {
-      if (sub.get_option(name)->count() > 0) throw InputError(fmt::format("option {}: applies with --force-source", name));
+      if (sub.get_option(name)->count() > 0)
+        throw InputError(fmt::format("option {}: applies with --force-source", name));
     }
     if (o->data.empty()) throw InputError("option --data is required (or --force-source to record a pose)");
     if (o->out.empty()) throw InputError("option -o is required: the sensor YAML to write");

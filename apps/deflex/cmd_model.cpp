@@ -8,13 +8,12 @@
 #include "cli_util.hpp"
 #include "command.hpp"
 #include "deflex/model/compliance.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::cli {
 namespace {
-
 
 nlohmann::json pose_json(const Pose& p) {
   const Eigen::Quaterniond q(p.linear());
@@ -85,8 +84,8 @@ void setup_ik(CLI::App& sub, int& exit_code) {
     IkRequest req;
     if (!o->config.empty()) {
       const auto c = parse_numbers(o->config, "--config", 4);
-      req.configuration =
-          ArmConfiguration{static_cast<int>(c[0]), static_cast<int>(c[1]), static_cast<int>(c[2]), static_cast<int>(c[3])};
+      req.configuration = ArmConfiguration{static_cast<int>(c[0]), static_cast<int>(c[1]), static_cast<int>(c[2]),
+                                           static_cast<int>(c[3])};
       if (c[3] < 0 || c[3] > 7) {
         throw InputError("option --config: cfx must be 0..7");
       }
@@ -97,8 +96,11 @@ void setup_ik(CLI::App& sub, int& exit_code) {
     Workspace ws(model);
     const IkResult r = inverse_kinematics(model, ws, target, req);
     if (o->json) {
-      nlohmann::json doc{{"status", to_string(r.status)}, {"ok", r.ok()}, {"message", r.message},
-                         {"analytic", r.analytic}, {"singularity", to_string(r.singularity)}};
+      nlohmann::json doc{{"status", to_string(r.status)},
+                         {"ok", r.ok()},
+                         {"message", r.message},
+                         {"analytic", r.analytic},
+                         {"singularity", to_string(r.singularity)}};
       if (r.ok()) {
         JointVector deg = r.q * (180.0 / kPi);
         doc["joints_deg"] = vector_to_json(deg);
@@ -114,12 +116,12 @@ void setup_ik(CLI::App& sub, int& exit_code) {
       for (int i = 0; i < r.q.size(); ++i) {
         std::cout << fmt::format(" {:.4f}", rad_to_deg(r.q[i]));
       }
-      std::cout << fmt::format("\nconfig [cf1,cf4,cf6,cfx]: [{},{},{},{}]  (KUKA S {} T {})\n"
-                               "solver: {}, residual {:.2e} m, {:.2e} rad\n",
-                               r.configuration.cf1, r.configuration.cf4, r.configuration.cf6, r.configuration.cfx,
-                               r.kuka.status, r.kuka.turn,
-                               r.analytic ? "analytic (ortho-parallel)" : "damped least squares", r.position_error_m,
-                               r.orientation_error_rad);
+      std::cout << fmt::format(
+          "\nconfig [cf1,cf4,cf6,cfx]: [{},{},{},{}]  (KUKA S {} T {})\n"
+          "solver: {}, residual {:.2e} m, {:.2e} rad\n",
+          r.configuration.cf1, r.configuration.cf4, r.configuration.cf6, r.configuration.cfx, r.kuka.status,
+          r.kuka.turn, r.analytic ? "analytic (ortho-parallel)" : "damped least squares", r.position_error_m,
+          r.orientation_error_rad);
     }
     if (!r.message.empty()) {
       std::cerr << fmt::format("deflex ik: {}: {}\n", r.ok() ? "warning" : "error", r.message);
@@ -157,13 +159,14 @@ void setup_deflect(CLI::App& sub, int& exit_code) {
     const Displacement dx = tcp_deflection(model, ws, q, wrench, opt);
     const Matrix6 C = cartesian_compliance(model, ws, q);
     if (o->json) {
-      print_json({{"robot", model.name()},
-                  {"dtheta_rad", vector_to_json(dtheta)},
-                  {"tcp_deflection_m", vector_to_json(dx)},
-                  {"tcp_deflection_units", "m, m, m, rad, rad, rad (base frame)"},
-                  {"cartesian_compliance", to_json(C)},
-                  {"cartesian_compliance_units", "rows/cols [m, m, m, rad, rad, rad] per [N, N, N, Nm, Nm, Nm] at the WAP"},
-                  {"complementary_stiffness", o->complementary}});
+      print_json(
+          {{"robot", model.name()},
+           {"dtheta_rad", vector_to_json(dtheta)},
+           {"tcp_deflection_m", vector_to_json(dx)},
+           {"tcp_deflection_units", "m, m, m, rad, rad, rad (base frame)"},
+           {"cartesian_compliance", to_json(C)},
+           {"cartesian_compliance_units", "rows/cols [m, m, m, rad, rad, rad] per [N, N, N, Nm, Nm, Nm] at the WAP"},
+           {"complementary_stiffness", o->complementary}});
     } else {
       std::cout << fmt::format("robot: {}\njoint deflection (mrad):", model.name());
       for (int i = 0; i < dtheta.size(); ++i) {
@@ -202,14 +205,14 @@ void setup_robot(CLI::App& sub, int& exit_code) {
                         {"min_deg", std::isfinite(j.lower_rad) ? nlohmann::json(rad_to_deg(j.lower_rad)) : nullptr},
                         {"max_deg", std::isfinite(j.upper_rad) ? nlohmann::json(rad_to_deg(j.upper_rad)) : nullptr}});
     }
-    print_json({{"name", model.name()},
-                {"source", model.description().source},
-                {"dof", model.dof()},
-                {"joints", joints},
-                {"stiffness_Nm_per_rad",
-                 model.has_stiffness() ? vector_to_json(model.stiffness()) : nlohmann::json(nullptr)},
-                {"flange_T_tcp", pose_json(model.description().flange_T_tcp)},
-                {"yaml", yaml}});
+    print_json(
+        {{"name", model.name()},
+         {"source", model.description().source},
+         {"dof", model.dof()},
+         {"joints", joints},
+         {"stiffness_Nm_per_rad", model.has_stiffness() ? vector_to_json(model.stiffness()) : nlohmann::json(nullptr)},
+         {"flange_T_tcp", pose_json(model.description().flange_T_tcp)},
+         {"yaml", yaml}});
     exit_code = 0;
   });
 }

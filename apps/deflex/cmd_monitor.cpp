@@ -10,10 +10,10 @@
 #include <fmt/format.h>
 
 #include "command.hpp"
-#include "deflex/text/errors.hpp"
-#include "deflex/text/output_file.hpp"
 #include "deflex/monitor/cycle_log_reader.hpp"
 #include "deflex/monitor/monitor_server.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/output_file.hpp"
 
 namespace deflex::cli {
 namespace {
@@ -30,17 +30,20 @@ struct MonitorOpts {
 void setup_monitor(CLI::App& sub, int& exit_code) {
   auto o = std::make_shared<MonitorOpts>();
   sub.add_option("--log", o->log, "A cycle log written by deflex online --log")->required();
-  sub.add_option("--monitor", o->address, "Serve the page at [ADDR:]PORT (default 127.0.0.1:8080; port 0: any free one)")
+  sub.add_option("--monitor", o->address,
+                 "Serve the page at [ADDR:]PORT (default 127.0.0.1:8080; port 0: any free one)")
       ->capture_default_str();
   sub.add_flag("--monitor-remote", o->remote, "Allow an address other hosts can reach");
-  sub.add_option("--report", o->report, "Write the page with the whole log in it to this HTML file instead of serving it");
+  sub.add_option("--report", o->report,
+                 "Write the page with the whole log in it to this HTML file instead of serving it");
   sub.add_option("--duration-s", o->duration_s, "Serve this long, then exit (0: until Ctrl-C)");
   sub.callback([o, &exit_code] {
     const monitor::MonitorAddress address = monitor::parse_monitor_address(o->address, o->remote, "--monitor");
     const auto feed = monitor::read_cycle_log_feed(o->log);
     if (!o->report.empty()) {
       write_output_file(o->report, monitor::monitor_report(*feed, "deflex monitor: " + o->log), "option --report");
-      std::cerr << fmt::format("deflex monitor: {} cycles of {} drawn into {}\n", feed->rows_added(), o->log, o->report);
+      std::cerr << fmt::format("deflex monitor: {} cycles of {} drawn into {}\n", feed->rows_added(), o->log,
+                               o->report);
       exit_code = 0;
       return;
     }

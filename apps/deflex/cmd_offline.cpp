@@ -10,8 +10,6 @@
 #include "cli_util.hpp"
 #include "command.hpp"
 #include "deflex/force/force_spec.hpp"
-#include "deflex/text/errors.hpp"
-#include "deflex/text/output_file.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/offline/offline_csv.hpp"
@@ -23,6 +21,8 @@
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/path_spec.hpp"
 #include "deflex/paths/pose_source.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/output_file.hpp"
 
 namespace deflex::cli {
 namespace {
@@ -52,8 +52,9 @@ nlohmann::json program_json(const RobotModel& model, const ProgramCompensation& 
                        {"deflection_mrad", t.deflection_rad * 1e3},
                        {"correction_mm", t.correction_m * 1e3},
                        {"joint_correction_deg", rad_to_deg(t.joint_correction_rad)},
-                       {"wrench_base_N_Nm", {t.wrench_base[0], t.wrench_base[1], t.wrench_base[2], t.wrench_base[3],
-                                             t.wrench_base[4], t.wrench_base[5]}}});
+                       {"wrench_base_N_Nm",
+                        {t.wrench_base[0], t.wrench_base[1], t.wrench_base[2], t.wrench_base[3], t.wrench_base[4],
+                         t.wrench_base[5]}}});
   }
   nlohmann::json unresolved = nlohmann::json::array();
   for (const UnresolvedConstruct& u : result.unresolved) {
@@ -63,8 +64,8 @@ nlohmann::json program_json(const RobotModel& model, const ProgramCompensation& 
   for (const ProgramFile& f : result.outputs) {
     outputs.push_back(f.path);
   }
-  return {{"robot", model.name()},      {"language", result.language}, {"force", result.force_description},
-          {"targets", targets},         {"unresolved", unresolved},    {"outputs", outputs}};
+  return {{"robot", model.name()}, {"language", result.language}, {"force", result.force_description},
+          {"targets", targets},    {"unresolved", unresolved},    {"outputs", outputs}};
 }
 
 /// --program-in: an existing RAPID or KRL program compensated target by target. The outputs are
@@ -74,8 +75,9 @@ void run_program(const OfflineOpts& o, int& exit_code) {
     throw InputError("option --program-in needs --program-out FILE (the input is never overwritten)");
   }
   if (!o.csv_out.empty() || !o.rapid_out.empty() || !o.trajectory_out.empty() || !o.nominal_trajectory_out.empty()) {
-    throw InputError("options -o, --rapid, --joint-trajectory and --nominal-trajectory write a new path's files; "
-                     "with --program-in the output is --program-out");
+    throw InputError(
+        "options -o, --rapid, --joint-trajectory and --nominal-trajectory write a new path's files; "
+        "with --program-in the output is --program-out");
   }
   OutputTransaction outputs;
   std::vector<OutputFile*> files;
@@ -91,8 +93,8 @@ void run_program(const OfflineOpts& o, int& exit_code) {
     }
   }
   if (forces.size() != 1) {
-    throw InputError(fmt::format("--program-in compensates for one load: the --force options describe {}",
-                                 forces.size()));
+    throw InputError(
+        fmt::format("--program-in compensates for one load: the --force options describe {}", forces.size()));
   }
   ProgramOptions options;
   options.tooldata = o.tooldata;
@@ -129,11 +131,11 @@ std::unique_ptr<PoseSource> make_pose_source(const OfflineOpts& o, ForceSpecCont
       checked_unit_quaternion(Eigen::Quaterniond(qv[0], qv[1], qv[2], qv[3]), "option --orientation-wxyz", 1e-3);
   if (o.circle_given) {
     const CirclePath& c = *context.circle;
-    path_text = fmt::format("circle centre ({:.1f}, {:.1f}, {:.1f}) mm, radius {:.1f} mm, normal ({:g}, {:g}, {:g}), "
-                            "{}, {} points",
-                            c.centre_m.x() * 1e3, c.centre_m.y() * 1e3, c.centre_m.z() * 1e3, c.radius_m * 1e3,
-                            c.normal.x(), c.normal.y(), c.normal.z(), c.clockwise ? "clockwise" : "counter-clockwise",
-                            c.points);
+    path_text = fmt::format(
+        "circle centre ({:.1f}, {:.1f}, {:.1f}) mm, radius {:.1f} mm, normal ({:g}, {:g}, {:g}), "
+        "{}, {} points",
+        c.centre_m.x() * 1e3, c.centre_m.y() * 1e3, c.centre_m.z() * 1e3, c.radius_m * 1e3, c.normal.x(), c.normal.y(),
+        c.normal.z(), c.clockwise ? "clockwise" : "counter-clockwise", c.points);
     return std::make_unique<CirclePoseSource>(c, orientation);
   }
   const LinePath l = parse_line_spec(o.line);
@@ -159,8 +161,8 @@ IkRequest first_ik_request(const OfflineOpts& o, const RobotModel& model) {
     if (c[3] < 0 || c[3] > 7) {
       throw InputError("option --config: cfx must be 0..7");
     }
-    first.configuration =
-        ArmConfiguration{static_cast<int>(c[0]), static_cast<int>(c[1]), static_cast<int>(c[2]), static_cast<int>(c[3])};
+    first.configuration = ArmConfiguration{static_cast<int>(c[0]), static_cast<int>(c[1]), static_cast<int>(c[2]),
+                                           static_cast<int>(c[3])};
   }
   if (!o.seed.empty()) {
     first.seed = parse_joints_deg(o.seed, model, "--seed-deg");
@@ -191,15 +193,17 @@ struct Run {
   OutputFile* rapid_file = nullptr;
   OutputFile* trajectory_file = nullptr;
   std::unique_ptr<OfflineCsvWriter> csv;
-  OfflineResult summary;         // with the points when an output needs them whole
-  std::optional<BarRange> bar;   // an LDBB's bar length and inclination along the path
-  std::string trajectory_text;   // "(compensated joint trajectory, 1.234 s at 10 mm/s)"
+  OfflineResult summary;        // with the points when an output needs them whole
+  std::optional<BarRange> bar;  // an LDBB's bar length and inclination along the path
+  std::string trajectory_text;  // "(compensated joint trajectory, 1.234 s at 10 mm/s)"
 };
 
 /// Every output of every run, prepared before the robot and the path are read.
 void prepare_outputs(const OfflineOpts& o, std::vector<Run>& runs, OutputTransaction& outputs, OutputFile*& nominal) {
   const bool several = runs.size() > 1;
-  const auto name = [&](const std::string& path, const Run& r) { return several ? path_with_label(path, r.label) : path; };
+  const auto name = [&](const std::string& path, const Run& r) {
+    return several ? path_with_label(path, r.label) : path;
+  };
   for (Run& r : runs) {
     if (!o.csv_out.empty()) {
       r.csv_file = &outputs.add(name(o.csv_out, r), "option -o");
@@ -333,12 +337,13 @@ std::vector<Run> make_runs(const OfflineOpts& o, const ForceSpecContext& context
 double write_whole_path_outputs(const OfflineOpts& o, const RobotModel& model, const std::string& path_text,
                                 const OfflineJobResult& job, std::vector<Run>& runs, RapidOptions& rapid,
                                 OutputFile* nominal_file) {
-  const auto write_trajectory = [&](const std::vector<Pose>& poses, const std::vector<JointVector>& q,
-                                    OutputFile& file, const std::string& what) {
+  const auto write_trajectory = [&](const std::vector<Pose>& poses, const std::vector<JointVector>& q, OutputFile& file,
+                                    const std::string& what) {
     const JointTrajectory t = trajectory_at_tcp_speed(poses, q, o.speed_mm_s * 1e-3, model, o.hold_start_s);
-    file.write(t.csv_text(fmt::format("deflex offline: {} joint trajectory of {} at {:g} mm/s ({} points, {:.3f} s); "
-                                      "stream it with deflex online --link egm-joint --program {}",
-                                      what, path_text, o.speed_mm_s, t.size(), t.duration_s(), file.path())));
+    file.write(
+        t.csv_text(fmt::format("deflex offline: {} joint trajectory of {} at {:g} mm/s ({} points, {:.3f} s); "
+                               "stream it with deflex online --link egm-joint --program {}",
+                               what, path_text, o.speed_mm_s, t.size(), t.duration_s(), file.path())));
     return t.duration_s();
   };
   const double nominal_s = nominal_file != nullptr
@@ -420,7 +425,8 @@ void setup_offline(CLI::App& sub, int& exit_code) {
   sub.add_option("--orientation-wxyz", o->orientation,
                  "TCP orientation held along a circle or line, unit quaternion \"w,x,y,z\" (default 0,0,1,0: tool "
                  "z axis pointing down for the IRB6700's tool0)");
-  sub.add_option("--config", o->config, "ABB confdata \"cf1,cf4,cf6,cfx\" at the first point (cfx kept along the path)");
+  sub.add_option("--config", o->config,
+                 "ABB confdata \"cf1,cf4,cf6,cfx\" at the first point (cfx kept along the path)");
   sub.add_option("--seed-deg", o->seed, "Preferred joint values at the first point, degrees \"j1,...,j6\"");
   sub.add_option("--force", o->forces,
                  "Force model (repeatable): \"ldbb:pivot_mm=X;Y;Z,force_N=F[;F2..],mode=push|pull\", "
@@ -431,17 +437,19 @@ void setup_offline(CLI::App& sub, int& exit_code) {
       ->required();
   sub.add_option("--speed-mm-s", o->speed_mm_s,
                  "TCP speed, mm/s (default 10): the RAPID speeddata and the timing of the joint trajectories");
-  sub.add_option("--joint-trajectory", o->trajectory_out,
-                 "Write the compensated path as a timed joint trajectory CSV (t_s,q1_deg..) at --speed-mm-s, for deflex "
-                 "online --program (hybrid strategy); one file per load when several");
+  sub.add_option(
+      "--joint-trajectory", o->trajectory_out,
+      "Write the compensated path as a timed joint trajectory CSV (t_s,q1_deg..) at --speed-mm-s, for deflex "
+      "online --program (hybrid strategy); one file per load when several");
   sub.add_option("--nominal-trajectory", o->nominal_trajectory_out,
                  "Write the uncompensated path as a timed joint trajectory CSV at --speed-mm-s, for deflex online "
                  "--program (online and predictive strategies)");
   sub.add_option("--hold-start-s", o->hold_start_s,
                  "Joint trajectories: hold the first point this long before moving, s (default 0)");
   sub.add_option("--zone", o->zone, "RAPID zonedata: fine (default) or z0, z1, z5, z10, ...");
-  sub.add_option("--motion", o->motion, "RAPID motion: absj (MoveAbsJ over jointtargets, default) or movel "
-                                        "(MoveL over robtargets with confdata)");
+  sub.add_option("--motion", o->motion,
+                 "RAPID motion: absj (MoveAbsJ over jointtargets, default) or movel "
+                 "(MoveL over robtargets with confdata)");
   sub.add_option("--tool", o->tool, "RAPID tooldata name (default tool0)");
   sub.add_option("--wobj", o->wobj, "RAPID wobjdata name (default wobj0)");
   sub.add_option("--module", o->module, "RAPID module name (default DeflexOffline; the load is appended when several)");

@@ -16,22 +16,21 @@
 
 #include "cli_util.hpp"
 #include "command.hpp"
+#include "deflex/force/force_spec.hpp"
+#include "deflex/model/robot_io.hpp"
 #include "deflex/monitor/cycle_log_reader.hpp"
 #include "deflex/monitor/monitor_server.hpp"
-#include "field_log.hpp"
-#include "deflex/force/force_spec.hpp"
-#include "deflex/text/errors.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/runtime/session.hpp"
 #include "deflex/sensors/force_source_spec.hpp"
 #include "deflex/sensors/wrench_tare.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/wire/egm_codec.hpp"
+#include "field_log.hpp"
 
 namespace deflex::cli {
 namespace {
 
 using runtime::LinkKind;
-
 
 std::atomic<bool> g_stop{false};
 extern "C" void on_stop_signal(int /*signal*/) { g_stop.store(true); }
@@ -47,7 +46,7 @@ SensorConfig sensor_or_default(const std::string& path) {
 
 struct OnlineOpts {
   std::string link, robot, sensor, force_source, program, strategy = "online", force_model, log, fault_dump,
-      jacobian_at = "nominal";
+                                                          jacobian_at = "nominal";
   // The settings controller-setup writes into the controller's side come from one place.
   static constexpr runtime::SessionOptionDefaults kShared = runtime::kSessionOptionDefaults;
   double period_ms = 0.0, max_joint_deg = kShared.max_joint_correction_deg, max_tcp_mm = kShared.max_tcp_correction_mm,
@@ -121,7 +120,8 @@ const std::vector<LinkOption>& link_options() {
 }
 
 void add_link_options(CLI::App& sub, OnlineOpts& o) {
-  sub.add_option("--egm-port", o.egm_port, "EGM: UDP port the controller's EGM messages arrive on (ABB examples: 6510)");
+  sub.add_option("--egm-port", o.egm_port,
+                 "EGM: UDP port the controller's EGM messages arrive on (ABB examples: 6510)");
   sub.add_option("--ramp-in-s", o.ramp_in_s,
                  "egm-joint, simple-message: blend from where the controller is to the program over this time, s")
       ->capture_default_str();
@@ -190,8 +190,9 @@ void add_sensor_options(CLI::App& sub, OnlineOpts& o) {
   sub.add_option("--rdt-calibration", o.rdt_calibration,
                  "rdt: counts to N and Nm: sensor (its netftapi2.xml over HTTP), FILE.xml (a saved page), http://URL, "
                  "onrobot-hex, or counts:counts_per_force=C,counts_per_torque=C,force_unit=U,torque_unit=U");
-  sub.add_option("--rdt-rate-hz", o.rdt_rate_hz,
-                 "rdt: the sensor's RDT rate, Hz (default: its page's comrdtrate; required for counts:, OnRobot 1000/n)");
+  sub.add_option(
+      "--rdt-rate-hz", o.rdt_rate_hz,
+      "rdt: the sensor's RDT rate, Hz (default: its page's comrdtrate; required for counts:, OnRobot 1000/n)");
   sub.add_flag("--rdt-buffered", o.rdt_buffered, "rdt: buffered streaming (several records a datagram)");
   sub.add_flag("--tare", o.tare,
                "rdt: take the sensor's offset at start, arm still, over --tare-window-s (refused when it moves); "
@@ -216,7 +217,8 @@ void check_sensor_options(const CLI::App& sub, const OnlineOpts& o) {
     }
   }
   for (const char* name : {"--tare-window-s", "--tare-max-std-N", "--tare-max-std-Nm", "--tare-pose-deg"}) {
-    if (!o.tare && sub.get_option(name)->count() > 0) throw InputError(fmt::format("option {}: applies with --tare", name));
+    if (!o.tare && sub.get_option(name)->count() > 0)
+      throw InputError(fmt::format("option {}: applies with --tare", name));
   }
 }
 
@@ -238,10 +240,12 @@ runtime::SessionConfig session_config(const OnlineOpts& o, const CLI::App& sub) 
   const runtime::LinkKindInfo& info = runtime::link_kind(c.link);
   c.strategy = parse_strategy(o.strategy);
   const auto positive = [](double v, const char* option) {
-    if (!std::isfinite(v) || !(v > 0.0)) throw InputError(fmt::format("option {}: must be a number > 0 (got {})", option, v));
+    if (!std::isfinite(v) || !(v > 0.0))
+      throw InputError(fmt::format("option {}: must be a number > 0 (got {})", option, v));
   };
   const auto non_negative = [](double v, const char* option) {
-    if (!std::isfinite(v) || v < 0.0) throw InputError(fmt::format("option {}: must be a number >= 0 (got {})", option, v));
+    if (!std::isfinite(v) || v < 0.0)
+      throw InputError(fmt::format("option {}: must be a number >= 0 (got {})", option, v));
   };
   const bool period_given = sub.get_option("--period-ms")->count() > 0;
   if (period_given) positive(o.period_ms, "--period-ms");
@@ -255,7 +259,8 @@ runtime::SessionConfig session_config(const OnlineOpts& o, const CLI::App& sub) 
   non_negative(o.duration_s, "--duration-s");
   if (period_given && o.period_ms > 1000.0) throw InputError("option --period-ms: at most 1000 ms");
   if (o.max_joint_deg > 10.0) {
-    throw InputError("option --max-joint-correction-deg: at most 10 deg (a compliance correction is a fraction of one)");
+    throw InputError(
+        "option --max-joint-correction-deg: at most 10 deg (a compliance correction is a fraction of one)");
   }
   c.online.period_s = period_given ? o.period_ms * 1e-3 : info.default_period_s;
   c.online.max_joint_correction_rad = deg_to_rad(o.max_joint_deg);
@@ -286,8 +291,8 @@ runtime::SessionConfig session_config(const OnlineOpts& o, const CLI::App& sub) 
   c.realtime.priority = o.rt_priority;
   c.realtime.cpu = o.rt_cpu;
   c.realtime.lock_memory = !o.rt_no_mlock;
-  if (!o.realtime && (sub.get_option("--rt-priority")->count() > 0 || sub.get_option("--rt-cpu")->count() > 0 ||
-                      o.rt_no_mlock)) {
+  if (!o.realtime &&
+      (sub.get_option("--rt-priority")->count() > 0 || sub.get_option("--rt-cpu")->count() > 0 || o.rt_no_mlock)) {
     throw InputError("options --rt-priority, --rt-cpu, --rt-no-mlock: apply with --realtime");
   }
   // Network.
@@ -354,8 +359,8 @@ runtime::SessionConfig session_config(const OnlineOpts& o, const CLI::App& sub) 
 
 // --tare: the sensor's offset, averaged with the arm still, the payload's weight at the tare pose left
 // in the reading (the pipeline's gravity compensation takes it out at every pose).
-void tare_sensor(const OnlineOpts& o, const RobotModel& model, const SensorConfig& sensor, const JointTrajectory* program,
-                 const OpenedForceSource& force, spdlog::logger& log) {
+void tare_sensor(const OnlineOpts& o, const RobotModel& model, const SensorConfig& sensor,
+                 const JointTrajectory* program, const OpenedForceSource& force, spdlog::logger& log) {
   if (sensor.bias_sensor.cwiseAbs().maxCoeff() > 0.0) {
     throw InputError(fmt::format(
         "option --tare: the sensor configuration {} gives a bias too ({:.3f} {:.3f} {:.3f} N ...): the offset would be "
@@ -383,8 +388,8 @@ void tare_sensor(const OnlineOpts& o, const RobotModel& model, const SensorConfi
     Workspace ws(model);
     forward_kinematics(model, ws, q);
     const Matrix3 base_R_sensor = ws.base_T_flange.linear() * sensor.flange_T_sensor.linear();
-    ts.expected_wrench_sensor =
-        payload_wrench_sensor(sensor.payload_mass_kg, sensor.payload_cog_sensor_m, sensor.gravity_base_m_s2, base_R_sensor);
+    ts.expected_wrench_sensor = payload_wrench_sensor(sensor.payload_mass_kg, sensor.payload_cog_sensor_m,
+                                                      sensor.gravity_base_m_s2, base_R_sensor);
   }
   log.info("tare: hold the arm still for {:g} s ({})", ts.window_s, pose_text);
   log.info("tare: {}", describe(force.rdt->tare(ts), ts));
@@ -410,7 +415,8 @@ void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
   std::unique_ptr<ForceModel> force_model;
   if (!o.force_model.empty()) force_model = parse_force_spec(o.force_model);
   std::shared_ptr<const JointTrajectory> program;
-  if (!o.program.empty()) program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o.program, model));
+  if (!o.program.empty())
+    program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o.program, model));
   check_sensor_options(sub, o);
   const auto log = make_field_logger("online", o.log_options);
   ForceSourceOptions fo;
@@ -423,9 +429,10 @@ void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
   if (force.sample_rate_hz > 0.0 && std::abs(force.sample_rate_hz - sensor.sample_rate_hz) > 1e-9) {
     // The filter is designed for the rate the samples come at: the sensor's own.
     if (!o.sensor.empty()) {
-      log->info("the force source streams at {:g} Hz: the low-pass filter is designed for it (the sensor file says {:g} "
-                "Hz)",
-                force.sample_rate_hz, sensor.sample_rate_hz);
+      log->info(
+          "the force source streams at {:g} Hz: the low-pass filter is designed for it (the sensor file says {:g} "
+          "Hz)",
+          force.sample_rate_hz, sensor.sample_rate_hz);
     }
     sensor.sample_rate_hz = force.sample_rate_hz;
   }
@@ -434,9 +441,15 @@ void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
   runtime::Session session(config, model, sensor, program, force_model.get(), force.source.get(), clock, {},
                            [log](runtime::LogLevel level, const std::string& text) {
                              switch (level) {
-                               case runtime::LogLevel::kInfo: log->info("{}", text); break;
-                               case runtime::LogLevel::kWarn: log->warn("{}", text); break;
-                               case runtime::LogLevel::kError: log->error("{}", text); break;
+                               case runtime::LogLevel::kInfo:
+                                 log->info("{}", text);
+                                 break;
+                               case runtime::LogLevel::kWarn:
+                                 log->warn("{}", text);
+                                 break;
+                               case runtime::LogLevel::kError:
+                                 log->error("{}", text);
+                                 break;
                              }
                            });
   // The monitor binds before anything is answered: a port in use is an error now, not mid-session.
@@ -448,11 +461,12 @@ void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
               o.monitor_window_s);
   }
   if (info.streams_program && !model.has_max_speed()) {
-    log->warn("the robot file gives no joint speed limits, so the program's speeds were not checked (add max_speed "
-              "to the robot file)");
+    log->warn(
+        "the robot file gives no joint speed limits, so the program's speeds were not checked (add max_speed "
+        "to the robot file)");
   }
-  log->info("deflex online: {}; robot {}; sensor {}; force from {}. Stop with Ctrl-C.", session.describe(), model.name(),
-            sensor.source, force.description);
+  log->info("deflex online: {}; robot {}; sensor {}; force from {}. Stop with Ctrl-C.", session.describe(),
+            model.name(), sensor.source, force.description);
 
   g_stop = false;
   struct sigaction sa {};
@@ -488,8 +502,9 @@ void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
   if (!summary.output_error.empty() && exit_code == 0) exit_code = 1;
   if (o.log_report && summary.output_error.empty()) {
     const std::string report = log_report_path(o.log);
-    write_output_file(report, monitor::monitor_report(*monitor::read_cycle_log_feed(o.log),
-                                                      fmt::format("deflex online: {} ({})", o.log, summary.reason_text)),
+    write_output_file(report,
+                      monitor::monitor_report(*monitor::read_cycle_log_feed(o.log),
+                                              fmt::format("deflex online: {} ({})", o.log, summary.reason_text)),
                       "option --log-report");
     log->info("the session's charts: {}", report);
   }
@@ -544,8 +559,9 @@ void setup_online(CLI::App& sub, int& exit_code) {
   sub.add_option("--stop-silence-s", o->stop_silence_s,
                  "No usable controller message this long: the controller is gone and the session stops (exit code 5); "
                  "shorter silences are ridden through. Default: egm-joint, egm-path 3; rsi 1");
-  sub.add_option("--end-silence-s", o->end_silence_s,
-                 "Streaming links: after the program's end, a controller silence this long ends the session (exit 0), s")
+  sub.add_option(
+         "--end-silence-s", o->end_silence_s,
+         "Streaming links: after the program's end, a controller silence this long ends the session (exit 0), s")
       ->capture_default_str();
   sub.add_flag("--end-on-silence", o->end_on_silence,
                "egm-path, rsi: a silence longer than --stop-silence-s after a healthy session is the planned end (the "

@@ -66,22 +66,23 @@ void pair_points(const TrackerFile& t, const TrackerFile& b, RegistrationInput& 
     for (const auto& p : b.points) base.insert(target_of(p.name));
     for (const auto& p : t.points) {
       if (base.count(target_of(p.name)) == 0) {
-        throw DataError(fmt::format("{}:{}: point '{}' is not in {} (pairs are made by name)", t.source, p.line,
-                                    p.name, b.source));
+        throw DataError(
+            fmt::format("{}:{}: point '{}' is not in {} (pairs are made by name)", t.source, p.line, p.name, b.source));
       }
       base.erase(target_of(p.name));
     }
     for (const auto& p : b.points) {
       if (base.count(target_of(p.name)) != 0) {
-        throw DataError(fmt::format("{}:{}: point '{}' is not in {} (pairs are made by name)", b.source, p.line,
-                                    p.name, t.source));
+        throw DataError(
+            fmt::format("{}:{}: point '{}' is not in {} (pairs are made by name)", b.source, p.line, p.name, t.source));
       }
     }
   }
   if (t.points.size() != b.points.size()) {
-    throw DataError(fmt::format("{} has {} point(s) and {} has {}: without names on both sides they pair by order and "
-                                "must be as many",
-                                t.source, t.points.size(), b.source, b.points.size()));
+    throw DataError(
+        fmt::format("{} has {} point(s) and {} has {}: without names on both sides they pair by order and "
+                    "must be as many",
+                    t.source, t.points.size(), b.source, b.points.size()));
   }
   for (std::size_t i = 0; i < t.points.size(); ++i) {
     in.tracker_m.push_back(t.points[i].p_m);
@@ -175,15 +176,17 @@ void setup_register(CLI::App& sub, int& exit_code) {
     } else {
       std::cout << fmt::format("Tracker frame{} -> robot base: {} point pair(s), {} circle(s)\n",
                                tracker_frame.empty() ? "" : fmt::format(" '{}'", tracker_frame), r.points, r.circles);
-      std::cout << fmt::format("  position {:.4f}, {:.4f}, {:.4f} mm; quaternion w x y z {:.9f}, {:.9f}, {:.9f}, {:.9f}\n",
-                               t.x() * 1e3, t.y() * 1e3, t.z() * 1e3, q.w(), q.x(), q.y(), q.z());
+      std::cout << fmt::format(
+          "  position {:.4f}, {:.4f}, {:.4f} mm; quaternion w x y z {:.9f}, {:.9f}, {:.9f}, {:.9f}\n", t.x() * 1e3,
+          t.y() * 1e3, t.z() * 1e3, q.w(), q.x(), q.y(), q.z());
       std::cout << "  residual per point, mm:\n";
       for (const auto& e : r.residuals) std::cout << fmt::format("    {:<28} {:.4f}\n", e.name, e.distance_m * 1e3);
       for (std::size_t k = 0; k < r.circles; ++k) {
-        std::cout << fmt::format("  circle {}: radius {:.4f} mm measured, {:.4f} mm in the base frame; fit RMS {:.4f} mm; "
-                                 "axis {:.3f} mrad off after the transform\n",
-                                 k + 1, in.tracker_circles[k].radius_m * 1e3, in.base_circles[k].radius_m * 1e3,
-                                 in.tracker_circles[k].rms_m * 1e3, r.circle_axis_error_rad[k] * 1e3);
+        std::cout << fmt::format(
+            "  circle {}: radius {:.4f} mm measured, {:.4f} mm in the base frame; fit RMS {:.4f} mm; "
+            "axis {:.3f} mrad off after the transform\n",
+            k + 1, in.tracker_circles[k].radius_m * 1e3, in.base_circles[k].radius_m * 1e3,
+            in.tracker_circles[k].rms_m * 1e3, r.circle_axis_error_rad[k] * 1e3);
       }
       std::cout << fmt::format("  RMS {:.4f} mm, max {:.4f} mm; written to {}\n", r.rms_m * 1e3, r.max_m * 1e3, o->out);
     }

@@ -32,7 +32,8 @@ std::shared_ptr<spdlog::logger> make_field_logger(const std::string& name, const
       {"critical", spdlog::level::critical},
       {"off", spdlog::level::off},
   }};
-  const auto* level = std::find_if(kLevels.begin(), kLevels.end(), [&](const auto& l) { return options.level == l.first; });
+  const auto* level =
+      std::find_if(kLevels.begin(), kLevels.end(), [&](const auto& l) { return options.level == l.first; });
   if (level == kLevels.end()) {
     throw InputError(fmt::format(
         "option --log-level: '{}' is not one of trace, debug, info, warn, error, critical, off", options.level));

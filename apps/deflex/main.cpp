@@ -12,10 +12,10 @@
 #include <fmt/format.h>
 
 #include "command.hpp"
-#include "option_ranges.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/output_file.hpp"
 #include "deflex/text/run_files.hpp"
+#include "option_ranges.hpp"
 
 namespace deflex::cli {
 
@@ -73,7 +73,8 @@ int run_program(int argc, char** argv) {
   deflex::remove_temporaries_on_signals();  // Ctrl-C leaves no temporary file beside an output
   CLI::App app{
       "deflex: predicts and compensates the elastic deflection of industrial robots under process forces.\n"
-      "Units: SI inside (m, rad, N, Nm, s); options and CSV columns name their unit (mm, deg where users expect them)."};
+      "Units: SI inside (m, rad, N, Nm, s); options and CSV columns name their unit (mm, deg where users expect "
+      "them)."};
   app.require_subcommand(1);
   app.set_version_flag("--version", "deflex 0.1.0");
   auto commands = command_registry();

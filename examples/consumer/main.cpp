@@ -38,8 +38,8 @@ int main(int argc, char** argv) {
     const Pose tcp = tcp_pose(robot, ws, q);
     Jacobian J(6, robot.dof());
     jacobian(robot, ws, q, EndPoint::kTcp, J);
-    std::printf("%s: TCP at (%.4f, %.4f, %.4f) m\n", robot.name().c_str(), tcp.translation().x(),
-                tcp.translation().y(), tcp.translation().z());
+    std::printf("%s: TCP at (%.4f, %.4f, %.4f) m\n", robot.name().c_str(), tcp.translation().x(), tcp.translation().y(),
+                tcp.translation().z());
 
     // 2. IK of that pose comes back to q.
     IkRequest request;
@@ -88,8 +88,8 @@ int main(int argc, char** argv) {
 
     // 6. A runtime session against the stand-in of an ABB EGM controller (egm-joint): a 2 s program
     //    holding q, a 300 N push at the TCP; every command within the session's bound of the nominal.
-    auto program = std::make_shared<const JointTrajectory>(std::vector<double>{0.0, 2.0},
-                                                           std::vector<JointVector>{q, q}, robot);
+    auto program =
+        std::make_shared<const JointTrajectory>(std::vector<double>{0.0, 2.0}, std::vector<JointVector>{q, q}, robot);
     runtime::SessionConfig config;
     config.link = runtime::LinkKind::kEgmJoint;
     config.status_interval_s = 0.0;

@@ -5,8 +5,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/paths/circle_path.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::python {
 namespace {
@@ -44,8 +44,8 @@ Array to_array(const py::handle& obj, const char* name, int ndim) {
     throw InputError(fmt::format("argument {}: cannot convert to float64", name));
   }
   if (ndim > 0 && a.ndim() != ndim) {
-    throw InputError(fmt::format("argument {}: expected a {}-dimensional array, got shape {}", name, ndim,
-                                 shape_text(a)));
+    throw InputError(
+        fmt::format("argument {}: expected a {}-dimensional array, got shape {}", name, ndim, shape_text(a)));
   }
   return a;
 }
@@ -120,9 +120,8 @@ Array joint_rows(const py::handle& obj, const char* name, int dof, bool& batch) 
 }
 
 namespace {
-const std::initializer_list<const InputRange*> kWrenchRanges = {&range::kForceN,   &range::kForceN,
-                                                                &range::kForceN,   &range::kMomentNm,
-                                                                &range::kMomentNm, &range::kMomentNm};
+const std::initializer_list<const InputRange*> kWrenchRanges = {
+    &range::kForceN, &range::kForceN, &range::kForceN, &range::kMomentNm, &range::kMomentNm, &range::kMomentNm};
 }  // namespace
 
 Vector6 wrench_vector(const py::handle& obj, const char* name) {
@@ -160,7 +159,8 @@ Pose pose_at(const double* d, const char* name, const std::string& where) {
     throw InputError(fmt::format("argument {}{}: the top-left 3x3 block is not a rotation matrix", name, where));
   }
   if (m(3, 0) != 0.0 || m(3, 1) != 0.0 || m(3, 2) != 0.0 || m(3, 3) != 1.0) {
-    throw InputError(fmt::format("argument {}{}: the last row of a homogeneous transform must be 0 0 0 1", name, where));
+    throw InputError(
+        fmt::format("argument {}{}: the last row of a homogeneous transform must be 0 0 0 1", name, where));
   }
   Pose p = Pose::Identity();
   p.linear() = r;
@@ -201,9 +201,10 @@ TrackerTrace tracker_trace(const py::handle& obj, const char* name) {
     t[i].t_s = timed ? *d++ : static_cast<double>(i);
     t[i].p_m = Vector3(d[0], d[1], d[2]);
     if (t[i].p_m.cwiseAbs().maxCoeff() > range::kLengthM.max) {
-      throw InputError(fmt::format("argument {}: row {}: a position of {:g} is beyond {:g} m: positions are in m (a "
-                                   "trace in mm divided by 1000)",
-                                   name, i, t[i].p_m.cwiseAbs().maxCoeff(), range::kLengthM.max));
+      throw InputError(
+          fmt::format("argument {}: row {}: a position of {:g} is beyond {:g} m: positions are in m (a "
+                      "trace in mm divided by 1000)",
+                      name, i, t[i].p_m.cwiseAbs().maxCoeff(), range::kLengthM.max));
     }
     d += 3;
   }

@@ -14,8 +14,8 @@
 #include <pybind11/stl/filesystem.h>
 
 #include "deflex/model/tracker_trace.hpp"
-#include "deflex/text/input_ranges.hpp"
 #include "deflex/model/types.hpp"
+#include "deflex/text/input_ranges.hpp"
 
 namespace deflex::python {
 

@@ -6,8 +6,8 @@
 #include <optional>
 #include <string>
 
-#include <nlohmann/json_fwd.hpp>
 #include <pybind11/pybind11.h>
+#include <nlohmann/json_fwd.hpp>
 
 #include "deflex/model/arm_configuration.hpp"
 #include "deflex/model/kinematics.hpp"
@@ -29,8 +29,8 @@ std::optional<ArmConfiguration> arm_configuration_arg(const py::handle& c);
 bool moment_about_tcp(const std::string& about);
 /// The wrench of row `row` of `wrenches` ((6,) for every row when not `per_row`, else (N, 6)) with its
 /// moment about the WAP at q, moved there from the TCP when `about_tcp` (FK at q into `ws`).
-Wrench wrench_at_wap(const RobotModel& model, Workspace& ws, const JointVector& q, const double* wrenches,
-                     bool per_row, std::ptrdiff_t row, bool about_tcp);
+Wrench wrench_at_wap(const RobotModel& model, Workspace& ws, const JointVector& q, const double* wrenches, bool per_row,
+                     std::ptrdiff_t row, bool about_tcp);
 
 /// A JSON document as the Python objects json.loads makes of it (dict, list, str, float, ...).
 py::object json_to_python(const nlohmann::json& doc);

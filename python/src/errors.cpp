@@ -31,10 +31,12 @@ void bind_errors(py::module_& m) {
   g_error = new_exception(m, "Error", PyExc_RuntimeError, "Base of every deflex error.");
   g_model_error = new_exception(m, "ModelError", g_error,
                                 "A robot description or configuration file is malformed: names the file and field.");
-  g_data_error = new_exception(m, "DataError", g_error, "A data file (CSV) is malformed: names the file, line and column.");
+  g_data_error =
+      new_exception(m, "DataError", g_error, "A data file (CSV) is malformed: names the file, line and column.");
   py::tuple input_bases = py::make_tuple(py::handle(g_error), py::handle(PyExc_ValueError));
-  g_input_error = new_exception(m, "InputError", input_bases.ptr(),
-                                "A value given is out of its domain (bad array shape or dtype, NaN, unreachable pose).");
+  g_input_error =
+      new_exception(m, "InputError", input_bases.ptr(),
+                    "A value given is out of its domain (bad array shape or dtype, NaN, unreachable pose).");
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);

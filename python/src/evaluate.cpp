@@ -60,8 +60,9 @@ void bind_evaluate(py::module_& m) {
                            s.accuracy_m, s.repeatability_m, s.evaluation_points, s.runs);
       });
 
-  m.def("read_tracker_csv", [](const PathArg& path) { return from_trace(read_tracker_csv(path_text(path))); }, "path"_a,
-        "A tracker CSV (t_s,x_mm,y_mm,z_mm) as an (N, 4) array [t_s, x_m, y_m, z_m].");
+  m.def(
+      "read_tracker_csv", [](const PathArg& path) { return from_trace(read_tracker_csv(path_text(path))); }, "path"_a,
+      "A tracker CSV (t_s,x_mm,y_mm,z_mm) as an (N, 4) array [t_s, x_m, y_m, z_m].");
   m.def(
       "mean_distance_to_path_m",
       [](const ArrayLike& loaded, const ArrayLike& reference) {
@@ -111,8 +112,8 @@ void bind_evaluate(py::module_& m) {
   // Tracker sessions: SA exports and unit-named CSV, registration, time alignment (docs/evaluation.md).
   m.def(
       "read_tracker_file",
-      [](const PathArg& path, const std::string& length_unit, const std::string& angle_unit,
-         const std::string& columns, const std::string& expect_frame) {
+      [](const PathArg& path, const std::string& length_unit, const std::string& angle_unit, const std::string& columns,
+         const std::string& expect_frame) {
         TrackerReadOptions o{length_unit, angle_unit, columns, expect_frame};
         const TrackerFile f = read_tracker_file(path_text(path), o);
         Array a = new_array({static_cast<py::ssize_t>(f.points.size()), 4});

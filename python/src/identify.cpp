@@ -30,8 +30,9 @@ std::vector<StiffnessMeasurement> measurements_from_arrays(const RobotModel& mod
   const Array weight = has_weight ? vector_array(weight_obj, "weight", n) : Array();
   // The ranges of the measurement file's columns (q_deg, fx_N, dx_mm ...), in SI here.
   require_in_ranges(q, "q", {&range::kAngleRad});
-  require_in_ranges(w, "wrench", {&range::kForceN, &range::kForceN, &range::kForceN, &range::kMomentNm,
-                                  &range::kMomentNm, &range::kMomentNm});
+  require_in_ranges(
+      w, "wrench",
+      {&range::kForceN, &range::kForceN, &range::kForceN, &range::kMomentNm, &range::kMomentNm, &range::kMomentNm});
   require_in_ranges(dp, "dp", {&range::kLengthM});
   if (has_rot) require_in_ranges(drot, "drot", {&range::kAngleRad});
   if (has_weight) require_in_ranges(weight, "weight", {&range::kWeight});
@@ -61,7 +62,8 @@ py::dict measurements_to_dict(const std::vector<StiffnessMeasurement>& data) {
   }
   py::dict out("q"_a = rows_of(data, &StiffnessMeasurement::q, dof),
                "wrench"_a = rows_of(data, &StiffnessMeasurement::wrench_base, 6),
-               "dp"_a = rows_of(data, &StiffnessMeasurement::dp_m, 3), "weight"_a = from_vector(weight), "line"_a = line);
+               "dp"_a = rows_of(data, &StiffnessMeasurement::dp_m, 3), "weight"_a = from_vector(weight),
+               "line"_a = line);
   out["drot"] = all_rot ? py::object(from_rows(drot, 3)) : py::none();
   return out;
 }
@@ -71,11 +73,15 @@ py::dict measurements_to_dict(const std::vector<StiffnessMeasurement>& data) {
 void bind_identify(py::module_& m) {
   py::class_<StiffnessEstimate>(m, "StiffnessEstimate",
                                 "Identified joint stiffness (Nm/rad) with standard errors and identifiability flags.")
-      .def_property_readonly("stiffness_nm_per_rad", [](const StiffnessEstimate& e) { return frozen(from_vector(e.stiffness_nm_per_rad)); })
-      .def_property_readonly("std_error_nm_per_rad", [](const StiffnessEstimate& e) { return frozen(from_vector(e.std_error_nm_per_rad)); })
-      .def_property_readonly("compliance_rad_per_nm", [](const StiffnessEstimate& e) { return frozen(from_vector(e.compliance_rad_per_nm)); })
-      .def_property_readonly("compliance_std_error_rad_per_nm",
-                             [](const StiffnessEstimate& e) { return frozen(from_vector(e.compliance_std_error_rad_per_nm)); })
+      .def_property_readonly("stiffness_nm_per_rad",
+                             [](const StiffnessEstimate& e) { return frozen(from_vector(e.stiffness_nm_per_rad)); })
+      .def_property_readonly("std_error_nm_per_rad",
+                             [](const StiffnessEstimate& e) { return frozen(from_vector(e.std_error_nm_per_rad)); })
+      .def_property_readonly("compliance_rad_per_nm",
+                             [](const StiffnessEstimate& e) { return frozen(from_vector(e.compliance_rad_per_nm)); })
+      .def_property_readonly(
+          "compliance_std_error_rad_per_nm",
+          [](const StiffnessEstimate& e) { return frozen(from_vector(e.compliance_std_error_rad_per_nm)); })
       .def_readonly("residual_rms_m", &StiffnessEstimate::residual_rms_m)
       .def_readonly("residual_max_m", &StiffnessEstimate::residual_max_m)
       .def_readonly("residual_rms_rad", &StiffnessEstimate::residual_rms_rad)
@@ -84,18 +90,19 @@ void bind_identify(py::module_& m) {
       .def_readonly("unidentifiable_joints", &StiffnessEstimate::unidentifiable_joints, "1-based joint numbers")
       .def_readonly("fixed_joints", &StiffnessEstimate::fixed_joints, "1-based joint numbers")
       .def_readonly("warnings", &StiffnessEstimate::warnings)
-      .def_property_readonly("robust_weights", [](const StiffnessEstimate& e) { return frozen(from_vector(e.robust_weights)); })
+      .def_property_readonly("robust_weights",
+                             [](const StiffnessEstimate& e) { return frozen(from_vector(e.robust_weights)); })
       .def_readonly("rejected_measurements", &StiffnessEstimate::rejected_measurements, "0-based indices")
       .def_readonly("measurements", &StiffnessEstimate::measurements)
       .def_readonly("iterations", &StiffnessEstimate::iterations)
       .def(py::pickle(
           [](const StiffnessEstimate& e) {
-            return py::make_tuple(e.stiffness_nm_per_rad, e.std_error_nm_per_rad, e.compliance_rad_per_nm,
-                                  e.compliance_std_error_rad_per_nm,
-                                  py::make_tuple(e.residual_rms_m, e.residual_max_m, e.residual_rms_rad, e.sigma_m,
-                                                 e.condition_number),
-                                  e.unidentifiable_joints, e.fixed_joints, e.warnings, e.robust_weights,
-                                  e.rejected_measurements, e.rejected_lines, e.measurements, e.iterations);
+            return py::make_tuple(
+                e.stiffness_nm_per_rad, e.std_error_nm_per_rad, e.compliance_rad_per_nm,
+                e.compliance_std_error_rad_per_nm,
+                py::make_tuple(e.residual_rms_m, e.residual_max_m, e.residual_rms_rad, e.sigma_m, e.condition_number),
+                e.unidentifiable_joints, e.fixed_joints, e.warnings, e.robust_weights, e.rejected_measurements,
+                e.rejected_lines, e.measurements, e.iterations);
           },
           [](const py::tuple& t) {
             if (t.size() != 13) throw InputError("deflex.StiffnessEstimate: not a pickled StiffnessEstimate");
@@ -121,26 +128,30 @@ void bind_identify(py::module_& m) {
             return e;
           }))
       .def("__repr__", [](const StiffnessEstimate& e) {
-        std::string s = fmt::format("StiffnessEstimate(stiffness_nm_per_rad={}, condition_number={:.3g}",
-                                    py::repr(from_vector(e.stiffness_nm_per_rad)).cast<std::string>(), e.condition_number);
+        std::string s =
+            fmt::format("StiffnessEstimate(stiffness_nm_per_rad={}, condition_number={:.3g}",
+                        py::repr(from_vector(e.stiffness_nm_per_rad)).cast<std::string>(), e.condition_number);
         std::vector<int> nan, poor;
         for (const int j : e.unidentifiable_joints) {
           (std::isnan(e.stiffness_nm_per_rad[j - 1]) ? nan : poor).push_back(j);
         }
         if (!nan.empty()) s += fmt::format(", not identified (NaN): joints {}", fmt::join(nan, ", "));
-        if (!poor.empty()) s += fmt::format(", poorly identified (shown, not to be used): joints {}", fmt::join(poor, ", "));
+        if (!poor.empty())
+          s += fmt::format(", poorly identified (shown, not to be used): joints {}", fmt::join(poor, ", "));
         return s + fmt::format(", {} warnings)", e.warnings.size());
       });
 
-  m.def("read_stiffness_measurements",
-        [](const PathArg& path) { return measurements_to_dict(read_stiffness_measurements(path_text(path))); }, "path"_a,
-        "The measurement CSV (docs/identify.md) as arrays in SI units: q (m, dof) rad, wrench (m, 6) N/Nm, dp (m, 3) "
-        "m, drot (m, 3) rad or None, weight (m,), line (file line of each row).");
+  m.def(
+      "read_stiffness_measurements",
+      [](const PathArg& path) { return measurements_to_dict(read_stiffness_measurements(path_text(path))); }, "path"_a,
+      "The measurement CSV (docs/identify.md) as arrays in SI units: q (m, dof) rad, wrench (m, 6) N/Nm, dp (m, 3) "
+      "m, drot (m, 3) rad or None, weight (m,), line (file line of each row).");
 
   m.def(
       "identify_stiffness",
       [](const RobotModel& model, const DataArg& data, const std::optional<ArrayLike>& wrench_pos,
-         const std::optional<ArrayLike>& dp_pos, const std::optional<ArrayLike>& q_kw, const std::optional<ArrayLike>& drot, const std::optional<ArrayLike>& weight, const OptionalFloats& fixed,
+         const std::optional<ArrayLike>& dp_pos, const std::optional<ArrayLike>& q_kw,
+         const std::optional<ArrayLike>& drot, const std::optional<ArrayLike>& weight, const OptionalFloats& fixed,
          bool robust, double rotation_scale_m, double max_relative_std_error) {
         std::vector<StiffnessMeasurement> measurements;
         const auto given = [](const std::optional<ArrayLike>& a) { return a && !a->is_none(); };
@@ -152,14 +163,16 @@ void bind_identify(py::module_& m) {
           measurements = read_stiffness_measurements(data.obj.cast<PathArg>().string());
         } else {
           // Arrays: by keyword, or positionally as (robot, q, wrench, dp).
-          if (!data.is_none() && given(q_kw)) throw InputError("identify_stiffness: q given twice (positionally and as q=)");
+          if (!data.is_none() && given(q_kw))
+            throw InputError("identify_stiffness: q given twice (positionally and as q=)");
           const py::object none = py::none();
           const py::object q = !data.is_none() ? data.obj : given(q_kw) ? q_kw->obj : none;
           const py::object w = given(wrench_pos) ? wrench_pos->obj : none;
           const py::object dp = given(dp_pos) ? dp_pos->obj : none;
           if (q.is_none() || w.is_none() || dp.is_none()) {
-            throw InputError("identify_stiffness: give the measurement CSV's path, or the arrays q (m, dof) rad, wrench "
-                             "(m, 6) N/Nm and dp (m, 3) m");
+            throw InputError(
+                "identify_stiffness: give the measurement CSV's path, or the arrays q (m, dof) rad, wrench "
+                "(m, 6) N/Nm and dp (m, 3) m");
           }
           measurements = measurements_from_arrays(model, q, w, dp, given(drot) ? drot->obj : none,
                                                   given(weight) ? weight->obj : none);
@@ -178,9 +191,9 @@ void bind_identify(py::module_& m) {
         py::gil_scoped_release release;
         return identify_stiffness(model, measurements, options);
       },
-      "robot"_a, "data"_a = py::none(), "wrench"_a = py::none(), "dp"_a = py::none(), "q"_a = py::none(), "drot"_a = py::none(), "weight"_a = py::none(),
-      "fixed_stiffness_nm_per_rad"_a = py::none(), "robust"_a = true, "rotation_scale_m"_a = 1.0,
-      "max_relative_std_error"_a = 0.5,
+      "robot"_a, "data"_a = py::none(), "wrench"_a = py::none(), "dp"_a = py::none(), "q"_a = py::none(),
+      "drot"_a = py::none(), "weight"_a = py::none(), "fixed_stiffness_nm_per_rad"_a = py::none(), "robust"_a = true,
+      "rotation_scale_m"_a = 1.0, "max_relative_std_error"_a = 0.5,
       "Joint stiffness from measured TCP deflections: data is the measurement CSV's path (str or os.PathLike), or "
       "the arrays q (m, dof) rad, wrench (m, 6) N/Nm (base frame, moment about the WAP) and dp (m, 3) m, positionally "
       "(robot, q, wrench, dp) or by keyword; optional drot (m, 3) rad and weight (m,). "
@@ -196,22 +209,34 @@ void bind_identify(py::module_& m) {
       "did not identify keeps the robot file's value (the note says which); InputError when it has none to keep.");
 
   py::class_<CalibrationPlan>(m, "CalibrationPlan", "Poses and loads of a compliance-calibration experiment.")
-      .def_property_readonly("pose", [](const CalibrationPlan& p) {
-        std::vector<int> v;
-        for (const auto& c : p.points) v.push_back(c.pose);
-        return v;
-      }, "1-based pose number of each row")
-      .def_property_readonly("q", [](const CalibrationPlan& p) {
-        return rows_of(p.points, &CalibrationPoint::q, p.points.empty() ? 0 : p.points.front().q.size());
-      }, "(rows, dof) rad")
-      .def_property_readonly("base_T_tcp", [](const CalibrationPlan& p) { return poses_of(p.points, &CalibrationPoint::base_T_tcp); },
-                             "(rows, 4, 4), m")
-      .def_property_readonly("wrench", [](const CalibrationPlan& p) { return rows_of(p.points, &CalibrationPoint::wrench_base, 6); },
-                             "(rows, 6) N, Nm at the WAP, base frame")
-      .def_property_readonly("load_point", [](const CalibrationPlan& p) { return rows_of(p.points, &CalibrationPoint::load_point_base, 3); },
-                             "(rows, 3) m, where the force acts")
-      .def_property_readonly("expected_dp", [](const CalibrationPlan& p) { return rows_of(p.points, &CalibrationPoint::expected_dp_m, 3); },
-                             "(rows, 3) m, first-order deflection with the robot file's stiffness")
+      .def_property_readonly(
+          "pose",
+          [](const CalibrationPlan& p) {
+            std::vector<int> v;
+            for (const auto& c : p.points) v.push_back(c.pose);
+            return v;
+          },
+          "1-based pose number of each row")
+      .def_property_readonly(
+          "q",
+          [](const CalibrationPlan& p) {
+            return rows_of(p.points, &CalibrationPoint::q, p.points.empty() ? 0 : p.points.front().q.size());
+          },
+          "(rows, dof) rad")
+      .def_property_readonly(
+          "base_T_tcp", [](const CalibrationPlan& p) { return poses_of(p.points, &CalibrationPoint::base_T_tcp); },
+          "(rows, 4, 4), m")
+      .def_property_readonly(
+          "wrench", [](const CalibrationPlan& p) { return rows_of(p.points, &CalibrationPoint::wrench_base, 6); },
+          "(rows, 6) N, Nm at the WAP, base frame")
+      .def_property_readonly(
+          "load_point",
+          [](const CalibrationPlan& p) { return rows_of(p.points, &CalibrationPoint::load_point_base, 3); },
+          "(rows, 3) m, where the force acts")
+      .def_property_readonly(
+          "expected_dp",
+          [](const CalibrationPlan& p) { return rows_of(p.points, &CalibrationPoint::expected_dp_m, 3); },
+          "(rows, 3) m, first-order deflection with the robot file's stiffness")
       .def_readonly("min_singular_value_m", &CalibrationPlan::min_singular_value_m)
       .def_readonly("condition_number", &CalibrationPlan::condition_number)
       .def_property_readonly("predicted_relative_std_error",
@@ -219,8 +244,10 @@ void bind_identify(py::module_& m) {
       .def_readonly("candidate_poses", &CalibrationPlan::candidate_poses)
       .def_readonly("reachable_poses", &CalibrationPlan::reachable_poses)
       .def_readonly("warnings", &CalibrationPlan::warnings)
-      .def("write_csv", [](const CalibrationPlan& p, const PathArg& path) { write_calibration_plan(path_text(path), p); },
-           "path"_a, "The plan as the operator's CSV (the same as deflex plan-calibration -o).");
+      .def(
+          "write_csv",
+          [](const CalibrationPlan& p, const PathArg& path) { write_calibration_plan(path_text(path), p); }, "path"_a,
+          "The plan as the operator's CSV (the same as deflex plan-calibration -o).");
 
   m.def(
       "plan_calibration",

@@ -8,9 +8,9 @@
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "deflex/model/compliance.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/text/errors.hpp"
 #include "parallel.hpp"
 
 namespace deflex::python {
@@ -23,8 +23,8 @@ bool moment_about_tcp(const std::string& about) {
   throw InputError(fmt::format("argument moment_about: '{}' is neither wap nor tcp", about));
 }
 
-Wrench wrench_at_wap(const RobotModel& model, Workspace& ws, const JointVector& q, const double* wrenches,
-                     bool per_row, std::ptrdiff_t row, bool about_tcp) {
+Wrench wrench_at_wap(const RobotModel& model, Workspace& ws, const JointVector& q, const double* wrenches, bool per_row,
+                     std::ptrdiff_t row, bool about_tcp) {
   const Wrench w = Eigen::Map<const Wrench>(wrenches + (per_row ? 6 * row : 0));
   if (!about_tcp) return w;
   forward_kinematics(model, ws, q);
@@ -109,31 +109,33 @@ Array batch_of(const RobotModel& model, const py::handle& q_obj, const char* q_n
 
 Array fk(const RobotModel& model, const ArrayLike& q_obj, const std::string& point, int threads) {
   const Frame f = frame_of(model, point);
-  return batch_of(model, q_obj, "q", {4, 4}, threads, [&](Workspace& ws, std::ptrdiff_t, const JointVector& qi, double* out) {
-    if (f.joint >= 0) {
-      write_pose(joint_frame(model, qi, f.joint), out);
-      return;
-    }
-    forward_kinematics(model, ws, qi);
-    write_pose(end_pose(ws, f.end), out);
-  });
+  return batch_of(model, q_obj, "q", {4, 4}, threads,
+                  [&](Workspace& ws, std::ptrdiff_t, const JointVector& qi, double* out) {
+                    if (f.joint >= 0) {
+                      write_pose(joint_frame(model, qi, f.joint), out);
+                      return;
+                    }
+                    forward_kinematics(model, ws, qi);
+                    write_pose(end_pose(ws, f.end), out);
+                  });
 }
 
 Array jacobian_of(const RobotModel& model, const ArrayLike& q_obj, const std::string& point, int threads) {
   const Frame f = frame_of(model, point);
   const int dof = model.dof();
-  return batch_of(model, q_obj, "q", {6, dof}, threads, [&](Workspace& ws, std::ptrdiff_t, const JointVector& qi, double* out) {
-    Eigen::Map<Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>> o(out, 6, dof);
-    if (f.joint >= 0) {
-      forward_kinematics(model, ws, qi);
-      point_jacobian(ws, joint_frame(model, qi, f.joint).translation(), ws.jacobian);
-      o = ws.jacobian;
-      o.rightCols(dof - 1 - f.joint).setZero();  // the joints after it do not move the frame
-      return;
-    }
-    jacobian(model, ws, qi, f.end, ws.jacobian);
-    o = ws.jacobian;
-  });
+  return batch_of(model, q_obj, "q", {6, dof}, threads,
+                  [&](Workspace& ws, std::ptrdiff_t, const JointVector& qi, double* out) {
+                    Eigen::Map<Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>> o(out, 6, dof);
+                    if (f.joint >= 0) {
+                      forward_kinematics(model, ws, qi);
+                      point_jacobian(ws, joint_frame(model, qi, f.joint).translation(), ws.jacobian);
+                      o = ws.jacobian;
+                      o.rightCols(dof - 1 - f.joint).setZero();  // the joints after it do not move the frame
+                      return;
+                    }
+                    jacobian(model, ws, qi, f.end, ws.jacobian);
+                    o = ws.jacobian;
+                  });
 }
 
 /// What deflect() returns: arrays of one configuration or of a batch.
@@ -146,9 +148,10 @@ struct Deflection {
 Array wrenches_for(const py::handle& w_obj, bool batch, py::ssize_t rows, bool& w_batch) {
   const Array w = wrench_rows(w_obj, "wrench", w_batch);
   if (w_batch && (!batch || w.shape(0) != rows)) {
-    throw InputError(fmt::format("argument wrench: expected shape (6,) or ({}, 6) (one wrench a configuration), got "
-                                 "({}, 6)",
-                                 rows, w.shape(0)));
+    throw InputError(
+        fmt::format("argument wrench: expected shape (6,) or ({}, 6) (one wrench a configuration), got "
+                    "({}, 6)",
+                    rows, w.shape(0)));
   }
   return w;
 }
@@ -195,7 +198,8 @@ Array configurations_under(const RobotModel& model, const ArrayLike& q_obj, cons
     const Wrench wi = wrench_at_wap(model, ws, qi, wd, w_batch, i, about_tcp);
     JointVector r(dof);
     if (deflected) {
-      failed[static_cast<std::size_t>(i)] = deflected_configuration(model, ws, qi, wi, r) != DeflectionStatus::kConverged;
+      failed[static_cast<std::size_t>(i)] =
+          deflected_configuration(model, ws, qi, wi, r) != DeflectionStatus::kConverged;
     } else {
       compensated_configuration(model, ws, qi, wi, r);
     }
@@ -203,9 +207,10 @@ Array configurations_under(const RobotModel& model, const ArrayLike& q_obj, cons
   });
   for (py::ssize_t i = 0; i < rows; ++i) {
     if (failed[static_cast<std::size_t>(i)]) {
-      throw InputError(fmt::format("deflected_configuration: {}the fixed-point iteration did not converge (load too "
-                                   "large for the model)",
-                                   batch ? fmt::format("row {}: ", i) : std::string()));
+      throw InputError(
+          fmt::format("deflected_configuration: {}the fixed-point iteration did not converge (load too "
+                      "large for the model)",
+                      batch ? fmt::format("row {}: ", i) : std::string()));
     }
   }
   return out;
@@ -288,7 +293,7 @@ py::object ik(const RobotModel& r, const ArrayLike& target, const std::optional<
 }
 
 py::object inverse_kinematics_of(const RobotModel& r, const ArrayLike& target, const ConfigurationArg& configuration,
-                                  const std::optional<ArrayLike>& seed) {
+                                 const std::optional<ArrayLike>& seed) {
   const std::optional<ArmConfiguration> conf = arm_configuration_arg(configuration);
   if (!is_pose_batch(target)) {
     IkRequest req = Seeds(r, seed, 0).request(r.dof(), 0);
@@ -335,7 +340,6 @@ std::optional<ArmConfiguration> arm_configuration_arg(const py::handle& c) {
   return ArmConfiguration{v[0], v[1], v[2], v[3]};
 }
 
-
 void bind_model(py::module_& m) {
   py::class_<Deflection>(m, "Deflection",
                          "Joint deflection dtheta_rad = K^-1 J_wap^T W (rad) and the first-order TCP deflection "
@@ -355,8 +359,9 @@ void bind_model(py::module_& m) {
       .def_property_readonly("status", [](const IkResult& r) { return std::string(to_string(r.status)); })
       .def_property_readonly("ok", &IkResult::ok)
       .def_property_readonly("q", [](const IkResult& r) { return frozen(from_vector(r.q)); })
-      .def_property_readonly("configuration", [](const IkResult& r) { return configuration_tuple(r.configuration); },
-                             "ABB confdata (cf1, cf4, cf6, cfx)")
+      .def_property_readonly(
+          "configuration", [](const IkResult& r) { return configuration_tuple(r.configuration); },
+          "ABB confdata (cf1, cf4, cf6, cfx)")
       .def_property_readonly("kuka_status", [](const IkResult& r) { return r.kuka.status; })
       .def_property_readonly("kuka_turn", [](const IkResult& r) { return r.kuka.turn; })
       .def_property_readonly("singularity", [](const IkResult& r) { return std::string(to_string(r.singularity)); })
@@ -397,16 +402,19 @@ void bind_model(py::module_& m) {
       "A validated, immutable robot (kinematics, joint limits, joint stiffness). Joints in rad, lengths in m, "
       "wrenches [Fx Fy Fz Mx My Mz] in N and Nm in the base frame with the moment about the WAP (moment_about='tcp' "
       "to give it about the TCP). Pickles (as its deflex YAML).")
-      .def_static("builtin", [] { return std::make_shared<RobotModel>(builtin_irb6700()); },
-                  "The built-in ABB IRB 6700-300/2.70.")
-      .def_static("from_file", [](const PathArg& path) { return std::make_shared<RobotModel>(load_robot(path_text(path))); },
-                  "path"_a, "A deflex YAML (.yaml/.yml) or URDF (.urdf) file; ModelError names the file, line, field.")
+      .def_static(
+          "builtin", [] { return std::make_shared<RobotModel>(builtin_irb6700()); },
+          "The built-in ABB IRB 6700-300/2.70.")
+      .def_static(
+          "from_file", [](const PathArg& path) { return std::make_shared<RobotModel>(load_robot(path_text(path))); },
+          "path"_a, "A deflex YAML (.yaml/.yml) or URDF (.urdf) file; ModelError names the file, line, field.")
       .def_static(
           "from_yaml",
           [](const std::string& text, const PathArg& base_dir) {
             return std::make_shared<RobotModel>(load_robot_yaml_text(text, "<yaml text>", path_text(base_dir)));
           },
-          "text"_a, "base_dir"_a = PathArg("."), "deflex robot YAML from a string (relative URDF paths against base_dir).")
+          "text"_a, "base_dir"_a = PathArg("."),
+          "deflex robot YAML from a string (relative URDF paths against base_dir).")
       .def_property_readonly("name", &RobotModel::name)
       .def_property_readonly("dof", &RobotModel::dof)
       .def_property_readonly("source", [](const RobotModel& r) { return r.description().source; })
@@ -419,8 +427,10 @@ void bind_model(py::module_& m) {
             return frozen(from_vector(r.stiffness()));
           },
           "Joint stiffness, Nm/rad; None when the robot file gives none (a bare URDF).")
-      .def_property_readonly("lower_limits", [](const RobotModel& r) { return frozen(from_vector(r.lower_limits())); }, "rad")
-      .def_property_readonly("upper_limits", [](const RobotModel& r) { return frozen(from_vector(r.upper_limits())); }, "rad")
+      .def_property_readonly(
+          "lower_limits", [](const RobotModel& r) { return frozen(from_vector(r.lower_limits())); }, "rad")
+      .def_property_readonly(
+          "upper_limits", [](const RobotModel& r) { return frozen(from_vector(r.upper_limits())); }, "rad")
       .def_property_readonly("has_analytic_ik", [](const RobotModel& r) { return has_analytic_ik(r); })
       .def_property_readonly(
           "frames",
@@ -431,11 +441,12 @@ void bind_model(py::module_& m) {
           },
           "The frames fk() and jacobian() take: tcp, flange, wap and the moving frame of each joint (joint1.., "
           "also by the joint's name in the robot file).")
-      .def_property_readonly("joint_names", [](const RobotModel& r) {
-        std::vector<std::string> names;
-        for (int i = 0; i < r.dof(); ++i) names.push_back(r.joint(i).name);
-        return names;
-      })
+      .def_property_readonly("joint_names",
+                             [](const RobotModel& r) {
+                               std::vector<std::string> names;
+                               for (int i = 0; i < r.dof(); ++i) names.push_back(r.joint(i).name);
+                               return names;
+                             })
       .def(
           "with_stiffness",
           [](const RobotModel& r, const ArrayLike& k, const std::string& note) {
@@ -457,8 +468,10 @@ void bind_model(py::module_& m) {
             }
             return out;
           },
-          "q"_a, "tolerance_rad"_a = 1e-9, "True when every joint is inside its limits; a bool array for a batch (N, dof).")
-      .def("to_yaml", [](const RobotModel& r) { return robot_to_yaml(r); }, "deflex YAML of the robot (m, deg).")
+          "q"_a, "tolerance_rad"_a = 1e-9,
+          "True when every joint is inside its limits; a bool array for a batch (N, dof).")
+      .def(
+          "to_yaml", [](const RobotModel& r) { return robot_to_yaml(r); }, "deflex YAML of the robot (m, deg).")
       .def(py::pickle([](const RobotModel& r) { return py::make_tuple(robot_to_yaml(r), r.description().source); },
                       &robot_from_state))
       .def("fk", &fk, "q"_a, "point"_a = "tcp", "threads"_a = 0,
@@ -475,10 +488,11 @@ void bind_model(py::module_& m) {
       .def(
           "cartesian_compliance",
           [](const RobotModel& r, const ArrayLike& q, int threads) {
-            return batch_of(r, q, "q", {6, 6}, threads, [&](Workspace& ws, std::ptrdiff_t, const JointVector& qi, double* out) {
-              Eigen::Map<Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> c(out);
-              c = cartesian_compliance(r, ws, qi);
-            });
+            return batch_of(r, q, "q", {6, 6}, threads,
+                            [&](Workspace& ws, std::ptrdiff_t, const JointVector& qi, double* out) {
+                              Eigen::Map<Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> c(out);
+                              c = cartesian_compliance(r, ws, qi);
+                            });
           },
           "q"_a, "threads"_a = 0,
           "C = J_wap K^-1 J_wap^T (6x6): [m, rad] per [N, Nm], at the WAP; (N, 6, 6) for a batch (N, dof).")
@@ -503,7 +517,8 @@ void bind_model(py::module_& m) {
            "each joint, the nearest the seed first ([0]: each joint at the turn nearest the seed); empty when there "
            "is none. Poses (N, 4, 4) give a list a pose (seed (dof,) or (N, dof)). Arms outside the analytic (OPW) "
            "family: the numerical solver's one solution.")
-      .def("inverse_kinematics", &inverse_kinematics_of, "pose"_a, "configuration"_a = py::none(), "seed"_a = py::none(),
+      .def("inverse_kinematics", &inverse_kinematics_of, "pose"_a, "configuration"_a = py::none(),
+           "seed"_a = py::none(),
            "One solution chosen by ABB confdata and/or the seed, with its status and message (never raises for an "
            "unreachable pose: see status); a list for poses (N, 4, 4).")
       .def("__repr__", [](const RobotModel& r) {
@@ -511,8 +526,9 @@ void bind_model(py::module_& m) {
                            r.has_stiffness() ? "with stiffness" : "no stiffness", r.description().source);
       });
 
-  m.def("load_robot", [](const PathArg& path) { return std::make_shared<RobotModel>(load_robot(path_text(path))); },
-        "path"_a, "Robot.from_file(path).");
+  m.def(
+      "load_robot", [](const PathArg& path) { return std::make_shared<RobotModel>(load_robot(path_text(path))); },
+      "path"_a, "Robot.from_file(path).");
   m.def(
       "pose",
       [](const ArrayLike& position, const ArrayLike& quaternion) {
@@ -522,7 +538,8 @@ void bind_model(py::module_& m) {
         p.translation() = vector3(position, "position_m");
         return from_pose(p);
       },
-      "position_m"_a, "quaternion_wxyz"_a, "A 4x4 homogeneous transform from a position (m) and a unit quaternion (w, x, y, z).");
+      "position_m"_a, "quaternion_wxyz"_a,
+      "A 4x4 homogeneous transform from a position (m) and a unit quaternion (w, x, y, z).");
 }
 
 }  // namespace deflex::python

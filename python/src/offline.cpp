@@ -10,7 +10,6 @@
 #include "deflex/force/constant_wrench_model.hpp"
 #include "deflex/force/force_spec.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/model/kinematics.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/offline/offline_csv.hpp"
@@ -21,6 +20,7 @@
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/path_spec.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::python {
 using namespace pybind11::literals;
@@ -35,7 +35,8 @@ class ArrayWrenchModel final : public ForceModel {
       : wrenches_(std::move(wrenches)), table_(table), tcp_T_wap_(tcp_T_wap), about_tcp_(about_tcp) {}
   [[nodiscard]] Wrench wrench_at(std::size_t index, const Pose& base_T_tcp) const override {
     if (table_ && index >= wrenches_.size()) {
-      throw InputError(fmt::format("force: the wrench array has {} rows, no row for path point {}", wrenches_.size(), index));
+      throw InputError(
+          fmt::format("force: the wrench array has {} rows, no row for path point {}", wrenches_.size(), index));
     }
     const Wrench& w = wrenches_[table_ ? index : 0];
     if (about_tcp_) return w;
@@ -45,12 +46,13 @@ class ArrayWrenchModel final : public ForceModel {
     const char* about = about_tcp_ ? "TCP" : "WAP";
     if (!table_) {
       const Wrench& w = wrenches_.front();
-      return fmt::format("constant wrench F = ({:g}, {:g}, {:g}) N, M = ({:g}, {:g}, {:g}) Nm (base frame, moment about "
-                         "the {})",
-                         w[0], w[1], w[2], w[3], w[4], w[5], about);
+      return fmt::format(
+          "constant wrench F = ({:g}, {:g}, {:g}) N, M = ({:g}, {:g}, {:g}) Nm (base frame, moment about "
+          "the {})",
+          w[0], w[1], w[2], w[3], w[4], w[5], about);
     }
-    return fmt::format("a wrench a point from a ({}, 6) array (N, Nm; base frame, moment about the {})", wrenches_.size(),
-                       about);
+    return fmt::format("a wrench a point from a ({}, 6) array (N, Nm; base frame, moment about the {})",
+                       wrenches_.size(), about);
   }
   [[nodiscard]] std::string label() const override { return table_ ? "array" : "constant"; }
   [[nodiscard]] std::optional<std::size_t> points() const override {
@@ -64,9 +66,7 @@ class ArrayWrenchModel final : public ForceModel {
   bool about_tcp_;
 };
 
-Pose tcp_T_wap(const RobotModel& model) {
-  return model.description().flange_T_tcp.inverse() * model.flange_T_wap();
-}
+Pose tcp_T_wap(const RobotModel& model) { return model.description().flange_T_tcp.inverse() * model.flange_T_wap(); }
 
 /// The force models of one `force` argument: a spec string (several loads when it lists several
 /// force_N values), or wrenches (6,) / (N, 6).
@@ -118,8 +118,7 @@ std::vector<OfflineResult> compensate_each(const RobotModel& model, const PathOr
   if (list_is_loads && (py::isinstance<py::list>(force.obj) || py::isinstance<py::tuple>(force.obj))) {
     // A list of loads: spec strings or wrench arrays, one load each (a list of six numbers is one wrench).
     const py::sequence seq = force.obj;
-    const bool one_wrench =
-        seq.size() == 6 && (py::isinstance<py::float_>(seq[0]) || py::isinstance<py::int_>(seq[0]));
+    const bool one_wrench = seq.size() == 6 && (py::isinstance<py::float_>(seq[0]) || py::isinstance<py::int_>(seq[0]));
     if (!one_wrench) {
       for (const py::handle item : seq) {
         for (auto& f : force_models(model, item, context, about)) forces.push_back(std::move(f));
@@ -183,7 +182,8 @@ JointTrajectory trajectory_from(const RobotModel& model, const ArrayLike& t_obj,
   }
   std::vector<double> ts(t.data(), t.data() + t.size());
   std::vector<JointVector> qs;
-  for (py::ssize_t i = 0; i < q.shape(0); ++i) qs.emplace_back(Eigen::Map<const Eigen::VectorXd>(q.data() + i * model.dof(), model.dof()));
+  for (py::ssize_t i = 0; i < q.shape(0); ++i)
+    qs.emplace_back(Eigen::Map<const Eigen::VectorXd>(q.data() + i * model.dof(), model.dof()));
   return JointTrajectory(std::move(ts), std::move(qs), model, "<arrays>");
 }
 
@@ -215,7 +215,9 @@ py::dict program_dict(const RobotModel& model, const ProgramCompensation& result
                   "summary"_a = program_summary(result));
 }
 
-Array point_rows(const OfflineResult& r, JointVector OfflinePoint::*field) { return frozen(rows_of(r.points, field, dof_of(r))); }
+Array point_rows(const OfflineResult& r, JointVector OfflinePoint::*field) {
+  return frozen(rows_of(r.points, field, dof_of(r)));
+}
 
 }  // namespace
 
@@ -228,8 +230,8 @@ void bind_offline(py::module_& m) {
   vector_property(circle, "normal", &CirclePath::normal);
   circle
       .def(py::init([](const std::optional<ArrayLike>& centre, std::optional<double> radius,
-                       const std::optional<ArrayLike>& normal, std::optional<double> start, std::optional<bool> clockwise,
-                       std::optional<int> points) {
+                       const std::optional<ArrayLike>& normal, std::optional<double> start,
+                       std::optional<bool> clockwise, std::optional<int> points) {
              CirclePath c = default_circle();
              if (centre) c.centre_m = vector3(*centre, "centre_m");
              if (radius) c.radius_m = *radius;
@@ -245,8 +247,8 @@ void bind_offline(py::module_& m) {
              c.normal.normalize();
              return c;
            }),
-           "centre_m"_a = py::none(), "radius_m"_a = py::none(), "normal"_a = py::none(), "start_angle_rad"_a = py::none(),
-           "clockwise"_a = py::none(), "points"_a = py::none())
+           "centre_m"_a = py::none(), "radius_m"_a = py::none(), "normal"_a = py::none(),
+           "start_angle_rad"_a = py::none(), "clockwise"_a = py::none(), "points"_a = py::none())
       .def_readwrite("radius_m", &CirclePath::radius_m)
       .def_readwrite("start_angle_rad", &CirclePath::start_angle_rad)
       .def_readwrite("clockwise", &CirclePath::clockwise)
@@ -273,10 +275,11 @@ void bind_offline(py::module_& m) {
             return c;
           }))
       .def("__repr__", [](const CirclePath& c) {
-        return fmt::format("Circle(centre_m=[{:g}, {:g}, {:g}], radius_m={:g}, normal=[{:g}, {:g}, {:g}], "
-                           "start_angle_rad={:g}, clockwise={}, points={})",
-                           c.centre_m.x(), c.centre_m.y(), c.centre_m.z(), c.radius_m, c.normal.x(), c.normal.y(),
-                           c.normal.z(), c.start_angle_rad, c.clockwise ? "True" : "False", c.points);
+        return fmt::format(
+            "Circle(centre_m=[{:g}, {:g}, {:g}], radius_m={:g}, normal=[{:g}, {:g}, {:g}], "
+            "start_angle_rad={:g}, clockwise={}, points={})",
+            c.centre_m.x(), c.centre_m.y(), c.centre_m.z(), c.radius_m, c.normal.x(), c.normal.y(), c.normal.z(),
+            c.start_angle_rad, c.clockwise ? "True" : "False", c.points);
       });
 
   m.def(
@@ -327,7 +330,8 @@ void bind_offline(py::module_& m) {
             incline.mutable_data()[i] = ldbb != nullptr ? ldbb->inclination_rad(p[i]) : std::nan("");
           }
           if (f->points() && *f->points() != p.size()) {
-            throw InputError(fmt::format("force: {} has {} points, the path {}", f->describe(), *f->points(), p.size()));
+            throw InputError(
+                fmt::format("force: {} has {} points, the path {}", f->describe(), *f->points(), p.size()));
           }
           py::dict d("description"_a = f->describe(), "label"_a = f->label(), "wrench"_a = w,
                      "moment_about"_a = about_tcp ? "tcp" : "wap");
@@ -344,25 +348,33 @@ void bind_offline(py::module_& m) {
       "`label`, and for an LDBB the bar's `bar_length_m` and `bar_inclination_rad` (to the base XY plane) a point.");
 
   py::class_<OfflineResult>(m, "OfflineResult", "A compensated path: one row a point (rad, m, N, Nm).")
-      .def_property_readonly("q_desired", [](const OfflineResult& r) { return point_rows(r, &OfflinePoint::q_desired); },
-                             "(N, dof) rad, from the path's IK")
-      .def_property_readonly("q_command", [](const OfflineResult& r) { return point_rows(r, &OfflinePoint::q_command); },
-                             "(N, dof) rad: q_desired - K^-1 J_wap(q_desired)^T W")
-      .def_property_readonly("tcp_desired", [](const OfflineResult& r) { return frozen(poses_of(r.points, &OfflinePoint::tcp_desired)); },
-                             "(N, 4, 4) m")
-      .def_property_readonly("tcp_command", [](const OfflineResult& r) { return frozen(poses_of(r.points, &OfflinePoint::tcp_command)); },
-                             "(N, 4, 4) m: FK(q_command)")
-      .def_property_readonly("wrench", [](const OfflineResult& r) { return frozen(rows_of(r.points, &OfflinePoint::wrench_base, 6)); },
-                             "(N, 6) N, Nm: base frame, moment about the WAP (see moment_about)")
-      .def_property_readonly("moment_about", [](const OfflineResult&) { return "wap"; },
-                             "Where the moments of `wrench` are taken: always the WAP (the TCP unless the robot file "
-                             "puts it elsewhere).")
-      .def_property_readonly("predicted_deflection",
-                             [](const OfflineResult& r) { return frozen(rows_of(r.points, &OfflinePoint::predicted_deflection, 6)); },
-                             "(N, 6) [m, rad]: uncompensated TCP displacement under the load")
-      .def_property_readonly("predicted_residual",
-                             [](const OfflineResult& r) { return frozen(rows_of(r.points, &OfflinePoint::predicted_residual, 6)); },
-                             "(N, 6) [m, rad]: after compensation (a check of the exact form)")
+      .def_property_readonly(
+          "q_desired", [](const OfflineResult& r) { return point_rows(r, &OfflinePoint::q_desired); },
+          "(N, dof) rad, from the path's IK")
+      .def_property_readonly(
+          "q_command", [](const OfflineResult& r) { return point_rows(r, &OfflinePoint::q_command); },
+          "(N, dof) rad: q_desired - K^-1 J_wap(q_desired)^T W")
+      .def_property_readonly(
+          "tcp_desired", [](const OfflineResult& r) { return frozen(poses_of(r.points, &OfflinePoint::tcp_desired)); },
+          "(N, 4, 4) m")
+      .def_property_readonly(
+          "tcp_command", [](const OfflineResult& r) { return frozen(poses_of(r.points, &OfflinePoint::tcp_command)); },
+          "(N, 4, 4) m: FK(q_command)")
+      .def_property_readonly(
+          "wrench", [](const OfflineResult& r) { return frozen(rows_of(r.points, &OfflinePoint::wrench_base, 6)); },
+          "(N, 6) N, Nm: base frame, moment about the WAP (see moment_about)")
+      .def_property_readonly(
+          "moment_about", [](const OfflineResult&) { return "wap"; },
+          "Where the moments of `wrench` are taken: always the WAP (the TCP unless the robot file "
+          "puts it elsewhere).")
+      .def_property_readonly(
+          "predicted_deflection",
+          [](const OfflineResult& r) { return frozen(rows_of(r.points, &OfflinePoint::predicted_deflection, 6)); },
+          "(N, 6) [m, rad]: uncompensated TCP displacement under the load")
+      .def_property_readonly(
+          "predicted_residual",
+          [](const OfflineResult& r) { return frozen(rows_of(r.points, &OfflinePoint::predicted_residual, 6)); },
+          "(N, 6) [m, rad]: after compensation (a check of the exact form)")
       .def_readonly("max_deflection_m", &OfflineResult::max_deflection_m)
       .def_readonly("mean_deflection_m", &OfflineResult::mean_deflection_m)
       .def_readonly("max_deflection_rad", &OfflineResult::max_deflection_rad)
@@ -371,9 +383,11 @@ void bind_offline(py::module_& m) {
       .def_readonly("max_correction_m", &OfflineResult::max_correction_m)
       .def_readonly("max_joint_correction_rad", &OfflineResult::max_joint_correction_rad)
       .def_readonly("force_description", &OfflineResult::force_description)
-      .def("summary", [](const OfflineResult& r) { return offline_summary(r); }, "The summary `deflex offline` prints.")
-      .def("write_csv", [](const OfflineResult& r, const PathArg& path) { write_offline_csv(r, path_text(path)); }, "path"_a,
-           "The CSV `deflex offline -o` writes.")
+      .def(
+          "summary", [](const OfflineResult& r) { return offline_summary(r); }, "The summary `deflex offline` prints.")
+      .def(
+          "write_csv", [](const OfflineResult& r, const PathArg& path) { write_offline_csv(r, path_text(path)); },
+          "path"_a, "The CSV `deflex offline -o` writes.")
       .def(
           "rapid_module",
           [](const OfflineResult& r, const std::string& module, const std::string& motion, double speed_mm_s,
@@ -405,8 +419,8 @@ void bind_offline(py::module_& m) {
           "robot's joint limits and speeds.")
       .def(
           "write_joint_trajectory",
-          [](const OfflineResult& r, const PathArg& path, const RobotModel& model, double speed_mm_s, double hold_start_s,
-             bool nominal, const std::string& comment) {
+          [](const OfflineResult& r, const PathArg& path, const RobotModel& model, double speed_mm_s,
+             double hold_start_s, bool nominal, const std::string& comment) {
             timed(model, r, speed_mm_s, hold_start_s, nominal).write_csv(path_text(path), comment);
           },
           "path"_a, "robot"_a, "speed_mm_s"_a = 10.0, "hold_start_s"_a = 0.0, "nominal"_a = false, "comment"_a = "",
@@ -457,8 +471,9 @@ void bind_offline(py::module_& m) {
             return r;
           }))
       .def("__repr__", [](const OfflineResult& r) {
-        return fmt::format("<deflex.OfflineResult {} points, force: {}, max deflection {:.4f} mm, max residual {:.2e} mm>",
-                           r.point_count, r.force_description, r.max_deflection_m * 1e3, r.max_residual_m * 1e3);
+        return fmt::format(
+            "<deflex.OfflineResult {} points, force: {}, max deflection {:.4f} mm, max residual {:.2e} mm>",
+            r.point_count, r.force_description, r.max_deflection_m * 1e3, r.max_residual_m * 1e3);
       });
 
   m.def(
@@ -468,9 +483,10 @@ void bind_offline(py::module_& m) {
         std::vector<OfflineResult> all =
             compensate_each(model, path, force, configuration, seed, orientation, predict, about, false);
         if (all.size() != 1) {
-          throw InputError(fmt::format("argument force: describes {} loads; compensate_path takes one (compensate_loads "
-                                       "gives one result a load)",
-                                       all.size()));
+          throw InputError(
+              fmt::format("argument force: describes {} loads; compensate_path takes one (compensate_loads "
+                          "gives one result a load)",
+                          all.size()));
         }
         return std::move(all.front());
       },
@@ -487,12 +503,11 @@ void bind_offline(py::module_& m) {
          const std::optional<ArrayLike>& seed, const ArrayLike& orientation, bool predict, const std::string& about) {
         return compensate_each(model, path, force, configuration, seed, orientation, predict, about, true);
       },
-      "robot"_a, "path"_a, "force"_a, "configuration"_a = py::none(),
-        "seed"_a = py::none(), "orientation_wxyz"_a = std::vector<double>{0.0, 0.0, 1.0, 0.0}, "predict"_a = true,
-        "moment_about"_a = "wap",
-        "compensate_path for several loads on one path (one IK): a spec with several force_N values "
-        "('ldbb:phi_deg=30,force_N=125;325;650'), or a list of specs and wrench arrays; one OfflineResult a load, in "
-        "order, as `deflex offline` with several --force options.");
+      "robot"_a, "path"_a, "force"_a, "configuration"_a = py::none(), "seed"_a = py::none(),
+      "orientation_wxyz"_a = std::vector<double>{0.0, 0.0, 1.0, 0.0}, "predict"_a = true, "moment_about"_a = "wap",
+      "compensate_path for several loads on one path (one IK): a spec with several force_N values "
+      "('ldbb:phi_deg=30,force_N=125;325;650'), or a list of specs and wrench arrays; one OfflineResult a load, in "
+      "order, as `deflex offline` with several --force options.");
 
   m.def(
       "compensate_program",
@@ -500,7 +515,8 @@ void bind_offline(py::module_& m) {
          const std::vector<std::string>& tooldata, const std::vector<std::string>& wobjdata, bool write) {
         std::vector<std::unique_ptr<ForceModel>> forces = force_models(model, force, {}, "tcp");
         if (forces.size() != 1) {
-          throw InputError(fmt::format("argument force: a program is compensated for one load; it describes {}", forces.size()));
+          throw InputError(
+              fmt::format("argument force: a program is compensated for one load; it describes {}", forces.size()));
         }
         ProgramOptions options;
         options.tooldata = tooldata;
@@ -535,9 +551,8 @@ void bind_offline(py::module_& m) {
       "against the robot (times increasing, limits, joint speeds); errors name the file and line.");
   m.def(
       "write_joint_trajectory",
-      [](const PathArg& path, const RobotModel& model, const ArrayLike& t, const ArrayLike& q, const std::string& comment) {
-        trajectory_from(model, t, q).write_csv(path_text(path), comment);
-      },
+      [](const PathArg& path, const RobotModel& model, const ArrayLike& t, const ArrayLike& q,
+         const std::string& comment) { trajectory_from(model, t, q).write_csv(path_text(path), comment); },
       "path"_a, "robot"_a, "t_s"_a, "q"_a, "comment"_a = "",
       "Times (s) and joints (N, dof) rad written as the CSV deflex online --program reads (deg), checked as it reads "
       "them; all or nothing.");

@@ -6,18 +6,18 @@
 
 #include "arrays.hpp"
 #include "bindings.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/model/kinematics.hpp"
 #include "deflex/online/online_compensator.hpp"
 #include "deflex/online/payload_identification.hpp"
 #include "deflex/online/sensor_config.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::python {
 using namespace pybind11::literals;
 void bind_online(py::module_& m) {
   py::class_<SensorConfig> sensor_class(m, "SensorConfig",
-                                  "Force-sensor conditioning (docs/online.md): crosstalk, frame, payload, bias, "
-                                  "low-pass, dead band, fault threshold. SI units.");
+                                        "Force-sensor conditioning (docs/online.md): crosstalk, frame, payload, bias, "
+                                        "low-pass, dead band, fault threshold. SI units.");
   sensor_class.def(py::init<>())
       .def_readwrite("name", &SensorConfig::name)
       .def_readwrite("components", &SensorConfig::components, "3 (forces) or 6 (forces and moments)")
@@ -41,7 +41,9 @@ void bind_online(py::module_& m) {
   pose_property(sensor_class, "flange_T_sensor", &SensorConfig::flange_T_sensor, "flange to sensor frame, m");
   vector_property(sensor_class, "payload_cog_sensor_m", &SensorConfig::payload_cog_sensor_m);
   vector_property(sensor_class, "bias_sensor", &SensorConfig::bias_sensor, "N, Nm");
-  m.def("load_sensor_config", [](const PathArg& p) { return load_sensor_config(path_text(p)); }, "path"_a, "A sensor configuration YAML (docs/online.md).");
+  m.def(
+      "load_sensor_config", [](const PathArg& p) { return load_sensor_config(path_text(p)); }, "path"_a,
+      "A sensor configuration YAML (docs/online.md).");
 
   py::class_<OnlineConfig>(m, "OnlineConfig", "Bounds and timing of the compensation cycle (s, rad, m).")
       .def(py::init<>())
@@ -53,7 +55,9 @@ void bind_online(py::module_& m) {
       .def_readwrite("fault_hold_s", &OnlineConfig::fault_hold_s)
       .def_property(
           "jacobian_at",
-          [](const OnlineConfig& c) { return std::string(c.jacobian_at == JacobianAt::kPlanned ? "planned" : "feedback"); },
+          [](const OnlineConfig& c) {
+            return std::string(c.jacobian_at == JacobianAt::kPlanned ? "planned" : "feedback");
+          },
           [](OnlineConfig& c, const std::string& v) {
             if (v != "planned" && v != "feedback") {
               throw InputError(fmt::format("jacobian_at: '{}' is neither planned nor feedback", v));
@@ -64,20 +68,26 @@ void bind_online(py::module_& m) {
       .def("validate", &OnlineConfig::validate);
 
   py::class_<CycleOutput>(m, "CycleOutput", "One compensation cycle's result.")
-      .def_property_readonly("q_command", [](const CycleOutput& o) { return frozen(from_vector(o.q_command)); },
-                             "q_planned - dtheta, rad")
-      .def_property_readonly("dtheta", [](const CycleOutput& o) { return frozen(from_vector(o.dtheta)); }, "applied correction, rad")
-      .def_property_readonly("wrench_base", [](const CycleOutput& o) { return frozen(from_vector(o.wrench_base)); },
-                             "wrench the model used, N/Nm (base frame, at the WAP)")
-      .def_property_readonly("wrench_measured_base", [](const CycleOutput& o) { return frozen(from_vector(o.wrench_measured_base)); })
-      .def_property_readonly("status", [](const CycleOutput& o) { return std::string(to_string(o.status)); },
-                             "ok, no_force_yet, stale_force, force_fault, held or invalid_input")
-      .def_property_readonly("usable", [](const CycleOutput& o) { return static_cast<int>(o.status) >= 0; },
-                             "False: q_command must not be sent")
+      .def_property_readonly(
+          "q_command", [](const CycleOutput& o) { return frozen(from_vector(o.q_command)); }, "q_planned - dtheta, rad")
+      .def_property_readonly(
+          "dtheta", [](const CycleOutput& o) { return frozen(from_vector(o.dtheta)); }, "applied correction, rad")
+      .def_property_readonly(
+          "wrench_base", [](const CycleOutput& o) { return frozen(from_vector(o.wrench_base)); },
+          "wrench the model used, N/Nm (base frame, at the WAP)")
+      .def_property_readonly("wrench_measured_base",
+                             [](const CycleOutput& o) { return frozen(from_vector(o.wrench_measured_base)); })
+      .def_property_readonly(
+          "status", [](const CycleOutput& o) { return std::string(to_string(o.status)); },
+          "ok, no_force_yet, stale_force, force_fault, held or invalid_input")
+      .def_property_readonly(
+          "usable", [](const CycleOutput& o) { return static_cast<int>(o.status) >= 0; },
+          "False: q_command must not be sent")
       .def_readonly("size_limited", &CycleOutput::size_limited)
       .def_readonly("rate_limited", &CycleOutput::rate_limited)
       .def_readonly("tcp_correction_m", &CycleOutput::tcp_correction_m)
-      .def_property_readonly("tcp_deflection_base_m", [](const CycleOutput& o) { return frozen(from_vector(o.tcp_deflection_base_m)); })
+      .def_property_readonly("tcp_deflection_base_m",
+                             [](const CycleOutput& o) { return frozen(from_vector(o.tcp_deflection_base_m)); })
       .def_readonly("force_age_s", &CycleOutput::force_age_s)
       .def_readonly("samples_used", &CycleOutput::samples_used);
 
@@ -96,10 +106,11 @@ void bind_online(py::module_& m) {
               throw InputError(fmt::format("argument on_full: '{}' is neither raise nor drop", on_full));
             }
             if (!drop && c.queued() == c.queue_capacity()) {
-              throw Error(fmt::format("push_force: the queue is full ({} samples, two cycles at the sensor's rate): "
-                                      "call step() between pushes as a real loop does, use replay() for a recorded "
-                                      "log, or on_full='drop' to drop the oldest",
-                                      c.queue_capacity()));
+              throw Error(
+                  fmt::format("push_force: the queue is full ({} samples, two cycles at the sensor's rate): "
+                              "call step() between pushes as a real loop does, use replay() for a recorded "
+                              "log, or on_full='drop' to drop the oldest",
+                              c.queue_capacity()));
             }
             ForceSample s;
             s.t_s = t_s;
@@ -124,7 +135,8 @@ void bind_online(py::module_& m) {
             CycleInput in;
             in.t_s = t_s;
             in.q_planned = joint_vector(q_planned, "q_planned", dof);
-            in.q_feedback = !q_feedback || q_feedback->is_none() ? in.q_planned : joint_vector(*q_feedback, "q_feedback", dof);
+            in.q_feedback =
+                !q_feedback || q_feedback->is_none() ? in.q_planned : joint_vector(*q_feedback, "q_feedback", dof);
             const bool about_tcp = moment_about_tcp(about);
             if (wrench_offset && !wrench_offset->is_none()) {
               in.wrench_offset_base = vector6(*wrench_offset, "wrench_offset");
@@ -183,16 +195,17 @@ void bind_online(py::module_& m) {
               py::ssize_t next = 0;
               for (py::ssize_t k = 0; k < n; ++k) {
                 if (k > 0 && !(tc.data()[k] > tc.data()[k - 1])) {
-                  throw InputError(fmt::format("argument t_cycle_s: cycle {} ({} s) is not after cycle {}", k,
-                                               tc.data()[k], k - 1));
+                  throw InputError(
+                      fmt::format("argument t_cycle_s: cycle {} ({} s) is not after cycle {}", k, tc.data()[k], k - 1));
                 }
                 int pushed = 0;
                 for (; next < m_samples && tf.data()[next] <= tc.data()[k]; ++next, ++pushed) {
                   if (c.queued() == c.queue_capacity()) {
-                    throw Error(fmt::format("replay: {} force samples fall before cycle {} ({} s), more than the "
-                                            "queue's {} (two cycles at the sensor's rate): the cycles are further "
-                                            "apart than SensorConfig.sample_rate_hz and OnlineConfig.period_s say",
-                                            pushed + 1, k, tc.data()[k], c.queue_capacity()));
+                    throw Error(
+                        fmt::format("replay: {} force samples fall before cycle {} ({} s), more than the "
+                                    "queue's {} (two cycles at the sensor's rate): the cycles are further "
+                                    "apart than SensorConfig.sample_rate_hz and OnlineConfig.period_s say",
+                                    pushed + 1, k, tc.data()[k], c.queue_capacity()));
                   }
                   ForceSample s;
                   s.t_s = tf.data()[next];
@@ -240,7 +253,8 @@ void bind_online(py::module_& m) {
         std::string source = "<arrays>";
         if (py::isinstance<py::str>(data.obj) || py::hasattr(data.obj, "__fspath__")) {
           if (wrench_obj && !wrench_obj->is_none()) {
-            throw InputError("identify_payload: give either data (a CSV path) or the arrays base_R_sensor and wrench_sensor");
+            throw InputError(
+                "identify_payload: give either data (a CSV path) or the arrays base_R_sensor and wrench_sensor");
           }
           source = data.obj.cast<PathArg>().string();
           poses = read_payload_observations(source, robot.get(), sensor.flange_T_sensor, sensor.crosstalk, has_moments);
@@ -248,11 +262,13 @@ void bind_online(py::module_& m) {
           const Array r = to_array(data, "base_R_sensor", 3);
           require_finite(r, "base_R_sensor");
           if (r.shape(1) != 3 || r.shape(2) != 3) throw InputError("argument base_R_sensor: expected shape (N, 3, 3)");
-          if (!wrench_obj || wrench_obj->is_none()) throw InputError("identify_payload: wrench_sensor (N, 3) or (N, 6) is missing");
+          if (!wrench_obj || wrench_obj->is_none())
+            throw InputError("identify_payload: wrench_sensor (N, 3) or (N, 6) is missing");
           const Array w = to_array(*wrench_obj, "wrench_sensor", 2);
           require_finite(w, "wrench_sensor");
           if (w.shape(0) != r.shape(0) || (w.shape(1) != 3 && w.shape(1) != 6)) {
-            throw InputError(fmt::format("argument wrench_sensor: expected shape ({}, 3) or ({}, 6)", r.shape(0), r.shape(0)));
+            throw InputError(
+                fmt::format("argument wrench_sensor: expected shape ({}, 3) or ({}, 6)", r.shape(0), r.shape(0)));
           }
           has_moments = w.shape(1) == 6;
           for (py::ssize_t i = 0; i < r.shape(0); ++i) {
@@ -277,8 +293,9 @@ void bind_online(py::module_& m) {
         sensor.source = source + " (identified payload)";
         sensor.validate();
         return py::dict("mass_kg"_a = e.mass_kg, "cog_sensor_m"_a = from_vector(Eigen::VectorXd(e.cog_sensor_m)),
-                        "bias_sensor"_a = from_vector(Eigen::VectorXd(e.bias_sensor)), "moments_used"_a = e.moments_used,
-                        "poses"_a = e.poses, "force_residual_rms_N"_a = e.force_residual_rms_N,
+                        "bias_sensor"_a = from_vector(Eigen::VectorXd(e.bias_sensor)),
+                        "moments_used"_a = e.moments_used, "poses"_a = e.poses,
+                        "force_residual_rms_N"_a = e.force_residual_rms_N,
                         "moment_residual_rms_Nm"_a = e.moment_residual_rms_Nm,
                         "force_condition_number"_a = e.force_condition_number,
                         "moment_condition_number"_a = e.moment_condition_number, "sensor"_a = sensor);

@@ -15,15 +15,14 @@
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "deflex/force/force_spec.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/runtime/session.hpp"
 #include "deflex/sensors/force_source_spec.hpp"
 #include "deflex/standin/standin_session.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::python {
 using namespace pybind11::literals;
 namespace {
-
 
 // One setting: its name, and how a Python value sets it in the session's configuration.
 using Setter = std::function<void(runtime::SessionConfig&, const py::handle&)>;
@@ -34,7 +33,9 @@ T as(const py::handle& v, const std::string& name) {
     return v.cast<T>();
   } catch (const py::cast_error&) {
     throw InputError(fmt::format("setting {}: {} is not a {}", name, py::str(py::repr(v)).cast<std::string>(),
-                                 std::is_same_v<T, bool> ? "bool" : std::is_same_v<T, std::string> ? "str" : "number"));
+                                 std::is_same_v<T, bool>          ? "bool"
+                                 : std::is_same_v<T, std::string> ? "str"
+                                                                  : "number"));
   }
 }
 
@@ -248,11 +249,14 @@ void bind_runtime(py::module_& m) {
            "strategy"_a = "online", "force_model"_a = "", "loop"_a = false, "rdt_calibration"_a = "")
       .def(
           "run",
-          [](PySession& s, double seconds) { return std::string(runtime::to_string(run_releasing(*s.session, seconds))); },
+          [](PySession& s, double seconds) {
+            return std::string(runtime::to_string(run_releasing(*s.session, seconds)));
+          },
           "seconds"_a = std::numeric_limits<double>::infinity(),
           "Runs the loop until the session ends (the stop reason is returned) or `seconds` pass ('running'). "
           "Ctrl-C stops it as a user stop and raises KeyboardInterrupt.")
-      .def("stop", [](PySession& s) { s.session->request_stop(); }, "Asks the loop to end the session (a user stop).")
+      .def(
+          "stop", [](PySession& s) { s.session->request_stop(); }, "Asks the loop to end the session (a user stop).")
       .def(
           "finish", [](PySession& s) { return summary_of(s.session->finish()); },
           "Ends the session and returns its summary (the dict of `deflex online --json`, plus 'text').")
@@ -270,7 +274,8 @@ void bind_runtime(py::module_& m) {
       "A session against an in-memory stand-in of the controller (the simulated cell's, with the real controller's "
       "behaviour, dead time included), on a clock it advances itself, with the faults of a cell on request: "
       "outage(), stall(), restart(), end_session(), motors_off(), sensor_silent(). force_base_N: the process force "
-      "at the TCP in the base frame; server_read_period_s: simple message, the robot program takes a point at most this "
+      "at the TCP in the base frame; server_read_period_s: simple message, the robot program takes a point at most "
+      "this "
       "often (a slow consumer); comm_timeout_s: EGM's \\CommTimeout, s. Settings as deflex.Session's.")
       .def(py::init([](const RobotHolder& robot, const std::string& link, const py::object& program,
                        const py::handle& force_base_n, const py::object& sensor, const std::string& strategy,
@@ -287,8 +292,8 @@ void bind_runtime(py::module_& m) {
              }
              sc.controller.egm_comm_timeout_s = comm_timeout_s;
              const SensorConfig sensor_config = sensor.is_none() ? SensorConfig{} : sensor.cast<SensorConfig>();
-             return std::make_unique<standin::StandInSession>(config, *robot, sensor_config, program_of(program, *robot),
-                                                              nullptr, sc);
+             return std::make_unique<standin::StandInSession>(config, *robot, sensor_config,
+                                                              program_of(program, *robot), nullptr, sc);
            }),
            "robot"_a, "link"_a, "program"_a, py::kw_only(), "force_base_N"_a = std::vector<double>{0.0, 0.0, 0.0},
            "sensor"_a = py::none(), "strategy"_a = "online", "server_read_period_s"_a = 0.0, "comm_timeout_s"_a = 1.0,
@@ -301,7 +306,8 @@ void bind_runtime(py::module_& m) {
            "The controller starts a new session (EGM, path correction; RSI after off_s of RSI_OFF).")
       .def("end_session", &standin::StandInSession::end_session, "mci_state"_a = 2, "EGM ends: 2 STOPPED, 1 ERROR.")
       .def("motors_off", &standin::StandInSession::motors_off, "An emergency stop.")
-      .def("sensor_silent", &standin::StandInSession::sensor_silent, "silent"_a, "The force sensor stops or comes back.")
+      .def("sensor_silent", &standin::StandInSession::sensor_silent, "silent"_a,
+           "The force sensor stops or comes back.")
       .def(
           "set_force", [](standin::StandInSession& s, const ArrayLike& f) { s.set_force(vector3(f, "force_base_N")); },
           "force_base_N"_a)

@@ -9,19 +9,17 @@
 
 #include "arrays.hpp"
 #include "bindings.hpp"
+#include "deflex/evaluate/tracker_files.hpp"
+#include "deflex/report/case_report.hpp"
+#include "deflex/report/html_report.hpp"
+#include "deflex/study/case_study.hpp"
 #include "deflex/study/study_tables.hpp"
 #include "deflex/text/errors.hpp"
-#include "deflex/evaluate/tracker_files.hpp"
 #include "deflex/text/output_file.hpp"
-#include "deflex/report/html_report.hpp"
-#include "deflex/report/case_report.hpp"
-#include "deflex/study/case_study.hpp"
 
 namespace deflex::python {
 using namespace pybind11::literals;
-py::object json_to_python(const nlohmann::json& doc) {
-  return py::module_::import("json").attr("loads")(doc.dump());
-}
+py::object json_to_python(const nlohmann::json& doc) { return py::module_::import("json").attr("loads")(doc.dump()); }
 
 namespace {
 
@@ -47,19 +45,24 @@ struct CaseStudyRun {
 }  // namespace
 
 void bind_study(py::module_& m) {
-  py::class_<CaseStudyRun>(m, "CaseStudyResult",
-                           "A case study's figures: tables (the dict of `deflex case-study --json`; lengths in mm as its "
-                           "keys say), links, counts, traces (with traces=True), and write_report().")
-      .def_property_readonly("tables", [](const CaseStudyRun& r) { return json_to_python(study_to_json(r.out.study)); },
-                             "setups -> loads -> uc_mm / c_mm / compensation by speed (mm/s), speeds_mm_s, seeds, "
-                             "speed_sweep, error_budget, paper")
-      .def_property_readonly("tables_text", [](const CaseStudyRun& r) { return study_tables_text(r.out.study); },
-                             "Tables 1 and 2 as `deflex case-study` prints them")
+  py::class_<CaseStudyRun>(
+      m, "CaseStudyResult",
+      "A case study's figures: tables (the dict of `deflex case-study --json`; lengths in mm as its "
+      "keys say), links, counts, traces (with traces=True), and write_report().")
+      .def_property_readonly(
+          "tables", [](const CaseStudyRun& r) { return json_to_python(study_to_json(r.out.study)); },
+          "setups -> loads -> uc_mm / c_mm / compensation by speed (mm/s), speeds_mm_s, seeds, "
+          "speed_sweep, error_budget, paper")
+      .def_property_readonly(
+          "tables_text", [](const CaseStudyRun& r) { return study_tables_text(r.out.study); },
+          "Tables 1 and 2 as `deflex case-study` prints them")
       .def_property_readonly("links", [](const CaseStudyRun& r) { return links_to_python(r.out.links); })
       .def_property_readonly("setup_paragraphs", [](const CaseStudyRun& r) { return r.out.setup_paragraphs; })
-      .def_property_readonly("notes", [](const CaseStudyRun& r) { return study::honest_notes(r.config, r.out.study); },
-                             "Where the figures differ from the paper's, as the report says it")
-      .def_property_readonly("simulated_s", [](const CaseStudyRun& r) { return r.out.simulated_s; }, "robot time simulated, s")
+      .def_property_readonly(
+          "notes", [](const CaseStudyRun& r) { return study::honest_notes(r.config, r.out.study); },
+          "Where the figures differ from the paper's, as the report says it")
+      .def_property_readonly(
+          "simulated_s", [](const CaseStudyRun& r) { return r.out.simulated_s; }, "robot time simulated, s")
       .def_property_readonly("wall_time_s", [](const CaseStudyRun& r) { return r.out.study.wall_time_s; })
       .def_property_readonly("runs", [](const CaseStudyRun& r) { return r.out.runs; })
       .def_property_readonly("calibrations", [](const CaseStudyRun& r) { return r.out.calibrations; })
@@ -100,8 +103,8 @@ void bind_study(py::module_& m) {
           },
           "out_dir"_a, "The traces as `--write-traces DIR` writes them (CSV and Spatial Analyzer export).")
       .def("__repr__", [](const CaseStudyRun& r) {
-        return fmt::format("<deflex.CaseStudyResult '{}': {} runs, {} calibrations, {} setups, {} traces>", r.config.name,
-                           r.out.runs, r.out.calibrations, r.out.study.setups.size(), r.traces.size());
+        return fmt::format("<deflex.CaseStudyResult '{}': {} runs, {} calibrations, {} setups, {} traces>",
+                           r.config.name, r.out.runs, r.out.calibrations, r.out.study.setups.size(), r.traces.size());
       });
 
   m.def(
@@ -145,8 +148,7 @@ void bind_study(py::module_& m) {
           py::gil_scoped_release release;
           run.out = study::run_case_study(run.config, options);
         }
-        std::sort(run.traces.begin(), run.traces.end(),
-                  [](const auto& a, const auto& b) { return a.first < b.first; });
+        std::sort(run.traces.begin(), run.traces.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
         return run;
       },
       "case"_a = py::none(), "seeds"_a = 0, "seed"_a = py::none(), "quick"_a = false, "speed_sweep"_a = true,

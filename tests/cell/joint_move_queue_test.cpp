@@ -8,8 +8,8 @@
 #include <gtest/gtest.h>
 
 #include "deflex/cell/joint_move_queue.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::cell {
 namespace {
@@ -81,7 +81,7 @@ TEST(JointMoveQueue, TwoMovesBlendInTheZoneAndMissTheCornerByDvTbOverFour) {
   expect_near(q.advance(0.25), start() + d1 + 0.05 * v2);  // on move 2's line a2 + v2 (t - 0.2)
   expect_near(q.advance(0.35), start() + d1 + d2);         // move 2 ramps down to its point
   expect_near(q.advance(0.40), start() + d1 + d2);
-  EXPECT_EQ(q.counters().corner_failures, 1u);             // no third move came: the arm stopped there
+  EXPECT_EQ(q.counters().corner_failures, 1u);  // no third move came: the arm stopped there
 }
 
 TEST(JointMoveQueue, AMoveKnownTooLateForTheZoneStopsTheArmAtThePointFirst) {

@@ -264,9 +264,9 @@ TEST(PathDrift, ASessionsRunsShareTheirSlowDriftByTheirDistanceInTime) {
     cross += first.offset_m().dot(next.offset_m());
     cross_far += first.offset_m().dot(far.offset_m());
   }
-  EXPECT_NEAR(std::sqrt(s1 / (3.0 * runs)), 12e-6, 0.04 * 12e-6);             // stationary
-  EXPECT_NEAR(cross / std::sqrt(s0 * s1), std::exp(-1.0), 0.03);               // one correlation time apart
-  EXPECT_NEAR(cross_far / std::sqrt(s0 * s_far), 0.0, 0.04);                   // independent
+  EXPECT_NEAR(std::sqrt(s1 / (3.0 * runs)), 12e-6, 0.04 * 12e-6);  // stationary
+  EXPECT_NEAR(cross / std::sqrt(s0 * s1), std::exp(-1.0), 0.03);   // one correlation time apart
+  EXPECT_NEAR(cross_far / std::sqrt(s0 * s_far), 0.0, 0.04);       // independent
   // No time between them: the same offset.
   const PathDrift a(d, 3);
   const PathDrift b(d, 4, a, 0.0);

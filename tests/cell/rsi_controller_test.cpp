@@ -46,9 +46,8 @@ struct Stand {
 
   explicit Stand(RsiControllerConfig c = {}, const JointVector& move_deg = JointVector::Zero(6)) : config(c) {
     const JointVector q0 = start_deg() * (kPi / 180.0);
-    program = std::make_shared<const JointTrajectory>(std::vector<double>{0.0, 10.0},
-                                                      std::vector<JointVector>{q0, q0 + move_deg * (kPi / 180.0)},
-                                                      robot, "program");
+    program = std::make_shared<const JointTrajectory>(
+        std::vector<double>{0.0, 10.0}, std::vector<JointVector>{q0, q0 + move_deg * (kPi / 180.0)}, robot, "program");
     controller = std::make_unique<RsiController>(config, robot, program, controller_port, kSensor);
   }
   /// One 4 ms tick; returns true when a <Rob> reached the sensor (decoded into `last`).
@@ -122,20 +121,20 @@ TEST(RsiController, AnythingButTheAwaitedAnswerIsLateAndTheTimeoutStopsRsi) {
   c.timeout = 6;
   Stand s(c);
   ASSERT_TRUE(s.tick());
-  s.answer(sen(s.last.ipoc, 0.1, "Other"));          // another SENTYPE
+  s.answer(sen(s.last.ipoc, 0.1, "Other"));  // another SENTYPE
   ASSERT_TRUE(s.tick());
-  s.answer(sen(s.last.ipoc - 4, 0.1));               // the previous cycle's IPOC
+  s.answer(sen(s.last.ipoc - 4, 0.1));  // the previous cycle's IPOC
   ASSERT_TRUE(s.tick());
-  s.answer(sen(s.last.ipoc, 0.1), &s.stranger);      // another sender
+  s.answer(sen(s.last.ipoc, 0.1), &s.stranger);  // another sender
   ASSERT_TRUE(s.tick());
   s.answer("<Sen Type=\"ImFree\"><AK A1=\"0.1\"/>");  // unreadable
   ASSERT_TRUE(s.tick());
-  EXPECT_EQ(s.last.delay, 4u);  // the controller reports the count in <Delay>
-  s.answer(sen(s.last.ipoc, 0.1));                   // a good one: taken, but the count stays
+  EXPECT_EQ(s.last.delay, 4u);      // the controller reports the count in <Delay>
+  s.answer(sen(s.last.ipoc, 0.1));  // a good one: taken, but the count stays
   ASSERT_TRUE(s.tick());
   EXPECT_EQ(s.last.delay, 4u);
   EXPECT_EQ(s.controller->counters().answers, 1u);
-  ASSERT_TRUE(s.tick());  // no answer: 5
+  ASSERT_TRUE(s.tick());   // no answer: 5
   EXPECT_FALSE(s.tick());  // no answer: 6 = Timeout, RSI stops and sends no more
   EXPECT_EQ(s.controller->counters().stopped, RsiStop::kTimeout);
   const JointVector held = s.controller->tick(s.t);

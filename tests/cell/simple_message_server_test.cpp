@@ -220,7 +220,8 @@ TEST(SimpleMessageServer, AnEmergencyStopIsReportedAndEveryPointRefused) {
 TEST(SimpleMessageServer, IndustrialCoreStyleRepliesEchoThePoint) {
   Client c(false);
   c.config.reply_with_data = true;
-  c.server = std::make_unique<SimpleMessageServer>(c.config, c.robot, server_start(), c.motion.server(), c.state.server());
+  c.server =
+      std::make_unique<SimpleMessageServer>(c.config, c.robot, server_start(), c.motion.server(), c.state.server());
   c.send(test::hand_traj_pt(false, 2, 0, 41, floats(server_start()), 0.0f, 0.1f));
   c.tick();
   const auto r = c.replies();

@@ -138,7 +138,9 @@ TEST_F(CaseStudyCli, SeedsSpreadAndTracesThatDeflexEvaluateReads) {
   ASSERT_TRUE(fs::exists(uc)) << r.out;
   EXPECT_TRUE(fs::exists(traces / "sensor-egm-joint_online_650N_50mm_s.csv"));
   EXPECT_TRUE(fs::exists(traces / "offline-program_offline_625N_50mm_s.csv"));
-  const Result e = run("evaluate --split-laps --mean-reference --json --unloaded " + unloaded.string() + " --loaded " + uc.string(), dir_);
+  const Result e =
+      run("evaluate --split-laps --mean-reference --json --unloaded " + unloaded.string() + " --loaded " + uc.string(),
+          dir_);
   ASSERT_EQ(e.exit_code, 0) << e.err;
   const nlohmann::json ev = nlohmann::json::parse(e.out);
   const double table_uc = doc["setups"][1]["loads"][2]["uc_mm_by_seed"]["50"][0];

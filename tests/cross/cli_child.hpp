@@ -108,9 +108,10 @@ inline const std::string kForceReplay = std::string(DEFLEX_SOURCE_DIR) + "/examp
 /// `speed_mm_s` after `hold_s` at rest, into DIR/nominal.csv; returns its path.
 inline std::string nominal_program(const std::string& dir, double speed_mm_s = 30.0, double hold_s = 0.5) {
   const std::string path = dir + "/nominal.csv";
-  const auto r = run_cli("offline --circle \"centre_mm=1800;0;900,radius_mm=129.9,points=81\" --force "
-                         "\"ldbb:phi_deg=30,force_N=400\" --speed-mm-s " + std::to_string(speed_mm_s) +
-                         " --hold-start-s " + std::to_string(hold_s) + " --nominal-trajectory " + path);
+  const auto r = run_cli(
+      "offline --circle \"centre_mm=1800;0;900,radius_mm=129.9,points=81\" --force "
+      "\"ldbb:phi_deg=30,force_N=400\" --speed-mm-s " +
+      std::to_string(speed_mm_s) + " --hold-start-s " + std::to_string(hold_s) + " --nominal-trajectory " + path);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   return path;
 }

@@ -70,8 +70,8 @@ TEST(CliEvaluate, MeanDeformationOfAnOffsetCircleIsTheOffset) {
   EXPECT_NEAR(doc["mean_deformation_mm"].get<double>(), 0.5, 1e-4) << r.out;
 
   std::ofstream(dir / "bad.csv") << "t_s,x_mm,y_mm,z_mm\n0,1,2,3\n0.001,1,nan,3\n";
-  const auto bad = run_cli("evaluate --unloaded " + (dir / "unloaded.csv").string() + " --loaded " +
-                           (dir / "bad.csv").string());
+  const auto bad =
+      run_cli("evaluate --unloaded " + (dir / "unloaded.csv").string() + " --loaded " + (dir / "bad.csv").string());
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("bad.csv:3"), std::string::npos) << bad.err;
   EXPECT_NE(bad.err.find("y_mm"), std::string::npos) << bad.err;

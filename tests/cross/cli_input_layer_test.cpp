@@ -39,7 +39,8 @@ TEST(CliInput, WrenchTableWithByteOrderMarkOrCrLinesMeansTheSame) {
   std::ofstream(d / "cr.csv", std::ios::binary) << replace_all(table, "\n", "\r");
   std::ofstream(d / "crlf.csv", std::ios::binary) << replace_all(table, "\n", "\r\n");
   const std::string path = " --path " + kSourceDir + "/examples/offline/square_path.csv --force table:";
-  const auto plain = run_cli("offline" + path + kSourceDir + "/examples/offline/square_wrench.csv -o " + (d / "plain.out").string());
+  const auto plain =
+      run_cli("offline" + path + kSourceDir + "/examples/offline/square_wrench.csv -o " + (d / "plain.out").string());
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
   for (const char* name : {"bom", "cr", "crlf"}) {
     const auto r = run_cli("offline" + path + (d / (std::string(name) + ".csv")).string() + " -o " +

@@ -40,7 +40,8 @@ TEST(CliModel, IkInvertsFkThroughTheCommandLine) {
     std::snprintf(buf, sizeof buf, "%s%.12f", i ? "," : "", f["quaternion_wxyz"][i].get<double>());
     quat += buf;
   }
-  const auto ik = run_cli("ik --position-mm " + pos + " --quaternion-wxyz " + quat + " --seed-deg 15,40,-20,30,60,-45 --json");
+  const auto ik =
+      run_cli("ik --position-mm " + pos + " --quaternion-wxyz " + quat + " --seed-deg 15,40,-20,30,60,-45 --json");
   ASSERT_EQ(ik.exit_code, 0) << ik.err;
   const auto j = nlohmann::json::parse(ik.out);
   const double want[6] = {15, 40, -20, 30, 60, -45};
@@ -81,7 +82,8 @@ TEST(CliModel, BadInputNamesTheOptionAndExitsWithTwo) {
 }
 
 TEST(CliModel, BadRobotFileNamesFileLineAndField) {
-  const auto path = std::filesystem::temp_directory_path() / ("deflex_bad_robot_" + std::to_string(::getpid()) + ".yaml");
+  const auto path =
+      std::filesystem::temp_directory_path() / ("deflex_bad_robot_" + std::to_string(::getpid()) + ".yaml");
   std::ofstream(path) << "deflex_robot: 1\nunits: {length: m, angle: deg}\nkinematics:\n  convention: standard_dh\n"
                          "  joints:\n    - {a: 0.3, alpha: -90, d: zero, min: -170, max: 170}\n";
   const auto r = run_cli("fk --robot " + path.string() + " --joints-deg 0");

@@ -21,11 +21,11 @@
 #include "cross/cli_child.hpp"
 #include "cross/cli_runner.hpp"
 #include "deflex/cell/egm_position_controller.hpp"
-#include "deflex/text/csv_table.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/monitor/monitor_server.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/transport/udp_transport.hpp"
 
 namespace deflex {
@@ -99,15 +99,30 @@ struct MonitorRun {
         log(dir + "/log.csv"),
         program(JointTrajectory::read_csv(program_path, builtin_irb6700())) {}
   std::vector<std::string> args(const std::vector<std::string>& extra) const {
-    std::vector<std::string> a{kDeflex, "online", "--link", "egm-joint", "--program", program_path, "--egm-port", "0",
-                               "--force-source", "csv:" + test::kForceReplay, "--loop", "--log", log,
-                               "--max-joint-correction-deg", "0.5", "--status-interval-s", "0.5"};
+    std::vector<std::string> a{kDeflex,
+                               "online",
+                               "--link",
+                               "egm-joint",
+                               "--program",
+                               program_path,
+                               "--egm-port",
+                               "0",
+                               "--force-source",
+                               "csv:" + test::kForceReplay,
+                               "--loop",
+                               "--log",
+                               log,
+                               "--max-joint-correction-deg",
+                               "0.5",
+                               "--status-interval-s",
+                               "0.5"};
     a.insert(a.end(), extra.begin(), extra.end());
     return a;
   }
 };
 
-void drive(Child& deflex, const JointTrajectory& program, double seconds, cell::EgmPositionGuidanceController** out = nullptr) {
+void drive(Child& deflex, const JointTrajectory& program, double seconds,
+           cell::EgmPositionGuidanceController** out = nullptr) {
   const int port = monitor_egm_port(deflex);
   ASSERT_GT(port, 0) << test::slurp(deflex.stderr_path);
   UdpTransport transport("127.0.0.1", 0);
@@ -160,9 +175,10 @@ TEST(CliMonitor, TheRenderedPageShowsTheCycleLogsValues) {
                      " > " + dom_path + " 2>/dev/null")
                         .c_str());
   if (const char* shot = std::getenv("DEFLEX_MONITOR_SCREENSHOT")) {  // the picture in docs/online.md
-    (void)std::system((browser + " --headless --no-sandbox --disable-gpu --hide-scrollbars --virtual-time-budget=1500 "
-                                 "--window-size=1400,900 --screenshot=" + std::string(shot) + " " + url +
-                       " >/dev/null 2>&1")
+    (void)std::system((browser +
+                       " --headless --no-sandbox --disable-gpu --hide-scrollbars --virtual-time-budget=1500 "
+                       "--window-size=1400,900 --screenshot=" +
+                       std::string(shot) + " " + url + " >/dev/null 2>&1")
                           .c_str());
   }
   browser_done = true;

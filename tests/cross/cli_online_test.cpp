@@ -21,9 +21,9 @@
 #include "cross/cli_runner.hpp"
 #include "deflex/cell/egm_path_controller.hpp"
 #include "deflex/cell/egm_position_controller.hpp"
-#include "deflex/text/csv_table.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
+#include "deflex/text/csv_table.hpp"
 #include "deflex/transport/udp_transport.hpp"
 
 namespace deflex {
@@ -40,7 +40,6 @@ int egm_port_of(const Child& c) { return test::port_of(c, "EGM on 127.0.0.1:"); 
 
 using test::kDeflex;
 
-
 TEST(CliOnline, EgmJointStreamsTheProgramWithinTheBoundOfIt) {
   const std::string dir = ::testing::TempDir() + "/cli_online_joint";
   fs::create_directories(dir);
@@ -51,7 +50,8 @@ TEST(CliOnline, EgmJointStreamsTheProgramWithinTheBoundOfIt) {
   Child deflex;
   spawn(deflex,
         {kDeflex, "online", "--link", "egm-joint", "--program", program_path, "--egm-port", "0", "--force-source",
-         "csv:" + test::kForceReplay, "--loop", "--log", log, "--max-joint-correction-deg", "0.5", "--status-interval-s", "0.5"},
+         "csv:" + test::kForceReplay, "--loop", "--log", log, "--max-joint-correction-deg", "0.5",
+         "--status-interval-s", "0.5"},
         dir + "/stderr.txt");
   const int port = egm_port_of(deflex);
   ASSERT_GT(port, 0) << test::slurp(deflex.stderr_path);
@@ -179,7 +179,8 @@ TEST(CliOnline, BadOptionsAndProgramsAreRefusedBeforeAnythingRuns) {
     return p;
   };
   const std::string header = "t_s,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\n";
-  expect("--link egm-joint --program " + write("back.csv", header + "0,0,20,10,0,60,0\n1,0,20,10,0,60,0\n0.5,0,20,10,0,60,0\n"),
+  expect("--link egm-joint --program " +
+             write("back.csv", header + "0,0,20,10,0,60,0\n1,0,20,10,0,60,0\n0.5,0,20,10,0,60,0\n"),
          "back.csv:4");
   expect("--link egm-joint --program " + write("limit.csv", header + "0,0,20,10,0,60,0\n1,0,20,75,0,60,0\n"),
          "joint 3 at 75.0000 deg is beyond its limits");

@@ -19,11 +19,11 @@
 
 #include "cross/cli_child.hpp"
 #include "deflex/cell/egm_position_controller.hpp"
-#include "deflex/text/csv_table.hpp"
 #include "deflex/model/kinematics.hpp"
-#include "deflex/model/types.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/model/types.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
+#include "deflex/text/csv_table.hpp"
 #include "deflex/transport/udp_transport.hpp"
 
 namespace deflex {
@@ -34,7 +34,7 @@ using test::Child;
 
 using test::kDeflex;
 const std::string kStandin = std::string(DEFLEX_SOURCE_DIR) + "/examples/online/rdt_sensor_standin.py";
-constexpr double kLbfInN = 4.4482216152605;       // 1 lbf in N
+constexpr double kLbfInN = 4.4482216152605;        // 1 lbf in N
 constexpr double kLbfInInNm = 0.1129848290276167;  // 1 lbf-in in Nm
 
 // The stand-in sensor streaming a constant wrench (N, Nm, sensor frame), in lbf and lbf-in counts.
@@ -42,13 +42,30 @@ struct Sensor {
   Child child;
   int rdt_port = -1, http_port = -1;
   Sensor(const Vector6& wrench, const std::string& dir, double noise_lbf = 0.0) {
-    const std::string w = fmt::format("{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f}", wrench[0] / kLbfInN,
-                                      wrench[1] / kLbfInN, wrench[2] / kLbfInN, wrench[3] / kLbfInInNm,
-                                      wrench[4] / kLbfInInNm, wrench[5] / kLbfInInNm);
+    const std::string w =
+        fmt::format("{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f}", wrench[0] / kLbfInN, wrench[1] / kLbfInN,
+                    wrench[2] / kLbfInN, wrench[3] / kLbfInInNm, wrench[4] / kLbfInInNm, wrench[5] / kLbfInInNm);
     test::spawn(child,
-                {"/usr/bin/env", "python3", kStandin, "--port", "0", "--http-port", "0", "--rate", "1000",
-                 "--force-unit", "lbf", "--counts-per-force", "100000", "--torque-unit", "lbf-in",
-                 "--counts-per-torque", "100000", "--wrench=" + w, "--noise", fmt::format("{}", noise_lbf)},
+                {"/usr/bin/env",
+                 "python3",
+                 kStandin,
+                 "--port",
+                 "0",
+                 "--http-port",
+                 "0",
+                 "--rate",
+                 "1000",
+                 "--force-unit",
+                 "lbf",
+                 "--counts-per-force",
+                 "100000",
+                 "--torque-unit",
+                 "lbf-in",
+                 "--counts-per-torque",
+                 "100000",
+                 "--wrench=" + w,
+                 "--noise",
+                 fmt::format("{}", noise_lbf)},
                 dir + "/sensor_stderr.txt");
     rdt_port = test::port_of(child, "RDT on 127.0.0.1:");
     http_port = test::port_of(child, "HTTP on 127.0.0.1:");
@@ -71,10 +88,9 @@ TEST(CliRdt, IdentifyPayloadFromPosesRecordedOffTheSensor) {
   Vector6 bias;
   bias << 1.5, -0.8, 2.2, 0.12, -0.05, 0.03;
   const Vector3 g(0.0, 0.0, -9.81);
-  const std::vector<std::vector<double>> poses_deg{{0, 20, 10, 0, 60, 0},   {30, 10, 20, 40, -50, 90},
-                                                   {-40, 30, 0, -60, 80, -30}, {10, 0, 30, 90, 45, 180},
-                                                   {60, 25, 15, -90, -70, 45}, {-20, 15, 5, 150, 30, -120},
-                                                   {0, 35, -10, 0, -30, 0}};
+  const std::vector<std::vector<double>> poses_deg{
+      {0, 20, 10, 0, 60, 0},      {30, 10, 20, 40, -50, 90},   {-40, 30, 0, -60, 80, -30}, {10, 0, 30, 90, 45, 180},
+      {60, 25, 15, -90, -70, 45}, {-20, 15, 5, 150, 30, -120}, {0, 35, -10, 0, -30, 0}};
   const std::string poses = dir + "/poses.csv";
   for (std::size_t p = 0; p < poses_deg.size(); ++p) {
     JointVector q(6);
@@ -87,8 +103,8 @@ TEST(CliRdt, IdentifyPayloadFromPosesRecordedOffTheSensor) {
     Sensor sensor(reading, dir, 0.01);
     ASSERT_GT(sensor.rdt_port, 0) << test::slurp(sensor.child.stderr_path);
     const std::string joints = fmt::format("{}", fmt::join(poses_deg[p], ","));
-    const auto r = test::run_cli(fmt::format("identify-payload {} --joints-deg {} --record {} --window-s 0.3",
-                                             sensor.args(), joints, poses));
+    const auto r = test::run_cli(
+        fmt::format("identify-payload {} --joints-deg {} --record {} --window-s 0.3", sensor.args(), joints, poses));
     ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
     EXPECT_NE(r.out.find(fmt::format("pose {} recorded into", p + 1)), std::string::npos) << r.out;
   }
@@ -129,11 +145,11 @@ TEST(CliRdt, OnlineOverRdtAgainstTheEgmStandIn) {
   ASSERT_GT(sensor.rdt_port, 0) << test::slurp(sensor.child.stderr_path);
   const std::string log = dir + "/log.csv";
   Child deflex;
-  std::vector<std::string> args{kDeflex, "online", "--link", "egm-joint", "--program", program_path, "--egm-port", "0",
-                                "--log", log, "--json"};
-  for (const std::string& a : {std::string("--force-source"), fmt::format("rdt:127.0.0.1:{}", sensor.rdt_port),
-                               std::string("--rdt-calibration"),
-                               fmt::format("http://127.0.0.1:{}/netftapi2.xml", sensor.http_port)}) {
+  std::vector<std::string> args{kDeflex,      "online", "--link", "egm-joint", "--program", program_path,
+                                "--egm-port", "0",      "--log",  log,         "--json"};
+  for (const std::string& a :
+       {std::string("--force-source"), fmt::format("rdt:127.0.0.1:{}", sensor.rdt_port),
+        std::string("--rdt-calibration"), fmt::format("http://127.0.0.1:{}/netftapi2.xml", sensor.http_port)}) {
     args.push_back(a);
   }
   test::spawn(deflex, args, dir + "/stderr.txt", dir + "/stdout.json");
@@ -176,8 +192,8 @@ TEST(CliRdt, OnlineOverRdtAgainstTheEgmStandIn) {
       worst_bound = std::max(worst_bound, std::abs(table.at(r, "q_command" + n) - table.at(r, "q_nominal" + n) -
                                                    table.at(r, "q_blend" + n)));
       if (r > 0 && table.at(r - 1, "replied") != 0.0) {
-        worst_step = std::max(worst_step, std::abs(table.at(r, "q_command" + n) - table.at(r - 1, "q_command" + n)) /
-                                              limit_deg[j - 1]);
+        worst_step = std::max(
+            worst_step, std::abs(table.at(r, "q_command" + n) - table.at(r - 1, "q_command" + n)) / limit_deg[j - 1]);
       }
     }
   }

@@ -20,8 +20,8 @@
 #include "cross/cli_child.hpp"
 #include "cross/cli_runner.hpp"
 #include "deflex/cell/rsi_controller.hpp"
-#include "deflex/text/csv_table.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/text/csv_table.hpp"
 #include "deflex/transport/udp_transport.hpp"
 #include "wire/protobuf_bytes.hpp"
 
@@ -52,7 +52,8 @@ cell::RsiControllerConfig controller_from_files(const std::string& dir) {
   c.sentype = m[1];
   const auto parameter = [&](const std::string& name) {
     std::smatch p;
-    EXPECT_TRUE(std::regex_search(context, p, std::regex("Name=\"" + name + R"re(" ParamID="\d+" ParamValue="([^"]+)")re")))
+    EXPECT_TRUE(
+        std::regex_search(context, p, std::regex("Name=\"" + name + R"re(" ParamID="\d+" ParamValue="([^"]+)")re")))
         << name;
     return std::stod(p[1]);
   };
@@ -68,15 +69,32 @@ TEST(CliRsi, CompensatesAgainstTheControllerSetUpFromTheGeneratedFiles) {
   fs::create_directories(dir + "/setup");
   Child deflex;
   test::spawn(deflex,
-              {kDeflex, "online", "--link", "rsi", "--rsi-port", "0", "--rsi-sentype", "Deflex",
-               "--max-joint-correction-deg", "0.2", "--force-source", "csv:" + test::kForceReplay, "--loop", "--log",
-               dir + "/cycles.csv", "--log-file", dir + "/field.log", "--status-interval-s", "0.5", "--json"},
+              {kDeflex,
+               "online",
+               "--link",
+               "rsi",
+               "--rsi-port",
+               "0",
+               "--rsi-sentype",
+               "Deflex",
+               "--max-joint-correction-deg",
+               "0.2",
+               "--force-source",
+               "csv:" + test::kForceReplay,
+               "--loop",
+               "--log",
+               dir + "/cycles.csv",
+               "--log-file",
+               dir + "/field.log",
+               "--status-interval-s",
+               "0.5",
+               "--json"},
               dir + "/stderr.txt", dir + "/stdout.json");
   const int port = test::port_of(deflex, "RSI on 127.0.0.1:");
   ASSERT_GT(port, 0) << test::slurp(deflex.stderr_path);
-  const auto setup = test::run_cli("controller-setup --link rsi --sensor-ip 127.0.0.1 --rsi-port " +
-                                   std::to_string(port) + " --rsi-sentype Deflex --max-joint-correction-deg 0.2 -o " +
-                                   dir + "/setup");
+  const auto setup =
+      test::run_cli("controller-setup --link rsi --sensor-ip 127.0.0.1 --rsi-port " + std::to_string(port) +
+                    " --rsi-sentype Deflex --max-joint-correction-deg 0.2 -o " + dir + "/setup");
   ASSERT_EQ(setup.exit_code, 0) << setup.err;
   const cell::RsiControllerConfig cc = controller_from_files(dir + "/setup");
   EXPECT_EQ(cc.sentype, "Deflex");
@@ -113,7 +131,8 @@ TEST(CliRsi, CompensatesAgainstTheControllerSetUpFromTheGeneratedFiles) {
   ASSERT_GT(table.rows(), 150u);
   double largest = 0.0;
   for (std::size_t r = 0; r < table.rows(); ++r) {
-    for (int j = 1; j <= 6; ++j) largest = std::max(largest, std::abs(table.at(r, "dtheta" + std::to_string(j) + "_deg")));
+    for (int j = 1; j <= 6; ++j)
+      largest = std::max(largest, std::abs(table.at(r, "dtheta" + std::to_string(j) + "_deg")));
     EXPECT_GE(table.at(r, "arrival_delay_ms"), 0.0);
     EXPECT_EQ(table.at(r, "replied"), 1.0);
   }
@@ -121,7 +140,8 @@ TEST(CliRsi, CompensatesAgainstTheControllerSetUpFromTheGeneratedFiles) {
   EXPECT_GT(largest, 1e-4);
   // The field log: time-stamped, leveled, one meaning per field in the status lines.
   const std::string field = test::slurp(dir + "/field.log");
-  EXPECT_TRUE(std::regex_search(field, std::regex(R"(\[\d{4}-\d\d-\d\d \d\d:\d\d:\d\d\.\d{3}\] \[info\] t=)"))) << field;
+  EXPECT_TRUE(std::regex_search(field, std::regex(R"(\[\d{4}-\d\d-\d\d \d\d:\d\d:\d\d\.\d{3}\] \[info\] t=)")))
+      << field;
   EXPECT_NE(field.find("in the last 0.5 s:"), std::string::npos) << field;
   EXPECT_NE(field.find("the controller counted"), std::string::npos) << field;
   EXPECT_EQ(field.find("[error]"), std::string::npos) << field;
@@ -188,8 +208,8 @@ TEST(CliRsi, HundredThousandEgmPacketsMissingARequiredFieldGiveCountersNotLines)
   fs::create_directories(dir);
   Child deflex;
   test::spawn(deflex,
-              {kDeflex, "online", "--link", "egm-path", "--egm-port", "0", "--force-source", "csv:" + test::kForceReplay,
-               "--loop", "--json", "--status-interval-s", "0.5"},
+              {kDeflex, "online", "--link", "egm-path", "--egm-port", "0", "--force-source",
+               "csv:" + test::kForceReplay, "--loop", "--json", "--status-interval-s", "0.5"},
               dir + "/stderr.txt", dir + "/stdout.json");
   const int port = test::port_of(deflex, "EGM on 127.0.0.1:");
   ASSERT_GT(port, 0) << test::slurp(deflex.stderr_path);
@@ -202,7 +222,8 @@ TEST(CliRsi, HundredThousandEgmPacketsMissingARequiredFieldGiveCountersNotLines)
     const auto packet = egm_missing_required(k);
     ASSERT_EQ(::sendto(fd, packet.data(), packet.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof(to)),
               static_cast<ssize_t>(packet.size()));
-    if (k % 200 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));  // the kernel queue holds a few hundred
+    if (k % 200 == 0)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));  // the kernel queue holds a few hundred
   }
   ::close(fd);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));

@@ -18,9 +18,9 @@
 #include "cross/cli_child.hpp"
 #include "deflex/cell/egm_position_controller.hpp"
 #include "deflex/cell/rsi_controller.hpp"
-#include "deflex/text/csv_table.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
+#include "deflex/text/csv_table.hpp"
 #include "deflex/transport/udp_transport.hpp"
 
 namespace deflex {
@@ -30,7 +30,6 @@ namespace fs = std::filesystem;
 using test::Child;
 
 using test::kDeflex;
-
 
 // Ticks `controller` in real time every 4 ms for `seconds`; `at(t)` is called before each tick.
 template <class Controller, class Hook>
@@ -56,8 +55,8 @@ TEST(CliRuntimeFaults, AStoppedAndContinuedProcessNeverStepsTheTarget) {
   const std::string log = dir + "/log.csv";
   Child deflex;
   test::spawn(deflex,
-              {kDeflex, "online", "--link", "egm-joint", "--program", program_path, "--egm-port", "0",
-               "--force-source", "csv:" + test::kForceReplay, "--loop", "--log", log},
+              {kDeflex, "online", "--link", "egm-joint", "--program", program_path, "--egm-port", "0", "--force-source",
+               "csv:" + test::kForceReplay, "--loop", "--log", log},
               dir + "/stderr.txt");
   const int port = test::port_of(deflex, "EGM on 127.0.0.1:");
   ASSERT_GT(port, 0) << test::slurp(deflex.stderr_path);
@@ -94,9 +93,9 @@ TEST(CliRuntimeFaults, AStoppedAndContinuedProcessNeverStepsTheTarget) {
     longest_gap = std::max(longest_gap, table.at(r, "t_s") - table.at(r - 1, "t_s"));
     largest_program_step = std::max(largest_program_step, table.at(r, "program_t_s") - table.at(r - 1, "program_t_s"));
   }
-  EXPECT_GT(longest_gap, 0.4);                        // the stall is in the log
-  EXPECT_LE(largest_program_step, 0.004 + 1e-9);     // the program never ran ahead of what was consumed
-  EXPECT_LE(worst, 1.0);                              // and no command stepped beyond the limit
+  EXPECT_GT(longest_gap, 0.4);                    // the stall is in the log
+  EXPECT_LE(largest_program_step, 0.004 + 1e-9);  // the program never ran ahead of what was consumed
+  EXPECT_LE(worst, 1.0);                          // and no command stepped beyond the limit
   const std::string err = test::slurp(deflex.stderr_path);
   EXPECT_NE(err.find("the controller was silent for 0.4"), std::string::npos) << err;
 }
@@ -106,8 +105,8 @@ TEST(CliRuntimeFaults, AStoppedRsiControllerEndsTheRunWithANonZeroCodeNamingIt) 
   fs::create_directories(dir);
   Child deflex;
   test::spawn(deflex,
-              {kDeflex, "online", "--link", "rsi", "--rsi-port", "0", "--force-source", "csv:" + test::kForceReplay, "--loop",
-               "--json"},
+              {kDeflex, "online", "--link", "rsi", "--rsi-port", "0", "--force-source", "csv:" + test::kForceReplay,
+               "--loop", "--json"},
               dir + "/stderr.txt", dir + "/stdout.json");
   const int port = test::port_of(deflex, "RSI on 127.0.0.1:");
   ASSERT_GT(port, 0) << test::slurp(deflex.stderr_path);
@@ -144,14 +143,14 @@ TEST(CliRuntimeFaults, RealTimeTheSystemRefusesIsExitTwoNamingThePermission) {
   if (std::system(("command -v " + drop.substr(0, drop.find(' ')) + " >/dev/null").c_str()) != 0) {
     GTEST_SKIP() << "no " << drop << "on this machine";
   }
-  const auto r = test::run_shell(drop + kDeflex + " online --link egm-joint --egm-port 0 --force-source csv:" + test::kForceReplay +
-                                 " --program " + program_path + " --realtime --duration-s 1");
+  const auto r = test::run_shell(drop + kDeflex + " online --link egm-joint --egm-port 0 --force-source csv:" +
+                                 test::kForceReplay + " --program " + program_path + " --realtime --duration-s 1");
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("option --realtime: the system refused SCHED_FIFO priority 80"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("CAP_SYS_NICE"), std::string::npos) << r.err;
   // Options for real time without it are refused too, naming them.
-  const auto o = test::run_cli("online --link egm-joint --egm-port 0 --force-source csv:" + test::kForceReplay + " --program " +
-                               program_path + " --rt-cpu 1");
+  const auto o = test::run_cli("online --link egm-joint --egm-port 0 --force-source csv:" + test::kForceReplay +
+                               " --program " + program_path + " --rt-cpu 1");
   EXPECT_EQ(o.exit_code, 2);
   EXPECT_NE(o.err.find("apply with --realtime"), std::string::npos) << o.err;
 }

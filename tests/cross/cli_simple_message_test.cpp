@@ -17,9 +17,9 @@
 
 #include "cross/cli_child.hpp"
 #include "deflex/cell/simple_message_server.hpp"
-#include "deflex/text/csv_table.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
+#include "deflex/text/csv_table.hpp"
 #include "deflex/transport/tcp_stream.hpp"
 #include "support/simple_message_frames.hpp"
 
@@ -84,8 +84,9 @@ struct Controller {
   TcpListener motion_listener{"127.0.0.1", 0}, state_listener{"127.0.0.1", 0};
   std::unique_ptr<TcpStream> motion, state;
   [[nodiscard]] std::vector<std::string> ports() const {
-    return {"--robot-host", "127.0.0.1", "--motion-port", std::to_string(motion_listener.port()), "--state-port",
-            std::to_string(state_listener.port())};
+    return {"--robot-host",  "127.0.0.1",
+            "--motion-port", std::to_string(motion_listener.port()),
+            "--state-port",  std::to_string(state_listener.port())};
   }
   bool accept() {
     motion = motion_listener.accept(10.0);
@@ -119,7 +120,6 @@ std::string temp_dir(const std::string& name) {
   return dir;
 }
 
-
 std::vector<std::string> join(std::vector<std::string> a, const std::vector<std::string>& b) {
   a.insert(a.end(), b.begin(), b.end());
   return a;
@@ -132,10 +132,11 @@ TEST(CliSimpleMessage, StreamsTheProgramWithinTheBoundAndCtrlCStopsTheArm) {
   const JointTrajectory program = JointTrajectory::read_csv(program_path, robot);
   const std::string log = dir + "/log.csv";
   Controller c;
-  Deflex deflex(join({"online", "--link", "simple-message", "--program", program_path, "--period-ms", "100",
-                      "--force-source", "csv:" + test::kForceReplay, "--loop", "--log", log, "--status-interval-s", "0.5"},
-                     c.ports()),
-                dir + "/stderr.txt");
+  Deflex deflex(
+      join({"online", "--link", "simple-message", "--program", program_path, "--period-ms", "100", "--force-source",
+            "csv:" + test::kForceReplay, "--loop", "--log", log, "--status-interval-s", "0.5"},
+           c.ports()),
+      dir + "/stderr.txt");
   ASSERT_TRUE(c.accept()) << deflex.err();
   cell::SimpleMessageServer server({}, robot, program.points().front(), *c.motion, *c.state);
   RealTime clock;
@@ -214,8 +215,7 @@ TEST(CliSimpleMessage, ALostConnectionStopsWithExitCodeSixAndSaysWhich) {
   EXPECT_EQ(deflex.wait(), 6);
   EXPECT_EQ(server.counters().stops, 1u);  // the motion connection still carried STOP_TRAJECTORY
   const std::string err = deflex.err();
-  EXPECT_NE(err.find("controller-stopped (exit code 6): the controller closed the state connection"),
-            std::string::npos)
+  EXPECT_NE(err.find("controller-stopped (exit code 6): the controller closed the state connection"), std::string::npos)
       << err;
   EXPECT_TRUE(fs::exists(dir + "/dump.csv"));
 }
@@ -241,7 +241,8 @@ TEST(CliSimpleMessage, AFrameThatCannotBeOneIsBadInputAndNamed) {
 TEST(CliSimpleMessage, BadOptionsAreRefusedBeforeAnythingConnects) {
   const std::string dir = temp_dir("cli_sm_options");
   const std::string program_path = test::nominal_program(dir);
-  const std::string base = "online --link simple-message --force-source csv:" + test::kForceReplay + " --program " + program_path;
+  const std::string base =
+      "online --link simple-message --force-source csv:" + test::kForceReplay + " --program " + program_path;
   const auto expect = [](const std::string& args, const std::string& fragment) {
     const auto r = test::run_cli(args);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
@@ -256,7 +257,8 @@ TEST(CliSimpleMessage, BadOptionsAreRefusedBeforeAnythingConnects) {
   expect(base + " --robot-host 127.0.0.1 --period-ms 100 --buffer-depth 0", "option --buffer-depth");
   expect(base + " --robot-host 127.0.0.1 --period-ms 100 --motion-port 70000", "option --motion-port");
   expect(base + " --robot-host 127.0.0.1 --period-ms 100 --reply-timeout-s 0", "option --reply-timeout-s");
-  expect("online --link simple-message --force-source csv:" + test::kForceReplay + " --robot-host 127.0.0.1 --period-ms 100",
+  expect("online --link simple-message --force-source csv:" + test::kForceReplay +
+             " --robot-host 127.0.0.1 --period-ms 100",
          "--program");
   // Nobody listening: the error names the address and port.
   auto gone = std::make_unique<TcpListener>("127.0.0.1", 0);

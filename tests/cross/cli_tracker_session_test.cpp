@@ -84,12 +84,12 @@ TEST(CliTrackerSession, RegisteredAndAlignedRunsGiveTheBaseFrameFigures) {
 
   const std::string unloaded = s.export_run("unloaded.csv", 812.25, 1);
   const std::string loaded = s.export_run("loaded_uc.csv", 903.5, 2);
-  const auto base_run = run_cli("evaluate --split-laps --json --unloaded " + kTrackerExamples + "unloaded.csv --loaded " +
-                                kTrackerExamples + "loaded_uc.csv");
+  const auto base_run = run_cli("evaluate --split-laps --json --unloaded " + kTrackerExamples +
+                                "unloaded.csv --loaded " + kTrackerExamples + "loaded_uc.csv");
   ASSERT_EQ(base_run.exit_code, 0) << base_run.err;
-  const auto tracker_run = run_cli("evaluate --split-laps --json --tracker-frame " + s.path("frame.yaml") +
-                                   " --unloaded " + unloaded + " --loaded " + loaded + " --align-to " + kTrackerExamples +
-                                   "unloaded.csv");
+  const auto tracker_run =
+      run_cli("evaluate --split-laps --json --tracker-frame " + s.path("frame.yaml") + " --unloaded " + unloaded +
+              " --loaded " + loaded + " --align-to " + kTrackerExamples + "unloaded.csv");
   ASSERT_EQ(tracker_run.exit_code, 0) << tracker_run.err;
   const auto b = nlohmann::json::parse(base_run.out), t = nlohmann::json::parse(tracker_run.out);
   EXPECT_NEAR(t["mean_deformation_mm"].get<double>(), b["mean_deformation_mm"].get<double>(), 0.005);
@@ -106,7 +106,8 @@ TEST(CliTrackerSession, BadFilesExitTwoNamingFileAndLine) {
   s.write("nounit.txt", "// Working Frame: T\nP1 1 2 3\nP2 1 2 3\n");
   s.write("ok.txt", "// Working Frame: T\n// Units: mm\n// Columns: target x y z time\nP1 1 2 3 0\nP2 1 2 3 0\n");
   s.write("line.txt", "// Units: mm\nA 0 0 0\nB 1 1 1\nC 2 2 2\n");
-  s.write("frame.yaml", "tracker_frame: \"Other\"\nbase_T_tracker:\n  position: [0, 0, 0]\n  quaternion_wxyz: [1, 0, 0, 0]\n");
+  s.write("frame.yaml",
+          "tracker_frame: \"Other\"\nbase_T_tracker:\n  position: [0, 0, 0]\n  quaternion_wxyz: [1, 0, 0, 0]\n");
   auto expect_refused = [](const test::CliRun& r, const std::string& text) {
     EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_NE(r.err.find(text), std::string::npos) << r.err;

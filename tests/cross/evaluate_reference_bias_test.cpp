@@ -58,10 +58,10 @@ TEST(EvaluateReferenceBias, MeanReferenceRemovesTheNoisyDenseReferencesBias) {
   const double truth = mean_mm("--unloaded " + (d / "exact.csv").string() + loaded);
   const double nearest = mean_mm("--unloaded " + (d / "unloaded.csv").string() + loaded);
   const double averaged = mean_mm("--mean-reference --unloaded " + (d / "unloaded.csv").string() + loaded);
-  std::cout << fmt::format("offset {:.4f} mm, noise {:.3f} mm: against the exact path {:.4f} mm, nearest noisy "
-                           "sample {:.4f} mm ({:+.1f}%), mean of the unloaded laps {:.4f} mm ({:+.1f}%)\n",
-                           kOffsetMm, kNoiseMm, truth, nearest, 100.0 * (nearest / truth - 1.0), averaged,
-                           100.0 * (averaged / truth - 1.0));
+  std::cout << fmt::format(
+      "offset {:.4f} mm, noise {:.3f} mm: against the exact path {:.4f} mm, nearest noisy "
+      "sample {:.4f} mm ({:+.1f}%), mean of the unloaded laps {:.4f} mm ({:+.1f}%)\n",
+      kOffsetMm, kNoiseMm, truth, nearest, 100.0 * (nearest / truth - 1.0), averaged, 100.0 * (averaged / truth - 1.0));
   // The figure the paper's metric aims at: |offset + loaded noise| across the path, a bit over 0.05.
   EXPECT_GT(truth, kOffsetMm);
   EXPECT_LT(truth, kOffsetMm + kNoiseMm);

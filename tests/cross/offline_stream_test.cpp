@@ -11,11 +11,11 @@
 
 #include "cli_runner.hpp"
 #include "deflex/force/constant_wrench_model.hpp"
-#include "deflex/text/csv_table.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/offline/compensate_path.hpp"
-#include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/detail/pose_path_csv.hpp"
+#include "deflex/paths/path_ik.hpp"
+#include "deflex/text/csv_table.hpp"
 
 namespace deflex {
 namespace {
@@ -41,8 +41,8 @@ TEST(OfflineStream, TheStreamedFileHoldsTheInMemoryResultPointForPoint) {
   const std::size_t n = 25000;
   const fs::path poses_file = write_pose_file(n);
   const fs::path out = fs::temp_directory_path() / "deflex_stream_out.csv";
-  const test::CliRun r =
-      test::run_cli("offline --path " + poses_file.string() + " --force constant:fx_N=120,fz_N=-450 -o " + out.string());
+  const test::CliRun r = test::run_cli("offline --path " + poses_file.string() +
+                                       " --force constant:fx_N=120,fz_N=-450 -o " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
   // The library, all in memory: poses, path IK, compensation.
@@ -62,8 +62,10 @@ TEST(OfflineStream, TheStreamedFileHoldsTheInMemoryResultPointForPoint) {
     ASSERT_EQ(t.at(i, "index"), static_cast<double>(i));
     const OfflinePoint& p = expected.points[i];
     for (int j = 0; j < model.dof(); ++j) {
-      worst_deg = std::max(worst_deg, std::abs(t.at(i, fmt::format("q{}_des_deg", j + 1)) - rad_to_deg(p.q_desired[j])));
-      worst_deg = std::max(worst_deg, std::abs(t.at(i, fmt::format("q{}_cmd_deg", j + 1)) - rad_to_deg(p.q_command[j])));
+      worst_deg =
+          std::max(worst_deg, std::abs(t.at(i, fmt::format("q{}_des_deg", j + 1)) - rad_to_deg(p.q_desired[j])));
+      worst_deg =
+          std::max(worst_deg, std::abs(t.at(i, fmt::format("q{}_cmd_deg", j + 1)) - rad_to_deg(p.q_command[j])));
     }
     worst_mm = std::max(worst_mm, std::abs(t.at(i, "deflection_mm") - p.predicted_deflection.head<3>().norm() * 1e3));
   }

@@ -490,8 +490,8 @@ TEST(ProgramRoundTrip, MigratedModuleWithConfOffIsCompensatedNearestThePreviousT
   const std::string out_dir = (fs::temp_directory_path() / ("deflex_migrated_" + std::to_string(::getpid()))).string();
   fs::create_directories(out_dir);
   const std::string in = kExamples + "migrated_pocket.mod";
-  const auto r = run_cli("offline --program-in " + in + " --force tool:fz_N=-300 --program-out " + out_dir +
-                         "/out.mod --json");
+  const auto r =
+      run_cli("offline --program-in " + in + " --force tool:fz_N=-300 --program-out " + out_dir + "/out.mod --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto doc = nlohmann::json::parse(r.out);
   ASSERT_EQ(doc["targets"].size(), 9u);
@@ -554,9 +554,8 @@ TEST(ProgramRoundTrip, MigratedModuleWithConfOffIsCompensatedNearestThePreviousT
     strict.replace(strict.find(conf), std::string(conf).size(), std::string(conf).substr(0, 6) + "On; ");
   }
   std::ofstream(out_dir + "/strict.mod", std::ios::binary) << strict;
-  const auto refused =
-      run_cli("offline --program-in " + out_dir + "/strict.mod --force tool:fz_N=-300 --program-out " + out_dir +
-              "/strict_out.mod");
+  const auto refused = run_cli("offline --program-in " + out_dir + "/strict.mod --force tool:fz_N=-300 --program-out " +
+                               out_dir + "/strict_out.mod");
   EXPECT_EQ(refused.exit_code, 2);
   EXPECT_NE(refused.err.find("strict.mod:41: MoveJ pApproach: configuration_unavailable"), std::string::npos)
       << refused.err;

@@ -25,7 +25,7 @@ Pose known_transform() {
 }
 
 std::vector<Vector3> base_points() {
-  return {{1.5, -0.5, 0.5}, {2.2, -0.4, 0.7}, {1.8, 0.6, 0.4}, {2.0, 0.0, 1.5},
+  return {{1.5, -0.5, 0.5}, {2.2, -0.4, 0.7}, {1.8, 0.6, 0.4},  {2.0, 0.0, 1.5},
           {1.6, 0.3, 1.2},  {2.5, 0.5, 0.9},  {1.9, -0.7, 1.0}, {2.3, 0.2, 0.3}};
 }
 
@@ -169,7 +169,8 @@ TEST(RegistrationRoundTrip, StudyTracesThroughSaExportsGiveTheBaseFrameFigures) 
   RegistrationInput in;
   in.base_m = base_points();
   std::normal_distribution<double> point_noise(0.0, 10e-6);
-  for (const auto& b : in.base_m) in.tracker_m.push_back(T.inverse() * b + Vector3(point_noise(rng), point_noise(rng), point_noise(rng)));
+  for (const auto& b : in.base_m)
+    in.tracker_m.push_back(T.inverse() * b + Vector3(point_noise(rng), point_noise(rng), point_noise(rng)));
   const FrameRegistration reg = register_frames(in);
 
   auto via_tracker = [&](const std::string& name) {

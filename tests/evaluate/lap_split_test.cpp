@@ -45,8 +45,9 @@ TEST(LapSplit, ThreeAnticlockwiseThenThreeClockwise) {
 TEST(LapSplit, AlternatingDirectionsAndAPartialPiece) {
   // CW, CCW, CW laps, then a quarter turn: 3 laps and one dropped piece.
   const int n = 1000;
-  const TrackerTrace t = concat({test::closed_circle(0.1, kLapCentre, n, true), test::closed_circle(0.1, kLapCentre, n, false),
-                                 test::closed_circle(0.1, kLapCentre, n, true), test::circle(0.1, kLapCentre, n / 4, 0.25)});
+  const TrackerTrace t =
+      concat({test::closed_circle(0.1, kLapCentre, n, true), test::closed_circle(0.1, kLapCentre, n, false),
+              test::closed_circle(0.1, kLapCentre, n, true), test::circle(0.1, kLapCentre, n / 4, 0.25)});
   const LapSplit s = split_laps(t);
   EXPECT_EQ(s.laps.size(), 3u);
   EXPECT_EQ(s.dropped_partial, 1);

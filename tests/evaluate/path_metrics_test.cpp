@@ -39,8 +39,8 @@ TEST(PathMetrics, CircleLiftedOutOfItsPlaneIsAtTheLiftEverywhere) {
   const double h = 0.3e-3;
   const int n = 8000;
   const TrackerTrace ref = test::closed_circle(r, Vector3(1.2, 0.3, 0.9), n);
-  const TrackerTrace loaded = test::shifted(test::circle(r, Vector3(1.2, 0.3, 0.9), 3001, 1.0, false, 0.123),
-                                            Vector3(0, 0, h));
+  const TrackerTrace loaded =
+      test::shifted(test::circle(r, Vector3(1.2, 0.3, 0.9), 3001, 1.0, false, 0.123), Vector3(0, 0, h));
   // The polyline lies inside the circle by at most the sagitta r (1 - cos(pi / n)).
   const double sagitta = r * (1.0 - std::cos(kPi / n));
   const PathDeviationStats st = path_deviation(loaded, ref);
@@ -141,9 +141,10 @@ TEST(PathMetrics, IndexAgreesWithBruteForceOnRandomPaths) {
     PolylineIndex::Nearest previous;
     for (int q = 0; q < 200; ++q) {
       const double scale = (q % 3 == 0) ? 2.0 : 0.05;  // far and near queries
-      const Vector3 base = pieces[static_cast<std::size_t>(q) % pieces.size()]
-                               [static_cast<std::size_t>(q * 7) % pieces[static_cast<std::size_t>(q) % pieces.size()].size()]
-                                   .p_m;
+      const Vector3 base =
+          pieces[static_cast<std::size_t>(q) % pieces.size()]
+                [static_cast<std::size_t>(q * 7) % pieces[static_cast<std::size_t>(q) % pieces.size()].size()]
+                    .p_m;
       const Vector3 p = base + scale * Vector3(u(rng), u(rng), u(rng));
       const auto near = index.nearest(p);
       ASSERT_NEAR(near.distance_m, brute_force_distance(pieces, p), 1e-12) << "trial " << trial << " query " << q;
@@ -207,8 +208,8 @@ TEST(MeanClosedPath, RemovesTheLowBiasOfANoisyDenseReference) {
   const double raw = mean_distance_to_path_m(loaded, reference);
   const TrackerTrace mean = mean_closed_path(reference);
   const double to_mean = mean_distance_to_path_m(loaded, mean);
-  EXPECT_LT(raw, 0.047e-3);                    // biased low by the reference's noise
-  EXPECT_NEAR(to_mean, 0.050e-3, 0.0015e-3);   // the offset, within a few percent
+  EXPECT_LT(raw, 0.047e-3);                   // biased low by the reference's noise
+  EXPECT_NEAR(to_mean, 0.050e-3, 0.0015e-3);  // the offset, within a few percent
   // The mean path lies on the circle to within the noise averaged over ~27 samples a bin: a radial
   // error of about 5 um / sqrt(27) = 1 um a bin, none beyond 5 sigma, and no bias.
   double worst = 0.0, sum = 0.0;

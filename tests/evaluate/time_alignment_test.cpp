@@ -15,7 +15,7 @@ namespace {
 // A commanded path with a start, a stop and changes of speed: a circle of 100 mm at up to 50 mm/s with
 // a hold before and after, sampled at 250 Hz on the program's clock.
 Vector3 command_at(double t) {
-  const double s = std::clamp(t - 1.0, 0.0, 20.0);                                 // 1 s hold, 20 s motion
+  const double s = std::clamp(t - 1.0, 0.0, 20.0);                                       // 1 s hold, 20 s motion
   const double phase = 2 * kPi * (s / 20.0 - std::sin(2 * kPi * s / 20.0) / (2 * kPi));  // smooth start and stop
   return {1.9 + 0.1 * std::cos(3 * phase), 0.1 * std::sin(3 * phase), 0.9};
 }

@@ -45,7 +45,8 @@ TEST(SaExport, CollectionGroupTargetWithHeaderInMillimetres) {
 TEST(SaExport, EveryNameLayoutWithoutAHeaderNeedsOnlyTheUnit) {
   TrackerReadOptions o;
   o.length_unit = "m";
-  for (const char* text : {"G T1 1 2 3\nG T2 4 5 6\n", "T1 1 2 3\nT2 4 5 6\n", "1 2 3\n4 5 6\n", "C,G,T1,1,2,3\nC,G,T2,4,5,6\n"}) {
+  for (const char* text :
+       {"G T1 1 2 3\nG T2 4 5 6\n", "T1 1 2 3\nT2 4 5 6\n", "1 2 3\n4 5 6\n", "C,G,T1,1,2,3\nC,G,T2,4,5,6\n"}) {
     const TrackerFile f = parse_tracker_file(text, "s.txt", o);
     ASSERT_EQ(f.points.size(), 2u) << text;
     EXPECT_EQ(f.unit_from, "option");
@@ -55,8 +56,8 @@ TEST(SaExport, EveryNameLayoutWithoutAHeaderNeedsOnlyTheUnit) {
 }
 
 TEST(SaExport, InchesFeetAndCentimetres) {
-  for (const auto& [unit, scale] : std::vector<std::pair<std::string, double>>{{"Inches", 0.0254}, {"Feet", 0.3048},
-                                                                                {"Centimeters", 0.01}, {"Meters", 1.0}}) {
+  for (const auto& [unit, scale] : std::vector<std::pair<std::string, double>>{
+           {"Inches", 0.0254}, {"Feet", 0.3048}, {"Centimeters", 0.01}, {"Meters", 1.0}}) {
     const TrackerFile f = parse_tracker_file("// Units: " + unit + "\nP1 10 0 -2\n", "s.txt");
     EXPECT_NEAR(f.points[0].p_m.x(), 10 * scale, 1e-15) << unit;
     EXPECT_NEAR(f.points[0].p_m.z(), -2 * scale, 1e-15) << unit;
@@ -73,8 +74,8 @@ TEST(SaExport, CylindricalAndSphericalAgainstHandComputedPoints) {
   EXPECT_NEAR(cyl.points[0].p_m.y(), 1.0, 1e-12);
   EXPECT_NEAR(cyl.points[0].p_m.z(), 0.5, 1e-12);
   // Spherical: r = 3 m, azimuth 90 deg, zenith angle 60 deg -> (0, 3 sin 60, 3 cos 60).
-  const TrackerFile sph = parse_tracker_file(
-      "// Units: Meters, Degrees\n// Columns: Target R Theta Phi\nP1 3 90 60\n", "s.txt");
+  const TrackerFile sph =
+      parse_tracker_file("// Units: Meters, Degrees\n// Columns: Target R Theta Phi\nP1 3 90 60\n", "s.txt");
   EXPECT_NEAR(sph.points[0].p_m.x(), 0.0, 1e-12);
   EXPECT_NEAR(sph.points[0].p_m.y(), 3.0 * std::sqrt(3.0) / 2.0, 1e-12);
   EXPECT_NEAR(sph.points[0].p_m.z(), 1.5, 1e-12);
@@ -155,8 +156,9 @@ TEST(TrackerFileErrors, EachNamesTheFileAndLine) {
   // Mixed coordinate types: the header says one, the columns another; or two in the header.
   EXPECT_NE(file_error_of("// Units: mm\n// Coordinate System: Cylindrical\nP1 1 2 3\n").find("mixed coordinate types"),
             std::string::npos);
-  EXPECT_NE(file_error_of("// Units: mm\n// Cartesian\n// Spherical\nP1 1 2 3\n").find("session.txt:3: mixed coordinate"),
-            std::string::npos);
+  EXPECT_NE(
+      file_error_of("// Units: mm\n// Cartesian\n// Spherical\nP1 1 2 3\n").find("session.txt:3: mixed coordinate"),
+      std::string::npos);
   // Another working frame than expected, or none named.
   TrackerReadOptions frame;
   frame.expect_frame = "Tracker";

@@ -10,9 +10,9 @@
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/force/tool_wrench_model.hpp"
 #include "deflex/force/wrench_table_model.hpp"
+#include "deflex/paths/path_spec.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
-#include "deflex/paths/path_spec.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex {
@@ -94,8 +94,9 @@ TEST(ForceSpec, ErrorsQuoteTheSpecAndKey) {
   EXPECT_NE(error_of([] { (void)parse_force_specs("ldbb:pivot_mm=1;2;3"); }).find("'force_N'"), std::string::npos);
   EXPECT_NE(error_of([] { (void)parse_force_specs("ldbb:phi_deg=30,force_N=100"); }).find("needs a circle"),
             std::string::npos);
-  EXPECT_NE(error_of([&] { (void)parse_force_specs("ldbb:phi_deg=30,pivot_mm=1;2;3,force_N=100", ctx); })
-                .find("exactly one of"),
+  EXPECT_NE(error_of([&] {
+              (void)parse_force_specs("ldbb:phi_deg=30,pivot_mm=1;2;3,force_N=100", ctx);
+            }).find("exactly one of"),
             std::string::npos);
   EXPECT_NE(error_of([] { (void)parse_force_specs("ldbb:pivot_mm=1;2;3,force_N=100,mode=shove"); }).find("'mode'"),
             std::string::npos);
@@ -166,12 +167,12 @@ TEST(WrenchTable, MalformedFilesNameLineAndColumn) {
     return error_of([&] { (void)WrenchTableModel(CsvTable::parse(text, "w.csv")); });
   };
   EXPECT_NE(parse_error("fx_N,fy_N\n1,2\n").find("fz_N"), std::string::npos);
-  EXPECT_NE(parse_error("index,fx_N,fy_N,fz_N\n0,1,2,3\n0,1,2,3\n").find("w.csv:3: column 'index': index 0 already "
-                                                                         "given on line 2"),
+  EXPECT_NE(parse_error("index,fx_N,fy_N,fz_N\n0,1,2,3\n0,1,2,3\n")
+                .find("w.csv:3: column 'index': index 0 already "
+                      "given on line 2"),
             std::string::npos);
   EXPECT_NE(parse_error("index,fx_N,fy_N,fz_N\n0.5,1,2,3\n").find("w.csv:2: column 'index'"), std::string::npos);
-  EXPECT_NE(parse_error("index,fx_N,fy_N,fz_N\n0,1,2,3\n5,1,2,3\n").find("w.csv:3: column 'index'"),
-            std::string::npos);
+  EXPECT_NE(parse_error("index,fx_N,fy_N,fz_N\n0,1,2,3\n5,1,2,3\n").find("w.csv:3: column 'index'"), std::string::npos);
   EXPECT_NE(parse_error("fx_N,fy_N,fz_N\n1,2\n").find("w.csv:2"), std::string::npos);
   EXPECT_EQ(parse_error("fx_N,fy_N,fz_N\n"), "w.csv: no wrench rows");
 }

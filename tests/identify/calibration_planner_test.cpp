@@ -4,22 +4,22 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
-#include <string>
 #include <random>
+#include <string>
 
-#include <Eigen/SVD>
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <Eigen/SVD>
 
 #include "deflex/identify/calibration_planner.hpp"
 #include "deflex/identify/calibration_simulation.hpp"
 #include "deflex/identify/stiffness_identification.hpp"
 #include "deflex/model/compliance.hpp"
+#include "deflex/model/inverse_kinematics.hpp"
+#include "deflex/model/linear_algebra.hpp"
+#include "deflex/model/robot_io.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
-#include "deflex/model/inverse_kinematics.hpp"
-#include "deflex/model/robot_io.hpp"
-#include "deflex/model/linear_algebra.hpp"
 
 namespace deflex {
 namespace {
@@ -144,8 +144,7 @@ TEST(CalibrationPlanner, GreedyDesignBeatsRandomDesignsOfTheSameSize) {
       target.linear() = Eigen::Matrix3d(Eigen::AngleAxisd(kPi, Vector3::UnitY()) *
                                         Eigen::AngleAxisd(kPi / 2 * static_cast<double>(rng() % 4), Vector3::UnitZ()));
       for (int a = 0; a < 3; ++a) {
-        target.translation()[a] =
-            std::uniform_real_distribution<double>(o.region_min_m[a], o.region_max_m[a])(rng);
+        target.translation()[a] = std::uniform_real_distribution<double>(o.region_min_m[a], o.region_max_m[a])(rng);
       }
       const IkResult ik = inverse_kinematics(model, ws, target);
       if (!ik.ok()) {
@@ -189,8 +188,8 @@ TEST(CalibrationPlanner, RunningThePlanIdentifiesTheStiffnessAsPredicted) {
     EXPECT_LT(std::abs(k - k_true[j]), 4.5 * se) << "joint " << j + 1;
     // The planner predicts se(c)/c_nominal; with the true compliance that is a relative error of
     // predicted * k_true / k_nominal. The noise estimate and the robust weights move it a little.
-    const double expected = plan.predicted_relative_std_error[j] * k_true[j] /
-                            model.stiffness()[static_cast<Eigen::Index>(j)];
+    const double expected =
+        plan.predicted_relative_std_error[j] * k_true[j] / model.stiffness()[static_cast<Eigen::Index>(j)];
     EXPECT_GT(se / k, 0.6 * expected) << "joint " << j + 1;
     EXPECT_LT(se / k, 1.6 * expected) << "joint " << j + 1;
   }

@@ -2,8 +2,8 @@
 // convex problem is the best feasible solution among the unconstrained fits on each subset).
 #include <random>
 
-#include <Eigen/QR>
 #include <gtest/gtest.h>
+#include <Eigen/QR>
 
 #include "deflex/identify/detail/nonnegative_least_squares.hpp"
 
@@ -82,7 +82,6 @@ TEST(NonnegativeLeastSquares, NegativeUnconstrainedComponentIsClampedWithTheOthe
   EXPECT_EQ(r.x[1], 0.0);
   EXPECT_TRUE(r.at_bound[1]);
 }
-
 
 TEST(NonnegativeLeastSquares, NoColumnsGiveAnEmptyConvergedSolution) {
   const NnlsResult r = nonnegative_least_squares(Eigen::MatrixXd(3, 0), Eigen::Vector3d(1.0, 2.0, 3.0));

@@ -12,9 +12,9 @@
 
 #include "deflex/identify/stiffness_identification.hpp"
 #include "deflex/model/compliance.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/text/errors.hpp"
 #include "model/kdl_chain.hpp"
 #include "model/test_robots.hpp"
 #include "support/allocation_guard.hpp"
@@ -22,7 +22,9 @@
 namespace deflex {
 namespace {
 
-RobotModel kr210_model() { return load_robot(std::string(DEFLEX_SOURCE_DIR) + "/examples/robots/kuka_kr210_r2700.yaml"); }
+RobotModel kr210_model() {
+  return load_robot(std::string(DEFLEX_SOURCE_DIR) + "/examples/robots/kuka_kr210_r2700.yaml");
+}
 
 // A random configuration inside the limits (wrist joints within +-150 deg) and away from
 // singularities, so every joint moves the TCP.

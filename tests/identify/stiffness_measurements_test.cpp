@@ -25,7 +25,8 @@ std::string error_of(const std::string& path) {
   return "no error";
 }
 
-const char* const kHeader = "q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg,fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,dx_mm,dy_mm,dz_mm\n";
+const char* const kHeader =
+    "q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg,fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,dx_mm,dy_mm,dz_mm\n";
 
 TEST(StiffnessMeasurements, ReadsTheIssueLayoutInSiUnits) {
   const std::string path = write_temp("m1.csv", std::string(kHeader) +
@@ -92,7 +93,8 @@ TEST(StiffnessMeasurements, BadFilesNameTheFileLineAndColumn) {
   EXPECT_NE(e.find("b2.csv:3"), std::string::npos) << e;
   EXPECT_NE(e.find("mz_Nm"), std::string::npos) << e;
 
-  e = error_of(write_temp("b3.csv", "q1_deg,q2_deg,fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,dx_mm,dy_mm\n0,0,1,2,3,4,5,6,0.1,0.2\n"));
+  e = error_of(
+      write_temp("b3.csv", "q1_deg,q2_deg,fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,dx_mm,dy_mm\n0,0,1,2,3,4,5,6,0.1,0.2\n"));
   EXPECT_NE(e.find("dz_mm"), std::string::npos) << e;
 
   e = error_of(write_temp("b4.csv", "fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm,dx_mm,dy_mm,dz_mm\n1,2,3,4,5,6,0.1,0.2,0.3\n"));
@@ -104,7 +106,8 @@ TEST(StiffnessMeasurements, BadFilesNameTheFileLineAndColumn) {
   EXPECT_NE(e.find("b5.csv:2"), std::string::npos) << e;
   EXPECT_NE(e.find("dx_mm"), std::string::npos) << e;
 
-  e = error_of(write_temp("b6.csv", std::string("weight,") + h.substr(0, h.size() - 1) + "\n0,0,0,0,0,0,0,1,2,3,4,5,6,1,2,3\n"));
+  e = error_of(
+      write_temp("b6.csv", std::string("weight,") + h.substr(0, h.size() - 1) + "\n0,0,0,0,0,0,0,1,2,3,4,5,6,1,2,3\n"));
   EXPECT_NE(e.find("weight"), std::string::npos) << e;
   EXPECT_NE(e.find(":2"), std::string::npos) << e;
 

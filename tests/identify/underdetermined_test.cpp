@@ -4,14 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <optional>
 #include <string>
-#include <limits>
 
 #include "deflex/identify/stiffness_identification.hpp"
 #include "deflex/model/compliance.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {

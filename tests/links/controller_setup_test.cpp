@@ -17,8 +17,8 @@
 #include <gtest/gtest.h>
 
 #include "deflex/egm/egm_controller_setup.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/rsi/rsi_controller_setup.hpp"
+#include "deflex/text/errors.hpp"
 #include "wire/libxml2_reader.hpp"
 
 namespace deflex {
@@ -62,7 +62,8 @@ RapidModule read_rapid(const std::string& text) {
   // Block lines stand alone; every other statement runs to its ';' (it may span lines).
   static const std::regex module_re(R"(^\s*MODULE\s+([A-Za-z][A-Za-z0-9_]{0,31})\s*$)");
   static const std::regex proc_re(R"(^\s*PROC\s+([A-Za-z][A-Za-z0-9_]{0,31})\s*\(\s*\)\s*$)");
-  static const std::regex decl_re(R"(^(LOCAL\s+)?(VAR|CONST|PERS)\s+([a-z_]+)\s+([A-Za-z][A-Za-z0-9_]{0,31})\s*(:=.*)?$)");
+  static const std::regex decl_re(
+      R"(^(LOCAL\s+)?(VAR|CONST|PERS)\s+([a-z_]+)\s+([A-Za-z][A-Za-z0-9_]{0,31})\s*(:=.*)?$)");
   std::istringstream in(code);
   std::string line, pending;
   std::vector<std::string> blocks;
@@ -157,8 +158,9 @@ TEST(ControllerSetup, EgmJointModuleIsWellFormedAndAgreesWithDeflex) {
   EXPECT_TRUE(m.problems.empty()) << ::testing::PrintToString(m.problems);
   EXPECT_EQ(m.name, "DeflexEgm");
   // The command the header names runs deflex bound to the address the controller sends to.
-  EXPECT_NE(file(files, ".mod").text.find("deflex online --link egm-joint --bind 192.168.125.50 --egm-port 6511 "
-                                          "--period-ms 4 --max-joint-correction-deg 0.3"),
+  EXPECT_NE(file(files, ".mod")
+                .text.find("deflex online --link egm-joint --bind 192.168.125.50 --egm-port 6511 "
+                           "--period-ms 4 --max-joint-correction-deg 0.3"),
             std::string::npos);
   EXPECT_EQ(m.statements.front(), "EGMReset deflex_egm_id");
   const RapidCall setup = call(m, "EGMSetupUC");

@@ -143,7 +143,8 @@ TEST(EgmJointLink, StartsWithinOneDegreeAndBlendsTheOffsetOut) {
   JointBench bench(test::hold_program(test::bench_robot(), q0, 10.0), arm, StrategyKind::kOnline, nullptr, config);
   bench.force.reading = Vector6::Zero();
   ASSERT_EQ(bench.tick(), LinkPollResult::kAnswered);
-  EXPECT_LT((bench.link.last_cycle().q_command - arm).cwiseAbs().maxCoeff(), 1e-12);  // the first command: where the arm is
+  EXPECT_LT((bench.link.last_cycle().q_command - arm).cwiseAbs().maxCoeff(),
+            1e-12);  // the first command: where the arm is
   for (int k = 0; k < 150; ++k) bench.tick();
   EXPECT_LT((bench.link.last_cycle().q_command - q0).cwiseAbs().maxCoeff(), 1e-12);  // after 0.6 s: the program
 }

@@ -124,8 +124,8 @@ TEST(EgmPathLink, SteadyStateCycleDoesNotAllocate) {
   const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
   const LdbbForceModel ldbb(Vector3(1.5, 0.0, 0.5), 400.0, true);
   for (StrategyKind kind : {StrategyKind::kOnline, StrategyKind::kHybrid, StrategyKind::kPredictive}) {
-    PathBench bench(test::sweep_program(test::bench_robot(), q0, pose_deg(8, -3, 4, 10, -5, 12), 20.0), "path",
-                    0.004, kind, &ldbb);
+    PathBench bench(test::sweep_program(test::bench_robot(), q0, pose_deg(8, -3, 4, 10, -5, 12), 20.0), "path", 0.004,
+                    kind, &ldbb);
     bench.force.reading = test::reading_at(bench.robot, q0, Vector3(50, 0, -400));
     for (int k = 0; k < 300; ++k) bench.tick();
     for (int k = 0; k < 200; ++k) {

@@ -11,8 +11,8 @@
 #include <memory>
 #include <vector>
 
-#include "deflex/standin/standin_session.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/standin/standin_session.hpp"
 #include "links/link_harness.hpp"
 #include "support/sampled_speed.hpp"
 
@@ -59,8 +59,8 @@ struct FaultBench {
   /// blend's (1.5 x the start tolerance over the ramp) and the correction's rate, over one period.
   [[nodiscard]] JointVector joint_step_limit() const {
     const double period = config.online.period_s;
-    const JointStreamConfig& s = kind == runtime::LinkKind::kSimpleMessage ? config.simple_message.stream
-                                                                             : config.egm_joint.stream;
+    const JointStreamConfig& s =
+        kind == runtime::LinkKind::kSimpleMessage ? config.simple_message.stream : config.egm_joint.stream;
     const bool streams = kind == runtime::LinkKind::kEgmJoint || kind == runtime::LinkKind::kSimpleMessage;
     JointVector limit = JointVector::Constant(6, period * config.online.max_correction_rate_rad_s);
     if (streams) {

@@ -264,8 +264,7 @@ TEST(FaultTable, EgmPathAStaleForceRampsTheOffsetOutOverSeveralAnswers) {
   std::size_t answers = 0;
   for (std::size_t k = at; k < b.wire().size() && b.wire()[k].offset_m.norm() > 1e-9; ++k) ++answers;
   EXPECT_EQ(b.wire().back().offset_m.norm(), 0.0);
-  EXPECT_GE(static_cast<double>(answers) + 1.0,
-            offset / (b.config.online.max_tcp_rate_m_s * b.config.online.period_s));
+  EXPECT_GE(static_cast<double>(answers) + 1.0, offset / (b.config.online.max_tcp_rate_m_s * b.config.online.period_s));
   EXPECT_GE(answers, 2u);
 }
 
@@ -332,7 +331,8 @@ TEST(FaultTable, RsiStoppedOnItsTimeoutByAStalledDeflexIsNamedWithinTwoCycles) {
   const runtime::SessionSummary& s = b.session->finish();
   EXPECT_EQ(s.reason, StopReason::kControllerStopped);
   EXPECT_EQ(s.exit_code, 6);
-  EXPECT_NE(s.reason_text.find("RSI stopped: the controller's late count reached its Timeout of 100"), std::string::npos)
+  EXPECT_NE(s.reason_text.find("RSI stopped: the controller's late count reached its Timeout of 100"),
+            std::string::npos)
       << s.reason_text;
   EXPECT_LE(b.t_s() - stopped_at, 0.0121);
   expect_invariants(b, "rsi timeout");

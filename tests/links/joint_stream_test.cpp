@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "deflex/link/joint_stream.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {
@@ -17,11 +17,9 @@ JointVector deg6(double a, double b, double c, double d, double e, double f) {
 }
 
 std::shared_ptr<const JointTrajectory> line(const RobotModel& robot) {
-  return std::make_shared<const JointTrajectory>(std::vector<double>{0.0, 2.0, 4.0},
-                                                 std::vector<JointVector>{deg6(0, 20, 10, 0, 60, 0),
-                                                                          deg6(4, 20, 10, 0, 60, 0),
-                                                                          deg6(8, 20, 10, 0, 60, 0)},
-                                                 robot);
+  return std::make_shared<const JointTrajectory>(
+      std::vector<double>{0.0, 2.0, 4.0},
+      std::vector<JointVector>{deg6(0, 20, 10, 0, 60, 0), deg6(4, 20, 10, 0, 60, 0), deg6(8, 20, 10, 0, 60, 0)}, robot);
 }
 
 TEST(JointStream, StartsWithinTheToleranceAndBlendsTheOffsetOut) {

@@ -12,10 +12,10 @@
 #include "deflex/cell/egm_position_controller.hpp"
 #include "deflex/egm/egm_joint_link.hpp"
 #include "deflex/egm/egm_path_link.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
-#include "deflex/transport/memory_network.hpp"
+#include "deflex/model/robot_io.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/transport/memory_network.hpp"
 #include "online/fd_jacobian.hpp"
 
 namespace deflex::test {
@@ -125,8 +125,9 @@ struct JointBench {
   std::unique_ptr<cell::EgmPositionGuidanceController> controller;
   double t_s = 0.0;
 
-  JointBench(std::shared_ptr<const JointTrajectory> p, const JointVector& arm_start, StrategyKind kind = StrategyKind::kOnline,
-             const ForceModel* model = nullptr, EgmJointLinkConfig config = {})
+  JointBench(std::shared_ptr<const JointTrajectory> p, const JointVector& arm_start,
+             StrategyKind kind = StrategyKind::kOnline, const ForceModel* model = nullptr,
+             EgmJointLinkConfig config = {})
       : compensator(robot, bench_sensor(), bench_online()),
         strategy(robot, kind, model),
         program(std::move(p)),

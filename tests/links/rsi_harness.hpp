@@ -10,8 +10,8 @@
 #include <memory>
 
 #include "deflex/cell/rsi_controller.hpp"
-#include "deflex/rsi/rsi_link.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/rsi/rsi_link.hpp"
 #include "links/link_harness.hpp"
 
 namespace deflex::test {

@@ -11,8 +11,8 @@
 
 #include <string>
 
-#include "deflex/transport/udp_transport.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/transport/udp_transport.hpp"
 #include "links/rsi_harness.hpp"
 #include "support/allocation_guard.hpp"
 #include "wire/libxml2_reader.hpp"

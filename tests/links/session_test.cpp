@@ -11,8 +11,8 @@
 #include "support/poses.hpp"
 
 #include "deflex/cell/egm_position_controller.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/runtime/session.hpp"
+#include "deflex/text/errors.hpp"
 #include "links/link_harness.hpp"
 #include "support/allocation_guard.hpp"
 #include "support/error_of.hpp"

@@ -23,8 +23,8 @@
 namespace deflex {
 namespace {
 
-using test::SimpleMessageBench;
 using test::ScriptedSimpleMessage;
+using test::SimpleMessageBench;
 
 using test::pose_deg;
 
@@ -336,8 +336,7 @@ TEST(SimpleMessageLink, ASilentControllerStopsTheLink) {
       r = s.step();
     }
     ASSERT_EQ(r, LinkPollResult::kStopped);
-    EXPECT_NE(std::string(s.link.stop_reason()).find("no reply to point 0"), std::string::npos)
-        << s.link.stop_reason();
+    EXPECT_NE(std::string(s.link.stop_reason()).find("no reply to point 0"), std::string::npos) << s.link.stop_reason();
   }
 }
 
@@ -391,8 +390,7 @@ TEST(SimpleMessageLink, EveryKindOfBadFrameStopsTheMotionAndSaysWhy) {
          return f.bytes;
        },
        "motion connection: frame LENGTH 4"},
-      {"unknown message type on the state port", false,
-       [](bool big) { return test::hand_header(big, 2017, 1, 0); },
+      {"unknown message type on the state port", false, [](bool big) { return test::hand_header(big, 2017, 1, 0); },
        "message type 2017 is not one the link speaks"},
       {"a request on the state port", false, [&](bool big) { return test::hand_joint_position(big, q0f, 0, 2); },
        "COMM_TYPE 2, TOPIC (1) expected"},

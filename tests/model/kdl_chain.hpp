@@ -23,16 +23,16 @@ inline KDL::Chain kdl_chain_from_dh(const RobotModel& model) {
   if (*d.dh_convention == DhConvention::kStandard) {
     for (std::size_t i = 0; i < n; ++i) {
       const DhRow& r = d.dh[i];
-      chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::RotZ),
-                                    KDL::Frame::DH(r.a_m, r.alpha_rad, r.d_m, r.theta_offset_rad)));
+      chain.addSegment(
+          KDL::Segment(KDL::Joint(KDL::Joint::RotZ), KDL::Frame::DH(r.a_m, r.alpha_rad, r.d_m, r.theta_offset_rad)));
     }
   } else {
     // Craig's convention: Rx(alpha_{i-1}) Tx(a_{i-1}) before joint i, Rz(q_i) Tz(d_i) at it.
     for (std::size_t i = 0; i < n; ++i) {
       const DhRow& r = d.dh[i];
-      chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::None),
-                                    KDL::Frame(KDL::Rotation::RotX(r.alpha_rad), KDL::Vector(0, 0, 0)) *
-                                        KDL::Frame(KDL::Vector(r.a_m, 0, 0))));
+      chain.addSegment(KDL::Segment(
+          KDL::Joint(KDL::Joint::None),
+          KDL::Frame(KDL::Rotation::RotX(r.alpha_rad), KDL::Vector(0, 0, 0)) * KDL::Frame(KDL::Vector(r.a_m, 0, 0))));
       chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::RotZ),
                                     KDL::Frame(KDL::Rotation::RotZ(r.theta_offset_rad), KDL::Vector(0, 0, r.d_m))));
     }

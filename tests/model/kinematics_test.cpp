@@ -53,7 +53,8 @@ void expect_fk_and_jacobian_match_kdl(const RobotModel& model, int samples) {
     }
     for (int r = 0; r < 6; ++r) {
       for (int c = 0; c < model.dof(); ++c) {
-        EXPECT_NEAR(J(r, c), kj(static_cast<unsigned>(r), static_cast<unsigned>(c)), 1e-12) << "row " << r << " col " << c;
+        EXPECT_NEAR(J(r, c), kj(static_cast<unsigned>(r), static_cast<unsigned>(c)), 1e-12)
+            << "row " << r << " col " << c;
       }
     }
   }

@@ -226,7 +226,8 @@ TEST(OpwIk, TheFkCheckOfABranchDoesNotDependOnTheOtherWristsLimits) {
   int flipped_only = 0;
   for (int s = 0; s < 400; ++s) {
     JointVector q(6);
-    for (int j = 0; j < 6; ++j) q[j] = 0.5 * (all_lower[j] + all_upper[j]) + 0.4 * u(rng) * (all_upper[j] - all_lower[j]);
+    for (int j = 0; j < 6; ++j)
+      q[j] = 0.5 * (all_lower[j] + all_upper[j]) + 0.4 * u(rng) * (all_upper[j] - all_lower[j]);
     const Pose target = tcp_pose(m, ws, q);
     const Pose canonical = g.opw_T_base * target * g.tcp_T_end;
     OpwBranches a, b;

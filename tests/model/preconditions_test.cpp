@@ -6,9 +6,9 @@
 #include <gtest/gtest.h>
 
 #include "deflex/model/compliance.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/model/kinematics.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/text/errors.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex {
@@ -61,8 +61,9 @@ TEST(Preconditions, AWorkspaceOfAnotherRobotIsRefused) {
   const RobotModel five(d);
   Workspace ws_five(five);
   const JointVector q = JointVector::Constant(6, 0.1);
-  EXPECT_NE(test::error_of([&] { forward_kinematics(six, ws_five, q); }).find("workspace was made for a robot of 5 joints"),
-            std::string::npos);
+  EXPECT_NE(
+      test::error_of([&] { forward_kinematics(six, ws_five, q); }).find("workspace was made for a robot of 5 joints"),
+      std::string::npos);
 }
 
 }  // namespace

@@ -5,9 +5,9 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/model/kinematics.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/text/errors.hpp"
 #include "test_robots.hpp"
 
 namespace deflex {
@@ -124,13 +124,14 @@ TEST(RobotFile, JointSpeedLimitsInTheFileUnitAndUnknownWhenAbsent) {
   const RobotModel none = load_robot_yaml_text(kGood, "robot.yaml");
   EXPECT_FALSE(none.has_max_speed());
   EXPECT_TRUE(std::isinf(none.max_speed()[0]));
-  const RobotModel deg =
-      load_robot_yaml_text(replace(kGood, "min: -170, max: 170}\n    - {a: 600", "min: -170, max: 170, max_speed: 45}\n    - {a: 600"),
-                           "robot.yaml");
+  const RobotModel deg = load_robot_yaml_text(
+      replace(kGood, "min: -170, max: 170}\n    - {a: 600", "min: -170, max: 170, max_speed: 45}\n    - {a: 600"),
+      "robot.yaml");
   EXPECT_NEAR(deg.max_speed()[0], kPi / 4.0, 1e-12);  // 45 deg/s
   EXPECT_TRUE(std::isinf(deg.max_speed()[1]));
-  expect_error(replace(kGood, "min: -170, max: 170}\n    - {a: 600", "min: -170, max: 170, max_speed: -3}\n    - {a: 600"),
-               {"robot.yaml:7", "kinematics.joints[1].max_speed", "positive"});
+  expect_error(
+      replace(kGood, "min: -170, max: 170}\n    - {a: 600", "min: -170, max: 170, max_speed: -3}\n    - {a: 600"),
+      {"robot.yaml:7", "kinematics.joints[1].max_speed", "positive"});
   // Written and read back: the limit survives (robot_to_yaml writes degrees per second).
   const std::string path = write_temp("speed_roundtrip.yaml", robot_to_yaml(builtin_irb6700()));
   const RobotModel back = load_robot(path);
@@ -179,9 +180,10 @@ TEST(RobotFile, UrdfChainMatchesTheDhModel) {
     EXPECT_LT(pose_difference(tcp_pose(urdf, wu, q), tcp_pose(dh, wd, q)).norm(), 1e-12);
   }
   // The same URDF through a deflex YAML that adds the stiffness.
-  const std::string yaml_path = write_temp("irb_urdf.yaml", std::string("deflex_robot: 1\nunits: {length: m, angle: deg}\n"
-                                                                        "kinematics: {convention: urdf, file: ") +
-                                                                path + "}\njoint_stiffness_Nm_per_rad: [1, 2, 3, 4, 5, 6]\n");
+  const std::string yaml_path =
+      write_temp("irb_urdf.yaml", std::string("deflex_robot: 1\nunits: {length: m, angle: deg}\n"
+                                              "kinematics: {convention: urdf, file: ") +
+                                      path + "}\njoint_stiffness_Nm_per_rad: [1, 2, 3, 4, 5, 6]\n");
   const RobotModel with_k = load_robot(yaml_path);
   EXPECT_DOUBLE_EQ(with_k.stiffness()[2], 3.0);
   fs::remove(path);

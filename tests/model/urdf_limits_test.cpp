@@ -7,9 +7,9 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "deflex/text/errors.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/model/detail/urdf_tree.hpp"
+#include "deflex/model/robot_io.hpp"
+#include "deflex/text/errors.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex {
@@ -54,8 +54,9 @@ TEST(UrdfLimits, ADocumentNestedDeeperThanTheLimitIsRefusedWithoutRecursion) {
   EXPECT_NE(msg.find("deep.urdf:4: XML nested deeper than 100 elements"), std::string::npos) << msg;
   // Comments, CDATA and quoted '>' do not count as elements; 100 levels are fine.
   std::string ok = "<?xml version=\"1.0\"?>\n<!-- <a><b> -->\n<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/>";
-  ok += "<joint name=\"j\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/><axis xyz=\"0 0 1\"/>"
-        "<limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/></joint>";
+  ok +=
+      "<joint name=\"j\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/><axis xyz=\"0 0 1\"/>"
+      "<limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/></joint>";
   for (int i = 0; i < 98; ++i) ok += "<x note=\"a > b\">";
   ok += "<![CDATA[<y><y><y>]]>";
   for (int i = 0; i < 98; ++i) ok += "</x>";
@@ -67,28 +68,35 @@ std::string one_joint(const std::string& origin, const std::string& robot_name =
   return "<?xml version=\"1.0\"?>\n<robot name=\"" + robot_name +
          "\">\n<link name=\"a\"/>\n<link name=\"b\"/>\n"
          "<joint name=\"j1\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/>" +
-         origin + "<axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/></joint>\n</robot>\n";
+         origin +
+         "<axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/></joint>\n</robot>\n";
 }
 
 TEST(UrdfLimits, OriginsRootsAndNamesFollowTheInputRules) {
-  EXPECT_NE(error_of([] { (void)read_urdf_tree("r.urdf", one_joint("<origin xyz=\"0 0 0\" rpy=\"0 1e300 0\"/>")); })
-                .find("r.urdf:5: joint 'j1': origin rpy: 1e+300 rad is outside -63..63 rad"),
+  EXPECT_NE(error_of([] {
+              (void)read_urdf_tree("r.urdf", one_joint("<origin xyz=\"0 0 0\" rpy=\"0 1e300 0\"/>"));
+            }).find("r.urdf:5: joint 'j1': origin rpy: 1e+300 rad is outside -63..63 rad"),
             std::string::npos);
-  EXPECT_NE(error_of([] { (void)read_urdf_tree("r.urdf", one_joint("<origin xyz=\"0 1e9 0\"/>")); })
-                .find("origin xyz: 1e+09 m is outside"),
+  EXPECT_NE(error_of([] {
+              (void)read_urdf_tree("r.urdf", one_joint("<origin xyz=\"0 1e9 0\"/>"));
+            }).find("origin xyz: 1e+09 m is outside"),
             std::string::npos);
-  EXPECT_NE(error_of([] { (void)read_urdf_tree("r.urdf", one_joint("<origin xyz=\"0 nan 0\"/>")); })
-                .find("origin xyz: 'nan' is not a finite number"),
+  EXPECT_NE(error_of([] {
+              (void)read_urdf_tree("r.urdf", one_joint("<origin xyz=\"0 nan 0\"/>"));
+            }).find("origin xyz: 'nan' is not a finite number"),
             std::string::npos);
-  EXPECT_NE(error_of([] { (void)read_urdf_tree("r.urdf", one_joint("<origin xyz=\"0 0\"/>")); })
-                .find("origin xyz: '0 0' is not three numbers"),
+  EXPECT_NE(error_of([] {
+              (void)read_urdf_tree("r.urdf", one_joint("<origin xyz=\"0 0\"/>"));
+            }).find("origin xyz: '0 0' is not three numbers"),
             std::string::npos);
-  EXPECT_NE(error_of([] { (void)read_urdf_tree("r.urdf", one_joint("") + "<robot name=\"second\"/>\n"); })
-                .find("r.urdf:7: a second root element <robot>"),
+  EXPECT_NE(error_of([] {
+              (void)read_urdf_tree("r.urdf", one_joint("") + "<robot name=\"second\"/>\n");
+            }).find("r.urdf:7: a second root element <robot>"),
             std::string::npos);
   // A byte TinyXML lets through (an overlong '/'), and one it refuses itself (Latin-1 e-acute).
-  EXPECT_NE(error_of([] { (void)read_urdf_tree("r.urdf", one_joint("", "arm\xC0\xAF")); })
-                .find("r.urdf:2: robot name: byte 0xC0 at position 4 is not UTF-8"),
+  EXPECT_NE(error_of([] {
+              (void)read_urdf_tree("r.urdf", one_joint("", "arm\xC0\xAF"));
+            }).find("r.urdf:2: robot name: byte 0xC0 at position 4 is not UTF-8"),
             std::string::npos);
   EXPECT_NE(error_of([] { (void)read_urdf_tree("r.urdf", one_joint("", "arm\xE9")); }).find("not well-formed XML"),
             std::string::npos);

@@ -8,13 +8,13 @@
 
 #include "deflex/force/constant_wrench_model.hpp"
 #include "deflex/force/wrench_table_model.hpp"
-#include "deflex/text/csv_table.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/offline/detail/krl_program.hpp"
-#include "deflex/offline/program_compensation.hpp"
 #include "deflex/offline/detail/program_text.hpp"
 #include "deflex/offline/detail/rapid_program.hpp"
+#include "deflex/offline/program_compensation.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
 #include "offline/program_fixtures.hpp"
 #include "support/error_of.hpp"
 
@@ -39,8 +39,9 @@ TEST(RapidProgram, SingleUseTargetsAreEditedInPlaceAndNothingElseChanges) {
 }
 
 TEST(RapidProgram, OptionalArgumentsAnywhereTheInstructionAllowsThem) {
-  const std::string in = module(std::string("  CONST robtarget p1:=") + kP1 + ";\n",
-                                "    MoveL \\Conc, p1 \\ID:=10, v100 \\V:=500, fine \\Inpos:=inpos50, tool0 \\WObj:=wobj0;\n");
+  const std::string in =
+      module(std::string("  CONST robtarget p1:=") + kP1 + ";\n",
+             "    MoveL \\Conc, p1 \\ID:=10, v100 \\V:=500, fine \\Inpos:=inpos50, tool0 \\WObj:=wobj0;\n");
   const ProgramCompensation r = rapid(in);
   ASSERT_EQ(r.targets.size(), 1u);
   EXPECT_EQ(r.targets[0].target, "p1");
@@ -97,9 +98,8 @@ TEST(RapidProgram, ToolsAndWorkObjectsFromTheModuleOrTheCommandLine) {
   // after it is compensated; a program with nothing to compensate is an error that lists why).
   ProgramOptions s = o;
   s.tooldata = {"tSpindle=[FALSE,[[0,0,200],[1,0,0,0]],[5,[0,0,100],[1,0,0,0],0,0,0]]"};
-  const ProgramCompensation st =
-      rapid(module(std::string("  CONST robtarget p2:=") + kP1 + ";\n" + data, body + "    MoveL p2,v100,fine,tool0;\n"),
-            s);
+  const ProgramCompensation st = rapid(
+      module(std::string("  CONST robtarget p2:=") + kP1 + ";\n" + data, body + "    MoveL p2,v100,fine,tool0;\n"), s);
   EXPECT_EQ(st.targets.size(), 1u);
   ASSERT_EQ(st.unresolved.size(), 1u);
   EXPECT_NE(st.unresolved[0].reason.find("stationary"), std::string::npos);
@@ -216,8 +216,9 @@ TEST(KrlProgram, PointsToolsAndErrors) {
   EXPECT_NEAR(from_dat.targets[0].correction_m, r.targets[0].correction_m, 1e-12);  // the same tool as TOOL_DATA[1]
   // A point without Status/Turn and nothing before it to continue from: the arm's configuration
   // when the program runs decides it, so it is listed.
-  const ProgramCompensation nost = krl(
-      "DEF dxt()\n$TOOL=TOOL_DATA[1]\n$BASE=$NULLFRAME\nLIN {X 1800,Y -300,Z 600,A 20,B 75,C 15}\nPTP XP1\nEND\n", kDat, o);
+  const ProgramCompensation nost =
+      krl("DEF dxt()\n$TOOL=TOOL_DATA[1]\n$BASE=$NULLFRAME\nLIN {X 1800,Y -300,Z 600,A 20,B 75,C 15}\nPTP XP1\nEND\n",
+          kDat, o);
   ASSERT_EQ(nost.unresolved.size(), 1u);
   EXPECT_EQ(nost.unresolved[0].line, 4);
   EXPECT_NE(nost.unresolved[0].reason.find("no Status and Turn"), std::string::npos);

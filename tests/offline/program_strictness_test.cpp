@@ -10,9 +10,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
 #include "deflex/offline/program_compensation.hpp"
+#include "deflex/text/errors.hpp"
 #include "offline/program_fixtures.hpp"
 
 namespace deflex {
@@ -41,10 +41,11 @@ TEST(RapidStrictness, MalformedDeclarationsNameTheLineAndTheField) {
   expect_error(module(std::string("  CONST jointtarget j1:=[[0,10,10,0,60],") + kExt + "];\n",
                       "    MoveAbsJ j1, v100, fine, tool0;\n"),
                {"t.mod:2", "jointtarget 'j1'", "field 'robax'", "5 values"});
-  expect_error(module(std::string("  PERS tooldata tGun:=[TRUE,[[0,0,200],[1,0,0,0]],[nan,[0,0,100],[1,0,0,0],0,0,0]];\n") +
-                          robtarget("p1", kP1),
-                      "    MoveL p1, v100, fine, tGun;\n"),
-               {"t.mod:2", "tooldata 'tGun'", "field 'tload.mass'"});
+  expect_error(
+      module(std::string("  PERS tooldata tGun:=[TRUE,[[0,0,200],[1,0,0,0]],[nan,[0,0,100],[1,0,0,0],0,0,0]];\n") +
+                 robtarget("p1", kP1),
+             "    MoveL p1, v100, fine, tGun;\n"),
+      {"t.mod:2", "tooldata 'tGun'", "field 'tload.mass'"});
   // A name declared twice where the controller sees both, a value of the wrong type, an index past the end.
   expect_error(module(robtarget("p1", kP1) + robtarget("p1", kP2), kMoveP1), {"t.mod:3", "declared twice", "line 2"});
   expect_error(module("  CONST num p1:=3;\n", kMoveP1), {"t.mod:4", "'p1' is a num (line 2), not a robtarget"});
@@ -140,11 +141,13 @@ ArmConfiguration nearest_configuration(const Pose& pose, const JointVector& seed
 
 TEST(RapidConfOff, FromWhereItStandsATargetTakesTheConfigurationNearestThePreviousOne) {
   const std::string data = kHome + robtarget("pFar", kForeign);
-  const std::string strict = module(data, "    MoveAbsJ jHome, v100, fine, tool0;\n    MoveL pFar, v100, fine, tool0;\n");
+  const std::string strict =
+      module(data, "    MoveAbsJ jHome, v100, fine, tool0;\n    MoveL pFar, v100, fine, tool0;\n");
   expect_error(strict, {"t.mod:6", "MoveL pFar", "configuration_unavailable", "[-2,0,-1,1]"});
   // ConfJ governs MoveJ only: a MoveL still checks its configuration.
-  expect_error(module(data, "    MoveAbsJ jHome, v100, fine, tool0;\n    ConfJ\\Off;\n    MoveL pFar, v100, fine, tool0;\n"),
-               {"t.mod:7", "configuration_unavailable"});
+  expect_error(
+      module(data, "    MoveAbsJ jHome, v100, fine, tool0;\n    ConfJ\\Off;\n    MoveL pFar, v100, fine, tool0;\n"),
+      {"t.mod:7", "configuration_unavailable"});
   const ProgramCompensation r = rapid(
       module(data, "    MoveAbsJ jHome, v100, fine, tool0;\n    ConfL\\Off;\n    MoveL pFar, v100, fine, tool0;\n"));
   ASSERT_EQ(r.targets.size(), 2u);
@@ -160,11 +163,13 @@ TEST(RapidConfOff, FromWhereItStandsATargetTakesTheConfigurationNearestThePrevio
   const std::string conf = fmt::format("[{},{},{},{}]", c.cf1, c.cf4, c.cf6, c.cfx);
   EXPECT_NE(r.outputs[0].text.find(conf + "," + kExt + "];"), std::string::npos) << r.outputs[0].text;
   // ConfL\On restores the check from where it stands.
-  expect_error(module(data, "    MoveAbsJ jHome, v100, fine, tool0;\n    ConfL\\Off;\n    MoveL pFar, v100, fine, tool0;\n"
-                            "    ConfL\\On;\n    MoveL pFar, v100, fine, tool0;\n"),
+  expect_error(module(data,
+                      "    MoveAbsJ jHome, v100, fine, tool0;\n    ConfL\\Off;\n    MoveL pFar, v100, fine, tool0;\n"
+                      "    ConfL\\On;\n    MoveL pFar, v100, fine, tool0;\n"),
                {"t.mod:9", "configuration_unavailable"});
   // The first target has no previous one: its own confdata decides, and the note says so.
-  const ProgramCompensation first = rapid(module(robtarget("p1", kP1), "    ConfJ\\Off;\n    MoveJ p1, v100, fine, tool0;\n"));
+  const ProgramCompensation first =
+      rapid(module(robtarget("p1", kP1), "    ConfJ\\Off;\n    MoveJ p1, v100, fine, tool0;\n"));
   EXPECT_EQ(first.targets.at(0).configuration_note, "ConfJ\\Off (line 4), no earlier target: its own confdata");
 }
 
@@ -210,8 +215,7 @@ TEST(KrlStrictness, AProgramWithoutItsDataListNamesTheMissingFile) {
   std::ofstream(dir + "/p.src") << kPtpXp1;
   const RobotModel m = load_robot(std::string(DEFLEX_SOURCE_DIR) + "/examples/robots/kuka_kr210_r3100_2_flange.yaml");
   const std::string missing = error_of([&] { (void)compensate_program(m, kPush, dir + "/p.src", dir + "/out.src"); });
-  EXPECT_NE(missing.find(dir + "/p.src: its data list " + dir + "/p.dat does not exist"), std::string::npos)
-      << missing;
+  EXPECT_NE(missing.find(dir + "/p.src: its data list " + dir + "/p.dat does not exist"), std::string::npos) << missing;
   std::filesystem::create_directories(dir + "/p.dat");
   const std::string folder = error_of([&] { (void)compensate_program(m, kPush, dir + "/p.src", dir + "/out.src"); });
   EXPECT_NE(folder.find(dir + "/p.dat: is a directory"), std::string::npos) << folder;

@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/online/butterworth_filter.hpp"
+#include "deflex/text/errors.hpp"
 #include "support/allocation_guard.hpp"
 
 namespace deflex {

@@ -4,8 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/online/force_pipeline.hpp"
+#include "deflex/text/errors.hpp"
 #include "support/allocation_guard.hpp"
 
 namespace deflex {

@@ -84,8 +84,8 @@ TEST(DelayEstimator, AnArmThatHasNotStartedYetGivesNoMeasurement) {
     if (e.measured() && std::isnan(first)) first = e.last_measurement_s();
   }
   ASSERT_TRUE(e.measured());
-  EXPECT_NEAR(first, delay, 2e-3);           // the first measurement is already the delay
-  EXPECT_NEAR(e.mean_s(), delay, 1e-3);      // and no early wrong one weighs on the mean
+  EXPECT_NEAR(first, delay, 2e-3);       // the first measurement is already the delay
+  EXPECT_NEAR(e.mean_s(), delay, 1e-3);  // and no early wrong one weighs on the mean
   EXPECT_EQ(e.outliers(), 0u);
 }
 

@@ -5,11 +5,11 @@
 
 #include <gtest/gtest.h>
 
-#include "support/allocation_guard.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/online/force_handoff.hpp"
 #include "deflex/online/online_compensator.hpp"
+#include "deflex/text/errors.hpp"
+#include "support/allocation_guard.hpp"
 
 namespace deflex {
 namespace {

@@ -5,9 +5,9 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/online/online_compensator.hpp"
+#include "deflex/text/errors.hpp"
 #include "online/fd_jacobian.hpp"
 #include "support/allocation_guard.hpp"
 
@@ -85,7 +85,7 @@ TEST_F(Compensator, CorrectionMatchesTheModel) {
   w << f, Vector3::Zero();
   const JointVector expected = model_dtheta(robot, q, w);
   EXPECT_LT((out.dtheta - expected).norm(), 1e-8 * expected.norm() + 1e-12) << out.dtheta.transpose() << "\n"
-                                                                              << expected.transpose();
+                                                                            << expected.transpose();
   EXPECT_LT((out.q_command - (q - expected)).norm(), 1e-8 * expected.norm() + 1e-12);
   EXPECT_GT(expected.norm(), 1e-5);  // a real correction, not zero
   EXPECT_FALSE(out.size_limited);
@@ -222,11 +222,12 @@ TEST_F(Compensator, InvalidInputsNeverProduceACommand) {
   EXPECT_TRUE(out.q_command.allFinite());
   EXPECT_EQ(out.q_command, q);
   EXPECT_EQ(comp.counters().samples_invalid, 1u);
-  EXPECT_THROW(OnlineCompensator(robot, flange_sensor(), [] {
-                 OnlineConfig c;
-                 c.watchdog_s = -1;
-                 return c;
-               }()),
+  EXPECT_THROW(OnlineCompensator(robot, flange_sensor(),
+                                 [] {
+                                   OnlineConfig c;
+                                   c.watchdog_s = -1;
+                                   return c;
+                                 }()),
                InputError);
 }
 

@@ -10,10 +10,10 @@
 #include "deflex/force/constant_wrench_model.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/force/wrench_table_model.hpp"
-#include "deflex/text/csv_table.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
 #include "online/fd_jacobian.hpp"
 #include "support/allocation_guard.hpp"
 

@@ -6,10 +6,10 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/model/kinematics.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/online/payload_identification.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {
@@ -76,8 +76,8 @@ TEST(PayloadIdentification, CsvWithJointsUsesTheRobotAndSensorMount) {
   std::ofstream out(path);
   out.precision(17);
   out << "q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg,fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm\n";
-  const double poses_deg[6][6] = {{0, 0, 0, 0, 30, 0},   {0, 0, 0, 90, 45, 0},  {0, 10, 0, -90, 60, 90},
-                                  {0, 0, 0, 0, -60, 45}, {0, 0, 0, 45, 90, 0},  {0, 0, 10, 180, 30, -90}};
+  const double poses_deg[6][6] = {{0, 0, 0, 0, 30, 0},   {0, 0, 0, 90, 45, 0}, {0, 10, 0, -90, 60, 90},
+                                  {0, 0, 0, 0, -60, 45}, {0, 0, 0, 45, 90, 0}, {0, 0, 10, 180, 30, -90}};
   for (const auto& p : poses_deg) {
     JointVector q(6);
     for (int j = 0; j < 6; ++j) {

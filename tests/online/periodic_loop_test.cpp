@@ -4,9 +4,9 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/online/detail/periodic_loop.hpp"
+#include "deflex/text/errors.hpp"
 #include "support/allocation_guard.hpp"
 
 namespace deflex {

@@ -3,10 +3,10 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/paths/circle_path.hpp"
 #include "deflex/paths/line_path.hpp"
 #include "deflex/paths/path_spec.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {

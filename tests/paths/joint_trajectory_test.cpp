@@ -8,9 +8,9 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
+#include "deflex/text/errors.hpp"
 #include "support/allocation_guard.hpp"
 
 namespace deflex {
@@ -59,9 +59,10 @@ TEST(JointTrajectory, PassesThroughItsPointsWithVelocityTheDerivativeOfPosition)
   traj.sample(-3.0, q, &qd);
   EXPECT_EQ(q, traj.points().front());
   // A hold in the middle stays a hold (no overshoot out of it).
-  const JointTrajectory hold({0, 1, 2, 3}, {deg6(0, 20, 10, 0, 60, 0), deg6(5, 20, 10, 0, 60, 0),
-                                            deg6(5, 20, 10, 0, 60, 0), deg6(10, 20, 10, 0, 60, 0)},
-                             robot);
+  const JointTrajectory hold(
+      {0, 1, 2, 3},
+      {deg6(0, 20, 10, 0, 60, 0), deg6(5, 20, 10, 0, 60, 0), deg6(5, 20, 10, 0, 60, 0), deg6(10, 20, 10, 0, 60, 0)},
+      robot);
   for (double t = 1.0; t <= 2.0; t += 0.05) {
     hold.sample(t, q);
     EXPECT_NEAR(q[0], deg_to_rad(5.0), 1e-12) << t;
@@ -83,8 +84,7 @@ TEST(JointTrajectory, RefusesWhatTheRobotCannotFollowNamingTheLineAndJoint) {
   };
   const JointVector a = deg6(0, 20, 10, 0, 60, 0);
   EXPECT_NE(error({0, 1, 1}, {a, a, a}).find("p.csv:4: time t_s = 1 s does not increase"), std::string::npos);
-  EXPECT_NE(error({0, std::nan(""), 2}, {a, a, a}).find("p.csv:3: time t_s is not a finite number"),
-            std::string::npos);
+  EXPECT_NE(error({0, std::nan(""), 2}, {a, a, a}).find("p.csv:3: time t_s is not a finite number"), std::string::npos);
   EXPECT_NE(error({0, 1, 2}, {a, deg6(0, 20, 75, 0, 60, 0), a}).find("p.csv:3: joint 3 at 75.0000 deg is beyond"),
             std::string::npos);
   // Joint 1's limit is 100 deg/s; a 10 deg step over 0.1 s from rest would peak at 150 deg/s.
@@ -107,7 +107,8 @@ TEST(JointTrajectory, CsvRoundTripAndBadFiles) {
     EXPECT_NEAR(back.times_s()[i], traj.times_s()[i], 1e-9);
     EXPECT_LT((back.points()[i] - traj.points()[i]).cwiseAbs().maxCoeff(), 1e-11);
   }
-  std::ofstream(path) << "t_s,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg,q7_deg\n0,0,20,10,0,60,0,0\n1,0,20,10,0,60,0,0\n";
+  std::ofstream(path)
+      << "t_s,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg,q7_deg\n0,0,20,10,0,60,0,0\n1,0,20,10,0,60,0,0\n";
   EXPECT_THROW((void)JointTrajectory::read_csv(path, robot), DataError);
   std::ofstream(path) << "t_s,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg\n0,0,20,10,0,60\n";
   EXPECT_THROW((void)JointTrajectory::read_csv(path, robot), DataError);

@@ -2,11 +2,11 @@
 // path CSV reader.
 #include <gtest/gtest.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/paths/detail/pose_path_csv.hpp"
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/path_spec.hpp"
-#include "deflex/paths/detail/pose_path_csv.hpp"
+#include "deflex/text/errors.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex {
@@ -113,16 +113,17 @@ TEST(PosePathCsv, ReadsMillimetresAndQuaternions) {
 }
 
 TEST(PosePathCsv, ErrorsNameFileLineAndColumn) {
-  EXPECT_NE(error_of([] { (void)parse_pose_path_csv("x_mm,y_mm,z_mm,qw,qx,qy,qz\n1,2,3,1,0,0,0\n4,5,6,0.5,0,0,0\n",
-                                                    "bad.csv"); })
-                .find("bad.csv:3: column 'qw'"),
+  EXPECT_NE(error_of([] {
+              (void)parse_pose_path_csv("x_mm,y_mm,z_mm,qw,qx,qy,qz\n1,2,3,1,0,0,0\n4,5,6,0.5,0,0,0\n", "bad.csv");
+            }).find("bad.csv:3: column 'qw'"),
             std::string::npos);
-  EXPECT_NE(error_of([] { (void)parse_pose_path_csv("x_mm,y_mm,z_mm,qw,qx,qy,qz\n1,2,x,1,0,0,0\n", "bad.csv"); })
-                .find("bad.csv:2"),
+  EXPECT_NE(error_of([] {
+              (void)parse_pose_path_csv("x_mm,y_mm,z_mm,qw,qx,qy,qz\n1,2,x,1,0,0,0\n", "bad.csv");
+            }).find("bad.csv:2"),
             std::string::npos);
-  EXPECT_NE(error_of([] { (void)parse_pose_path_csv("x,y_mm,z_mm,qw,qx,qy,qz\n1,2,3,1,0,0,0\n", "bad.csv"); })
-                .find("x_mm"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of([] { (void)parse_pose_path_csv("x,y_mm,z_mm,qw,qx,qy,qz\n1,2,3,1,0,0,0\n", "bad.csv"); }).find("x_mm"),
+      std::string::npos);
   EXPECT_THROW((void)parse_pose_path_csv("x_mm,y_mm,z_mm,qw,qx,qy,qz\n", "empty.csv"), DataError);
   EXPECT_THROW((void)read_pose_path_csv("/nonexistent/path.csv"), Error);
 }

@@ -61,7 +61,8 @@ TEST(Figures, EveryTextAtLeast11PxAndEveryFigureWithinThePage) {
       }
       const double half = t.anchor == "middle" ? 0.25 * t.size * static_cast<double>(t.content.size()) : 0.0;
       const double left = t.anchor == "end" ? t.x - 0.5 * t.size * static_cast<double>(t.content.size()) : t.x - half;
-      const double right = t.anchor == "start" ? t.x + 0.5 * t.size * static_cast<double>(t.content.size()) : t.x + half;
+      const double right =
+          t.anchor == "start" ? t.x + 0.5 * t.size * static_cast<double>(t.content.size()) : t.x + half;
       EXPECT_GE(left, 0.0) << name << ": " << t.content;
       EXPECT_LE(right, w) << name << ": " << t.content;
     }
@@ -244,7 +245,8 @@ TEST(Parity, PointsAndBandsAtTheirCoordinates) {
   EXPECT_TRUE(found);
   // The shaded band: its corners lie on y = 0.65 x and y = 1.35 x.
   const auto polys = tags(svg, "polygon");
-  const auto band = std::find_if(polys.begin(), polys.end(), [](const auto& p) { return attribute(p, "fill") == "#dcefd8"; });
+  const auto band =
+      std::find_if(polys.begin(), polys.end(), [](const auto& p) { return attribute(p, "fill") == "#dcefd8"; });
   ASSERT_NE(band, polys.end());
   for (const auto& [px, py] : test::point_list(attribute(*band, "points"))) {
     const double ratio = log_value(py, 0.1, y01, 1.0, y1) / log_value(px, 0.1, x01, 1.0, x1);
@@ -323,8 +325,8 @@ TEST(SpeedSweep, FittedRangesWhiskersAndTheLabelOffTheData) {
   EXPECT_NEAR(std::max(number(w, "y1"), number(w, "y2")), b->y + (0.74 - *lo) * px_per_mm, 0.05);
   // "the paper's speeds" is said in the legend, above every plotted point and whisker.
   const auto ts = test::texts(svg);
-  const auto label = std::find_if(ts.begin(), ts.end(),
-                                  [](const auto& t) { return t.content.find("paper&#39;s speeds") != std::string::npos; });
+  const auto label = std::find_if(
+      ts.begin(), ts.end(), [](const auto& t) { return t.content.find("paper&#39;s speeds") != std::string::npos; });
   ASSERT_NE(label, ts.end());
   for (const auto& l : tags(svg, "line")) {
     if (attribute(l, "class") == "whisker") {
@@ -495,17 +497,17 @@ TEST(Figures, BadInputDrawsNoDataNeverNan) {
 
 TEST(HtmlReport, SaysWhatTheFiguresAreOf) {
   const std::string html = html_report(test::synthetic_report());
-  for (const char* needle : {
-           // Method: the reference, the second metric, the seeds.
-           "laps (3 clockwise and 3 anticlockwise in the protocol) averaged into one closed path",
-           "Time-synchronous error: for every tracker point", "Seeds: 3 seeds (11, 12, 13)",
-           // ISO: against the unloaded laps' mean, RT_p of the compensated laps, means over the seeds.
-           "with the mean of the unloaded laps at the same speed as the reference path",
-           "RT<sub>p</sub>: the path repeatability of the compensated run's laps",
-           // Compensation beside the paper's: online 650 N, the paper's 80%.
-           "<td>80%</td><td class=\"l\">77% / 83% / 81%</td>",
-           // Whiskers say what they are.
-           "whiskers: the range (min to max) over the seeds"}) {
+  for (const char* needle :
+       {// Method: the reference, the second metric, the seeds.
+        "laps (3 clockwise and 3 anticlockwise in the protocol) averaged into one closed path",
+        "Time-synchronous error: for every tracker point", "Seeds: 3 seeds (11, 12, 13)",
+        // ISO: against the unloaded laps' mean, RT_p of the compensated laps, means over the seeds.
+        "with the mean of the unloaded laps at the same speed as the reference path",
+        "RT<sub>p</sub>: the path repeatability of the compensated run's laps",
+        // Compensation beside the paper's: online 650 N, the paper's 80%.
+        "<td>80%</td><td class=\"l\">77% / 83% / 81%</td>",
+        // Whiskers say what they are.
+        "whiskers: the range (min to max) over the seeds"}) {
     EXPECT_NE(html.find(needle), std::string::npos) << needle;
   }
   EXPECT_EQ(html.find("Path plots"), std::string::npos);

@@ -10,8 +10,8 @@
 #include <gtest/gtest.h>
 
 #include "deflex/model/tracker_trace.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/report/html_report.hpp"
+#include "deflex/text/errors.hpp"
 #include "svg_scan.hpp"
 #include "synthetic_study.hpp"
 #include "xml_check.hpp"
@@ -186,13 +186,12 @@ TEST(HtmlReport, SelfContainedWellFormedAndComplete) {
   const ReportContent content = test::synthetic_report();
   const std::string html = html_report(content);
   EXPECT_EQ(test::xml_problem(html), "");
-  for (const char* needle : {"Table 1: offline compensation", "Table 2: online compensation",
-                             "Table 3: hybrid (beyond the paper)", "Figure 5", "ISO 9283", "Error budget",
-                             "Speed sweep", "Paths, laps and directions", "Notes",
-                             "force sensor compliance &lt;unmodelled&gt;", "Compensation per load",
-                             "Parity with the paper", "Time-synchronous error beside",
-                             "LDBB loads 125-650 N &amp; speeds", "<span class=\"paper\">(0.12)</span>",
-                             "<span class=\"paper\">(1.10)</span>"}) {
+  for (const char* needle :
+       {"Table 1: offline compensation", "Table 2: online compensation", "Table 3: hybrid (beyond the paper)",
+        "Figure 5", "ISO 9283", "Error budget", "Speed sweep", "Paths, laps and directions", "Notes",
+        "force sensor compliance &lt;unmodelled&gt;", "Compensation per load", "Parity with the paper",
+        "Time-synchronous error beside", "LDBB loads 125-650 N &amp; speeds", "<span class=\"paper\">(0.12)</span>",
+        "<span class=\"paper\">(1.10)</span>"}) {
     EXPECT_NE(html.find(needle), std::string::npos) << needle;
   }
   // Figure 5 (the paper's setups), its companion (hybrid), compensation, parity, for the one path

@@ -21,8 +21,8 @@ inline std::string xml_problem(const std::string& doc) {
         return at(i, "unterminated entity");
       }
       const std::string ent = doc.substr(i + 1, semi - i - 1);
-      const bool numeric = ent.size() > 1 && ent[0] == '#' &&
-                           ent.find_first_not_of("0123456789", 1) == std::string::npos;
+      const bool numeric =
+          ent.size() > 1 && ent[0] == '#' && ent.find_first_not_of("0123456789", 1) == std::string::npos;
       if (!numeric && ent != "amp" && ent != "lt" && ent != "gt" && ent != "quot" && ent != "apos") {
         return at(i, "unknown entity &" + ent + ";");
       }
@@ -59,7 +59,8 @@ inline std::string xml_problem(const std::string& doc) {
       ++j;
     }
     const std::size_t name_start = j;
-    while (j < doc.size() && (std::isalnum(static_cast<unsigned char>(doc[j])) != 0 || doc[j] == '-' || doc[j] == ':')) {
+    while (j < doc.size() &&
+           (std::isalnum(static_cast<unsigned char>(doc[j])) != 0 || doc[j] == '-' || doc[j] == ':')) {
       ++j;
     }
     const std::string name = doc.substr(name_start, j - name_start);
@@ -90,7 +91,8 @@ inline std::string xml_problem(const std::string& doc) {
     const bool self_closing = doc[j - 1] == '/';
     if (closing) {
       if (stack.empty() || stack.back() != name) {
-        return at(i, "</" + name + "> does not close <" + (stack.empty() ? std::string("nothing") : stack.back()) + ">");
+        return at(i,
+                  "</" + name + "> does not close <" + (stack.empty() ? std::string("nothing") : stack.back()) + ">");
       }
       stack.pop_back();
     } else if (!self_closing) {

@@ -51,8 +51,8 @@ TEST(ForceSequence, AStraySampleFarAheadDoesNotMakeTheRealOnesLate) {
 TEST(ForceSequence, ARestartedOrJumpingSenderIsFollowedAndLateSamplesAreDropped) {
   Stream f;
   for (std::uint32_t s : {500u, 501u, 502u, 502u, 501u, 503u}) f.send(s);  // a duplicate and a late one
-  for (std::uint32_t s : {3u, 4u}) f.send(s);                         // restarted from a small number
-  for (std::uint32_t s : {60000u, 60001u, 60002u, 60003u}) f.send(s);  // a jump for good: 3 to confirm
+  for (std::uint32_t s : {3u, 4u}) f.send(s);                              // restarted from a small number
+  for (std::uint32_t s : {60000u, 60001u, 60002u, 60003u}) f.send(s);      // a jump for good: 3 to confirm
   const auto got = f.taken();
   EXPECT_EQ(got, (std::vector<std::uint32_t>{500, 501, 502, 503, 3, 4, 60002, 60003}));
   EXPECT_EQ(f.source.counters().out_of_order, 2u);

@@ -10,9 +10,9 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/sensors/detail/csv_force_replay.hpp"
 #include "deflex/sensors/detail/udp_force_source.hpp"
+#include "deflex/text/errors.hpp"
 #include "support/allocation_guard.hpp"
 
 namespace deflex {
@@ -27,8 +27,7 @@ class Sender {
   }
   ~Sender() { ::close(fd_); }
   void send(const void* data, std::size_t n) {
-    ASSERT_EQ(::sendto(fd_, data, n, 0, reinterpret_cast<const sockaddr*>(&to_), sizeof(to_)),
-              static_cast<ssize_t>(n));
+    ASSERT_EQ(::sendto(fd_, data, n, 0, reinterpret_cast<const sockaddr*>(&to_), sizeof(to_)), static_cast<ssize_t>(n));
   }
 
  private:
@@ -130,7 +129,8 @@ TEST(UdpForceSource, ARestartedSenderIsAcceptedAgain) {
 
 TEST(CsvForceReplay, ReplaysByTheClockAndLoops) {
   const std::string path = ::testing::TempDir() + "/replay.csv";
-  std::ofstream(path) << "t_s,fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm\n10.0,1,0,0,0,0,0.5\n10.1,2,0,0,0,0,0\n10.2,3,0,0,0,0,0\n";
+  std::ofstream(path)
+      << "t_s,fx_N,fy_N,fz_N,mx_Nm,my_Nm,mz_Nm\n10.0,1,0,0,0,0,0.5\n10.1,2,0,0,0,0,0\n10.2,3,0,0,0,0,0\n";
   CsvForceReplay r(path, true);
   ForceSample s;
   r.advance_to(0.0);

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "cross/cli_child.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/sensors/rdt_force_source.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/wire/rdt.hpp"
 #include "sensors/rdt_test_sensor.hpp"
 #include "support/error_of.hpp"

@@ -60,9 +60,11 @@ TEST(CaseConfig, ErrorsNameTheFileLineAndField) {
   EXPECT_NE(bad_strategy.find("telepathy"), std::string::npos);
   const std::string nan = error_of(paper_with("bar_length_mm: 150", "bar_length_mm: .nan"));
   EXPECT_NE(nan.find("ldbb.bar_length_mm"), std::string::npos) << nan;
-  const std::string bad_link = error_of(paper_with("strategy: hybrid, link: egm-joint", "strategy: hybrid, link: egm-path"));
+  const std::string bad_link =
+      error_of(paper_with("strategy: hybrid, link: egm-joint", "strategy: hybrid, link: egm-path"));
   EXPECT_NE(bad_link.find("hybrid strategy streams the offline program"), std::string::npos) << bad_link;
-  const std::string offline_link = error_of(paper_with("strategy: offline, link: program", "strategy: offline, link: egm-joint"));
+  const std::string offline_link =
+      error_of(paper_with("strategy: offline, link: program", "strategy: offline, link: egm-joint"));
   EXPECT_NE(offline_link.find("setups[1].link"), std::string::npos) << offline_link;
   const std::string frame = error_of(paper_with("path_corr_frame: tool", "path_corr_frame: world"));
   EXPECT_NE(frame.find("controller.path_corr_frame"), std::string::npos) << frame;
@@ -110,8 +112,6 @@ TEST(CaseConfig, NewEffectsAreSizedInThePaperCaseAndSwitchOff) {
   EXPECT_EQ(m.cell.sensor.misalignment_rad, 0.0);
 }
 
-
-
 TEST(CaseConfig, TheTwinsFurtherEffectsAreSizedCheckedAndSwitchOff) {
   const CaseConfig c = paper_case();
   const auto& r = c.cell.robot;
@@ -158,16 +158,19 @@ TEST(CaseConfig, OutOfRangeEffectSizesAndSeedsAreRefusedByName) {
   EXPECT_NE(stiff.find("0..50 %"), std::string::npos) << stiff;
   const std::string follow = error_of(paper_with("servo_following_ms: 8", "servo_following_ms: 500"));
   EXPECT_NE(follow.find("servo_following_ms"), std::string::npos) << follow;
-  const std::string tilt = error_of(paper_with("base_tilt_compliance_nrad_per_Nm: 0.3", "base_tilt_compliance_nrad_per_Nm: -1"));
+  const std::string tilt =
+      error_of(paper_with("base_tilt_compliance_nrad_per_Nm: 0.3", "base_tilt_compliance_nrad_per_Nm: -1"));
   EXPECT_NE(tilt.find("base_tilt_compliance_nrad_per_Nm"), std::string::npos) << tilt;
   const std::string drift = error_of(paper_with("zero_drift_N_per_10min: 0.4", "zero_drift_N_per_10min: .nan"));
   EXPECT_NE(drift.find("zero_drift_N_per_10min"), std::string::npos) << drift;
   const std::string slip = error_of(paper_with("stick_slip_travel_mm: 0.5", "stick_slip_travel_mm: 0"));
   EXPECT_NE(slip.find("stick_slip_travel_mm"), std::string::npos) << slip;
-  const std::string from = error_of(paper_with("  ldbb_force_error_pct: 5", "  force_from: tracker\n  ldbb_force_error_pct: 5"));
+  const std::string from =
+      error_of(paper_with("  ldbb_force_error_pct: 5", "  force_from: tracker\n  ldbb_force_error_pct: 5"));
   EXPECT_NE(from.find("calibration.force_from"), std::string::npos) << from;
   EXPECT_NE(from.find("sensor or ldbb"), std::string::npos) << from;
-  const std::string bias = error_of(paper_with("  ldbb_force_error_pct: 5", "  ldbb_force_bias_pct: -60\n  ldbb_force_error_pct: 5"));
+  const std::string bias =
+      error_of(paper_with("  ldbb_force_error_pct: 5", "  ldbb_force_bias_pct: -60\n  ldbb_force_error_pct: 5"));
   EXPECT_NE(bias.find("calibration.ldbb_force_bias_pct"), std::string::npos) << bias;
   const std::string seeds = error_of(paper_with("seeds: 4", "seeds: 0"));
   EXPECT_NE(seeds.find("protocol.seeds"), std::string::npos) << seeds;

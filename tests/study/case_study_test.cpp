@@ -106,10 +106,10 @@ TEST(SimulatedRun, ModelConsistentCellIsCompensatedDownToTheTrackerNoise) {
     Strategy strategy;
     double allowed;  // of the floor
   };
-  for (const Way& w : {Way{false, LinkKind::kProgram, Strategy::kOffline, 1.15},
-                       Way{true, LinkKind::kEgmJoint, Strategy::kOnline, 1.3},
-                       Way{true, LinkKind::kEgmPath, Strategy::kOnline, 1.3},
-                       Way{true, LinkKind::kSimpleMessage, Strategy::kPredictive, 1.3}}) {
+  for (const Way& w :
+       {Way{false, LinkKind::kProgram, Strategy::kOffline, 1.15},
+        Way{true, LinkKind::kEgmJoint, Strategy::kOnline, 1.3}, Way{true, LinkKind::kEgmPath, Strategy::kOnline, 1.3},
+        Way{true, LinkKind::kSimpleMessage, Strategy::kPredictive, 1.3}}) {
     const SetupCell cell = build_setup_cell(c, w.sensor);
     RunSpec r = spec(RunKind::kUnloaded, w.strategy, 0.0, 1, w.link);
     r.speed_m_s = 0.02;
@@ -306,8 +306,8 @@ TEST(CellModule, IncludesNothingOfTheStrategiesOrTheirLinks) {
     std::ifstream in(entry.path());
     std::stringstream text;
     text << in.rdbuf();
-    for (const char* forbidden : {"deflex/online/", "deflex/offline/", "deflex/link/", "deflex/egm/",
-                                  "deflex/study/", "deflex/identify/"}) {
+    for (const char* forbidden :
+         {"deflex/online/", "deflex/offline/", "deflex/link/", "deflex/egm/", "deflex/study/", "deflex/identify/"}) {
       EXPECT_EQ(text.str().find(forbidden), std::string::npos) << entry.path() << " includes " << forbidden;
     }
     ++files;

@@ -137,8 +137,7 @@ TEST(StudyTables, TextTableShowsOursBesideThePapers) {
 TEST(StudyTables, MarkdownAndCsv) {
   const StudyResult s = example_study();
   const std::string md = study_tables_markdown(s);
-  EXPECT_NE(md.find("| load | UC mm | C1 10 mm/s | C2 30 mm/s | C3 50 mm/s | compensation |"), std::string::npos)
-      << md;
+  EXPECT_NE(md.find("| load | UC mm | C1 10 mm/s | C2 30 mm/s | C3 50 mm/s | compensation |"), std::string::npos) << md;
   EXPECT_NE(md.find("| 125 N | 0.121 (0.12) |"), std::string::npos) << md;
   const auto path = (std::filesystem::temp_directory_path() / "deflex_study.csv").string();
   write_study_csv(s, path);
@@ -154,7 +153,6 @@ TEST(StudyTables, MarkdownAndCsv) {
   EXPECT_EQ(lines[4].substr(0, 20), "hybrid,650,10,1,0.1,");
   std::filesystem::remove(path);
 }
-
 
 TEST(StudyTables, SpeedColumnsValueLookupAndPercentText) {
   // The given columns win, in the given order; without them every speed any load reports, ascending
@@ -238,8 +236,9 @@ TEST(StudyTables, MeansAndSpreadOverSeedsAndTheirJsonAndCsv) {
   std::string header, row;
   std::getline(in, header);
   std::getline(in, row);
-  EXPECT_EQ(header, "setup,load_N,speed_mm_s,seed,laps,residual_mm_all,uc_mm,effect,size,residual_mm_without_it,"
-                    "share_of_residual");
+  EXPECT_EQ(header,
+            "setup,load_N,speed_mm_s,seed,laps,residual_mm_all,uc_mm,effect,size,residual_mm_without_it,"
+            "share_of_residual");
   EXPECT_EQ(row, "online,650,50,7,6,0.2,1.1,lost motion,40 urad,0.15,0.25");
 }
 

@@ -13,16 +13,16 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
-#include <iostream>
-#include <map>
-#include <thread>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iostream>
+#include <map>
 #include <regex>
 #include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -49,9 +49,11 @@ CliRun run_limited(const std::string& args, int seconds, const std::string& stdo
   const std::string tag = std::to_string(::getpid()) + "_" + std::to_string(counter++);
   const auto out = dir / ("deflex_sweep_out_" + tag);
   const auto err = dir / ("deflex_sweep_err_" + tag);
-  const std::string stdout_redirect = stdout_to.empty() ? ">" + out.string() : stdout_to == "-" ? ">&-" : ">" + stdout_to;
-  const std::string cmd = "timeout -k 2 " + std::to_string(seconds) + " " + std::string(DEFLEX_CLI) + " " + args +
-                          " " + stdout_redirect + " 2>" + err.string() + " </dev/null";
+  const std::string stdout_redirect = stdout_to.empty()  ? ">" + out.string()
+                                      : stdout_to == "-" ? ">&-"
+                                                         : ">" + stdout_to;
+  const std::string cmd = "timeout -k 2 " + std::to_string(seconds) + " " + std::string(DEFLEX_CLI) + " " + args + " " +
+                          stdout_redirect + " 2>" + err.string() + " </dev/null";
   const int status = std::system(cmd.c_str());
   CliRun r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -131,10 +133,11 @@ void add_csv_cases(const CsvKind& k, std::vector<BadInput>& cases) {
   const std::string file = k.kind + ".csv";
   const std::string at_row = "{D}/" + file + ":" + std::to_string(l.first_row_line);
   const auto cell_case = [&](const std::string& tag, const std::string& value, const std::string& says) {
-    cases.push_back({k.kind + "_cell_" + tag, replace_all(k.command, "{F}", "{D}/" + file),
-                     {{file, edit_line(k.base, l.first_row_line,
-                                       [&](std::string s) { return set_cell(s, l.column, value); })}},
-                     {at_row, "'" + k.column + "'", says}});
+    cases.push_back(
+        {k.kind + "_cell_" + tag,
+         replace_all(k.command, "{F}", "{D}/" + file),
+         {{file, edit_line(k.base, l.first_row_line, [&](std::string s) { return set_cell(s, l.column, value); })}},
+         {at_row, "'" + k.column + "'", says}});
   };
   cell_case("huge", "1e308", "outside");
   cell_case("minus_huge", "-1e308", "outside");
@@ -145,19 +148,26 @@ void add_csv_cases(const CsvKind& k, std::vector<BadInput>& cases) {
   cell_case("hex", "0x10", "is not a number");
   cell_case("decimal_comma", "1;5", "is not a number");
   cell_case("empty", "", "empty cell");
-  cases.push_back({k.kind + "_extra_cell", replace_all(k.command, "{F}", "{D}/" + file),
+  cases.push_back({k.kind + "_extra_cell",
+                   replace_all(k.command, "{F}", "{D}/" + file),
                    {{file, edit_line(k.base, l.first_row_line, [](std::string s) { return s + ",7"; })}},
                    {at_row, "cells, the header has"}});
-  cases.push_back({k.kind + "_semicolons", replace_all(k.command, "{F}", "{D}/" + file),
+  cases.push_back({k.kind + "_semicolons",
+                   replace_all(k.command, "{F}", "{D}/" + file),
                    {{file, replace_all(k.base, ",", ";")}},
                    {"{D}/" + file + ":" + std::to_string(l.header_line), "commas"}});
-  cases.push_back({k.kind + "_duplicate_column", replace_all(k.command, "{F}", "{D}/" + file),
+  cases.push_back({k.kind + "_duplicate_column",
+                   replace_all(k.command, "{F}", "{D}/" + file),
                    {{file, edit_line(k.base, l.header_line,
                                      [&](std::string s) { return set_cell(s, l.column == 0 ? 1 : 0, k.column); })}},
                    {"{D}/" + file + ":" + std::to_string(l.header_line), "appears twice"}});
-  cases.push_back({k.kind + "_empty_file", replace_all(k.command, "{F}", "{D}/" + file), {{file, ""}},
+  cases.push_back({k.kind + "_empty_file",
+                   replace_all(k.command, "{F}", "{D}/" + file),
+                   {{file, ""}},
                    {"{D}/" + file, "no header row"}});
-  cases.push_back({k.kind + "_missing_file", replace_all(k.command, "{F}", "{D}/no-such-" + file), {},
+  cases.push_back({k.kind + "_missing_file",
+                   replace_all(k.command, "{F}", "{D}/no-such-" + file),
+                   {},
                    {"{D}/no-such-" + file, "does not exist"}});
   cases.push_back({k.kind + "_directory", replace_all(k.command, "{F}", "{D}"), {}, {"{D}", "directory"}});
   if (k.strict_columns) {
@@ -171,7 +181,9 @@ void add_csv_cases(const CsvKind& k, std::vector<BadInput>& cases) {
       const bool data = n > l.header_line && !line.empty() && line[0] != '#';
       text += line + (n == l.header_line ? "," + k.column + "x" : data ? ",0" : "") + "\n";
     }
-    cases.push_back({k.kind + "_unknown_column", replace_all(k.command, "{F}", "{D}/" + file), {{file, text}},
+    cases.push_back({k.kind + "_unknown_column",
+                     replace_all(k.command, "{F}", "{D}/" + file),
+                     {{file, text}},
                      {"{D}/" + file, "unknown column '" + k.column + "x'", "did you mean '" + k.column + "'"}});
   }
 }
@@ -195,14 +207,21 @@ void add_yaml_cases(const YamlKind& k, std::vector<BadInput>& cases) {
     cases.push_back({k.kind + "_" + tag, cmd, {{file, text}}, {"{D}/" + file + ":", field}});
   }
   // The first top-level key again at the end: yaml-cpp would keep the first silently.
-  const std::string first_key = k.base.substr(k.base.find("\ndeflex_") + 1, k.base.find(':', k.base.find("\ndeflex_")) - k.base.find("\ndeflex_") - 1);
-  cases.push_back({k.kind + "_duplicate_key", cmd, {{file, k.base + "\n" + first_key + ": 1\n"}},
+  const std::string first_key = k.base.substr(
+      k.base.find("\ndeflex_") + 1, k.base.find(':', k.base.find("\ndeflex_")) - k.base.find("\ndeflex_") - 1);
+  cases.push_back({k.kind + "_duplicate_key",
+                   cmd,
+                   {{file, k.base + "\n" + first_key + ": 1\n"}},
                    {"{D}/" + file + ":", "'" + first_key + "'", "given twice"}});
-  cases.push_back({k.kind + "_unknown_key", cmd, {{file, k.base + "\nnmae: x\n"}},
+  cases.push_back({k.kind + "_unknown_key",
+                   cmd,
+                   {{file, k.base + "\nnmae: x\n"}},
                    {"{D}/" + file + ":", "unknown field", "did you mean 'name'"}});
   cases.push_back({k.kind + "_syntax", cmd, {{file, k.base + "\n  - [unclosed\n"}}, {"{D}/" + file + ":", "YAML"}});
   cases.push_back({k.kind + "_empty", cmd, {{file, ""}}, {"{D}/" + file}});
-  cases.push_back({k.kind + "_missing", replace_all(k.command, "{F}", "{D}/no-such.yaml"), {},
+  cases.push_back({k.kind + "_missing",
+                   replace_all(k.command, "{F}", "{D}/no-such.yaml"),
+                   {},
                    {"{D}/no-such.yaml", "does not exist"}});
 }
 
@@ -272,11 +291,15 @@ std::vector<BadInput> file_cases() {
       }
       heavy += line + "\n";
     }
-    cases.push_back({"payload_absurd_mass", "identify-payload --data {D}/heavy.csv -o {D}/p.yaml", {{"heavy.csv", heavy}},
+    cases.push_back({"payload_absurd_mass",
+                     "identify-payload --data {D}/heavy.csv -o {D}/p.yaml",
+                     {{"heavy.csv", heavy}},
                      {"{D}/heavy.csv", "payload mass", "outside"}});
   }
   const std::string fk = "fk --robot {F} --joints-deg 0,30,10,0,50,0";
-  add_yaml_cases({"robot", read("examples/robots/kuka_kr210_r2700.yaml"), fk,
+  add_yaml_cases({"robot",
+                  read("examples/robots/kuka_kr210_r2700.yaml"),
+                  fk,
                   {{"stiffness_huge", "3.5e6,", "1e308,", "joint_stiffness_Nm_per_rad[1]"},
                    {"stiffness_tiny", "3.5e6,", "1e-3,", "joint_stiffness_Nm_per_rad[1]"},
                    {"stiffness_nan", "3.5e6,", ".nan,", "joint_stiffness_Nm_per_rad[1]"},
@@ -289,7 +312,8 @@ std::vector<BadInput> file_cases() {
                     "base_frame.quaternion_wxyz[2]"},
                    {"units_unknown", "length: m,", "length: inch,", "units.length"}}},
                  cases);
-  add_yaml_cases({"sensor", read("examples/online/sensor_3axis.yaml"),
+  add_yaml_cases({"sensor",
+                  read("examples/online/sensor_3axis.yaml"),
                   "online --link egm-path --egm-port 0 --sensor-config {F} --force-source "
                   "csv:{S}/examples/online/force_replay.csv --duration-s 0.1",
                   {{"mass_huge", "mass_kg: 8.5", "mass_kg: 2.8e305", "payload.mass_kg"},
@@ -298,22 +322,23 @@ std::vector<BadInput> file_cases() {
                    {"bias_nan", "[1.5, -0.8, 2.2]", "[1.5, .nan, 2.2]", "bias.force_N[2]"},
                    {"cog_huge", "[0, 0, 0.09]", "[0, 0, 1e308]", "payload.cog_sensor_m[3]"}}},
                  cases);
-  add_yaml_cases({"case", read("data/cases/paper.yaml"),
-                  "case-study --case {F} --quick --seeds 1 --no-sweep --no-budget --no-progress --out {D}/cs",
-                  {{"sweep_load_negative", "sweep_load_N: 650", "sweep_load_N: -650", "protocol.sweep_load_N"},
-                   {"sweep_load_huge", "sweep_load_N: 650", "sweep_load_N: 1e9", "protocol.sweep_load_N"},
-                   {"drift_offset_huge", "offset_um: 12 ", "offset_um: 1e15 ", "drift.offset_um"},
-                   {"tracker_rate_huge", "rate_Hz: 1000\n", "rate_Hz: 1e12\n", "rate_Hz"},
-                   {"servo_period_tiny", "servo_period_ms: 4", "servo_period_ms: 1e-9", "controller.servo_period_ms"},
-                   {"paper_uc_short", "paper_uc_mm: [0.12, 0.38, 0.62]", "paper_uc_mm: [0.12, 0.38]",
-                    "setups[1].paper_uc_mm"},
-                   {"points_huge", "points: 81 ", "points: 1e9 ", "circle.points"},
-                   {"lost_motion_short", "lost_motion_urad: [25, 25, 25, 40, 40, 40]",
-                    "lost_motion_urad: [25, 25, 25]", "true_robot.lost_motion_urad"},
-                   {"hardening_long", "hardening_softening: [0.5, 0.5, 0.5, 0.5, 0.5, 0.5]",
-                    "hardening_softening: [0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5]", "true_robot.hardening_softening"},
-                   {"sensor_rate_huge", "rate_Hz: 1000\n  gravity_mass", "rate_Hz: 100000\n  gravity_mass", "sensor.rate_Hz"}}},
-                 cases);
+  add_yaml_cases(
+      {"case",
+       read("data/cases/paper.yaml"),
+       "case-study --case {F} --quick --seeds 1 --no-sweep --no-budget --no-progress --out {D}/cs",
+       {{"sweep_load_negative", "sweep_load_N: 650", "sweep_load_N: -650", "protocol.sweep_load_N"},
+        {"sweep_load_huge", "sweep_load_N: 650", "sweep_load_N: 1e9", "protocol.sweep_load_N"},
+        {"drift_offset_huge", "offset_um: 12 ", "offset_um: 1e15 ", "drift.offset_um"},
+        {"tracker_rate_huge", "rate_Hz: 1000\n", "rate_Hz: 1e12\n", "rate_Hz"},
+        {"servo_period_tiny", "servo_period_ms: 4", "servo_period_ms: 1e-9", "controller.servo_period_ms"},
+        {"paper_uc_short", "paper_uc_mm: [0.12, 0.38, 0.62]", "paper_uc_mm: [0.12, 0.38]", "setups[1].paper_uc_mm"},
+        {"points_huge", "points: 81 ", "points: 1e9 ", "circle.points"},
+        {"lost_motion_short", "lost_motion_urad: [25, 25, 25, 40, 40, 40]", "lost_motion_urad: [25, 25, 25]",
+         "true_robot.lost_motion_urad"},
+        {"hardening_long", "hardening_softening: [0.5, 0.5, 0.5, 0.5, 0.5, 0.5]",
+         "hardening_softening: [0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5]", "true_robot.hardening_softening"},
+        {"sensor_rate_huge", "rate_Hz: 1000\n  gravity_mass", "rate_Hz: 100000\n  gravity_mass", "sensor.rate_Hz"}}},
+      cases);
 
   // URDF structure (the URDF reader names the line and the joint).
   const std::string urdf = read("examples/robots/ros-industrial/abb_irb6700_235_265.urdf");
@@ -326,14 +351,15 @@ std::vector<BadInput> file_cases() {
       return;
     }
     text.replace(p, from.size(), to);
-    cases.push_back({"urdf_" + tag, "fk --robot {D}/arm.urdf --joints-deg 0,30,10,0,50,0", {{"arm.urdf", text}},
+    cases.push_back({"urdf_" + tag,
+                     "fk --robot {D}/arm.urdf --joints-deg 0,30,10,0,50,0",
+                     {{"arm.urdf", text}},
                      {"{D}/arm.urdf", says}});
   };
   urdf_case("two_parents", "<child link=\"link_2\"/>", "<child link=\"link_3\"/>", "two parents");
   urdf_case("mimic_on_chain", "<joint name=\"joint_2\" type=\"revolute\">",
             "<joint name=\"joint_2\" type=\"revolute\"><mimic joint=\"joint_1\"/>", "mimic");
-  urdf_case("origin_huge", "<origin xyz=\"0 0 1.135\"", "<origin xyz=\"0 0 1e308\"",
-            "outside");
+  urdf_case("origin_huge", "<origin xyz=\"0 0 1.135\"", "<origin xyz=\"0 0 1e308\"", "outside");
   return cases;
 }
 
@@ -384,36 +410,52 @@ std::vector<BadInput> option_cases() {
     }
   }
   // Typos named with the nearest option or subcommand.
-  cases.push_back({"typo_option", "fk --jionts-deg 0,30,10,0,50,0", {}, {"'--jionts-deg'", "did you mean '--joints-deg'"}});
+  cases.push_back(
+      {"typo_option", "fk --jionts-deg 0,30,10,0,50,0", {}, {"'--jionts-deg'", "did you mean '--joints-deg'"}});
   cases.push_back({"typo_subcommand", "defelct", {}, {"'defelct'", "did you mean 'deflect'"}});
   cases.push_back({"missing_required", "fk", {}, {"--joints-deg", "required"}});
   cases.push_back({"threads_negative", "case-study --threads -1", {}, {"--threads", "0..256"}});
-  cases.push_back({"identify_without_robot", "identify --data {S}/examples/identify/kr210_synthetic_measurements.csv",
-                   {}, {"--robot", "required"}});
-  cases.push_back({"plan_without_robot", "plan-calibration --region-mm 1300,1900,-400,400,500,1100 --load-N 800 -o {D}/p.csv",
-                   {}, {"--robot", "required"}});
+  cases.push_back({"identify_without_robot",
+                   "identify --data {S}/examples/identify/kr210_synthetic_measurements.csv",
+                   {},
+                   {"--robot", "required"}});
+  cases.push_back({"plan_without_robot",
+                   "plan-calibration --region-mm 1300,1900,-400,400,500,1100 --load-N 800 -o {D}/p.csv",
+                   {},
+                   {"--robot", "required"}});
   cases.push_back({"max_rel_nan",
                    "identify --robot builtin --data {S}/examples/identify/kr210_synthetic_measurements.csv "
                    "--max-relative-std-error nan",
-                   {}, {"--max-relative-std-error"}});
+                   {},
+                   {"--max-relative-std-error"}});
   cases.push_back({"deflect_without_stiffness",
                    "deflect --robot {S}/examples/robots/ros-industrial/fanuc_m10ia.urdf --joints-deg 0,0,0,0,-90,0 "
                    "--wrench 0,0,-100,0,0,0",
-                   {}, {"no joint stiffness", "--stiffness-Nm-per-rad"}});
+                   {},
+                   {"no joint stiffness", "--stiffness-Nm-per-rad"}});
   cases.push_back({"joints_wrong_count", "fk --joints-deg 0,30,10", {}, {"--joints-deg", "expected 6"}});
   cases.push_back({"joints_decimal_comma", "fk --joints-deg '0;5,30,10,0,50,0'", {}, {"--joints-deg"}});
-  cases.push_back({"stiffness_option_huge", "deflect --joints-deg 0,30,10,0,50,0 --wrench 0,0,-1,0,0,0 "
+  cases.push_back({"stiffness_option_huge",
+                   "deflect --joints-deg 0,30,10,0,50,0 --wrench 0,0,-1,0,0,0 "
                    "--stiffness-Nm-per-rad 1e308,1e6,1e6,1e6,1e6,1e6",
-                   {}, {"--stiffness-Nm-per-rad", "outside"}});
-  cases.push_back({"force_spec_typo", "offline --circle default --force 'ldbb:phi_deg=45,forse_N=125' -o {D}/o.csv", {},
+                   {},
+                   {"--stiffness-Nm-per-rad", "outside"}});
+  cases.push_back({"force_spec_typo",
+                   "offline --circle default --force 'ldbb:phi_deg=45,forse_N=125' -o {D}/o.csv",
+                   {},
                    {"forse_N", "did you mean 'force_N'"}});
-  cases.push_back({"circle_points_huge", "offline --circle points=1000000000 --force constant:fz_N=1 -o {D}/o.csv", {},
+  cases.push_back({"circle_points_huge",
+                   "offline --circle points=1000000000 --force constant:fz_N=1 -o {D}/o.csv",
+                   {},
                    {"key 'points'", "3..1000000"}});
   cases.push_back({"line_points_huge",
                    "offline --line 'start_mm=1500;0;1000,end_mm=1600;0;1000,points=1000000000' --force constant:fz_N=1 "
                    "-o {D}/o.csv",
-                   {}, {"key 'points'", "2..100000000"}});
-  cases.push_back({"force_spec_huge", "offline --circle default --force 'constant:fz_N=1e308' -o {D}/o.csv", {},
+                   {},
+                   {"key 'points'", "2..100000000"}});
+  cases.push_back({"force_spec_huge",
+                   "offline --circle default --force 'constant:fz_N=1e308' -o {D}/o.csv",
+                   {},
                    {"fz_N", "outside"}});
   return cases;
 }
@@ -440,7 +482,8 @@ struct FileState {
 std::map<std::string, FileState> snapshot(const fs::path& dir) {
   std::map<std::string, FileState> out;
   std::error_code ec;
-  for (auto it = fs::recursive_directory_iterator(dir, ec); it != fs::recursive_directory_iterator(); it.increment(ec)) {
+  for (auto it = fs::recursive_directory_iterator(dir, ec); it != fs::recursive_directory_iterator();
+       it.increment(ec)) {
     struct stat st {};
     if (::lstat(it->path().c_str(), &st) != 0) continue;
     FileState f;
@@ -472,7 +515,9 @@ std::string changes(const std::map<std::string, FileState>& before, const std::m
       out += "deleted " + name + "; ";
     } else if (!(it->second == f)) {
       out += "changed " + name + (it->second.inode != f.inode ? " (inode)" : "") +
-             (it->second.size != f.size ? " (size " + std::to_string(f.size) + " -> " + std::to_string(it->second.size) + ")" : "") +
+             (it->second.size != f.size
+                  ? " (size " + std::to_string(f.size) + " -> " + std::to_string(it->second.size) + ")"
+                  : "") +
              "; ";
     }
   }
@@ -487,7 +532,9 @@ std::string check(const BadInput& c) {
   const fs::path dir = fs::temp_directory_path() / ("deflex_sweep_" + std::to_string(::getpid()) + "_" + c.name);
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const auto expand = [&](const std::string& s) { return replace_all(replace_all(s, "{D}", dir.string()), "{S}", kSrc); };
+  const auto expand = [&](const std::string& s) {
+    return replace_all(replace_all(s, "{D}", dir.string()), "{S}", kSrc);
+  };
   std::string problems;
   try {
     for (const auto& [name, text] : c.files) {

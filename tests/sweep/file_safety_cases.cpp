@@ -35,34 +35,69 @@ std::vector<OutputUse> output_uses() {
   const std::string measurements = source_file("examples/identify/kr210_synthetic_measurements.csv");
   const std::string module = source_file("examples/programs/deburr_housing.mod");
   const std::string offline = "offline --path {D}/path.csv --force constant:fz_N=-100 ";
-  const std::string plan = "plan-calibration --robot {D}/robot.yaml --region-mm 1300,1900,-400,400,500,1100 "
-                           "--load-N 800 --poses 3 --grid 2 ";
+  const std::string plan =
+      "plan-calibration --robot {D}/robot.yaml --region-mm 1300,1900,-400,400,500,1100 "
+      "--load-N 800 --poses 3 --grid 2 ";
   return {
-      {"offline_csv", offline + "-o {O}", "option -o", "path.csv", {{"path.csv", path}, {"bad.csv", unreachable}},
+      {"offline_csv",
+       offline + "-o {O}",
+       "option -o",
+       "path.csv",
+       {{"path.csv", path}, {"bad.csv", unreachable}},
        replace_all(offline, "path.csv", "bad.csv") + "-o {O}"},
-      {"offline_rapid", offline + "--rapid {O}", "option --rapid", "path.csv", {{"path.csv", path}, {"bad.csv", unreachable}},
-       replace_all(offline, "path.csv", "bad.csv") + "--rapid {O}", "mod"},
-      {"offline_trajectory", offline + "--joint-trajectory {O}", "option --joint-trajectory", "path.csv",
-       {{"path.csv", path}, {"bad.csv", unreachable}}, replace_all(offline, "path.csv", "bad.csv") + "--joint-trajectory {O}"},
-      {"offline_nominal", offline + "--nominal-trajectory {O}", "option --nominal-trajectory", "path.csv",
+      {"offline_rapid",
+       offline + "--rapid {O}",
+       "option --rapid",
+       "path.csv",
+       {{"path.csv", path}, {"bad.csv", unreachable}},
+       replace_all(offline, "path.csv", "bad.csv") + "--rapid {O}",
+       "mod"},
+      {"offline_trajectory",
+       offline + "--joint-trajectory {O}",
+       "option --joint-trajectory",
+       "path.csv",
+       {{"path.csv", path}, {"bad.csv", unreachable}},
+       replace_all(offline, "path.csv", "bad.csv") + "--joint-trajectory {O}"},
+      {"offline_nominal",
+       offline + "--nominal-trajectory {O}",
+       "option --nominal-trajectory",
+       "path.csv",
        {{"path.csv", path}, {"bad.csv", unreachable}},
        replace_all(offline, "path.csv", "bad.csv") + "--nominal-trajectory {O}"},
-      {"program_out", "offline --program-in {D}/in.mod --force tool:fz_N=-150 --program-out {O}",
-       "option --program-out", "in.mod",
+      {"program_out",
+       "offline --program-in {D}/in.mod --force tool:fz_N=-150 --program-out {O}",
+       "option --program-out",
+       "in.mod",
        {{"in.mod", module}, {"bad.mod", with(module, "MoveL Target_20,", "MoveL Target_20\\Speed:=3,")}},
-       "offline --program-in {D}/bad.mod --force tool:fz_N=-150 --program-out {O}", "mod"},
-      {"write_robot", "identify --robot {D}/robot.yaml --data {D}/m.csv --write-robot {O}", "option --write-robot",
-       "m.csv", {{"robot.yaml", robot}, {"m.csv", measurements}, {"bad.csv", with(measurements, "\n", "\n#\n") + "1,2\n"}},
-       "identify --robot {D}/robot.yaml --data {D}/bad.csv --write-robot {O}", "yaml"},
-      {"plan", plan + "-o {O}", "option -o", "robot.yaml", {{"robot.yaml", robot}},
+       "offline --program-in {D}/bad.mod --force tool:fz_N=-150 --program-out {O}",
+       "mod"},
+      {"write_robot",
+       "identify --robot {D}/robot.yaml --data {D}/m.csv --write-robot {O}",
+       "option --write-robot",
+       "m.csv",
+       {{"robot.yaml", robot}, {"m.csv", measurements}, {"bad.csv", with(measurements, "\n", "\n#\n") + "1,2\n"}},
+       "identify --robot {D}/robot.yaml --data {D}/bad.csv --write-robot {O}",
+       "yaml"},
+      {"plan",
+       plan + "-o {O}",
+       "option -o",
+       "robot.yaml",
+       {{"robot.yaml", robot}},
        replace_all(plan, "--load-N 800", "--load-N 800 --quaternion-wxyz 2,0,0,0") + "-o {O}"},
-      {"plan_synthetic", plan + "-o {D}/plan.csv --synthetic-measurements {O}", "option --synthetic-measurements",
-       "robot.yaml", {{"robot.yaml", robot}},
+      {"plan_synthetic",
+       plan + "-o {D}/plan.csv --synthetic-measurements {O}",
+       "option --synthetic-measurements",
+       "robot.yaml",
+       {{"robot.yaml", robot}},
        replace_all(plan, "--load-N 800", "--load-N 800 --quaternion-wxyz 2,0,0,0") +
            "-o {D}/plan.csv --synthetic-measurements {O}"},
-      {"payload", "identify-payload --data {D}/pl.csv -o {O}", "option -o", "pl.csv",
+      {"payload",
+       "identify-payload --data {D}/pl.csv -o {O}",
+       "option -o",
+       "pl.csv",
        {{"pl.csv", source_file("examples/online/payload_poses.csv")}},
-       "identify-payload --data {D}/pl.csv --sensor-config {D}/none.yaml -o {O}", "yaml"},
+       "identify-payload --data {D}/pl.csv --sensor-config {D}/none.yaml -o {O}",
+       "yaml"},
   };
 }
 
@@ -71,32 +106,49 @@ void add_output_cases(const OutputUse& u, std::vector<BadInput>& cases) {
   const std::string name = "out_" + u.tag + "_";
   const std::string o = "out." + u.extension;
   cases.push_back({name + "same_file", cmd("{D}/" + u.input), u.files, {"{D}/" + u.input, "the same file"}});
-  cases.push_back({name + "hard_link", cmd("{D}/hard." + u.extension), u.files, {"the same file"}, 2,
+  cases.push_back({name + "hard_link",
+                   cmd("{D}/hard." + u.extension),
+                   u.files,
+                   {"the same file"},
+                   2,
                    [input = u.input, ext = u.extension](const fs::path& d) {
                      fs::create_hard_link(d / input, d / ("hard." + ext));
                    }});
-  cases.push_back({name + "link_to_input", cmd("{D}/" + o), u.files, {"the same file"}, 2,
-                   [input = u.input, o](const fs::path& d) { fs::create_symlink(input, d / o); }});
-  cases.push_back({name + "missing_folder", cmd("{D}/nodir/" + o), u.files, {u.option, "the folder", "does not exist"}});
-  cases.push_back({name + "folder", cmd("{D}/sub"), u.files, {u.option, "is a directory"}, 2,
-                   [](const fs::path& d) { fs::create_directories(d / "sub"); }});
-  cases.push_back({name + "dangling_link", cmd("{D}/" + o), u.files, {u.option, "symbolic link to nothing"}, 2,
+  cases.push_back(
+      {name + "link_to_input", cmd("{D}/" + o), u.files, {"the same file"}, 2, [input = u.input, o](const fs::path& d) {
+         fs::create_symlink(input, d / o);
+       }});
+  cases.push_back(
+      {name + "missing_folder", cmd("{D}/nodir/" + o), u.files, {u.option, "the folder", "does not exist"}});
+  cases.push_back({name + "folder", cmd("{D}/sub"), u.files, {u.option, "is a directory"}, 2, [](const fs::path& d) {
+                     fs::create_directories(d / "sub");
+                   }});
+  cases.push_back({name + "dangling_link",
+                   cmd("{D}/" + o),
+                   u.files,
+                   {u.option, "symbolic link to nothing"},
+                   2,
                    [o](const fs::path& d) { fs::create_symlink("nowhere", d / o); }});
-  cases.push_back({name + "fifo_no_reader", cmd("{D}/pipe"), u.files, {u.option, "no process reads"}, 2,
-                   [](const fs::path& d) { ::mkfifo((d / "pipe").c_str(), 0600); }});
+  cases.push_back(
+      {name + "fifo_no_reader", cmd("{D}/pipe"), u.files, {u.option, "no process reads"}, 2, [](const fs::path& d) {
+         ::mkfifo((d / "pipe").c_str(), 0600);
+       }});
   // /dev/full takes no byte: the job failed (exit 1), the device stays (checked at the sweep's end).
   if (u.tag != "program_out") {
     cases.push_back({name + "dev_full", cmd("/dev/full"), u.files, {"'/dev/full'", "No space left on device"}, 1});
   }
   if (!u.failing.empty()) {
     // The case: the output a link to a user's file, the run failing: link and file untouched.
-    cases.push_back({name + "link_kept_on_failure", replace_all(u.failing, "{O}", "{D}/" + o),
+    cases.push_back({name + "link_kept_on_failure",
+                     replace_all(u.failing, "{O}", "{D}/" + o),
                      [&] {
                        auto f = u.files;
                        f.emplace_back("user_file.txt", "a user's file, not deflex's\n");
                        return f;
                      }(),
-                     {}, 2, [o](const fs::path& d) { fs::create_symlink("user_file.txt", d / o); }});
+                     {},
+                     2,
+                     [o](const fs::path& d) { fs::create_symlink("user_file.txt", d / o); }});
   }
 }
 
@@ -109,11 +161,17 @@ std::vector<BadInput> output_cases() {
   }
   const std::string offline = "offline --circle default --force constant:fz_N=-100 ";
   cases.push_back({"out_two_outputs_one_file", offline + "-o {D}/o.csv --rapid {D}/o.csv", {}, {"are the same file"}});
-  cases.push_back({"out_two_outputs_through_a_link", offline + "-o {D}/o.csv --joint-trajectory {D}/sub/../o.csv", {},
-                   {"are the same file"}, 2, [](const fs::path& d) { fs::create_directories(d / "sub"); }});
-  cases.push_back({"out_two_loads_two_outputs_one_name", "offline --circle default --force 'constant:fz_N=-100' "
-                                                             "--force 'constant:fz_N=-200' -o {D}/o.mod --rapid {D}/o.mod",
-                   {}, {"are the same file"}});
+  cases.push_back({"out_two_outputs_through_a_link",
+                   offline + "-o {D}/o.csv --joint-trajectory {D}/sub/../o.csv",
+                   {},
+                   {"are the same file"},
+                   2,
+                   [](const fs::path& d) { fs::create_directories(d / "sub"); }});
+  cases.push_back({"out_two_loads_two_outputs_one_name",
+                   "offline --circle default --force 'constant:fz_N=-100' "
+                   "--force 'constant:fz_N=-200' -o {D}/o.mod --rapid {D}/o.mod",
+                   {},
+                   {"are the same file"}});
   cases.push_back({"out_krl_dat_is_the_input_dat",
                    "offline --robot {S}/examples/robots/kuka_kr210_r3100_2_flange.yaml --program-in {D}/p.src "
                    "--force tool:fx_N=-150 --tooldata 'TOOL_DATA[1]={X 250,Y 0,Z 0,A 0,B 0,C 0}' --tooldata "
@@ -121,29 +179,43 @@ std::vector<BadInput> output_cases() {
                    "0,C 0}' --program-out {D}/q.src",
                    {{"p.src", source_file("examples/programs/deburr_bracket.src")},
                     {"p.dat", source_file("examples/programs/deburr_bracket.dat")}},
-                   {"the same file"}, 2, [](const fs::path& d) { fs::create_hard_link(d / "p.dat", d / "q.dat"); }});
+                   {"the same file"},
+                   2,
+                   [](const fs::path& d) { fs::create_hard_link(d / "p.dat", d / "q.dat"); }});
   // One output that cannot be written must stop the others too: the o.csv was left behind.
   const std::string square = "offline --path {S}/examples/offline/square_path.csv --force constant:fz_N=-100 ";
-  cases.push_back({"out_all_or_none_rapid_in_missing_folder", square + "-o {D}/o.csv --rapid {D}/nodir/o.mod", {},
+  cases.push_back({"out_all_or_none_rapid_in_missing_folder",
+                   square + "-o {D}/o.csv --rapid {D}/nodir/o.mod",
+                   {},
                    {"option --rapid", "does not exist"}});
   cases.push_back({"out_all_or_none_trajectory_in_missing_folder",
-                   square + "-o {D}/o.csv --joint-trajectory {D}/nodir/t.csv", {}, {"option --joint-trajectory"}});
-  cases.push_back({"out_all_or_none_rapid_to_dev_full", square + "-o {D}/o.csv --rapid /dev/full", {},
-                   {"'/dev/full'", "No space left on device"}, 1});
+                   square + "-o {D}/o.csv --joint-trajectory {D}/nodir/t.csv",
+                   {},
+                   {"option --joint-trajectory"}});
+  cases.push_back({"out_all_or_none_rapid_to_dev_full",
+                   square + "-o {D}/o.csv --rapid /dev/full",
+                   {},
+                   {"'/dev/full'", "No space left on device"},
+                   1});
   cases.push_back({"out_all_or_none_synthetic_in_missing_folder",
                    "plan-calibration --robot builtin --region-mm 1300,1900,-400,400,500,1100 --load-N 800 --poses 3 "
                    "--grid 2 -o {D}/p.csv --synthetic-measurements {D}/nodir/s.csv",
-                   {}, {"option --synthetic-measurements", "does not exist"}});
+                   {},
+                   {"option --synthetic-measurements", "does not exist"}});
   cases.push_back({"out_all_or_none_krl_dat_unwritable",
                    "offline --robot {S}/examples/robots/kuka_kr210_r3100_2_flange.yaml --program-in "
                    "{S}/examples/programs/deburr_bracket.src --force tool:fx_N=-150 --tooldata 'TOOL_DATA[1]={X 250,Y "
                    "0,Z 0,A 0,B 0,C 0}' --tooldata 'TOOL_DATA[2]={X 320,Y 0,Z 40,A 0,B -10,C 0}' --wobjdata "
                    "'BASE_DATA[1]={X 1800,Y -300,Z 500,A 0,B 0,C 0}' --program-out {D}/out.src",
-                   {}, {"{D}/out.dat", "is a directory"}, 2,
+                   {},
+                   {"{D}/out.dat", "is a directory"},
+                   2,
                    [](const fs::path& d) { fs::create_directories(d / "out.dat"); }});
-  cases.push_back({"out_case_study_out_is_a_file", "case-study --quick --seeds 1 --no-sweep --no-budget --no-progress "
-                                                   "--out {D}/report.txt",
-                   {{"report.txt", "a user's file\n"}}, {"option --out", "cannot create the folder"}});
+  cases.push_back({"out_case_study_out_is_a_file",
+                   "case-study --quick --seeds 1 --no-sweep --no-budget --no-progress "
+                   "--out {D}/report.txt",
+                   {{"report.txt", "a user's file\n"}},
+                   {"option --out", "cannot create the folder"}});
   // stdout that cannot be written: the job failed, said on stderr.
   for (const auto& [tag, args] : std::vector<std::pair<std::string, std::string>>{
            {"fk", "fk --joints-deg 0,30,10,0,50,0"},
@@ -152,7 +224,8 @@ std::vector<BadInput> output_cases() {
            {"robot", "robot"},
            {"offline_summary", offline + "--json"}}) {
     cases.push_back({"stdout_closed_" + tag, args, {}, {"writing to stdout failed"}, 1, {}, "-"});
-    cases.push_back({"stdout_full_" + tag, args, {}, {"writing to stdout failed", "No space left"}, 1, {}, "/dev/full"});
+    cases.push_back(
+        {"stdout_full_" + tag, args, {}, {"writing to stdout failed", "No space left"}, 1, {}, "/dev/full"});
   }
   cases.push_back({"stdout_closed_as_output", offline + "-o /dev/stdout", {}, {"stdout is closed"}, 2, {}, "-"});
   return cases;
@@ -184,8 +257,9 @@ std::vector<BadInput> input_file_cases() {
            "--synthetic-measurements {D}/s.csv --synthetic-robot {I}",
        "t.yaml", 16 * mib + 1},
       {"payload_data", "identify-payload --data {I} -o {D}/p.yaml", "pl.csv", 1024 * mib + 1},
-      {"payload_sensor", "identify-payload --data {S}/examples/online/payload_poses.csv --sensor-config {I} -o {D}/p.yaml",
-       "s.yaml", 16 * mib + 1},
+      {"payload_sensor",
+       "identify-payload --data {S}/examples/online/payload_poses.csv --sensor-config {I} -o {D}/p.yaml", "s.yaml",
+       16 * mib + 1},
       {"evaluate_unloaded", "evaluate --unloaded {I} --loaded {S}/examples/evaluate/loaded_uc.csv", "u.csv",
        1024 * mib + 1},
       {"evaluate_commanded",
@@ -199,28 +273,48 @@ std::vector<BadInput> input_file_cases() {
   for (const InputUse& u : uses) {
     const auto cmd = [&](const std::string& in) { return replace_all(u.command, "{I}", in); };
     const std::string file = u.name;
-    cases.push_back({"in_" + u.tag + "_fifo", cmd("{D}/" + file), {}, {"{D}/" + file, "is a FIFO"}, 2,
-                     [file](const fs::path& d) { ::mkfifo((d / file).c_str(), 0600); }});
-    cases.push_back({"in_" + u.tag + "_dev_zero", cmd("{D}/" + file), {}, {"{D}/" + file, "is a character device"}, 2,
+    cases.push_back(
+        {"in_" + u.tag + "_fifo", cmd("{D}/" + file), {}, {"{D}/" + file, "is a FIFO"}, 2, [file](const fs::path& d) {
+           ::mkfifo((d / file).c_str(), 0600);
+         }});
+    cases.push_back({"in_" + u.tag + "_dev_zero",
+                     cmd("{D}/" + file),
+                     {},
+                     {"{D}/" + file, "is a character device"},
+                     2,
                      [file](const fs::path& d) { fs::create_symlink("/dev/zero", d / file); }});
-    cases.push_back({"in_" + u.tag + "_folder", cmd("{D}/" + file), {}, {"{D}/" + file, "is a directory"}, 2,
+    cases.push_back({"in_" + u.tag + "_folder",
+                     cmd("{D}/" + file),
+                     {},
+                     {"{D}/" + file, "is a directory"},
+                     2,
                      [file](const fs::path& d) { fs::create_directories(d / file); }});
     // A sparse file one byte over the limit: refused from its size before a byte is read.
-    cases.push_back({"in_" + u.tag + "_oversize", cmd("{D}/" + file), {},
-                     {"{D}/" + file, std::to_string(u.over) + " bytes; deflex reads"}, 2,
+    cases.push_back({"in_" + u.tag + "_oversize",
+                     cmd("{D}/" + file),
+                     {},
+                     {"{D}/" + file, std::to_string(u.over) + " bytes; deflex reads"},
+                     2,
                      [file, size = u.over](const fs::path& d) {
                        std::ofstream(d / file).close();
                        fs::resize_file(d / file, size);
                      }});
   }
   // The URDF a robot YAML names, and the .dat beside a KRL program, are inputs too.
-  cases.push_back({"in_urdf_named_by_yaml_fifo", "fk --robot {D}/r.yaml --joints-deg 0,30,10,0,50,0",
-                   {{"r.yaml", "deflex_robot: 1\nunits: {length: m, angle: deg}\nkinematics: {convention: urdf, file: "
-                               "arm.urdf}\n"}},
-                   {"{D}/arm.urdf", "is a FIFO"}, 2, [](const fs::path& d) { ::mkfifo((d / "arm.urdf").c_str(), 0600); }});
-  cases.push_back({"in_krl_dat_fifo", "offline --program-in {D}/p.src --force tool:fz_N=-1 --program-out {D}/o.src",
+  cases.push_back({"in_urdf_named_by_yaml_fifo",
+                   "fk --robot {D}/r.yaml --joints-deg 0,30,10,0,50,0",
+                   {{"r.yaml",
+                     "deflex_robot: 1\nunits: {length: m, angle: deg}\nkinematics: {convention: urdf, file: "
+                     "arm.urdf}\n"}},
+                   {"{D}/arm.urdf", "is a FIFO"},
+                   2,
+                   [](const fs::path& d) { ::mkfifo((d / "arm.urdf").c_str(), 0600); }});
+  cases.push_back({"in_krl_dat_fifo",
+                   "offline --program-in {D}/p.src --force tool:fz_N=-1 --program-out {D}/o.src",
                    {{"p.src", source_file("examples/programs/deburr_bracket.src")}},
-                   {"{D}/p.dat", "is a FIFO"}, 2, [](const fs::path& d) { ::mkfifo((d / "p.dat").c_str(), 0600); }});
+                   {"{D}/p.dat", "is a FIFO"},
+                   2,
+                   [](const fs::path& d) { ::mkfifo((d / "p.dat").c_str(), 0600); }});
   return cases;
 }
 

@@ -16,9 +16,9 @@ namespace deflex::test {
 
 struct BadInput {
   std::string name = {};
-  std::string args = {};                                         ///< {D}: scratch directory, {S}: source tree
+  std::string args = {};                                        ///< {D}: scratch directory, {S}: source tree
   std::vector<std::pair<std::string, std::string>> files = {};  ///< written into {D} first
-  std::vector<std::string> expect = {};                          ///< each must appear in stderr
+  std::vector<std::string> expect = {};                         ///< each must appear in stderr
   int exit_code = 2;
   std::function<void(const std::filesystem::path& dir)> setup = {};  ///< FIFOs, links, sparse files
   std::string stdout_to = {};  ///< "": captured; "-": closed (>&-); else a file such as /dev/full

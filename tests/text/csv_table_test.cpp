@@ -19,9 +19,7 @@ std::string temp_path(const std::string& name) {
   return (std::filesystem::temp_directory_path() / ("deflex_csv_" + name)).string();
 }
 
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
-}
+void write_text(const std::string& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
 
 std::string message_of(const std::string& text) {
   try {

@@ -41,8 +41,8 @@ struct Checker {
     if (want != got && ++failures <= 10) {
       std::uint64_t bits = 0;
       std::memcpy(&bits, &v, sizeof bits);
-      ADD_FAILURE() << "bits 0x" << std::hex << bits << ": std::to_chars gives '" << want << "', format_g10 '"
-                    << got << "'";
+      ADD_FAILURE() << "bits 0x" << std::hex << bits << ": std::to_chars gives '" << want << "', format_g10 '" << got
+                    << "'";
     }
   }
 };
@@ -59,8 +59,8 @@ TEST(FormatG10, SpecialValues) {
   Checker check;
   for (double v : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
                    -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::max(),
-                   std::numeric_limits<double>::min(), std::numeric_limits<double>::denorm_min(), 1e-13, 1e10,
-                   -1e10, 9.9999999995e9, 1e-4, 9.99999999995e-5, 0.0001, 1e9, 123456789012.0}) {
+                   std::numeric_limits<double>::min(), std::numeric_limits<double>::denorm_min(), 1e-13, 1e10, -1e10,
+                   9.9999999995e9, 1e-4, 9.99999999995e-5, 0.0001, 1e9, 123456789012.0}) {
     check(v);
   }
   EXPECT_EQ(check.failures, 0);

@@ -105,7 +105,10 @@ TEST(CsvInput, SeparatorsRangesAndUnknownColumnsAreNamed) {
 TEST(YamlInput, RepeatedKeysAreRefusedWithTheirLine) {
   const std::string msg = error_of([] { (void)yaml::Field::load_string("a: 1\nb:\n  c: 2\n  c: 3\n", "f.yaml"); });
   EXPECT_NE(msg.find("f.yaml:4:3: field 'b.c': key given twice (first at line 3)"), std::string::npos) << msg;
-  EXPECT_NO_THROW((void)yaml::Field::load_string("\xEF\xBB\xBF" "a: 1\n", "bom.yaml"));
+  EXPECT_NO_THROW(
+      (void)yaml::Field::load_string("\xEF\xBB\xBF"
+                                     "a: 1\n",
+                                     "bom.yaml"));
 }
 
 TEST(YamlInput, OneDocumentPlainKeysAndUtf8Text) {
@@ -124,11 +127,11 @@ TEST(YamlInput, OneDocumentPlainKeysAndUtf8Text) {
 
 TEST(Utf8Text, ValidSequencesOnly) {
   EXPECT_FALSE(invalid_utf8_at("ascii, \xC3\xA9, \xE2\x82\xAC, \xF0\x9F\x98\x80"));
-  EXPECT_EQ(invalid_utf8_at("a\xC3"), 1u);              // cut short
-  EXPECT_EQ(invalid_utf8_at("\xC0\xAF"), 0u);           // overlong '/'
-  EXPECT_EQ(invalid_utf8_at("ab\xED\xA0\x80"), 2u);     // a surrogate
-  EXPECT_EQ(invalid_utf8_at("\xF4\x90\x80\x80"), 0u);   // past U+10FFFF
-  EXPECT_EQ(invalid_utf8_at("x\x80"), 1u);              // a continuation byte alone
+  EXPECT_EQ(invalid_utf8_at("a\xC3"), 1u);             // cut short
+  EXPECT_EQ(invalid_utf8_at("\xC0\xAF"), 0u);          // overlong '/'
+  EXPECT_EQ(invalid_utf8_at("ab\xED\xA0\x80"), 2u);    // a surrogate
+  EXPECT_EQ(invalid_utf8_at("\xF4\x90\x80\x80"), 0u);  // past U+10FFFF
+  EXPECT_EQ(invalid_utf8_at("x\x80"), 1u);             // a continuation byte alone
 }
 
 TEST(YamlInput, KeysWithUnitsAreRangeChecked) {

@@ -12,8 +12,8 @@
 #include <csignal>
 
 #include <fcntl.h>
-#include <sys/wait.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -96,8 +96,9 @@ TEST(InputFile, RefusesFifosDevicesAndFoldersWithoutBlocking) {
   // A missing file, and a missing folder on its way, are said as such.
   EXPECT_NE(error_of([&] { (void)read_input_file(s.at("none.csv"), InputKind::kCsvTable); }).find("does not exist"),
             std::string::npos);
-  EXPECT_NE(error_of([&] { (void)read_input_file(s.at("no-folder/none.csv"), InputKind::kCsvTable); })
-                .find("does not exist: there is no folder"),
+  EXPECT_NE(error_of([&] {
+              (void)read_input_file(s.at("no-folder/none.csv"), InputKind::kCsvTable);
+            }).find("does not exist: there is no folder"),
             std::string::npos);
 }
 
@@ -244,8 +245,8 @@ TEST(OutputTransaction, AllOrNoneWhenARenameFails) {
   }
   EXPECT_NE(msg.find("'" + s.at("b.csv") + "'"), std::string::npos) << msg;
   EXPECT_NE(msg.find("no output of this command was put in place"), std::string::npos) << msg;
-  EXPECT_EQ(slurp(s.at("a.csv")), "old a\n");        // put back
-  EXPECT_EQ(inode_of(s.at("a.csv")), a_inode);       // the very file it was
+  EXPECT_EQ(slurp(s.at("a.csv")), "old a\n");                       // put back
+  EXPECT_EQ(inode_of(s.at("a.csv")), a_inode);                      // the very file it was
   EXPECT_EQ(s.names(), (std::set<std::string>{"a.csv", "b.csv"}));  // no c.csv, no temporary or kept file
 }
 

@@ -44,7 +44,8 @@ TEST(EgmCodecDiagnostics, AMissingRequiredFieldIsCountedSilently) {
   const Bytes p = robot(5, false);  // EgmCartesian without its required y and z
   const std::uint64_t before = egm_protobuf_log_messages();
   testing::internal::CaptureStderr();
-  for (int k = 0; k < 1000; ++k) EXPECT_EQ(codec.decode_robot(p.data(), p.size(), m), EgmDecodeStatus::kMissingRequired);
+  for (int k = 0; k < 1000; ++k)
+    EXPECT_EQ(codec.decode_robot(p.data(), p.size(), m), EgmDecodeStatus::kMissingRequired);
   const std::string printed = testing::internal::GetCapturedStderr();
   EXPECT_EQ(printed, "");
   EXPECT_EQ(egm_protobuf_log_messages(), before);  // nothing was even attempted to be printed

@@ -249,10 +249,9 @@ TEST(EgmCodec, PathCorrectionAgainstTheHandWrittenWireFormat) {
   EXPECT_EQ(codec.encode_path_corr(out, buf, sizeof(buf)), 0u);
 }
 
-
 TEST(EgmCodec, TimeStampWrapsLikeTheUint32Field) {
   EXPECT_EQ(egm_time_stamp_ms(0.0), 0u);
-  EXPECT_EQ(egm_time_stamp_ms(1.2345), 1234u);  // whole milliseconds, truncated
+  EXPECT_EQ(egm_time_stamp_ms(1.2345), 1234u);             // whole milliseconds, truncated
   EXPECT_EQ(egm_time_stamp_ms(4294967.295), 4294967295u);  // the largest value before the wrap
   // 2^32 ms = 4294967.296 s: the field wraps to 0 and counts on (49.7 days of uptime).
   EXPECT_EQ(egm_time_stamp_ms(4294967.296 + 10.0), 10000u);

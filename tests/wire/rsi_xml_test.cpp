@@ -14,8 +14,8 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/wire/rsi_xml.hpp"
 #include "deflex/wire/detail/xml_scanner.hpp"
+#include "deflex/wire/rsi_xml.hpp"
 #include "support/allocation_guard.hpp"
 #include "wire/libxml2_reader.hpp"
 
@@ -115,12 +115,24 @@ struct Generator {
     const double v = std::uniform_real_distribution<double>(-180.0, 180.0)(rng);
     char buf[64];
     switch (pick(6)) {
-      case 0: std::snprintf(buf, sizeof(buf), "%.4f", v); break;
-      case 1: std::snprintf(buf, sizeof(buf), "%.17g", v); break;
-      case 2: std::snprintf(buf, sizeof(buf), "%e", v); break;
-      case 3: std::snprintf(buf, sizeof(buf), "%d", static_cast<int>(v)); break;
-      case 4: std::snprintf(buf, sizeof(buf), "+%.3f", std::abs(v)); break;
-      default: std::snprintf(buf, sizeof(buf), "%.6E", v * 1e-3); break;
+      case 0:
+        std::snprintf(buf, sizeof(buf), "%.4f", v);
+        break;
+      case 1:
+        std::snprintf(buf, sizeof(buf), "%.17g", v);
+        break;
+      case 2:
+        std::snprintf(buf, sizeof(buf), "%e", v);
+        break;
+      case 3:
+        std::snprintf(buf, sizeof(buf), "%d", static_cast<int>(v));
+        break;
+      case 4:
+        std::snprintf(buf, sizeof(buf), "+%.3f", std::abs(v));
+        break;
+      default:
+        std::snprintf(buf, sizeof(buf), "%.6E", v * 1e-3);
+        break;
     }
     return buf;
   }
@@ -247,7 +259,8 @@ TEST(RsiXml, EveryTruncationAndManyMutationsAreRefusedWheneverLibxml2RefusesThem
   std::mt19937 rng(11);
   for (int d = 0; d < 12; ++d) {
     const std::string doc = g.rob();
-    for (std::size_t n = 0; n < doc.size(); ++n) expect_agreement(doc.substr(0, n), v, "truncated at " + std::to_string(n));
+    for (std::size_t n = 0; n < doc.size(); ++n)
+      expect_agreement(doc.substr(0, n), v, "truncated at " + std::to_string(n));
     for (std::size_t at = 0; at < doc.size(); ++at) {
       std::string deleted = doc;
       deleted.erase(at, 1);
@@ -337,15 +350,17 @@ TEST(RsiXml, TheControllersSideRoundTripsThroughLibxml2) {
   EXPECT_EQ(back.actual_deg[1], -90.25);
 
   // The controller reads an answer only of its own SENTYPE, with every axis.
-  const std::string sen = "<Sen Type=\"ImFree\"><AK A1=\"0.1\" A2=\"0.2\" A3=\"0.3\" A4=\"0.4\" A5=\"0.5\" A6=\"-0.6\"/>"
-                          "<IPOC>987654321</IPOC></Sen>";
+  const std::string sen =
+      "<Sen Type=\"ImFree\"><AK A1=\"0.1\" A2=\"0.2\" A3=\"0.3\" A4=\"0.4\" A5=\"0.5\" A6=\"-0.6\"/>"
+      "<IPOC>987654321</IPOC></Sen>";
   RsiSensorMessage s;
   ASSERT_EQ(decode_rsi_sensor(bytes(sen), sen.size(), "ImFree", 6, s), RsiDecodeStatus::kOk);
   EXPECT_EQ(s.ipoc, 987654321u);
   EXPECT_EQ(s.correction_deg[5], -0.6);
   EXPECT_EQ(decode_rsi_sensor(bytes(sen), sen.size(), "Other", 6, s), RsiDecodeStatus::kForeign);
-  const std::string five = "<Sen Type=\"ImFree\"><AK A1=\"0.1\" A2=\"0.2\" A3=\"0.3\" A4=\"0.4\" A5=\"0.5\"/>"
-                           "<IPOC>1</IPOC></Sen>";
+  const std::string five =
+      "<Sen Type=\"ImFree\"><AK A1=\"0.1\" A2=\"0.2\" A3=\"0.3\" A4=\"0.4\" A5=\"0.5\"/>"
+      "<IPOC>1</IPOC></Sen>";
   EXPECT_EQ(decode_rsi_sensor(bytes(five), five.size(), "ImFree", 6, s), RsiDecodeStatus::kMissingAxes);
 }
 

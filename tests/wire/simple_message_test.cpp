@@ -39,11 +39,11 @@ struct Words {
   }
 };
 
-constexpr std::uint32_t kOneF = 0x3F800000;       // 1.0f
-constexpr std::uint32_t kMinusHalfF = 0xBF000000; // -0.5f
-constexpr std::uint32_t kQuarterF = 0x3E800000;   // 0.25f
-constexpr std::uint32_t kTenthF = 0x3DCCCCCD;     // 0.1f
-constexpr std::uint32_t kTwoF = 0x40000000;       // 2.0f
+constexpr std::uint32_t kOneF = 0x3F800000;        // 1.0f
+constexpr std::uint32_t kMinusHalfF = 0xBF000000;  // -0.5f
+constexpr std::uint32_t kQuarterF = 0x3E800000;    // 0.25f
+constexpr std::uint32_t kTenthF = 0x3DCCCCCD;      // 0.1f
+constexpr std::uint32_t kTwoF = 0x40000000;        // 2.0f
 constexpr std::uint32_t kNanF = 0x7FC00000;
 
 // JOINT_TRAJ_PT service request: sequence 7, joints (1, -0.5, 2, 0 ...), velocity 0.25, duration 0.1.
@@ -65,8 +65,8 @@ TEST(SimpleMessageWire, JointTrajPtEncodesToTheHandWrittenFrameInBothByteOrders)
     p.velocity = 0.25f;
     p.duration_s = 0.1f;
     Bytes out(100, 0xAA);
-    const std::size_t n = sm::encode(order, {sm::kJointTrajPt, sm::kServiceRequest, sm::kReplyInvalid}, p, out.data(),
-                                     out.size());
+    const std::size_t n =
+        sm::encode(order, {sm::kJointTrajPt, sm::kServiceRequest, sm::kReplyInvalid}, p, out.data(), out.size());
     ASSERT_EQ(n, 68u);
     out.resize(n);
     EXPECT_EQ(out, traj_pt_request(big)) << (big ? "big" : "little");

@@ -30,9 +30,9 @@ struct TrueRobotConfig {
   /// Torque-dependent gear stiffness (hardening of the reducers), per joint: the tangent compliance
   /// at total joint torque x is C (1 + s exp(-|x|/tau_h)), i.e. (1+s) times softer near zero torque
   /// than at large torque (C: the true compliance above). Empty or zero s: linear gears.
-  std::vector<double> hardening_softening;  ///< s per joint
-  std::vector<double> hardening_torque_nm;  ///< tau_h per joint
-  double upper_arm_ei_nm2 = 0.0;            ///< upper arm bending stiffness EI, joint 2 to joint 3 (0: rigid)
+  std::vector<double> hardening_softening;       ///< s per joint
+  std::vector<double> hardening_torque_nm;       ///< tau_h per joint
+  double upper_arm_ei_nm2 = 0.0;                 ///< upper arm bending stiffness EI, joint 2 to joint 3 (0: rigid)
   double base_tilt_compliance_rad_per_nm = 0.0;  ///< foundation and base: tilt per Nm of moment about the base
   /// Stiffness that depends on the joint's motion: the process deflection of a joint is scaled by
   ///   (1 - speed_stiffening tanh(|v|/v_ref)) (1 + direction_asymmetry tanh(v/v_ref) sign(tau)),
@@ -53,11 +53,11 @@ struct TrueRobotConfig {
 /// each loaded run are different runs at different times) is displaced by its own small rigid
 /// motion plus a slow random wander within the run.
 struct DriftConfig {
-  double offset_m = 0.0;       ///< 1-sigma per axis of the run's rigid offset (thermal drift)
+  double offset_m = 0.0;          ///< 1-sigma per axis of the run's rigid offset (thermal drift)
   double offset_time_s = 1200.0;  ///< its correlation time: runs this far apart drift nearly independently
-  double rotation_rad = 0.0;   ///< 1-sigma per axis of the run's small rotation about the base origin
-  double wander_m = 0.0;       ///< stationary 1-sigma per axis of the wander within a run
-  double wander_time_s = 1.0;  ///< correlation time of the wander (Ornstein-Uhlenbeck process)
+  double rotation_rad = 0.0;      ///< 1-sigma per axis of the run's small rotation about the base origin
+  double wander_m = 0.0;          ///< stationary 1-sigma per axis of the wander within a run
+  double wander_time_s = 1.0;     ///< correlation time of the wander (Ornstein-Uhlenbeck process)
   /// The motors warm more under load: a loaded run's own extra rigid offset, 1-sigma per axis at the
   /// reference load, growing with the square of the load (heat goes with the current squared).
   double load_offset_m = 0.0;
@@ -101,8 +101,8 @@ struct LdbbConfig {
   double time_constant_s = 0.3;  ///< pneumatic first-order response
   double ripple = 0.0;           ///< relative amplitude
   double ripple_hz = 2.0;
-  double noise = 0.0;                       ///< relative 1-sigma per servo cycle
-  double force_bias = 0.0;                  ///< true force = set-point * (1 + bias): unknown to the force model
+  double noise = 0.0;       ///< relative 1-sigma per servo cycle
+  double force_bias = 0.0;  ///< true force = set-point * (1 + bias): unknown to the force model
   /// The same after the bar's maintenance and recalibration (the paper's online tests came after it):
   /// the runs with the force sensor mounted use this one.
   double force_bias_recalibrated = 0.0;

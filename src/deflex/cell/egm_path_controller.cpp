@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include <Eigen/Dense>
 #include <fmt/format.h>
+#include <Eigen/Dense>
 
 #include "deflex/text/errors.hpp"
 
@@ -28,8 +28,8 @@ EgmPathCorrectionController::EgmPathCorrectionController(const ControllerConfig&
   } else if (config_.path_corr_frame == "path") {
     frame_ = Frame::kPath;
   } else {
-    throw InputError(fmt::format("controller: path-correction frame '{}' is not tool, flange or path",
-                                 config_.path_corr_frame));
+    throw InputError(
+        fmt::format("controller: path-correction frame '{}' is not tool, flange or path", config_.path_corr_frame));
   }
   buffer_.assign(2048, 0);
   pending_.resize(64);
@@ -75,8 +75,12 @@ const JointVector& EgmPathCorrectionController::tick(double t_s) {
   jacobian(model_, ws_, planned_, EndPoint::kTcp, jac_);
   Matrix3 base_R_frame;
   switch (frame_) {
-    case Frame::kTool: base_R_frame = ws_.base_T_tcp.linear(); break;
-    case Frame::kFlange: base_R_frame = ws_.base_T_flange.linear(); break;
+    case Frame::kTool:
+      base_R_frame = ws_.base_T_tcp.linear();
+      break;
+    case Frame::kFlange:
+      base_R_frame = ws_.base_T_flange.linear();
+      break;
     case Frame::kPath: {
       const Vector3 v = jac_.topRows<3>() * planned_velocity_;
       if (v.norm() > 1e-6) direction_ = v.normalized();
@@ -88,7 +92,8 @@ const JointVector& EgmPathCorrectionController::tick(double t_s) {
       break;
     }
   }
-  const double a = config_.path_corr_filter_s > 0.0 && dt > 0.0 ? 1.0 - std::exp(-dt / config_.path_corr_filter_s) : 1.0;
+  const double a =
+      config_.path_corr_filter_s > 0.0 && dt > 0.0 ? 1.0 - std::exp(-dt / config_.path_corr_filter_s) : 1.0;
   applied_m_ += a * (base_R_frame * active_frame_m_ - applied_m_);
   // The TCP moves by the offset, its orientation stays: solve J dq = [offset; 0].
   Eigen::Matrix<double, 6, 1> twist;

@@ -5,8 +5,8 @@
 
 namespace deflex::cell {
 
-EgmPositionGuidanceController::EgmPositionGuidanceController(const ControllerConfig& config,
-                                                             const JointVector& q_start, DatagramTransport& transport,
+EgmPositionGuidanceController::EgmPositionGuidanceController(const ControllerConfig& config, const JointVector& q_start,
+                                                             DatagramTransport& transport,
                                                              const DatagramAddress& sensor)
     : config_(config), transport_(transport), sensor_(sensor), codec_(static_cast<int>(q_start.size())) {
   const auto n = q_start.size();

@@ -26,10 +26,10 @@
 namespace deflex::cell {
 
 struct EgmControllerCounters {
-  std::uint64_t sent = 0;          ///< EgmRobot messages
-  std::uint64_t targets = 0;       ///< EgmSensor messages taken
-  std::uint64_t ignored = 0;       ///< datagrams that were not a usable answer
-  bool timed_out = false;          ///< EGM stopped for lack of answers
+  std::uint64_t sent = 0;     ///< EgmRobot messages
+  std::uint64_t targets = 0;  ///< EgmSensor messages taken
+  std::uint64_t ignored = 0;  ///< datagrams that were not a usable answer
+  bool timed_out = false;     ///< EGM stopped for lack of answers
 };
 
 class EgmPositionGuidanceController final : public RobotController {

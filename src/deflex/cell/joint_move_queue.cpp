@@ -134,8 +134,8 @@ const JointVector& JointMoveQueue::advance(double t_s) noexcept {
         const double tb_in = zone_half_time(T_, L_);
         const double decision = s_ + T_ - tb_in;
         if (t >= decision) {
-          const bool next_known = config_.zone_m > 0.0 && count_ > 0 &&
-                                  queue_[head_].known_s + config_.latency_s <= decision;
+          const bool next_known =
+              config_.zone_m > 0.0 && count_ > 0 && queue_[head_].known_s + config_.latency_s <= decision;
           bvin_ = sv_;
           if (next_known) {
             // Blend into the next move: the smaller of the two moves' zones.

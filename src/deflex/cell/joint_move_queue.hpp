@@ -25,10 +25,10 @@
 namespace deflex::cell {
 
 struct JointMoveConfig {
-  double zone_m = 0.010;      ///< zone radius at the TCP (RAPID z10, abb_driver's corner zone); 0: fine points
-  double latency_s = 0.05;    ///< a move must be known this long before the planner starts or blends into it
-  double ramp_s = 0.1;        ///< from rest to a move's speed, and back to rest at a fine point
-  double stop_time_s = 0.1;   ///< StopMove: the speed ramps to zero over this time
+  double zone_m = 0.010;     ///< zone radius at the TCP (RAPID z10, abb_driver's corner zone); 0: fine points
+  double latency_s = 0.05;   ///< a move must be known this long before the planner starts or blends into it
+  double ramp_s = 0.1;       ///< from rest to a move's speed, and back to rest at a fine point
+  double stop_time_s = 0.1;  ///< StopMove: the speed ramps to zero over this time
   /// Throws InputError naming the setting.
   void validate() const;
 };

@@ -3,8 +3,8 @@
 
 namespace deflex::cell {
 
-LaserTracker::LaserTracker(const TrackerConfig& config, std::uint64_t seed, double first_sample_s,
-                           double last_sample_s, double time_origin_s)
+LaserTracker::LaserTracker(const TrackerConfig& config, std::uint64_t seed, double first_sample_s, double last_sample_s,
+                           double time_origin_s)
     : config_(config),
       rng_(seed),
       next_s_(first_sample_s),

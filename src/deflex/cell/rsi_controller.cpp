@@ -12,9 +12,12 @@ namespace deflex::cell {
 
 const char* to_string(RsiStop s) {
   switch (s) {
-    case RsiStop::kRunning: return "running";
-    case RsiStop::kTimeout: return "stopped: Timeout reached (late answers)";
-    case RsiStop::kMaxCorrection: return "stopped: AXISCORRMON MaxAi exceeded";
+    case RsiStop::kRunning:
+      return "running";
+    case RsiStop::kTimeout:
+      return "stopped: Timeout reached (late answers)";
+    case RsiStop::kMaxCorrection:
+      return "stopped: AXISCORRMON MaxAi exceeded";
   }
   return "unknown";
 }
@@ -30,8 +33,8 @@ RsiController::RsiController(const RsiControllerConfig& config, const RobotModel
       sensor_(sensor) {
   const bool ok = std::isfinite(config_.cycle_s) && config_.cycle_s > 0.0 && config_.timeout >= 1 &&
                   config_.lower_limit_deg <= 0.0 && config_.upper_limit_deg >= 0.0 &&
-                  config_.max_correction_deg > 0.0 && config_.correction_dead_time_s >= 0.0 &&
-                  config_.precision >= 0 && config_.precision <= 12 && valid_rsi_sentype(config_.sentype);
+                  config_.max_correction_deg > 0.0 && config_.correction_dead_time_s >= 0.0 && config_.precision >= 0 &&
+                  config_.precision <= 12 && valid_rsi_sentype(config_.sentype);
   if (!ok) throw InputError(fmt::format("RSI controller: bad configuration (SENTYPE '{}')", config_.sentype));
   if (program_->dof() != model_.dof()) throw InputError("RSI controller: the program is for another robot");
   const int n = model_.dof();

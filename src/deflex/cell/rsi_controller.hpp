@@ -81,7 +81,9 @@ class RsiController final : public RobotController {
   void pause(double from_s, double to_s);
 
  private:
-  void stop(RsiStop why) { if (counters_.stopped == RsiStop::kRunning) counters_.stopped = why; }
+  void stop(RsiStop why) {
+    if (counters_.stopped == RsiStop::kRunning) counters_.stopped = why;
+  }
   void pose_of(const JointVector& q, std::array<double, 6>& xyzabc);
 
   RsiControllerConfig config_;

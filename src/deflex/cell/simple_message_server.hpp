@@ -31,13 +31,13 @@ namespace deflex::cell {
 
 struct SimpleMessageServerConfig {
   simple_message::ByteOrder byte_order = simple_message::ByteOrder::kLittle;  ///< RAPID PackRawBytes: little
-  std::size_t buffer_points = 4;     ///< points accepted and not yet taken by the motion task
-  double state_period_s = 0.1;       ///< ROS_stateServer's update_rate
-  bool publish_status = true;        ///< a ROBOT_STATUS after each JOINT_POSITION, as ROS_stateServer does
-  bool reply_with_data = false;      ///< ABB: header-only replies; industrial_core servers echo the point
-  bool record_points = false;        ///< keep every accepted point with its time (stand-ins check the wire with it)
+  std::size_t buffer_points = 4;  ///< points accepted and not yet taken by the motion task
+  double state_period_s = 0.1;    ///< ROS_stateServer's update_rate
+  bool publish_status = true;     ///< a ROBOT_STATUS after each JOINT_POSITION, as ROS_stateServer does
+  bool reply_with_data = false;   ///< ABB: header-only replies; industrial_core servers echo the point
+  bool record_points = false;     ///< keep every accepted point with its time (stand-ins check the wire with it)
   std::size_t max_frame_bytes = simple_message::kDefaultMaxFrameBytes;
-  JointMoveConfig motion;            ///< the motion task's MoveAbsJ with its zone
+  JointMoveConfig motion;  ///< the motion task's MoveAbsJ with its zone
   /// The server task reads the motion connection at most once this often (0: every tick): a slow
   /// robot program (a busy task, a slow loop) that takes points less often than deflex sends them.
   double read_period_s = 0.0;
@@ -46,17 +46,17 @@ struct SimpleMessageServerConfig {
 };
 
 struct SimpleMessageServerCounters {
-  std::uint64_t requests = 0;          ///< JOINT_TRAJ_PT frames taken from the motion connection
-  std::uint64_t accepted = 0;          ///< points queued (SUCCESS)
-  std::uint64_t refused_full = 0;      ///< FAILURE: the buffer was full
-  std::uint64_t refused_invalid = 0;   ///< FAILURE: the point was refused
-  std::uint64_t stops = 0;             ///< STOP_TRAJECTORY requests
-  std::uint64_t skipped = 0;           ///< frames of another type or too short: no reply
+  std::uint64_t requests = 0;         ///< JOINT_TRAJ_PT frames taken from the motion connection
+  std::uint64_t accepted = 0;         ///< points queued (SUCCESS)
+  std::uint64_t refused_full = 0;     ///< FAILURE: the buffer was full
+  std::uint64_t refused_invalid = 0;  ///< FAILURE: the point was refused
+  std::uint64_t stops = 0;            ///< STOP_TRAJECTORY requests
+  std::uint64_t skipped = 0;          ///< frames of another type or too short: no reply
   std::uint64_t replies = 0;
-  std::uint64_t joint_positions = 0;   ///< JOINT_POSITION topics published
-  bool motion_closed = false;          ///< the motion connection is over (the client left, or out of step)
+  std::uint64_t joint_positions = 0;  ///< JOINT_POSITION topics published
+  bool motion_closed = false;         ///< the motion connection is over (the client left, or out of step)
   bool state_closed = false;
-  bool out_of_step = false;            ///< a frame LENGTH that cannot be closed the motion connection
+  bool out_of_step = false;  ///< a frame LENGTH that cannot be closed the motion connection
 };
 
 class SimpleMessageServer final : public RobotController {

@@ -177,8 +177,8 @@ Vector3 TrueRobot::structural_displacement(const Workspace& ws, const Wrench& w)
   return d;
 }
 
-Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd_in, const Wrench& wrench_base,
-                         TrueRobotState& state, double dt_s) const {
+Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd_in, const Wrench& wrench_base, TrueRobotState& state,
+                         double dt_s) const {
   const RobotModel& m = *true_;
   const int n = m.dof();
   const auto& rc = config_.robot;

@@ -92,7 +92,7 @@ class TrueRobot {
   JointMatrix joint_compliance_;
   std::array<GearHardening, kMaxJoints> hardening_{};
   bool hardening_on_ = false;
-  double last_d_m_ = 0.0;  ///< wrist centre to flange along the flange z axis
+  double last_d_m_ = 0.0;            ///< wrist centre to flange along the flange z axis
   double upper_arm_length_m_ = 0.0;  ///< joint 2 axis to joint 3 axis
 };
 

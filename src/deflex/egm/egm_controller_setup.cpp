@@ -34,20 +34,22 @@ void EgmSetupOptions::validate() const {
   for (const auto& [value, option] : {std::pair{&device, "--egm-device"}, std::pair{&egm_config, "--egm-config"},
                                       std::pair{&module, "--module"}, std::pair{&tool, "--tool"}}) {
     if (!plain_identifier(*value, 32)) {
-      throw InputError(fmt::format("option {}: '{}' is not a RAPID name (a letter, then letters, digits or '_', at "
-                                   "most 32)",
-                                   option, *value));
+      throw InputError(
+          fmt::format("option {}: '{}' is not a RAPID name (a letter, then letters, digits or '_', at "
+                      "most 32)",
+                      option, *value));
     }
   }
   positive(period_ms, 1000.0, "--period-ms");
   const double cycles = period_ms / 4.0;
   if (std::abs(cycles - std::round(cycles)) > 1e-9) {
-    throw InputError(fmt::format("option --period-ms: EGM's \\SampleRate is a multiple of the 4 ms cycle (got {})",
-                                 period_ms));
+    throw InputError(
+        fmt::format("option --period-ms: EGM's \\SampleRate is a multiple of the 4 ms cycle (got {})", period_ms));
   }
   if (!path_correction && std::abs(period_ms - 4.0) > 1e-9) {
-    throw InputError("option --period-ms: position guidance runs at EGM's 4 ms (deflex online --link egm-joint "
-                     "--period-ms 4)");
+    throw InputError(
+        "option --period-ms: position guidance runs at EGM's 4 ms (deflex online --link egm-joint "
+        "--period-ms 4)");
   }
   positive(max_joint_correction_deg, 10.0, "--max-joint-correction-deg");
   positive(max_tcp_correction_mm, 1000.0, "--max-tcp-correction-mm");
@@ -65,12 +67,14 @@ void EgmSetupOptions::validate() const {
     positive(max_speed_deviation_deg_s, 10000.0, "--max-speed-deviation-deg-s");
   }
   if (!std::isnan(max_pos_deviation_deg) && max_pos_deviation_deg < max_joint_correction_deg) {
-    throw InputError("option --max-pos-deviation-deg: smaller than deflex's own --max-joint-correction-deg, so the "
-                     "controller would stop EGM on a correction deflex allows");
+    throw InputError(
+        "option --max-pos-deviation-deg: smaller than deflex's own --max-joint-correction-deg, so the "
+        "controller would stop EGM on a correction deflex allows");
   }
   for (const auto* list : {&program_peak_speed_deg_s, &robot_max_speed_deg_s}) {
     for (double v : *list) {
-      if (!std::isfinite(v) || v < 0.0) throw InputError("controller setup: joint speeds must be finite and >= 0 deg/s");
+      if (!std::isfinite(v) || v < 0.0)
+        throw InputError("controller setup: joint speeds must be finite and >= 0 deg/s");
     }
   }
   if (path_frame != "tool" && path_frame != "flange" && path_frame != "path") {
@@ -83,8 +87,9 @@ EgmSupervision egm_supervision(const EgmSetupOptions& o) {
   const std::vector<double>& speeds =
       !o.program_peak_speed_deg_s.empty() ? o.program_peak_speed_deg_s : o.robot_max_speed_deg_s;
   s.basis = !o.program_peak_speed_deg_s.empty() ? "the program's peak joint speeds"
-            : !o.robot_max_speed_deg_s.empty() ? "the robot's joint speed limits (give --program for tighter values)"
-                                               : "a 250 deg/s joint speed (give --program or --robot for tighter values)";
+            : !o.robot_max_speed_deg_s.empty()
+                ? "the robot's joint speed limits (give --program for tighter values)"
+                : "a 250 deg/s joint speed (give --program or --robot for tighter values)";
   double fastest_program = speeds.empty() ? 250.0 : 0.0;
   for (double v : speeds) fastest_program = std::max(fastest_program, v);
   const double blend = o.ramp_in_s > 0.0 ? 1.5 * o.start_tolerance_deg / o.ramp_in_s : 0.0;
@@ -92,7 +97,8 @@ EgmSupervision egm_supervision(const EgmSetupOptions& o) {
   // Rounded up to what RAPID is given (0.01 deg, 1 deg/s), never below what deflex may send.
   const double derived_speed = std::ceil(1.25 * s.fastest_command_deg_s);
   const double derived_pos =
-      std::ceil((o.max_joint_correction_deg + o.start_tolerance_deg + fastest_program * o.follow_lag_s) * 100.0) / 100.0;
+      std::ceil((o.max_joint_correction_deg + o.start_tolerance_deg + fastest_program * o.follow_lag_s) * 100.0) /
+      100.0;
   s.max_speed_deviation_deg_s = std::isnan(o.max_speed_deviation_deg_s) ? derived_speed : o.max_speed_deviation_deg_s;
   s.max_pos_deviation_deg = std::isnan(o.max_pos_deviation_deg) ? derived_pos : o.max_pos_deviation_deg;
   s.comm_timeout_s = std::isnan(o.comm_timeout_s) ? o.stop_silence_s : o.comm_timeout_s;
@@ -121,8 +127,7 @@ std::vector<ControllerFile> egm_controller_setup(const EgmSetupOptions& o) {
       fmt::arg("device", o.device), fmt::arg("joint", plain_number(o.max_joint_correction_deg)),
       fmt::arg("tcp", plain_number(o.max_tcp_correction_mm)), fmt::arg("period", plain_number(o.period_ms)),
       fmt::arg("more", o.path_correction ? fmt::format(" --path-corr-frame {}", o.path_frame)
-                                         : fmt::format(" --ramp-in-s {} --program P.csv",
-                                                       plain_number(o.ramp_in_s))));
+                                         : fmt::format(" --ramp-in-s {} --program P.csv", plain_number(o.ramp_in_s))));
   if (!o.path_correction) {
     std::string conditions, joints;
     for (int j = 1; j <= 6; ++j) {
@@ -151,8 +156,8 @@ std::vector<ControllerFile> egm_controller_setup(const EgmSetupOptions& o) {
         fmt::arg("config", o.egm_config), fmt::arg("device", o.device),
         fmt::arg("timeout", plain_number(sup.comm_timeout_s)), fmt::arg("basis", sup.basis),
         fmt::arg("fastest", plain_number(std::round(sup.fastest_command_deg_s * 10.0) / 10.0)),
-        fmt::arg("joint", plain_number(o.max_joint_correction_deg)),
-        fmt::arg("tool", o.tool), fmt::arg("conditions", conditions), fmt::arg("lp", plain_number(o.lowpass_hz)),
+        fmt::arg("joint", plain_number(o.max_joint_correction_deg)), fmt::arg("tool", o.tool),
+        fmt::arg("conditions", conditions), fmt::arg("lp", plain_number(o.lowpass_hz)),
         fmt::arg("period", plain_number(o.period_ms)), fmt::arg("maxpos", plain_number(sup.max_pos_deviation_deg)),
         fmt::arg("maxspeed", plain_number(sup.max_speed_deviation_deg_s)), fmt::arg("joints", joints),
         fmt::arg("cond", plain_number(o.cond_time_s)), fmt::arg("ramp", plain_number(o.ramp_in_s)));
@@ -190,9 +195,8 @@ std::vector<ControllerFile> egm_controller_setup(const EgmSetupOptions& o) {
         "  !   EGMMoveC deflex_egm_id,p20,p30,v50,fine,{tool}\\WObj:=wobj0;\n"
         "  !   deflex_egm_path_end;\n",
         fmt::arg("period", plain_number(o.period_ms)), fmt::arg("frame_note", frame_note),
-        fmt::arg("config", o.egm_config),
-        fmt::arg("device", o.device), fmt::arg("timeout", plain_number(sup.comm_timeout_s)), fmt::arg("frame", frame),
-        fmt::arg("tool", o.tool));
+        fmt::arg("config", o.egm_config), fmt::arg("device", o.device),
+        fmt::arg("timeout", plain_number(sup.comm_timeout_s)), fmt::arg("frame", frame), fmt::arg("tool", o.tool));
   }
   mod += "ENDMODULE\n";
 

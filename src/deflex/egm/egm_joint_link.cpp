@@ -2,14 +2,14 @@
 #include "deflex/egm/egm_joint_link.hpp"
 
 #include <algorithm>
-#include <utility>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 
@@ -17,10 +17,14 @@ namespace {
 
 const char* mci_name(int state) {
   switch (state) {
-    case 1: return "ERROR";
-    case 2: return "STOPPED";
-    case 3: return "RUNNING";
-    default: return "UNDEFINED";
+    case 1:
+      return "ERROR";
+    case 2:
+      return "STOPPED";
+    case 3:
+      return "RUNNING";
+    default:
+      return "UNDEFINED";
   }
 }
 

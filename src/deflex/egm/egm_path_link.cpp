@@ -8,16 +8,19 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 
 const char* to_string(PathCorrFrame f) {
   switch (f) {
-    case PathCorrFrame::kTool: return "tool";
-    case PathCorrFrame::kFlange: return "flange";
-    case PathCorrFrame::kPath: return "path";
+    case PathCorrFrame::kTool:
+      return "tool";
+    case PathCorrFrame::kFlange:
+      return "flange";
+    case PathCorrFrame::kPath:
+      return "path";
   }
   return "unknown";
 }
@@ -58,8 +61,8 @@ EgmPathLink::EgmPathLink(OnlineCompensator& compensator, OnlineStrategy& strateg
       ws_(compensator.model()),
       jac_(6, compensator.model().dof()) {
   const int n = compensator.model().dof();
-  for (JointVector* q : {&feedback_, &planned_, &previous_feedback_, &velocity_, &target_, &sent_offset_joints_,
-                         &reference_}) {
+  for (JointVector* q :
+       {&feedback_, &planned_, &previous_feedback_, &velocity_, &target_, &sent_offset_joints_, &reference_}) {
     *q = JointVector::Zero(n);
   }
   tx_.assign(512, 0);
@@ -109,9 +112,10 @@ bool EgmPathLink::controller_state(const EgmRobotMessage& m) noexcept {
 }
 
 std::string EgmPathLink::protocol_summary() const {
-  return fmt::format("egm-path: largest TCP rotation the model predicted {:.3f} mrad ({} cycles above {:g} mrad; path "
-                     "correction cannot rotate)",
-                     max_rotation_rad_ * 1e3, rotation_warnings_, config_.rotation_warning_rad * 1e3);
+  return fmt::format(
+      "egm-path: largest TCP rotation the model predicted {:.3f} mrad ({} cycles above {:g} mrad; path "
+      "correction cannot rotate)",
+      max_rotation_rad_ * 1e3, rotation_warnings_, config_.rotation_warning_rad * 1e3);
 }
 
 LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {

@@ -13,8 +13,8 @@
 #pragma once
 
 #include "deflex/egm/egm_receiver.hpp"
-#include "deflex/model/kinematics.hpp"
 #include "deflex/link/controller_link.hpp"
+#include "deflex/model/kinematics.hpp"
 #include "deflex/online/delay_estimator.hpp"
 
 namespace deflex {

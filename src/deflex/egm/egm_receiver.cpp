@@ -92,15 +92,32 @@ EgmReceiver::Result EgmReceiver::drain(double timeout_s, bool& restarted) noexce
       continue;
     }
     switch (codec_.decode_robot(rx_.data(), static_cast<std::size_t>(n), msg_)) {
-      case EgmDecodeStatus::kOk: break;
-      case EgmDecodeStatus::kMalformed: ++counters_.malformed; continue;
-      case EgmDecodeStatus::kTruncated: ++counters_.truncated; continue;
-      case EgmDecodeStatus::kMissingHeader: ++counters_.missing_header; continue;
-      case EgmDecodeStatus::kMissingJoints: ++counters_.missing_joints; continue;
-      case EgmDecodeStatus::kNonFinite: ++counters_.non_finite; continue;
-      case EgmDecodeStatus::kEmpty: ++counters_.empty; continue;
-      case EgmDecodeStatus::kSequenceOutOfRange: ++counters_.sequence_out_of_range; continue;
-      case EgmDecodeStatus::kMissingRequired: ++counters_.missing_required; continue;
+      case EgmDecodeStatus::kOk:
+        break;
+      case EgmDecodeStatus::kMalformed:
+        ++counters_.malformed;
+        continue;
+      case EgmDecodeStatus::kTruncated:
+        ++counters_.truncated;
+        continue;
+      case EgmDecodeStatus::kMissingHeader:
+        ++counters_.missing_header;
+        continue;
+      case EgmDecodeStatus::kMissingJoints:
+        ++counters_.missing_joints;
+        continue;
+      case EgmDecodeStatus::kNonFinite:
+        ++counters_.non_finite;
+        continue;
+      case EgmDecodeStatus::kEmpty:
+        ++counters_.empty;
+        continue;
+      case EgmDecodeStatus::kSequenceOutOfRange:
+        ++counters_.sequence_out_of_range;
+        continue;
+      case EgmDecodeStatus::kMissingRequired:
+        ++counters_.missing_required;
+        continue;
     }
     // A packet whose joints no robot of this model can have (a corrupted or foreign sender) must not
     // be answered: its correction would be computed at a configuration that is not the arm's.

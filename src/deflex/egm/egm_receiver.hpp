@@ -48,8 +48,8 @@ struct EgmReceiverConfig {
 class EgmReceiver {
  public:
   /// `transport`, `clock` and `counters` must outlive the receiver. Throws InputError.
-  EgmReceiver(DatagramTransport& transport, const Clock& clock, const RobotModel& model, const EgmReceiverConfig& config,
-              LinkCounters& counters);
+  EgmReceiver(DatagramTransport& transport, const Clock& clock, const RobotModel& model,
+              const EgmReceiverConfig& config, LinkCounters& counters);
 
   enum class Result { kNothing, kNoneUsable, kMessage };
   /// Waits up to timeout_s, drains, and leaves the newest usable message in message(). `restarted`

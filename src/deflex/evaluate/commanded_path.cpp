@@ -3,9 +3,9 @@
 
 #include <fmt/format.h>
 
+#include "deflex/model/kinematics.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
-#include "deflex/model/kinematics.hpp"
 
 namespace deflex {
 
@@ -45,9 +45,10 @@ CommandedPath read_commanded_path(const std::string& path, const RobotModel* mod
     return out;
   }
   if (!mm && !m) {
-    throw DataError(fmt::format("{}: neither a Cartesian path (t_s,x_mm,y_mm,z_mm or x_m...), a joint trajectory "
-                                "(t_s,q1_deg,...) nor a cycle log (program_t_s,q_nominal1_deg,...)",
-                                path));
+    throw DataError(
+        fmt::format("{}: neither a Cartesian path (t_s,x_mm,y_mm,z_mm or x_m...), a joint trajectory "
+                    "(t_s,q1_deg,...) nor a cycle log (program_t_s,q_nominal1_deg,...)",
+                    path));
   }
   out.kind = "Cartesian path";
   const std::string s = mm ? "_mm" : "_m";

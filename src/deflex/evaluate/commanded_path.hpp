@@ -5,8 +5,8 @@
 
 #include <string>
 
-#include "deflex/model/tracker_trace.hpp"
 #include "deflex/model/robot_model.hpp"
+#include "deflex/model/tracker_trace.hpp"
 
 namespace deflex {
 

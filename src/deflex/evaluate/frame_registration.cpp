@@ -4,13 +4,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
-#include <fmt/format.h>
 
+#include "deflex/model/linear_algebra.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/yaml_fields.hpp"
-#include "deflex/model/linear_algebra.hpp"
 
 namespace deflex {
 namespace {
@@ -88,9 +88,10 @@ CircleFit fit_circle(const std::vector<Vector3>& points, const std::string& what
   fit.rms_m = std::sqrt(ss / static_cast<double>(xy.size()));
   fit.arc_rad = std::min(2 * kPi, max_a - min_a);
   if (fit.arc_rad < 20.0 * kPi / 180.0) {
-    throw InputError(fmt::format("{}: the points span {:.1f} degrees of arc; at least 20 are needed for a centre and "
-                                 "axis worth registering with",
-                                 what, fit.arc_rad * 180.0 / kPi));
+    throw InputError(
+        fmt::format("{}: the points span {:.1f} degrees of arc; at least 20 are needed for a centre and "
+                    "axis worth registering with",
+                    what, fit.arc_rad * 180.0 / kPi));
   }
   if (swept < 0.0) normal = -normal;  // right-hand rule along the direction of travel
   fit.axis = normal;
@@ -110,9 +111,10 @@ FrameRegistration register_frames(const RegistrationInput& in) {
   if (!finite_all(in.tracker_m) || !finite_all(in.base_m)) throw InputError("registration: a point is not finite");
   const std::size_t np = in.tracker_m.size(), nc = in.tracker_circles.size();
   if (np + nc == 0 || (nc == 0 && np < 3)) {
-    throw InputError(fmt::format("registration: {} point pair(s) and no circle: at least 3 points off one line are "
-                                 "needed (or circles)",
-                                 np));
+    throw InputError(
+        fmt::format("registration: {} point pair(s) and no circle: at least 3 points off one line are "
+                    "needed (or circles)",
+                    np));
   }
   // Every point feature: the measured points and the circles' centres.
   std::vector<Vector3> a = in.tracker_m, b = in.base_m;

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "deflex/text/output_file.hpp"
 #include "deflex/model/types.hpp"
+#include "deflex/text/output_file.hpp"
 
 namespace deflex {
 
@@ -47,7 +47,7 @@ struct RegistrationResidual {
 };
 
 struct FrameRegistration {
-  Pose base_T_tracker = Pose::Identity();  ///< p_base = base_T_tracker * p_tracker
+  Pose base_T_tracker = Pose::Identity();       ///< p_base = base_T_tracker * p_tracker
   std::vector<RegistrationResidual> residuals;  ///< one per point, then one per circle centre
   std::vector<double> circle_axis_error_rad;    ///< angle between each rotated tracker axis and its base axis
   double rms_m = 0.0;

@@ -92,11 +92,11 @@ Iso9283Path iso9283_path(const std::vector<TrackerTrace>& repeated_runs, const T
   }
   // 1..100000, the range `deflex evaluate --evaluation-points` takes (the Python module calls this directly).
   if (evaluation_points < 1 || evaluation_points > 100000) {
-    throw InputError(
-        fmt::format("ISO 9283 path figures: {} evaluation points (need 1..100000)", evaluation_points));
+    throw InputError(fmt::format("ISO 9283 path figures: {} evaluation points (need 1..100000)", evaluation_points));
   }
   if (!(max_offset_m > 0.0) || !(max_offset_m <= 100.0)) {
-    throw InputError("ISO 9283 path figures: the largest offset of a run from the path must be positive, at most 100 m");
+    throw InputError(
+        "ISO 9283 path figures: the largest offset of a run from the path must be positive, at most 100 m");
   }
   if (reference.size() < 2) {
     throw InputError("ISO 9283 path figures: the reference path needs at least 2 samples");

@@ -133,9 +133,10 @@ TrackerTrace mean_closed_path(const TrackerTrace& trace, int bins) {
     out.push_back(m);
   }
   if (out.size() < static_cast<std::size_t>(0.9 * bins)) {
-    throw InputError(fmt::format("mean path: only {} of {} angle bins hold a sample: not a closed path around its "
-                                 "centre",
-                                 out.size(), bins));
+    throw InputError(
+        fmt::format("mean path: only {} of {} angle bins hold a sample: not a closed path around its "
+                    "centre",
+                    out.size(), bins));
   }
   out.push_back(out.front());
   return out;

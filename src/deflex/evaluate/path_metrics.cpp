@@ -40,8 +40,8 @@ struct PolylineIndex::Impl {
   };
   struct Node {
     Vector3 lo, hi;
-    std::uint32_t start = 0, end = 0;  // leaf: segments [start, end)
-    std::uint32_t left = 0, right = 0; // inner node: children (0 = none: the root is never a child)
+    std::uint32_t start = 0, end = 0;   // leaf: segments [start, end)
+    std::uint32_t left = 0, right = 0;  // inner node: children (0 = none: the root is never a child)
   };
   std::vector<Vector3> vertices;
   std::vector<Segment> segments;
@@ -154,8 +154,8 @@ void PolylineIndex::init(const std::vector<const TrackerTrace*>& piece_ptrs) {
     const auto first = static_cast<std::uint32_t>(m.vertices.size());
     for (std::size_t i = 0; i < piece.size(); ++i) {
       if (!piece[i].p_m.allFinite()) {
-        throw InputError(fmt::format("reference path: sample {} (t = {} s) has a position that is not finite", i,
-                                     piece[i].t_s));
+        throw InputError(
+            fmt::format("reference path: sample {} (t = {} s) has a position that is not finite", i, piece[i].t_s));
       }
       m.vertices.push_back(piece[i].p_m);
     }
@@ -228,8 +228,8 @@ PathDeviationStats stats_of(const std::vector<const TrackerTrace*>& loaded, cons
     const TrackerTrace& trace = *trace_ptr;
     for (std::size_t i = 0; i < trace.size(); ++i) {
       if (!trace[i].p_m.allFinite()) {
-        throw InputError(fmt::format("loaded path: sample {} (t = {} s) has a position that is not finite", i,
-                                     trace[i].t_s));
+        throw InputError(
+            fmt::format("loaded path: sample {} (t = {} s) has a position that is not finite", i, trace[i].t_s));
       }
       hint = index.nearest(trace[i].p_m, i > 0 ? &hint : nullptr);
       d.push_back(hint.distance_m);

@@ -25,9 +25,9 @@ class Commanded {
   void at(double t, Vector3& p, Vector3& v) {
     if (fresh_ || k_ + 1 >= c_.size() || c_[k_].t_s > t) {  // a new pass starts with a binary search
       fresh_ = false;
-      k_ = static_cast<std::size_t>(std::upper_bound(c_.begin(), c_.end(), t,
-                                                     [](double x, const TrackerSample& s) { return x < s.t_s; }) -
-                                    c_.begin());
+      k_ = static_cast<std::size_t>(
+          std::upper_bound(c_.begin(), c_.end(), t, [](double x, const TrackerSample& s) { return x < s.t_s; }) -
+          c_.begin());
       k_ = k_ == 0 ? 0 : k_ - 1;
     }
     while (k_ + 2 < c_.size() && c_[k_ + 1].t_s <= t) ++k_;
@@ -64,7 +64,8 @@ double cost(const TrackerTrace& m, const std::vector<std::size_t>& idx, Commande
     ss += (m[i].p_m - p).squaredNorm();
     ++inside;
   }
-  return inside >= min_inside && inside > 0 ? ss / static_cast<double>(inside) : std::numeric_limits<double>::infinity();
+  return inside >= min_inside && inside > 0 ? ss / static_cast<double>(inside)
+                                            : std::numeric_limits<double>::infinity();
 }
 
 // Gauss-Newton on the offset (and the drift when asked) over samples [first, last).
@@ -112,16 +113,19 @@ TimeAlignment align_time(const TrackerTrace& measured, const TrackerTrace& comma
     for (std::size_t i = 0; i < trace->size(); ++i) {
       if (!std::isfinite((*trace)[i].t_s) || !(*trace)[i].p_m.allFinite() ||
           (i > 0 && !((*trace)[i].t_s > (*trace)[i - 1].t_s))) {
-        throw InputError(fmt::format("time alignment: the {} trace's sample {} is not finite or not later than the one "
-                                     "before",
-                                     trace == &measured ? "measured" : "commanded", i + 1));
+        throw InputError(
+            fmt::format("time alignment: the {} trace's sample {} is not finite or not later than the one "
+                        "before",
+                        trace == &measured ? "measured" : "commanded", i + 1));
       }
     }
   }
   Commanded c(commanded);
   double moving = 0.0;
-  for (std::size_t i = 1; i < commanded.size(); ++i) moving = std::max(moving, (commanded[i].p_m - commanded[i - 1].p_m).norm());
-  if (!(moving > 1e-9)) throw InputError("time alignment: the commanded path never moves, so it has no timing to match");
+  for (std::size_t i = 1; i < commanded.size(); ++i)
+    moving = std::max(moving, (commanded[i].p_m - commanded[i - 1].p_m).norm());
+  if (!(moving > 1e-9))
+    throw InputError("time alignment: the commanded path never moves, so it has no timing to match");
 
   const double tm0 = measured.front().t_s, tm1 = measured.back().t_s;
   const double need = 0.5 * std::min(tm1 - tm0, c.end() - c.start());
@@ -131,14 +135,16 @@ TimeAlignment align_time(const TrackerTrace& measured, const TrackerTrace& comma
     hi = std::min(hi, o.centre_s + o.search_s);
   }
   if (!(hi >= lo)) {
-    throw InputError(fmt::format("time alignment: no offset in the searched range puts half of the measured run "
-                                 "({:.3f} s) inside the commanded one ({:.3f} s)",
-                                 tm1 - tm0, c.end() - c.start()));
+    throw InputError(
+        fmt::format("time alignment: no offset in the searched range puts half of the measured run "
+                    "({:.3f} s) inside the commanded one ({:.3f} s)",
+                    tm1 - tm0, c.end() - c.start()));
   }
   // Coarse: a subsample of the run against every offset on a grid fine against the run's sampling.
   std::vector<std::size_t> coarse_idx;
   const std::size_t coarse_n = std::min<std::size_t>(400, measured.size());
-  for (std::size_t k = 0; k < coarse_n; ++k) coarse_idx.push_back(k * (measured.size() - 1) / std::max<std::size_t>(1, coarse_n - 1));
+  for (std::size_t k = 0; k < coarse_n; ++k)
+    coarse_idx.push_back(k * (measured.size() - 1) / std::max<std::size_t>(1, coarse_n - 1));
   const double dt_m = (tm1 - tm0) / static_cast<double>(measured.size() - 1);
   const double step = std::max((hi - lo) / 20000.0, std::min(dt_m, (hi - lo) / 10.0));
   Model best;
@@ -162,7 +168,8 @@ TimeAlignment align_time(const TrackerTrace& measured, const TrackerTrace& comma
   const double g = 0.5 * (std::sqrt(5.0) - 1.0);
   for (int it = 0; it < 40 && b - a > 1e-7; ++it) {
     const double x1 = b - g * (b - a), x2 = a + g * (b - a);
-    if (cost(measured, all, c, {x1, 0.0, best.t_ref}, min_all) < cost(measured, all, c, {x2, 0.0, best.t_ref}, min_all)) {
+    if (cost(measured, all, c, {x1, 0.0, best.t_ref}, min_all) <
+        cost(measured, all, c, {x2, 0.0, best.t_ref}, min_all)) {
       b = x2;
     } else {
       a = x1;

@@ -22,12 +22,12 @@ struct TimeAlignmentOptions {
 /// program time = tracker time + offset_s + drift * (tracker time - reference_t_s).
 struct TimeAlignment {
   double offset_s = 0.0;
-  double drift = 0.0;             ///< dimensionless (1e-6 = 1 ppm); 0 unless fitted
-  double reference_t_s = 0.0;     ///< the tracker time the drift is taken about (the run's middle)
-  double offset_std_s = 0.0;      ///< standard uncertainty of offset_s, from the spread over blocks
-  double rms_m = 0.0;             ///< RMS distance of the measured points from the command at their time
-  std::size_t samples = 0;        ///< measured samples inside the commanded span at the offset found
-  double moving_fraction = 0.0;   ///< share of those samples where the command moves (hold still: no timing)
+  double drift = 0.0;            ///< dimensionless (1e-6 = 1 ppm); 0 unless fitted
+  double reference_t_s = 0.0;    ///< the tracker time the drift is taken about (the run's middle)
+  double offset_std_s = 0.0;     ///< standard uncertainty of offset_s, from the spread over blocks
+  double rms_m = 0.0;            ///< RMS distance of the measured points from the command at their time
+  std::size_t samples = 0;       ///< measured samples inside the commanded span at the offset found
+  double moving_fraction = 0.0;  ///< share of those samples where the command moves (hold still: no timing)
   [[nodiscard]] double program_time(double tracker_t_s) const {
     return tracker_t_s + offset_s + drift * (tracker_t_s - reference_t_s);
   }

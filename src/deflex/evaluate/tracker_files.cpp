@@ -20,7 +20,8 @@ namespace {
 
 std::string lower(std::string_view s) {
   std::string out(s);
-  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(out.begin(), out.end(), out.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return out;
 }
 
@@ -331,7 +332,8 @@ TrackerFile parse_sa(const std::string& text, const std::string& source, const T
     }
     // The length unit: from the header or the option, never guessed; both must agree.
     if (!options.length_unit.empty() && !length_scale(options.length_unit)) {
-      throw InputError(fmt::format("option --tracker-units: '{}' is not one of mm, m, cm, in, ft", options.length_unit));
+      throw InputError(
+          fmt::format("option --tracker-units: '{}' is not one of mm, m, cm, in, ft", options.length_unit));
     }
     if (!h.length_unit.empty() && !options.length_unit.empty() && h.length_unit != options.length_unit) {
       fail_at(source, h.unit_line,
@@ -426,16 +428,25 @@ TrackerFile parse_sa(const std::string& text, const std::string& source, const T
       }
       switch (c) {
         case Col::kX:
-        case Col::kR: v[0] = *value; break;
+        case Col::kR:
+          v[0] = *value;
+          break;
         case Col::kY:
-        case Col::kAzimuth: v[1] = *value; break;
+        case Col::kAzimuth:
+          v[1] = *value;
+          break;
         case Col::kZ:
           if (layout->coordinates == "cartesian" || layout->coordinates == "cylindrical") v[2] = *value;
           break;
         case Col::kZenith:
-        case Col::kElevation: v[2] = *value; break;
-        case Col::kTime: p.t_s = *value; break;
-        default: break;
+        case Col::kElevation:
+          v[2] = *value;
+          break;
+        case Col::kTime:
+          p.t_s = *value;
+          break;
+        default:
+          break;
       }
     }
     p.p_m = to_cartesian(*layout, v, length, angle);
@@ -464,9 +475,10 @@ TrackerFile parse_csv(const std::string& text, const std::string& source, const 
   if (!mm && !m) {
     std::string have;
     for (const auto& c : table.columns()) have += (have.empty() ? "" : ", ") + c;
-    throw DataError(fmt::format("{}: no position columns with a unit in their name: give x_mm,y_mm,z_mm or "
-                                "x_m,y_m,z_m (have: {})",
-                                source, have));
+    throw DataError(
+        fmt::format("{}: no position columns with a unit in their name: give x_mm,y_mm,z_mm or "
+                    "x_m,y_m,z_m (have: {})",
+                    source, have));
   }
   const std::string suffix = mm ? "_mm" : "_m";
   table.require({"x" + suffix, "y" + suffix, "z" + suffix});
@@ -524,13 +536,13 @@ bool looks_like_csv(const std::string& text, const std::string& source) {
 TrackerFile parse_tracker_file(const std::string& text, const std::string& source, const TrackerReadOptions& options) {
   std::string body = text;
   if (body.rfind("\xEF\xBB\xBF", 0) == 0) body.erase(0, 3);
-  TrackerFile f =
-      looks_like_csv(body, source) ? parse_csv(body, source, options) : parse_sa(body, source, options);
+  TrackerFile f = looks_like_csv(body, source) ? parse_csv(body, source, options) : parse_sa(body, source, options);
   if (!options.expect_frame.empty() && f.frame.empty() && f.format == "sa") {
     // A file that names no frame cannot be checked against the expected one; say so rather than pass.
-    throw DataError(fmt::format("{}: the header names no working frame, and '{}' was expected (export with the SA "
-                                "version and frame comments, or leave out --expect-frame)",
-                                source, options.expect_frame));
+    throw DataError(
+        fmt::format("{}: the header names no working frame, and '{}' was expected (export with the SA "
+                    "version and frame comments, or leave out --expect-frame)",
+                    source, options.expect_frame));
   }
   return f;
 }
@@ -541,9 +553,9 @@ TrackerFile read_tracker_file(const std::string& path, const TrackerReadOptions&
 
 TrackerTrace timed_trace(const TrackerFile& file, const std::string& what) {
   if (!file.has_time) {
-    throw DataError(fmt::format("{}: {} needs time stamps and the points have none{}", file.source, what,
-                                file.format == "sa" ? " (export with time stamps, or name a time column)"
-                                                    : " (no t_s column)"));
+    throw DataError(
+        fmt::format("{}: {} needs time stamps and the points have none{}", file.source, what,
+                    file.format == "sa" ? " (export with time stamps, or name a time column)" : " (no t_s column)"));
   }
   TrackerTrace trace;
   trace.reserve(file.points.size());
@@ -553,8 +565,8 @@ TrackerTrace timed_trace(const TrackerFile& file, const std::string& what) {
       throw DataError(fmt::format("{}:{}: {} needs a time stamp on every point", file.source, p.line, what));
     }
     if (i > 0 && !(p.t_s > file.points[i - 1].t_s)) {
-      throw DataError(fmt::format("{}:{}: time stamp {} s {} line {}'s ({} s): {} needs increasing stamps",
-                                  file.source, p.line, number_text(p.t_s),
+      throw DataError(fmt::format("{}:{}: time stamp {} s {} line {}'s ({} s): {} needs increasing stamps", file.source,
+                                  p.line, number_text(p.t_s),
                                   p.t_s == file.points[i - 1].t_s ? "repeats" : "goes back from",
                                   file.points[i - 1].line, number_text(file.points[i - 1].t_s), what));
     }
@@ -577,7 +589,8 @@ void write_sa_export(const TrackerTrace& trace, OutputFile& out, const SaExportO
   text += fmt::format("// Working Frame: {}\n", o.frame);
   text += "// Units: Millimeters\n";
   text += "// Coordinate System: Cartesian\n";
-  text += fmt::format("// Columns: Collection{0}Group{0}Target{0}X{0}Y{0}Z{1}\n", sep, o.time ? fmt::format("{}Time", sep) : "");
+  text += fmt::format("// Columns: Collection{0}Group{0}Target{0}X{0}Y{0}Z{1}\n", sep,
+                      o.time ? fmt::format("{}Time", sep) : "");
   out.write(text);
   std::string line;
   for (std::size_t i = 0; i < trace.size(); ++i) {

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "deflex/model/tracker_trace.hpp"
-#include "deflex/text/output_file.hpp"
 #include "deflex/model/types.hpp"
+#include "deflex/text/output_file.hpp"
 
 namespace deflex {
 
@@ -30,13 +30,13 @@ struct TrackerPoint {
 
 /// The points of one file and what its header said.
 struct TrackerFile {
-  std::string source;            ///< the path, for messages
-  std::string format;            ///< "sa" or "csv"
-  std::string frame;             ///< the working frame the header names ("" when it names none)
-  std::string version;           ///< the SA version line's text ("" when absent)
-  std::string coordinates;       ///< "cartesian", "cylindrical" or "spherical"
-  std::string length_unit;       ///< "mm", "m", "cm", "in" or "ft": where it came from is in `unit_from`
-  std::string unit_from;         ///< "header", "option" or "column names"
+  std::string source;       ///< the path, for messages
+  std::string format;       ///< "sa" or "csv"
+  std::string frame;        ///< the working frame the header names ("" when it names none)
+  std::string version;      ///< the SA version line's text ("" when absent)
+  std::string coordinates;  ///< "cartesian", "cylindrical" or "spherical"
+  std::string length_unit;  ///< "mm", "m", "cm", "in" or "ft": where it came from is in `unit_from`
+  std::string unit_from;    ///< "header", "option" or "column names"
   bool has_time = false;
   bool has_names = false;
   std::vector<TrackerPoint> points;
@@ -78,9 +78,9 @@ struct SaExportOptions {
   std::string frame = "Robot Base";  ///< the working frame named in the header
   std::string collection = "deflex";
   std::string group = "trace";
-  bool comma = false;        ///< comma separated instead of spaces
-  bool scientific = false;   ///< full-precision scientific notation instead of 6 decimals of a mm
-  bool time = true;          ///< a time column (s)
+  bool comma = false;       ///< comma separated instead of spaces
+  bool scientific = false;  ///< full-precision scientific notation instead of 6 decimals of a mm
+  bool time = true;         ///< a time column (s)
 };
 /// Writes `trace` as an SA ASCII export: comment lines naming the version, working frame, units
 /// (millimetres) and columns, then "Collection Group Target X Y Z [Time]" a point, targets named

@@ -47,11 +47,11 @@ TrackerRuns read_tracker_runs(const std::vector<std::string>& paths, const Track
     if (s.laps.empty()) {
       throw InputError(fmt::format("{}: --split-laps found no full lap of a closed path in the {} run", p, group));
     }
-    out.notes.push_back(fmt::format("{}: {} lap{}{}", p, s.laps.size(), s.laps.size() == 1 ? "" : "s",
-                                    s.dropped_partial > 0 ? fmt::format(" ({} partial piece{} left out)",
-                                                                        s.dropped_partial,
-                                                                        s.dropped_partial == 1 ? "" : "s")
-                                                          : ""));
+    out.notes.push_back(fmt::format(
+        "{}: {} lap{}{}", p, s.laps.size(), s.laps.size() == 1 ? "" : "s",
+        s.dropped_partial > 0
+            ? fmt::format(" ({} partial piece{} left out)", s.dropped_partial, s.dropped_partial == 1 ? "" : "s")
+            : ""));
     for (std::size_t k = 0; k < s.laps.size(); ++k) {
       out.runs.push_back(std::move(s.laps[k]));
       out.names.push_back(fmt::format("{} lap {}", p, k + 1));

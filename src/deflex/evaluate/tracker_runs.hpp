@@ -18,20 +18,20 @@ namespace deflex {
 
 /// How the files are read.
 struct TrackerRunReading {
-  TrackerReadOptions options;      ///< format options of the files
-  bool have_frame = false;         ///< apply `frame` (tracker frame -> robot base)
+  TrackerReadOptions options;  ///< format options of the files
+  bool have_frame = false;     ///< apply `frame` (tracker frame -> robot base)
   TrackerFrame frame;
-  bool align = false;              ///< put each file on the program's clock against `commanded`
+  bool align = false;  ///< put each file on the program's clock against `commanded`
   CommandedPath commanded;
   TimeAlignmentOptions alignment;
-  bool split_laps = false;         ///< one run a full lap of a closed path, partial pieces left out
+  bool split_laps = false;  ///< one run a full lap of a closed path, partial pieces left out
 };
 
 /// One group of runs (unloaded or loaded).
 struct TrackerRuns {
   std::vector<TrackerTrace> runs;
-  std::vector<std::string> names;  ///< a run's file, and its lap ("a.csv lap 2"), for messages
-  std::vector<TrackerTrace> whole; ///< when aligning: each file whole (the time-synchronous figures)
+  std::vector<std::string> names;   ///< a run's file, and its lap ("a.csv lap 2"), for messages
+  std::vector<TrackerTrace> whole;  ///< when aligning: each file whole (the time-synchronous figures)
   std::vector<std::pair<std::string, TimeAlignment>> alignments;  ///< when aligning: a file's alignment
   std::vector<std::string> notes;  ///< with lap splitting: "a.csv: 3 laps (1 partial piece left out)"
 };

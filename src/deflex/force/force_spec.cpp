@@ -9,8 +9,8 @@
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/force/tool_wrench_model.hpp"
 #include "deflex/force/wrench_table_model.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/paths/key_value_spec.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {
@@ -31,8 +31,9 @@ std::vector<std::unique_ptr<ForceModel>> parse_ldbb(const std::string& spec, con
   }
   Vector3 pivot_m;
   if (keys.has("pivot_mm") == keys.has("phi_deg")) {
-    keys.fail("give exactly one of 'pivot_mm' (X;Y;Z of the table pivot, mm, base frame) and 'phi_deg' (bar "
-              "inclination to the circle's plane)");
+    keys.fail(
+        "give exactly one of 'pivot_mm' (X;Y;Z of the table pivot, mm, base frame) and 'phi_deg' (bar "
+        "inclination to the circle's plane)");
   }
   if (keys.has("pivot_mm")) {
     const auto p = keys.numbers("pivot_mm", 3);
@@ -73,7 +74,8 @@ Wrench parse_wrench_keys(const std::string& spec, const std::string& body) {
 
 Vector3 ldbb_pivot_for_circle(const CirclePath& circle, double phi_rad) {
   if (!std::isfinite(phi_rad) || std::abs(phi_rad) >= deg_to_rad(89.0)) {
-    throw InputError(fmt::format("LDBB: inclination phi must be within +-89 deg (got {:.3f} deg)", rad_to_deg(phi_rad)));
+    throw InputError(
+        fmt::format("LDBB: inclination phi must be within +-89 deg (got {:.3f} deg)", rad_to_deg(phi_rad)));
   }
   if (!circle.normal.allFinite() || circle.normal.norm() < 1e-12) {
     throw InputError("LDBB: the circle's normal must be a finite, non-zero vector");
@@ -107,8 +109,8 @@ std::vector<std::unique_ptr<ForceModel>> parse_force_specs(const std::string& sp
     models.push_back(std::make_unique<WrenchTableModel>(WrenchTableModel::read_file(file)));
     return models;
   }
-  throw InputError(fmt::format("force spec '{}': unknown kind '{}' (use ldbb:..., constant:..., tool:... or table:FILE.csv)",
-                               spec, kind));
+  throw InputError(fmt::format(
+      "force spec '{}': unknown kind '{}' (use ldbb:..., constant:..., tool:... or table:FILE.csv)", spec, kind));
 }
 
 std::unique_ptr<ForceModel> parse_force_spec(const std::string& spec, const ForceSpecContext& context) {

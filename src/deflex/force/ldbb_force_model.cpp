@@ -24,8 +24,8 @@ Wrench LdbbForceModel::wrench_at(std::size_t index, const Pose& base_T_tcp) cons
   const double length = bar.norm();
   // A real bar is 100-600 mm long; under 1 mm the direction is rounding noise.
   if (!(length > 1e-3)) {
-    throw InputError(fmt::format("LDBB: path point {} is {:.3g} mm from the pivot: no bar direction", index,
-                                 length * 1e3));
+    throw InputError(
+        fmt::format("LDBB: path point {} is {:.3g} mm from the pivot: no bar direction", index, length * 1e3));
   }
   Wrench w = Wrench::Zero();
   w.head<3>() = (push_ ? force_N_ : -force_N_) / length * bar;

@@ -53,8 +53,8 @@ WrenchTableModel WrenchTableModel::read_file(const std::string& path) {
 
 Wrench WrenchTableModel::wrench_at(std::size_t index, const Pose& /*base_T_tcp*/) const {
   if (index >= wrenches_.size()) {
-    throw InputError(fmt::format("{}: no wrench for path point {} (the table has {} points)", source_, index,
-                                 wrenches_.size()));
+    throw InputError(
+        fmt::format("{}: no wrench for path point {} (the table has {} points)", source_, index, wrenches_.size()));
   }
   return wrenches_[index];
 }

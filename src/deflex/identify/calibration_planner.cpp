@@ -6,15 +6,15 @@
 #include <limits>
 #include <tuple>
 
+#include <fmt/format.h>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
-#include <fmt/format.h>
 
 #include "deflex/identify/stiffness_identification.hpp"
+#include "deflex/model/inverse_kinematics.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/input_ranges.hpp"
-#include "deflex/model/inverse_kinematics.hpp"
 
 namespace deflex {
 namespace {
@@ -309,8 +309,7 @@ void design_figures(const JointMatrix& G, double noise_m, CalibrationPlan& plan)
   plan.condition_number = kInf;
   plan.predicted_relative_std_error.assign(static_cast<std::size_t>(n), kInf);
   if (no > 0) {
-    const Eigen::VectorXd en =
-        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Gn, Eigen::EigenvaluesOnly).eigenvalues();
+    const Eigen::VectorXd en = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Gn, Eigen::EigenvaluesOnly).eigenvalues();
     const bool full_rank = en[0] > 1e-12 * en[no - 1];
     if (full_rank && no == n) {
       plan.condition_number = std::sqrt(en[no - 1] / en[0]);
@@ -349,23 +348,25 @@ void warn_about_weak_joints(double noise_m, CalibrationPlan& plan) {
 CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanOptions& o) {
   check_options(o);
   if (!model.has_stiffness()) {
-    throw InputError(fmt::format("plan_calibration: robot '{}' has no joint stiffness; nominal values (even rough "
-                                 "ones) are needed to weigh the joints against each other",
-                                 model.name()));
+    throw InputError(
+        fmt::format("plan_calibration: robot '{}' has no joint stiffness; nominal values (even rough "
+                    "ones) are needed to weigh the joints against each other",
+                    model.name()));
   }
   const int n = model.dof();
   CalibrationPlan plan;
   std::vector<CandidatePose> poses = reachable_candidate_poses(model, o, plan.candidate_poses);
   plan.reachable_poses = static_cast<int>(poses.size());
   if (poses.empty()) {
-    throw InputError(fmt::format("plan_calibration: no pose of the region is reachable with the requested tool "
-                                 "orientation inside the joint limits and away from singularities ({} tried)",
-                                 plan.candidate_poses));
+    throw InputError(
+        fmt::format("plan_calibration: no pose of the region is reachable with the requested tool "
+                    "orientation inside the joint limits and away from singularities ({} tried)",
+                    plan.candidate_poses));
   }
   int wanted = o.poses;
   if (wanted > plan.reachable_poses) {
-    plan.warnings.push_back(fmt::format("only {} reachable poses in the region; the plan uses all of them",
-                                        plan.reachable_poses));
+    plan.warnings.push_back(
+        fmt::format("only {} reachable poses in the region; the plan uses all of them", plan.reachable_poses));
     wanted = plan.reachable_poses;
   }
 
@@ -393,9 +394,9 @@ void write_calibration_plan(OutputFile& out, const CalibrationPlan& plan, const 
   for (Eigen::Index j = 1; j <= n; ++j) {
     cols.push_back(fmt::format("q{}_deg", j));
   }
-  for (const char* c : {"x_mm", "y_mm", "z_mm", "qw", "qx", "qy", "qz", "fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm",
-                        "mz_Nm", "load_x_mm", "load_y_mm", "load_z_mm", "expected_dx_mm", "expected_dy_mm",
-                        "expected_dz_mm"}) {
+  for (const char* c :
+       {"x_mm", "y_mm", "z_mm", "qw", "qx", "qy", "qz", "fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm", "load_x_mm",
+        "load_y_mm", "load_z_mm", "expected_dx_mm", "expected_dy_mm", "expected_dz_mm"}) {
     cols.emplace_back(c);
   }
   CsvWriter w(out, cols);

@@ -8,17 +8,17 @@
 
 #include <Eigen/Geometry>
 
-#include "deflex/text/output_file.hpp"
 #include "deflex/model/robot_model.hpp"
+#include "deflex/text/output_file.hpp"
 
 namespace deflex {
 
 struct CalibrationPlanOptions {
   Vector3 region_min_m = Vector3(1.2, -0.5, 0.6);  ///< box of TCP positions, robot base frame, m
   Vector3 region_max_m = Vector3(1.8, 0.5, 1.4);
-  double load_n = 500.0;    ///< magnitude of the applied force, N
-  int poses = 12;           ///< number of distinct poses in the plan
-  int loads_per_pose = 2;   ///< loads applied (one after the other) at each pose
+  double load_n = 500.0;   ///< magnitude of the applied force, N
+  int poses = 12;          ///< number of distinct poses in the plan
+  int loads_per_pose = 2;  ///< loads applied (one after the other) at each pose
   /// The force is applied at a point this far from the WAP, perpendicular to the tool's z axis
   /// (a calibration bar on the tool), so it also twists the wrist; 0: forces at the WAP only.
   double lever_m = 0.25;
@@ -27,18 +27,18 @@ struct CalibrationPlanOptions {
   Eigen::Quaterniond orientation = Eigen::Quaterniond(0.0, 0.0, 1.0, 0.0);
   /// Candidate turns of the tool about its own z axis, rad.
   std::vector<double> spin_rad = {0.0, kPi / 2, kPi, 3 * kPi / 2};
-  int grid_per_axis = 4;    ///< candidate positions per axis of the region
-  double noise_m = 10e-6;   ///< tracker noise per axis, m, for the predicted standard errors
+  int grid_per_axis = 4;   ///< candidate positions per axis of the region
+  double noise_m = 10e-6;  ///< tracker noise per axis, m, for the predicted standard errors
 };
 
 /// One row of the plan: go to q, apply `wrench_base` (the force at `load_point_base`), measure.
 struct CalibrationPoint {
-  int pose = 0;            ///< 1-based pose number (several loads share a pose)
-  JointVector q;           ///< rad
-  Pose base_T_tcp;         ///< the TCP pose at q
-  Wrench wrench_base;      ///< at the WAP, base frame, N and Nm
-  Vector3 load_point_base; ///< where the force acts, base frame, m
-  Vector3 expected_dp_m;   ///< first-order deflection with the robot file's stiffness, m
+  int pose = 0;             ///< 1-based pose number (several loads share a pose)
+  JointVector q;            ///< rad
+  Pose base_T_tcp;          ///< the TCP pose at q
+  Wrench wrench_base;       ///< at the WAP, base frame, N and Nm
+  Vector3 load_point_base;  ///< where the force acts, base frame, m
+  Vector3 expected_dp_m;    ///< first-order deflection with the robot file's stiffness, m
 };
 
 struct CalibrationPlan {
@@ -50,8 +50,8 @@ struct CalibrationPlan {
   double condition_number = 0.0;
   /// se(c_j)/c_j predicted for `noise_m` (the same as se(k_j)/k_j to first order).
   std::vector<double> predicted_relative_std_error;
-  int candidate_poses = 0;   ///< grid points x spins tried
-  int reachable_poses = 0;   ///< of those, reachable inside the joint limits and not near singular
+  int candidate_poses = 0;  ///< grid points x spins tried
+  int reachable_poses = 0;  ///< of those, reachable inside the joint limits and not near singular
   std::vector<std::string> warnings;
 };
 
@@ -64,7 +64,8 @@ struct CalibrationPlan {
 
 /// Writes the plan as CSV for the cell operator (docs/identify.md): pose, q1_deg.., x_mm..,
 /// qw..qz, fx_N..mz_Nm, load_x_mm.., expected_dx_mm..; the plan figures as comment lines.
-void write_calibration_plan(OutputFile& out, const CalibrationPlan& plan, const std::vector<std::string>& comments = {});
+void write_calibration_plan(OutputFile& out, const CalibrationPlan& plan,
+                            const std::vector<std::string>& comments = {});
 /// The same into a file of its own (output_file.hpp).
 void write_calibration_plan(const std::string& path, const CalibrationPlan& plan,
                             const std::vector<std::string>& comments = {});

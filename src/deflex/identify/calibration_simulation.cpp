@@ -26,8 +26,8 @@ std::vector<StiffnessMeasurement> simulate_calibration(const RobotModel& truth, 
   for (std::size_t i = 0; i < plan.points.size(); ++i) {
     const CalibrationPoint& p = plan.points[i];
     if (p.q.size() != truth.dof()) {
-      throw InputError(fmt::format("simulate_calibration: plan point {} has {} joints, the robot {}", i + 1,
-                                   p.q.size(), truth.dof()));
+      throw InputError(fmt::format("simulate_calibration: plan point {} has {} joints, the robot {}", i + 1, p.q.size(),
+                                   truth.dof()));
     }
     StiffnessMeasurement m;
     m.q = p.q;

@@ -14,7 +14,8 @@ namespace deflex {
 /// the identification's first-order model); the displacement is FK(q_actual) - FK(q) of the TCP
 /// plus Gaussian noise of `noise_m` per axis from a generator seeded with `seed`. Throws InputError
 /// when `truth` has no stiffness or a deflection does not converge.
-[[nodiscard]] std::vector<StiffnessMeasurement> simulate_calibration(const RobotModel& truth, const CalibrationPlan& plan,
-                                                                     double noise_m, unsigned seed);
+[[nodiscard]] std::vector<StiffnessMeasurement> simulate_calibration(const RobotModel& truth,
+                                                                     const CalibrationPlan& plan, double noise_m,
+                                                                     unsigned seed);
 
 }  // namespace deflex

@@ -34,9 +34,10 @@ void SpillFile::open() {
   buf.push_back('\0');
   fd_ = ::mkstemp(buf.data());
   if (fd_ < 0) {
-    throw Error(fmt::format("{}: too many to keep in memory, and no scratch file could be made in {} ({}); set TMPDIR "
-                            "to a writable directory",
-                            what_, directory_, std::strerror(errno)));
+    throw Error(
+        fmt::format("{}: too many to keep in memory, and no scratch file could be made in {} ({}); set TMPDIR "
+                    "to a writable directory",
+                    what_, directory_, std::strerror(errno)));
   }
   ::unlink(buf.data());  // gone from the directory now; the space is freed when the process ends
 }
@@ -60,8 +61,8 @@ void SpillFile::write_at(std::uint64_t offset, const double* values, std::size_t
       continue;
     }
     if (n <= 0) {
-      throw Error(fmt::format("{}: writing the scratch file in {} failed ({}); free space there or set TMPDIR",
-                              what_, directory_, n < 0 ? std::strerror(errno) : "nothing written"));
+      throw Error(fmt::format("{}: writing the scratch file in {} failed ({}); free space there or set TMPDIR", what_,
+                              directory_, n < 0 ? std::strerror(errno) : "nothing written"));
     }
     p += n;
     left -= static_cast<std::size_t>(n);

@@ -7,15 +7,15 @@
 #include <limits>
 #include <memory>
 
+#include <fmt/format.h>
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
 #include <Eigen/SVD>
-#include <fmt/format.h>
 
 #include "deflex/identify/detail/nonnegative_least_squares.hpp"
 #include "deflex/identify/detail/spill_file.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/model/linear_algebra.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 
@@ -32,7 +32,6 @@ void stiffness_regressor(const RobotModel& model, Workspace& ws, const JointVect
 }
 
 namespace {
-
 
 // Wilson-Hilferty approximation of the chi-square quantile with k degrees of freedom at the
 // standard normal quantile z; good to a few percent for k >= 1, enough to set robust thresholds.
@@ -187,7 +186,7 @@ using RowBlock = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::D
 // rows a slab at a time, each slab stacked under the R found so far (the same R, up to the signs of
 // its rows, as one QR of the whole tall matrix, without holding it).
 struct Triangular {
-  Eigen::MatrixXd R;      // p x p, zero below row `rows`
+  Eigen::MatrixXd R;  // p x p, zero below row `rows`
   Eigen::VectorXd qty;
   Eigen::Index rows = 0;  // min(equations, p): fewer equations than unknowns leave R short
 };
@@ -234,7 +233,7 @@ Triangular blocked_qr(const RowStore& s, const std::vector<int>& cols, const Eig
 
 // Singular values (descending) and right singular vectors of the scaled, weighted columns `cols`.
 DynamicSvd svd_of(const RowStore& s, const std::vector<int>& cols, const Eigen::VectorXd& scale,
-                                         const std::vector<double>& omega) {
+                  const std::vector<double>& omega) {
   const Triangular t = blocked_qr(s, cols, scale, omega);
   return DynamicSvd(t.R.topRows(t.rows), Eigen::ComputeFullV);
 }
@@ -350,9 +349,9 @@ void drop_collinear_joint_groups(const RowStore& s, const Eigen::VectorXd& col_n
     }
     // The joints in the unobservable direction: the smallest singular value's vector or, with fewer
     // equations than joints, every joint with a component in the null space (V's trailing columns).
-    const Eigen::MatrixXd null_basis =
-        underdetermined ? Eigen::MatrixXd(svd.matrixV().rightCols(svd.matrixV().cols() - sv.size()))
-                        : Eigen::MatrixXd(svd.matrixV().col(last));
+    const Eigen::MatrixXd null_basis = underdetermined
+                                           ? Eigen::MatrixXd(svd.matrixV().rightCols(svd.matrixV().cols() - sv.size()))
+                                           : Eigen::MatrixXd(svd.matrixV().col(last));
     std::vector<int> group;
     for (Eigen::Index k = 0; k < null_basis.rows(); ++k) {
       if (null_basis.row(k).norm() > 0.1) {
@@ -385,9 +384,10 @@ void hold_left_out_joints(RowStore& s, const RobotModel& model, std::vector<int>
     if (model.has_stiffness()) {
       const double k = model.stiffness()[j];
       move_known_compliance_to_rhs(s, j, 1.0 / k);
-      warnings.push_back(fmt::format("joint {}: not identified (NaN in the estimate); the others were fitted "
-                                     "with it held at the robot file's {:.4g} Nm/rad",
-                                     j + 1, k));
+      warnings.push_back(
+          fmt::format("joint {}: not identified (NaN in the estimate); the others were fitted "
+                      "with it held at the robot file's {:.4g} Nm/rad",
+                      j + 1, k));
     } else {
       warnings.push_back(fmt::format(
           "joint {}: not identified (NaN in the estimate); the others were fitted with it taken as rigid (the robot "
@@ -503,9 +503,8 @@ WeightedFit fit_robustly(const RowStore& s, const std::vector<int>& estimated, c
     return fit;
   }
   double b2 = 0.0;
-  s.for_each([&](std::size_t, int rows, const double* block) {
-    b2 += RowBlock(block, rows, width).col(n).squaredNorm();
-  });
+  s.for_each(
+      [&](std::size_t, int rows, const double* block) { b2 += RowBlock(block, rows, width).col(n).squaredNorm(); });
   const double rhs_scale = std::sqrt(b2 / static_cast<double>(s.total_rows()));
   std::vector<double> d_over(m);
   double sigma = 0.0;
@@ -617,8 +616,7 @@ Eigen::VectorXd scaled_compliance_variances(const RowStore& s, const std::vector
     const auto pp = static_cast<Eigen::Index>(passive.size());
     const Eigen::MatrixXd R = blocked_qr(s, passive, col_norm, omega).R;
     // (R^T R)^-1 = R^-1 R^-T: diagonal = squared row norms of R^-1.
-    const Eigen::MatrixXd Rinv =
-        R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(pp, pp));
+    const Eigen::MatrixXd Rinv = R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(pp, pp));
     var_scaled = sigma2 * Rinv.rowwise().squaredNorm();
   }
   return var_scaled;
@@ -635,10 +633,10 @@ void report_estimated_joints(const std::vector<int>& estimated, const WeightedFi
     if (fit.at_bound[k]) {
       est.compliance_rad_per_nm[ju] = 0.0;
       left_out.push_back(j);
-      est.warnings.push_back(fmt::format(
-          "joint {}: the fit puts its compliance at the c >= 0 bound (the data want it rigid or negative); "
-          "its stiffness is not identified",
-          j + 1));
+      est.warnings.push_back(
+          fmt::format("joint {}: the fit puts its compliance at the c >= 0 bound (the data want it rigid or negative); "
+                      "its stiffness is not identified",
+                      j + 1));
       continue;
     }
     const auto pk = static_cast<Eigen::Index>(std::find(passive.begin(), passive.end(), j) - passive.begin());
@@ -662,8 +660,7 @@ void report_estimated_joints(const std::vector<int>& estimated, const WeightedFi
 
 // The joints not identified into est (1-based, sorted), and a warning naming the measurements rejected as
 // outliers (file line where known; the first ten). `lines` has one entry per measurement.
-void list_unidentified_and_rejected(std::vector<int>& left_out, const std::vector<int>& lines,
-                                    StiffnessEstimate& est) {
+void list_unidentified_and_rejected(std::vector<int>& left_out, const std::vector<int>& lines, StiffnessEstimate& est) {
   std::sort(left_out.begin(), left_out.end());
   for (int j : left_out) {
     est.unidentifiable_joints.push_back(j + 1);
@@ -688,8 +685,7 @@ void list_unidentified_and_rejected(std::vector<int>& left_out, const std::vecto
 StiffnessIdentifier::StiffnessIdentifier(const RobotModel& model, const IdentificationOptions& options)
     : model_(model), options_(options), ws_(model), block_(6, model.dof()) {
   const int n = model.dof();
-  if (!options.fixed_stiffness_nm_per_rad.empty() &&
-      static_cast<int>(options.fixed_stiffness_nm_per_rad.size()) != n) {
+  if (!options.fixed_stiffness_nm_per_rad.empty() && static_cast<int>(options.fixed_stiffness_nm_per_rad.size()) != n) {
     throw InputError(fmt::format("identify_stiffness: {} fixed-stiffness entries for a {}-joint robot",
                                  options.fixed_stiffness_nm_per_rad.size(), n));
   }
@@ -715,8 +711,8 @@ void StiffnessIdentifier::add(const StiffnessMeasurement& m) {
   const int n = model_.dof();
   const std::size_t i = store_->rows.size();
   if (m.q.size() != n) {
-    throw InputError(fmt::format("{}: {} joint values for a {}-joint robot ({})", where(m, i), m.q.size(), n,
-                                 model_.name()));
+    throw InputError(
+        fmt::format("{}: {} joint values for a {}-joint robot ({})", where(m, i), m.q.size(), n, model_.name()));
   }
   if (!m.q.allFinite() || !m.wrench_base.allFinite() || !m.dp_m.allFinite() ||
       (m.drot_rad && !m.drot_rad->allFinite())) {

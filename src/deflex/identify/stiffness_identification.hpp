@@ -60,8 +60,8 @@ struct StiffnessEstimate {
   std::vector<double> std_error_nm_per_rad;
   std::vector<double> compliance_rad_per_nm;            ///< c = 1/k (0 at the bound, NaN if not estimated)
   std::vector<double> compliance_std_error_rad_per_nm;  ///< its standard error
-  double residual_rms_m = 0.0;    ///< RMS of the position residuals of the measurements kept
-  double residual_max_m = 0.0;    ///< largest position residual norm of the measurements kept
+  double residual_rms_m = 0.0;                          ///< RMS of the position residuals of the measurements kept
+  double residual_max_m = 0.0;                          ///< largest position residual norm of the measurements kept
   double residual_rms_rad = 0.0;  ///< RMS of the orientation residuals (0 without orientation data)
   double sigma_m = 0.0;           ///< estimated noise per component (the standard errors' sigma), m
   /// Condition number of the weighted regressor of the estimated joints, columns scaled to unit
@@ -82,7 +82,8 @@ struct StiffnessEstimate {
 /// kinematics, tool (TCP: the measured point) and WAP. Throws InputError when a measurement's joint
 /// count differs from the robot's, a value is not finite, the options do not fit the robot, or no
 /// joint is left to estimate; names the measurement (file line when known).
-[[nodiscard]] StiffnessEstimate identify_stiffness(const RobotModel& model, const std::vector<StiffnessMeasurement>& data,
+[[nodiscard]] StiffnessEstimate identify_stiffness(const RobotModel& model,
+                                                   const std::vector<StiffnessMeasurement>& data,
                                                    const IdentificationOptions& options = {});
 
 /// The same a measurement at a time, for data too large to hold as StiffnessMeasurement objects (a

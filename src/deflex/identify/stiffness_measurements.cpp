@@ -57,8 +57,8 @@ StiffnessMeasurementReader::StiffnessMeasurementReader(const std::string& csv_pa
     }
     d_cols_.push_back(*c);
   }
-  const int rot_count = static_cast<int>(t.has("drx_rad")) + static_cast<int>(t.has("dry_rad")) +
-                        static_cast<int>(t.has("drz_rad"));
+  const int rot_count =
+      static_cast<int>(t.has("drx_rad")) + static_cast<int>(t.has("dry_rad")) + static_cast<int>(t.has("drz_rad"));
   if (rot_count != 0 && rot_count != 3) {
     throw DataError(fmt::format("{}: give all three of drx_rad, dry_rad, drz_rad or none", csv_path));
   }

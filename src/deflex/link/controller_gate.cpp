@@ -49,12 +49,21 @@ bool ControllerGate::take(const DatagramAddress& from, std::uint64_t number, std
     (void)sequence_.observe(number);
   } else {
     switch (sequence_.observe(number)) {
-      case SequenceVerdict::kDuplicate: ++counters.duplicate; return false;
-      case SequenceVerdict::kOutOfOrder: ++counters.out_of_order; return false;
-      case SequenceVerdict::kFarAhead: ++counters.far_ahead; return false;
-      case SequenceVerdict::kRestart: session_start = true; break;
+      case SequenceVerdict::kDuplicate:
+        ++counters.duplicate;
+        return false;
+      case SequenceVerdict::kOutOfOrder:
+        ++counters.out_of_order;
+        return false;
+      case SequenceVerdict::kFarAhead:
+        ++counters.far_ahead;
+        return false;
+      case SequenceVerdict::kRestart:
+        session_start = true;
+        break;
       case SequenceVerdict::kFirst:
-      case SequenceVerdict::kNext: break;
+      case SequenceVerdict::kNext:
+        break;
     }
   }
   if (session_start && have_sender_) ++counters.restarts;
@@ -62,8 +71,8 @@ bool ControllerGate::take(const DatagramAddress& from, std::uint64_t number, std
   std::uint64_t stamp_step = stamp_ms - last_stamp_ms_;
   if (config_.stamp_bits == 32) stamp_step &= 0xFFFFFFFFULL;
   const double cycles = std::max(1.0, std::round(static_cast<double>(step) / config_.numbers_per_cycle));
-  timing_.on_message(static_cast<double>(stamp_step) * 1e-3, now_s, session_start ? 1 : static_cast<std::uint64_t>(cycles),
-                     session_start, counters, arrival);
+  timing_.on_message(static_cast<double>(stamp_step) * 1e-3, now_s,
+                     session_start ? 1 : static_cast<std::uint64_t>(cycles), session_start, counters, arrival);
   last_stamp_ms_ = stamp_ms;
   resync_ = false;
   last_heard_s_ = now_s;

@@ -23,7 +23,7 @@ struct ControllerGateConfig {
   /// How far the sequence number moves in one cycle: 1 for a counter (EGM seqno), the period in ms
   /// for a millisecond time stamp (RSI IPOC). Gives the cycles missed between two messages.
   double numbers_per_cycle = 1.0;
-  int stamp_bits = 32;             ///< width of the millisecond time stamp: 32 wraps (EGM tm), 64 (IPOC)
+  int stamp_bits = 32;  ///< width of the millisecond time stamp: 32 wraps (EGM tm), 64 (IPOC)
   /// Throws InputError naming the setting.
   void validate() const;
 };

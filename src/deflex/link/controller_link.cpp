@@ -9,33 +9,47 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 
 const char* to_string(LinkState s) {
   switch (s) {
-    case LinkState::kWaiting: return "waiting";
-    case LinkState::kRunning: return "running";
-    case LinkState::kFinished: return "finished";
-    case LinkState::kRefused: return "refused";
-    case LinkState::kStopped: return "stopped";
+    case LinkState::kWaiting:
+      return "waiting";
+    case LinkState::kRunning:
+      return "running";
+    case LinkState::kFinished:
+      return "finished";
+    case LinkState::kRefused:
+      return "refused";
+    case LinkState::kStopped:
+      return "stopped";
   }
   return "unknown";
 }
 
 const char* to_string(LinkStopCause c) {
   switch (c) {
-    case LinkStopCause::kNone: return "not stopped";
-    case LinkStopCause::kRequested: return "stop requested";
-    case LinkStopCause::kEnded: return "session ended";
-    case LinkStopCause::kProtocol: return "protocol error";
-    case LinkStopCause::kSilent: return "controller silent";
-    case LinkStopCause::kConnection: return "connection lost";
-    case LinkStopCause::kController: return "controller stopped or faulted";
-    case LinkStopCause::kSafety: return "safety guard";
-    case LinkStopCause::kTooSlow: return "controller too slow";
+    case LinkStopCause::kNone:
+      return "not stopped";
+    case LinkStopCause::kRequested:
+      return "stop requested";
+    case LinkStopCause::kEnded:
+      return "session ended";
+    case LinkStopCause::kProtocol:
+      return "protocol error";
+    case LinkStopCause::kSilent:
+      return "controller silent";
+    case LinkStopCause::kConnection:
+      return "connection lost";
+    case LinkStopCause::kController:
+      return "controller stopped or faulted";
+    case LinkStopCause::kSafety:
+      return "safety guard";
+    case LinkStopCause::kTooSlow:
+      return "controller too slow";
   }
   return "unknown";
 }
@@ -110,10 +124,11 @@ bool ControllerLink::apply_silence_rules(double now) noexcept {
               "the controller went quiet for %.2f s after a healthy session (--end-on-silence): its program's end",
               silent);
   } else {
-    stop_link(LinkStopCause::kSilent,
-              "no usable message from the controller for %.2f s (the stop silence is %.2f s): it stopped or the network "
-              "is down (%" PRIu64 " datagrams rejected in all)",
-              silent, rules_.stop_silence_s, counters_.rejected());
+    stop_link(
+        LinkStopCause::kSilent,
+        "no usable message from the controller for %.2f s (the stop silence is %.2f s): it stopped or the network "
+        "is down (%" PRIu64 " datagrams rejected in all)",
+        silent, rules_.stop_silence_s, counters_.rejected());
   }
   return true;
 }

@@ -29,12 +29,12 @@ enum class LinkState : int {
 /// KDL's sign convention: >= 0 nothing is wrong with the link (positive: nothing to do), < 0 a
 /// message was not answered for a reason the caller should know.
 enum class LinkPollResult : int {
-  kAnswered = 0,     ///< a controller message was handled and answered
-  kIdle = 1,         ///< nothing arrived
-  kRejected = 2,     ///< datagrams arrived but none was usable (counted)
-  kNotAnswered = -1, ///< a usable message was not answered (invalid cycle): counted
-  kRefused = -2,     ///< the start was refused: see start_distance() (returned once)
-  kStopped = -3,     ///< the link stopped: see stop_cause(), stop_reason() (returned once)
+  kAnswered = 0,      ///< a controller message was handled and answered
+  kIdle = 1,          ///< nothing arrived
+  kRejected = 2,      ///< datagrams arrived but none was usable (counted)
+  kNotAnswered = -1,  ///< a usable message was not answered (invalid cycle): counted
+  kRefused = -2,      ///< the start was refused: see start_distance() (returned once)
+  kStopped = -3,      ///< the link stopped: see stop_cause(), stop_reason() (returned once)
 };
 
 /// Why a link stopped (LinkState::kStopped). The runtime maps each to a stop reason and an exit code

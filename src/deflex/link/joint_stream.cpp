@@ -69,8 +69,8 @@ void JointStream::consumed(double period_s) noexcept {
   if (!started_ || !(period_s > 0.0)) return;
   if (program_t_s_ < trajectory_->end_time_s()) ++cycles_;
   ++blend_cycles_;
-  program_t_s_ = std::min(trajectory_->start_time_s() + static_cast<double>(cycles_) * period_s,
-                          trajectory_->end_time_s());
+  program_t_s_ =
+      std::min(trajectory_->start_time_s() + static_cast<double>(cycles_) * period_s, trajectory_->end_time_s());
   blend_t_s_ = static_cast<double>(blend_cycles_) * period_s;
 }
 

@@ -22,8 +22,8 @@
 namespace deflex {
 
 struct JointStreamConfig {
-  double ramp_in_s = 1.0;                        ///< s, blend from the anchor to the program
-  double start_tolerance_rad = kPi / 180.0;      ///< the anchor must be this close to the command (1 deg)
+  double ramp_in_s = 1.0;                    ///< s, blend from the anchor to the program
+  double start_tolerance_rad = kPi / 180.0;  ///< the anchor must be this close to the command (1 deg)
   /// Throws InputError on a negative or non-finite value.
   void validate() const;
 };
@@ -63,7 +63,7 @@ class JointStream {
   // Cycles consumed, counted: the times are start + n x period, so thousands of cycles add no
   // rounding (a sum of 0.1 s steps would miss the program's end by an ulp).
   std::uint64_t cycles_ = 0, blend_cycles_ = 0;
-  JointVector offset_;      // the blend's offset at its start
+  JointVector offset_;  // the blend's offset at its start
   JointVector distance_;
   mutable JointVector scratch_, scratch_velocity_;
 };

@@ -9,34 +9,42 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 
 const char* to_string(CommandForm f) {
   switch (f) {
-    case CommandForm::kJointTarget: return "joint target";
-    case CommandForm::kJointOffset: return "joint offset";
-    case CommandForm::kTcpOffset: return "TCP offset";
+    case CommandForm::kJointTarget:
+      return "joint target";
+    case CommandForm::kJointOffset:
+      return "joint offset";
+    case CommandForm::kTcpOffset:
+      return "TCP offset";
   }
   return "unknown";
 }
 
 double CommandLimits::resolution_rad(double v) const noexcept {
   switch (rounding) {
-    case WireRounding::kExact: return 0.0;
+    case WireRounding::kExact:
+      return 0.0;
     // Half an ulp of a float32 of that size, and a little more for the double sums around it.
-    case WireRounding::kFloat32: return std::max(std::abs(v), 1.0) * static_cast<double>(std::numeric_limits<float>::epsilon());
-    case WireRounding::kDecimalsDeg: return deg_to_rad(0.5 * std::pow(10.0, -decimals)) * (1.0 + 1e-9);
+    case WireRounding::kFloat32:
+      return std::max(std::abs(v), 1.0) * static_cast<double>(std::numeric_limits<float>::epsilon());
+    case WireRounding::kDecimalsDeg:
+      return deg_to_rad(0.5 * std::pow(10.0, -decimals)) * (1.0 + 1e-9);
   }
   return 0.0;
 }
 
 double CommandLimits::round(double v) const noexcept {
   switch (rounding) {
-    case WireRounding::kExact: return v;
-    case WireRounding::kFloat32: return static_cast<double>(static_cast<float>(v));
+    case WireRounding::kExact:
+      return v;
+    case WireRounding::kFloat32:
+      return static_cast<double>(static_cast<float>(v));
     case WireRounding::kDecimalsDeg: {
       const double scale = std::pow(10.0, decimals);
       return deg_to_rad(std::round(rad_to_deg(v) * scale) / scale);
@@ -47,7 +55,8 @@ double CommandLimits::round(double v) const noexcept {
 
 void CommandLimits::validate(int dof) const {
   const auto positive = [](double v, const char* what) {
-    if (!std::isfinite(v) || !(v > 0.0)) throw InputError(fmt::format("command limits: {} must be > 0 (got {})", what, v));
+    if (!std::isfinite(v) || !(v > 0.0))
+      throw InputError(fmt::format("command limits: {} must be > 0 (got {})", what, v));
   };
   positive(joint_bound_rad, "the joint bound");
   positive(tcp_bound_m, "the TCP bound");
@@ -55,7 +64,8 @@ void CommandLimits::validate(int dof) const {
     positive(tcp_step_m, "the TCP step limit");
   } else {
     if (joint_step_rad.size() != dof) {
-      throw InputError(fmt::format("command limits: {} joint step limits for a robot of {} joints", joint_step_rad.size(), dof));
+      throw InputError(
+          fmt::format("command limits: {} joint step limits for a robot of {} joints", joint_step_rad.size(), dof));
     }
     for (int j = 0; j < dof; ++j) positive(joint_step_rad[j], "a joint's step limit");
   }
@@ -90,10 +100,11 @@ CommandLimits command_limits(CommandForm form, const OnlineConfig& online, int d
   }
   const double tcp_step = online.max_tcp_rate_m_s * period;
   if (tcp_step > online.max_tcp_correction_m) {
-    throw InputError(fmt::format(
-        "the correction's TCP rate bound allows {:.4g} mm a cycle ({:g} mm/s x {:g} ms), more than its TCP bound of {:g} "
-        "mm: lower --max-tcp-rate-mm-s or --period-ms, or raise --max-tcp-correction-mm",
-        tcp_step * 1e3, online.max_tcp_rate_m_s * 1e3, period * 1e3, online.max_tcp_correction_m * 1e3));
+    throw InputError(
+        fmt::format("the correction's TCP rate bound allows {:.4g} mm a cycle ({:g} mm/s x {:g} ms), more than its TCP "
+                    "bound of {:g} "
+                    "mm: lower --max-tcp-rate-mm-s or --period-ms, or raise --max-tcp-correction-mm",
+                    tcp_step * 1e3, online.max_tcp_rate_m_s * 1e3, period * 1e3, online.max_tcp_correction_m * 1e3));
   }
   CommandLimits l;
   l.form = form;
@@ -276,8 +287,9 @@ bool LinkCycle::guard(const JointVector* reference) noexcept {
       r.step_rad = std::max(r.step_rad, step);
       fraction = std::max(fraction, step / limits_.joint_step_rad[j]);
       if (step > limits_.joint_step_rad[j] * kRel + 2.0 * res + 1e-12) {
-        return refuse("joint %d of the command moved %.6f deg in one cycle, beyond the step limit %.6f deg: nothing sent",
-                      j + 1, rad_to_deg(step), rad_to_deg(limits_.joint_step_rad[j]));
+        return refuse(
+            "joint %d of the command moved %.6f deg in one cycle, beyond the step limit %.6f deg: nothing sent", j + 1,
+            rad_to_deg(step), rad_to_deg(limits_.joint_step_rad[j]));
       }
     }
   }

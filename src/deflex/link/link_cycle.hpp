@@ -112,8 +112,8 @@ struct CycleStats {
   /// Joint target: the largest |command - program| of any joint, the blend included (what the status
   /// line reports next to the bound: the blend is not hidden).
   double max_program_deviation_rad = 0.0;
-  double max_step_rad = 0.0;       ///< largest step between consecutive commands of any joint (joint forms)
-  double max_step_m = 0.0;         ///< largest step of the TCP offset (TCP form)
+  double max_step_rad = 0.0;  ///< largest step between consecutive commands of any joint (joint forms)
+  double max_step_m = 0.0;    ///< largest step of the TCP offset (TCP form)
   /// max_step_rad as a fraction of that joint's step limit, and the same for the TCP (<= 1 on the wire).
   double max_step_fraction = 0.0;
 };

@@ -32,11 +32,11 @@ class LinkTiming {
   [[nodiscard]] double period_s() const { return period_s_; }
 
  private:
-  static constexpr int kBlocks = 8;             // the minimum is taken over kBlocks blocks ...
-  static constexpr double kBlockS = 1.0;        // ... of this many seconds of receipt time
+  static constexpr int kBlocks = 8;       // the minimum is taken over kBlocks blocks ...
+  static constexpr double kBlockS = 1.0;  // ... of this many seconds of receipt time
   double period_s_;
   bool have_ = false;
-  double stamp_s_ = 0.0;        // the continuous time stamp of the session
+  double stamp_s_ = 0.0;  // the continuous time stamp of the session
   double previous_offset_s_ = 0.0;
   double jitter_s_ = 0.0;
   std::array<double, kBlocks> block_min_{};

@@ -42,8 +42,8 @@ void joint_deflection(const RobotModel& model, Workspace& ws, const JointVector&
 
 /// Complementary stiffness K_c(q, W) = d(J_wap(q)^T W)/dq (n x n, Nm/rad), with the wrench held
 /// fixed in the base frame and applied at the WAP as it moves. Analytic.
-void complementary_stiffness(const RobotModel& model, Workspace& ws, const JointVector& q,
-                             const Wrench& wrench_base, JointMatrix& Kc);
+void complementary_stiffness(const RobotModel& model, Workspace& ws, const JointVector& q, const Wrench& wrench_base,
+                             JointMatrix& Kc);
 
 /// Compensated command for a known wrench (exact form): the arm, commanded to q_cmd, deflects to
 /// q_cmd + K^-1 J(q_actual)^T W; asking q_actual = q_desired gives
@@ -65,8 +65,8 @@ enum class DeflectionStatus : int {
 /// solves q = q_cmd + K^-1 J_wap(q)^T W by fixed-point iteration (contracts quickly at realistic
 /// loads: the correction is ~1e-3 rad). Stops when the step is below tol_rad.
 DeflectionStatus deflected_configuration(const RobotModel& model, Workspace& ws, const JointVector& q_cmd,
-                                         const Wrench& wrench_base, JointVector& q_actual,
-                                         double tol_rad = 1e-13, int max_iterations = 50);
+                                         const Wrench& wrench_base, JointVector& q_actual, double tol_rad = 1e-13,
+                                         int max_iterations = 50);
 
 /// The same fixed point, iterated from `q_start` instead of q_cmd: a caller that knows where the
 /// arm will nearly be (q_cmd + K^-1 J(q_cmd)^T W, or the configuration the command was computed for)
@@ -74,7 +74,6 @@ DeflectionStatus deflected_configuration(const RobotModel& model, Workspace& ws,
 /// the step test still certifies it, so a poor start costs iterations, never accuracy.
 DeflectionStatus deflected_configuration_from(const RobotModel& model, Workspace& ws, const JointVector& q_cmd,
                                               const Wrench& wrench_base, const JointVector& q_start,
-                                              JointVector& q_actual, double tol_rad = 1e-13,
-                                              int max_iterations = 50);
+                                              JointVector& q_actual, double tol_rad = 1e-13, int max_iterations = 50);
 
 }  // namespace deflex

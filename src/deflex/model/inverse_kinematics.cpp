@@ -7,11 +7,11 @@
 #include <cmath>
 #include <utility>
 
-#include <Eigen/SVD>
 #include <fmt/format.h>
+#include <Eigen/SVD>
 
-#include "deflex/model/opw_ik.hpp"
 #include "deflex/model/linear_algebra.hpp"
+#include "deflex/model/opw_ik.hpp"
 
 namespace deflex {
 namespace {

@@ -314,7 +314,11 @@ void opw_branches(const OpwGeometry& g, const Pose& opw_T_end, double theta4_whe
   out.count = 0;
   out.reachable = false;
   const Matrix3& Re = opw_T_end.linear();
-  const OpwTarget t{g, Re, opw_T_end.translation() - g.c4 * Re.col(2), theta4_when_singular, near_singular_threshold,
+  const OpwTarget t{g,
+                    Re,
+                    opw_T_end.translation() - g.c4 * Re.col(2),
+                    theta4_when_singular,
+                    near_singular_threshold,
                     opw_fit_limits(fit)};
   const Vector3& w = t.w;
   const double rho2 = w.x() * w.x() + w.y() * w.y();

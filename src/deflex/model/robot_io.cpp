@@ -9,12 +9,12 @@
 #include <fmt/format.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include "deflex/model/detail/urdf_tree.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/input_file.hpp"
 #include "deflex/text/input_ranges.hpp"
 #include "deflex/text/output_file.hpp"
-#include "deflex/model/detail/urdf_tree.hpp"
 #include "deflex/text/yaml_fields.hpp"
 
 namespace deflex {
@@ -60,7 +60,8 @@ Units parse_units(const yaml::Field& root) {
 Pose urdf_pose(const urdf::Pose& p) {
   Pose out = Pose::Identity();
   out.translation() = Vector3(p.position.x, p.position.y, p.position.z);
-  out.linear() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).normalized().toRotationMatrix();
+  out.linear() =
+      Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).normalized().toRotationMatrix();
   return out;
 }
 
@@ -241,7 +242,9 @@ const std::string& builtin_irb6700_yaml() {
 
 RobotModel builtin_irb6700() { return load_robot_yaml_text(builtin_irb6700_yaml(), "<built-in IRB6700>"); }
 
-RobotModel load_robot_or_builtin(const std::string& path) { return path.empty() ? builtin_irb6700() : load_robot(path); }
+RobotModel load_robot_or_builtin(const std::string& path) {
+  return path.empty() ? builtin_irb6700() : load_robot(path);
+}
 
 namespace {
 std::string pose_yaml(const Pose& p) {
@@ -262,15 +265,15 @@ std::string robot_to_yaml(const RobotModel& model) {
     for (std::size_t i = 0; i < d.dh.size(); ++i) {
       const DhRow& r = d.dh[i];
       const double speed = d.joints[i].max_speed_rad_s;
-      out += fmt::format("    - {{a: {:.9g}, alpha: {:.9g}, d: {:.9g}, offset: {:.9g}, min: {:.9g}, max: {:.9g}{}}}\n", r.a_m,
-                         rad_to_deg(r.alpha_rad), r.d_m, rad_to_deg(r.theta_offset_rad),
+      out += fmt::format("    - {{a: {:.9g}, alpha: {:.9g}, d: {:.9g}, offset: {:.9g}, min: {:.9g}, max: {:.9g}{}}}\n",
+                         r.a_m, rad_to_deg(r.alpha_rad), r.d_m, rad_to_deg(r.theta_offset_rad),
                          rad_to_deg(d.joints[i].lower_rad), rad_to_deg(d.joints[i].upper_rad),
                          std::isfinite(speed) ? fmt::format(", max_speed: {:.9g}", rad_to_deg(speed)) : "");
     }
   } else if (!d.urdf_file.empty()) {
-    out += fmt::format("  convention: urdf\n  file: {}\n  base_link: {}\n  tip_link: {}\n",
-                       yaml::scalar_text(d.urdf_file), yaml::scalar_text(d.urdf_base_link),
-                       yaml::scalar_text(d.urdf_tip_link));
+    out +=
+        fmt::format("  convention: urdf\n  file: {}\n  base_link: {}\n  tip_link: {}\n", yaml::scalar_text(d.urdf_file),
+                    yaml::scalar_text(d.urdf_base_link), yaml::scalar_text(d.urdf_tip_link));
   } else {
     throw InputError("robot_to_yaml: the chain was built in code (neither DH nor URDF) and has no file form");
   }

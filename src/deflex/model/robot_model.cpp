@@ -81,11 +81,12 @@ RobotModel::RobotModel(RobotDescription desc) : desc_(std::move(desc)) {
       fail(d, where + ".offset", "not a finite number");
     }
     if (std::isnan(j.lower_rad) || std::isnan(j.upper_rad) || !(j.lower_rad < j.upper_rad)) {
-      fail(d, where + ".limits", fmt::format("lower limit ({} rad) must be below upper limit ({} rad)",
-                                             j.lower_rad, j.upper_rad));
+      fail(d, where + ".limits",
+           fmt::format("lower limit ({} rad) must be below upper limit ({} rad)", j.lower_rad, j.upper_rad));
     }
     if (std::isnan(j.max_speed_rad_s) || !(j.max_speed_rad_s > 0.0)) {
-      fail(d, where + ".max_speed", fmt::format("joint speed limit must be positive (got {} rad/s)", j.max_speed_rad_s));
+      fail(d, where + ".max_speed",
+           fmt::format("joint speed limit must be positive (got {} rad/s)", j.max_speed_rad_s));
     }
     max_speed_[static_cast<int>(i)] = j.max_speed_rad_s;
     lower_[static_cast<int>(i)] = j.lower_rad;
@@ -134,9 +135,10 @@ RobotModel::RobotModel(RobotDescription desc) : desc_(std::move(desc)) {
 
 const JointVector& RobotModel::stiffness() const {
   if (!has_stiffness()) {
-    throw ModelError(fmt::format("{}: field 'joint_stiffness_Nm_per_rad': the robot '{}' has no joint stiffness; "
-                                 "add it to the robot file or identify it (deflex identify)",
-                                 desc_.source, desc_.name));
+    throw ModelError(
+        fmt::format("{}: field 'joint_stiffness_Nm_per_rad': the robot '{}' has no joint stiffness; "
+                    "add it to the robot file or identify it (deflex identify)",
+                    desc_.source, desc_.name));
   }
   return stiffness_;
 }

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "deflex/text/output_file.hpp"
 #include "deflex/model/types.hpp"
+#include "deflex/text/output_file.hpp"
 
 namespace deflex {
 

@@ -21,8 +21,7 @@ using Pose = Eigen::Isometry3d;
 /// Joint values (rad), joint deflections (rad) or joint torques (Nm), one entry a joint.
 using JointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxJoints, 1>;
 /// n x n joint-space matrix (stiffness, Nm/rad).
-using JointMatrix =
-    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxJoints, kMaxJoints>;
+using JointMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxJoints, kMaxJoints>;
 /// 6 x n geometric Jacobian: rows 0-2 linear velocity (m/s per rad/s), rows 3-5 angular velocity,
 /// both in the robot base frame.
 using Jacobian = Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::ColMajor, 6, kMaxJoints>;

@@ -49,8 +49,8 @@ bool skip_past(const std::string& text, std::size_t& i, const char* end, int& li
   if (at == std::string::npos) {
     return false;
   }
-  line += static_cast<int>(std::count(text.begin() + static_cast<std::ptrdiff_t>(i),
-                                      text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+  line += static_cast<int>(
+      std::count(text.begin() + static_cast<std::ptrdiff_t>(i), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
   i = at + std::char_traits<char>::length(end);
   return true;
 }
@@ -200,8 +200,9 @@ void read_joints(const std::string& file, const TiXmlElement* robot, UrdfTree& t
       }
     }
     if (const auto it = joint_index.find(j.name); it != joint_index.end()) {
-      fail(file, j.line, fmt::format("joint '{}' is defined twice (also on line {})", j.name,
-                                     tree.joints[static_cast<std::size_t>(it->second)].line));
+      fail(file, j.line,
+           fmt::format("joint '{}' is defined twice (also on line {})", j.name,
+                       tree.joints[static_cast<std::size_t>(it->second)].line));
     }
     if (const auto it = tree.parent_joint_of.find(j.child); it != tree.parent_joint_of.end()) {
       const UrdfJointEntry& first = tree.joints[static_cast<std::size_t>(it->second)];
@@ -220,7 +221,9 @@ void read_joints(const std::string& file, const TiXmlElement* robot, UrdfTree& t
 void refuse_loops(const std::string& file, const UrdfTree& tree) {
   const auto parent_link = [&](int l) {
     const auto p = tree.parent_joint_of.find(tree.links[static_cast<std::size_t>(l)]);
-    return p == tree.parent_joint_of.end() ? -1 : tree.link_index.at(tree.joints[static_cast<std::size_t>(p->second)].parent);
+    return p == tree.parent_joint_of.end()
+               ? -1
+               : tree.link_index.at(tree.joints[static_cast<std::size_t>(p->second)].parent);
   };
   std::vector<char> state(tree.links.size(), 0);  // 0 not seen, 1 on the current walk, 2 reaches a root
   for (const UrdfJointEntry& start : tree.joints) {

@@ -120,9 +120,11 @@ std::shared_ptr<runtime::MonitorFeed> read_cycle_log_feed(const std::string& pat
     }
     runtime::MonitorRow r;
     r.t_s = value(c.t);
-    if (!std::isfinite(r.t_s)) throw DataError(fmt::format("{}:{}: column 't_s': a cycle without a time", path, line_no));
+    if (!std::isfinite(r.t_s))
+      throw DataError(fmt::format("{}:{}: column 't_s': a cycle without a time", path, line_no));
     if (r.t_s < last_t) {
-      throw DataError(fmt::format("{}:{}: column 't_s': time goes back ({} s after {} s)", path, line_no, r.t_s, last_t));
+      throw DataError(
+          fmt::format("{}:{}: column 't_s': time goes back ({} s after {} s)", path, line_no, r.t_s, last_t));
     }
     last_t = r.t_s;
     r.program_t_s = value(c.pt);

@@ -47,9 +47,10 @@ MonitorAddress parse_monitor_address(const std::string& text, bool allow_remote,
     throw InputError(fmt::format("option {} '{}': '{}' is not an IPv4 address", option, text, a.host));
   }
   if (!allow_remote && !is_loopback(a.host)) {
-    throw InputError(fmt::format("option {} '{}': {} is reachable from other hosts; the page shows the cell's data "
-                                 "to anyone who can reach it: add --monitor-remote to allow that",
-                                 option, text, a.host));
+    throw InputError(
+        fmt::format("option {} '{}': {} is reachable from other hosts; the page shows the cell's data "
+                    "to anyone who can reach it: add --monitor-remote to allow that",
+                    option, text, a.host));
   }
   return a;
 }
@@ -131,9 +132,9 @@ std::string monitor_report(const runtime::MonitorFeed& feed, const std::string& 
   const std::string marker = "<!--DEFLEX_STATIC_DATA-->";
   const auto at = page.find(marker);
   if (at != std::string::npos) {
-    page.replace(at, marker.size(),
-                 fmt::format("<script>window.DEFLEX_STATIC = {};\nwindow.DEFLEX_TITLE = \"{}\";</script>", safe,
-                             escaped_title));
+    page.replace(
+        at, marker.size(),
+        fmt::format("<script>window.DEFLEX_STATIC = {};\nwindow.DEFLEX_TITLE = \"{}\";</script>", safe, escaped_title));
   }
   return page;
 }

@@ -29,8 +29,8 @@ PathCompensator::PathCompensator(const RobotModel& model, const ForceModel& forc
       dtheta_desired_(model.dof()),
       q_start_(model.dof()) {
   if (!model.has_stiffness()) {
-    throw InputError(fmt::format("robot '{}' ({}): no joint stiffness; offline compensation needs one",
-                                 model.name(), model.description().source));
+    throw InputError(fmt::format("robot '{}' ({}): no joint stiffness; offline compensation needs one", model.name(),
+                                 model.description().source));
   }
   result_.robot_name = model.name();
   result_.stiffness_note = model.description().stiffness_note;
@@ -85,10 +85,12 @@ const OfflinePoint& PathCompensator::compensate(std::size_t i, const JointVector
   // already computed above); commanded to q_cmd it goes back to q_desired, the configuration the
   // command was computed for. The step test still certifies each fixed point to 1e-13 rad.
   q_start_ = pt.q_desired + dtheta_desired_;
-  if (deflected_configuration_from(model, ws, pt.q_desired, pt.wrench_base, q_start_, q_actual_,
-                                   kDeflectionTolRad) != DeflectionStatus::kConverged) {
-    throw InputError(fmt::format("path point {}: the predicted deflection does not converge (load far beyond the "
-                                 "model's range)", i));
+  if (deflected_configuration_from(model, ws, pt.q_desired, pt.wrench_base, q_start_, q_actual_, kDeflectionTolRad) !=
+      DeflectionStatus::kConverged) {
+    throw InputError(
+        fmt::format("path point {}: the predicted deflection does not converge (load far beyond the "
+                    "model's range)",
+                    i));
   }
   pt.predicted_deflection = pose_difference(tcp_at_desired, tcp_pose(model, ws, q_actual_));
   // Its first step from q_desired needs K^-1 J(q_desired)^T W, which is dtheta_desired: taken here
@@ -96,8 +98,8 @@ const OfflinePoint& PathCompensator::compensate(std::size_t i, const JointVector
   q_actual_ = pt.q_command + dtheta_desired_;
   if ((q_actual_ - pt.q_desired).cwiseAbs().maxCoeff() >= kDeflectionTolRad) {
     q_start_ = q_actual_;
-    if (deflected_configuration_from(model, ws, pt.q_command, pt.wrench_base, q_start_, q_actual_,
-                                     kDeflectionTolRad) != DeflectionStatus::kConverged) {
+    if (deflected_configuration_from(model, ws, pt.q_command, pt.wrench_base, q_start_, q_actual_, kDeflectionTolRad) !=
+        DeflectionStatus::kConverged) {
       throw InputError(fmt::format("path point {}: the deflection of the compensated command does not converge", i));
     }
   }
@@ -134,7 +136,8 @@ OfflineResult compensate_path(const RobotModel& model, const JointPath& path, co
     throw InputError("offline compensation: the path has no points");
   }
   if (tcp_poses.size() != n) {
-    throw InputError(fmt::format("offline compensation: {} joint configurations but {} TCP poses", n, tcp_poses.size()));
+    throw InputError(
+        fmt::format("offline compensation: {} joint configurations but {} TCP poses", n, tcp_poses.size()));
   }
   if (const auto force_points = force.points(); force_points && *force_points != n) {
     throw InputError(fmt::format("offline compensation: the force model ({}) has {} points, the path {}",

@@ -15,10 +15,10 @@ namespace deflex {
 /// One compensated path point. Joint values in rad, poses and displacements in the base frame (m,
 /// rad), wrench in N and Nm.
 struct OfflinePoint {
-  JointVector q_desired;  ///< from the path's inverse kinematics
-  JointVector q_command;  ///< compensated command, exact form: q_desired - K^-1 J_wap(q_desired)^T W
-  Pose tcp_desired;       ///< the pose the task wants (the path's pose)
-  Pose tcp_command;       ///< FK(q_command): the equivalent compensated Cartesian target
+  JointVector q_desired;                   ///< from the path's inverse kinematics
+  JointVector q_command;                   ///< compensated command, exact form: q_desired - K^-1 J_wap(q_desired)^T W
+  Pose tcp_desired;                        ///< the pose the task wants (the path's pose)
+  Pose tcp_command;                        ///< FK(q_command): the equivalent compensated Cartesian target
   ArmConfiguration configuration_command;  ///< confdata of q_command (for robtargets)
   /// The wrench the model uses: base frame, moment about the robot's wrench application point
   /// (the force model's moment about the TCP, moved to the WAP when the two differ).
@@ -35,12 +35,12 @@ struct OfflinePoint {
 struct OfflineResult {
   std::vector<OfflinePoint> points;  ///< empty when the path was streamed (PathCompensator)
   std::size_t point_count = 0;       ///< points compensated
-  double max_deflection_m = 0.0;   ///< largest |translation| of predicted_deflection
-  double mean_deflection_m = 0.0;  ///< mean |translation| of predicted_deflection over all points
+  double max_deflection_m = 0.0;     ///< largest |translation| of predicted_deflection
+  double mean_deflection_m = 0.0;    ///< mean |translation| of predicted_deflection over all points
   double max_deflection_rad = 0.0;
   double max_residual_m = 0.0;  ///< largest |translation| of predicted_residual
   double max_residual_rad = 0.0;
-  double max_correction_m = 0.0;        ///< largest |p_command - p_desired|
+  double max_correction_m = 0.0;          ///< largest |p_command - p_desired|
   double max_joint_correction_rad = 0.0;  ///< largest |q_command - q_desired| over joints and points
   std::string robot_name;
   std::string stiffness_note;

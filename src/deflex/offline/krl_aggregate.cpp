@@ -7,8 +7,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/offline/detail/program_text.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 
@@ -49,8 +49,7 @@ double bits_value(const KrlFile& f, std::size_t i, KrlComponent& c) {
   const std::string digits = s.size() >= 3 ? s.substr(2, s.size() - 3) : std::string();
   long bits = 0;
   const auto r = std::from_chars(digits.data(), digits.data() + digits.size(), bits, base == 'B' ? 2 : 16);
-  if ((base != 'B' && base != 'H') || digits.empty() || r.ec != std::errc() ||
-      r.ptr != digits.data() + digits.size()) {
+  if ((base != 'B' && base != 'H') || digits.empty() || r.ec != std::errc() || r.ptr != digits.data() + digits.size()) {
     f.fail(i, fmt::format("{} is not a KRL bit literal ('B0110' or 'H1F')", s));
   }
   c.bit_digits = base == 'B' ? static_cast<int>(digits.size()) : 0;
@@ -130,14 +129,14 @@ bool krl_axis_type(const std::string& t) { return t == "E6AXIS" || t == "AXIS"; 
 void check_krl_point(const KrlFile& f, const KrlAggregate& a, const std::string& type, const std::string& what) {
   static const std::vector<std::string> kFrame = {"X", "Y", "Z", "A", "B", "C"};
   static const std::vector<std::string> kPos = {"X", "Y", "Z", "A", "B", "C", "S", "T"};
-  static const std::vector<std::string> kE6Pos = {"X", "Y", "Z", "A", "B", "C", "S", "T",
-                                                   "E1", "E2", "E3", "E4", "E5", "E6"};
+  static const std::vector<std::string> kE6Pos = {"X", "Y",  "Z",  "A",  "B",  "C",  "S",
+                                                  "T", "E1", "E2", "E3", "E4", "E5", "E6"};
   static const std::vector<std::string> kAxis = {"A1", "A2", "A3", "A4", "A5", "A6"};
   static const std::vector<std::string> kE6Axis = {"A1", "A2", "A3", "A4", "A5", "A6",
                                                    "E1", "E2", "E3", "E4", "E5", "E6"};
   const std::string t = type.empty() ? a.type : type;
   const bool axis = t.empty() ? a.find("A1") != nullptr : krl_axis_type(t);
-  const std::vector<std::string>& allowed = t == "FRAME" ? kFrame
+  const std::vector<std::string>& allowed = t == "FRAME"  ? kFrame
                                             : t == "POS"  ? kPos
                                             : t == "AXIS" ? kAxis
                                             : axis        ? kE6Axis

@@ -17,11 +17,11 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/offline/detail/krl_aggregate.hpp"
 #include "deflex/offline/detail/program_targets.hpp"
 #include "deflex/offline/detail/program_text.hpp"
 #include "deflex/offline/detail/program_write_back.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {
@@ -470,8 +470,8 @@ class KrlReader {
       value = &decl->value;
     }
     const bool joint = value->find("A1") != nullptr;
-    const bool complete = joint ? value->numbers({"A1", "A2", "A3", "A4", "A5", "A6"})
-                                : value->numbers({"X", "Y", "Z", "A", "B", "C"});
+    const bool complete =
+        joint ? value->numbers({"A1", "A2", "A3", "A4", "A5", "A6"}) : value->numbers({"X", "Y", "Z", "A", "B", "C"});
     if (!complete && decl != nullptr) {
       f.fail(tb, fmt::format("{}: the point '{}' ({} line {}) does not give every component ({}): the controller "
                              "stops here",
@@ -486,9 +486,9 @@ class KrlReader {
   }
 
   /// One PTP/LIN/CIRC line: every target resolved into `uses`/`info`, or listed.
-  void motion(std::size_t b, std::size_t e, const std::string& first, const FrameState& tool,
-              const FrameState& base, std::size_t& force_index, ProgramCompensation& result,
-              std::vector<ProgramTargetUse>& uses, std::vector<Use>& info) {
+  void motion(std::size_t b, std::size_t e, const std::string& first, const FrameState& tool, const FrameState& base,
+              std::size_t& force_index, ProgramCompensation& result, std::vector<ProgramTargetUse>& uses,
+              std::vector<Use>& info) {
     const KrlFile& f = src_;
     for (const Range& target : motion_targets(b, e, first)) {
       const std::size_t index = force_index++;
@@ -598,8 +598,8 @@ class KrlReader {
       for (const UnresolvedConstruct& c : result.unresolved) {
         list += fmt::format("\n  {}:{}: {}: {}", c.file, c.line, c.text, c.reason);
       }
-      throw DataError(fmt::format("{}: none of its motion targets can be compensated before the program runs:{}",
-                                  src_.file, list));
+      throw DataError(
+          fmt::format("{}: none of its motion targets can be compensated before the program runs:{}", src_.file, list));
     }
   }
 

@@ -5,9 +5,9 @@
 
 #include <fmt/format.h>
 
+#include "deflex/offline/detail/quaternion_sign.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
-#include "deflex/offline/detail/quaternion_sign.hpp"
 
 namespace deflex {
 namespace {
@@ -17,8 +17,8 @@ double clean(double v) { return std::abs(v) < 1e-11 ? 0.0 : v; }
 
 void add_pose(std::vector<double>& row, const Pose& p, const Eigen::Quaterniond& q) {
   const Vector3 t = p.translation() * 1e3;
-  row.insert(row.end(), {clean(t.x()), clean(t.y()), clean(t.z()), clean(q.w()), clean(q.x()), clean(q.y()),
-                         clean(q.z())});
+  row.insert(row.end(),
+             {clean(t.x()), clean(t.y()), clean(t.z()), clean(q.w()), clean(q.x()), clean(q.y()), clean(q.z())});
 }
 
 }  // namespace
@@ -47,9 +47,10 @@ std::vector<std::string> offline_csv_columns(int dof) {
 OfflineCsvWriter::OfflineCsvWriter(OutputFile& out, int dof, const std::string& robot_name,
                                    const std::string& force_description, bool predicted)
     : dof_(dof), out_(out, offline_csv_columns(dof)) {
-  out_.comment(fmt::format("deflex offline: robot {}; force {}; wrench in the base frame, moment about the WAP; "
-                           "deflection = loaded minus unloaded TCP pose when commanded to the desired joints{}",
-                           robot_name, force_description, predicted ? "" : " (not predicted: columns are zero)"));
+  out_.comment(
+      fmt::format("deflex offline: robot {}; force {}; wrench in the base frame, moment about the WAP; "
+                  "deflection = loaded minus unloaded TCP pose when commanded to the desired joints{}",
+                  robot_name, force_description, predicted ? "" : " (not predicted: columns are zero)"));
   row_.reserve(offline_csv_columns(dof).size());
 }
 

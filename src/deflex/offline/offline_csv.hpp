@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "deflex/text/csv_table.hpp"
 #include "deflex/offline/compensate_path.hpp"
+#include "deflex/text/csv_table.hpp"
 
 namespace deflex {
 

@@ -63,9 +63,8 @@ OfflineJobResult run_offline_job(const RobotModel& model, PoseSource& source, co
       }
     }
   }
-  const bool holds = options.keep_nominal || std::any_of(loads.begin(), loads.end(), [](const OfflineLoad& l) {
-                       return l.keep_points;
-                     });
+  const bool holds = options.keep_nominal ||
+                     std::any_of(loads.begin(), loads.end(), [](const OfflineLoad& l) { return l.keep_points; });
   PathIkSolver ik(model, options.first);
   OfflineJobResult result;
   Pose pose;

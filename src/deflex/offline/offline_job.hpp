@@ -39,20 +39,19 @@ struct BarRange {
 };
 
 struct OfflineJobResult {
-  std::vector<OfflineResult> loads;   ///< one a load, in order; `points` filled when keep_points
+  std::vector<OfflineResult> loads;           ///< one a load, in order; `points` filled when keep_points
   std::vector<std::optional<BarRange>> bars;  ///< one a load: set for an LdbbForceModel
-  ArmConfiguration configuration;     ///< the arm configuration the path was solved in
+  ArmConfiguration configuration;             ///< the arm configuration the path was solved in
   std::size_t points = 0;
-  std::vector<Pose> poses;            ///< keep_nominal: the path's poses
-  std::vector<JointVector> q_nominal; ///< keep_nominal: their inverse kinematics (rad)
+  std::vector<Pose> poses;             ///< keep_nominal: the path's poses
+  std::vector<JointVector> q_nominal;  ///< keep_nominal: their inverse kinematics (rad)
 };
 
 /// Runs the job. Throws InputError when there is no load or no point, a load has no force model,
 /// more points are to be kept than check_held_path_points() allows, and every error of PathIkSolver
 /// and PathCompensator (each naming the path point), before a CSV writer is finished.
 [[nodiscard]] OfflineJobResult run_offline_job(const RobotModel& model, PoseSource& source,
-                                               const std::vector<OfflineLoad>& loads,
-                                               const OfflineJobOptions& options);
+                                               const std::vector<OfflineLoad>& loads, const OfflineJobOptions& options);
 
 /// Labels for the loads' files ("ldbb_125N_push"), identifier-safe and unique: a repeated label gets
 /// "_2", "_3" ... by its position.

@@ -11,9 +11,10 @@ std::string offline_summary(const OfflineResult& result) {
   s += fmt::format("force: {}\n", result.force_description);
   s += fmt::format("points: {}\n", result.point_count);
   if (result.predicted) {
-    s += fmt::format("predicted TCP deflection, uncompensated: max {:.4f} mm, mean {:.4f} mm (max rotation {:.4f} "
-                     "mrad)\n",
-                     result.max_deflection_m * 1e3, result.mean_deflection_m * 1e3, result.max_deflection_rad * 1e3);
+    s += fmt::format(
+        "predicted TCP deflection, uncompensated: max {:.4f} mm, mean {:.4f} mm (max rotation {:.4f} "
+        "mrad)\n",
+        result.max_deflection_m * 1e3, result.mean_deflection_m * 1e3, result.max_deflection_rad * 1e3);
   }
   s += fmt::format("compensation: largest TCP offset {:.4f} mm, largest joint correction {:.5f} deg\n",
                    result.max_correction_m * 1e3, rad_to_deg(result.max_joint_correction_rad));

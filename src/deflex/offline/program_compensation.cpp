@@ -7,12 +7,12 @@
 
 #include <fmt/format.h>
 
+#include "deflex/offline/detail/krl_program.hpp"
+#include "deflex/offline/detail/program_text.hpp"
+#include "deflex/offline/detail/rapid_program.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/input_file.hpp"
 #include "deflex/text/output_file.hpp"
-#include "deflex/offline/detail/krl_program.hpp"
-#include "deflex/offline/detail/rapid_program.hpp"
-#include "deflex/offline/detail/program_text.hpp"
 
 namespace deflex {
 namespace {
@@ -23,8 +23,7 @@ namespace fs = std::filesystem;
 bool same_file(const std::string& a, const std::string& b) {
   struct stat sa {};
   struct stat sb {};
-  return ::stat(a.c_str(), &sa) == 0 && ::stat(b.c_str(), &sb) == 0 && sa.st_dev == sb.st_dev &&
-         sa.st_ino == sb.st_ino;
+  return ::stat(a.c_str(), &sa) == 0 && ::stat(b.c_str(), &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
 
 bool is_rapid(const std::string& ext) { return ext == ".MOD" || ext == ".MODX" || ext == ".PRG" || ext == ".SYS"; }
@@ -38,9 +37,10 @@ std::string krl_data_list(const std::string& src) {
       return dat;
     }
   }
-  throw InputError(fmt::format("{}: its data list {} does not exist: a KRL program's points are declared in the "
-                               ".dat beside the .src (give both, as the controller has them)",
-                               src, fs::path(src).replace_extension(".dat").string()));
+  throw InputError(
+      fmt::format("{}: its data list {} does not exist: a KRL program's points are declared in the "
+                  ".dat beside the .src (give both, as the controller has them)",
+                  src, fs::path(src).replace_extension(".dat").string()));
 }
 
 }  // namespace
@@ -71,9 +71,10 @@ ProgramCompensation compensate_program(const RobotModel& model, const ForceModel
   const auto refuse_same = [&](const std::string& in) {
     for (const std::string& out : outputs) {
       if (same_file(in, out)) {
-        throw InputError(fmt::format("{}: the compensated program must go to another file than the input {} (it is "
-                                     "the same file)",
-                                     out, in));
+        throw InputError(
+            fmt::format("{}: the compensated program must go to another file than the input {} (it is "
+                        "the same file)",
+                        out, in));
       }
     }
   };
@@ -120,9 +121,10 @@ std::string program_summary(const ProgramCompensation& result) {
                      configured);
   }
   if (!result.unresolved.empty()) {
-    s += fmt::format("left unchanged (computed at run time, declared in another module, or an instruction deflex does "
-                     "not compensate): {}\n",
-                     result.unresolved.size());
+    s += fmt::format(
+        "left unchanged (computed at run time, declared in another module, or an instruction deflex does "
+        "not compensate): {}\n",
+        result.unresolved.size());
     for (const UnresolvedConstruct& u : result.unresolved) {
       s += fmt::format("  {}:{}: {}: {}\n", u.file, u.line, u.text, u.reason);
     }

@@ -25,8 +25,8 @@ struct ProgramTargetReport {
   std::string file;
   int line = 0;
   std::string instruction;
-  std::string target;         ///< as written in the input
-  std::string action;         ///< "edited in place", "literal edited" or "copy NAME"
+  std::string target;  ///< as written in the input
+  std::string action;  ///< "edited in place", "literal edited" or "copy NAME"
   /// How the arm configuration was chosen: "" when the target's own (confdata, Status/Turn);
   /// otherwise why not, e.g. "ConfL\\Off: the configuration nearest the previous target's".
   std::string configuration_note;

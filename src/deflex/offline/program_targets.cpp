@@ -7,8 +7,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/offline/compensate_path.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {

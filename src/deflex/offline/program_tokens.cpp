@@ -6,8 +6,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/offline/detail/program_text.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {

@@ -41,8 +41,8 @@ std::vector<WriteBackStep> plan_write_back(const std::vector<WriteBackUse>& uses
         s = {WriteBackStep::Kind::kInPlace, b == a, a};
         continue;
       }
-      const auto same = std::find_if(copies.begin(), copies.end(),
-                                     [&](std::size_t c) { return uses[c].numbers == uses[b].numbers; });
+      const auto same =
+          std::find_if(copies.begin(), copies.end(), [&](std::size_t c) { return uses[c].numbers == uses[b].numbers; });
       s = {WriteBackStep::Kind::kCopy, same == copies.end(), same == copies.end() ? b : *same};
       if (s.first) {
         copies.push_back(b);

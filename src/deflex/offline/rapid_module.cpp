@@ -8,14 +8,14 @@
 
 #include <fmt/format.h>
 
+#include "deflex/offline/detail/quaternion_sign.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/output_file.hpp"
-#include "deflex/offline/detail/quaternion_sign.hpp"
 
 namespace deflex {
 namespace {
 
-const char* const kZones[] = {"fine", "z0",  "z1",  "z5",  "z10", "z15",  "z20",  "z30",
+const char* const kZones[] = {"fine", "z0",  "z1",  "z5",  "z10",  "z15",  "z20", "z30",
                               "z40",  "z50", "z60", "z80", "z100", "z150", "z200"};
 
 // Writes 0.0 for -0.0 and tiny values, so RAPID never sees "-0.0000".
@@ -44,9 +44,10 @@ void check_rapid_options(const RapidOptions& options) {
   for (const auto& [what, name] : {std::pair{"module name", &options.module_name}, std::pair{"tool", &options.tool},
                                    std::pair{"work object", &options.wobj}}) {
     if (!is_rapid_identifier(*name)) {
-      throw InputError(fmt::format("RAPID {} '{}' is not a RAPID identifier (a letter, then letters, digits or _, at "
-                                   "most 32 characters)",
-                                   what, *name));
+      throw InputError(
+          fmt::format("RAPID {} '{}' is not a RAPID identifier (a letter, then letters, digits or _, at "
+                      "most 32 characters)",
+                      what, *name));
     }
   }
   if (!std::isfinite(options.speed_mm_s) || options.speed_mm_s <= 0.0 || options.speed_mm_s > 7000.0) {
@@ -57,8 +58,8 @@ void check_rapid_options(const RapidOptions& options) {
     zone_ok = zone_ok || options.zone == z;
   }
   if (!zone_ok) {
-    throw InputError(fmt::format("RAPID zone '{}' is not a predefined zonedata (fine, z0, z1, z5, z10, ... z200)",
-                                 options.zone));
+    throw InputError(
+        fmt::format("RAPID zone '{}' is not a predefined zonedata (fine, z0, z1, z5, z10, ... z200)", options.zone));
   }
 }
 
@@ -71,8 +72,8 @@ std::string rapid_module(const OfflineResult& result, const RapidOptions& option
   for (std::size_t i = 0; i < n; ++i) {
     const OfflinePoint& p = result.points[i];
     if (p.q_command.size() != 6) {
-      throw InputError(fmt::format("RAPID export supports 6-axis robots (point {} has {} joints)", i,
-                                   p.q_command.size()));
+      throw InputError(
+          fmt::format("RAPID export supports 6-axis robots (point {} has {} joints)", i, p.q_command.size()));
     }
     if (!p.q_command.allFinite() || !p.tcp_command.matrix().allFinite()) {
       throw InputError(fmt::format("RAPID export: point {} is not finite", i));
@@ -92,9 +93,10 @@ std::string rapid_module(const OfflineResult& result, const RapidOptions& option
   s += fmt::format("  ! Force model: {}\n", result.force_description);
   s += "  ! Compensation: exact lumped joint-compliance form q_cmd = q_des - K^-1 J(q_des)^T W per point.\n";
   if (result.predicted) {
-    s += fmt::format("  ! Predicted TCP deflection without compensation: max {:.4f} mm, mean {:.4f} mm; with: max "
-                     "{:.2e} mm.\n",
-                     result.max_deflection_m * 1e3, result.mean_deflection_m * 1e3, result.max_residual_m * 1e3);
+    s += fmt::format(
+        "  ! Predicted TCP deflection without compensation: max {:.4f} mm, mean {:.4f} mm; with: max "
+        "{:.2e} mm.\n",
+        result.max_deflection_m * 1e3, result.mean_deflection_m * 1e3, result.max_residual_m * 1e3);
   }
   s += fmt::format("  ! {} points, {} with {}, TCP speed {:g} mm/s, zone {}{}.\n", n,
                    joint ? "MoveAbsJ over jointtargets (deg)" : "MoveL over robtargets (mm, quaternion, confdata)",
@@ -130,8 +132,8 @@ std::string rapid_module(const OfflineResult& result, const RapidOptions& option
       const ArmConfiguration& c = p.configuration_command;
       q_previous = quaternion_near(p.tcp_command, q_previous);
       s += fmt::format("  CONST robtarget {}:=[[{:.4f},{:.4f},{:.4f}],{},[{},{},{},{}],{}];\n", target_name(i),
-                       clean(t.x(), 1e-4), clean(t.y(), 1e-4), clean(t.z(), 1e-4), quaternion_text(q_previous),
-                       c.cf1, c.cf4, c.cf6, c.cfx, eax);
+                       clean(t.x(), 1e-4), clean(t.y(), 1e-4), clean(t.z(), 1e-4), quaternion_text(q_previous), c.cf1,
+                       c.cf4, c.cf6, c.cfx, eax);
     }
   }
   s += "\n  PROC main()\n";

@@ -14,12 +14,12 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/offline/detail/program_targets.hpp"
 #include "deflex/offline/detail/program_text.hpp"
 #include "deflex/offline/detail/program_write_back.hpp"
 #include "deflex/offline/detail/quaternion_sign.hpp"
 #include "deflex/offline/detail/rapid_values.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {
@@ -36,7 +36,7 @@ struct Decl {
   int routine = -1;  // the routine declaring it, -1: the module
   std::vector<int> dims;
   bool literal = false;
-  bool run_time = false;  // a literal that names a num the program changes
+  bool run_time = false;    // a literal that names a num the program changes
   std::size_t end_tok = 0;  // the ';'
   RapidValue value;
 };
@@ -51,7 +51,7 @@ struct Instruction {
   std::size_t tok = 0;
   std::string name;
   std::size_t end_tok = 0;
-  std::vector<Span> args;                // positional expressions
+  std::vector<Span> args;               // positional expressions
   std::map<std::string, Span> options;  // upper name -> value
 };
 
@@ -212,10 +212,11 @@ class RapidReader {
         s.tok = lex_rapid(d.text, where);
         const auto end = parse_rapid_value(s, 0, s.tok.size(), d.value);
         if (!end || *end != s.tok.size()) {
-          throw InputError(fmt::format("{}: not a literal {} value ({})", where, type,
-                                       std::string(type) == "tooldata"
-                                           ? "[robhold,[[x,y,z],[q1,q2,q3,q4]],[mass,[cx,cy,cz],[a1,a2,a3,a4],ix,iy,iz]]"
-                                           : "[robhold,ufprog,\"ufmec\",[[x,y,z],[q1,q2,q3,q4]],[[x,y,z],[q1,q2,q3,q4]]]"));
+          throw InputError(
+              fmt::format("{}: not a literal {} value ({})", where, type,
+                          std::string(type) == "tooldata"
+                              ? "[robhold,[[x,y,z],[q1,q2,q3,q4]],[mass,[cx,cy,cz],[a1,a2,a3,a4],ix,iy,iz]]"
+                              : "[robhold,ufprog,\"ufmec\",[[x,y,z],[q1,q2,q3,q4]],[[x,y,z],[q1,q2,q3,q4]]]"));
         }
         check_rapid_value(
             d.value, type, [](const std::string&) { return std::nullopt; },
@@ -223,8 +224,8 @@ class RapidReader {
       } catch (const DataError& e) {
         throw InputError(e.what());
       }
-      for (const std::size_t frame : std::string(type) == "tooldata" ? std::vector<std::size_t>{1}
-                                                                      : std::vector<std::size_t>{3, 4}) {
+      for (const std::size_t frame :
+           std::string(type) == "tooldata" ? std::vector<std::size_t>{1} : std::vector<std::size_t>{3, 4}) {
         if (!rapid_pose(d.value.items[frame])) {
           throw InputError(fmt::format("{}: the quaternion of its frame is not of unit length", where));
         }
@@ -374,16 +375,16 @@ class RapidReader {
         continue;  // several dimensions or a size given by a name: not resolved (see plain_ref)
       }
       if (d.value.kind != RapidValue::Kind::kList || d.value.items.size() != static_cast<std::size_t>(d.dims[0])) {
-        src_.fail(d.value.token, fmt::format("{} '{}{{{}}}': {} values for {} elements", d.type, d.name, d.dims[0],
-                                             d.value.kind == RapidValue::Kind::kList ? d.value.items.size() : 1,
-                                             d.dims[0]));
+        src_.fail(d.value.token,
+                  fmt::format("{} '{}{{{}}}': {} values for {} elements", d.type, d.name, d.dims[0],
+                              d.value.kind == RapidValue::Kind::kList ? d.value.items.size() : 1, d.dims[0]));
       }
       for (std::size_t e = 0; e < d.value.items.size(); ++e) {
         const auto element_fail = [&](std::size_t token, const std::string& what) {
           src_.fail(token, fmt::format("{} '{}{{{}}}': {}", d.type, d.name, e + 1, what));
         };
-        d.run_time =
-            check_rapid_value(d.value.items[e], d.type, lookup, element_fail) == RapidValueState::kRunTime || d.run_time;
+        d.run_time = check_rapid_value(d.value.items[e], d.type, lookup, element_fail) == RapidValueState::kRunTime ||
+                     d.run_time;
       }
     }
   }
@@ -544,7 +545,8 @@ class RapidReader {
         return std::nullopt;
       }
       if (index < 0 || index >= d->dims[0]) {
-        src_.fail(b + 2, fmt::format("index {} is outside {}{{{}}} (1..{})", index + 1, d->name, d->dims[0], d->dims[0]));
+        src_.fail(b + 2,
+                  fmt::format("index {} is outside {}{{{}}} (1..{})", index + 1, d->name, d->dims[0], d->dims[0]));
       }
       v = &v->items[static_cast<std::size_t>(index)];
     }
@@ -746,9 +748,9 @@ class RapidReader {
   // --- the walk over the program ---------------------------------------------------------------
 
   /// A resolved use of a motion's k-th target; false with the reason listed when it is not resolvable.
-  bool resolve_use(const Instruction& ins, const Motion& m, std::size_t k, std::size_t force_index,
-                   const ToolWobj& tw, const ConfState& conf, bool first_use, ProgramCompensation& result,
-                   ProgramTargetUse& u, Use& x) const {
+  bool resolve_use(const Instruction& ins, const Motion& m, std::size_t k, std::size_t force_index, const ToolWobj& tw,
+                   const ConfState& conf, bool first_use, ProgramCompensation& result, ProgramTargetUse& u,
+                   Use& x) const {
     const auto [b, e] = ins.args[k];
     const int routine = routine_of_[ins.tok];
     const int line = src_.tok[ins.tok].line;
@@ -801,11 +803,12 @@ class RapidReader {
       const int off_line = m.conf == 'J' ? conf.joint_off_line : m.conf == 'L' ? conf.linear_off_line : 0;
       if (off_line > 0) {
         u.nearest_previous = true;
-        x.conf_note = first_use ? fmt::format("Conf{}\\Off (line {}), no earlier target: its own confdata", m.conf,
-                                              off_line)
-                                : fmt::format("Conf{}\\Off (line {}): the configuration nearest the previous "
-                                              "target's",
-                                              m.conf, off_line);
+        x.conf_note = first_use
+                          ? fmt::format("Conf{}\\Off (line {}), no earlier target: its own confdata", m.conf, off_line)
+                          : fmt::format(
+                                "Conf{}\\Off (line {}): the configuration nearest the previous "
+                                "target's",
+                                m.conf, off_line);
       }
     }
     x.ref = *ref;
@@ -858,9 +861,9 @@ class RapidReader {
       for (std::size_t k = 0; k < n_targets; ++k) {
         const std::size_t index = force_index++;
         if (!tw) {
-          result.unresolved.push_back(
-              {src_.file, t[i].line, fmt::format("{} {}", m->name, src_.span(ins.args[k].first, ins.args[k].second)),
-               why});
+          result.unresolved.push_back({src_.file, t[i].line,
+                                       fmt::format("{} {}", m->name, src_.span(ins.args[k].first, ins.args[k].second)),
+                                       why});
           continue;
         }
         ProgramTargetUse u;
@@ -882,8 +885,8 @@ class RapidReader {
       for (const UnresolvedConstruct& c : result.unresolved) {
         list += fmt::format("\n  {}:{}: {}: {}", c.file, c.line, c.text, c.reason);
       }
-      throw DataError(fmt::format("{}: none of its motion targets can be compensated before the program runs:{}",
-                                  src_.file, list));
+      throw DataError(
+          fmt::format("{}: none of its motion targets can be compensated before the program runs:{}", src_.file, list));
     }
   }
 
@@ -960,8 +963,8 @@ class RapidReader {
       }
       if (step.first) {
         const Decl& d = *x.ref.decl;
-        names[a] = copy_name(x.ref.element >= 0 ? fmt::format("{}{}", d.name, x.ref.element + 1) : d.name, "_c", 32,
-                             taken);
+        names[a] =
+            copy_name(x.ref.element >= 0 ? fmt::format("{}{}", d.name, x.ref.element + 1) : d.name, "_c", 32, taken);
         const std::size_t at = end_of_line(src_.text, t[d.end_tok].end);
         const bool unterminated = at == src_.text.size() && src_.text.back() != '\n' && src_.text.back() != '\r';
         const RapidValue& v = *x.ref.value;

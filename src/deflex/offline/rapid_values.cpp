@@ -6,8 +6,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/offline/detail/program_text.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 
@@ -97,8 +97,7 @@ const std::vector<Layout>& layouts() {
       {"pose", {{"trans", "pos"}, {"rot", "orient"}}},
       {"robtarget", {{"trans", "pos"}, {"rot", "orient"}, {"robconf", "confdata"}, {"extax", "extjoint"}}},
       {"jointtarget", {{"robax", "robjoint"}, {"extax", "extjoint"}}},
-      {"loaddata",
-       {{"mass", "num"}, {"cog", "pos"}, {"aom", "orient"}, {"ix", "num"}, {"iy", "num"}, {"iz", "num"}}},
+      {"loaddata", {{"mass", "num"}, {"cog", "pos"}, {"aom", "orient"}, {"ix", "num"}, {"iy", "num"}, {"iz", "num"}}},
       {"tooldata", {{"robhold", "bool"}, {"tframe", "pose"}, {"tload", "loaddata"}}},
       {"wobjdata",
        {{"robhold", "bool"}, {"ufprog", "bool"}, {"ufmec", "string"}, {"uframe", "pose"}, {"oframe", "pose"}}},

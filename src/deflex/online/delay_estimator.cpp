@@ -11,7 +11,8 @@ DelayEstimator::DelayEstimator(double initial_delay_s, double window_s)
     : window_s_(window_s), delay_s_(initial_delay_s), last_s_(std::numeric_limits<double>::quiet_NaN()) {}
 
 void DelayEstimator::record_reference(double t_s, const JointVector& q_ref) noexcept {
-  if (!std::isfinite(t_s) || !q_ref.allFinite() || (count_ > 0 && !(t_s > t_[static_cast<std::size_t>((head_ + kRing - 1) % kRing)]))) {
+  if (!std::isfinite(t_s) || !q_ref.allFinite() ||
+      (count_ > 0 && !(t_s > t_[static_cast<std::size_t>((head_ + kRing - 1) % kRing)]))) {
     return;
   }
   const auto h = static_cast<std::size_t>(head_);
@@ -30,9 +31,8 @@ void DelayEstimator::observe_feedback(double t_s, const JointVector& q_feedback)
   // The arm must be moving: standing (before it starts, or stopped) it matches any reference that
   // passed its place, at any delay.
   constexpr double kMinStepRad = 1e-6;
-  const double feedback_step = have_feedback_ && last_feedback_.size() == q_feedback.size()
-                                   ? (q_feedback - last_feedback_).norm()
-                                   : 0.0;
+  const double feedback_step =
+      have_feedback_ && last_feedback_.size() == q_feedback.size() ? (q_feedback - last_feedback_).norm() : 0.0;
   const double feedback_dt = t_s - last_feedback_t_;
   const bool moving = have_feedback_ && feedback_step >= kMinStepRad && feedback_dt > 0.0;
   last_feedback_ = q_feedback;

@@ -6,8 +6,8 @@
 // are used (at rest every reference matches; an arm that has not started yet matches the
 // reference's start at any delay), and once settled a measurement far from the estimate is left out (a run of
 // them that agree with each other, a link whose delay changed, starts the estimate afresh from them;
-// scattered mismatches, as when the arm comes to rest, never do). The predictive strategy leads by this delay. Fixed ring: no
-// allocation.
+// scattered mismatches, as when the arm comes to rest, never do). The predictive strategy leads by this delay. Fixed
+// ring: no allocation.
 #pragma once
 
 #include <array>
@@ -34,7 +34,9 @@ class DelayEstimator {
   /// The last single measurement, s (NaN before the first).
   [[nodiscard]] double last_measurement_s() const { return last_s_; }
   /// The mean of every measurement taken, s (NaN before the first).
-  [[nodiscard]] double mean_s() const { return measurements_ > 0 ? sum_s_ / static_cast<double>(measurements_) : last_s_; }
+  [[nodiscard]] double mean_s() const {
+    return measurements_ > 0 ? sum_s_ / static_cast<double>(measurements_) : last_s_;
+  }
   /// Measurements left out as mismatches.
   [[nodiscard]] std::uint64_t outliers() const { return outliers_; }
 
@@ -50,12 +52,12 @@ class DelayEstimator {
   std::uint64_t measurements_ = 0;
   std::uint64_t outliers_ = 0;
   int consecutive_outliers_ = 0;  // in a row, and agreeing with each other (a changed link)
-  double outlier_sum_s_ = 0.0;     // their sum
-  JointVector last_feedback_;  // the previous feedback sample: the arm must be moving too
+  double outlier_sum_s_ = 0.0;    // their sum
+  JointVector last_feedback_;     // the previous feedback sample: the arm must be moving too
   double last_feedback_t_ = 0.0;
   bool have_feedback_ = false;
-  int last_k_ = 0;       // segments back from the newest reference at the last match
-  int since_full_ = 0;   // samples since the last search of the whole window
+  int last_k_ = 0;      // segments back from the newest reference at the last match
+  int since_full_ = 0;  // samples since the last search of the whole window
   double sum_s_ = 0.0;
 };
 

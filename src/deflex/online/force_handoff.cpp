@@ -26,9 +26,7 @@ bool ForceHandoff::push(const ForceSample& sample) noexcept {
   return false;
 }
 
-bool ForceHandoff::latest(ForceSample& out) noexcept {
-  return queue_.pop(out);
-}
+bool ForceHandoff::latest(ForceSample& out) noexcept { return queue_.pop(out); }
 
 ForceSourceStats ForceHandoff::stats() const noexcept {
   ForceSourceStats s;

@@ -29,12 +29,18 @@ void OnlineConfig::validate() const {
 
 const char* to_string(CycleStatus s) {
   switch (s) {
-    case CycleStatus::kOk: return "ok";
-    case CycleStatus::kNoForceYet: return "no_force_yet";
-    case CycleStatus::kStaleForce: return "stale_force";
-    case CycleStatus::kForceFault: return "force_fault";
-    case CycleStatus::kHeld: return "held";
-    case CycleStatus::kInvalidInput: return "invalid_input";
+    case CycleStatus::kOk:
+      return "ok";
+    case CycleStatus::kNoForceYet:
+      return "no_force_yet";
+    case CycleStatus::kStaleForce:
+      return "stale_force";
+    case CycleStatus::kForceFault:
+      return "force_fault";
+    case CycleStatus::kHeld:
+      return "held";
+    case CycleStatus::kInvalidInput:
+      return "invalid_input";
   }
   return "unknown";
 }

@@ -7,8 +7,8 @@
 #pragma once
 
 #include <array>
-#include <vector>
 #include <cstdint>
+#include <vector>
 
 #include "deflex/model/kinematics.hpp"
 #include "deflex/online/cycle_types.hpp"

@@ -9,10 +9,14 @@ namespace deflex {
 
 const char* to_string(StrategyKind kind) {
   switch (kind) {
-    case StrategyKind::kOnline: return "online";
-    case StrategyKind::kHybrid: return "hybrid";
-    case StrategyKind::kPredictive: return "predictive";
-    case StrategyKind::kNone: return "none";
+    case StrategyKind::kOnline:
+      return "online";
+    case StrategyKind::kHybrid:
+      return "hybrid";
+    case StrategyKind::kPredictive:
+      return "predictive";
+    case StrategyKind::kNone:
+      return "none";
   }
   return "unknown";
 }
@@ -36,9 +40,10 @@ OnlineStrategy::OnlineStrategy(const RobotModel& model, StrategyKind kind, const
     Pose far = Pose::Identity();
     far.translation() = Vector3(1e3, 1e3, 1e3);
     if (!force_->wrench_at_pose(far, probe) && !force_->wrench_at_pose(Pose::Identity(), probe)) {
-      throw InputError(fmt::format("force model '{}' needs a path index; the online strategies need a model of the "
-                                   "pose (ldbb:..., constant:...)",
-                                   force_->describe()));
+      throw InputError(
+          fmt::format("force model '{}' needs a path index; the online strategies need a model of the "
+                      "pose (ldbb:..., constant:...)",
+                      force_->describe()));
     }
   }
 }

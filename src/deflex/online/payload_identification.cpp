@@ -3,13 +3,13 @@
 
 #include <cmath>
 
-#include <Eigen/Dense>
 #include <fmt/format.h>
+#include <Eigen/Dense>
 
-#include "deflex/text/csv_table.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/model/kinematics.hpp"
 #include "deflex/model/linear_algebra.hpp"
+#include "deflex/text/csv_table.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 
@@ -33,10 +33,10 @@ Solved solve(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const char* wha
   Solved r;
   r.condition = s(s.size() - 1) > 0.0 ? s(0) / s(s.size() - 1) : std::numeric_limits<double>::infinity();
   if (!(r.condition < 1e8)) {
-    throw InputError(fmt::format(
-        "payload identification: the poses do not excite every {} unknown (condition number {:.3g}); "
-        "use orientations that turn the sensor about at least two different axes",
-        what, r.condition));
+    throw InputError(
+        fmt::format("payload identification: the poses do not excite every {} unknown (condition number {:.3g}); "
+                    "use orientations that turn the sensor about at least two different axes",
+                    what, r.condition));
   }
   r.x = svd.solve(b);
   r.rms = std::sqrt((A * r.x - b).squaredNorm() / static_cast<double>(b.size()));
@@ -77,10 +77,10 @@ PayloadEstimate identify_payload(const std::vector<PayloadObservation>& poses, b
   e.force_residual_rms_N = f.rms;
   e.force_condition_number = f.condition;
   if (e.mass_kg < 0.0) {
-    throw InputError(fmt::format(
-        "payload identification: the mass comes out negative ({:.4g} kg): check the force sign and the "
-        "orientation columns",
-        e.mass_kg));
+    throw InputError(
+        fmt::format("payload identification: the mass comes out negative ({:.4g} kg): check the force sign and the "
+                    "orientation columns",
+                    e.mass_kg));
   }
   if (use_moments) {
     const Solved t = solve(At, bt, "moment");
@@ -105,8 +105,9 @@ std::vector<PayloadObservation> read_payload_observations(const std::string& csv
   }
   const bool quaternion = t.has("qw");
   if (!quaternion && !t.has("q1_deg")) {
-    throw DataError(csv_path + ": no orientation columns: give the sensor orientation as qw,qx,qy,qz (base_R_sensor) "
-                               "or the robot joints as q1_deg..qN_deg");
+    throw DataError(csv_path +
+                    ": no orientation columns: give the sensor orientation as qw,qx,qy,qz (base_R_sensor) "
+                    "or the robot joints as q1_deg..qN_deg");
   }
   if (quaternion) {
     t.require({"qw", "qx", "qy", "qz"});

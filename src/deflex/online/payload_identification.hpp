@@ -23,7 +23,7 @@ struct PayloadEstimate {
   bool moments_used = false;
   double force_residual_rms_N = 0.0;
   double moment_residual_rms_Nm = 0.0;
-  double force_condition_number = 0.0;   ///< of the force regressor; large = poses too alike
+  double force_condition_number = 0.0;  ///< of the force regressor; large = poses too alike
   double moment_condition_number = 0.0;
   int poses = 0;
 };

@@ -175,7 +175,8 @@ std::string sensor_config_to_yaml(const SensorConfig& c) {
   const Eigen::Quaterniond q(c.flange_T_sensor.linear());
   out += fmt::format("flange_T_sensor_m_deg: {{position: {}, quaternion_wxyz: [{:.12g}, {:.12g}, {:.12g}, {:.12g}]}}\n",
                      v3(c.flange_T_sensor.translation()), q.w(), q.x(), q.y(), q.z());
-  out += fmt::format("bias: {{force_N: {}, moment_Nm: {}}}\n", v3(c.bias_sensor.head<3>()), v3(c.bias_sensor.tail<3>()));
+  out +=
+      fmt::format("bias: {{force_N: {}, moment_Nm: {}}}\n", v3(c.bias_sensor.head<3>()), v3(c.bias_sensor.tail<3>()));
   out += fmt::format("payload: {{mass_kg: {:.9g}, cog_sensor_m: {}}}\n", c.payload_mass_kg, v3(c.payload_cog_sensor_m));
   out += fmt::format("gravity_base_m_s2: {}\n", v3(c.gravity_base_m_s2));
   out += fmt::format("lowpass: {{cutoff_hz: {:.9g}, order: {}}}\n", c.lowpass_cutoff_hz, c.lowpass_order);

@@ -18,16 +18,16 @@ struct SensorConfig {
   Matrix6 crosstalk = Matrix6::Identity();
   /// Flange to sensor frame (the sensor sits between flange and end effector).
   Pose flange_T_sensor = Pose::Identity();
-  double payload_mass_kg = 0.0;                         ///< end effector beyond the sensor
-  Vector3 payload_cog_sensor_m = Vector3::Zero();       ///< its centre of gravity, sensor frame
-  Vector6 bias_sensor = Vector6::Zero();                ///< reading at zero load and zero payload, N/Nm
+  double payload_mass_kg = 0.0;                          ///< end effector beyond the sensor
+  Vector3 payload_cog_sensor_m = Vector3::Zero();        ///< its centre of gravity, sensor frame
+  Vector6 bias_sensor = Vector6::Zero();                 ///< reading at zero load and zero payload, N/Nm
   Vector3 gravity_base_m_s2 = Vector3(0.0, 0.0, -9.81);  ///< gravity in the robot base frame
 
-  double lowpass_cutoff_hz = 25.0;  ///< the paper's value
-  int lowpass_order = 2;            ///< 1..8
-  double sample_rate_hz = 1000.0;   ///< rate at which samples arrive (the filter is designed for it)
-  double dead_band_N = 0.0;         ///< |F| below this counts as zero force
-  double dead_band_Nm = 0.0;        ///< |M| below this counts as zero moment
+  double lowpass_cutoff_hz = 25.0;     ///< the paper's value
+  int lowpass_order = 2;               ///< 1..8
+  double sample_rate_hz = 1000.0;      ///< rate at which samples arrive (the filter is designed for it)
+  double dead_band_N = 0.0;            ///< |F| below this counts as zero force
+  double dead_band_Nm = 0.0;           ///< |M| below this counts as zero moment
   double fault_threshold_N = 5000.0;   ///< |F| above this is a fault: the sample never moves the robot
   double fault_threshold_Nm = 2000.0;  ///< same for |M|
 

@@ -5,8 +5,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/paths/pose_source.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 

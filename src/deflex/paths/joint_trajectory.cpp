@@ -22,7 +22,8 @@ void hermite(double u, double h, const JointVector& q0, const JointVector& q1, c
   const double h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u, h01 = -2 * u3 + 3 * u2, h11 = u3 - u2;
   q = h00 * q0 + (h10 * h) * m0 + h01 * q1 + (h11 * h) * m1;
   if (qd != nullptr) {
-    const double d00 = (6 * u2 - 6 * u) / h, d10 = 3 * u2 - 4 * u + 1, d01 = (-6 * u2 + 6 * u) / h, d11 = 3 * u2 - 2 * u;
+    const double d00 = (6 * u2 - 6 * u) / h, d10 = 3 * u2 - 4 * u + 1, d01 = (-6 * u2 + 6 * u) / h,
+                 d11 = 3 * u2 - 2 * u;
     *qd = d00 * q0 + d10 * m0 + d01 * q1 + d11 * m1;
   }
 }
@@ -64,8 +65,8 @@ JointTrajectory::JointTrajectory(std::vector<double> t_s, std::vector<JointVecto
       throw InputError(fmt::format("{}: time t_s is not a finite number", where(i)));
     }
     if (i > 0 && !(t_[i] > t_[i - 1])) {
-      throw InputError(fmt::format("{}: time t_s = {} s does not increase (previous point {} s)", where(i), t_[i],
-                                   t_[i - 1]));
+      throw InputError(
+          fmt::format("{}: time t_s = {} s does not increase (previous point {} s)", where(i), t_[i], t_[i - 1]));
     }
     if (q_[i].size() != n) {
       throw InputError(fmt::format("{}: {} joints for a robot of {}", where(i), q_[i].size(), n));

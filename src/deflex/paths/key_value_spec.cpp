@@ -52,7 +52,8 @@ KeyValueSpec::KeyValueSpec(std::string spec, const std::string& body, std::vecto
       known = known || a == key;
     }
     if (!known) {
-      fail(fmt::format("unknown key '{}'{} (allowed: {})", key, did_you_mean(key, allowed_), fmt::join(allowed_, ", ")));
+      fail(
+          fmt::format("unknown key '{}'{} (allowed: {})", key, did_you_mean(key, allowed_), fmt::join(allowed_, ", ")));
     }
     if (values_.count(key) != 0) {
       fail(fmt::format("key '{}' given twice", key));

@@ -3,9 +3,9 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
-#include "deflex/paths/pose_source.hpp"
 #include "deflex/paths/circle_path.hpp"
+#include "deflex/paths/pose_source.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 

@@ -60,10 +60,10 @@ const JointVector& PathIkSolver::next(const Pose& base_T_tcp) {
     for (int j = 0; j < model_.dof(); ++j) {
       const double step = std::abs(r.q[j] - q_[j]);
       if (step > options_.max_joint_step_rad) {
-        throw InputError(fmt::format(
-            "path point {}: joint {} moves {:.2f} deg from point {} (limit {:.2f} deg): the path passes a "
-            "singularity or a joint limit with this configuration, or it is sampled too coarsely",
-            i, j + 1, rad_to_deg(step), i - 1, rad_to_deg(options_.max_joint_step_rad)));
+        throw InputError(
+            fmt::format("path point {}: joint {} moves {:.2f} deg from point {} (limit {:.2f} deg): the path passes a "
+                        "singularity or a joint limit with this configuration, or it is sampled too coarsely",
+                        i, j + 1, rad_to_deg(step), i - 1, rad_to_deg(options_.max_joint_step_rad)));
       }
     }
   }

@@ -5,8 +5,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/paths/key_value_spec.hpp"
 #include "deflex/paths/detail/pose_path_csv.hpp"
+#include "deflex/paths/key_value_spec.hpp"
 
 namespace deflex {
 namespace {

@@ -5,16 +5,17 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/paths/detail/pose_path_csv.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 
 void check_held_path_points(std::size_t held) {
   if (held >= kMaxHeldPathPoints) {
-    throw InputError(fmt::format("path: more than {} poses to hold in memory; deflex offline streams longer paths to "
-                                 "CSV (without --rapid, --joint-trajectory and --nominal-trajectory)",
-                                 kMaxHeldPathPoints));
+    throw InputError(
+        fmt::format("path: more than {} poses to hold in memory; deflex offline streams longer paths to "
+                    "CSV (without --rapid, --joint-trajectory and --nominal-trajectory)",
+                    kMaxHeldPathPoints));
   }
 }
 

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "deflex/text/csv_table.hpp"
 #include "deflex/paths/circle_path.hpp"
 #include "deflex/paths/line_path.hpp"
+#include "deflex/text/csv_table.hpp"
 
 namespace deflex {
 
@@ -93,7 +93,6 @@ class PoseCsvSource final : public PoseSource {
 
  private:
   void find_columns();
-
 
   CsvReader reader_;
   std::size_t x_, y_, z_, qw_, qx_, qy_, qz_;

@@ -9,13 +9,12 @@
 
 #include <fmt/format.h>
 
-#include "deflex/study/paper_figures.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
+#include "deflex/study/paper_figures.hpp"
 #include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {
-
 
 const char* const kCss = R"(
 body { font-family: Helvetica, Arial, sans-serif; color: #222; max-width: 1060px; margin: 24px auto; padding: 0 16px; line-height: 1.45; }
@@ -117,17 +116,17 @@ std::string results_tables(const StudyResult& study) {
       h += fmt::format("<tr><td class=\"l\">{:g} N</td><td>{}</td>", l.load_N,
                        with_paper(mm_spread(l.uc_mean_spread()), pr != nullptr ? pr->uc_mm : kNaN));
       for (const int v : speeds) {
-        h += fmt::format("<td>{}</td>", with_paper(mm_spread(l.c_spread(v)),
-                                                   pr != nullptr ? value_at_speed(pr->c_mm, v) : kNaN));
+        h += fmt::format("<td>{}</td>",
+                         with_paper(mm_spread(l.c_spread(v)), pr != nullptr ? value_at_speed(pr->c_mm, v) : kNaN));
       }
       for (const int v : speeds) {
-        const double paper_comp =
-            pr != nullptr ? compensation_ratio(pr->uc_mm, value_at_speed(pr->c_mm, v)) : kNaN;  // its UC: the speeds' mean
+        const double paper_comp = pr != nullptr ? compensation_ratio(pr->uc_mm, value_at_speed(pr->c_mm, v))
+                                                : kNaN;  // its UC: the speeds' mean
         const std::string ours = percent_text(value_at_speed(l.compensation, v));
-        h += fmt::format("<td>{}</td>", std::isfinite(paper_comp)
-                                            ? fmt::format("{} <span class=\"paper\">({:.0f}%)</span>", ours,
-                                                          paper_comp * 100.0)
-                                            : ours);
+        h += fmt::format("<td>{}</td>",
+                         std::isfinite(paper_comp)
+                             ? fmt::format("{} <span class=\"paper\">({:.0f}%)</span>", ours, paper_comp * 100.0)
+                             : ours);
       }
       if (pt != nullptr) {
         if (pr != nullptr && std::isfinite(l.uc_mean_mm())) {
@@ -321,7 +320,8 @@ std::string budget_tables(const StudyResult& study) {
     return "";
   }
   std::string h =
-      "<h2 id=\"budget\">Error budget</h2>\n<p class=\"caption\">Each effect of the simulated cell that the compensators' model "
+      "<h2 id=\"budget\">Error budget</h2>\n<p class=\"caption\">Each effect of the simulated cell that the "
+      "compensators' model "
       "lacks, its size, and the compensated residual when that effect alone is switched off. Its share is "
       "(residual with all effects - residual without it) / residual with all effects; shares need not add up to "
       "100% (effects interact, and tracker noise stays in every run). The residual with every effect on is one "
@@ -367,24 +367,25 @@ bool any_setup(const StudyResult& study, bool with_paper) {
 
 std::string figures_html(const StudyResult& study) {
   auto whiskers_of = [&](const char* what) {
-    return study.seed_count() > 1 ? fmt::format("{}: the mean over {}; whiskers: the range (min to max) over the seeds.",
-                                               what, seeds_text(study))
-                                 : std::string("One seed: no whiskers.");
+    return study.seed_count() > 1
+               ? fmt::format("{}: the mean over {}; whiskers: the range (min to max) over the seeds.", what,
+                             seeds_text(study))
+               : std::string("One seed: no whiskers.");
   };
   const std::string whiskers = whiskers_of("Bars");
   std::string h;
   const bool paper_setups = any_setup(study, true), other_setups = any_setup(study, false);
   h += "<h2 id=\"figure5\">Figure 5: mean deformation after compensation</h2>\n";
-  h += "<div class=\"fig\">\n" +
-       svg_figure5(study, paper_setups ? SetupSelection::kPaper : SetupSelection::kAll) + "</div>\n";
+  h += "<div class=\"fig\">\n" + svg_figure5(study, paper_setups ? SetupSelection::kPaper : SetupSelection::kAll) +
+       "</div>\n";
   h += "<p class=\"caption\">Upper panel: our residual after compensation (C) per load and speed; lower panel: the "
        "uncompensated deviation (UC, pale), the mean over the speeds as in the paper. Outlined bars: the paper's "
        "values (Tables 1 and 2) beside ours. " +
        whiskers + "</p>\n";
   if (paper_setups && other_setups) {
     h += "<div class=\"fig\">\n" + svg_figure5(study, SetupSelection::kBeyondPaper) + "</div>\n";
-    h += "<p class=\"caption\">The same, on the same axes, for the setups the paper did not run. " + whiskers +
-         "</p>\n";
+    h +=
+        "<p class=\"caption\">The same, on the same axes, for the setups the paper did not run. " + whiskers + "</p>\n";
   }
   h += "<h2 id=\"compensation\">Compensation per load</h2>\n";
   h += "<p class=\"caption\">The figure the paper quotes: offline about 67% at every load, online 69% to 80%, "
@@ -420,9 +421,10 @@ std::string html_report(const ReportContent& content) {
   if (study.wall_time_s > 0.0) {
     sub += fmt::format(" &#183; {:.1f} s wall time", study.wall_time_s);
   }
-  h += fmt::format("<p class=\"sub\">{}. Reference: the paper's Tables 1 and 2 and Figure 5 "
-                   "(offline and online compliance compensation of an ABB IRB6700 on a loaded circle).</p>\n",
-                   sub);
+  h += fmt::format(
+      "<p class=\"sub\">{}. Reference: the paper's Tables 1 and 2 and Figure 5 "
+      "(offline and online compliance compensation of an ABB IRB6700 on a loaded circle).</p>\n",
+      sub);
   if (!content.setup_paragraphs.empty()) {
     h += "<h2 id=\"setup\">Setup</h2>\n";
     for (const auto& p : content.setup_paragraphs) {
@@ -458,12 +460,12 @@ std::string html_report(const ReportContent& content) {
   h += budget_tables(study);
   if (!study.speed_sweep.empty()) {
     h += "<h2 id=\"sweep\">Speed sweep</h2>\n<div class=\"fig\">\n" + svg_speed_sweep(study) + "</div>\n";
-    h += "<p class=\"caption\">Beyond the paper's 10-50 mm/s (shaded): how each strategy's compensation holds up "
-         "as the TCP speed grows and the compensation cycle and delay start to matter. The time-synchronous panel "
-         "shows the lag the nearest-point metric does not see. " +
-         std::string(study.seed_count() > 1 ? "Points: the mean over the seeds; whiskers: min to max over them. "
-                                           : "") +
-         "Each panel's range is fitted to its data; points at one speed are drawn side by side.</p>\n";
+    h +=
+        "<p class=\"caption\">Beyond the paper's 10-50 mm/s (shaded): how each strategy's compensation holds up "
+        "as the TCP speed grows and the compensation cycle and delay start to matter. The time-synchronous panel "
+        "shows the lag the nearest-point metric does not see. " +
+        std::string(study.seed_count() > 1 ? "Points: the mean over the seeds; whiskers: min to max over them. " : "") +
+        "Each panel's range is fitted to its data; points at one speed are drawn side by side.</p>\n";
   }
   if (!content.notes.empty()) {
     h += "<h2 id=\"notes\">Notes</h2>\n";

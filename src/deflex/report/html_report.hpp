@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "deflex/study/study_tables.hpp"
-#include "deflex/study/error_budget.hpp"
 #include "deflex/report/svg_charts.hpp"
+#include "deflex/study/error_budget.hpp"
+#include "deflex/study/study_tables.hpp"
 
 namespace deflex {
 

@@ -105,8 +105,9 @@ void Canvas::polyline(const std::vector<double>& xy, const std::string& stroke, 
   for (std::size_t i = 0; i + 1 < xy.size(); i += 2) {
     pts += fmt::format("{}{:.1f},{:.1f}", i == 0 ? "" : " ", xy[i], xy[i + 1]);
   }
-  body_ += fmt::format(R"(<polyline points="{}" fill="none" stroke="{}" stroke-width="{:.2f}" stroke-linejoin="round"{}/>)",
-                       pts, stroke, width, extra.empty() ? "" : " " + extra);
+  body_ +=
+      fmt::format(R"(<polyline points="{}" fill="none" stroke="{}" stroke-width="{:.2f}" stroke-linejoin="round"{}/>)",
+                  pts, stroke, width, extra.empty() ? "" : " " + extra);
   body_ += "\n";
 }
 
@@ -169,12 +170,23 @@ std::string xml_escape(const std::string& text) {
   out.reserve(text.size());
   for (const char ch : text) {
     switch (ch) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += ch;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        out += ch;
     }
   }
   return out;

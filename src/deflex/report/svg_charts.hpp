@@ -8,9 +8,9 @@
 
 #include <string>
 
-#include "deflex/study/study_tables.hpp"
 #include "deflex/evaluate/lap_split.hpp"
 #include "deflex/model/tracker_trace.hpp"
+#include "deflex/study/study_tables.hpp"
 
 namespace deflex {
 

@@ -21,7 +21,6 @@ using svg::Canvas;
 using svg::kMinFont;
 using svg::Scale;
 
-
 TrackerTrace finite_only(const TrackerTrace& t) {
   TrackerTrace out;
   out.reserve(t.size());
@@ -140,7 +139,8 @@ double mean_of(const std::vector<LapDeviation>& laps, int clockwise /* -1: any *
 }
 
 int count_of(const std::vector<LapDeviation>& laps, bool clockwise) {
-  return static_cast<int>(std::count_if(laps.begin(), laps.end(), [&](const auto& l) { return l.clockwise == clockwise; }));
+  return static_cast<int>(
+      std::count_if(laps.begin(), laps.end(), [&](const auto& l) { return l.clockwise == clockwise; }));
 }
 
 constexpr int kSectors = 72;  // 5 deg each
@@ -189,20 +189,23 @@ void arrowhead(Canvas& c, double x, double y, double dx, double dy, const std::s
 }
 
 std::string direction_name(bool clockwise) { return clockwise ? "clockwise" : "anticlockwise"; }
-std::string direction_colour(bool clockwise) {
-  return clockwise ? svg::kClockwiseColour : svg::kAnticlockwiseColour;
-}
+std::string direction_colour(bool clockwise) { return clockwise ? svg::kClockwiseColour : svg::kAnticlockwiseColour; }
 std::string direction_mean_colour(bool clockwise) { return clockwise ? "#8F3B00" : "#2E1A4F"; }
 std::string direction_dash(bool clockwise) { return clockwise ? "" : R"(stroke-dasharray="6 3")"; }
 
 // The base direction an angle on a horizontal circle points to (seen from above).
 std::string compass(int deg) {
   switch (deg) {
-    case 0: return "+x";
-    case 90: return "+y";
-    case 180: return "-x";
-    case 270: return "-y";
-    default: return "";
+    case 0:
+      return "+x";
+    case 90:
+      return "+y";
+    case 180:
+      return "-x";
+    case 270:
+      return "-y";
+    default:
+      return "";
   }
 }
 
@@ -214,9 +217,7 @@ void titles(Canvas& c, const std::string& title, const std::string& of) {
   }
 }
 
-void no_data(Canvas& c, const std::string& why) {
-  c.text(c.width() / 2.0, c.height() / 2.0, why, 14.0, "middle");
-}
+void no_data(Canvas& c, const std::string& why) { c.text(c.width() / 2.0, c.height() / 2.0, why, 14.0, "middle"); }
 
 }  // namespace
 
@@ -255,8 +256,8 @@ std::string svg_path_plot(const PathPlot& plot) {
     }
   }
   const double mag = plot.magnification > 0.0 ? plot.magnification
-                     : max_dev > 0.0             ? svg::nice_floor(0.12 * ref->size_m / max_dev)
-                                                 : 1.0;
+                     : max_dev > 0.0          ? svg::nice_floor(0.12 * ref->size_m / max_dev)
+                                              : 1.0;
   auto mean_text = [&](const char* name, const std::vector<Dev>& ds, const TrackerTrace& lap) {
     if (ds.empty()) {
       return fmt::format("{} (no data)", name);
@@ -448,8 +449,8 @@ std::string svg_lap_overlay(const PathPlot& plot) {
           pen = false;
           continue;
         }
-        d += fmt::format("{}{:.1f},{:.1f}", pen ? " L" : (d.empty() ? "M" : " M"), x(sector_centre_deg(k)),
-                         y(means[k]));
+        d +=
+            fmt::format("{}{:.1f},{:.1f}", pen ? " L" : (d.empty() ? "M" : " M"), x(sector_centre_deg(k)), y(means[k]));
         pen = true;
       }
       if (!d.empty()) {
@@ -548,9 +549,10 @@ std::string svg_polar_deviation(const PathPlot& plot) {
     rings.push_back(k * ring_step);
   }
   for (const double mm : rings) {
-    c.circle(cx, cy, radius(mm), "none",
-             fmt::format(R"(stroke="{}" stroke-width="{}" {} class="ring" data-mm="{:.6g}")", mm == 0.0 ? "#888" : "#bbb",
-                         mm == 0.0 ? "1.5" : "1", mm == 0.0 ? "" : R"(stroke-dasharray="4 3")", mm));
+    c.circle(
+        cx, cy, radius(mm), "none",
+        fmt::format(R"(stroke="{}" stroke-width="{}" {} class="ring" data-mm="{:.6g}")", mm == 0.0 ? "#888" : "#bbb",
+                    mm == 0.0 ? "1.5" : "1", mm == 0.0 ? "" : R"(stroke-dasharray="4 3")", mm));
   }
   for (const auto& cv : curves) {
     std::string d;
@@ -609,9 +611,8 @@ std::string svg_polar_deviation(const PathPlot& plot) {
   }
   c.text(cx, cy + r_out + 44.0, "Distance from the reference drawn outward from the 0 mm ring", 12.0, "middle",
          R"(fill="#444")");
-  c.text(cx, cy + r_out + 60.0,
-         fmt::format("(1 mm = {:.0f} px); angle as in the per-lap figure", px_per_mm), 12.0, "middle",
-         R"(fill="#444")");
+  c.text(cx, cy + r_out + 60.0, fmt::format("(1 mm = {:.0f} px); angle as in the per-lap figure", px_per_mm), 12.0,
+         "middle", R"(fill="#444")");
   return c.str();
 }
 

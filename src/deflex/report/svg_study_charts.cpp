@@ -18,12 +18,14 @@ using svg::Canvas;
 using svg::kMinFont;
 using svg::Scale;
 
-
 bool selected(const std::string& setup, SetupSelection which) {
   switch (which) {
-    case SetupSelection::kPaper: return paper_has_setup(setup);
-    case SetupSelection::kBeyondPaper: return !paper_has_setup(setup);
-    case SetupSelection::kAll: return true;
+    case SetupSelection::kPaper:
+      return paper_has_setup(setup);
+    case SetupSelection::kBeyondPaper:
+      return !paper_has_setup(setup);
+    case SetupSelection::kAll:
+      return true;
   }
   return true;
 }
@@ -360,9 +362,10 @@ void parity_axes(Canvas& c, const ParityFrame& f) {
 void parity_bands(Canvas& c, const ParityFrame& f) {
   const svg::LogScale& xs = f.xs;
   const svg::LogScale& ys = f.ys;
-  c.raw(fmt::format(R"(<clipPath id="deflex-parity-area"><rect x="{:.2f}" y="{:.2f}" width="{:.2f}" height="{:.2f}"/></clipPath>)"
-                    "\n<g clip-path=\"url(#deflex-parity-area)\">\n",
-                    f.pl, f.pt, f.ps, f.ps));
+  c.raw(fmt::format(
+      R"(<clipPath id="deflex-parity-area"><rect x="{:.2f}" y="{:.2f}" width="{:.2f}" height="{:.2f}"/></clipPath>)"
+      "\n<g clip-path=\"url(#deflex-parity-area)\">\n",
+      f.pl, f.pt, f.ps, f.ps));
   const double e0 = f.d0 / 2.0, e1 = f.d1 * 2.0;  // beyond the plot, clipped
   c.polygon({xs(e0), ys(e0 * 0.65), xs(e1), ys(e1 * 0.65), xs(e1), ys(e1 * 1.35), xs(e0), ys(e0 * 1.35)}, "#dcefd8");
   for (const double k : {0.75, 1.25}) {
@@ -409,8 +412,7 @@ ParityCounts parity_markers(Canvas& c, const ParityFrame& f, const std::vector<P
 }
 
 /// The legend (the setups' colours, the markers, the lines and bands) from (rx, ry) down; ry ends below it.
-void parity_legend(Canvas& c, const StudyResult& study, const std::vector<ParityPoint>& points, double rx,
-                   double& ry) {
+void parity_legend(Canvas& c, const StudyResult& study, const std::vector<ParityPoint>& points, double rx, double& ry) {
   std::map<std::size_t, std::string> setups;
   for (const auto& p : points) {
     setups.emplace(p.setup_index, p.setup);

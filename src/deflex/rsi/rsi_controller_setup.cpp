@@ -29,11 +29,13 @@ void RsiSetupOptions::validate() const {
         "option --context: '{}' must be a KRL name (a letter, then letters, digits or '_', at most 24)", context));
   }
   if (!(std::abs(period_ms - 4.0) < 1e-9 || std::abs(period_ms - 12.0) < 1e-9)) {
-    throw InputError(fmt::format("option --period-ms: RSI runs at 4 ms (#IPO_FAST) or 12 ms (#IPO), not {}", period_ms));
+    throw InputError(
+        fmt::format("option --period-ms: RSI runs at 4 ms (#IPO_FAST) or 12 ms (#IPO), not {}", period_ms));
   }
-  if (!std::isfinite(max_joint_correction_deg) || !(max_joint_correction_deg > 0.0) || max_joint_correction_deg > 10.0) {
-    throw InputError(fmt::format("option --max-joint-correction-deg: must be > 0 and <= 10 (got {})",
-                                 max_joint_correction_deg));
+  if (!std::isfinite(max_joint_correction_deg) || !(max_joint_correction_deg > 0.0) ||
+      max_joint_correction_deg > 10.0) {
+    throw InputError(
+        fmt::format("option --max-joint-correction-deg: must be > 0 and <= 10 (got {})", max_joint_correction_deg));
   }
   if (!std::isfinite(monitor_factor) || monitor_factor < 1.0 || monitor_factor > 10.0) {
     throw InputError("option --rsi-monitor-factor: AXISCORRMON's MaxAi must be 1..10 times the bound");
@@ -42,10 +44,11 @@ void RsiSetupOptions::validate() const {
   // A Timeout that outlasts deflex's restart silence would let RSI go on after deflex has started a
   // new session from zero correction: the controller's offset would then step.
   if (timeout * period_ms * 1e-3 >= restart_silence_s) {
-    throw InputError(fmt::format("option --rsi-timeout: {} late answers of {} ms outlast deflex's {} s restart "
-                                 "silence; at most {}",
-                                 timeout, plain_number(period_ms), plain_number(restart_silence_s),
-                                 static_cast<int>(std::ceil(restart_silence_s / (period_ms * 1e-3))) - 1));
+    throw InputError(
+        fmt::format("option --rsi-timeout: {} late answers of {} ms outlast deflex's {} s restart "
+                    "silence; at most {}",
+                    timeout, plain_number(period_ms), plain_number(restart_silence_s),
+                    static_cast<int>(std::ceil(restart_silence_s / (period_ms * 1e-3))) - 1));
   }
   if (precision < 1 || precision > 12) throw InputError("option --rsi-precision: 1..12 decimals");
   if (axes < 1 || axes > 6) throw InputError("the RSI context corrects 1..6 axes (A1..A6)");
@@ -98,7 +101,8 @@ std::vector<ControllerFile> rsi_controller_setup(const RsiSetupOptions& o) {
   std::string inputs, lower, upper, monitor;
   for (int a = 1; a <= o.axes; ++a) {
     inputs += fmt::format("      <Input InIdx=\"{0}\" OutObjID=\"ETHERNET1\" OutIdx=\"{0}\" />\n", a);
-    lower += fmt::format("      <Parameter Name=\"LowerLimA{}\" ParamID=\"{}\" ParamValue=\"{}\" />\n", a, a, plain_number(-bound));
+    lower += fmt::format("      <Parameter Name=\"LowerLimA{}\" ParamID=\"{}\" ParamValue=\"{}\" />\n", a, a,
+                         plain_number(-bound));
     upper += fmt::format("      <Parameter Name=\"UpperLimA{}\" ParamID=\"{}\" ParamValue=\"{}\" />\n", a, 12 + a,
                          plain_number(bound));
     monitor += fmt::format("      <Parameter Name=\"MaxA{}\" ParamID=\"{}\" ParamValue=\"{}\" />\n", a, a,
@@ -133,9 +137,9 @@ std::vector<ControllerFile> rsi_controller_setup(const RsiSetupOptions& o) {
       "    </Parameters>\n"
       "  </RSIObject>\n"
       "</RSIObjects>\n",
-      fmt::arg("bound", plain_number(bound)), fmt::arg("max", plain_number(bound * o.monitor_factor)), fmt::arg("timeout", o.timeout),
-      fmt::arg("ethernet", ethernet_file), fmt::arg("precision", o.precision), fmt::arg("inputs", inputs),
-      fmt::arg("lower", lower), fmt::arg("upper", upper), fmt::arg("monitor", monitor));
+      fmt::arg("bound", plain_number(bound)), fmt::arg("max", plain_number(bound * o.monitor_factor)),
+      fmt::arg("timeout", o.timeout), fmt::arg("ethernet", ethernet_file), fmt::arg("precision", o.precision),
+      fmt::arg("inputs", inputs), fmt::arg("lower", lower), fmt::arg("upper", upper), fmt::arg("monitor", monitor));
 
   const std::string krl = fmt::format(
       "DEF {name}( )\n"
@@ -162,8 +166,9 @@ std::vector<ControllerFile> rsi_controller_setup(const RsiSetupOptions& o) {
       "  HALT\n"
       "ENDIF\n"
       "END\n",
-      fmt::arg("name", o.context), fmt::arg("bound", plain_number(bound)), fmt::arg("period", plain_number(o.period_ms)),
-      fmt::arg("command", command), fmt::arg("mode", std::abs(o.period_ms - 4.0) < 1e-9 ? "#IPO_FAST" : "#IPO"));
+      fmt::arg("name", o.context), fmt::arg("bound", plain_number(bound)),
+      fmt::arg("period", plain_number(o.period_ms)), fmt::arg("command", command),
+      fmt::arg("mode", std::abs(o.period_ms - 4.0) < 1e-9 ? "#IPO_FAST" : "#IPO"));
 
   return {
       {ethernet_file, ethernet,

@@ -22,17 +22,17 @@
 namespace deflex {
 
 struct RsiSetupOptions {
-  std::string sensor_ip;              ///< deflex's IPv4 address as the controller reaches it (<IP_NUMBER>)
-  std::uint16_t port = 49152;         ///< deflex online --rsi-port (<PORT>)
-  std::string sentype = "ImFree";     ///< deflex online --rsi-sentype (<SENTYPE>)
-  std::string context = "deflex_rsi";  ///< base name of the files (and the KRL program's name)
-  double period_ms = 4.0;             ///< deflex online --period-ms: 4 (#IPO_FAST) or 12 (#IPO)
+  std::string sensor_ip;                  ///< deflex's IPv4 address as the controller reaches it (<IP_NUMBER>)
+  std::uint16_t port = 49152;             ///< deflex online --rsi-port (<PORT>)
+  std::string sentype = "ImFree";         ///< deflex online --rsi-sentype (<SENTYPE>)
+  std::string context = "deflex_rsi";     ///< base name of the files (and the KRL program's name)
+  double period_ms = 4.0;                 ///< deflex online --period-ms: 4 (#IPO_FAST) or 12 (#IPO)
   double max_joint_correction_deg = 0.5;  ///< deflex online --max-joint-correction-deg: AXISCORR's limits
   /// AXISCORRMON MaxAi as a multiple of the bound: beyond what AXISCORR lets through, so it only
   /// trips when something other than deflex corrects the axes.
   double monitor_factor = 1.2;
-  int timeout = 100;                  ///< ETHERNET Timeout: late answers before RSI stops
-  int precision = 4;                  ///< ETHERNET Precision: decimals of the values the controller sends
+  int timeout = 100;  ///< ETHERNET Timeout: late answers before RSI stops
+  int precision = 4;  ///< ETHERNET Precision: decimals of the values the controller sends
   int axes = 6;
   /// The silence after which deflex starts a new session from zero correction (RsiLinkConfig); the
   /// Timeout must stop RSI before it, so a new session is always a new RSI_ON.

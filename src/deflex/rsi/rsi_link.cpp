@@ -7,16 +7,17 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 
 void RsiLinkConfig::validate() const {
   if (!valid_rsi_sentype(sentype)) {
-    throw InputError(fmt::format("RSI link: SENTYPE '{}' must be 1..32 letters, digits, '_' or '-', starting with a "
-                                 "letter (the controller's <SENTYPE>)",
-                                 sentype));
+    throw InputError(
+        fmt::format("RSI link: SENTYPE '{}' must be 1..32 letters, digits, '_' or '-', starting with a "
+                    "letter (the controller's <SENTYPE>)",
+                    sentype));
   }
   if (max_document_bytes < 64 || max_document_bytes > 65507) {
     throw InputError("RSI link: max_document_bytes must be 64..65507");
@@ -141,15 +142,32 @@ RsiLink::Drain RsiLink::drain(double timeout_s, bool& restarted) noexcept {
       continue;
     }
     switch (decode_rsi_robot(rx_.data(), static_cast<std::size_t>(n), axes, msg_)) {
-      case RsiDecodeStatus::kOk: break;
-      case RsiDecodeStatus::kMalformed: ++counters_.malformed; continue;
-      case RsiDecodeStatus::kTruncated: ++counters_.truncated; continue;
-      case RsiDecodeStatus::kMissingIpoc: ++counters_.missing_header; continue;
-      case RsiDecodeStatus::kMissingAxes: ++counters_.missing_joints; continue;
-      case RsiDecodeStatus::kNonFinite: ++counters_.non_finite; continue;
-      case RsiDecodeStatus::kEmpty: ++counters_.empty; continue;
-      case RsiDecodeStatus::kForeign: ++counters_.foreign_document; continue;
-      case RsiDecodeStatus::kIpocOutOfRange: ++counters_.sequence_out_of_range; continue;
+      case RsiDecodeStatus::kOk:
+        break;
+      case RsiDecodeStatus::kMalformed:
+        ++counters_.malformed;
+        continue;
+      case RsiDecodeStatus::kTruncated:
+        ++counters_.truncated;
+        continue;
+      case RsiDecodeStatus::kMissingIpoc:
+        ++counters_.missing_header;
+        continue;
+      case RsiDecodeStatus::kMissingAxes:
+        ++counters_.missing_joints;
+        continue;
+      case RsiDecodeStatus::kNonFinite:
+        ++counters_.non_finite;
+        continue;
+      case RsiDecodeStatus::kEmpty:
+        ++counters_.empty;
+        continue;
+      case RsiDecodeStatus::kForeign:
+        ++counters_.foreign_document;
+        continue;
+      case RsiDecodeStatus::kIpocOutOfRange:
+        ++counters_.sequence_out_of_range;
+        continue;
     }
     if (!plausible(msg_)) {
       ++counters_.out_of_limits;

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "deflex/text/output_file.hpp"
 #include "deflex/runtime/record_queue.hpp"
+#include "deflex/text/output_file.hpp"
 
 namespace deflex::runtime {
 

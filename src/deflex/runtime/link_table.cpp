@@ -13,8 +13,8 @@ const std::array<LinkKindInfo, 4>& link_kinds() {
   // late answers), so 1 s of silence means it stopped; simple message has its own state timeout.
   static const std::array<LinkKindInfo, 4> kinds{{
       {LinkKind::kEgmJoint, "egm-joint",
-       "ABB EGM position guidance (EGMActJoint/EGMRunJoint): deflex streams --program", true,
-       CommandForm::kJointTarget, 0.004, 3.0},
+       "ABB EGM position guidance (EGMActJoint/EGMRunJoint): deflex streams --program", true, CommandForm::kJointTarget,
+       0.004, 3.0},
       {LinkKind::kEgmPath, "egm-path",
        "ABB EGM path correction (EGMActMove + EGMMoveL/EGMMoveC): the controller runs its own program, deflex sends "
        "whole TCP offsets",

@@ -14,11 +14,11 @@ enum class LinkKind : int { kEgmJoint = 0, kEgmPath = 1, kRsi = 2, kSimpleMessag
 
 struct LinkKindInfo {
   LinkKind kind;
-  const char* name;             ///< the --link value
+  const char* name;  ///< the --link value
   const char* help;
-  bool streams_program;         ///< deflex is the motion source: needs a program (--program)
-  CommandForm form;             ///< what goes on the wire
-  double default_period_s;      ///< the controller's cycle when none is given
+  bool streams_program;           ///< deflex is the motion source: needs a program (--program)
+  CommandForm form;               ///< what goes on the wire
+  double default_period_s;        ///< the controller's cycle when none is given
   double default_stop_silence_s;  ///< how long a silence is ridden through by default
 };
 

@@ -116,7 +116,8 @@ std::string MonitorFeed::json(std::uint64_t since) const {
     }
     out += ']';
   };
-  column("t", [](const MonitorRow& r) { return r.t_s; }, true);
+  column(
+      "t", [](const MonitorRow& r) { return r.t_s; }, true);
   column("pt", [](const MonitorRow& r) { return r.program_t_s; });
   column("seq", [](const MonitorRow& r) { return static_cast<double>(r.sequence); });
   column("st", [](const MonitorRow& r) { return r.status; });

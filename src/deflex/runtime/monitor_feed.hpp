@@ -18,8 +18,8 @@ namespace deflex::runtime {
 struct MonitorRow {
   double t_s = 0.0, program_t_s = 0.0;
   std::uint64_t sequence = 0;
-  int status = 0;  ///< CycleStatus
-  double wrench[6] = {};  ///< conditioned wrench the model used, base frame: N, Nm
+  int status = 0;            ///< CycleStatus
+  double wrench[6] = {};     ///< conditioned wrench the model used, base frame: N, Nm
   double raw_force[3] = {};  ///< the sensor's force in the base frame, N
   double dtheta_deg[kMaxJoints] = {};
   double tcp_mm[3] = {};
@@ -36,7 +36,7 @@ struct MonitorSetup {
   double program_duration_s = 0.0;  ///< streaming links' program, 0 otherwise
   double window_s = 30.0;           ///< history kept (a recorded log keeps everything)
   bool recorded = false;
-  std::string source;               ///< the log's path for a recorded session
+  std::string source;  ///< the log's path for a recorded session
 };
 
 /// The rows of the last window_s seconds, the session's state and stop reason, as JSON for the page.

@@ -69,9 +69,10 @@ RealtimeGrant make_current_thread_realtime(const RealtimeOptions& o) {
     CPU_SET(o.cpu, &set);
     const int err = pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
     if (err != 0) {
-      throw InputError(fmt::format("option --rt-cpu: CPU {} is not available to this process ({}; the CPUs it may use: "
-                                   "{})",
-                                   o.cpu, std::strerror(err), allowed_cpus()));
+      throw InputError(
+          fmt::format("option --rt-cpu: CPU {} is not available to this process ({}; the CPUs it may use: "
+                      "{})",
+                      o.cpu, std::strerror(err), allowed_cpus()));
     }
     g.pinned = true;
   }
@@ -94,7 +95,8 @@ RealtimeGrant make_current_thread_realtime(const RealtimeOptions& o) {
       pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal);
       throw InputError(fmt::format(
           "option --realtime: the system refused to lock the process's memory ({}): it needs the CAP_IPC_LOCK "
-          "capability or a locked-memory limit large enough for deflex (now {} bytes: `ulimit -l` shows KiB; grant it in "
+          "capability or a locked-memory limit large enough for deflex (now {} bytes: `ulimit -l` shows KiB; grant it "
+          "in "
           "/etc/security/limits.conf, e.g. '@realtime - memlock unlimited'), or --rt-no-mlock",
           std::strerror(e), rlimit_text(RLIMIT_MEMLOCK)));
     }

@@ -11,8 +11,8 @@ namespace deflex::runtime {
 
 struct RealtimeOptions {
   bool enabled = false;
-  int priority = 80;   ///< SCHED_FIFO priority, 1..99 (the kernel's own threads run at 50 on PREEMPT_RT)
-  int cpu = -1;        ///< CPU the loop is pinned to; -1: not pinned
+  int priority = 80;  ///< SCHED_FIFO priority, 1..99 (the kernel's own threads run at 50 on PREEMPT_RT)
+  int cpu = -1;       ///< CPU the loop is pinned to; -1: not pinned
   bool lock_memory = true;
   /// Throws InputError naming the setting.
   void validate() const;

@@ -6,10 +6,10 @@
 
 #include <fmt/format.h>
 
+#include "deflex/online/online_strategy.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/transport/tcp_stream.hpp"
 #include "deflex/transport/udp_transport.hpp"
-#include "deflex/online/online_strategy.hpp"
 
 namespace deflex::runtime {
 
@@ -27,7 +27,8 @@ void check_config(const SessionConfig& c, const LinkKindInfo& kind, const JointT
   c.online.validate();
   c.realtime.validate();
   const auto non_negative = [](double v, const char* option) {
-    if (!std::isfinite(v) || v < 0.0) throw InputError(fmt::format("option {}: must be a number >= 0 (got {})", option, v));
+    if (!std::isfinite(v) || v < 0.0)
+      throw InputError(fmt::format("option {}: must be a number >= 0 (got {})", option, v));
   };
   non_negative(c.duration_s, "--duration-s");
   non_negative(c.status_interval_s, "--status-interval-s");
@@ -42,9 +43,10 @@ void check_config(const SessionConfig& c, const LinkKindInfo& kind, const JointT
     throw InputError("session: the reporter's queue holds 16..16777216 entries");
   }
   if (kind.streams_program && program == nullptr) {
-    throw InputError(fmt::format("option --program: {} streams a nominal program: give --program P.csv (deflex offline "
-                                 "--nominal-trajectory writes one)",
-                                 kind.name));
+    throw InputError(
+        fmt::format("option --program: {} streams a nominal program: give --program P.csv (deflex offline "
+                    "--nominal-trajectory writes one)",
+                    kind.name));
   }
   if (!kind.streams_program && program != nullptr) {
     throw InputError(
@@ -129,7 +131,8 @@ void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
       EgmJointLinkConfig c = config_.egm_joint;
       c.stop = rules;
       c.history_cycles = config_.history_cycles;
-      DatagramTransport& t = datagram(net.egm_port, "--egm-port", "the EGM links need the port the controller sends to");
+      DatagramTransport& t =
+          datagram(net.egm_port, "--egm-port", "the EGM links need the port the controller sends to");
       link_ = std::make_unique<EgmJointLink>(*compensator_, *strategy_, std::move(program), t, clock_, force, c);
       where_ = fmt::format("EGM on {}", to_string(t.local_address()));
       break;
@@ -138,7 +141,8 @@ void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
       EgmPathLinkConfig c = config_.egm_path;
       c.stop = rules;
       c.history_cycles = config_.history_cycles;
-      DatagramTransport& t = datagram(net.egm_port, "--egm-port", "the EGM links need the port the controller sends to");
+      DatagramTransport& t =
+          datagram(net.egm_port, "--egm-port", "the EGM links need the port the controller sends to");
       link_ = std::make_unique<EgmPathLink>(*compensator_, *strategy_, t, clock_, force, c);
       where_ = fmt::format("EGM on {} (corrections in the {} frame)", to_string(t.local_address()), to_string(c.frame));
       break;
@@ -147,7 +151,8 @@ void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
       RsiLinkConfig c = config_.rsi;
       c.stop = rules;
       c.history_cycles = config_.history_cycles;
-      DatagramTransport& t = datagram(net.rsi_port, "--rsi-port", "the RSI link needs the port the controller sends to");
+      DatagramTransport& t =
+          datagram(net.rsi_port, "--rsi-port", "the RSI link needs the port the controller sends to");
       link_ = std::make_unique<RsiLink>(*compensator_, *strategy_, t, clock_, force, c);
       where_ = fmt::format("RSI on {}; answers <Sen Type=\"{}\">", to_string(t.local_address()), c.sentype);
       break;
@@ -177,8 +182,8 @@ void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
       } else {
         where_ = fmt::format("simple message ({}-endian)", simple_message::to_string(c.byte_order));
       }
-      link_ = std::make_unique<SimpleMessageLink>(*compensator_, *strategy_, std::move(program), *motion, *state, clock_,
-                                                  force, c);
+      link_ = std::make_unique<SimpleMessageLink>(*compensator_, *strategy_, std::move(program), *motion, *state,
+                                                  clock_, force, c);
       break;
     }
   }
@@ -189,8 +194,8 @@ std::string Session::describe() const {
   const OnlineConfig& o = config_.online;
   std::string program;
   if (program_) {
-    program = fmt::format("; program {} ({} points, {:.1f} s)", program_->source(), program_->size(),
-                          program_->duration_s());
+    program =
+        fmt::format("; program {} ({} points, {:.1f} s)", program_->source(), program_->size(), program_->duration_s());
   }
   return fmt::format(
       "{} link, strategy {}; {}{}; {}; rate bounds {:g} deg/s a joint and {:g} mm/s at the TCP; watchdog {:g} ms; "
@@ -294,7 +299,9 @@ const SessionSummary& Session::finish() {
   const double now = clock_.now_s();
   // Why, in a sentence.
   switch (reason_) {
-    case StopReason::kUserStop: reason_text_ = "stopped on request (SIGINT, SIGTERM or the caller)"; break;
+    case StopReason::kUserStop:
+      reason_text_ = "stopped on request (SIGINT, SIGTERM or the caller)";
+      break;
     case StopReason::kDuration:
       reason_text_ = fmt::format("the session's time limit of {:g} s passed", config_.duration_s);
       break;
@@ -315,7 +322,9 @@ const SessionSummary& Session::finish() {
           rad_to_deg(tolerance), program_ ? program_->source() : std::string("?"), joints);
       break;
     }
-    default: reason_text_ = link_->stop_reason(); break;
+    default:
+      reason_text_ = link_->stop_reason();
+      break;
   }
   if (reporter_) {
     if (reporter_thread_.joinable()) {
@@ -358,19 +367,21 @@ void Session::build_summary() {
 
   const bool tcp = s.limits.form == CommandForm::kTcpOffset;
   const std::string invariants =
-      tcp ? fmt::format("largest TCP offset {:.4f} mm of the {:g} mm bound, largest step {:.4f} mm ({:.0f}% of its {:.4f} "
-                        "mm limit)",
-                        s.stats.max_deviation_m * 1e3, s.limits.tcp_bound_m * 1e3, s.stats.max_step_m * 1e3,
-                        s.stats.max_step_fraction * 100.0, s.limits.tcp_step_m * 1e3)
-          : fmt::format("largest |command - nominal| {:.5f} deg of the {:g} deg bound, largest TCP correction {:.4f} mm of "
-                        "{:g} mm, largest step {:.5f} deg ({:.0f}% of its limit){}",
-                        rad_to_deg(s.stats.max_deviation_rad), rad_to_deg(s.limits.joint_bound_rad),
-                        s.stats.max_deviation_m * 1e3, s.limits.tcp_bound_m * 1e3, rad_to_deg(s.stats.max_step_rad),
-                        s.stats.max_step_fraction * 100.0,
-                        s.limits.form == CommandForm::kJointTarget
-                            ? fmt::format(", largest |command - program| {:.5f} deg (with the ramp-in blend)",
-                                          rad_to_deg(s.stats.max_program_deviation_rad))
-                            : std::string());
+      tcp ? fmt::format(
+                "largest TCP offset {:.4f} mm of the {:g} mm bound, largest step {:.4f} mm ({:.0f}% of its {:.4f} "
+                "mm limit)",
+                s.stats.max_deviation_m * 1e3, s.limits.tcp_bound_m * 1e3, s.stats.max_step_m * 1e3,
+                s.stats.max_step_fraction * 100.0, s.limits.tcp_step_m * 1e3)
+          : fmt::format(
+                "largest |command - nominal| {:.5f} deg of the {:g} deg bound, largest TCP correction {:.4f} mm of "
+                "{:g} mm, largest step {:.5f} deg ({:.0f}% of its limit){}",
+                rad_to_deg(s.stats.max_deviation_rad), rad_to_deg(s.limits.joint_bound_rad),
+                s.stats.max_deviation_m * 1e3, s.limits.tcp_bound_m * 1e3, rad_to_deg(s.stats.max_step_rad),
+                s.stats.max_step_fraction * 100.0,
+                s.limits.form == CommandForm::kJointTarget
+                    ? fmt::format(", largest |command - program| {:.5f} deg (with the ramp-in blend)",
+                                  rad_to_deg(s.stats.max_program_deviation_rad))
+                    : std::string());
   std::string text = fmt::format(
       "deflex online: the {} session ended: {} (exit code {}): {}\n"
       "  {} cycles, {} answers in {:.1f} s; rejected datagrams {} (malformed {}, truncated {}, oversized {}, empty {}, "
@@ -386,7 +397,8 @@ void Session::build_summary() {
   if (reporter_) text += fmt::format("  timing: {}\n", reporter_->timing_text());
   if (const std::string protocol = l.protocol_summary(); !protocol.empty()) text += fmt::format("  {}\n", protocol);
   text += fmt::format(
-      "  measured delay {:.1f} ms; force samples ok {}, fault {}, invalid {}, dropped {}; fault episodes {} ({} faulted "
+      "  measured delay {:.1f} ms; force samples ok {}, fault {}, invalid {}, dropped {}; fault episodes {} ({} "
+      "faulted "
       "cycles)\n",
       s.measured_delay_s * 1e3, s.compensator.samples_ok, s.compensator.samples_fault, s.compensator.samples_invalid,
       s.compensator.samples_dropped, s.fault_episodes, s.faulted_cycles);
@@ -395,48 +407,49 @@ void Session::build_summary() {
                         program_->duration_s(), s.program_behind_s);
   }
   if (!config_.log_path.empty() && reporter_) {
-    text += fmt::format("  cycle log {}: {} rows{}\n", config_.log_path, reporter_->log_rows(),
-                        s.log_dropped > 0 ? fmt::format(" ({} cycles never reached it: the disk was slower than the loop)",
-                                                        s.log_dropped)
-                                          : std::string());
+    text +=
+        fmt::format("  cycle log {}: {} rows{}\n", config_.log_path, reporter_->log_rows(),
+                    s.log_dropped > 0
+                        ? fmt::format(" ({} cycles never reached it: the disk was slower than the loop)", s.log_dropped)
+                        : std::string());
   }
   s.text = text;
 
   const auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
-  nlohmann::json j = {
-      {"link", s.link},
-      {"strategy", to_string(config_.strategy)},
-      {"stop_reason", to_string(s.reason)},
-      {"exit_code", s.exit_code},
-      {"reason", s.reason_text},
-      {"duration_s", s.duration_s},
-      {"cycles", s.cycles},
-      {"answers", s.answers},
-      {"counters", counters_json(c)},
-      {"invariants",
-       {{"form", to_string(s.limits.form)},
-        {"max_deviation_deg", rad_to_deg(s.stats.max_deviation_rad)},
-        {"joint_bound_deg", rad_to_deg(s.limits.joint_bound_rad)},
-        {"max_tcp_correction_mm", s.stats.max_deviation_m * 1e3},
-        {"tcp_bound_mm", s.limits.tcp_bound_m * 1e3},
-        {"max_step_deg", rad_to_deg(s.stats.max_step_rad)},
-        {"max_step_mm", s.stats.max_step_m * 1e3},
-        {"max_step_fraction", s.stats.max_step_fraction},
-        {"max_program_deviation_deg", rad_to_deg(s.stats.max_program_deviation_rad)}}},
-      {"measured_delay_ms", number(s.measured_delay_s * 1e3)},
-      {"force_samples",
-       {{"ok", s.compensator.samples_ok},
-        {"fault", s.compensator.samples_fault},
-        {"invalid", s.compensator.samples_invalid},
-        {"dropped", s.compensator.samples_dropped}}},
-      {"fault_episodes", s.fault_episodes},
-      {"faulted_cycles", s.faulted_cycles},
-      {"log", config_.log_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(config_.log_path)},
-      {"log_dropped", s.log_dropped},
-      {"realtime", realtime_.text}};
+  nlohmann::json j = {{"link", s.link},
+                      {"strategy", to_string(config_.strategy)},
+                      {"stop_reason", to_string(s.reason)},
+                      {"exit_code", s.exit_code},
+                      {"reason", s.reason_text},
+                      {"duration_s", s.duration_s},
+                      {"cycles", s.cycles},
+                      {"answers", s.answers},
+                      {"counters", counters_json(c)},
+                      {"invariants",
+                       {{"form", to_string(s.limits.form)},
+                        {"max_deviation_deg", rad_to_deg(s.stats.max_deviation_rad)},
+                        {"joint_bound_deg", rad_to_deg(s.limits.joint_bound_rad)},
+                        {"max_tcp_correction_mm", s.stats.max_deviation_m * 1e3},
+                        {"tcp_bound_mm", s.limits.tcp_bound_m * 1e3},
+                        {"max_step_deg", rad_to_deg(s.stats.max_step_rad)},
+                        {"max_step_mm", s.stats.max_step_m * 1e3},
+                        {"max_step_fraction", s.stats.max_step_fraction},
+                        {"max_program_deviation_deg", rad_to_deg(s.stats.max_program_deviation_rad)}}},
+                      {"measured_delay_ms", number(s.measured_delay_s * 1e3)},
+                      {"force_samples",
+                       {{"ok", s.compensator.samples_ok},
+                        {"fault", s.compensator.samples_fault},
+                        {"invalid", s.compensator.samples_invalid},
+                        {"dropped", s.compensator.samples_dropped}}},
+                      {"fault_episodes", s.fault_episodes},
+                      {"faulted_cycles", s.faulted_cycles},
+                      {"log", config_.log_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(config_.log_path)},
+                      {"log_dropped", s.log_dropped},
+                      {"realtime", realtime_.text}};
   if (reporter_) j["timing"] = reporter_->timing_json();
   if (program_) {
-    j["program"] = {{"time_s", s.program_time_s}, {"duration_s", program_->duration_s()}, {"behind_s", s.program_behind_s}};
+    j["program"] = {
+        {"time_s", s.program_time_s}, {"duration_s", program_->duration_s()}, {"behind_s", s.program_behind_s}};
   }
   s.json = std::move(j);
 }

@@ -58,16 +58,16 @@ struct SessionConfig {
   EgmPathLinkConfig egm_path;
   RsiLinkConfig rsi;
   SimpleMessageLinkConfig simple_message;
-  double duration_s = 0.0;               ///< > 0: the session ends (planned) after this long
-  double status_interval_s = 1.0;        ///< a status line this often (0: none)
-  std::string log_path;                  ///< the cycle log CSV ("" none)
-  std::string fault_dump_path;           ///< the fault dump CSV ("" none)
-  std::size_t history_cycles = 1000;     ///< cycles kept for a fault dump
-  double fault_quiet_s = 1.0;            ///< a fault episode ends after this long without a fault
-  std::size_t queue_entries = 8192;      ///< the loop-to-reporter ring (32 s of 4 ms cycles)
-  bool collect_cycles = false;           ///< keep every cycle in memory (Python's cycle log)
-  bool monitor = false;                  ///< feed the live monitor page (monitor_feed() gives its data)
-  double monitor_window_s = 30.0;        ///< the history the page keeps and shows
+  double duration_s = 0.0;            ///< > 0: the session ends (planned) after this long
+  double status_interval_s = 1.0;     ///< a status line this often (0: none)
+  std::string log_path;               ///< the cycle log CSV ("" none)
+  std::string fault_dump_path;        ///< the fault dump CSV ("" none)
+  std::size_t history_cycles = 1000;  ///< cycles kept for a fault dump
+  double fault_quiet_s = 1.0;         ///< a fault episode ends after this long without a fault
+  std::size_t queue_entries = 8192;   ///< the loop-to-reporter ring (32 s of 4 ms cycles)
+  bool collect_cycles = false;        ///< keep every cycle in memory (Python's cycle log)
+  bool monitor = false;               ///< feed the live monitor page (monitor_feed() gives its data)
+  double monitor_window_s = 30.0;     ///< the history the page keeps and shows
   RealtimeOptions realtime;
 };
 
@@ -83,23 +83,23 @@ struct SessionEndpoints {
 struct SessionSummary {
   StopReason reason = StopReason::kRunning;
   int exit_code = 0;
-  std::string reason_text;       ///< a sentence naming what stopped it
-  std::string link;              ///< "egm-joint" ...
+  std::string reason_text;  ///< a sentence naming what stopped it
+  std::string link;         ///< "egm-joint" ...
   double duration_s = 0.0;
   std::uint64_t cycles = 0, answers = 0;
   LinkCounters counters;
-  CycleStats stats;              ///< the command against its invariants, on the wire values
+  CycleStats stats;  ///< the command against its invariants, on the wire values
   CommandLimits limits;
   CompensatorCounters compensator;
-  double measured_delay_s = 0.0; ///< the mean of the link's delay measurements (NaN before one)
-  std::uint64_t log_dropped = 0; ///< entries the reporter never saw (a full ring: the log has gaps)
+  double measured_delay_s = 0.0;  ///< the mean of the link's delay measurements (NaN before one)
+  std::uint64_t log_dropped = 0;  ///< entries the reporter never saw (a full ring: the log has gaps)
   std::uint64_t fault_episodes = 0, faulted_cycles = 0;
   std::uint64_t late_answers = 0;
-  double program_time_s = 0.0;   ///< streaming links: where the program was at the end (its own axis)
-  double program_behind_s = 0.0; ///< how far behind real time the program ran
-  std::string output_error;      ///< the cycle log could not be written ("" when it was, or none was asked)
-  std::string text;              ///< the summary as lines for a person
-  nlohmann::json json;           ///< the same for a program
+  double program_time_s = 0.0;    ///< streaming links: where the program was at the end (its own axis)
+  double program_behind_s = 0.0;  ///< how far behind real time the program ran
+  std::string output_error;       ///< the cycle log could not be written ("" when it was, or none was asked)
+  std::string text;               ///< the summary as lines for a person
+  nlohmann::json json;            ///< the same for a program
 };
 
 class Session {

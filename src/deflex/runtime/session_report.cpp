@@ -151,9 +151,9 @@ void SessionReporter::begin_episode(const SessionEntry& e) {
   faulted_ = 1;
   ++episodes_;
   const LinkCycleRecord& r = e.record;
-  log(LogLevel::kWarn, fmt::format("fault episode {} began: status {}, |F| {:.1f} N{}", episodes_, to_string(r.status),
-                                   r.wrench_measured_base.head<3>().norm(),
-                                   r.replied ? "" : " (that message was not answered)"));
+  log(LogLevel::kWarn,
+      fmt::format("fault episode {} began: status {}, |F| {:.1f} N{}", episodes_, to_string(r.status),
+                  r.wrench_measured_base.head<3>().norm(), r.replied ? "" : " (that message was not answered)"));
   write_dump(fmt::format("fault episode {}", episodes_));
 }
 
@@ -161,7 +161,8 @@ void SessionReporter::write_dump(const std::string& why) {
   if (setup_.dump_path.empty()) return;
   std::string text = cycle_log_header(setup_.joints);
   const std::size_t first = (ring_head_ + ring_.size() - ring_count_) % ring_.size();
-  for (std::size_t k = 0; k < ring_count_; ++k) append_cycle_row(text, ring_[(first + k) % ring_.size()], setup_.joints, bounds());
+  for (std::size_t k = 0; k < ring_count_; ++k)
+    append_cycle_row(text, ring_[(first + k) % ring_.size()], setup_.joints, bounds());
   try {
     write_fault_dump(setup_.dump_path, text);
   } catch (const Error& e) {
@@ -178,7 +179,8 @@ void SessionReporter::end(double now_s, StopReason reason, const std::string& re
     log(LogLevel::kInfo, fmt::format("fault episode {} ended with the session: {} faulted cycles over {:.2f} s",
                                      episodes_, faulted_, last_fault_s_ - episode_began_s_));
   }
-  if (exit_code(reason) != 0 && reason != StopReason::kStartRefused) write_dump("the session stopped (" + reason_text + ")");
+  if (exit_code(reason) != 0 && reason != StopReason::kStartRefused)
+    write_dump("the session stopped (" + reason_text + ")");
   if (log_) {
     try {
       log_->close();
@@ -205,11 +207,12 @@ std::string SessionReporter::status_line(double now_s) {
     line = fmt::format("waiting for the controller (received {}, rejected {})", c.datagrams, c.rejected());
   } else {
     const bool silent = last_t_s_ >= 0.0 && now_s - last_t_s_ > std::max(2.0 * setup_.period_s, 0.02);
-    std::string now_part = silent ? fmt::format("SILENT for {:.2f} s (nothing consumed: the {} waits)", now_s - last_t_s_,
-                                                setup_.streams_program ? "program" : "correction")
-                                  : fmt::format("status {}, |F| {:.1f} N, TCP correction {:.3f} mm, loop delay {:.1f} ms",
-                                                to_string(r.status), r.wrench_measured_base.head<3>().norm(),
-                                                r.tcp_correction_m.norm() * 1e3, r.delay_s * 1e3);
+    std::string now_part = silent
+                               ? fmt::format("SILENT for {:.2f} s (nothing consumed: the {} waits)", now_s - last_t_s_,
+                                             setup_.streams_program ? "program" : "correction")
+                               : fmt::format("status {}, |F| {:.1f} N, TCP correction {:.3f} mm, loop delay {:.1f} ms",
+                                             to_string(r.status), r.wrench_measured_base.head<3>().norm(),
+                                             r.tcp_correction_m.norm() * 1e3, r.delay_s * 1e3);
     std::string program;
     if (setup_.streams_program) {
       program = fmt::format(" | program {:.1f}/{:.1f} s, {:.2f} s behind real time",
@@ -217,8 +220,8 @@ std::string SessionReporter::status_line(double now_s) {
     }
     std::string invariants;
     if (setup_.limits.form == CommandForm::kTcpOffset) {
-      invariants = fmt::format("max TCP offset {:.4f} mm (bound {:g} mm)", window_dev_m_ * 1e3,
-                               setup_.limits.tcp_bound_m * 1e3);
+      invariants =
+          fmt::format("max TCP offset {:.4f} mm (bound {:g} mm)", window_dev_m_ * 1e3, setup_.limits.tcp_bound_m * 1e3);
     } else {
       invariants = fmt::format("max |command-nominal| {:.4f} deg (bound {:g} deg)", rad_to_deg(window_dev_rad_),
                                rad_to_deg(setup_.limits.joint_bound_rad));

@@ -49,12 +49,12 @@ struct ReportSetup {
   CommandLimits limits;
   bool streams_program = false;
   double program_start_s = 0.0, program_duration_s = 0.0;
-  std::string log_path;       ///< "" no cycle log
-  std::string dump_path;      ///< "" no fault dump file (episodes are still counted and named)
+  std::string log_path;   ///< "" no cycle log
+  std::string dump_path;  ///< "" no fault dump file (episodes are still counted and named)
   std::size_t dump_cycles = 1000;
   double fault_quiet_s = 1.0;  ///< an episode ends after this long without a fault
   double status_interval_s = 1.0;
-  bool collect = false;        ///< keep every cycle's record (Python's cycle log)
+  bool collect = false;  ///< keep every cycle's record (Python's cycle log)
   LogSink sink;
   std::shared_ptr<MonitorFeed> monitor;  ///< the live page's data (null: no monitor)
 };

@@ -7,17 +7,17 @@
 namespace deflex::runtime {
 
 enum class StopReason : int {
-  kRunning = 0,           ///< not ended yet
-  kProgramEnd = 1,        ///< the program ran to its end, or the controller ended the session as planned
-  kUserStop = 2,          ///< SIGINT, SIGTERM, request_stop()
-  kDuration = 3,          ///< the session's time limit
-  kStartRefused = 4,      ///< the arm was not where the program starts: nothing was sent
-  kControllerSilent = 5,  ///< no usable controller message for longer than the stop silence
-  kControllerStopped = 6, ///< the controller stopped or faulted (RSI Timeout, EGM ended early, motors off, e-stop,
-                          ///< refused points, a closed connection)
-  kProtocol = 7,          ///< the controller sent what its protocol does not allow
-  kSafety = 8,            ///< deflex's final guard refused a command (bound, step limit, invalid cycle)
-  kTooSlow = 9,           ///< the controller falls behind the program past the stated limit
+  kRunning = 0,            ///< not ended yet
+  kProgramEnd = 1,         ///< the program ran to its end, or the controller ended the session as planned
+  kUserStop = 2,           ///< SIGINT, SIGTERM, request_stop()
+  kDuration = 3,           ///< the session's time limit
+  kStartRefused = 4,       ///< the arm was not where the program starts: nothing was sent
+  kControllerSilent = 5,   ///< no usable controller message for longer than the stop silence
+  kControllerStopped = 6,  ///< the controller stopped or faulted (RSI Timeout, EGM ended early, motors off, e-stop,
+                           ///< refused points, a closed connection)
+  kProtocol = 7,           ///< the controller sent what its protocol does not allow
+  kSafety = 8,             ///< deflex's final guard refused a command (bound, step limit, invalid cycle)
+  kTooSlow = 9,            ///< the controller falls behind the program past the stated limit
 };
 
 [[nodiscard]] const char* to_string(StopReason r);

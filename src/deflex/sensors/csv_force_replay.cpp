@@ -33,9 +33,9 @@ CsvForceReplay::CsvForceReplay(const std::string& csv_path, bool loop) : loop_(l
     samples_.push_back(s);
   }
   // One sample period beyond the last sample, so a looped replay keeps its spacing.
-  const double step = samples_.size() > 1 ? (samples_.back().t_s - samples_.front().t_s) /
-                                                 static_cast<double>(samples_.size() - 1)
-                                           : 0.001;
+  const double step = samples_.size() > 1
+                          ? (samples_.back().t_s - samples_.front().t_s) / static_cast<double>(samples_.size() - 1)
+                          : 0.001;
   duration_s_ = samples_.back().t_s - samples_.front().t_s + step;
 }
 

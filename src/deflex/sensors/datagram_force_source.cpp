@@ -36,17 +36,25 @@ bool DatagramForceSource::latest(ForceSample& out) noexcept {
       return false;  // nothing new (or a socket error: also nothing usable)
     }
     ++counters_.received;
-    if (static_cast<std::size_t>(n) > buf.size() || !decode_force_datagram(buf.data(), static_cast<std::size_t>(n), d)) {
+    if (static_cast<std::size_t>(n) > buf.size() ||
+        !decode_force_datagram(buf.data(), static_cast<std::size_t>(n), d)) {
       ++counters_.malformed;
       continue;
     }
     switch (sequence_.observe(d.sequence)) {
       case SequenceVerdict::kDuplicate:
-      case SequenceVerdict::kOutOfOrder: ++counters_.out_of_order; continue;
-      case SequenceVerdict::kFarAhead: ++counters_.far_ahead; continue;
-      case SequenceVerdict::kRestart: ++counters_.restarts; break;
+      case SequenceVerdict::kOutOfOrder:
+        ++counters_.out_of_order;
+        continue;
+      case SequenceVerdict::kFarAhead:
+        ++counters_.far_ahead;
+        continue;
+      case SequenceVerdict::kRestart:
+        ++counters_.restarts;
+        break;
       case SequenceVerdict::kFirst:
-      case SequenceVerdict::kNext: break;
+      case SequenceVerdict::kNext:
+        break;
     }
     ++counters_.accepted;
     out.t_s = d.t_s;

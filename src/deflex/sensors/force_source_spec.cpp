@@ -3,10 +3,10 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
-#include "deflex/text/parse_number.hpp"
 #include "deflex/sensors/detail/csv_force_replay.hpp"
 #include "deflex/sensors/detail/udp_force_source.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/parse_number.hpp"
 
 namespace deflex {
 

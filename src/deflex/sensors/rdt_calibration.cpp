@@ -11,11 +11,11 @@
 #include <cmath>
 #include <utility>
 
-#include "deflex/text/input_file.hpp"
-#include "deflex/text/errors.hpp"
-#include "deflex/text/parse_number.hpp"
 #include "deflex/paths/key_value_spec.hpp"
 #include "deflex/sensors/detail/http_fetch.hpp"
+#include "deflex/text/errors.hpp"
+#include "deflex/text/input_file.hpp"
+#include "deflex/text/parse_number.hpp"
 
 namespace deflex {
 namespace {

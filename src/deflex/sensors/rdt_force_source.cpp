@@ -52,11 +52,16 @@ void RdtStreamSettings::validate() const {
 
 const char* to_string(RdtStreamState s) {
   switch (s) {
-    case RdtStreamState::kIdle: return "idle";
-    case RdtStreamState::kRequested: return "requested";
-    case RdtStreamState::kStreaming: return "streaming";
-    case RdtStreamState::kStalled: return "stalled";
-    case RdtStreamState::kNoAnswer: return "no_answer";
+    case RdtStreamState::kIdle:
+      return "idle";
+    case RdtStreamState::kRequested:
+      return "requested";
+    case RdtStreamState::kStreaming:
+      return "streaming";
+    case RdtStreamState::kStalled:
+      return "stalled";
+    case RdtStreamState::kNoAnswer:
+      return "no_answer";
   }
   return "?";
 }
@@ -222,7 +227,9 @@ bool RdtForceSource::in_order(std::uint32_t rdt_sequence) noexcept {
       seen_ = (d >= kSeenWindow ? 0 : seen_ << d) | 1u;
       rdt_step_ = d;
       return true;
-    case SequenceVerdict::kDuplicate: ++counters_.duplicates; return false;
+    case SequenceVerdict::kDuplicate:
+      ++counters_.duplicates;
+      return false;
     case SequenceVerdict::kOutOfOrder: {
       const std::int64_t back = -d;
       if (back < kSeenWindow && ((seen_ >> back) & 1u) != 0) {
@@ -237,7 +244,9 @@ bool RdtForceSource::in_order(std::uint32_t rdt_sequence) noexcept {
       }
       return false;
     }
-    case SequenceVerdict::kFarAhead: ++counters_.far_ahead; return false;
+    case SequenceVerdict::kFarAhead:
+      ++counters_.far_ahead;
+      return false;
   }
   return false;
 }
@@ -306,8 +315,11 @@ void RdtForceSource::take(const RdtRecord& record) noexcept {
       tare_.add(s);
       ++counters_.held_by_tare;
       return;
-    case TareState::kDone: s.wrench_sensor = tare_.apply(s.wrench_sensor); break;
-    case TareState::kOff: break;
+    case TareState::kDone:
+      s.wrench_sensor = tare_.apply(s.wrench_sensor);
+      break;
+    case TareState::kOff:
+      break;
   }
   push(s);
 }
@@ -341,7 +353,8 @@ void RdtForceSource::supervise() noexcept {
         next_request_s_ = now;
       }
       break;
-    default: break;
+    default:
+      break;
   }
   if ((state_ == RdtStreamState::kStalled || state_ == RdtStreamState::kNoAnswer) && now >= next_request_s_) {
     ++counters_.re_requests;

@@ -34,10 +34,14 @@ void TareSettings::validate() const {
 
 const char* to_string(TareState s) {
   switch (s) {
-    case TareState::kOff: return "off";
-    case TareState::kCollecting: return "collecting";
-    case TareState::kDone: return "done";
-    case TareState::kRejected: return "rejected";
+    case TareState::kOff:
+      return "off";
+    case TareState::kCollecting:
+      return "collecting";
+    case TareState::kDone:
+      return "done";
+    case TareState::kRejected:
+      return "rejected";
   }
   return "?";
 }
@@ -46,8 +50,10 @@ std::string describe(const TareResult& r, const TareSettings& s) {
   const double std_f = r.std_sensor.head<3>().maxCoeff();
   const double std_t = r.std_sensor.tail<3>().maxCoeff();
   switch (r.state) {
-    case TareState::kOff: return "tare: off";
-    case TareState::kCollecting: return fmt::format("tare: collecting, {} of {} samples", r.samples, r.samples_wanted);
+    case TareState::kOff:
+      return "tare: off";
+    case TareState::kCollecting:
+      return fmt::format("tare: collecting, {} of {} samples", r.samples, r.samples_wanted);
     case TareState::kDone:
       return fmt::format("tare done: {} samples over {} s, offset {}, standard deviation at most {:.3f} N, {:.4f} Nm",
                          r.samples, number_text(s.window_s), axes(r.offset_sensor), std_f, std_t);

@@ -2,17 +2,17 @@
 #include "deflex/simple_message/simple_message_link.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
-#include <utility>
 #include <cstdarg>
-#include <array>
 #include <cstdio>
+#include <utility>
 
 #include <fmt/format.h>
 
-#include "deflex/text/errors.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 
@@ -39,15 +39,15 @@ void SimpleMessageLinkConfig::validate() const {
         fmt::format("simple message link: max FAILURE replies in a row must be >= 1 (got {})", max_failures));
   }
   if (max_frame_bytes < sm::kHeaderBytes + sm::kJointTrajPtBytes || max_frame_bytes > (std::size_t{1} << 20)) {
-    throw InputError(fmt::format("simple message link: the largest frame must be 64 bytes..1 MiB (got {})",
-                                 max_frame_bytes));
+    throw InputError(
+        fmt::format("simple message link: the largest frame must be 64 bytes..1 MiB (got {})", max_frame_bytes));
   }
   if (!std::isnan(initial_delay_s) && !(std::isfinite(initial_delay_s) && initial_delay_s >= 0.0)) {
     throw InputError(fmt::format("simple message link: the initial delay must be >= 0 s (got {})", initial_delay_s));
   }
   if (!std::isfinite(max_behind_s) || !(max_behind_s > 0.0)) {
-    throw InputError(fmt::format("simple message link: the largest delay behind the program must be > 0 s (got {})",
-                                 max_behind_s));
+    throw InputError(
+        fmt::format("simple message link: the largest delay behind the program must be > 0 s (got {})", max_behind_s));
   }
   stream.validate();
   stop.validate();
@@ -88,10 +88,11 @@ SimpleMessageLink::SimpleMessageLink(OnlineCompensator& compensator, OnlineStrat
   const RobotModel& model = compensator.model();
   const int n = model.dof();
   if (n > static_cast<int>(sm::kWireJoints)) {
-    throw InputError(fmt::format("simple message link: the robot has {} joints, the protocol carries {}", n,
-                                 sm::kWireJoints));
+    throw InputError(
+        fmt::format("simple message link: the robot has {} joints, the protocol carries {}", n, sm::kWireJoints));
   }
-  for (JointVector* q : {&program_, &program_velocity_, &blend_, &blend_velocity_, &nominal_, &last_sent_, &feedback_}) {
+  for (JointVector* q :
+       {&program_, &program_velocity_, &blend_, &blend_velocity_, &nominal_, &last_sent_, &feedback_}) {
     *q = JointVector::Zero(n);
   }
   // A controller that reports joints beyond its own limits (plus 1 deg) is sending garbage.
@@ -133,8 +134,8 @@ void SimpleMessageLink::send_stop() noexcept {
   }
   unsigned char* at = outbox_.reserve(kPointFrameBytes);
   if (at == nullptr) return;  // cannot happen: a point is queued only with room for a STOP behind it
-  const std::size_t n = sm::encode(config_.byte_order, {sm::kJointTrajPt, sm::kServiceRequest, sm::kReplyInvalid},
-                                   stop, at, kPointFrameBytes);
+  const std::size_t n = sm::encode(config_.byte_order, {sm::kJointTrajPt, sm::kServiceRequest, sm::kReplyInvalid}, stop,
+                                   at, kPointFrameBytes);
   outbox_.commit(n);
   ++sm_.stops_sent;
   stop_reply_due_ = true;
@@ -392,7 +393,8 @@ std::string SimpleMessageLink::protocol_summary() const {
 LinkPollResult SimpleMessageLink::poll(double timeout_s) noexcept {
   if (state_ == LinkState::kRefused || state_ == LinkState::kStopped) {
     if (!motion_closed_) flush();  // the STOP_TRAJECTORY, if the window held it back
-    if (winding_down()) wait_readable_any(motion_, state_port_, std::isfinite(timeout_s) ? std::max(timeout_s, 0.0) : 0.0);
+    if (winding_down())
+      wait_readable_any(motion_, state_port_, std::isfinite(timeout_s) ? std::max(timeout_s, 0.0) : 0.0);
     discard_input();
     return announce_terminal();
   }
@@ -446,7 +448,9 @@ LinkPollResult SimpleMessageLink::poll(double timeout_s) noexcept {
 
 LinkPollResult SimpleMessageLink::send_point(double now) noexcept {
   const auto t_start = std::chrono::steady_clock::now();
-  const auto compute = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count(); };
+  const auto compute = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  };
   // How far behind its schedule the program runs: a controller that takes a point less often than once
   // a cycle (FAILURE replies, slow replies) makes it late; past the limit the motion stops.
   const double due = first_origin_s_ + (static_cast<double>(accepted_) + 1.0 - config_.buffer_depth) * period_s_;
@@ -490,7 +494,8 @@ LinkPollResult SimpleMessageLink::send_point(double now) noexcept {
   }
   const JointVector& command = cycle_.joint_command();  // float32-rounded: what the wire carries
   point_ = sm::JointTrajPt{};
-  for (int j = 0; j < command.size(); ++j) point_.joints_rad[static_cast<std::size_t>(j)] = static_cast<float>(command[j]);
+  for (int j = 0; j < command.size(); ++j)
+    point_.joints_rad[static_cast<std::size_t>(j)] = static_cast<float>(command[j]);
   // The velocity field: the fastest joint's share of its top speed (ABB's and Fanuc's servers ignore it).
   double velocity = 0.0;
   const RobotModel& model = cycle_.compensator().model();

@@ -52,7 +52,7 @@ struct SimpleMessageLinkConfig {
   /// The program may fall this far behind its schedule (a controller slower than one point a cycle)
   /// before the link stops the motion (kTooSlow), s.
   double max_behind_s = 2.0;
-  LinkStopRules stop;            ///< end_silence_s: after the program's last point is taken, the session ends
+  LinkStopRules stop;  ///< end_silence_s: after the program's last point is taken, the session ends
   std::size_t max_frame_bytes = simple_message::kDefaultMaxFrameBytes;  ///< a longer LENGTH is out of step
   JointStreamConfig stream;
   std::size_t history_cycles = 1000;  ///< ring of the last cycles (100 s at 100 ms)
@@ -66,16 +66,16 @@ struct SimpleMessageLinkConfig {
 struct SimpleMessageCounters {
   std::uint64_t state_frames = 0, motion_frames = 0;  ///< frames received on each connection
   std::uint64_t joint_positions = 0, robot_statuses = 0;
-  std::uint64_t points_sent = 0;       ///< JOINT_TRAJ_PT requests, repeats included
-  std::uint64_t points_accepted = 0;   ///< SUCCESS replies
-  std::uint64_t failures = 0;          ///< FAILURE replies (the point was not taken)
-  std::uint64_t unknown_type = 0;      ///< frames of a message type the link does not speak
-  std::uint64_t unexpected = 0;        ///< a reply nothing was waiting for, a request or topic on the motion port
-  std::uint64_t wrong_sequence = 0;    ///< a reply naming another point than the one waiting
-  std::uint64_t partial_writes = 0;    ///< writes the stream took only part of (the rest went later)
-  std::uint64_t stops_sent = 0;        ///< STOP_TRAJECTORY requests
-  double behind_s = 0.0;               ///< how far behind its schedule the program is now (s)
-  double max_behind_s = 0.0;           ///< the most it was
+  std::uint64_t points_sent = 0;      ///< JOINT_TRAJ_PT requests, repeats included
+  std::uint64_t points_accepted = 0;  ///< SUCCESS replies
+  std::uint64_t failures = 0;         ///< FAILURE replies (the point was not taken)
+  std::uint64_t unknown_type = 0;     ///< frames of a message type the link does not speak
+  std::uint64_t unexpected = 0;       ///< a reply nothing was waiting for, a request or topic on the motion port
+  std::uint64_t wrong_sequence = 0;   ///< a reply naming another point than the one waiting
+  std::uint64_t partial_writes = 0;   ///< writes the stream took only part of (the rest went later)
+  std::uint64_t stops_sent = 0;       ///< STOP_TRAJECTORY requests
+  double behind_s = 0.0;              ///< how far behind its schedule the program is now (s)
+  double max_behind_s = 0.0;          ///< the most it was
 };
 
 class SimpleMessageLink final : public ControllerLink {

@@ -122,7 +122,7 @@ StandInSession::StandInSession(const runtime::SessionConfig& config, const Robot
       sc.byte_order = config_.simple_message.byte_order;
       sc.record_points = true;
       auto c = std::make_unique<cell::SimpleMessageServer>(sc, robot, program_->points().front(), motion_.server(),
-                                                          state_.server());
+                                                           state_.server());
       server_ = c.get();
       controller_ = std::move(c);
       break;

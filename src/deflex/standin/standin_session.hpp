@@ -32,13 +32,13 @@ struct WireCommand {
 };
 
 struct StandInConfig {
-  cell::ControllerConfig controller;          ///< EGM's period, dead time, filter, gain, timeout (path frame: tool)
-  cell::SimpleMessageServerConfig server;     ///< the RAPID server's buffer, state period, read period
+  cell::ControllerConfig controller;       ///< EGM's period, dead time, filter, gain, timeout (path frame: tool)
+  cell::SimpleMessageServerConfig server;  ///< the RAPID server's buffer, state period, read period
   /// The RSI controller; its AXISCORR limits and AXISCORRMON follow the session's bound when NaN.
   cell::RsiControllerConfig rsi;
-  double network_latency_s = 0.0002;          ///< one way
-  Vector3 force_base_n = Vector3::Zero();     ///< the process force at the TCP, base frame (N)
-  double sensor_rate_hz = 250.0;              ///< samples a second the stand-in sensor gives (one a tick at 250 Hz)
+  double network_latency_s = 0.0002;       ///< one way
+  Vector3 force_base_n = Vector3::Zero();  ///< the process force at the TCP, base frame (N)
+  double sensor_rate_hz = 250.0;           ///< samples a second the stand-in sensor gives (one a tick at 250 Hz)
 };
 
 /// A force/torque sensor at the flange of the stand-in arm: the wrench `force_base_n` at the TCP

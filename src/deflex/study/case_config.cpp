@@ -86,10 +86,14 @@ const char* to_string(Strategy s) {
 
 const char* to_string(LinkKind k) {
   switch (k) {
-    case LinkKind::kProgram: return "program";
-    case LinkKind::kEgmJoint: return "egm-joint";
-    case LinkKind::kEgmPath: return "egm-path";
-    case LinkKind::kSimpleMessage: return "simple-message";
+    case LinkKind::kProgram:
+      return "program";
+    case LinkKind::kEgmJoint:
+      return "egm-joint";
+    case LinkKind::kEgmPath:
+      return "egm-path";
+    case LinkKind::kSimpleMessage:
+      return "simple-message";
   }
   return "?";
 }
@@ -195,8 +199,7 @@ SetupConfig read_case_setup(const yaml::Field& s, const std::vector<SetupConfig>
   if (sc.strategy == Strategy::kHybrid && sc.link == LinkKind::kEgmPath)
     s.at("link").fail("the hybrid strategy streams the offline program: its link is egm-joint or simple-message");
   sc.sensor_mounted = s.at("sensor").as_bool();
-  if (sc.strategy != Strategy::kOffline && !sc.sensor_mounted)
-    s.at("sensor").fail("online strategies need the sensor");
+  if (sc.strategy != Strategy::kOffline && !sc.sensor_mounted) s.at("sensor").fail("online strategies need the sensor");
   for (const auto& other : others) {
     if (other.name == sc.name) s.at("name").fail("two setups have this name");
   }
@@ -241,11 +244,16 @@ void read_case_setups(const yaml::Field& root, const yaml::Field& proto, CaseCon
 // The case file's "true_robot": how the simulated arm differs from the model deflex is given.
 void read_case_true_robot(const yaml::Field& root, CaseConfig& c) {
   const auto r = root.at("true_robot");
-  r.only_keys({"stiffness_scale", "stiffness_spread_pct", "coupling_23", "forearm_EI_Nm2", "forearm_length_mm",
-               "lost_motion_urad", "lost_motion_torque_Nm", "gravity_torque_Nm", "dh_length_sigma_mm",
-               "dh_angle_sigma_deg", "hardening_softening", "hardening_torque_Nm", "upper_arm_EI_Nm2",
-               "base_tilt_compliance_nrad_per_Nm", "speed_stiffening_pct", "direction_asymmetry_pct",
-               "speed_ref_mrad_s", "servo_following_ms", "servo_compliance_pct", "servo_integral_s"});
+  r.only_keys({"stiffness_scale",       "stiffness_spread_pct",
+               "coupling_23",           "forearm_EI_Nm2",
+               "forearm_length_mm",     "lost_motion_urad",
+               "lost_motion_torque_Nm", "gravity_torque_Nm",
+               "dh_length_sigma_mm",    "dh_angle_sigma_deg",
+               "hardening_softening",   "hardening_torque_Nm",
+               "upper_arm_EI_Nm2",      "base_tilt_compliance_nrad_per_Nm",
+               "speed_stiffening_pct",  "direction_asymmetry_pct",
+               "speed_ref_mrad_s",      "servo_following_ms",
+               "servo_compliance_pct",  "servo_integral_s"});
   auto& t = c.cell.robot;
   t.upper_arm_ei_nm2 = non_negative_or(r, "upper_arm_EI_Nm2", 0.0);
   t.base_tilt_compliance_rad_per_nm = non_negative_or(r, "base_tilt_compliance_nrad_per_Nm", 0.0) * 1e-9;
@@ -341,9 +349,8 @@ void read_case_ldbb(const yaml::Field& root, CaseConfig& c) {
   d.stick_slip_travel_m =
       case_number(l, "stick_slip_travel_mm", non_negative, 0.5, from_milli, above(0.0, "must be positive"));
   d.bar_length_m = positive(l.at("bar_length_mm")) * kMm;
-  d.inclination_rad =
-      case_number(l, "inclination_deg", any_sign, kRequired, from_deg,
-                  inside(deg_to_rad(89.0), "must be within +-89 deg"));
+  d.inclination_rad = case_number(l, "inclination_deg", any_sign, kRequired, from_deg,
+                                  inside(deg_to_rad(89.0), "must be within +-89 deg"));
   d.push = l.at("push").as_bool();
   d.time_constant_s = positive(l.at("time_constant_s"));
   d.ripple = non_negative(l.at("ripple_pct")) / 100.0;
@@ -433,9 +440,8 @@ void read_case_calibration(const yaml::Field& root, CaseConfig& c) {
   b.load_n = case_number(cal, "load_N", positive, kRequired, unscaled, at_most(5000.0, "must be at most 5000 N"));
   b.points_per_arc = case_whole(cal, "points_per_arc", kRequired, 2, 1000, "must be 2..1000");
   b.window_s = positive(cal.at("window_ms")) * kMm;
-  b.ldbb_force_error =
-      case_number(cal, "ldbb_force_error_pct", non_negative, kRequired, from_pct,
-                  at_most(0.5, "must be within 0..50 %"));
+  b.ldbb_force_error = case_number(cal, "ldbb_force_error_pct", non_negative, kRequired, from_pct,
+                                   at_most(0.5, "must be within 0..50 %"));
 }
 
 // The case file's optional "drift" (of the path between and during runs) and "error_budget".
@@ -594,12 +600,11 @@ std::string effect_size(const CaseConfig& c, Effect e) {
     case Effect::kTrackerNoise:
       return fmt::format("{:.1f} um (1 sigma)", c.cell.tracker.noise_m * 1e6);
     case Effect::kCalibrationNoise:
-      return fmt::format("LDBB force {:.1f} % (1 sigma){} at calibration, force from the {}",
-                         c.calibration.ldbb_force_error * 100,
-                         c.calibration.ldbb_force_bias != 0.0
-                             ? fmt::format(" {:+.0f} % bias", c.calibration.ldbb_force_bias * 100)
-                             : std::string(),
-                         c.calibration.force_from_sensor ? "sensor when mounted" : "LDBB set-point");
+      return fmt::format(
+          "LDBB force {:.1f} % (1 sigma){} at calibration, force from the {}", c.calibration.ldbb_force_error * 100,
+          c.calibration.ldbb_force_bias != 0.0 ? fmt::format(" {:+.0f} % bias", c.calibration.ldbb_force_bias * 100)
+                                               : std::string(),
+          c.calibration.force_from_sensor ? "sensor when mounted" : "LDBB set-point");
     case Effect::kLatency:
       return fmt::format("dead time {:.0f} ms, filter {:.0f} Hz", c.cell.controller.egm_dead_time_s * 1e3,
                          c.cell.controller.egm_lowpass_hz);

@@ -65,12 +65,12 @@ struct OnlineSettings {
 /// operating space (not the test circle), each run unloaded and then loaded by the LDBB, the deflection
 /// measured by the tracker time-synchronously between the two passes.
 struct CalibrationConfig {
-  int arcs = 6;                   ///< calibration arcs (each at its own height, radius and bar direction)
-  double arc_rad = 2.6;           ///< the angle each arc sweeps (150 deg)
-  double speed_m_s = 0.02;        ///< TCP speed along the arcs (quasi-static)
-  double load_n = 500.0;          ///< LDBB set-point during the loaded passes
-  int points_per_arc = 15;        ///< measurements along each arc
-  double window_s = 0.2;          ///< tracker samples averaged per measurement (time-synchronous)
+  int arcs = 6;             ///< calibration arcs (each at its own height, radius and bar direction)
+  double arc_rad = 2.6;     ///< the angle each arc sweeps (150 deg)
+  double speed_m_s = 0.02;  ///< TCP speed along the arcs (quasi-static)
+  double load_n = 500.0;    ///< LDBB set-point during the loaded passes
+  int points_per_arc = 15;  ///< measurements along each arc
+  double window_s = 0.2;    ///< tracker samples averaged per measurement (time-synchronous)
   /// The LDBB's force against its set-point at calibration time, relative 1-sigma, drawn per seed: a
   /// setup without the force sensor knows only the set-point (a setup with it measures the force).
   double ldbb_force_error = 0.0;
@@ -155,11 +155,11 @@ enum class Effect {
   kLdbbStickSlip,      ///< the cylinder seal's stick-slip
 };
 inline constexpr std::array<Effect, 21> kAllEffects = {
-    Effect::kStiffnessMismatch, Effect::kJointCoupling,   Effect::kLinkBending,      Effect::kSensorCompliance,
-    Effect::kLostMotion,        Effect::kKinematicErrors, Effect::kLdbbForceError,   Effect::kLdbbRipple,
-    Effect::kSensorErrors,      Effect::kTrackerNoise,    Effect::kCalibrationNoise, Effect::kLatency,
+    Effect::kStiffnessMismatch, Effect::kJointCoupling,   Effect::kLinkBending,       Effect::kSensorCompliance,
+    Effect::kLostMotion,        Effect::kKinematicErrors, Effect::kLdbbForceError,    Effect::kLdbbRipple,
+    Effect::kSensorErrors,      Effect::kTrackerNoise,    Effect::kCalibrationNoise,  Effect::kLatency,
     Effect::kPathDrift,         Effect::kGearHardening,   Effect::kSensorCalibration, Effect::kBaseCompliance,
-    Effect::kMotionStiffness,   Effect::kServo,           Effect::kSensorDrift,      Effect::kThermalLoadDrift,
+    Effect::kMotionStiffness,   Effect::kServo,           Effect::kSensorDrift,       Effect::kThermalLoadDrift,
     Effect::kLdbbStickSlip};
 [[nodiscard]] const char* to_string(Effect e);
 /// Short description of the effect's size in `config` (for the error budget table).

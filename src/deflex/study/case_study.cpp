@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -12,16 +13,15 @@
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <tuple>
-#include <array>
 #include <thread>
+#include <tuple>
 
 #include "deflex/evaluate/iso9283_path.hpp"
 #include "deflex/evaluate/lap_split.hpp"
-#include "deflex/model/tracker_trace.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
-#include "deflex/text/errors.hpp"
+#include "deflex/model/tracker_trace.hpp"
 #include "deflex/study/detail/simulated_run.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::study {
 namespace {
@@ -123,7 +123,8 @@ double run_cost(const CaseConfig& c, double speed_m_s, int laps) {
 double calibration_cost(const CaseConfig& c) {
   if (c.exact_model) return 0.0;
   const double hold_s = std::max(1.5, 5.0 * c.cell.ldbb.time_constant_s);
-  return 2.0 * c.calibration.arcs * (hold_s + c.calibration.arc_rad * c.cell.ldbb.bar_length_m / c.calibration.speed_m_s);
+  return 2.0 * c.calibration.arcs *
+         (hold_s + c.calibration.arc_rad * c.cell.ldbb.bar_length_m / c.calibration.speed_m_s);
 }
 
 const char* describe(Strategy s, LinkKind link) {
@@ -455,10 +456,10 @@ void run_loaded_job(StudyContext& x, LoadedJob& j) {
            run.trace);
   }
   if (j.plot) j.keep = std::move(run);
-  x.progress.add(run_cost(x.config, j.speed, x.laps),
-                 fmt::format("seed {}: {} {} N {} mm/s", x.cfg_of(j.seed).seed,
-                             j.kind == RunKind::kUncompensated ? "UC" : to_string(j.strategy), j.load_n,
-                             mm_s(j.speed)));
+  x.progress.add(
+      run_cost(x.config, j.speed, x.laps),
+      fmt::format("seed {}: {} {} N {} mm/s", x.cfg_of(j.seed).seed,
+                  j.kind == RunKind::kUncompensated ? "UC" : to_string(j.strategy), j.load_n, mm_s(j.speed)));
 }
 
 // One run of the error budget: a cell built without the effect (its own calibration), its unloaded
@@ -713,9 +714,8 @@ std::string describe_protocol(const StudyContext& x) {
       rad_to_deg(config.cell.ldbb.inclination_rad), x.laps_cw, x.laps_ccw, config.cell.tracker.rate_hz,
       config.cell.tracker.noise_m * 1e6, k.servo_period_s * 1e3, k.egm_period_s * 1e3, k.egm_dead_time_s * 1e3,
       k.egm_lowpass_hz, k.egm_position_gain_per_s, k.path_corr_period_s * 1e3, k.path_corr_dead_time_s * 1e3,
-      config.online.stream_period_s * 1e3, config.online.stream_buffer_depth, n_seeds,
-      n_seeds == 1 ? "" : "s", config.seed,
-      n_seeds == 1 ? std::string() : fmt::format(" to {}", x.cfg_of(n_seeds - 1).seed));
+      config.online.stream_period_s * 1e3, config.online.stream_buffer_depth, n_seeds, n_seeds == 1 ? "" : "s",
+      config.seed, n_seeds == 1 ? std::string() : fmt::format(" to {}", x.cfg_of(n_seeds - 1).seed));
 }
 }  // namespace
 

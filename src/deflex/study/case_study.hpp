@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "deflex/study/case_config.hpp"
-#include "deflex/study/study_tables.hpp"
 #include "deflex/evaluate/lap_split.hpp"
 #include "deflex/model/tracker_trace.hpp"
+#include "deflex/study/case_config.hpp"
+#include "deflex/study/study_tables.hpp"
 
 namespace deflex::study {
 
@@ -47,15 +47,15 @@ struct PlotTraces {
 /// What deflex's links did in the online runs (every run of the study, summed or maximised).
 struct LinkSummary {
   std::string setup;
-  std::string link;                       ///< the link kind (egm-joint, egm-path, ...)
-  bool joint_commands = true;             ///< the link sends joints (else Cartesian offsets)
-  std::uint64_t cycles = 0;               ///< controller messages answered
-  std::uint64_t rejected = 0;             ///< datagrams counted and not answered
-  std::uint64_t guard_trips = 0;          ///< commands the final check stopped (must be 0)
-  double max_command_deviation_rad = 0.0; ///< largest |command - nominal|, any joint, any cycle
-  double bound_rad = 0.0;                 ///< the bound it must stay within
+  std::string link;                        ///< the link kind (egm-joint, egm-path, ...)
+  bool joint_commands = true;              ///< the link sends joints (else Cartesian offsets)
+  std::uint64_t cycles = 0;                ///< controller messages answered
+  std::uint64_t rejected = 0;              ///< datagrams counted and not answered
+  std::uint64_t guard_trips = 0;           ///< commands the final check stopped (must be 0)
+  double max_command_deviation_rad = 0.0;  ///< largest |command - nominal|, any joint, any cycle
+  double bound_rad = 0.0;                  ///< the bound it must stay within
   double max_tcp_correction_m = 0.0;
-  double measured_delay_s = 0.0;          ///< the link's measured delay (mean over the runs)
+  double measured_delay_s = 0.0;  ///< the link's measured delay (mean over the runs)
 };
 
 struct CaseStudyOutput {

@@ -12,12 +12,12 @@
 #include "deflex/cell/laser_tracker.hpp"
 #include "deflex/cell/ldbb_device.hpp"
 #include "deflex/cell/path_drift.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/online/force_pipeline.hpp"
 #include "deflex/paths/circle_path.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/study/detail/simulated_run.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::study {
 namespace {
@@ -34,9 +34,9 @@ struct Arc {
 };
 
 Arc arc_of(int k) {
-  static const Arc kArcs[6] = {{deg_to_rad(15), 0.05, true, 0.0},           {deg_to_rad(15), -0.05, false, 2.1},
-                               {deg_to_rad(50), 0.05, false, 4.2},          {deg_to_rad(50), -0.05, true, 1.0},
-                               {deg_to_rad(-30), 0.0, true, 3.1},           {deg_to_rad(-30), 0.03, false, 5.2}};
+  static const Arc kArcs[6] = {{deg_to_rad(15), 0.05, true, 0.0},  {deg_to_rad(15), -0.05, false, 2.1},
+                               {deg_to_rad(50), 0.05, false, 4.2}, {deg_to_rad(50), -0.05, true, 1.0},
+                               {deg_to_rad(-30), 0.0, true, 3.1},  {deg_to_rad(-30), 0.03, false, 5.2}};
   Arc a = kArcs[k % 6];
   const int round = k / 6;  // the round of six arcs
   a.start_rad += 0.37 * round;
@@ -132,8 +132,8 @@ CalibrationArc plan_calibration_arc(const CalibrationRig& rig, int k) {
   IkRequest first;
   if (nominal.dof() == 6) first.seed = rig.have_state ? rig.state.q_actual : rig.seed_q;
   const JointPath path = solve_path_ik(nominal, poses, first);
-  return CalibrationArc{k, arc, pivot, trajectory_at_tcp_speed(poses, path.q, cal.speed_m_s, nominal, rig.hold_s),
-                        {}, std::nullopt};
+  return CalibrationArc{
+      k, arc, pivot, trajectory_at_tcp_speed(poses, path.q, cal.speed_m_s, nominal, rig.hold_s), {}, std::nullopt};
 }
 
 // Runs one pass over an arc's program (loaded = 0: unloaded, 1: loaded) and records what the tracker
@@ -154,9 +154,9 @@ void run_calibration_pass(CalibrationRig& rig, CalibrationArc& arc, int loaded) 
   bar.push = arc.arc.push;
   cell::LdbbDevice device(bar, arc.pivot, loaded ? cal.load_n : 0.0, splitmix(pass_seed ^ 1));
   // The loaded pass follows the unloaded one a pass later: its thermal drift has hardly moved.
-  cell::PathDrift drift = loaded ? cell::PathDrift(cc.drift, splitmix(pass_seed ^ 2), *arc.unloaded_drift,
-                                                   program.end_time_s(), cal.load_n)
-                                 : cell::PathDrift(cc.drift, splitmix(pass_seed ^ 2));
+  cell::PathDrift drift =
+      loaded ? cell::PathDrift(cc.drift, splitmix(pass_seed ^ 2), *arc.unloaded_drift, program.end_time_s(), cal.load_n)
+             : cell::PathDrift(cc.drift, splitmix(pass_seed ^ 2));
   if (!loaded) arc.unloaded_drift.emplace(drift);
   cell::LaserTracker tracker(cc.tracker, splitmix(pass_seed ^ 3), hold_s, program.end_time_s(), 0.0);
   ForcePipeline pipeline(rig.sheet, rig.sensor_T_wap);

@@ -19,13 +19,13 @@ struct ErrorBudgetEntry {
 };
 
 struct ErrorBudget {
-  std::string setup;              ///< which setup, load and speed the budget was run for
+  std::string setup;  ///< which setup, load and speed the budget was run for
   double load_N = 0.0;
   double speed_mm_s = 0.0;
-  double residual_mm_all = 0.0;   ///< compensated residual with every effect on
-  double uc_mm = 0.0;             ///< uncompensated deviation, for scale (0 = not given)
-  std::uint64_t seed = 0;         ///< the seed its runs are of (0 = not given)
-  int laps = 0;                   ///< laps per run (0 = not given)
+  double residual_mm_all = 0.0;  ///< compensated residual with every effect on
+  double uc_mm = 0.0;            ///< uncompensated deviation, for scale (0 = not given)
+  std::uint64_t seed = 0;        ///< the seed its runs are of (0 = not given)
+  int laps = 0;                  ///< laps per run (0 = not given)
   std::vector<ErrorBudgetEntry> entries;
 };
 

@@ -17,18 +17,17 @@
 #include "deflex/cell/simple_message_server.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/model/compliance.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/offline/compensate_path.hpp"
-#include "deflex/sensors/datagram_force_source.hpp"
 #include "deflex/online/online_strategy.hpp"
 #include "deflex/paths/circle_path.hpp"
 #include "deflex/runtime/session.hpp"
+#include "deflex/sensors/datagram_force_source.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/transport/memory_network.hpp"
 #include "deflex/transport/memory_stream.hpp"
 
 namespace deflex::study {
 namespace {
-
 
 // Seeds of the run's components, each from the run's own seed.
 enum class Component : std::uint64_t { kLdbb = 1, kSensor = 2, kTracker = 3, kDrift = 4 };
@@ -65,7 +64,8 @@ std::uint64_t run_seed(std::uint64_t case_seed, bool sensor_mounted, RunKind kin
 
 SetupCell build_setup_cell(const CaseConfig& config, bool sensor_mounted) {
   // The same physical robot in every setup: its draws depend on the case seed only.
-  auto robot = std::make_shared<const cell::TrueRobot>(config.cell, sensor_mounted, splitmix(config.seed ^ 0xabcdefULL));
+  auto robot =
+      std::make_shared<const cell::TrueRobot>(config.cell, sensor_mounted, splitmix(config.seed ^ 0xabcdefULL));
   CellCalibration calibration =
       calibrate_setup(config, *robot, splitmix(config.seed ^ (sensor_mounted ? 0x1111ULL : 0x2222ULL)));
   CirclePath circle;
@@ -232,8 +232,8 @@ RunPlan plan_simulated_run(const CaseConfig& config, const SetupCell& setup, con
   const bool compensated = spec.kind == RunKind::kCompensated;
   const bool linked = spec.link != LinkKind::kProgram;
   if (linked && !robot.sensor_mounted()) {
-    throw InputError(fmt::format("run: the {} link's online strategies need the force sensor mounted",
-                                 to_string(spec.link)));
+    throw InputError(
+        fmt::format("run: the {} link's online strategies need the force sensor mounted", to_string(spec.link)));
   }
   const RobotModel& identified = setup.calibration.identified;
   const bool offline_program =
@@ -246,12 +246,11 @@ RunPlan plan_simulated_run(const CaseConfig& config, const SetupCell& setup, con
   const double motion_end_s = program->end_time_s();
   // The arm follows a streamed program a little late: let the tracker see the motion to its end.
   // (The streaming server runs a buffer of points behind: a second.)
-  const double run_end_s =
-      motion_end_s + (spec.link == LinkKind::kSimpleMessage ? 1.0 : linked ? 0.5 : 0.0);
+  const double run_end_s = motion_end_s + (spec.link == LinkKind::kSimpleMessage ? 1.0 : linked ? 0.5 : 0.0);
   const double dt = c.controller.servo_period_s;
   const auto ticks = static_cast<long>(std::ceil(run_end_s / dt));
-  return RunPlan{config, setup, spec, robot, c, loaded, compensated, linked, std::move(program),
-                 c.ldbb.settle_s, run_end_s, dt, ticks};
+  return RunPlan{config,          setup,     spec, robot, c, loaded, compensated, linked, std::move(program),
+                 c.ldbb.settle_s, run_end_s, dt,   ticks};
 }
 
 // The controller the run's link talks to: the robot program itself, EGM position guidance, EGM path
@@ -267,11 +266,11 @@ std::unique_ptr<cell::RobotController> make_run_controller(const RunPlan& plan, 
       break;
     case LinkKind::kEgmJoint:
       controller = std::make_unique<cell::EgmPositionGuidanceController>(c.controller, program->points().front(),
-                                                                          net.controller_port, kDeflexEgm);
+                                                                         net.controller_port, kDeflexEgm);
       break;
     case LinkKind::kEgmPath:
       controller = std::make_unique<cell::EgmPathCorrectionController>(c.controller, robot.nominal_model(), program,
-                                                                        net.controller_port, kDeflexEgm);
+                                                                       net.controller_port, kDeflexEgm);
       break;
     case LinkKind::kSimpleMessage:
       controller = std::make_unique<cell::SimpleMessageServer>(cell::SimpleMessageServerConfig{}, robot.nominal_model(),

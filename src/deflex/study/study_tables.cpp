@@ -15,7 +15,6 @@
 namespace deflex {
 namespace {
 
-
 nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 nlohmann::json speed_map(const std::map<int, double>& m) {
@@ -137,7 +136,8 @@ Grid setup_grid(const SetupResult& s, const std::vector<int>& speeds, const Pape
     }
     Spread comp = l.compensation_spread();
     if (comp.n <= 1) comp.mean = mean_over(l.compensation, speeds);
-    r.cells.push_back(cell_with_paper(percent_spread(comp), pr != nullptr ? percent_text(paper_compensation(*pr)) : ""));
+    r.cells.push_back(
+        cell_with_paper(percent_spread(comp), pr != nullptr ? percent_text(paper_compensation(*pr)) : ""));
     g.rows.push_back(r);
   }
   return g;
@@ -274,7 +274,10 @@ int LoadResult::seeds() const {
 
 void LoadResult::fill_means() {
   const std::pair<std::map<int, std::vector<double>>*, std::map<int, double>*> pairs[] = {
-      {&uc_mm_by_seed, &uc_mm}, {&c_mm_by_seed, &c_mm}, {&uc_sync_mm_by_seed, &uc_sync_mm}, {&c_sync_mm_by_seed, &c_sync_mm}};
+      {&uc_mm_by_seed, &uc_mm},
+      {&c_mm_by_seed, &c_mm},
+      {&uc_sync_mm_by_seed, &uc_sync_mm},
+      {&c_sync_mm_by_seed, &c_sync_mm}};
   for (const auto& [by_seed, mean] : pairs) {
     for (const auto& [v, list] : *by_seed) (*mean)[v] = mean_of(list);
   }
@@ -475,19 +478,18 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
       const std::string lw = fmt::format("{}.loads[{}]", where, li++);
       LoadResult l;
       l.load_N = read_number(jl, "load_N", lw);
-      const std::pair<const char*, std::map<int, double>*> maps[] = {
-          {"uc_mm", &l.uc_mm},
-          {"c_mm", &l.c_mm},
-          {"compensation", &l.compensation},
-          {"uc_std_mm", &l.uc_std_mm},
-          {"c_std_mm", &l.c_std_mm},
-          {"uc_max_mm", &l.uc_max_mm},
-          {"c_max_mm", &l.c_max_mm},
-          {"iso_accuracy_uc_mm", &l.iso_accuracy_uc_mm},
-          {"iso_accuracy_c_mm", &l.iso_accuracy_c_mm},
-          {"iso_repeatability_mm", &l.iso_repeatability_mm},
-          {"uc_sync_mm", &l.uc_sync_mm},
-          {"c_sync_mm", &l.c_sync_mm}};
+      const std::pair<const char*, std::map<int, double>*> maps[] = {{"uc_mm", &l.uc_mm},
+                                                                     {"c_mm", &l.c_mm},
+                                                                     {"compensation", &l.compensation},
+                                                                     {"uc_std_mm", &l.uc_std_mm},
+                                                                     {"c_std_mm", &l.c_std_mm},
+                                                                     {"uc_max_mm", &l.uc_max_mm},
+                                                                     {"c_max_mm", &l.c_max_mm},
+                                                                     {"iso_accuracy_uc_mm", &l.iso_accuracy_uc_mm},
+                                                                     {"iso_accuracy_c_mm", &l.iso_accuracy_c_mm},
+                                                                     {"iso_repeatability_mm", &l.iso_repeatability_mm},
+                                                                     {"uc_sync_mm", &l.uc_sync_mm},
+                                                                     {"c_sync_mm", &l.c_sync_mm}};
       for (const auto& [key, m] : maps) {
         if (jl.contains(key)) {
           *m = read_speed_map(jl.at(key), lw + "." + key);
@@ -576,7 +578,8 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
       }
       if (jb.contains("laps")) {
         const double laps = read_number(jb, "laps", bw);
-        if (laps < 0 || laps > 1e6 || laps != std::floor(laps)) throw DataError(fmt::format("{}: laps: not a lap count", bw));
+        if (laps < 0 || laps > 1e6 || laps != std::floor(laps))
+          throw DataError(fmt::format("{}: laps: not a lap count", bw));
         b.laps = static_cast<int>(laps);
       }
       if (jb.contains("entries")) {
@@ -735,8 +738,9 @@ std::string study_tables_markdown(const StudyResult& study) {
     }
     const auto sync = sync_rows(s, speeds);
     if (!sync.empty()) {
-      out += "\nTime-synchronous error in mm (against the unloaded run at the same time: it sees lag along the path, "
-             "which the nearest-point distance does not).\n\n| load | UC |";
+      out +=
+          "\nTime-synchronous error in mm (against the unloaded run at the same time: it sees lag along the path, "
+          "which the nearest-point distance does not).\n\n| load | UC |";
       for (int v : speeds) out += fmt::format(" C {} mm/s |", v);
       out += "\n| --- | ---: |";
       for (std::size_t c = 0; c < speeds.size(); ++c) out += " ---: |";
@@ -770,8 +774,8 @@ std::string study_csv_text(const StudyResult& study) {
         f += fmt::format("{},{:g},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", csv_text_cell(s.setup),
                          l.load_N, v, at(l.uc_mm), at(l.c_mm), at(l.compensation), at(l.uc_std_mm), at(l.c_std_mm),
                          at(l.uc_max_mm), at(l.c_max_mm), at(l.iso_accuracy_uc_mm), at(l.iso_accuracy_c_mm),
-                         at(l.iso_repeatability_mm), at(l.uc_sync_mm), at(l.c_sync_mm), cs.n, cell(cs.sd),
-                         cell(cs.min), cell(cs.max), cell(pr != nullptr ? pr->uc_mm : kNaN),
+                         at(l.iso_repeatability_mm), at(l.uc_sync_mm), at(l.c_sync_mm), cs.n, cell(cs.sd), cell(cs.min),
+                         cell(cs.max), cell(pr != nullptr ? pr->uc_mm : kNaN),
                          pr != nullptr ? at(pr->c_mm) : std::string());
       }
     }
@@ -785,9 +789,9 @@ std::string sweep_csv_text(const StudyResult& study) {
   f += "setup,load_N,speed_mm_s,uc_mm,c_mm,compensation,c_sync_mm,seeds,c_mm_seed_sd,c_mm_seed_min,c_mm_seed_max\n";
   for (const auto& p : study.speed_sweep) {
     const Spread cs = p.c_mm_by_seed.empty() ? spread_of({p.c_mm}) : spread_of(p.c_mm_by_seed);
-    f += fmt::format("{},{:g},{:g},{},{},{},{},{},{},{},{}\n", csv_text_cell(p.setup), p.load_N, p.speed_mm_s, cell(p.uc_mm),
-                     cell(p.c_mm), cell(p.compensation), cell(p.c_sync_mm), cs.n, cell(cs.sd), cell(cs.min),
-                     cell(cs.max));
+    f += fmt::format("{},{:g},{:g},{},{},{},{},{},{},{},{}\n", csv_text_cell(p.setup), p.load_N, p.speed_mm_s,
+                     cell(p.uc_mm), cell(p.c_mm), cell(p.compensation), cell(p.c_sync_mm), cs.n, cell(cs.sd),
+                     cell(cs.min), cell(cs.max));
   }
   return f;
 }

@@ -33,11 +33,11 @@ struct Spread {
 /// they are the mean of, in the study's seed order.
 struct LoadResult {
   double load_N = 0.0;
-  std::map<int, double> uc_mm;         ///< mean distance of the loaded uncompensated path from the unloaded one
-  std::map<int, double> c_mm;          ///< the same for the loaded compensated path
-  std::map<int, double> compensation;  ///< 1 - C/UC at the same speed (fraction, 0.67 = 67%)
-  std::map<int, double> uc_std_mm, c_std_mm;    ///< standard deviation of the distances (optional)
-  std::map<int, double> uc_max_mm, c_max_mm;    ///< largest distance (optional)
+  std::map<int, double> uc_mm;                ///< mean distance of the loaded uncompensated path from the unloaded one
+  std::map<int, double> c_mm;                 ///< the same for the loaded compensated path
+  std::map<int, double> compensation;         ///< 1 - C/UC at the same speed (fraction, 0.67 = 67%)
+  std::map<int, double> uc_std_mm, c_std_mm;  ///< standard deviation of the distances (optional)
+  std::map<int, double> uc_max_mm, c_max_mm;  ///< largest distance (optional)
   std::map<int, double> iso_accuracy_uc_mm, iso_accuracy_c_mm;  ///< ISO 9283 AT_p vs the unloaded path (optional)
   std::map<int, double> iso_repeatability_mm;                   ///< ISO 9283 RT_p of the compensated runs (optional)
   /// The time-synchronous (along-path) error against the unloaded run at the same time (optional): it
@@ -76,19 +76,19 @@ struct SweepPoint {
   double uc_mm = 0.0;  ///< mean over the seeds
   double c_mm = 0.0;   ///< mean over the seeds
   double compensation = 0.0;
-  double c_sync_mm = std::numeric_limits<double>::quiet_NaN();  ///< time-synchronous error, mean over the seeds
+  double c_sync_mm = std::numeric_limits<double>::quiet_NaN();         ///< time-synchronous error, mean over the seeds
   std::vector<double> uc_mm_by_seed, c_mm_by_seed, c_sync_mm_by_seed;  ///< optional
 };
 
 struct StudyResult {
   std::vector<SetupResult> setups;
-  std::vector<int> speeds_mm_s;          ///< the table columns C1, C2, C3 ... (mm/s)
-  std::vector<SweepPoint> speed_sweep;   ///< optional
+  std::vector<int> speeds_mm_s;            ///< the table columns C1, C2, C3 ... (mm/s)
+  std::vector<SweepPoint> speed_sweep;     ///< optional
   std::vector<ErrorBudget> error_budgets;  ///< optional
-  std::string case_name;                 ///< optional, shown in headings
-  std::uint64_t seed = 0;                ///< the first seed
-  std::vector<std::uint64_t> seeds;      ///< every seed the figures are over (empty: just `seed`)
-  double wall_time_s = 0.0;              ///< optional, 0 = not reported
+  std::string case_name;                   ///< optional, shown in headings
+  std::uint64_t seed = 0;                  ///< the first seed
+  std::vector<std::uint64_t> seeds;        ///< every seed the figures are over (empty: just `seed`)
+  double wall_time_s = 0.0;                ///< optional, 0 = not reported
 
   /// How many seeds the figures are over (at least 1: `seed` alone when `seeds` is empty).
   [[nodiscard]] std::size_t seed_count() const { return std::max<std::size_t>(1, seeds.size()); }

@@ -92,8 +92,8 @@ bool CsvReader::next_line(std::string_view& out) {
       return true;
     }
     if (size - begin_ > kLongestLine) {
-      throw DataError(fmt::format("{}:{}: a line longer than {} bytes: not a CSV data file", source_, line_ + 1,
-                                  kLongestLine));
+      throw DataError(
+          fmt::format("{}:{}: a line longer than {} bytes: not a CSV data file", source_, line_ + 1, kLongestLine));
     }
     // Keep the partial line, read the next chunk behind it.
     buffer_.erase(0, begin_);
@@ -116,10 +116,11 @@ void CsvReader::read_header() {
     if (tl.find(',') == std::string_view::npos) {
       for (const char sep : {';', '\t', '|'}) {
         if (tl.find(sep) != std::string_view::npos) {
-          throw DataError(fmt::format("{}:{}: header: the columns are separated by '{}': deflex CSV files separate "
-                                      "columns with commas (export with ',' as the separator and '.' as the decimal "
-                                      "point)",
-                                      source_, line_, sep == '\t' ? std::string("\\t") : std::string(1, sep)));
+          throw DataError(
+              fmt::format("{}:{}: header: the columns are separated by '{}': deflex CSV files separate "
+                          "columns with commas (export with ',' as the separator and '.' as the decimal "
+                          "point)",
+                          source_, line_, sep == '\t' ? std::string("\\t") : std::string(1, sep)));
         }
       }
     }
@@ -131,9 +132,10 @@ void CsvReader::read_header() {
         throw DataError(fmt::format("{}:{}: header: column {} has no name", source_, line_, i));
       }
       if (parse_double(name)) {
-        throw DataError(fmt::format("{}:{}: header: column {} is named '{}', a number: the first row must name the "
-                                    "columns (e.g. t_s,x_mm,y_mm,z_mm)",
-                                    source_, line_, i, name));
+        throw DataError(
+            fmt::format("{}:{}: header: column {} is named '{}', a number: the first row must name the "
+                        "columns (e.g. t_s,x_mm,y_mm,z_mm)",
+                        source_, line_, i, name));
       }
       if (!index_.emplace(std::string(name), i - 1).second) {
         throw DataError(fmt::format("{}:{}: header: column '{}' appears twice", source_, line_, name));
@@ -162,9 +164,10 @@ void CsvReader::parse_row(std::string_view line) {
     const std::optional<double> v = parse_double(cell);
     if (!v) {
       if (cell.find(';') != std::string_view::npos) {
-        throw DataError(fmt::format("{}:{}: column '{}': '{}' is not a number (the row is separated by ';': deflex "
-                                    "CSV files separate cells with commas)",
-                                    source_, line_, name, cell));
+        throw DataError(
+            fmt::format("{}:{}: column '{}': '{}' is not a number (the row is separated by ';': deflex "
+                        "CSV files separate cells with commas)",
+                        source_, line_, name, cell));
       }
       throw DataError(fmt::format("{}:{}: column '{}': {}", source_, line_, name, not_a_number(cell)));
     }
@@ -229,8 +232,8 @@ void allow_only_columns(const std::string& source, const std::vector<std::string
                         const std::vector<std::string>& allowed) {
   for (const std::string& c : columns) {
     if (std::find(allowed.begin(), allowed.end(), c) == allowed.end()) {
-      throw DataError(fmt::format("{}: unknown column '{}'{} (this file takes: {})", source, c, did_you_mean(c, allowed),
-                                  fmt::join(allowed, ", ")));
+      throw DataError(fmt::format("{}: unknown column '{}'{} (this file takes: {})", source, c,
+                                  did_you_mean(c, allowed), fmt::join(allowed, ", ")));
     }
   }
 }

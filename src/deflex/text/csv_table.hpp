@@ -28,8 +28,8 @@ struct InputRange;
 
 /// Streams a CSV file of numbers: a header row, then one row of finite numbers per line, every row
 /// with the header's number of cells, each number inside the range its column's unit allows
-/// (input_ranges.hpp: 1e308 mm is an error naming the line and column). Columns may come in any order; they are found by name. Errors
-/// throw DataError naming the file, the line and the column.
+/// (input_ranges.hpp: 1e308 mm is an error naming the line and column). Columns may come in any order; they are found
+/// by name. Errors throw DataError naming the file, the line and the column.
 class CsvReader {
  public:
   /// Opens the file (input_file.hpp: a regular file within the limit of `kind`) and reads its header
@@ -70,8 +70,8 @@ class CsvReader {
 
   std::string source_;
   std::unique_ptr<InputFile> file_;  // null when reading text held in memory
-  std::string buffer_;     // the bytes read and not yet consumed, from begin_
-  std::size_t begin_ = 0;  // first unconsumed byte of buffer_
+  std::string buffer_;               // the bytes read and not yet consumed, from begin_
+  std::size_t begin_ = 0;            // first unconsumed byte of buffer_
   bool eof_ = false;
   bool pending_cr_ = false;  // the last line ended with '\r': a '\n' right after it is the same ending
   bool first_bytes_ = true;  // a byte-order mark is skipped only at the very start

@@ -36,14 +36,12 @@ const char* kind_of_file(mode_t mode) {
 
 void check_stat(const std::string& path, const InputKindInfo& info, const struct stat& st) {
   if (!S_ISREG(st.st_mode)) {
-    refuse(path,
-           fmt::format("is {}, not a regular file: deflex reads the {} from a regular file", kind_of_file(st.st_mode),
-                       info.what));
+    refuse(path, fmt::format("is {}, not a regular file: deflex reads the {} from a regular file",
+                             kind_of_file(st.st_mode), info.what));
   }
   if (static_cast<std::uint64_t>(st.st_size) > info.max_bytes) {
-    refuse(path,
-           fmt::format("the {} is {} bytes; deflex reads a {} of up to {} bytes ({} MiB)", info.what, st.st_size,
-                       info.what, info.max_bytes, info.max_bytes / kMiB));
+    refuse(path, fmt::format("the {} is {} bytes; deflex reads a {} of up to {} bytes ({} MiB)", info.what, st.st_size,
+                             info.what, info.max_bytes, info.max_bytes / kMiB));
   }
 }
 
@@ -60,17 +58,24 @@ const InputKindInfo& input_kind_info(InputKind kind) {
   static const InputKindInfo kTable{"data file", 1024 * kMiB};
   static const InputKindInfo kStream{"data file", 16384 * kMiB};  // streamed: memory is not the bound
   switch (kind) {
-    case InputKind::kRobotFile: return kRobot;
-    case InputKind::kUrdf: return kUrdf;
-    case InputKind::kConfig: return kConfig;
-    case InputKind::kProgram: return kProgram;
-    case InputKind::kCsvTable: return kTable;
-    case InputKind::kCsvStream: return kStream;
+    case InputKind::kRobotFile:
+      return kRobot;
+    case InputKind::kUrdf:
+      return kUrdf;
+    case InputKind::kConfig:
+      return kConfig;
+    case InputKind::kProgram:
+      return kProgram;
+    case InputKind::kCsvTable:
+      return kTable;
+    case InputKind::kCsvStream:
+      return kStream;
   }
   return kConfig;
 }
 
-InputFile::InputFile(const std::string& path, InputKind kind, const std::string& updated_as) : path_(path), kind_(kind) {
+InputFile::InputFile(const std::string& path, InputKind kind, const std::string& updated_as)
+    : path_(path), kind_(kind) {
   const InputKindInfo& info = input_kind_info(kind);
   if (path.empty()) {
     refuse("<empty path>", fmt::format("no file name given for the {}", info.what));
@@ -128,13 +133,13 @@ std::size_t InputFile::read(char* buffer, std::size_t n) {
       continue;
     }
     if (got < 0) {
-      throw DataError(fmt::format("{}: reading the {} failed: {}", path_, input_kind_info(kind_).what,
-                                  std::strerror(errno)));
+      throw DataError(
+          fmt::format("{}: reading the {} failed: {}", path_, input_kind_info(kind_).what, std::strerror(errno)));
     }
     read_ += static_cast<std::uint64_t>(got);
     if (read_ > input_kind_info(kind_).max_bytes) {
-      throw DataError(fmt::format("{}: the {} grew past {} bytes while it was read", path_,
-                                  input_kind_info(kind_).what, input_kind_info(kind_).max_bytes));
+      throw DataError(fmt::format("{}: the {} grew past {} bytes while it was read", path_, input_kind_info(kind_).what,
+                                  input_kind_info(kind_).max_bytes));
     }
     return static_cast<std::size_t>(got);
   }

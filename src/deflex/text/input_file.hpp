@@ -27,7 +27,7 @@ enum class InputKind {
 };
 
 struct InputKindInfo {
-  std::string_view what;     ///< "robot file", for messages
+  std::string_view what;    ///< "robot file", for messages
   std::uint64_t max_bytes;  ///< files larger than this are refused before reading
 };
 

@@ -69,8 +69,8 @@ std::optional<std::string> range_violation(double value, const InputRange& r) {
   }
   const std::string unit = r.unit.empty() ? std::string() : fmt::format(" {}", r.unit);
   const std::string sign = r.min > 0.0 && !(value > 0.0) ? "must be positive: " : "";
-  return sign + fmt::format("{:g}{} is outside {:g}..{:g}{} (the {} range deflex accepts)", value, unit, r.min, r.max, unit,
-                     r.quantity);
+  return sign + fmt::format("{:g}{} is outside {:g}..{:g}{} (the {} range deflex accepts)", value, unit, r.min, r.max,
+                            unit, r.quantity);
 }
 
 }  // namespace deflex

@@ -116,9 +116,10 @@ OutputFile::OutputFile(std::string path, std::string what) : path_(std::move(pat
     const int err = errno;
     struct stat link {};
     if (::lstat(path_.c_str(), &link) == 0 && S_ISLNK(link.st_mode)) {
-      throw InputError(fmt::format("{}: a symbolic link to nothing ({}): deflex writes through a link only onto an "
-                                   "existing file",
-                                   name, std::strerror(err)));
+      throw InputError(
+          fmt::format("{}: a symbolic link to nothing ({}): deflex writes through a link only onto an "
+                      "existing file",
+                      name, std::strerror(err)));
     }
     if (err != ENOENT) {
       throw InputError(fmt::format("{}: cannot be written: {}", name, std::strerror(err)));
@@ -131,7 +132,8 @@ OutputFile::OutputFile(std::string path, std::string what) : path_(std::move(pat
       struct stat s {};
       if ((g_closed_streams & (1U << fd)) != 0 && ::fstat(fd, &s) == 0 && s.st_dev == st.st_dev &&
           s.st_ino == st.st_ino) {
-        throw InputError(fmt::format("{}: the program's {} is closed", name, fd == STDOUT_FILENO ? "stdout" : "stderr"));
+        throw InputError(
+            fmt::format("{}: the program's {} is closed", name, fd == STDOUT_FILENO ? "stdout" : "stderr"));
       }
     }
     open_stream(-1, path_);
@@ -201,8 +203,8 @@ void OutputFile::create_temporary(const std::string& target_path, bool existed, 
     if (fd_ < 0 && (errno != EEXIST || attempt > 100)) {
       const int err = errno;
       temp_.clear();
-      throw InputError(fmt::format("{} '{}': cannot create a file in the folder '{}': {}", what_, path_, dir,
-                                   std::strerror(err)));
+      throw InputError(
+          fmt::format("{} '{}': cannot create a file in the folder '{}': {}", what_, path_, dir, std::strerror(err)));
     }
   }
   slot_ = claim_slot(temp_);
@@ -273,8 +275,8 @@ void OutputFile::finish() {
 
 void OutputFile::rename_into_place() {
   if (::rename(temp_.c_str(), target_.c_str()) != 0) {
-    throw OutputError(fmt::format("{} '{}': the written file could not be put in place ({})", what_, path_,
-                                  std::strerror(errno)));
+    throw OutputError(
+        fmt::format("{} '{}': the written file could not be put in place ({})", what_, path_, std::strerror(errno)));
   }
   committed_ = true;
   temp_.clear();
@@ -324,8 +326,8 @@ OutputFile& OutputTransaction::add(const std::string& path, const std::string& w
   auto file = std::make_unique<OutputFile>(path, what);
   for (const auto& other : files_) {
     if (!file->stream_ && !other->stream_ && other->target_ == file->target_) {
-      throw InputError(fmt::format("{} '{}' and {} '{}' are the same file: give each output its own name",
-                                   other->what_, other->path_, file->what_, file->path_));
+      throw InputError(fmt::format("{} '{}' and {} '{}' are the same file: give each output its own name", other->what_,
+                                   other->path_, file->what_, file->path_));
     }
   }
   files_.push_back(std::move(file));
@@ -359,9 +361,8 @@ void OutputTransaction::commit() {
         ::unlink(k.c_str());  // the hard links made above (gone already when put back)
       }
     }
-    throw OutputError(lost.empty()
-                          ? fmt::format("{}; no output of this command was put in place", e.what())
-                          : fmt::format("{}; already replaced and not restorable: {}", e.what(), lost));
+    throw OutputError(lost.empty() ? fmt::format("{}; no output of this command was put in place", e.what())
+                                   : fmt::format("{}; already replaced and not restorable: {}", e.what(), lost));
   }
   for (std::size_t k = 0; k < files_.size(); ++k) {
     if (!kept[k].empty()) {

@@ -66,9 +66,10 @@ void record_input_file(const FileId& id, const std::string& path) {
     return;
   }
   if (const Entry* out = find(r.outputs, id)) {
-    throw InputError(fmt::format("{}: this input is the file {} '{}' writes (the same file): deflex never writes a "
-                                 "file it reads; give the output another name",
-                                 path, out->what, out->path));
+    throw InputError(
+        fmt::format("{}: this input is the file {} '{}' writes (the same file): deflex never writes a "
+                    "file it reads; give the output another name",
+                    path, out->what, out->path));
   }
   if (find(r.inputs, id) == nullptr) {
     r.inputs.push_back({id, path, {}});
@@ -82,9 +83,10 @@ void record_output_file(const FileId& id, const std::string& path, const std::st
     return;
   }
   if (const Entry* in = find(r.inputs, id)) {
-    throw InputError(fmt::format("{} '{}': this output is the input '{}' (the same file): deflex never writes a file "
-                                 "it reads; give the output another name",
-                                 what, path, in->path));
+    throw InputError(
+        fmt::format("{} '{}': this output is the input '{}' (the same file): deflex never writes a file "
+                    "it reads; give the output another name",
+                    what, path, in->path));
   }
   if (const Entry* other = find(r.outputs, id)) {
     // The same output written again (a fault dump rewritten at each episode) is that output's own

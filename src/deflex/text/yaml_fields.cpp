@@ -9,8 +9,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/text/input_file.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/text/input_file.hpp"
 #include "deflex/text/nearest_name.hpp"
 #include "deflex/text/parse_number.hpp"
 #include "deflex/text/utf8_text.hpp"
@@ -40,8 +40,8 @@ void refuse_duplicate_keys(const YAML::Node& node, const std::string& file, cons
   if (node.IsScalar()) {
     // Names and notes go into JSON and YAML, which require UTF-8: a Latin-1 byte is named here.
     if (const auto bad = utf8_problem(node.Scalar())) {
-      throw ModelError(fmt::format("{}: field '{}': {}", where_of(file, node.Mark()), path.empty() ? "<document>" : path,
-                                   *bad));
+      throw ModelError(
+          fmt::format("{}: field '{}': {}", where_of(file, node.Mark()), path.empty() ? "<document>" : path, *bad));
     }
     return;
   }
@@ -126,7 +126,9 @@ void Field::fail(const std::string& message) const {
   throw ModelError(fmt::format("{}: field '{}': {}", where, path_.empty() ? "<document>" : path_, message));
 }
 
-bool Field::has(const std::string& key) const { return node_.IsMap() && node_[key].IsDefined() && !node_[key].IsNull(); }
+bool Field::has(const std::string& key) const {
+  return node_.IsMap() && node_[key].IsDefined() && !node_[key].IsNull();
+}
 
 Field Field::at(const std::string& key) const {
   const std::string child = path_.empty() ? key : path_ + "." + key;
@@ -247,7 +249,8 @@ void Field::only_keys(const std::vector<std::string>& allowed) const {
     const std::string key = kv.first.as<std::string>();
     if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
       Field(kv.first, file_, path_.empty() ? key : path_ + "." + key)
-          .fail(fmt::format("unknown field{} (allowed here: {})", did_you_mean(key, allowed), fmt::join(allowed, ", ")));
+          .fail(
+              fmt::format("unknown field{} (allowed here: {})", did_you_mean(key, allowed), fmt::join(allowed, ", ")));
     }
   }
 }

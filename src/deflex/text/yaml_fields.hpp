@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
+#include <yaml-cpp/yaml.h>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <yaml-cpp/yaml.h>
 
 #include "deflex/text/input_file.hpp"
 #include "deflex/text/input_ranges.hpp"

@@ -74,7 +74,8 @@ MemoryTransport& MemoryNetwork::add_endpoint(const DatagramAddress& address, dou
       throw InputError(fmt::format("memory network: address {} is taken", to_string(address)));
     }
   }
-  endpoints_.push_back(std::unique_ptr<MemoryTransport>(new MemoryTransport(*this, address, latency_s, depth_, max_bytes_)));
+  endpoints_.push_back(
+      std::unique_ptr<MemoryTransport>(new MemoryTransport(*this, address, latency_s, depth_, max_bytes_)));
   return *endpoints_.back();
 }
 

@@ -21,9 +21,9 @@ namespace deflex {
 class MemoryNetwork;
 
 struct MemoryNetworkCounters {
-  std::uint64_t delivered = 0;       ///< datagrams handed to a receiver
-  std::uint64_t dropped_full = 0;    ///< the destination's queue was full (a lost datagram)
-  std::uint64_t dropped_no_route = 0;  ///< no endpoint has the destination address
+  std::uint64_t delivered = 0;          ///< datagrams handed to a receiver
+  std::uint64_t dropped_full = 0;       ///< the destination's queue was full (a lost datagram)
+  std::uint64_t dropped_no_route = 0;   ///< no endpoint has the destination address
   std::uint64_t dropped_oversized = 0;  ///< larger than the network's datagram size (send_to fails)
   std::uint64_t dropped_outage = 0;     ///< sent during an outage (add_outage): lost
 };

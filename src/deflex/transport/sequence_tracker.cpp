@@ -21,7 +21,9 @@ std::int64_t ahead(int bits, std::uint64_t from, std::uint64_t to) {
 }
 }  // namespace
 
-std::int64_t SequenceTracker::distance(std::uint64_t number) const noexcept { return ahead(rules_.bits, last_, number); }
+std::int64_t SequenceTracker::distance(std::uint64_t number) const noexcept {
+  return ahead(rules_.bits, last_, number);
+}
 
 SequenceVerdict SequenceTracker::observe(std::uint64_t number) noexcept {
   if (!have_) {

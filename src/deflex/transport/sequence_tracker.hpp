@@ -13,10 +13,10 @@
 namespace deflex {
 
 struct SequenceRules {
-  int bits = 32;                     ///< 32 (wraps at 2^32) or 64
-  std::uint64_t max_ahead = 250;     ///< a step forward larger than this is a jump
-  std::uint64_t restart_max = 16;    ///< a jump back to a number <= this is a restart (0: no such rule)
-  int confirm = 3;                   ///< datagrams in a row that make a jump a new sequence
+  int bits = 32;                   ///< 32 (wraps at 2^32) or 64
+  std::uint64_t max_ahead = 250;   ///< a step forward larger than this is a jump
+  std::uint64_t restart_max = 16;  ///< a jump back to a number <= this is a restart (0: no such rule)
+  int confirm = 3;                 ///< datagrams in a row that make a jump a new sequence
   /// Throws InputError when a value is out of its range.
   void validate() const;
 };

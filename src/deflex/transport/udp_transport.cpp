@@ -77,7 +77,7 @@ bool UdpTransport::wait_readable(double timeout_s) noexcept {
   // of a larger double to int is undefined (in practice INT_MIN, which poll() takes as "forever").
   constexpr double kMaxMs = std::numeric_limits<int>::max();
   const double ms_wanted = std::ceil(timeout_s * 1000.0);
-  const int ms = !(ms_wanted > 0.0)       ? 0
+  const int ms = !(ms_wanted > 0.0)    ? 0
                  : ms_wanted >= kMaxMs ? std::numeric_limits<int>::max()
                                        : static_cast<int>(ms_wanted);
   return ::poll(&p, 1, ms) > 0 && (p.revents & POLLIN) != 0;

@@ -30,7 +30,7 @@ class UdpTransport final : public DatagramTransport {
  private:
   int fd_ = -1;
   DatagramAddress local_;
-  bool stamped_ = false;  // the kernel time-stamps datagrams (SO_TIMESTAMPNS)
+  bool stamped_ = false;       // the kernel time-stamps datagrams (SO_TIMESTAMPNS)
   long long receipt_ns_ = -1;  // CLOCK_REALTIME of the last datagram received, ns (-1: unknown)
 };
 

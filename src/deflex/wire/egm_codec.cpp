@@ -13,15 +13,24 @@ namespace deflex {
 
 const char* to_string(EgmDecodeStatus s) {
   switch (s) {
-    case EgmDecodeStatus::kOk: return "ok";
-    case EgmDecodeStatus::kMalformed: return "malformed";
-    case EgmDecodeStatus::kTruncated: return "truncated";
-    case EgmDecodeStatus::kMissingHeader: return "missing_header";
-    case EgmDecodeStatus::kMissingJoints: return "missing_joints";
-    case EgmDecodeStatus::kNonFinite: return "non_finite";
-    case EgmDecodeStatus::kEmpty: return "empty";
-    case EgmDecodeStatus::kSequenceOutOfRange: return "sequence_out_of_range";
-    case EgmDecodeStatus::kMissingRequired: return "missing_required";
+    case EgmDecodeStatus::kOk:
+      return "ok";
+    case EgmDecodeStatus::kMalformed:
+      return "malformed";
+    case EgmDecodeStatus::kTruncated:
+      return "truncated";
+    case EgmDecodeStatus::kMissingHeader:
+      return "missing_header";
+    case EgmDecodeStatus::kMissingJoints:
+      return "missing_joints";
+    case EgmDecodeStatus::kNonFinite:
+      return "non_finite";
+    case EgmDecodeStatus::kEmpty:
+      return "empty";
+    case EgmDecodeStatus::kSequenceOutOfRange:
+      return "sequence_out_of_range";
+    case EgmDecodeStatus::kMissingRequired:
+      return "missing_required";
   }
   return "unknown";
 }
@@ -86,9 +95,15 @@ bool header_seqno_fits(const unsigned char* data, std::size_t size) {
     bool bad = false;
     if (!read_varint(p, end, tag, bad) || bad) return true;
     switch (tag & 7) {
-      case 0: if (!read_varint(p, end, len, bad) || bad) return true; break;
-      case 1: p += 8; break;
-      case 5: p += 4; break;
+      case 0:
+        if (!read_varint(p, end, len, bad) || bad) return true;
+        break;
+      case 1:
+        p += 8;
+        break;
+      case 5:
+        p += 4;
+        break;
       case 2: {
         if (!read_varint(p, end, len, bad) || bad || len > static_cast<std::uint64_t>(end - p)) return true;
         const unsigned char* h = p;
@@ -104,7 +119,8 @@ bool header_seqno_fits(const unsigned char* data, std::size_t size) {
         }
         break;
       }
-      default: return true;
+      default:
+        return true;
     }
   }
   return true;

@@ -50,12 +50,12 @@ struct EgmPathCorrMessage {
 /// KDL's sign convention: 0 accepted, < 0 rejected (the packet is counted and ignored).
 enum class EgmDecodeStatus : int {
   kOk = 0,
-  kMalformed = -1,      ///< not a valid protobuf message (bad wire type, bad nesting, bad enum ...)
-  kTruncated = -2,      ///< a field runs past the end of the packet
-  kMissingHeader = -3,  ///< no header or no sequence number
-  kMissingJoints = -4,  ///< feedback joints absent, or feedback or planned joints of another count
-  kNonFinite = -5,      ///< NaN or infinite joint values
-  kEmpty = -6,          ///< zero-length packet
+  kMalformed = -1,           ///< not a valid protobuf message (bad wire type, bad nesting, bad enum ...)
+  kTruncated = -2,           ///< a field runs past the end of the packet
+  kMissingHeader = -3,       ///< no header or no sequence number
+  kMissingJoints = -4,       ///< feedback joints absent, or feedback or planned joints of another count
+  kNonFinite = -5,           ///< NaN or infinite joint values
+  kEmpty = -6,               ///< zero-length packet
   kSequenceOutOfRange = -7,  ///< header.seqno wider than its uint32 field (protobuf would truncate it)
   kMissingRequired = -8,     ///< a field proto2 requires is missing (protobuf would print an error line)
 };

@@ -227,15 +227,24 @@ struct Writer {
 
 const char* to_string(RsiDecodeStatus s) {
   switch (s) {
-    case RsiDecodeStatus::kOk: return "ok";
-    case RsiDecodeStatus::kMalformed: return "malformed";
-    case RsiDecodeStatus::kTruncated: return "truncated";
-    case RsiDecodeStatus::kMissingIpoc: return "missing_ipoc";
-    case RsiDecodeStatus::kMissingAxes: return "missing_axes";
-    case RsiDecodeStatus::kNonFinite: return "non_finite";
-    case RsiDecodeStatus::kEmpty: return "empty";
-    case RsiDecodeStatus::kForeign: return "foreign";
-    case RsiDecodeStatus::kIpocOutOfRange: return "ipoc_out_of_range";
+    case RsiDecodeStatus::kOk:
+      return "ok";
+    case RsiDecodeStatus::kMalformed:
+      return "malformed";
+    case RsiDecodeStatus::kTruncated:
+      return "truncated";
+    case RsiDecodeStatus::kMissingIpoc:
+      return "missing_ipoc";
+    case RsiDecodeStatus::kMissingAxes:
+      return "missing_axes";
+    case RsiDecodeStatus::kNonFinite:
+      return "non_finite";
+    case RsiDecodeStatus::kEmpty:
+      return "empty";
+    case RsiDecodeStatus::kForeign:
+      return "foreign";
+    case RsiDecodeStatus::kIpocOutOfRange:
+      return "ipoc_out_of_range";
   }
   return "unknown";
 }

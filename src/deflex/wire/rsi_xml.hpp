@@ -22,11 +22,11 @@ namespace deflex {
 
 /// What deflex reads from a <Rob> document. Degrees and mm as on the wire; convert at the edge.
 struct RsiRobotMessage {
-  std::uint64_t ipoc = 0;      ///< the cycle's time stamp (ms counter), echoed in the answer
-  JointVector actual_deg;      ///< AIPos: where the axes are
-  JointVector setpoint_deg;    ///< ASPos: where the controller's own program puts them (has_setpoint)
+  std::uint64_t ipoc = 0;    ///< the cycle's time stamp (ms counter), echoed in the answer
+  JointVector actual_deg;    ///< AIPos: where the axes are
+  JointVector setpoint_deg;  ///< ASPos: where the controller's own program puts them (has_setpoint)
   bool has_setpoint = false;
-  std::uint64_t delay = 0;     ///< <Delay D>: answers the controller counted late so far (has_delay)
+  std::uint64_t delay = 0;  ///< <Delay D>: answers the controller counted late so far (has_delay)
   bool has_delay = false;
   /// <RIst> and <RSol>: X Y Z (mm) A B C (degrees, KUKA's Z-Y'-X''), when sent.
   std::array<double, 6> rist{}, rsol{};

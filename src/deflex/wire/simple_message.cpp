@@ -129,10 +129,14 @@ std::size_t encode(ByteOrder order, const Header& header, const RobotStatus& sta
 
 const char* to_string(FrameStatus status) {
   switch (status) {
-    case FrameStatus::kComplete: return "complete";
-    case FrameStatus::kIncomplete: return "incomplete";
-    case FrameStatus::kTooShort: return "length below the 12-byte header";
-    case FrameStatus::kOversized: return "length beyond the maximum";
+    case FrameStatus::kComplete:
+      return "complete";
+    case FrameStatus::kIncomplete:
+      return "incomplete";
+    case FrameStatus::kTooShort:
+      return "length below the 12-byte header";
+    case FrameStatus::kOversized:
+      return "length beyond the maximum";
   }
   return "unknown";
 }
@@ -163,10 +167,14 @@ FrameView view_frame(ByteOrder order, const unsigned char* frame, std::size_t fr
 
 const char* to_string(DecodeStatus status) {
   switch (status) {
-    case DecodeStatus::kOk: return "ok";
-    case DecodeStatus::kTruncated: return "truncated";
-    case DecodeStatus::kTooLong: return "longer than the message";
-    case DecodeStatus::kNonFinite: return "non-finite value";
+    case DecodeStatus::kOk:
+      return "ok";
+    case DecodeStatus::kTruncated:
+      return "truncated";
+    case DecodeStatus::kTooLong:
+      return "longer than the message";
+    case DecodeStatus::kNonFinite:
+      return "non-finite value";
   }
   return "unknown";
 }
@@ -209,12 +217,18 @@ DecodeStatus decode(ByteOrder order, const unsigned char* data, std::size_t byte
 
 const char* message_type_name(std::int32_t msg_type) noexcept {
   switch (msg_type) {
-    case kPing: return "PING";
-    case kJointPosition: return "JOINT_POSITION";
-    case kJointTrajPt: return "JOINT_TRAJ_PT";
-    case kJointTraj: return "JOINT_TRAJ";
-    case kRobotStatus: return "ROBOT_STATUS";
-    default: return "unknown";
+    case kPing:
+      return "PING";
+    case kJointPosition:
+      return "JOINT_POSITION";
+    case kJointTrajPt:
+      return "JOINT_TRAJ_PT";
+    case kJointTraj:
+      return "JOINT_TRAJ";
+    case kRobotStatus:
+      return "ROBOT_STATUS";
+    default:
+      return "unknown";
   }
 }
 

@@ -47,8 +47,8 @@ inline constexpr std::size_t kHeaderBytes = 12;  ///< MSG_TYPE, COMM_TYPE, REPLY
 inline constexpr std::size_t kWireJoints = 10;   ///< joint slots in every joint message (unused ones 0)
 /// 52: sequence, joints, velocity, duration.
 inline constexpr std::size_t kJointTrajPtBytes = 4 + 4 * kWireJoints + 4 + 4;
-inline constexpr std::size_t kJointPositionBytes = 4 + 4 * kWireJoints;         ///< 44: sequence, joints
-inline constexpr std::size_t kRobotStatusBytes = std::size_t{7} * 4;                        ///< 28: seven int32
+inline constexpr std::size_t kJointPositionBytes = 4 + 4 * kWireJoints;  ///< 44: sequence, joints
+inline constexpr std::size_t kRobotStatusBytes = std::size_t{7} * 4;     ///< 28: seven int32
 /// industrial_core reads frames into 1024-byte buffers: a longer LENGTH is no simple message deflex
 /// speaks, and on a stream it means the reader is out of step.
 inline constexpr std::size_t kDefaultMaxFrameBytes = 1024;
@@ -63,7 +63,7 @@ struct Header {
 struct JointTrajPt {
   std::int32_t sequence = 0;
   std::array<float, kWireJoints> joints_rad{};
-  float velocity = 0.0f;   ///< one scalar for the move, normalised (fraction of the joints' top speed)
+  float velocity = 0.0f;  ///< one scalar for the move, normalised (fraction of the joints' top speed)
   float duration_s = 0.0f;
 };
 

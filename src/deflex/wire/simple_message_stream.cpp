@@ -30,9 +30,7 @@ unsigned char* FrameReader::space() noexcept {
   return buffer_.data() + end_;
 }
 
-std::size_t FrameReader::space_bytes() const noexcept {
-  return buffer_.size() - (end_ - begin_);
-}
+std::size_t FrameReader::space_bytes() const noexcept { return buffer_.size() - (end_ - begin_); }
 
 void FrameReader::commit(std::size_t n) noexcept { end_ = std::min(buffer_.size(), end_ + n); }
 

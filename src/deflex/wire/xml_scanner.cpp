@@ -30,11 +30,16 @@ bool equal_ignoring_case(std::string_view a, std::string_view b) {
 
 const char* to_string(XmlError e) {
   switch (e) {
-    case XmlError::kNone: return "none";
-    case XmlError::kTruncated: return "truncated";
-    case XmlError::kSyntax: return "not well-formed";
-    case XmlError::kUnsupported: return "outside the supported XML subset";
-    case XmlError::kTooComplex: return "too deep or too many attributes";
+    case XmlError::kNone:
+      return "none";
+    case XmlError::kTruncated:
+      return "truncated";
+    case XmlError::kSyntax:
+      return "not well-formed";
+    case XmlError::kUnsupported:
+      return "outside the supported XML subset";
+    case XmlError::kTooComplex:
+      return "too deep or too many attributes";
   }
   return "unknown";
 }
@@ -189,7 +194,8 @@ XmlToken XmlScanner::start_tag() noexcept {
     const char* at = pos_;
     if (!read_attribute(a)) return XmlToken::kError;
     for (int i = 0; i < attribute_count_; ++i) {
-      if (attributes_[static_cast<std::size_t>(i)].name == a.name) return fail(XmlError::kSyntax, at);  // [WFC: Unique Att Spec]
+      if (attributes_[static_cast<std::size_t>(i)].name == a.name)
+        return fail(XmlError::kSyntax, at);  // [WFC: Unique Att Spec]
     }
     if (attribute_count_ == kMaxAttributes) return fail(XmlError::kTooComplex, at);
     attributes_[static_cast<std::size_t>(attribute_count_++)] = a;
@@ -272,7 +278,7 @@ XmlToken XmlScanner::next() noexcept {
         }
         if (comment_start < 0 || pos_ + 1 == end_) return fail(XmlError::kTruncated, pos_);
         if (pos_[1] == '?' || pos_[1] == '!') return fail(XmlError::kUnsupported, pos_);  // PI, DOCTYPE
-        if (where_ == Where::kEpilog) return fail(XmlError::kSyntax, pos_);  // a second root element
+        if (where_ == Where::kEpilog) return fail(XmlError::kSyntax, pos_);               // a second root element
         return start_tag();
       }
       case Where::kContent: {

@@ -7,7 +7,7 @@
 namespace deflex {
 
 struct NnlsResult {
-  Eigen::VectorXd x;                    ///< the solution, every entry >= 0
+  Eigen::VectorXd x;                               ///< the solution, every entry >= 0
   Eigen::Array<bool, Eigen::Dynamic, 1> at_bound;  ///< true where x_j = 0 is held by the constraint
   int iterations = 0;
   bool converged = false;  ///< false only when the iteration limit was hit (degenerate input)

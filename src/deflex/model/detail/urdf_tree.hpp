@@ -34,7 +34,7 @@ struct UrdfTree {
   std::vector<int> link_lines;
   std::vector<UrdfJointEntry> joints;
   std::string root;
-  std::unordered_map<std::string, int> link_index;    ///< link name -> index into links
+  std::unordered_map<std::string, int> link_index;       ///< link name -> index into links
   std::unordered_map<std::string, int> parent_joint_of;  ///< link name -> index of the joint whose child it is
 
   [[nodiscard]] bool has_link(const std::string& name) const;

@@ -16,16 +16,16 @@ namespace deflex {
 
 /// One resolved use of a target, as far as writing it back is concerned.
 struct WriteBackUse {
-  const void* target = nullptr;  ///< the declared target (array element) it reads; null: a literal in the motion
-  std::string name;              ///< the declaration's name, upper case (its references are counted by name)
+  const void* target = nullptr;      ///< the declared target (array element) it reads; null: a literal in the motion
+  std::string name;                  ///< the declaration's name, upper case (its references are counted by name)
   std::vector<std::string> numbers;  ///< the new numbers' text
 };
 
 /// What to do with one use.
 struct WriteBackStep {
   enum class Kind { kLiteral, kInPlace, kCopy } kind = Kind::kLiteral;
-  bool first = false;       ///< kInPlace: edit the declaration with this use's numbers; kCopy: declare the copy
-  std::size_t source = 0;   ///< kCopy: the use that declares the copy this one reads (itself when first)
+  bool first = false;      ///< kInPlace: edit the declaration with this use's numbers; kCopy: declare the copy
+  std::size_t source = 0;  ///< kCopy: the use that declares the copy this one reads (itself when first)
 };
 
 /// The steps, one a use. `references` counts every reference to a name in the program (upper case).

@@ -14,8 +14,8 @@ namespace deflex {
 
 struct LoopStats {
   std::uint64_t cycles = 0;
-  std::uint64_t overruns = 0;      ///< cycles that started later than one period after the previous one
-  double max_cycle_work_s = 0.0;   ///< longest time spent in callbacks + compensator in one cycle
+  std::uint64_t overruns = 0;     ///< cycles that started later than one period after the previous one
+  double max_cycle_work_s = 0.0;  ///< longest time spent in callbacks + compensator in one cycle
 };
 
 /// Fills q_planned and q_feedback (rad) of the input (t_s is set by the loop). Return false to stop.

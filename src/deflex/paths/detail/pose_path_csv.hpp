@@ -14,7 +14,6 @@ namespace deflex {
 /// the memory.
 inline constexpr int kMaxPathPoints = 100'000'000;
 
-
 /// Reads base_T_tcp poses (converted to m). Throws DataError naming the file, line and column on a
 /// missing column, a non-numeric cell, a quaternion whose norm is off 1 by more than 1e-3 (a typo,
 /// not rounding), or a file without rows.

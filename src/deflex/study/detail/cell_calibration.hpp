@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "deflex/cell/true_robot.hpp"
-#include "deflex/study/case_config.hpp"
 #include "deflex/identify/stiffness_identification.hpp"
+#include "deflex/study/case_config.hpp"
 
 namespace deflex::study {
 

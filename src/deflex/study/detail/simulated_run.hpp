@@ -12,13 +12,13 @@
 
 #include "deflex/cell/force_sensor.hpp"
 #include "deflex/cell/true_robot.hpp"
-#include "deflex/model/tracker_trace.hpp"
 #include "deflex/link/controller_link.hpp"
+#include "deflex/model/tracker_trace.hpp"
 #include "deflex/online/sensor_config.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/paths/path_ik.hpp"
-#include "deflex/study/detail/cell_calibration.hpp"
 #include "deflex/study/case_config.hpp"
+#include "deflex/study/detail/cell_calibration.hpp"
 
 namespace deflex::study {
 
@@ -51,11 +51,11 @@ struct RunOutput {
   TrackerTrace trace;  ///< tracker samples from the start of the laps (t = 0) to the end of the motion
   double simulated_s = 0.0;
   // What deflex's link did (online setups).
-  std::uint64_t link_cycles = 0;       ///< controller messages answered
+  std::uint64_t link_cycles = 0;  ///< controller messages answered
   LinkCounters link_counters;
   double max_command_deviation_rad = 0.0;  ///< largest |command - nominal| of any joint, any cycle
   double max_tcp_correction_m = 0.0;
-  double measured_delay_s = 0.0;       ///< the mean of the link's delay measurements over the run
+  double measured_delay_s = 0.0;  ///< the mean of the link's delay measurements over the run
 };
 
 /// SplitMix64's finaliser: a well-mixed 64-bit value from any seed (the cell's seeds are derived by it).
