@@ -16,7 +16,6 @@
 #include "deflex/identify/stiffness_identification.hpp"
 #include "deflex/model/compliance.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
-#include "deflex/model/linear_algebra.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
@@ -52,7 +51,7 @@ double min_singular_value(const RobotModel& model, const std::vector<std::pair<J
       A.block(3 * static_cast<Eigen::Index>(i), j, 3, 1) = Jt.col(j).head<3>() * tau * model.compliance()[j];
     }
   }
-  return singular_values(A).minCoeff();
+  return Eigen::JacobiSVD<Eigen::MatrixXd>(A).singularValues().minCoeff();
 }
 
 TEST(CalibrationPlanner, PosesAreReachableInTheRegionAndLoadsAreWhatTheRowsSay) {

@@ -10,7 +10,6 @@
 #include <fmt/format.h>
 #include <Eigen/SVD>
 
-#include "deflex/model/linear_algebra.hpp"
 #include "deflex/model/opw_ik.hpp"
 
 namespace deflex {
@@ -228,7 +227,8 @@ KukaConfiguration kuka_configuration(const RobotModel& model, Workspace& ws, con
 double jacobian_min_singular_value(const RobotModel& model, Workspace& ws, const JointVector& q) {
   Jacobian J;
   jacobian(model, ws, q, EndPoint::kTcp, J);
-  return singular_values(J).minCoeff();
+  Eigen::JacobiSVD<Jacobian> svd(J);
+  return svd.singularValues().minCoeff();
 }
 
 namespace {

@@ -1,20 +1,15 @@
-// Eigen's JacobiSVD of a dynamic matrix, compiled once. Each translation unit that instantiates
-// Eigen::JacobiSVD<Eigen::MatrixXd> spends about 20 s of CPU at -O3 on it (measured with GCC 12 on the
-// build host: inverse_kinematics.cpp 37 s with it, 13 s without), and four modules use it; declared
-// here as an explicit instantiation that linear_algebra.cpp defines, they share one.
+// The SVD deflex uses wherever it needs a dynamic one (identification, registration, payload
+// identification). Not instantiated explicitly in the library: an explicit instantiation in an
+// instrumented build interposed on Orocos KDL's own copy (its LMA solver holds one), and the two
+// sides allocate differently under AddressSanitizer.
 #pragma once
 
 #include <Eigen/Core>
 #include <Eigen/SVD>
 
-extern template class Eigen::JacobiSVD<Eigen::MatrixXd>;
-
 namespace deflex {
 
 /// The SVD deflex uses wherever it needs one (identification, registration, payload identification).
 using DynamicSvd = Eigen::JacobiSVD<Eigen::MatrixXd>;
-
-/// The singular values of `m`, largest first.
-[[nodiscard]] Eigen::VectorXd singular_values(const Eigen::MatrixXd& m);
 
 }  // namespace deflex
