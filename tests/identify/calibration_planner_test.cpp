@@ -9,13 +9,13 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
-#include <Eigen/SVD>
 
 #include "deflex/identify/calibration_planner.hpp"
 #include "deflex/identify/calibration_simulation.hpp"
 #include "deflex/identify/stiffness_identification.hpp"
 #include "deflex/model/compliance.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
+#include "deflex/model/linear_algebra.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
@@ -51,7 +51,7 @@ double min_singular_value(const RobotModel& model, const std::vector<std::pair<J
       A.block(3 * static_cast<Eigen::Index>(i), j, 3, 1) = Jt.col(j).head<3>() * tau * model.compliance()[j];
     }
   }
-  return Eigen::JacobiSVD<Eigen::MatrixXd>(A).singularValues().minCoeff();
+  return singular_values(A).minCoeff();
 }
 
 TEST(CalibrationPlanner, PosesAreReachableInTheRegionAndLoadsAreWhatTheRowsSay) {

@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 #include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
+#include <Eigen/QR>
 
 #include "deflex/model/linear_algebra.hpp"
 #include "deflex/text/errors.hpp"
@@ -144,8 +144,7 @@ FrameRegistration register_frames(const RegistrationInput& in) {
     spread.col(static_cast<Eigen::Index>(a.size() + k)) = std::sqrt(w) * in.tracker_circles[k].axis;
   }
   // The rotation is fixed only if the features span at least two directions.
-  const DynamicSvd svd(spread);
-  const auto& sv = svd.singularValues();
+  const Eigen::VectorXd sv = singular_values(spread);
   if (sv.size() < 2 || !(sv[1] > 1e-3 * sv[0])) {
     throw InputError(
         "registration: the points lie on one line (and no circle axis leaves it): the rotation about that line is "

@@ -7,8 +7,9 @@
 #include <tuple>
 
 #include <fmt/format.h>
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
+#include <Eigen/LU>
 
 #include "deflex/identify/stiffness_identification.hpp"
 #include "deflex/model/inverse_kinematics.hpp"

@@ -10,7 +10,6 @@
 #include <fmt/format.h>
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
-#include <Eigen/SVD>
 
 #include "deflex/identify/detail/nonnegative_least_squares.hpp"
 #include "deflex/identify/detail/spill_file.hpp"
@@ -232,10 +231,10 @@ Triangular blocked_qr(const RowStore& s, const std::vector<int>& cols, const Eig
 }
 
 // Singular values (descending) and right singular vectors of the scaled, weighted columns `cols`.
-DynamicSvd svd_of(const RowStore& s, const std::vector<int>& cols, const Eigen::VectorXd& scale,
-                  const std::vector<double>& omega) {
+Svd svd_of(const RowStore& s, const std::vector<int>& cols, const Eigen::VectorXd& scale,
+           const std::vector<double>& omega) {
   const Triangular t = blocked_qr(s, cols, scale, omega);
-  return DynamicSvd(t.R.topRows(t.rows), Eigen::ComputeFullV);
+  return Svd(t.R.topRows(t.rows));
 }
 
 // The estimate before anything is known: every joint's values NaN, the measurement count set.
@@ -339,7 +338,7 @@ void drop_collinear_joint_groups(const RowStore& s, const Eigen::VectorXd& col_n
                                  std::vector<int>& left_out, std::vector<std::string>& warnings) {
   while (estimated.size() > 1) {
     const auto svd = svd_of(s, estimated, col_norm, omega);
-    const Eigen::VectorXd& sv = svd.singularValues();
+    const Eigen::VectorXd& sv = svd.values();
     const Eigen::Index last = sv.size() - 1;
     // Fewer equations than joints: the SVD has fewer singular values than columns, and V's trailing
     // columns span a null space the smallest singular value does not show.
@@ -349,9 +348,9 @@ void drop_collinear_joint_groups(const RowStore& s, const Eigen::VectorXd& col_n
     }
     // The joints in the unobservable direction: the smallest singular value's vector or, with fewer
     // equations than joints, every joint with a component in the null space (V's trailing columns).
-    const Eigen::MatrixXd null_basis = underdetermined
-                                           ? Eigen::MatrixXd(svd.matrixV().rightCols(svd.matrixV().cols() - sv.size()))
-                                           : Eigen::MatrixXd(svd.matrixV().col(last));
+    const Eigen::MatrixXd null_basis =
+        underdetermined ? Eigen::MatrixXd(svd.right_vectors().rightCols(svd.right_vectors().cols() - sv.size()))
+                        : Eigen::MatrixXd(svd.right_vectors().col(last));
     std::vector<int> group;
     for (Eigen::Index k = 0; k < null_basis.rows(); ++k) {
       if (null_basis.row(k).norm() > 0.1) {
@@ -603,7 +602,7 @@ double residual_variance(const WeightedResidualSums& sums, std::size_t passive_j
 double scaled_condition_number(const RowStore& s, const std::vector<int>& estimated, const Eigen::VectorXd& col_norm,
                                const std::vector<double>& omega) {
   const auto svd = svd_of(s, estimated, col_norm, omega);
-  const Eigen::VectorXd& sv = svd.singularValues();
+  const Eigen::VectorXd& sv = svd.values();
   return sv[sv.size() - 1] > 0.0 ? sv[0] / sv[sv.size() - 1] : std::numeric_limits<double>::infinity();
 }
 

@@ -227,8 +227,16 @@ KukaConfiguration kuka_configuration(const RobotModel& model, Workspace& ws, con
 double jacobian_min_singular_value(const RobotModel& model, Workspace& ws, const JointVector& q) {
   Jacobian J;
   jacobian(model, ws, q, EndPoint::kTcp, J);
-  Eigen::JacobiSVD<Jacobian> svd(J);
-  return svd.singularValues().minCoeff();
+  // The 6 x n Jacobian padded with zeros to a square matrix has J's singular values and max(6, n) - min(6, n)
+  // zeros, so Jacobi's SVD needs no QR preconditioner (which made up most of this file's compile time) and,
+  // with fixed capacities, allocates nothing. The smallest of J's own is the min(6, n)-th largest.
+  constexpr int kSide = std::max(6, kMaxJoints);
+  using Square = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kSide, kSide>;
+  const Eigen::Index side = std::max<Eigen::Index>(6, J.cols());
+  Square padded = Square::Zero(side, side);
+  padded.topLeftCorner(6, J.cols()) = J;
+  const Eigen::JacobiSVD<Square, Eigen::NoQRPreconditioner> svd(padded);
+  return svd.singularValues()[std::min<Eigen::Index>(6, J.cols()) - 1];
 }
 
 namespace {

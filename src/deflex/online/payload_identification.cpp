@@ -28,8 +28,8 @@ struct Solved {
 };
 
 Solved solve(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const char* what) {
-  DynamicSvd svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
-  const auto& s = svd.singularValues();
+  const Svd svd(A);
+  const Eigen::VectorXd& s = svd.values();
   Solved r;
   r.condition = s(s.size() - 1) > 0.0 ? s(0) / s(s.size() - 1) : std::numeric_limits<double>::infinity();
   if (!(r.condition < 1e8)) {
