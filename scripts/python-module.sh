@@ -11,6 +11,8 @@
 #                              interpreter that build used: no compiling), else compile only the
 #                              module against that build (about a minute)
 #            --rebuild         with --from-build: compile the module even when the ABI matches
+#            --build-type T    CMake build type of what is compiled (default Release; None compiles
+#                              the module unoptimised, in about half the time, as the tests do)
 #            --no-install      build only
 #
 # What the interpreter needs: NumPy (PY -m pip install numpy; conda install numpy; Debian:
@@ -24,12 +26,14 @@ build_dir=""
 from_build=""
 rebuild=0
 install=1
+build_type=Release
 while [ $# -gt 0 ]; do
   case "$1" in
     --python) python="$2"; shift 2 ;;
     --build-dir) build_dir="$2"; shift 2 ;;
     --from-build) from_build="$2"; shift 2 ;;
     --rebuild) rebuild=1; shift ;;
+    --build-type) build_type="$2"; shift 2 ;;
     --no-install) install=0; shift ;;
     -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "python-module: unknown option '$1' (--help)" >&2; exit 2 ;;
@@ -61,14 +65,14 @@ elif [ -n "$from_build" ]; then
     fail "$from_build is no deflex build (no deflexConfig.cmake): build deflex there first (README), or drop --from-build"
   build_dir=${build_dir:-build-python/$soabi}
   say "compiling the module for $soabi in $build_dir against the library of $from_build"
-  cmake -S python -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -Ddeflex_DIR="$(cd "$from_build" && pwd)" \
+  cmake -S python -B "$build_dir" -DCMAKE_BUILD_TYPE="$build_type" -Ddeflex_DIR="$(cd "$from_build" && pwd)" \
     -DPython3_EXECUTABLE="$exe" >/dev/null
   cmake --build "$build_dir" -j"$(nproc)" --target deflex_python
   module_dir="$build_dir/python/deflex"
 else
   build_dir=${build_dir:-build-python/$soabi}
   say "building in $build_dir"
-  cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE="$exe" -DDEFLEX_PYTHON=ON \
+  cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE="$build_type" -DPython3_EXECUTABLE="$exe" -DDEFLEX_PYTHON=ON \
     -DDEFLEX_BUILD_TESTS=OFF -DDEFLEX_BUILD_BENCHMARKS=OFF >/dev/null
   cmake --build "$build_dir" -j"$(nproc)" --target deflex_python
   module_dir="$build_dir/python/deflex"

@@ -4,7 +4,8 @@
 # rebuilt) and installs it into the venv (PyPI is out of reach here, so the venv sees the system's
 # NumPy through --system-site-packages), and the paper's workflow example runs under that venv's
 # python alone (no PYTHONPATH), from another folder. A venv without NumPy is refused by
-# the script with the command that fixes it, and importing deflex there says the same.
+# the script with the command that fixes it, and importing deflex there says the same. The module is
+# compiled unoptimised (--build-type None: half the compile time; the library it calls is the build's).
 #   second_interpreter.sh PYTHON3 SOURCE_DIR BUILD_DIR WORK_DIR
 set -euo pipefail
 python3=$1 source_dir=$2 build_dir=$3 work=$4
@@ -12,7 +13,7 @@ rm -rf "$work" && mkdir -p "$work"
 unset PYTHONPATH
 "$python3" -m venv --system-site-packages "$work/venv"
 "$source_dir/scripts/python-module.sh" --python "$work/venv/bin/python" --from-build "$build_dir" --rebuild \
-  --build-dir "$work/module-build"
+  --build-type None --build-dir "$work/module-build"
 test -f "$work/module-build/python/deflex/_deflex.pyi"  # compiled here, stubs and all
 site=$("$work/venv/bin/python" -c 'import sysconfig; print(sysconfig.get_paths()["platlib"])')
 test -f "$site/deflex/__init__.py"
