@@ -1,17 +1,23 @@
 // Broken preconditions of the online pieces refused in every build type (the tests run in Release in
 // CI): a strategy handed joint vectors of the wrong count or not finite, on the real-time path (a
-// status, no exception, no allocation). Before, the hybrid and model-predictive strategies ran
-// forward kinematics on the wrong count, whose InputError left a noexcept function: std::terminate.
+// status, no exception, no allocation), and a delay estimator set up with a delay or a window that
+// is not a number. Before, the hybrid and model-predictive strategies ran forward kinematics on the
+// wrong count, whose InputError left a noexcept function: std::terminate. A NaN initial delay was the
+// predictive strategy's lead until the first measurement (every cycle then invalid), and a NaN or
+// negative window made the estimator never measure anything.
 #include <limits>
+#include <string>
 
 #include <gtest/gtest.h>
 
 #include "deflex/force/constant_wrench_model.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/model/robot_io.hpp"
+#include "deflex/online/delay_estimator.hpp"
 #include "deflex/online/online_strategy.hpp"
 #include "deflex/text/errors.hpp"
 #include "support/allocation_guard.hpp"
+#include "support/error_of.hpp"
 
 namespace deflex {
 namespace {
@@ -55,6 +61,18 @@ TEST(OnlinePreconditions, AStrategyRefusesJointVectorsOfTheWrongCountOrNotFinite
       EXPECT_EQ(s.prepare(in, good, good, 0.05, 0.009), StrategyStatus::kOk) << to_string(kind);
     }
   }
+}
+
+TEST(OnlinePreconditions, ADelayEstimatorWithADelayOrWindowThatIsNotANumberIsRefusedAtSetUp) {
+  for (const double delay : {kNaN, -0.01, std::numeric_limits<double>::infinity()}) {
+    const std::string error = test::error_of([&] { DelayEstimator e(delay); });
+    EXPECT_NE(error.find("initial_delay_s"), std::string::npos) << delay << ": " << error;
+  }
+  for (const double window : {kNaN, 0.0, -0.5, std::numeric_limits<double>::infinity()}) {
+    const std::string error = test::error_of([&] { DelayEstimator e(0.05, window); });
+    EXPECT_NE(error.find("window_s"), std::string::npos) << window << ": " << error;
+  }
+  EXPECT_NO_THROW(DelayEstimator(0.0, 0.5));
 }
 
 }  // namespace
