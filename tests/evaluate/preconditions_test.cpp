@@ -1,9 +1,10 @@
 // Broken preconditions of the evaluation refused in every build type (the tests run in Release in
 // CI): a trace with a sample that is not finite where a plane is fitted (laps, the mean closed path),
-// and lap thresholds that are not numbers in range. Before, one NaN sample made the plane NaN:
-// best_fit_plane, split_laps and directed_laps answered from it without an error, and
-// mean_closed_path blamed the path for not going round its centre; a NaN turn threshold dropped
-// every lap, a NaN reversal threshold switched reversals off.
+// lap thresholds that are not numbers in range, and a time search range that is not a number. Before,
+// one NaN sample made the plane NaN: best_fit_plane, split_laps and directed_laps answered from it
+// without an error, and mean_closed_path blamed the path for not going round its centre; a NaN turn
+// threshold dropped every lap, a NaN reversal threshold switched reversals off; and a NaN search
+// range or centre was ignored, so every offset was searched where the caller asked for a window.
 #include <functional>
 #include <limits>
 #include <string>
@@ -11,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/evaluate/lap_split.hpp"
+#include "deflex/evaluate/time_alignment.hpp"
 #include "deflex/text/errors.hpp"
 #include "evaluate/synthetic_paths.hpp"
 #include "support/error_of.hpp"
@@ -45,6 +47,20 @@ TEST(EvaluatePreconditions, LapThresholdsOutOfRangeAreRefused) {
     EXPECT_NE(error.find("reversal_rad"), std::string::npos) << reversal << ": " << error;
   }
   EXPECT_FALSE(split_laps(trace, 0.95 * 2.0 * kPi).laps.empty());
+}
+
+TEST(EvaluatePreconditions, ATimeSearchRangeOrCentreThatIsNotANumberIsRefused) {
+  // A command that moves, and a measured run of it: the check comes before any search.
+  const TrackerTrace commanded = test::circle(0.1, Vector3(1.5, 0.0, 1.0), 2000, 1.0);
+  const TrackerTrace measured = commanded;
+  TimeAlignmentOptions o;
+  o.search_s = kNaN;
+  std::string error = test::error_of([&] { (void)align_time(measured, commanded, o); });
+  EXPECT_NE(error.find("search_s"), std::string::npos) << error;
+  o.search_s = 0.5;
+  o.centre_s = kNaN;
+  error = test::error_of([&] { (void)align_time(measured, commanded, o); });
+  EXPECT_NE(error.find("centre_s"), std::string::npos) << error;
 }
 
 }  // namespace
