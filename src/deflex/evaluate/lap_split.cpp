@@ -17,6 +17,13 @@ PathPlane best_fit_plane(const TrackerTrace& path) {
   if (path.size() < 2) {
     throw InputError("plane of a path: fewer than 2 samples");
   }
+  // One NaN makes the whole plane NaN, and the laps and the mean path built on it nonsense: refused
+  // here, where split_laps, directed_laps and mean_closed_path all begin.
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    if (!path[i].p_m.allFinite()) {
+      throw InputError(fmt::format("plane of a path: sample {} (t = {} s) is not finite", i, path[i].t_s));
+    }
+  }
   PathPlane pl;
   for (const auto& s : path) {
     pl.centroid_m += s.p_m;
@@ -41,6 +48,14 @@ PathPlane best_fit_plane(const TrackerTrace& path) {
 }
 
 LapSplit split_laps(const TrackerTrace& trace, double min_turn_rad, double reversal_rad) {
+  // A lap closes after a full turn, so a piece can never turn more than 2 pi; compared with >= and >
+  // below, a NaN threshold dropped every lap or never saw a reversal.
+  if (!(min_turn_rad > 0.0 && min_turn_rad <= 2.0 * kPi)) {
+    throw InputError(fmt::format("laps: min_turn_rad must be in (0, 2 pi] (got {})", min_turn_rad));
+  }
+  if (!std::isfinite(reversal_rad) || !(reversal_rad > 0.0)) {
+    throw InputError(fmt::format("laps: reversal_rad must be finite and > 0 (got {})", reversal_rad));
+  }
   const PathPlane pl = best_fit_plane(trace);
   auto angle_of = [&](const Vector3& p) {
     const Vector3 r = p - pl.centroid_m;

@@ -17,7 +17,7 @@ struct PathPlane {
   Vector3 u = Vector3::UnitX();
   Vector3 v = Vector3::UnitY();
 };
-/// Throws InputError for fewer than 2 samples.
+/// Throws InputError for fewer than 2 samples or a sample that is not finite (naming it, 0-based).
 PathPlane best_fit_plane(const TrackerTrace& path);
 
 struct LapSplit {
@@ -29,7 +29,9 @@ struct LapSplit {
 /// allowed) by the angle it turns about the centroid in its plane of best fit: a lap ends after a
 /// full turn (2 pi) or where the direction of travel reverses (the angle falls back by more than
 /// `reversal_rad` from its extreme; the lap ends at the extreme). Pieces that turn less than
-/// `min_turn_rad` are dropped and counted. Throws InputError for fewer than 2 samples.
+/// `min_turn_rad` are dropped and counted. Throws InputError for fewer than 2 samples, a sample that is
+/// not finite (as best_fit_plane does), a min_turn_rad outside (0, 2 pi] or a reversal_rad that is not
+/// finite and > 0.
 LapSplit split_laps(const TrackerTrace& trace, double min_turn_rad = 0.9 * 2.0 * kPi,
                     double reversal_rad = deg_to_rad(5.0));
 
@@ -48,7 +50,8 @@ std::vector<DirectedLap> directed_laps(const TrackerTrace& trace);
 /// bins in angle order and the first repeated at the end. A nearest-point distance to a dense, noisy
 /// reference is biased low (the reference's noise fills a band the loaded point finds its nearest
 /// neighbour in); to the laps' mean it is not. Needs a path around its centroid: throws InputError
-/// for fewer than 2 samples or when fewer than 90 % of the bins hold a sample.
+/// for fewer than 2 samples, a sample that is not finite, or when fewer than 90 % of the bins hold a
+/// sample.
 TrackerTrace mean_closed_path(const TrackerTrace& trace, int bins = 3600);
 
 }  // namespace deflex

@@ -109,6 +109,13 @@ TimeAlignment align_time(const TrackerTrace& measured, const TrackerTrace& comma
     throw InputError(fmt::format("time alignment: {} measured and {} commanded samples; at least 10 of each are needed",
                                  measured.size(), commanded.size()));
   }
+  // Compared with > and <= below, where a NaN quietly widened the search to every offset.
+  if (std::isnan(o.search_s)) {
+    throw InputError("time alignment: search_s is not a number (0 or less searches every offset)");
+  }
+  if (!std::isfinite(o.centre_s)) {
+    throw InputError(fmt::format("time alignment: centre_s must be finite (got {})", o.centre_s));
+  }
   for (const auto* trace : {&measured, &commanded}) {
     for (std::size_t i = 0; i < trace->size(); ++i) {
       if (!std::isfinite((*trace)[i].t_s) || !(*trace)[i].p_m.allFinite() ||

@@ -39,7 +39,8 @@ struct TimeAlignment {
 /// tracker first); both with strictly increasing time stamps. The measured path may deviate from the
 /// commanded one (deflection, a lag); what is found is the offset that best explains it in time, so a
 /// constant lag of the robot behind its command is part of the offset. Throws InputError for fewer than
-/// 10 samples in either trace, a commanded path that never moves, or a search range with no overlap.
+/// 10 samples in either trace, a commanded path that never moves, a search_s that is NaN or a centre_s
+/// that is not finite, or a search range with no overlap.
 TimeAlignment align_time(const TrackerTrace& measured, const TrackerTrace& commanded,
                          const TimeAlignmentOptions& options = {});
 

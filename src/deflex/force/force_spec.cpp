@@ -80,6 +80,12 @@ Vector3 ldbb_pivot_for_circle(const CirclePath& circle, double phi_rad) {
   if (!circle.normal.allFinite() || circle.normal.norm() < 1e-12) {
     throw InputError("LDBB: the circle's normal must be a finite, non-zero vector");
   }
+  if (!circle.centre_m.allFinite()) {
+    throw InputError("LDBB: the circle's centre is not finite");
+  }
+  if (!std::isfinite(circle.radius_m) || !(circle.radius_m > 0.0)) {
+    throw InputError(fmt::format("LDBB: the circle's radius must be positive and finite (got {} m)", circle.radius_m));
+  }
   return circle.centre_m - circle.normal.normalized() * (circle.radius_m * std::tan(phi_rad));
 }
 

@@ -43,7 +43,7 @@ struct ForceSpecContext {
                                                            const ForceSpecContext& context = {});
 
 /// The LDBB pivot for a bar inclined by phi (rad) to the circle's plane (see the file comment), m.
-/// Throws InputError unless |phi| < 89 deg.
+/// Throws InputError unless |phi| < 89 deg and the circle's normal, centre and radius (> 0) are finite.
 [[nodiscard]] Vector3 ldbb_pivot_for_circle(const CirclePath& circle, double phi_rad);
 
 }  // namespace deflex

@@ -20,6 +20,9 @@ LdbbForceModel::LdbbForceModel(Vector3 pivot_base_m, double force_N, bool push)
 }
 
 Wrench LdbbForceModel::wrench_at(std::size_t index, const Pose& base_T_tcp) const {
+  if (!base_T_tcp.translation().allFinite()) {
+    throw InputError(fmt::format("LDBB: path point {}: the TCP position is not finite", index));
+  }
   const Vector3 bar = base_T_tcp.translation() - pivot_base_m_;
   const double length = bar.norm();
   // A real bar is 100-600 mm long; under 1 mm the direction is rounding noise.

@@ -20,7 +20,7 @@ class LdbbForceModel final : public ForceModel {
   /// Throws InputError for a non-finite pivot or a force magnitude that is not positive and finite.
   LdbbForceModel(Vector3 pivot_base_m, double force_N, bool push);
 
-  /// Throws InputError when the TCP is at the pivot (no bar direction).
+  /// Throws InputError when the TCP position is not finite or is at the pivot (no bar direction).
   [[nodiscard]] Wrench wrench_at(std::size_t index, const Pose& base_T_tcp) const override;
   [[nodiscard]] bool wrench_at_pose(const Pose& base_T_tcp, Wrench& out) const noexcept override;
   [[nodiscard]] std::string describe() const override;

@@ -694,6 +694,19 @@ StiffnessIdentifier::StiffnessIdentifier(const RobotModel& model, const Identifi
   if (!(options.max_relative_std_error > 0.0) || !std::isfinite(options.max_relative_std_error)) {
     throw InputError("identify_stiffness: max_relative_std_error must be finite and > 0");
   }
+  // Fractions of the largest column or singular value, compared with < and >= in solve(): a NaN
+  // switched the excitation check off and made every joint "collinear".
+  const auto fraction = [](double v, const char* name) {
+    if (!(v >= 0.0 && v < 1.0)) {
+      throw InputError(fmt::format("identify_stiffness: {} must be in [0, 1) (got {})", name, v));
+    }
+  };
+  fraction(options.min_relative_excitation, "min_relative_excitation");
+  fraction(options.min_relative_singular_value, "min_relative_singular_value");
+  if (options.max_robust_iterations < 0) {
+    throw InputError(
+        fmt::format("identify_stiffness: max_robust_iterations must be >= 0 (got {})", options.max_robust_iterations));
+  }
   store_ = std::make_unique<RowStoreHolder>(n, options.rows_in_memory_bytes);
 }
 

@@ -92,7 +92,9 @@ struct StiffnessEstimate {
 /// gives exactly what identify_stiffness gives for the same measurements.
 class StiffnessIdentifier {
  public:
-  /// Throws InputError when the options do not fit the robot.
+  /// Throws InputError when the options do not fit the robot or are out of their domain (a threshold
+  /// that is not in [0, 1), NaN included; a scale or error bound that is not finite and > 0; a negative
+  /// iteration count), in Release too.
   StiffnessIdentifier(const RobotModel& model, const IdentificationOptions& options = {});
   ~StiffnessIdentifier();
   StiffnessIdentifier(const StiffnessIdentifier&) = delete;

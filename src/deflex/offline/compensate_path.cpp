@@ -52,6 +52,14 @@ const OfflinePoint& PathCompensator::compensate(std::size_t i, const JointVector
   if (pt.q_desired.size() != model.dof() || !pt.q_desired.allFinite()) {
     throw InputError(fmt::format("path point {}: joint vector must hold {} finite values", i, model.dof()));
   }
+  // The pose is the caller's (a force model may not look at it, and the residual is measured from
+  // it): a NaN here gave NaN points whose figures the max and mean silently left out.
+  if (!pt.tcp_desired.translation().allFinite()) {
+    throw InputError(fmt::format("path point {}: the desired TCP pose has a non-finite position", i));
+  }
+  if (!pt.tcp_desired.linear().allFinite()) {
+    throw InputError(fmt::format("path point {}: the desired TCP pose has a non-finite orientation", i));
+  }
   const Wrench wrench_tcp = force_.wrench_at(i, pt.tcp_desired);
   if (!wrench_tcp.allFinite()) {
     throw InputError(fmt::format("path point {}: the force model gave a non-finite wrench", i));

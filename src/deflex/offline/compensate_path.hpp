@@ -55,10 +55,11 @@ struct OfflineOptions {
 };
 
 /// Compensates every point of `path` (joint values from solve_path_ik) whose desired poses are
-/// `tcp_poses`, under the wrench `force` predicts at each point. Throws InputError when the sizes
-/// disagree, the force model has data for a different number of points, the robot has no joint
-/// stiffness, a compensated joint leaves its limits, or the deflection does not converge (a load far
-/// beyond the model's range); each names the path point (0-based).
+/// `tcp_poses`, under the wrench `force` predicts at each point. Throws InputError, in Release too,
+/// when the sizes disagree, the force model has data for a different number of points, the robot has
+/// no joint stiffness, a point's joints or desired pose are not finite, a compensated joint leaves its
+/// limits, or the deflection does not converge (a load far beyond the model's range); each names the
+/// path point (0-based).
 [[nodiscard]] OfflineResult compensate_path(const RobotModel& model, const JointPath& path,
                                             const std::vector<Pose>& tcp_poses, const ForceModel& force,
                                             const OfflineOptions& options);

@@ -5,10 +5,24 @@
 #include <cmath>
 #include <limits>
 
+#include <fmt/format.h>
+
+#include "deflex/text/errors.hpp"
+
 namespace deflex {
 
 DelayEstimator::DelayEstimator(double initial_delay_s, double window_s)
-    : window_s_(window_s), delay_s_(initial_delay_s), last_s_(std::numeric_limits<double>::quiet_NaN()) {}
+    : window_s_(window_s), delay_s_(initial_delay_s), last_s_(std::numeric_limits<double>::quiet_NaN()) {
+  // Checked once here, so observe_feedback() compares with them without looking again: a NaN delay
+  // was the predictive strategy's lead until the first measurement, a NaN window never measured.
+  if (!std::isfinite(initial_delay_s) || initial_delay_s < 0.0) {
+    throw InputError(
+        fmt::format("delay estimator: initial_delay_s must be finite and >= 0 s (got {})", initial_delay_s));
+  }
+  if (!std::isfinite(window_s) || !(window_s > 0.0)) {
+    throw InputError(fmt::format("delay estimator: window_s must be finite and > 0 s (got {})", window_s));
+  }
+}
 
 void DelayEstimator::record_reference(double t_s, const JointVector& q_ref) noexcept {
   if (!std::isfinite(t_s) || !q_ref.allFinite() ||

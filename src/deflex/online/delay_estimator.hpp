@@ -20,7 +20,8 @@ namespace deflex {
 class DelayEstimator {
  public:
   /// `initial_delay_s`: the estimate until the first measurement. `window_s`: how far back a
-  /// reference is looked for (longer than any delay expected).
+  /// reference is looked for (longer than any delay expected). Throws InputError unless the delay is
+  /// finite and >= 0 and the window finite and > 0.
   explicit DelayEstimator(double initial_delay_s = 0.05, double window_s = 0.5);
 
   /// The reference the controller was given (or reports following) at time t_s.

@@ -48,6 +48,12 @@ OnlineStrategy::OnlineStrategy(const RobotModel& model, StrategyKind kind, const
   }
 }
 
+bool OnlineStrategy::joints_usable(const JointVector& q) const noexcept {
+  // forward_kinematics throws on the wrong count, which would end the program from this noexcept
+  // path; the cycle's joints come from the wire each cycle, so nothing at set-up can vouch for them.
+  return q.size() == model_.dof() && q.allFinite();
+}
+
 bool OnlineStrategy::model_wrench_at(const JointVector& q, Wrench& out) noexcept {
   forward_kinematics(model_, ws_, q);
   Wrench at_tcp;
@@ -71,6 +77,7 @@ StrategyStatus OnlineStrategy::prepare(CycleInput& in, const JointVector& q_feed
     case StrategyKind::kOnline:
       return StrategyStatus::kOk;
     case StrategyKind::kHybrid:
+      if (!joints_usable(q_feedback)) return StrategyStatus::kInvalidInput;
       // The offline program already holds the model's part; correct only what the model missed.
       if (!model_wrench_at(q_feedback, model_wrench_fb_)) return StrategyStatus::kModelForceUnavailable;
       in.wrench_offset_base = -model_wrench_fb_;
@@ -83,6 +90,7 @@ StrategyStatus OnlineStrategy::prepare(CycleInput& in, const JointVector& q_feed
       }
       // With a model: its change from the pose the force was measured at to the pose the command is
       // for; the filter's lag (time, not pose) along the measured slope.
+      if (!joints_usable(q_feedback) || !joints_usable(q_target)) return StrategyStatus::kInvalidInput;
       Wrench at_target;
       if (!model_wrench_at(q_feedback, model_wrench_fb_) || !model_wrench_at(q_target, at_target)) {
         return StrategyStatus::kModelForceUnavailable;

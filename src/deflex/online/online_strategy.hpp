@@ -29,6 +29,9 @@ enum class StrategyKind { kOnline, kHybrid, kPredictive, kNone };
 enum class StrategyStatus : int {
   kOk = 0,
   kModelForceUnavailable = -1,  ///< the force model has no value at this pose (degenerate geometry)
+  /// A joint vector the strategy needs has the wrong count or a value that is not finite (the
+  /// compensator refuses the same cycle with CycleStatus::kInvalidInput).
+  kInvalidInput = -2,
 };
 
 class OnlineStrategy {
@@ -43,7 +46,9 @@ class OnlineStrategy {
   /// Fills in.wrench_offset_base and in.wrench_lead_s for one cycle. `q_feedback`: where the arm is
   /// (the pose the measured force belongs to); `q_target`: the configuration the command is for;
   /// `delay_s`: how long after it is sent a command shows in the feedback (measured by the link);
-  /// `filter_lag_s`: the force low-pass's own lag. Never allocates or throws.
+  /// `filter_lag_s`: the force low-pass's own lag. Never allocates or throws: a q_feedback (hybrid,
+  /// predictive with a model) or q_target (predictive with a model) that does not hold one finite value
+  /// a joint gives kInvalidInput, in Release too.
   StrategyStatus prepare(CycleInput& in, const JointVector& q_feedback, const JointVector& q_target, double delay_s,
                          double filter_lag_s) noexcept;
 
@@ -53,6 +58,7 @@ class OnlineStrategy {
   [[nodiscard]] const Wrench& last_model_wrench() const { return model_wrench_fb_; }
 
  private:
+  [[nodiscard]] bool joints_usable(const JointVector& q) const noexcept;
   bool model_wrench_at(const JointVector& q, Wrench& out) noexcept;
 
   RobotModel model_;

@@ -198,6 +198,12 @@ JointTrajectory trajectory_at_tcp_speed(const std::vector<Pose>& poses, const st
   if (poses.size() != q.size() || poses.empty()) {
     throw InputError(fmt::format("trajectory: {} poses for {} joint points", poses.size(), q.size()));
   }
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    // The times come from the positions: a NaN one would surface as a time "not a finite number".
+    if (!poses[i].translation().allFinite()) {
+      throw InputError(fmt::format("trajectory: pose {} has a non-finite position", i));
+    }
+  }
   std::vector<double> t;
   std::vector<JointVector> points;
   if (hold_start_s > 0.0) {

@@ -57,8 +57,9 @@ class JointTrajectory {
 
 /// Times a sampled TCP path for a constant TCP speed (m/s): t_0 = hold_start_s, and each point
 /// |p_i - p_{i-1}| / speed after the previous one (at least 1 ms, for points at the same position).
-/// `poses` (base_T_tcp) and `q` (their joints) are the same length. Throws InputError on a bad speed
-/// or mismatched lengths, and as the constructor does when the result breaks a joint limit.
+/// `poses` (base_T_tcp) and `q` (their joints) are the same length. Throws InputError on a bad speed,
+/// mismatched lengths or a pose whose position is not finite (naming it, 0-based), and as the
+/// constructor does when the result breaks a joint limit.
 [[nodiscard]] JointTrajectory trajectory_at_tcp_speed(const std::vector<Pose>& poses, const std::vector<JointVector>& q,
                                                       double speed_m_s, const RobotModel& model,
                                                       double hold_start_s = 0.0);

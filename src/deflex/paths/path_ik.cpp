@@ -42,7 +42,13 @@ JointPath solve_path_ik(const RobotModel& model, const std::vector<Pose>& poses,
 }
 
 PathIkSolver::PathIkSolver(const RobotModel& model, const IkRequest& first, const PathIkOptions& options)
-    : model_(model), options_(options), ws_(model), request_(first), q_(model.dof()) {}
+    : model_(model), options_(options), ws_(model), request_(first), q_(model.dof()) {
+  // Checked once here: next() compares every joint step with it, and a NaN bound would pass any jump.
+  if (!(options.max_joint_step_rad > 0.0)) {
+    throw InputError(fmt::format("path inverse kinematics: max_joint_step_rad must be > 0 rad (got {})",
+                                 options.max_joint_step_rad));
+  }
+}
 
 const JointVector& PathIkSolver::next(const Pose& base_T_tcp) {
   const std::size_t i = index_;

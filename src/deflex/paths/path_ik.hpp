@@ -21,7 +21,8 @@ struct PathIkOptions {
   /// Largest change of any joint between neighbouring points. A larger step means the nearest
   /// solution lies on the other side of a singularity or a joint wrapped: the path is not
   /// followable with the chosen configuration, or it is sampled too coarsely. 30 deg by default
-  /// (a circle of 81 points moves the IRB6700's joints by about 1 deg a point).
+  /// (a circle of 81 points moves the IRB6700's joints by about 1 deg a point). Must be > 0 (infinity:
+  /// no bound); the solver refuses anything else, NaN included, when it is made.
   double max_joint_step_rad = deg_to_rad(30.0);
   /// Near-singular poses stop the path (IK there is ill-conditioned and the compensation would
   /// move joints by large amounts); set true to accept them.
@@ -41,6 +42,7 @@ struct PathIkOptions {
 /// gives exactly what solve_path_ik gives for that point, and throws the same InputError.
 class PathIkSolver {
  public:
+  /// Throws InputError when options.max_joint_step_rad is not > 0.
   PathIkSolver(const RobotModel& model, const IkRequest& first, const PathIkOptions& options = {});
   /// The solver keeps a reference to the model: a temporary would dangle, so it does not compile.
   PathIkSolver(RobotModel&& model, const IkRequest& first, const PathIkOptions& options = {}) = delete;
