@@ -31,6 +31,7 @@ enum class StrategyStatus : int {
   kModelForceUnavailable = -1,  ///< the force model has no value at this pose (degenerate geometry)
 };
 
+/// Thread safety: one thread at a time (its own Workspace); the force model it reads may be shared.
 class OnlineStrategy {
  public:
   /// `force_model` (not owned, may be null; must outlive the strategy): required by hybrid, used by
