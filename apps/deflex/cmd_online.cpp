@@ -119,6 +119,31 @@ const std::vector<LinkOption>& link_options() {
   return options;
 }
 
+// The controller's cycle and what every command is held to: the correction's bounds and rates, the
+// force watchdog, where the Jacobian is taken.
+void add_bound_options(CLI::App& sub, OnlineOpts& o) {
+  sub.add_option("--period-ms", o.period_ms,
+                 "The controller's cycle in ms (default: egm-joint and rsi 4; egm-path 48, the EGMActMove SampleRate; "
+                 "simple-message 100, the paper's)");
+  sub.add_option("--max-joint-correction-deg", o.max_joint_deg,
+                 "Bound on each joint's correction, degrees: no command leaves the nominal by more")
+      ->capture_default_str();
+  sub.add_option("--max-tcp-correction-mm", o.max_tcp_mm, "Bound on the TCP displacement of the correction, mm")
+      ->capture_default_str();
+  sub.add_option("--max-rate-deg-s", o.max_rate_deg_s,
+                 "Bound on each joint's correction rate, deg/s (times the period: the correction's largest step a "
+                 "cycle, which must fit in its bound)")
+      ->capture_default_str();
+  sub.add_option("--max-tcp-rate-mm-s", o.max_tcp_rate_mm_s,
+                 "Bound on the rate of the correction's TCP translation, mm/s: a stale force ramps out at it on every "
+                 "link (egm-path: the offset's largest step a cycle)")
+      ->capture_default_str();
+  sub.add_option("--watchdog-ms", o.watchdog_ms, "No valid force sample for this long: ramp the correction to zero")
+      ->capture_default_str();
+  sub.add_option("--jacobian-at", o.jacobian_at, "nominal (the configuration the command is for) or feedback")
+      ->capture_default_str();
+}
+
 void add_link_options(CLI::App& sub, OnlineOpts& o) {
   sub.add_option("--egm-port", o.egm_port,
                  "EGM: UDP port the controller's EGM messages arrive on (ABB examples: 6510)");
@@ -536,26 +561,7 @@ void setup_online(CLI::App& sub, int& exit_code) {
   sub.add_option("--force", o->force_model,
                  "Force model of the process, a pose model: ldbb:pivot_mm=X;Y;Z,force_N=F,mode=push|pull or "
                  "constant:fx_N=.. (hybrid: required; predictive: optional)");
-  sub.add_option("--period-ms", o->period_ms,
-                 "The controller's cycle in ms (default: egm-joint and rsi 4; egm-path 48, the EGMActMove SampleRate; "
-                 "simple-message 100, the paper's)");
-  sub.add_option("--max-joint-correction-deg", o->max_joint_deg,
-                 "Bound on each joint's correction, degrees: no command leaves the nominal by more")
-      ->capture_default_str();
-  sub.add_option("--max-tcp-correction-mm", o->max_tcp_mm, "Bound on the TCP displacement of the correction, mm")
-      ->capture_default_str();
-  sub.add_option("--max-rate-deg-s", o->max_rate_deg_s,
-                 "Bound on each joint's correction rate, deg/s (times the period: the correction's largest step a "
-                 "cycle, which must fit in its bound)")
-      ->capture_default_str();
-  sub.add_option("--max-tcp-rate-mm-s", o->max_tcp_rate_mm_s,
-                 "Bound on the rate of the correction's TCP translation, mm/s: a stale force ramps out at it on every "
-                 "link (egm-path: the offset's largest step a cycle)")
-      ->capture_default_str();
-  sub.add_option("--watchdog-ms", o->watchdog_ms, "No valid force sample for this long: ramp the correction to zero")
-      ->capture_default_str();
-  sub.add_option("--jacobian-at", o->jacobian_at, "nominal (the configuration the command is for) or feedback")
-      ->capture_default_str();
+  add_bound_options(sub, *o);
   sub.add_option("--stop-silence-s", o->stop_silence_s,
                  "No usable controller message this long: the controller is gone and the session stops (exit code 5); "
                  "shorter silences are ridden through. Default: egm-joint, egm-path 3; rsi 1");

@@ -12,6 +12,7 @@
 
 namespace deflex::cell {
 
+/// Thread safety: one thread at a time (the simulation's), with its transport.
 class DaqStream {
  public:
   /// `transport` must outlive the stream; samples go to `deflex_force_port`.

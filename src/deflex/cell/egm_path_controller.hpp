@@ -17,6 +17,7 @@
 
 namespace deflex::cell {
 
+/// Thread safety: one thread at a time (the simulation's), with its transport.
 class EgmPathCorrectionController final : public RobotController {
  public:
   /// `kinematics`: the controller's own model (nominal kinematics and the tool). `program`: the path

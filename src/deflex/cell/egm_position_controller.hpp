@@ -32,6 +32,7 @@ struct EgmControllerCounters {
   bool timed_out = false;     ///< EGM stopped for lack of answers
 };
 
+/// Thread safety: one thread at a time (the simulation's), with its transport.
 class EgmPositionGuidanceController final : public RobotController {
  public:
   /// The arm starts at rest at `q_start` (rad). `transport` must outlive the controller; the sensor

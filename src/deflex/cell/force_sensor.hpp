@@ -22,6 +22,7 @@ struct SensorCalibration {
   Vector3 ee_cog_m = Vector3::Zero();
 };
 
+/// Thread safety: one thread at a time (sample() draws from its own random generator).
 class ForceSensorDaq {
  public:
   /// `seed` draws the noise of this run; `unit_seed` draws what belongs to the physical sensor (its

@@ -42,6 +42,7 @@ struct JointMoveCounters {
   std::uint64_t stops = 0;            ///< stop() calls that found the arm moving
 };
 
+/// Thread safety: one thread at a time (the simulation's).
 class JointMoveQueue {
  public:
   /// The arm at rest at `q_start` (rad); at most `capacity` (>= 1) moves wait in the queue. `model`

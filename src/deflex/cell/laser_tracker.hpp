@@ -13,6 +13,7 @@
 
 namespace deflex::cell {
 
+/// Thread safety: one thread at a time (observe() draws from its own random generator).
 class LaserTracker {
  public:
   /// Samples from `first_sample_s` on (simulation time), stamped relative to `time_origin_s`, until

@@ -13,6 +13,7 @@
 
 namespace deflex::cell {
 
+/// Thread safety: one thread at a time (its state and its own random generator).
 class LdbbDevice {
  public:
   /// `nominal_pivot_m`: the pivot the force model assumes; the true pivot adds config.pivot_error_m.

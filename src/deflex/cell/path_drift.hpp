@@ -14,6 +14,7 @@
 
 namespace deflex::cell {
 
+/// Thread safety: one thread at a time (advance() draws from its own random generator).
 class PathDrift {
  public:
   /// `load_n`: the run's process load (its motors warm more: the load offset of DriftConfig).

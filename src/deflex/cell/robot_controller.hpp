@@ -12,6 +12,7 @@
 
 namespace deflex::cell {
 
+/// Thread safety: one thread at a time (the simulation's), for every controller.
 class RobotController {
  public:
   virtual ~RobotController() = default;
@@ -30,6 +31,7 @@ class RobotController {
 };
 
 /// Runs a program of its own: the joint trajectory's interpolation, exactly, each servo tick.
+/// Thread safety: one thread at a time; the program it shares is immutable.
 class ProgramController final : public RobotController {
  public:
   explicit ProgramController(std::shared_ptr<const JointTrajectory> program) : program_(std::move(program)) {

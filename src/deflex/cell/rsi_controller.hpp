@@ -58,6 +58,7 @@ struct RsiControllerCounters {
   RsiStop stopped = RsiStop::kRunning;
 };
 
+/// Thread safety: one thread at a time (the simulation's), with its transport.
 class RsiController final : public RobotController {
  public:
   /// `kinematics`: the controller's own model (for RIst/RSol). `program`: the KRL motion it runs.

@@ -59,6 +59,7 @@ struct SimpleMessageServerCounters {
   bool out_of_step = false;  ///< a frame LENGTH that cannot be closed the motion connection
 };
 
+/// Thread safety: one thread at a time (the simulation's), with its connections.
 class SimpleMessageServer final : public RobotController {
  public:
   /// The arm starts at rest at `q_start` (rad). `motion` and `state` are the accepted connections of

@@ -17,6 +17,8 @@ namespace deflex::cell {
 /// Lost motion of one joint as a play operator with saturation: the joint torque must exceed
 /// `torque_nm` in the new direction before the joint travels across its band of +-half_width_rad,
 /// so the offset depends on the sign of the torque and on its history (CW and CCW laps differ).
+/// Thread safety: one thread at a time (update() changes its state): part of one run's
+/// TrueRobotState.
 struct LostMotion {
   double half_width_rad = 0.0;
   double torque_nm = 1.0;
@@ -55,6 +57,8 @@ struct TrueRobotState {
   bool have_torque_lowpass = false;
 };
 
+/// Thread safety: immutable once built: one true robot may serve runs on any number of threads,
+/// each with its own Workspace and TrueRobotState.
 class TrueRobot {
  public:
   /// `sensor_mounted` puts the sensor's height and compliance between flange and end effector.

@@ -34,6 +34,7 @@ struct EgmJointLinkConfig {
   double initial_delay_s = 0.05;      ///< the delay assumed until it is measured (ABB users: ~50 ms)
 };
 
+/// Thread safety: one thread at a time (the loop's), as every ControllerLink.
 class EgmJointLink final : public ControllerLink {
  public:
   /// Every reference must outlive the link. `force` may be null (push samples into the compensator

@@ -43,6 +43,7 @@ struct EgmPathLinkConfig {
   void validate() const;
 };
 
+/// Thread safety: one thread at a time (the loop's), as every ControllerLink.
 class EgmPathLink final : public ControllerLink {
  public:
   /// Every reference must outlive the link. `force` may be null. Throws InputError.

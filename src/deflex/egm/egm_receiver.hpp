@@ -45,6 +45,7 @@ struct EgmReceiverConfig {
   return config;
 }
 
+/// Thread safety: one thread at a time (the link's).
 class EgmReceiver {
  public:
   /// `transport`, `clock` and `counters` must outlive the receiver. Throws InputError.

@@ -14,6 +14,7 @@ namespace deflex {
 /// times: a bounding-box hierarchy over the segments skips every part of the path farther than the
 /// best point found so far, so a query costs about O(log n) for the dense paths a tracker records.
 /// The answer is exact (the same as a brute-force search over all segments).
+/// Thread safety: immutable once built: nearest() from any number of threads.
 class PolylineIndex {
  public:
   /// Throws InputError when there is no sample at all or a position is not finite.

@@ -5,6 +5,7 @@
 
 namespace deflex {
 
+/// Thread safety: immutable once built: any number of threads may share one.
 class ConstantWrenchModel final : public ForceModel {
  public:
   /// [Fx Fy Fz Mx My Mz], N and Nm, base frame, moment about the TCP. Throws InputError if not finite.

@@ -16,6 +16,8 @@ namespace deflex {
 /// compliance model takes), [F; M] in N and Nm, robot base frame, with the moment taken about the
 /// TCP — the only point a force model knows. compensate_path() moves the moment to the robot's
 /// wrench application point when the two differ.
+/// Thread safety: deflex's models are immutable once built, so any number of threads may share one;
+/// a model of your own is as safe to share as its const calls are.
 class ForceModel {
  public:
   virtual ~ForceModel() = default;

@@ -15,6 +15,7 @@ namespace deflex {
 /// away from the pivot. As the TCP goes round a circle whose axis passes through the pivot, the
 /// force keeps its inclination phi to the circle's plane and its horizontal part turns with the TCP
 /// (paper, Figure 4).
+/// Thread safety: immutable once built: any number of threads may share one.
 class LdbbForceModel final : public ForceModel {
  public:
   /// Throws InputError for a non-finite pivot or a force magnitude that is not positive and finite.

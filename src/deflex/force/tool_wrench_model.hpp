@@ -6,6 +6,7 @@
 
 namespace deflex {
 
+/// Thread safety: immutable once built: any number of threads may share one.
 class ToolWrenchModel final : public ForceModel {
  public:
   /// [Fx Fy Fz Mx My Mz], N and Nm, in the TCP frame, moment about the TCP: the wrench the process

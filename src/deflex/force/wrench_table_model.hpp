@@ -15,6 +15,7 @@ namespace deflex {
 
 class CsvTable;
 
+/// Thread safety: immutable once built: any number of threads may share one.
 class WrenchTableModel final : public ForceModel {
  public:
   /// Throws DataError naming the file, line and column of any malformed, duplicate or missing row.

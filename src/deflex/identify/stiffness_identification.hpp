@@ -90,6 +90,8 @@ struct StiffnessEstimate {
 /// million rows streamed from a file): add() checks and keeps a measurement's regressor rows in
 /// compact form (8 (dof + 1) bytes a row: 168 bytes for a 6-joint position measurement), solve()
 /// gives exactly what identify_stiffness gives for the same measurements.
+/// Thread safety: one thread at a time (its own Workspace and row store); identifiers on different
+/// threads may share the model.
 class StiffnessIdentifier {
  public:
   /// Throws InputError when the options do not fit the robot or are out of their domain (a threshold

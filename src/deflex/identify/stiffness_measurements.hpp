@@ -35,6 +35,7 @@ std::vector<StiffnessMeasurement> read_stiffness_measurements(const std::string&
 
 /// The same file a row at a time (deflex identify streams a million rows through it): next() gives
 /// the measurements read_stiffness_measurements gives, with the same errors.
+/// Thread safety: one thread at a time (next() reads the file on).
 class StiffnessMeasurementReader {
  public:
   /// Opens the file and checks its columns; throws DataError as read_stiffness_measurements does.

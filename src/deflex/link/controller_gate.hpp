@@ -28,6 +28,7 @@ struct ControllerGateConfig {
   void validate() const;
 };
 
+/// Thread safety: one thread at a time (the link's).
 class ControllerGate {
  public:
   /// Throws InputError on a bad configuration.

@@ -68,6 +68,8 @@ struct LinkStopRules {
   void validate() const;
 };
 
+/// Thread safety: one thread at a time (the loop's), together with the compensator, strategy and
+/// force source it drives, for every link.
 class ControllerLink {
  public:
   virtual ~ControllerLink() = default;

@@ -28,6 +28,8 @@ struct JointStreamConfig {
   void validate() const;
 };
 
+/// Thread safety: one thread at a time, const calls included (sample() writes scratch vectors of
+/// its own); the trajectory it shares is immutable.
 class JointStream {
  public:
   /// `trajectory` is shared (a long program is not copied). Throws InputError on a bad config.

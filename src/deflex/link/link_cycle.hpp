@@ -118,6 +118,8 @@ struct CycleStats {
   double max_step_fraction = 0.0;
 };
 
+/// Thread safety: one thread at a time (the link's), together with the compensator and strategy it
+/// drives.
 class LinkCycle {
  public:
   enum class Verdict : int {

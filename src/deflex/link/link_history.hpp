@@ -10,6 +10,7 @@
 
 namespace deflex {
 
+/// Thread safety: one thread at a time (the link's).
 class LinkHistory {
  public:
   /// `cycles` >= 1 records of `joints` joints each, allocated here once.

@@ -16,6 +16,7 @@
 
 namespace deflex {
 
+/// Thread safety: one thread at a time (the link's).
 class LinkTiming {
  public:
   /// `period_s`: the controller's cycle (what "late" is measured in). Throws InputError unless > 0.

@@ -10,6 +10,8 @@ namespace deflex {
 
 /// Per-call scratch for one RobotModel (Pinocchio's Model/Data split). Create one per thread;
 /// it holds the results of the last forward_kinematics() call.
+/// Thread safety: one thread at a time (forward_kinematics() writes it, and the algorithms built on
+/// it read what it wrote): each thread its own.
 struct Workspace {
   explicit Workspace(const RobotModel& model);
 

@@ -74,6 +74,8 @@ void set_dh_chain(RobotDescription& desc, DhConvention convention, const std::ve
                   const std::vector<double>& max_speed_rad_s = {});
 
 /// A validated robot description with quantities derived once. Immutable.
+/// Thread safety: immutable once built: any number of threads may share one, each with its own
+/// Workspace.
 class RobotModel {
  public:
   /// Validates the description (sizes, finite numbers, unit axes, limits, positive stiffness).

@@ -27,6 +27,8 @@ struct MonitorAddress {
 /// InputError naming `option`.
 MonitorAddress parse_monitor_address(const std::string& text, bool allow_remote, const std::string& option);
 
+/// Thread safety: it serves from threads of its own, which only read the feed (MonitorFeed locks);
+/// the object is made and destroyed on one thread, and port() and url() are immutable.
 class MonitorServer {
  public:
   /// Binds now (InputError naming the address when it cannot: in use, not this host's), serves on

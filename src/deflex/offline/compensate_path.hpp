@@ -69,6 +69,8 @@ struct OfflineOptions {
 /// The same a point at a time, for paths too long to hold: compensate() gives exactly the point
 /// compensate_path gives, throws the same errors, and keeps only the summary (max, mean), so memory
 /// does not grow with the path.
+/// Thread safety: one thread at a time (its own Workspace and running summary); compensators on
+/// different threads may share the model and the force model.
 class PathCompensator {
  public:
   /// Throws InputError when the robot has no joint stiffness.

@@ -21,6 +21,7 @@ void write_offline_csv(const OfflineResult& result, const std::string& path);
 
 /// The same file a point at a time (deflex offline streams long paths through it): the rows are
 /// byte for byte those write_offline_csv writes, into an output of the caller's transaction.
+/// Thread safety: one thread at a time.
 class OfflineCsvWriter {
  public:
   OfflineCsvWriter(OutputFile& out, int dof, const std::string& robot_name, const std::string& force_description,

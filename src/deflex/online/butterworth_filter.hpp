@@ -34,6 +34,7 @@ struct ButterworthDesign {
 [[nodiscard]] double dc_group_delay_s(const ButterworthDesign& design);
 
 /// The Butterworth low-pass run on 6 channels at once (a wrench), Direct Form II transposed.
+/// Thread safety: one thread at a time (step() changes its state).
 class ButterworthLowPass {
  public:
   ButterworthLowPass() = default;

@@ -17,6 +17,7 @@
 
 namespace deflex {
 
+/// Thread safety: one thread at a time (the link's).
 class DelayEstimator {
  public:
   /// `initial_delay_s`: the estimate until the first measurement. `window_s`: how far back a

@@ -16,6 +16,8 @@
 
 namespace deflex {
 
+/// Thread safety: push() from one producer thread while latest() and stats() run on one consumer
+/// thread, without locks; never two producers or two consumers.
 class ForceHandoff final : public ForceSource {
  public:
   /// Holds `capacity` samples (1 to 1 << 24; two cycles at the sensor's rate is the compensator's own

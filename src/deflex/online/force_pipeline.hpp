@@ -27,6 +27,7 @@ struct ConditionedWrench {
 /// dead band. The paper filters before subtracting gravity; since the filter is linear with unit DC
 /// gain the two orders agree at a fixed orientation, and subtracting gravity first stays exact while
 /// the orientation changes.
+/// Thread safety: one thread at a time (the filter's state).
 class ForcePipeline {
  public:
   /// `sensor_T_wap`: the WAP in the sensor frame (flange_T_sensor^-1 flange_T_wap). Throws InputError

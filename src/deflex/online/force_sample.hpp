@@ -36,6 +36,8 @@ struct ForceSourceStats {
 /// sample not returned before (oldest first; a source that fell behind may skip samples) and false
 /// when there is nothing new. The compensator calls it until it returns false, once per cycle, so
 /// that every sample passes through the low-pass filter designed for the sensor's sample rate.
+/// Thread safety: one thread at a time (the loop's) for every source but ForceHandoff, whose push()
+/// is for a driver's own thread.
 class ForceSource {
  public:
   virtual ~ForceSource() = default;

@@ -16,6 +16,8 @@
 
 namespace deflex {
 
+/// Thread safety: one thread at a time: push_force(), drain() and step() on the loop's thread (a
+/// sensor driver on a thread of its own hands its samples over through ForceHandoff).
 class OnlineCompensator {
  public:
   /// Throws ModelError when the model has no stiffness, InputError on a bad configuration.

@@ -34,6 +34,7 @@ enum class StrategyStatus : int {
   kInvalidInput = -2,
 };
 
+/// Thread safety: one thread at a time (its own Workspace); the force model it reads may be shared.
 class OnlineStrategy {
  public:
   /// `force_model` (not owned, may be null; must outlive the strategy): required by hybrid, used by

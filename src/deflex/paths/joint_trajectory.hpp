@@ -14,6 +14,8 @@
 
 namespace deflex {
 
+/// Thread safety: immutable once built: sample() and every const call from any number of threads
+/// (sessions and simulated controllers share one as std::shared_ptr<const JointTrajectory>).
 class JointTrajectory {
  public:
   JointTrajectory() = default;

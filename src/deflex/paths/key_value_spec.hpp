@@ -9,6 +9,7 @@
 
 namespace deflex {
 
+/// Thread safety: immutable once parsed: any number of threads may share one.
 class KeyValueSpec {
  public:
   /// Parses `body` (the part after "kind:"). `spec` is quoted in errors. Throws InputError on an

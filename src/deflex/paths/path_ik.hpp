@@ -40,6 +40,8 @@ struct PathIkOptions {
 
 /// The same, a pose at a time, for paths too long to hold (deflex offline streams them): next()
 /// gives exactly what solve_path_ik gives for that point, and throws the same InputError.
+/// Thread safety: one thread at a time (its own Workspace); solvers on different threads may share
+/// the model.
 class PathIkSolver {
  public:
   /// Throws InputError when options.max_joint_step_rad is not > 0.

@@ -21,6 +21,7 @@ inline constexpr std::size_t kMaxHeldPathPoints = 1'000'000;
 /// Throws InputError "path: more than N poses to hold in memory..." when `held` reaches the bound.
 void check_held_path_points(std::size_t held);
 
+/// Thread safety: one thread at a time (next() moves it on), for every source.
 class PoseSource {
  public:
   virtual ~PoseSource() = default;
@@ -34,6 +35,7 @@ class PoseSource {
 };
 
 /// The poses of sample_circle(), in the same order and to the last bit.
+/// Thread safety: one thread at a time (next() moves it on).
 class CirclePoseSource final : public PoseSource {
  public:
   /// Throws InputError for a radius, centre, point count or orientation sample_circle refuses.
@@ -50,6 +52,7 @@ class CirclePoseSource final : public PoseSource {
 };
 
 /// The poses of sample_line(), in the same order and to the last bit.
+/// Thread safety: one thread at a time (next() moves it on).
 class LinePoseSource final : public PoseSource {
  public:
   LinePoseSource(const LinePath& line, const Eigen::Quaterniond& tcp_orientation);
@@ -64,6 +67,7 @@ class LinePoseSource final : public PoseSource {
 
 /// Poses held by the caller, in order. It keeps a reference to them (the ownership rule of
 /// docs/architecture.md), so a temporary vector does not compile.
+/// Thread safety: one thread at a time (next() moves it on); threads may share the poses.
 class PoseListSource final : public PoseSource {
  public:
   explicit PoseListSource(const std::vector<Pose>& poses) : poses_(poses) {}
@@ -82,6 +86,7 @@ class PoseListSource final : public PoseSource {
 
 /// The poses of read_pose_path_csv(), read a row at a time (columns x_mm,y_mm,z_mm,qw,qx,qy,qz in
 /// any order). Throws DataError naming the file, line and column, as read_pose_path_csv does.
+/// Thread safety: one thread at a time (next() reads the file on).
 class PoseCsvSource final : public PoseSource {
  public:
   explicit PoseCsvSource(const std::string& path);

@@ -53,6 +53,7 @@ struct RsiLinkConfig {
   void validate() const;
 };
 
+/// Thread safety: one thread at a time (the loop's), as every ControllerLink.
 class RsiLink final : public ControllerLink {
  public:
   /// Every reference must outlive the link. `force` may be null. Throws InputError.

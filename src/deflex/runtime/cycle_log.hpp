@@ -30,6 +30,7 @@ void append_cycle_row(std::string& out, const SessionEntry& e, int joints, const
 /// The cycle log as an output of deflex (model/output_file.hpp): written into a temporary file beside
 /// the path and put in place when the session ends (whatever ended it: the log is the record of what
 /// happened), never truncating the path before then; a session that dies leaves the path as it was.
+/// Thread safety: one thread at a time (the session's reporter).
 class CycleLogFile {
  public:
   /// Prepares `path` now, so a path that cannot be an output is an error at the session's start, and

@@ -40,7 +40,8 @@ struct MonitorSetup {
 };
 
 /// The rows of the last window_s seconds, the session's state and stop reason, as JSON for the page.
-/// Thread-safe: one writer (the reporter, or a log reader), any number of readers.
+/// Thread safety: add() and set_state() from one writer thread (the reporter, or a log reader)
+/// while any number of threads read json() and rows_added() (under a mutex); setup() is immutable.
 class MonitorFeed {
  public:
   explicit MonitorFeed(MonitorSetup setup);

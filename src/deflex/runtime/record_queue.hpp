@@ -28,6 +28,8 @@ struct SessionEntry {
   CompensatorCounters compensator;
 };
 
+/// Thread safety: push() from one producer thread while pop() runs on one consumer thread, without
+/// locks; never two producers or two consumers.
 template <class T>
 class SpscRing {
  public:

@@ -102,6 +102,9 @@ struct SessionSummary {
   nlohmann::json json;            ///< the same for a program
 };
 
+/// Thread safety: one thread drives it (poll(), service(), run(), finish() and the accessors; while
+/// run() runs, the reporter works on a thread of its own); request_stop() is safe from any thread
+/// or a signal handler, and the feed of monitor_feed() from any thread.
 class Session {
  public:
   /// Builds everything and validates every option (InputError naming it): the link's options, the

@@ -26,6 +26,7 @@ enum class LogLevel { kInfo, kWarn, kError };
 using LogSink = std::function<void(LogLevel, const std::string&)>;
 
 /// Quantiles from a fixed histogram of `bins` bins of width `bin` (values beyond fall in the last).
+/// Thread safety: one thread at a time.
 class Histogram {
  public:
   Histogram(double bin, std::size_t bins) : bin_(bin), counts_(bins, 0) {}
@@ -59,6 +60,8 @@ struct ReportSetup {
   std::shared_ptr<MonitorFeed> monitor;  ///< the live page's data (null: no monitor)
 };
 
+/// Thread safety: one thread at a time (the session's reporter thread, or the caller's service()
+/// when stepped).
 class SessionReporter {
  public:
   /// Opens the cycle log and checks the dump path (an unwritable one is an error now, not at the

@@ -23,6 +23,7 @@ struct ForceSourceCounters {
 /// restarted sender.
 [[nodiscard]] SequenceRules force_sequence_rules();
 
+/// Thread safety: one thread at a time (the loop's), with its transport.
 class DatagramForceSource : public ForceSource {
  public:
   /// `transport` must outlive the source.

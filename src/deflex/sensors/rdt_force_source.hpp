@@ -90,6 +90,7 @@ struct RdtCounters {
 
 /// An RDT sensor over any datagram transport: UDP on a cell, the in-memory network in tests and
 /// simulations. The clock measures the stall and answer timeouts and the back-off.
+/// Thread safety: one thread at a time (the loop's), with its transport and clock.
 class RdtForceSource final : public ForceSource {
  public:
   /// `transport` and `clock` must outlive the source. `sensor`: its address and RDT port. Throws
@@ -188,6 +189,7 @@ class RdtForceSource final : public ForceSource {
 
 /// An RDT sensor over its own UDP socket, on the wall clock: what `--force-source rdt:HOST[:PORT]`
 /// builds. Set-up calls block and throw; latest() is the source's.
+/// Thread safety: one thread at a time: the set-up calls, then latest() on the loop's thread.
 class RdtUdpForceSource final : public ForceSource {
  public:
   /// Binds an ephemeral UDP port on `bind_address` (the sensor answers to the address and port the

@@ -62,6 +62,7 @@ struct TareResult {
 
 /// The tare's state machine and running statistics (Welford's, so a long window stays exact).
 /// Never allocates; add() and apply() never throw.
+/// Thread safety: one thread at a time.
 class WrenchTare {
  public:
   /// Starts a new window of `settings.window_s` at `rate_hz` samples a second. Throws InputError.

@@ -78,6 +78,7 @@ struct SimpleMessageCounters {
   double max_behind_s = 0.0;          ///< the most it was
 };
 
+/// Thread safety: one thread at a time (the loop's), as every ControllerLink.
 class SimpleMessageLink final : public ControllerLink {
  public:
   /// Every reference must outlive the link; `motion` and `state` are connected streams (the

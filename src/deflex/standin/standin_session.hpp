@@ -43,6 +43,7 @@ struct StandInConfig {
 
 /// A force/torque sensor at the flange of the stand-in arm: the wrench `force_base_n` at the TCP
 /// exerts, in the sensor frame, moment about the sensor origin (plain frame algebra; no noise).
+/// Thread safety: one thread at a time (the stand-in's).
 class ArmForceSensor final : public ForceSource {
  public:
   ArmForceSensor(const RobotModel& robot, const SensorConfig& sensor);
@@ -60,6 +61,9 @@ class ArmForceSensor final : public ForceSource {
   bool have_ = false;
 };
 
+/// Thread safety: one thread at a time: the stand-in runs its controller, network, clock and
+/// stepped session on the caller's thread (only session().request_stop() may come from elsewhere,
+/// as for any Session).
 class StandInSession {
  public:
   /// Builds the stand-in of `config.link`'s controller and deflex's session on it. `program`: the

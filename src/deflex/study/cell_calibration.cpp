@@ -16,6 +16,7 @@
 #include "deflex/paths/circle_path.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/paths/path_ik.hpp"
+#include "deflex/study/detail/cell_arm.hpp"
 #include "deflex/study/detail/simulated_run.hpp"
 #include "deflex/text/errors.hpp"
 
@@ -171,20 +172,16 @@ void run_calibration_pass(CalibrationRig& rig, CalibrationArc& arc, int loaded) 
     state = fresh;
     state.lost_motion = lost_motion;
   }
-  Vector3 p_prev = drift.apply(robot.solve(ws, q, Wrench::Zero(), state));
+  CellArm arm{robot, ws, state, device, drift};
+  Vector3 p_prev = arm.at_rest(q);
   Vector3 v_prev = Vector3::Zero();
   const auto ticks = static_cast<long>(std::ceil(program.end_time_s() / dt));
   double next_sample = 1.0 / cc.sensor.rate_hz;
   for (long i = 1; i <= ticks; ++i) {
     const double t = static_cast<double>(i) * dt;
     program.sample(t, q);
-    Wrench w = Wrench::Zero();
-    if (loaded) {
-      device.advance(dt);
-      w = device.wrench(p_prev, v_prev);
-    }
-    drift.advance(dt);
-    const Vector3 p = drift.apply(robot.solve(ws, q, w, state, dt));
+    Wrench w;
+    const Vector3 p = arm.tick(q, loaded != 0, p_prev, v_prev, dt, w);
     if (rig.force_from_sensor && loaded) {
       const Matrix3 base_R_flange = ws.base_T_flange.linear();
       forward_kinematics(rig.nominal, rig.ws_nominal, q);  // the orientation deflex knows (nominal, encoders)

@@ -22,6 +22,7 @@
 #include "deflex/paths/circle_path.hpp"
 #include "deflex/runtime/session.hpp"
 #include "deflex/sensors/datagram_force_source.hpp"
+#include "deflex/study/detail/cell_arm.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/transport/memory_network.hpp"
 #include "deflex/transport/memory_stream.hpp"
@@ -411,7 +412,8 @@ RunOutput drive_simulated_run(SimulatedRun& run) {
   Workspace ws(robot.true_model());
   JointVector q_motor = plan.program->points().front();
   cell::TrueRobotState state = robot.initial_state(q_motor);
-  Vector3 p_prev = drift.apply(robot.solve(ws, q_motor, Wrench::Zero(), state));
+  CellArm arm{robot, ws, state, ldbb, drift};
+  Vector3 p_prev = arm.at_rest(q_motor);
   Vector3 v_prev = Vector3::Zero();
   const double daq_period = 1.0 / c.sensor.rate_hz;
   double next_daq = daq_period;
@@ -420,14 +422,8 @@ RunOutput drive_simulated_run(SimulatedRun& run) {
     const double t = static_cast<double>(k) * dt;
     clock.set(t);
     q_motor = controller.tick(t);
-    Wrench w = Wrench::Zero();
-    if (loaded) {
-      ldbb.advance(dt);
-      w = ldbb.wrench(p_prev, v_prev);
-    }
-    drift.advance(dt);
-    // Drift moves the whole arm (thermal growth, repeatability), so the LDBB sees it too.
-    const Vector3 p = drift.apply(robot.solve(ws, q_motor, w, state, dt));
+    Wrench w;
+    const Vector3 p = arm.tick(q_motor, loaded, p_prev, v_prev, dt, w);
     controller.encoders(state.q_motor);
     if (linked) {
       // The DAQ streams this tick's samples; the EGM message sent this tick reaches deflex after the

@@ -31,6 +31,8 @@ struct Spread {
 /// Figures of one load of one setup. Every map is keyed by the TCP speed in mm/s; lengths in mm.
 /// With several seeds the plain maps hold the mean over the seeds and the *_by_seed maps the values
 /// they are the mean of, in the study's seed order.
+/// Thread safety: a value: const calls from any number of threads; fill_compensation() and
+/// fill_means() need it to themselves.
 struct LoadResult {
   double load_N = 0.0;
   std::map<int, double> uc_mm;                ///< mean distance of the loaded uncompensated path from the unloaded one

@@ -30,6 +30,7 @@ struct InputRange;
 /// with the header's number of cells, each number inside the range its column's unit allows
 /// (input_ranges.hpp: 1e308 mm is an error naming the line and column). Columns may come in any order; they are found
 /// by name. Errors throw DataError naming the file, the line and the column.
+/// Thread safety: one thread at a time (next() moves its read position and its row).
 class CsvReader {
  public:
   /// Opens the file (input_file.hpp: a regular file within the limit of `kind`) and reads its header
@@ -84,6 +85,7 @@ class CsvReader {
 };
 
 /// A whole CSV file of numbers in memory (see CsvReader for the rules).
+/// Thread safety: immutable once read: any number of threads may share one.
 class CsvTable {
  public:
   /// Reads and checks the whole file (at most 1 GiB, InputKind::kCsvTable). Throws DataError.
@@ -148,6 +150,7 @@ void for_each_csv_cell(std::string_view line, F&& f) {
 /// writer's own buffer, never into a temporary string, and the buffer goes to the output in 64 kB
 /// pieces. The output is an OutputFile (output_file.hpp): nothing appears at the path before the
 /// file is committed, and a failed write throws OutputError naming it.
+/// Thread safety: one thread at a time (each thread its own writer).
 class CsvWriter {
  public:
   /// Into `out`, one output of a transaction: finish() flushes, the transaction commits.

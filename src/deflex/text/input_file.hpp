@@ -37,6 +37,8 @@ struct InputKindInfo {
 /// An input file opened for reading: a regular file within its kind's size limit. Throws DataError
 /// "PATH: ..." when the file cannot be opened, is not a regular file (naming what it is), is larger
 /// than the limit, or is a file this run writes (InputError, see run_files.hpp).
+/// Thread safety: one thread at a time (each read moves its position); files opened on different
+/// threads are independent.
 class InputFile {
  public:
   /// `updated_as`: the file is read to be rewritten whole by this run's output of that name (a row

@@ -26,6 +26,8 @@ namespace deflex {
 
 /// One output file. Nothing appears at the path until commit() (or the transaction's commit());
 /// destroyed uncommitted, it removes its temporary file and leaves the target untouched.
+/// Thread safety: one thread at a time; outputs on different threads are independent (the signal
+/// handler's table of temporary files is atomic).
 class OutputFile {
  public:
   /// Prepares `path` (creates the temporary file, or opens a stream). `what` names the output in
@@ -74,6 +76,7 @@ class OutputFile {
 /// before the first is renamed into place, and a rename that fails puts back the files already
 /// renamed (the previous file from a hard link kept for the purpose; a file new in this run is
 /// removed again), so the outputs appear all or none.
+/// Thread safety: one thread at a time, its files included.
 class OutputTransaction {
  public:
   OutputTransaction() = default;

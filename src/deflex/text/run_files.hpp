@@ -14,6 +14,8 @@ namespace deflex {
 
 /// Records the inputs and outputs of one run until it is destroyed. Scopes do not nest: a second
 /// scope while one is alive is a programming error (std::logic_error).
+/// Thread safety: made and destroyed on one thread; while it lives, files may be opened on any
+/// thread (the record is kept under a mutex: the case study writes from its worker threads).
 class RunFilesScope {
  public:
   RunFilesScope();

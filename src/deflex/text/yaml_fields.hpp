@@ -15,6 +15,8 @@
 namespace deflex::yaml {
 
 /// A YAML node with the file it came from and its dotted path, for error messages.
+/// Thread safety: one thread at a time, counting every Field of one document as one: copies share
+/// yaml-cpp's nodes, whose const reads are not safe from two threads at once.
 class Field {
  public:
   Field(const YAML::Node& node, std::string file, std::string path);

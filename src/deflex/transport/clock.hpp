@@ -8,6 +8,8 @@
 namespace deflex {
 
 /// Seconds since some fixed start, monotonic. Reading it never allocates, locks or throws.
+/// Thread safety: now_s() is const, and a SteadyClock may be read from any number of threads at
+/// once (a session's loop and its reporter both read it); a ManualClock belongs to one thread.
 class Clock {
  public:
   virtual ~Clock() = default;
@@ -20,6 +22,7 @@ class Clock {
 };
 
 /// std::chrono::steady_clock, in seconds since construction.
+/// Thread safety: immutable once made: now_s() from any number of threads.
 class SteadyClock final : public Clock {
  public:
   SteadyClock() : start_(std::chrono::steady_clock::now()) {}
@@ -32,6 +35,7 @@ class SteadyClock final : public Clock {
 };
 
 /// A clock set by its owner (simulations, tests). Starts at 0 s.
+/// Thread safety: one thread at a time (set() and advance() are plain writes that now_s() reads).
 class ManualClock final : public Clock {
  public:
   [[nodiscard]] double now_s() const noexcept override { return now_s_; }

@@ -23,6 +23,8 @@ struct DatagramAddress {
 /// "127.0.0.1:6510".
 [[nodiscard]] std::string to_string(const DatagramAddress& address);
 
+/// Thread safety: one thread at a time (the thread of the link or simulation that owns the
+/// endpoint), for every transport.
 class DatagramTransport {
  public:
   virtual ~DatagramTransport() = default;

@@ -30,6 +30,8 @@ struct MemoryNetworkCounters {
 
 /// One endpoint of a MemoryNetwork. Datagrams come out in the order they were sent to it, each once
 /// its delivery time has come.
+/// Thread safety: one thread at a time, together with its network (one network belongs to one
+/// simulation).
 class MemoryTransport final : public DatagramTransport {
  public:
   /// True when the oldest waiting datagram has arrived by the clock's time (never waits).
@@ -62,6 +64,8 @@ class MemoryTransport final : public DatagramTransport {
   double receipt_s_ = std::numeric_limits<double>::quiet_NaN();
 };
 
+/// Thread safety: one thread at a time: the network, its endpoints and its clock belong to one
+/// simulation.
 class MemoryNetwork {
  public:
   explicit MemoryNetwork(const Clock& clock, std::size_t max_datagram_bytes = 2048, std::size_t queue_depth = 512);

@@ -18,6 +18,7 @@ namespace deflex {
 class MemoryStreamPair;
 
 /// One end of a MemoryStreamPair.
+/// Thread safety: one thread at a time, together with its pair.
 class MemoryStreamEnd final : public StreamTransport {
  public:
   bool wait_readable(double timeout_s) noexcept override;
@@ -36,6 +37,7 @@ class MemoryStreamEnd final : public StreamTransport {
   bool closed_ = false;
 };
 
+/// Thread safety: one thread at a time: the pair and both its ends belong to one simulation.
 class MemoryStreamPair {
  public:
   /// `latency_s` >= 0 one way; `window_bytes` >= 1 unread bytes per direction; `max_writes` >= 1

@@ -34,6 +34,7 @@ enum class SequenceVerdict {
   return v == SequenceVerdict::kFirst || v == SequenceVerdict::kNext || v == SequenceVerdict::kRestart;
 }
 
+/// Thread safety: one thread at a time (observe() changes it).
 class SequenceTracker {
  public:
   explicit SequenceTracker(const SequenceRules& rules = {}) : rules_(rules) {}

@@ -10,6 +10,8 @@
 
 namespace deflex {
 
+/// Thread safety: one thread at a time (the thread of the link or simulation that owns the
+/// connection), for every stream.
 class StreamTransport {
  public:
   /// What read() and write() return once the connection is over (closed by either end, or broken).

@@ -12,6 +12,8 @@
 
 namespace deflex {
 
+/// Thread safety: one thread at a time (a read or write that finds the connection over marks it
+/// ended).
 class TcpStream final : public StreamTransport {
  public:
   /// Connects to `host` (a name or an IPv4 address) at `port`, waiting up to `timeout_s`. Throws Error
@@ -39,6 +41,7 @@ class TcpStream final : public StreamTransport {
   std::string peer_;
 };
 
+/// Thread safety: one thread at a time.
 class TcpListener {
  public:
   /// Listens on `address:port` (port 0: ephemeral, read it back with port()). Throws Error naming the

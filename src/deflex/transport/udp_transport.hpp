@@ -11,6 +11,7 @@
 
 namespace deflex {
 
+/// Thread safety: one thread at a time (receive() keeps the time stamp since_receipt_s() reads).
 class UdpTransport final : public DatagramTransport {
  public:
   /// Binds `address:port` (port 0: ephemeral, read it back with port()). Throws Error naming the

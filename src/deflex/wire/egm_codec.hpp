@@ -61,6 +61,8 @@ enum class EgmDecodeStatus : int {
 };
 [[nodiscard]] const char* to_string(EgmDecodeStatus s);
 
+/// Thread safety: one thread at a time (it reuses its own protobuf messages); codecs on different
+/// threads are independent.
 class EgmCodec {
  public:
   /// `expected_joints`: the robot's joint count; packets with another count are rejected.

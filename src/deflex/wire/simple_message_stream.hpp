@@ -12,6 +12,7 @@
 
 namespace deflex::simple_message {
 
+/// Thread safety: one thread at a time.
 class FrameReader {
  public:
   /// Frames longer than `max_frame_bytes` (LENGTH) are out of step. Throws InputError when
@@ -43,6 +44,7 @@ class FrameReader {
   std::int64_t length_ = 0;
 };
 
+/// Thread safety: one thread at a time.
 class FrameOutbox {
  public:
   /// Holds up to `capacity` bytes not yet taken by the stream. Throws InputError when 0.
