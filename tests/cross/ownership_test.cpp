@@ -21,12 +21,13 @@ static_assert(!std::is_constructible_v<PathCompensator, RobotModel, const Consta
 static_assert(!std::is_constructible_v<PathCompensator, const RobotModel&, ConstantWrenchModel>);
 static_assert(!std::is_constructible_v<PathCompensator, RobotModel, ConstantWrenchModel>);
 static_assert(!std::is_constructible_v<PathIkSolver, RobotModel, const IkRequest&>);
-static_assert(!std::is_constructible_v<OnlineStrategy, RobotModel, StrategyKind, const ForceModel*>);
 // Named objects: the forms the library means.
 static_assert(std::is_constructible_v<PathCompensator, const RobotModel&, const ConstantWrenchModel&>);
 static_assert(std::is_constructible_v<PathIkSolver, const RobotModel&, const IkRequest&>);
 static_assert(std::is_constructible_v<OnlineStrategy, const RobotModel&, StrategyKind, const ForceModel*>);
-// The online compensator copies its model, so a temporary is fine there.
+// The online compensator and the online strategy copy their model, so a temporary is fine there (the
+// strategy's force model is a pointer, which a temporary cannot give without an explicit address).
+static_assert(std::is_constructible_v<OnlineStrategy, RobotModel, StrategyKind, const ForceModel*>);
 static_assert(std::is_constructible_v<OnlineCompensator, RobotModel, const SensorConfig&, const OnlineConfig&>);
 
 TEST(Ownership, OnlineCompensatorOutlivesTheModelItWasGiven) {

@@ -37,12 +37,11 @@ enum class StrategyStatus : int {
 /// Thread safety: one thread at a time (its own Workspace); the force model it reads may be shared.
 class OnlineStrategy {
  public:
-  /// `force_model` (not owned, may be null; must outlive the strategy): required by hybrid, used by
-  /// predictive when given. Throws InputError when hybrid has none, or when the model cannot give a
-  /// wrench from a pose alone (a path-indexed table).
+  /// The strategy keeps a copy of `model`, so a temporary is fine. `force_model` (not owned, may be
+  /// null; must outlive the strategy): required by hybrid, used by predictive when given. Throws
+  /// InputError when hybrid has none, or when the model cannot give a wrench from a pose alone (a
+  /// path-indexed table).
   OnlineStrategy(const RobotModel& model, StrategyKind kind, const ForceModel* force_model);
-  /// The strategy keeps a reference to the model: a temporary would dangle, so it does not compile.
-  OnlineStrategy(RobotModel&& model, StrategyKind kind, const ForceModel* force_model) = delete;
 
   /// Fills in.wrench_offset_base and in.wrench_lead_s for one cycle. `q_feedback`: where the arm is
   /// (the pose the measured force belongs to); `q_target`: the configuration the command is for;
