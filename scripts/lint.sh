@@ -41,6 +41,12 @@ else
   sources=()
   while IFS= read -r f; do
     [ -f "$f" ] || continue  # deleted since
+    # Changes to comments alone (whole comment lines, whitespace) change nothing clang-tidy sees, unless
+    # they touch a NOLINT.
+    if [ -z "$(git diff -w -I '^[[:space:]]*//' "$base" HEAD -- "$f")" ] &&
+      ! git diff "$base" HEAD -- "$f" | grep -q '^[-+].*NOLINT'; then
+      continue
+    fi
     case "$f" in
       *.cpp) sources+=("$f") ;;
       *.hpp)
