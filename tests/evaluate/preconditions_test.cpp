@@ -63,5 +63,16 @@ TEST(EvaluatePreconditions, ATimeSearchRangeOrCentreThatIsNotANumberIsRefused) {
   EXPECT_NE(error.find("centre_s"), std::string::npos) << error;
 }
 
+TEST(EvaluatePreconditions, AnAlignmentThatIsNotANumberIsRefusedWhenTimesAreMapped) {
+  // Before: a NaN offset (an alignment of the caller's own) turned every time stamp into NaN.
+  const TrackerTrace trace = test::circle(0.1, Vector3(1.5, 0.0, 1.0), 100, 1.0);
+  TimeAlignment alignment;
+  alignment.offset_s = 0.25;
+  EXPECT_NEAR(to_program_time(trace, alignment)[10].t_s, trace[10].t_s + 0.25, 1e-15);
+  alignment.drift = kNaN;
+  const std::string error = test::error_of([&] { (void)to_program_time(trace, alignment); });
+  EXPECT_NE(error.find("drift"), std::string::npos) << error;
+}
+
 }  // namespace
 }  // namespace deflex

@@ -10,6 +10,7 @@
 
 #include "deflex/force/force_spec.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
+#include "deflex/force/tool_wrench_model.hpp"
 #include "deflex/text/errors.hpp"
 #include "support/error_of.hpp"
 
@@ -44,6 +45,21 @@ TEST(ForcePreconditions, AnLdbbWrenchAtANonFiniteTcpPositionNamesThePosition) {
   EXPECT_NE(error.find("TCP position is not finite"), std::string::npos) << error;
   Wrench w;
   EXPECT_FALSE(ldbb.wrench_at_pose(tcp, w));
+}
+
+TEST(ForcePreconditions, AToolWrenchAtANonFiniteOrientationIsRefused) {
+  // Before: the tool's wrench rotated by a NaN matrix came back NaN, without an error.
+  Wrench tool = Wrench::Zero();
+  tool[2] = -150.0;
+  const ToolWrenchModel model(tool);
+  Pose tcp = Pose::Identity();
+  tcp.linear()(0, 2) = kNaN;
+  const std::string error = test::error_of([&] { (void)model.wrench_at(0, tcp); });
+  EXPECT_NE(error.find("orientation is not finite"), std::string::npos) << error;
+  // A finite orientation: the wrench turned with the tool (its z along -z of the base: +150 N along z).
+  Pose down = Pose::Identity();
+  down.linear() = Eigen::Quaterniond(0.0, 0.0, 1.0, 0.0).toRotationMatrix();
+  EXPECT_NEAR(model.wrench_at(0, down)[2], 150.0, 1e-12);
 }
 
 }  // namespace

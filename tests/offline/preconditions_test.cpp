@@ -13,8 +13,10 @@
 #include "deflex/force/tool_wrench_model.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "deflex/offline/compensate_path.hpp"
+#include "deflex/offline/offline_csv.hpp"
 #include "deflex/paths/path_spec.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/text/output_file.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex {
@@ -51,6 +53,23 @@ TEST(OfflinePreconditions, ADesiredPoseWithAnInfiniteOrientationIsRefusedAsThePo
   const std::string error = test::error_of([&] { (void)compensate_path(c.model, c.path, c.poses, force); });
   EXPECT_NE(error.find("path point 5"), std::string::npos) << error;
   EXPECT_NE(error.find("orientation"), std::string::npos) << error;
+}
+
+TEST(OfflinePreconditions, ACsvRowWhoseCommandHasTheWrongJointCountIsRefused) {
+  // Before: only the desired joints' count was checked, and a 5-joint command was read past its end
+  // into a 6-joint row.
+  Circle c;
+  const ConstantWrenchModel force(push_down());
+  std::vector<OfflinePoint> points = compensate_path(c.model, c.path, c.poses, force).points;
+  OfflinePoint& bad = points[2];
+  bad.q_command.conservativeResize(5);
+  const std::string path = ::testing::TempDir() + "deflex_offline_preconditions.csv";
+  OutputFile out(path, "offline CSV");  // never committed: nothing is left at the path
+  OfflineCsvWriter writer(out, c.model.dof(), c.model.name(), force.describe(), true);
+  writer.write(0, points[0]);
+  const std::string error = test::error_of([&] { writer.write(2, bad); });
+  EXPECT_NE(error.find("path point 2"), std::string::npos) << error;
+  EXPECT_NE(error.find("5 command joints"), std::string::npos) << error;
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/model/robot_io.hpp"
+#include "deflex/paths/circle_path.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/path_spec.hpp"
@@ -41,6 +42,19 @@ TEST(PathPreconditions, ATimedPathThroughANonFinitePoseNamesThePose) {
   const std::string error = test::error_of([&] { (void)trajectory_at_tcp_speed(poses, path.q, 0.02, model); });
   EXPECT_NE(error.find("pose 4"), std::string::npos) << error;
   EXPECT_NE(error.find("position"), std::string::npos) << error;
+}
+
+TEST(PathPreconditions, ACirclePointAtANonFiniteAngleOrOnANonFiniteCircleIsRefused) {
+  // Before: a NaN angle, centre or radius gave a NaN point without an error.
+  const CirclePath circle = default_circle();
+  std::string error = test::error_of([&] { (void)circle_point(circle, kNaN); });
+  EXPECT_NE(error.find("angle"), std::string::npos) << error;
+  CirclePath no_radius = circle;
+  no_radius.radius_m = std::numeric_limits<double>::infinity();
+  error = test::error_of([&] { (void)circle_point(no_radius, 0.0); });
+  EXPECT_NE(error.find("radius"), std::string::npos) << error;
+  // A finite one lies on the circle: at its radius from the centre.
+  EXPECT_NEAR((circle_point(circle, 1.0) - circle.centre_m).norm(), circle.radius_m, 1e-12);
 }
 
 }  // namespace

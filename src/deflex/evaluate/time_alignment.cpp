@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -241,6 +242,12 @@ TimeAlignment align_time(const TrackerTrace& measured, const TrackerTrace& comma
 }
 
 TrackerTrace to_program_time(const TrackerTrace& measured, const TimeAlignment& alignment) {
+  for (const auto& [name, value] : {std::pair{"offset_s", alignment.offset_s}, std::pair{"drift", alignment.drift},
+                                    std::pair{"reference_t_s", alignment.reference_t_s}}) {
+    if (!std::isfinite(value)) {
+      throw InputError(fmt::format("time alignment: {} is not a finite number", name));
+    }
+  }
   TrackerTrace out = measured;
   for (auto& s : out) s.t_s = alignment.program_time(s.t_s);
   return out;

@@ -44,7 +44,8 @@ struct TimeAlignment {
 TimeAlignment align_time(const TrackerTrace& measured, const TrackerTrace& commanded,
                          const TimeAlignmentOptions& options = {});
 
-/// The trace with each time stamp mapped to program time.
+/// The trace with each time stamp mapped to program time. Throws InputError when the alignment's
+/// offset_s, drift or reference_t_s is not finite.
 TrackerTrace to_program_time(const TrackerTrace& measured, const TimeAlignment& alignment);
 
 }  // namespace deflex

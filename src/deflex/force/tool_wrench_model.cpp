@@ -15,6 +15,9 @@ ToolWrenchModel::ToolWrenchModel(const Wrench& wrench_tool) : wrench_tool_(wrenc
 
 Wrench ToolWrenchModel::wrench_at(std::size_t /*index*/, const Pose& base_T_tcp) const {
   const Matrix3& R = base_T_tcp.linear();
+  if (!R.allFinite()) {
+    throw InputError("tool wrench: the TCP orientation is not finite");
+  }
   Wrench w;
   w.head<3>() = R * wrench_tool_.head<3>();
   w.tail<3>() = R * wrench_tool_.tail<3>();

@@ -14,7 +14,8 @@ class ToolWrenchModel final : public ForceModel {
   /// not finite.
   explicit ToolWrenchModel(const Wrench& wrench_tool);
 
-  /// The tool-frame wrench rotated into the base frame by the TCP orientation of `base_T_tcp`.
+  /// The tool-frame wrench rotated into the base frame by the TCP orientation of `base_T_tcp`. Throws
+  /// InputError when that orientation is not finite.
   [[nodiscard]] Wrench wrench_at(std::size_t index, const Pose& base_T_tcp) const override;
   [[nodiscard]] std::string describe() const override;
   [[nodiscard]] std::string label() const override { return "tool"; }

@@ -55,8 +55,9 @@ OfflineCsvWriter::OfflineCsvWriter(OutputFile& out, int dof, const std::string& 
 }
 
 void OfflineCsvWriter::write(std::size_t index, const OfflinePoint& p) {
-  if (p.q_desired.size() != dof_) {
-    throw InputError(fmt::format("path point {}: {} joints for a {}-joint file", index, p.q_desired.size(), dof_));
+  if (p.q_desired.size() != dof_ || p.q_command.size() != dof_) {
+    throw InputError(fmt::format("path point {}: {} desired and {} command joints for a {}-joint file", index,
+                                 p.q_desired.size(), p.q_command.size(), dof_));
   }
   if (index == 0 || !have_quaternion_) {
     q_desired_ = canonical_quaternion(p.tcp_desired);

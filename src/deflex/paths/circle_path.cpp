@@ -29,6 +29,12 @@ void circle_frame(const CirclePath& circle, Vector3& u, Vector3& v) {
 }
 
 Vector3 circle_point(const CirclePath& circle, double angle_rad) {
+  if (!std::isfinite(angle_rad)) {
+    throw InputError("circle point: the angle is not a finite number");
+  }
+  if (!circle.centre_m.allFinite() || !std::isfinite(circle.radius_m)) {
+    throw InputError("circle point: the circle's centre and radius must be finite");
+  }
   Vector3 u, v;
   circle_frame(circle, u, v);
   return circle.centre_m + circle.radius_m * (std::cos(angle_rad) * u + std::sin(angle_rad) * v);

@@ -32,7 +32,8 @@ struct CirclePath {
 void circle_frame(const CirclePath& circle, Vector3& u, Vector3& v);
 
 /// Point of the circle at the angle `angle_rad` from the start direction (before start_angle is
-/// applied and regardless of direction), base frame, m.
+/// applied and regardless of direction), base frame, m. Throws InputError for an angle, centre or
+/// radius that is not finite, and as circle_frame does.
 [[nodiscard]] Vector3 circle_point(const CirclePath& circle, double angle_rad);
 
 /// Samples the circle into base_T_tcp poses, all with `tcp_orientation` (normalised; it must be a
