@@ -45,7 +45,7 @@ struct FrameState {
   std::string why;
 };
 
-struct Use {
+struct KrlUse {
   const KrlDecl* decl = nullptr;  // null: an inline aggregate in the .src
   const KrlAggregate* value = nullptr;
   std::size_t ref_b = 0, ref_e = 0;  // .src tokens of the reference
@@ -488,7 +488,7 @@ class KrlReader {
   /// One PTP/LIN/CIRC line: every target resolved into `uses`/`info`, or listed.
   void motion(std::size_t b, std::size_t e, const std::string& first, const FrameState& tool, const FrameState& base,
               std::size_t& force_index, ProgramCompensation& result, std::vector<ProgramTargetUse>& uses,
-              std::vector<Use>& info) {
+              std::vector<KrlUse>& info) {
     const KrlFile& f = src_;
     for (const Range& target : motion_targets(b, e, first)) {
       const std::size_t index = force_index++;
@@ -543,7 +543,7 @@ class KrlReader {
           u.continue_from_previous = true;
         }
       }
-      Use x;
+      KrlUse x;
       x.decl = decl;
       x.value = value;
       x.ref_b = tb;
@@ -560,7 +560,7 @@ class KrlReader {
   }
 
   /// Walks the .src line by line: frames followed, every motion resolved or listed.
-  void collect(ProgramCompensation& result, std::vector<ProgramTargetUse>& uses, std::vector<Use>& info) {
+  void collect(ProgramCompensation& result, std::vector<ProgramTargetUse>& uses, std::vector<KrlUse>& info) {
     FrameState tool;
     FrameState base;
     if (frames_.count("$TOOL") != 0) {
@@ -604,8 +604,8 @@ class KrlReader {
   }
 
   /// The new numbers of every use, from its compensated result.
-  static void compute_numbers(std::vector<Use>& info, const std::vector<ProgramTargetResult>& results) {
-    for (Use& x : info) {
+  static void compute_numbers(std::vector<KrlUse>& info, const std::vector<ProgramTargetResult>& results) {
+    for (KrlUse& x : info) {
       const ProgramTargetResult& r = results[x.use_index];
       const KrlAggregate& v = *x.value;
       if (x.joint) {
@@ -632,7 +632,7 @@ class KrlReader {
   }
 
   /// A compensated copy of declaration `d` named `name`, as a line of the .dat.
-  std::string copy_line(const KrlDecl& d, const Use& y, const std::string& name, const std::string& eol) const {
+  std::string copy_line(const KrlDecl& d, const KrlUse& y, const std::string& name, const std::string& eol) const {
     if (d.element == 0) {
       // The declaration's line, renamed, with the new numbers.
       const std::size_t line_begin =
@@ -659,11 +659,11 @@ class KrlReader {
 
   /// The new numbers written back (program_write_back.hpp): literals into the .src, points and their
   /// copies into the .dat, a copy's name into the .src.
-  void write_back(const std::vector<Use>& info, std::vector<std::string>& actions, std::vector<TextEdit>& src_edits,
+  void write_back(const std::vector<KrlUse>& info, std::vector<std::string>& actions, std::vector<TextEdit>& src_edits,
                   std::vector<TextEdit>& dat_edits) const {
     const KrlFile& f = src_;
     std::vector<WriteBackUse> uses;
-    for (const Use& x : info) {
+    for (const KrlUse& x : info) {
       WriteBackUse u;
       u.target = x.decl;
       u.name = x.decl == nullptr ? std::string() : to_upper(x.decl->name);
@@ -680,7 +680,7 @@ class KrlReader {
     actions.assign(info.size(), {});
     std::vector<std::string> names(info.size());  // the copy each use declares
     for (std::size_t a = 0; a < info.size(); ++a) {
-      const Use& x = info[a];
+      const KrlUse& x = info[a];
       const WriteBackStep& step = steps[a];
       if (step.kind != WriteBackStep::Kind::kCopy) {
         if (step.kind == WriteBackStep::Kind::kLiteral || step.first) {
@@ -722,7 +722,7 @@ ProgramCompensation KrlReader::run(const std::string& output_src) {
   result.language = "KRL";
   result.force_description = force_.describe();
   std::vector<ProgramTargetUse> uses;
-  std::vector<Use> info;
+  std::vector<KrlUse> info;
   collect(result, uses, info);
   const std::vector<ProgramTargetResult> results = compensate_program_targets(model_, uses, force_);
   compute_numbers(info, results);
@@ -731,7 +731,7 @@ ProgramCompensation KrlReader::run(const std::string& output_src) {
   std::vector<TextEdit> dat_edits;
   write_back(info, actions, src_edits, dat_edits);
   for (std::size_t a = 0; a < info.size(); ++a) {
-    const Use& x = info[a];
+    const KrlUse& x = info[a];
     result.targets.push_back(
         target_report(results[x.use_index], src_.file, x.line, x.instruction, x.written, actions[a]));
     if (!uses[x.use_index].joint && uses[x.use_index].continue_from_previous) {

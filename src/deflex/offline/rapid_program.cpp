@@ -125,7 +125,7 @@ struct ConfState {
 };
 
 /// One resolved use and what writing it back needs.
-struct Use {
+struct RapidUse {
   TargetRef ref;
   std::string type;
   Pose base_T_wobj = Pose::Identity();
@@ -750,7 +750,7 @@ class RapidReader {
   /// A resolved use of a motion's k-th target; false with the reason listed when it is not resolvable.
   bool resolve_use(const Instruction& ins, const Motion& m, std::size_t k, std::size_t force_index, const ToolWobj& tw,
                    const ConfState& conf, bool first_use, ProgramCompensation& result, ProgramTargetUse& u,
-                   Use& x) const {
+                   RapidUse& x) const {
     const auto [b, e] = ins.args[k];
     const int routine = routine_of_[ins.tok];
     const int line = src_.tok[ins.tok].line;
@@ -821,7 +821,7 @@ class RapidReader {
   }
 
   /// Walks the program in the order of its text: every motion's targets resolved or listed.
-  void collect(ProgramCompensation& result, std::vector<ProgramTargetUse>& uses, std::vector<Use>& info) const {
+  void collect(ProgramCompensation& result, std::vector<ProgramTargetUse>& uses, std::vector<RapidUse>& info) const {
     std::size_t force_index = 0;
     std::size_t motion_count = 0;
     ConfState conf;
@@ -867,7 +867,7 @@ class RapidReader {
           continue;
         }
         ProgramTargetUse u;
-        Use x;
+        RapidUse x;
         if (resolve_use(ins, *m, k, index, *tw, conf, uses.empty(), result, u, x)) {
           x.use_index = uses.size();
           info.push_back(x);
@@ -891,8 +891,8 @@ class RapidReader {
   }
 
   /// The new numbers of every use, from its compensated result.
-  void compute_numbers(std::vector<Use>& info, const std::vector<ProgramTargetResult>& results) const {
-    for (Use& x : info) {
+  void compute_numbers(std::vector<RapidUse>& info, const std::vector<ProgramTargetResult>& results) const {
+    for (RapidUse& x : info) {
       const ProgramTargetResult& r = results[x.use_index];
       const RapidValue& v = *x.ref.value;
       const auto nodes = target_numbers(v, x.type);
@@ -930,10 +930,10 @@ class RapidReader {
   }
 
   /// The module with the new numbers written back (program_write_back.hpp).
-  std::string write_back(const std::vector<Use>& info, std::vector<std::string>& actions) const {
+  std::string write_back(const std::vector<RapidUse>& info, std::vector<std::string>& actions) const {
     const Tokens& t = src_.tok;
     std::vector<WriteBackUse> uses;
-    for (const Use& x : info) {
+    for (const RapidUse& x : info) {
       WriteBackUse u;
       u.target = x.ref.literal ? nullptr : x.ref.value;  // a declaration's value node: one per element
       u.name = x.ref.literal ? std::string() : to_upper(x.ref.decl->name);
@@ -950,7 +950,7 @@ class RapidReader {
     actions.assign(info.size(), {});
     std::vector<std::string> names(info.size());  // the copy each use declares
     for (std::size_t a = 0; a < info.size(); ++a) {
-      const Use& x = info[a];
+      const RapidUse& x = info[a];
       const WriteBackStep& step = steps[a];
       if (step.kind != WriteBackStep::Kind::kCopy) {
         if (step.kind == WriteBackStep::Kind::kLiteral || step.first) {
@@ -1003,14 +1003,14 @@ ProgramCompensation RapidReader::run(const std::string& output_path) {
   result.language = "RAPID";
   result.force_description = force_.describe();
   std::vector<ProgramTargetUse> uses;
-  std::vector<Use> info;
+  std::vector<RapidUse> info;
   collect(result, uses, info);
   const std::vector<ProgramTargetResult> results = compensate_program_targets(model_, uses, force_);
   compute_numbers(info, results);
   std::vector<std::string> actions;
   const std::string text = write_back(info, actions);
   for (std::size_t a = 0; a < info.size(); ++a) {
-    const Use& x = info[a];
+    const RapidUse& x = info[a];
     result.targets.push_back(
         target_report(results[x.use_index], src_.file, x.line, x.instruction, x.written, actions[a]));
     result.targets.back().configuration_note = x.conf_note;
