@@ -23,15 +23,6 @@
 namespace deflex::cli {
 namespace {
 
-SensorConfig sensor_or_default(const std::string& path) {
-  if (path.empty()) {
-    SensorConfig c;  // identity crosstalk, no payload, no bias, sensor at the flange
-    c.source = "<default sensor: identity crosstalk, no payload, no bias>";
-    return c;
-  }
-  return load_sensor_config(path);
-}
-
 struct PayloadOpts {
   std::string robot, sensor, data, out;
   bool json = false;
@@ -89,7 +80,7 @@ std::string existing_poses(const std::string& path, const std::string& header, i
 // as it was.
 void record_pose(const PayloadOpts& o, int& exit_code) {
   const RobotModel model = load_cli_robot("identify-payload", o.robot);
-  const SensorConfig sensor = sensor_or_default(o.sensor);
+  const SensorConfig sensor = load_sensor_config_or_defaults(o.sensor);
   const JointVector q = parse_joints_deg(o.joints_deg, model, "--joints-deg");
   const bool moments = sensor.components == 6;
   const std::string header = pose_header(model.dof(), moments);
@@ -190,7 +181,7 @@ void record_pose(const PayloadOpts& o, int& exit_code) {
 
 void identify(const PayloadOpts& o, int& exit_code) {
   OutputFile out(o.out, "option -o");  // prepared first: the file written is never one read
-  SensorConfig sensor = sensor_or_default(o.sensor);
+  SensorConfig sensor = load_sensor_config_or_defaults(o.sensor);
   const RobotModel model = load_cli_robot("identify-payload", o.robot);
   bool has_moments = false;
   const auto poses = read_payload_observations(o.data, &model, sensor.flange_T_sensor, sensor.crosstalk, has_moments);

@@ -35,15 +35,6 @@ using runtime::LinkKind;
 std::atomic<bool> g_stop{false};
 extern "C" void on_stop_signal(int /*signal*/) { g_stop.store(true); }
 
-SensorConfig sensor_or_default(const std::string& path) {
-  if (path.empty()) {
-    SensorConfig c;  // identity crosstalk, no payload, no bias, sensor at the flange
-    c.source = "<default sensor: identity crosstalk, no payload, no bias>";
-    return c;
-  }
-  return load_sensor_config(path);
-}
-
 struct OnlineOpts {
   std::string link, robot, sensor, force_source, program, strategy = "online", force_model, log, fault_dump,
                                                           jacobian_at = "nominal";
@@ -436,7 +427,7 @@ void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
   const runtime::SessionConfig config = session_config(o, sub);
   const runtime::LinkKindInfo& info = runtime::link_kind(config.link);
   const RobotModel model = load_cli_robot("online", o.robot);
-  SensorConfig sensor = sensor_or_default(o.sensor);
+  SensorConfig sensor = load_sensor_config_or_defaults(o.sensor);
   std::unique_ptr<ForceModel> force_model;
   if (!o.force_model.empty()) force_model = parse_force_spec(o.force_model);
   std::shared_ptr<const JointTrajectory> program;

@@ -187,6 +187,19 @@ TEST(SensorConfig, ExampleLoadsAndBadFieldsNameTheLine) {
   expect_error("deflex_sensor: 1\npayload: {mass_kg: -1}\n", "mass_kg");
 }
 
+TEST(SensorConfig, WithoutAFileTheDefaultsSayWhereTheyCameFrom) {
+  const SensorConfig d = load_sensor_config_or_defaults("");
+  EXPECT_TRUE(d.crosstalk.isIdentity(0.0));
+  EXPECT_EQ(d.payload_mass_kg, 0.0);
+  EXPECT_TRUE(d.bias_sensor.isZero(0.0));
+  EXPECT_TRUE(d.flange_T_sensor.matrix().isIdentity(0.0));
+  EXPECT_NE(d.source.find("default sensor"), std::string::npos) << d.source;
+  // With a path it is the file's, and a missing file is an error, never the defaults.
+  const std::string example = std::string(DEFLEX_SOURCE_DIR) + "/examples/online/sensor_3axis.yaml";
+  EXPECT_NEAR(load_sensor_config_or_defaults(example).payload_mass_kg, 8.5, 1e-12);
+  EXPECT_THROW((void)load_sensor_config_or_defaults(::testing::TempDir() + "/no_such_sensor.yaml"), Error);
+}
+
 }  // namespace
 }  // namespace deflex
 

@@ -60,6 +60,15 @@ Vector3 read_vector3(const yaml::Field& f) { return f.as_vector3(); }
 
 }  // namespace
 
+SensorConfig load_sensor_config_or_defaults(const std::string& yaml_path) {
+  if (yaml_path.empty()) {
+    SensorConfig c;
+    c.source = "<default sensor: identity crosstalk, no payload, no bias>";
+    return c;
+  }
+  return load_sensor_config(yaml_path);
+}
+
 SensorConfig load_sensor_config(const std::string& yaml_path) {
   const yaml::Field root = yaml::Field::load_file(yaml_path);
   root.only_keys({"deflex_sensor", "name", "components", "sample_rate_hz", "crosstalk", "flange_T_sensor_m_deg", "bias",

@@ -39,6 +39,11 @@ struct SensorConfig {
 /// the defaults above. Throws ModelError "FILE:LINE: field 'x': ..." on any bad field.
 SensorConfig load_sensor_config(const std::string& yaml_path);
 
+/// load_sensor_config(yaml_path), or for an empty path the defaults above (identity crosstalk, no
+/// payload, no bias, the sensor at the flange) with a source that says so: what the command line's
+/// --sensor-config gives when it is left out.
+SensorConfig load_sensor_config_or_defaults(const std::string& yaml_path);
+
 /// The configuration as YAML in the format load_sensor_config() reads.
 std::string sensor_config_to_yaml(const SensorConfig& config);
 
