@@ -12,7 +12,7 @@
 #                              module against that build (about a minute)
 #            --rebuild         with --from-build: compile the module even when the ABI matches
 #            --build-type T    CMake build type of what is compiled (default Release; None compiles
-#                              the module unoptimised, in about half the time, as the tests do)
+#                              the module unoptimised, a sixth faster, as the tests do)
 #            --no-install      build only
 #
 # What the interpreter needs: NumPy (PY -m pip install numpy; conda install numpy; Debian:
