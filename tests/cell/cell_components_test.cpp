@@ -22,7 +22,8 @@ LdbbConfig quiet_ldbb() {
   c.time_constant_s = 0.3;
   c.ripple = 0.0;
   c.noise = 0.0;
-  c.force_bias = 0.0;
+  c.seal_friction = 0.0;
+  c.seal_friction_spread = 0.0;
   c.ball_friction = 0.0;
   return c;
 }
@@ -43,15 +44,50 @@ TEST(LdbbDevice, PushesAlongTheBarFromTheTruePivot) {
   EXPECT_NEAR((pull.wrench(tcp, Vector3::Zero()).head<3>() + 400.0 * bar.normalized()).norm(), 0.0, 1e-9);
 }
 
-TEST(LdbbDevice, FirstOrderResponseToTheSetPointWithBias) {
+TEST(LdbbDevice, FirstOrderResponseToTheSetPoint) {
   LdbbConfig c = quiet_ldbb();
-  c.force_bias = -0.1;
   LdbbDevice d(c, Vector3::Zero(), 500.0, 1);
   const double dt = 0.001;
   for (int i = 0; i < 300; ++i) d.advance(dt);  // one time constant
-  EXPECT_NEAR(d.magnitude_n(), 450.0 * (1.0 - std::exp(-1.0)), 1e-6);
+  EXPECT_NEAR(d.magnitude_n(), 500.0 * (1.0 - std::exp(-1.0)), 1e-6);
   for (int i = 0; i < 3000; ++i) d.advance(dt);
-  EXPECT_NEAR(d.magnitude_n(), 450.0 * (1.0 - std::exp(-11.0)), 1e-6);
+  EXPECT_NEAR(d.magnitude_n(), 500.0 * (1.0 - std::exp(-11.0)), 1e-6);
+}
+
+TEST(LdbbDevice, TheSealHoldsItsFrictionAgainstThePistonsLastMotion) {
+  // A pushing bar along +z from the origin, 400 N, the seal good for 15 % with 0.1 mm of
+  // pre-sliding. Extending (the arm yields) the friction builds linearly over the pre-sliding and
+  // then takes 15 % off; standing still it holds; retracting 0.1 mm takes it through zero; past
+  // 0.2 mm back it adds 15 %. Pulling, the same extension adds to the force.
+  LdbbConfig c = quiet_ldbb();
+  c.seal_friction = 0.15;
+  c.seal_presliding_m = 1e-4;
+  LdbbDevice d(c, Vector3::Zero(), 400.0, 1);
+  d.settle();
+  EXPECT_DOUBLE_EQ(d.seal_friction(), 0.15);
+  auto push_at = [&](double length_m) { return d.wrench(Vector3(0, 0, length_m), Vector3::Zero())[2]; };
+  EXPECT_NEAR(push_at(0.15), 400.0, 1e-9);               // first contact: nothing held yet
+  EXPECT_NEAR(push_at(0.15 + 0.5e-4), 370.0, 1e-6);      // half the pre-sliding: half of 60 N
+  EXPECT_NEAR(push_at(0.15 + 3e-4), 340.0, 1e-6);        // sliding out: -15 %
+  EXPECT_NEAR(push_at(0.15 + 3e-4), 340.0, 1e-6);        // standing: held
+  EXPECT_NEAR(push_at(0.15 + 2e-4), 400.0, 1e-6);        // 0.1 mm back: through zero
+  EXPECT_NEAR(push_at(0.15 + 0.5e-4), 460.0, 1e-6);      // sliding in: +15 %
+  c.push = false;
+  LdbbDevice pull(c, Vector3::Zero(), 400.0, 1);
+  pull.settle();
+  EXPECT_NEAR(pull.wrench(Vector3(0, 0, 0.15), Vector3::Zero())[2], -400.0, 1e-9);
+  EXPECT_NEAR(pull.wrench(Vector3(0, 0, 0.15 + 3e-4), Vector3::Zero())[2], -460.0, 1e-6);
+  // Its level differs from run to run around the mean by the spread (here 3 %, 400 runs).
+  c.seal_friction_spread = 0.03;
+  double sum = 0.0, sum2 = 0.0;
+  for (std::uint64_t seed = 1; seed <= 400; ++seed) {
+    const double mu = LdbbDevice(c, Vector3::Zero(), 400.0, seed).seal_friction();
+    sum += mu;
+    sum2 += mu * mu;
+  }
+  const double mean = sum / 400.0;
+  EXPECT_NEAR(mean, 0.15, 0.006);
+  EXPECT_NEAR(std::sqrt(sum2 / 400.0 - mean * mean), 0.03, 0.005);
 }
 
 TEST(LdbbDevice, BallFrictionOpposesTheMotionAcrossTheBar) {

@@ -76,7 +76,12 @@ TEST(CaseConfig, ErrorsNameTheFileLineAndField) {
 TEST(CaseConfig, EffectSwitchesTurnOffTheirEffect) {
   const CaseConfig c = paper_case();
   EXPECT_EQ(without_effect(c, Effect::kTrackerNoise).cell.tracker.noise_m, 0.0);
-  EXPECT_EQ(without_effect(c, Effect::kLdbbForceError).cell.ldbb.force_bias, 0.0);
+  EXPECT_EQ(without_effect(c, Effect::kLdbbForceError).cell.ldbb.pivot_error_m.norm(), 0.0);
+  EXPECT_EQ(without_effect(c, Effect::kLdbbSealFriction).cell.ldbb.seal_friction, 0.0);
+  EXPECT_GT(c.cell.ldbb.seal_friction, 0.0);
+  EXPECT_EQ(without_effect(c, Effect::kSensorMoment).cell.sensor.moment_crosstalk, 0.0);
+  EXPECT_EQ(without_effect(c, Effect::kTrackerClock).cell.tracker.trigger_jitter_s, 0.0);
+  EXPECT_EQ(without_effect(c, Effect::kTrackerClock).cell.tracker.clock_rate_error, 0.0);
   EXPECT_EQ(without_effect(c, Effect::kSensorCompliance).cell.sensor.lateral_compliance_m_per_n, 0.0);
   const CaseConfig lat = without_effect(c, Effect::kLatency);
   EXPECT_EQ(lat.cell.controller.egm_dead_time_s, 0.0);
@@ -165,13 +170,21 @@ TEST(CaseConfig, OutOfRangeEffectSizesAndSeedsAreRefusedByName) {
   EXPECT_NE(drift.find("zero_drift_N_per_10min"), std::string::npos) << drift;
   const std::string slip = error_of(paper_with("stick_slip_travel_mm: 0.5", "stick_slip_travel_mm: 0"));
   EXPECT_NE(slip.find("stick_slip_travel_mm"), std::string::npos) << slip;
-  const std::string from =
-      error_of(paper_with("  ldbb_force_error_pct: 5", "  force_from: tracker\n  ldbb_force_error_pct: 5"));
+  const std::string from = error_of(paper_with("  force_from: ldbb", "  force_from: tracker"));
   EXPECT_NE(from.find("calibration.force_from"), std::string::npos) << from;
-  EXPECT_NE(from.find("sensor or ldbb"), std::string::npos) << from;
-  const std::string bias =
-      error_of(paper_with("  ldbb_force_error_pct: 5", "  ldbb_force_bias_pct: -60\n  ldbb_force_error_pct: 5"));
+  EXPECT_NE(from.find("ldbb or sensor"), std::string::npos) << from;
+  // The keys of the tuned bar bias are gone, and a file that still has them is told what replaced them.
+  const std::string bias = error_of(paper_with("  force_from: ldbb", "  force_from: ldbb\n  ldbb_force_bias_pct: -15"));
   EXPECT_NE(bias.find("calibration.ldbb_force_bias_pct"), std::string::npos) << bias;
+  EXPECT_NE(bias.find("seal_friction_pct"), std::string::npos) << bias;
+  const std::string old_bias = error_of(paper_with("  seal_friction_pct: 15", "  force_bias_pct: -15\n  seal_friction_pct: 15"));
+  EXPECT_NE(old_bias.find("ldbb.force_bias_pct"), std::string::npos) << old_bias;
+  const std::string seal = error_of(paper_with("  seal_friction_pct: 15", "  seal_friction_pct: 70"));
+  EXPECT_NE(seal.find("ldbb.seal_friction_pct"), std::string::npos) << seal;
+  const std::string moment = error_of(paper_with("  nominal_moment_Nm: 50", "  nominal_moment_Nm: 0"));
+  EXPECT_NE(moment.find("sensor.nominal_moment_Nm"), std::string::npos) << moment;
+  const std::string clock = error_of(paper_with("  clock_rate_ppm: 50", "  clock_rate_ppm: -5"));
+  EXPECT_NE(clock.find("tracker.clock_rate_ppm"), std::string::npos) << clock;
   const std::string seeds = error_of(paper_with("seeds: 4", "seeds: 0"));
   EXPECT_NE(seeds.find("protocol.seeds"), std::string::npos) << seeds;
   const std::string old_budget = error_of(paper_with("  load_index: 2", "  load_index: 2\n  laps_each_way: 1"));

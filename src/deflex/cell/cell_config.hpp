@@ -92,6 +92,16 @@ struct SensorConfig {
   /// The zero drifts after it was tared at the start of a run (temperature, creep): a linear drift
   /// whose change over 10 minutes is zero_drift_n (1-sigma per channel, drawn per run).
   double zero_drift_n = 0.0;
+  /// A 3-component sensor's force channels also answer to the bending and torsional moments about
+  /// its point of origin (the process force's lever to the TCP), which it cannot measure and so
+  /// cannot decouple: each force channel reads up to moment_crosstalk x nominal_lateral_force_n per
+  /// nominal_moment_nm of each moment (drawn once per physical sensor), and the response grows by
+  /// moment_overload_growth per nominal moment beyond the nominal (the spring body leaves the range
+  /// it was calibrated in).
+  double moment_crosstalk = 0.0;
+  double nominal_moment_nm = 50.0;
+  double nominal_lateral_force_n = 1000.0;
+  double moment_overload_growth = 0.0;
 };
 
 struct LdbbConfig {
@@ -102,10 +112,16 @@ struct LdbbConfig {
   double ripple = 0.0;           ///< relative amplitude
   double ripple_hz = 2.0;
   double noise = 0.0;       ///< relative 1-sigma per servo cycle
-  double force_bias = 0.0;  ///< true force = set-point * (1 + bias): unknown to the force model
-  /// The same after the bar's maintenance and recalibration (the paper's online tests came after it):
-  /// the runs with the force sensor mounted use this one.
-  double force_bias_recalibrated = 0.0;
+  /// The cylinder's seal friction (one physical model for the calibration and the tests): the seal
+  /// carries up to seal_friction x the pneumatic force against the piston's last motion: less force
+  /// reaches the TCP while the piston last moved with the load (as when the arm yields to it), more
+  /// while it last moved against it (as when the path shortens a pushing bar). Its level differs from
+  /// run to run (seal_friction_spread, 1-sigma, drawn when the bar is pressurised), and it changes
+  /// sign only after the piston has slid back by the seal's pre-sliding travel. The bar reports its
+  /// set-point (pressure x area): the friction is what it does not know.
+  double seal_friction = 0.0;
+  double seal_friction_spread = 0.0;
+  double seal_presliding_m = 0.0001;
   /// The cylinder's seal friction sticks and slips: a sawtooth of this relative amplitude, one tooth
   /// per stick_slip_travel_m of the TCP's travel.
   double stick_slip = 0.0;
@@ -119,6 +135,11 @@ struct LdbbConfig {
 struct TrackerConfig {
   double noise_m = 0.0;  ///< 1-sigma per axis per sample
   double rate_hz = 1000.0;
+  /// The tracker runs on its own clock, started by the robot program's trigger: the start lands
+  /// this late or early (1-sigma per run), and the clock runs fast or slow by this fraction (1-sigma
+  /// per run). Its time stamps are its own clock's.
+  double trigger_jitter_s = 0.0;
+  double clock_rate_error = 0.0;
 };
 
 /// The robot controller: its servo, and how it treats what an external sensor sends over EGM.

@@ -1,6 +1,8 @@
 // Force sensor and DAQ of the simulated cell (see force_sensor.hpp).
 #include "deflex/cell/force_sensor.hpp"
 
+#include <cmath>
+
 namespace deflex::cell {
 
 ForceSensorDaq::ForceSensorDaq(const SensorConfig& sensor, const ToolConfig& tool, std::uint64_t seed,
@@ -22,6 +24,14 @@ ForceSensorDaq::ForceSensorDaq(const SensorConfig& sensor, const ToolConfig& too
   for (int i = 0; i < 3; ++i) sensitivity_[i] = 1.0 + sensor.sensitivity_error * normal_(rng_);
   flange_R_sensor_ = Eigen::AngleAxisd(sensor.misalignment_rad, Vector3::UnitZ()).toRotationMatrix();
   calibration_.decoupling = crosstalk_.inverse() * (Matrix3::Identity() + residual);
+  // The force channels' response to moments: a property of the spring body, drawn after the other
+  // unit draws so they stay what they were.
+  const double per_nm = sensor.moment_crosstalk * sensor.nominal_lateral_force_n / sensor.nominal_moment_nm;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) moment_crosstalk_(i, j) = per_nm * uniform(rng_);
+  }
+  // The point of origin is the sensor's centre; the end effector's length counts from its top.
+  lever_m_ = Vector3(0.0, 0.0, tool.ee_length_m + 0.5 * sensor.height_m);
   rng_.seed(seed);  // noise and zero drift: this run's own
   normal_.reset();
   for (int i = 0; i < 3; ++i) zero_drift_n_per_s_[i] = sensor.zero_drift_n / 600.0 * normal_(rng_);
@@ -34,8 +44,21 @@ Vector3 ForceSensorDaq::sample(const Vector3& process_force_base_n, const Matrix
   const Vector3 weight_base(0.0, 0.0, -tool_.ee_mass_kg * kGravity);
   const Vector3 f_sensor = (base_R_flange * flange_R_sensor_).transpose() * (process_force_base_n + weight_base);
   Vector3 noise(normal_(rng_), normal_(rng_), normal_(rng_));
-  return crosstalk_ * sensitivity_.asDiagonal() * f_sensor + config_.bias_n + zero_drift_n_per_s_ * t_s +
-         config_.noise_n * noise;
+  Vector3 reading = crosstalk_ * sensitivity_.asDiagonal() * f_sensor + config_.bias_n + zero_drift_n_per_s_ * t_s +
+                    config_.noise_n * noise;
+  if (config_.moment_crosstalk > 0.0) {
+    // The moments about the point of origin of the process force (at the TCP) and of the end
+    // effector's weight (at its centre of gravity); beyond the nominal moment the response grows.
+    const Matrix3 sensor_R_base = (base_R_flange * flange_R_sensor_).transpose();
+    const Vector3 cog = tool_.ee_cog_m + Vector3(0.0, 0.0, 0.5 * config_.height_m);
+    Vector3 m = lever_m_.cross(sensor_R_base * process_force_base_n) + cog.cross(sensor_R_base * weight_base);
+    for (int j = 0; j < 3; ++j) {
+      const double over = std::abs(m[j]) / config_.nominal_moment_nm - 1.0;
+      if (over > 0.0) m[j] *= 1.0 + config_.moment_overload_growth * over;
+    }
+    reading += moment_crosstalk_ * m;
+  }
+  return reading;
 }
 
 }  // namespace deflex::cell

@@ -38,6 +38,9 @@ class ForceSensorDaq {
   [[nodiscard]] const Matrix3& crosstalk() const { return crosstalk_; }
   /// True sensitivity of each channel relative to the calibration sheet's (1 + error).
   [[nodiscard]] const Vector3& sensitivity() const { return sensitivity_; }
+  /// N read on each force channel per N m of each moment about the point of origin, within the
+  /// nominal moment (this physical sensor's draw).
+  [[nodiscard]] const Matrix3& moment_crosstalk() const { return moment_crosstalk_; }
   /// True sensor frame in the flange frame: a turn of misalignment_rad about the tool axis.
   [[nodiscard]] const Matrix3& flange_R_sensor() const { return flange_R_sensor_; }
 
@@ -48,6 +51,8 @@ class ForceSensorDaq {
   Vector3 sensitivity_ = Vector3::Ones();
   Matrix3 flange_R_sensor_ = Matrix3::Identity();
   Vector3 zero_drift_n_per_s_ = Vector3::Zero();
+  Matrix3 moment_crosstalk_ = Matrix3::Zero();  // N of each force channel per N m of each moment, at nominal
+  Vector3 lever_m_ = Vector3::Zero();           // point of origin to the TCP, sensor frame
   SensorCalibration calibration_;
   std::mt19937_64 rng_;
   boost::random::normal_distribution<double> normal_{0.0, 1.0};

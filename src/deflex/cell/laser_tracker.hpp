@@ -1,6 +1,8 @@
 // The laser tracker (Leica AT901-class with a 0.5" reflector on the TCP): samples the true TCP at
 // its own rate with its noise, between the servo ticks of the simulation (the TCP interpolated
-// linearly within a tick). Time stamps count from a chosen origin (the start of the laps).
+// linearly within a tick). Time stamps are the tracker's own clock's: it is started by the program's
+// trigger at a chosen origin (the start of the laps), late or early by the trigger's jitter, and runs
+// fast or slow by its rate error.
 #pragma once
 
 #include <cstdint>
@@ -29,6 +31,8 @@ class LaserTracker {
   std::mt19937_64 rng_;
   boost::random::normal_distribution<double> normal_{0.0, 1.0};
   double next_s_, last_s_, origin_s_, period_s_;
+  double trigger_s_ = 0.0;  // when its clock read zero, relative to the origin (simulation time)
+  double rate_ = 1.0;       // its clock's seconds per simulated second
 };
 
 }  // namespace deflex::cell

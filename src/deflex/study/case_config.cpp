@@ -312,8 +312,17 @@ void read_case_tool_and_sensor(const yaml::Field& root, CaseConfig& c) {
   s.only_keys({"height_mm", "lateral_compliance_um_per_N", "axial_compliance_um_per_N",
                "rotational_compliance_urad_per_Nm", "crosstalk_pct", "crosstalk_calibration_residual_pct", "noise_N",
                "bias_N", "rate_Hz", "gravity_mass_error_pct", "sensitivity_error_pct", "misalignment_deg",
-               "daq_latency_ms", "zero_drift_N_per_10min"});
+               "daq_latency_ms", "zero_drift_N_per_10min", "moment_crosstalk_pct", "nominal_moment_Nm",
+               "nominal_lateral_force_N", "moment_overload_growth_pct"});
   auto& f = c.cell.sensor;
+  f.moment_crosstalk =
+      case_number(s, "moment_crosstalk_pct", non_negative, 0.0, from_pct, at_most(0.2, "must be within 0..20 %"));
+  f.nominal_moment_nm = case_number(s, "nominal_moment_Nm", positive, 50.0, unscaled,
+                                    at_most(1e5, "must be at most 100000 N m"));
+  f.nominal_lateral_force_n = case_number(s, "nominal_lateral_force_N", positive, 1000.0, unscaled,
+                                          at_most(1e6, "must be at most 1000000 N"));
+  f.moment_overload_growth = case_number(s, "moment_overload_growth_pct", non_negative, 0.0, from_pct,
+                                         at_most(5.0, "must be within 0..500 %"));
   f.zero_drift_n =
       case_number(s, "zero_drift_N_per_10min", non_negative, 0.0, unscaled, at_most(50.0, "must be within 0..50 N"));
   f.height_m = non_negative(s.at("height_mm")) * kMm;
@@ -339,12 +348,24 @@ void read_case_tool_and_sensor(const yaml::Field& root, CaseConfig& c) {
 // The case file's "ldbb": the loading device (bar, pneumatic force and its errors).
 void read_case_ldbb(const yaml::Field& root, CaseConfig& c) {
   const auto l = root.at("ldbb");
+  for (const char* gone : {"force_bias_pct", "force_bias_recalibrated_pct"}) {
+    if (l.has(gone)) {
+      l.at(gone).fail(
+          "is no longer a key: the bar's force error is its seal friction (seal_friction_pct, "
+          "seal_friction_spread_pct, seal_presliding_mm), the same in the calibration and the tests "
+          "(docs/error-budget.md)");
+    }
+  }
   l.only_keys({"bar_length_mm", "inclination_deg", "push", "time_constant_s", "ripple_pct", "ripple_Hz", "noise_pct",
-               "force_bias_pct", "force_bias_recalibrated_pct", "pivot_error_mm", "ball_friction", "ball_radius_mm",
-               "settle_s", "stick_slip_pct", "stick_slip_travel_mm"});
+               "seal_friction_pct", "seal_friction_spread_pct", "seal_presliding_mm", "pivot_error_mm", "ball_friction",
+               "ball_radius_mm", "settle_s", "stick_slip_pct", "stick_slip_travel_mm"});
   auto& d = c.cell.ldbb;
-  d.force_bias_recalibrated =
-      case_number(l, "force_bias_recalibrated_pct", any_sign, 0.0, from_pct, inside(0.5, "must be within +-50 %"));
+  d.seal_friction =
+      case_number(l, "seal_friction_pct", non_negative, 0.0, from_pct, at_most(0.5, "must be within 0..50 %"));
+  d.seal_friction_spread =
+      case_number(l, "seal_friction_spread_pct", non_negative, 0.0, from_pct, at_most(0.2, "must be within 0..20 %"));
+  d.seal_presliding_m = case_number(l, "seal_presliding_mm", non_negative, 0.1, from_milli,
+                                    within(1e-6, 0.005, "must be within 0.001..5 mm"));
   d.stick_slip = case_number(l, "stick_slip_pct", non_negative, 0.0, from_pct, at_most(0.2, "must be within 0..20 %"));
   d.stick_slip_travel_m =
       case_number(l, "stick_slip_travel_mm", non_negative, 0.5, from_milli, above(0.0, "must be positive"));
@@ -356,7 +377,6 @@ void read_case_ldbb(const yaml::Field& root, CaseConfig& c) {
   d.ripple = non_negative(l.at("ripple_pct")) / 100.0;
   d.ripple_hz = positive(l.at("ripple_Hz"));
   d.noise = non_negative(l.at("noise_pct")) / 100.0;
-  d.force_bias = case_number(l, "force_bias_pct", any_sign, kRequired, from_pct, inside(0.5, "must be within +-50 %"));
   d.pivot_error_m = l.at("pivot_error_mm").as_vector3() * kMm;
   d.ball_friction = non_negative(l.at("ball_friction"));
   d.ball_radius_m = non_negative(l.at("ball_radius_mm")) * kMm;
@@ -367,8 +387,13 @@ void read_case_ldbb(const yaml::Field& root, CaseConfig& c) {
 // network and EGM settings (each setting checked once all are read).
 void read_case_tracker_and_controller(const yaml::Field& root, CaseConfig& c) {
   const auto tr = root.at("tracker");
-  tr.only_keys({"noise_um", "rate_Hz"});
+  tr.only_keys({"noise_um", "rate_Hz", "trigger_jitter_ms", "clock_rate_ppm"});
   c.cell.tracker.noise_m = non_negative(tr.at("noise_um")) * kUm;
+  c.cell.tracker.trigger_jitter_s =
+      case_number(tr, "trigger_jitter_ms", non_negative, 0.0, from_milli, at_most(0.1, "must be within 0..100 ms"));
+  c.cell.tracker.clock_rate_error = case_number(tr, "clock_rate_ppm", non_negative, 0.0, unscaled,
+                                                at_most(1000.0, "must be within 0..1000 ppm")) *
+                                    1e-6;
   // The cell simulates every sample: beyond 10 kHz a study takes minutes and gigabytes.
   c.cell.tracker.rate_hz =
       case_number(tr, "rate_Hz", positive, kRequired, unscaled,
@@ -425,13 +450,17 @@ void read_case_online(const yaml::Field& root, CaseConfig& c) {
 // The case file's "calibration": the moving calibration run that identifies the stiffness.
 void read_case_calibration(const yaml::Field& root, CaseConfig& c) {
   const auto cal = root.at("calibration");
-  cal.only_keys({"arcs", "arc_deg", "speed_mm_s", "load_N", "points_per_arc", "window_ms", "ldbb_force_error_pct",
-                 "ldbb_force_bias_pct", "force_from"});
+  for (const char* gone : {"ldbb_force_error_pct", "ldbb_force_bias_pct"}) {
+    if (cal.has(gone)) {
+      cal.at(gone).fail(
+          "is no longer a key: the calibration takes the bar's own force error (its seal friction, "
+          "ldbb.seal_friction_pct) from the same bar model as the tests (docs/error-budget.md)");
+    }
+  }
+  cal.only_keys({"arcs", "arc_deg", "speed_mm_s", "load_N", "points_per_arc", "window_ms", "force_from"});
   auto& b = c.calibration;
-  b.ldbb_force_bias =
-      case_number(cal, "ldbb_force_bias_pct", any_sign, 0.0, from_pct, inside(0.5, "must be within +-50 %"));
-  const std::string force_from = cal.get("force_from", std::string("sensor"));
-  if (force_from != "sensor" && force_from != "ldbb") cal.at("force_from").fail("must be sensor or ldbb");
+  const std::string force_from = cal.get("force_from", std::string("ldbb"));
+  if (force_from != "sensor" && force_from != "ldbb") cal.at("force_from").fail("must be ldbb or sensor");
   b.force_from_sensor = force_from == "sensor";
   b.arcs = case_whole(cal, "arcs", kRequired, 3, 60, "must be 3..60");
   b.arc_rad = case_number(cal, "arc_deg", positive, kRequired, from_deg, at_most(2.0 * kPi, "must be at most 360 deg"));
@@ -440,8 +469,6 @@ void read_case_calibration(const yaml::Field& root, CaseConfig& c) {
   b.load_n = case_number(cal, "load_N", positive, kRequired, unscaled, at_most(5000.0, "must be at most 5000 N"));
   b.points_per_arc = case_whole(cal, "points_per_arc", kRequired, 2, 1000, "must be 2..1000");
   b.window_s = positive(cal.at("window_ms")) * kMm;
-  b.ldbb_force_error = case_number(cal, "ldbb_force_error_pct", non_negative, kRequired, from_pct,
-                                   at_most(0.5, "must be within 0..50 %"));
 }
 
 // The case file's optional "drift" (of the path between and during runs) and "error_budget".
@@ -536,15 +563,15 @@ const char* to_string(Effect e) {
     case Effect::kKinematicErrors:
       return "kinematic (DH) errors";
     case Effect::kLdbbForceError:
-      return "LDBB force error (bias, pivot, ball friction)";
+      return "LDBB pivot error and ball friction";
     case Effect::kLdbbRipple:
       return "LDBB ripple and noise";
     case Effect::kSensorErrors:
       return "sensor crosstalk, noise, bias, gravity";
     case Effect::kTrackerNoise:
       return "laser tracker noise";
-    case Effect::kCalibrationNoise:
-      return "calibration load error";
+    case Effect::kLdbbSealFriction:
+      return "LDBB seal friction (calibration and tests)";
     case Effect::kLatency:
       return "EGM dead time and filter, latencies";
     case Effect::kPathDrift:
@@ -565,6 +592,10 @@ const char* to_string(Effect e) {
       return "thermal drift of a loaded run";
     case Effect::kLdbbStickSlip:
       return "LDBB seal stick-slip";
+    case Effect::kSensorMoment:
+      return "force sensor's response to bending moments";
+    case Effect::kTrackerClock:
+      return "tracker clock (trigger jitter, rate)";
   }
   return "?";
 }
@@ -590,21 +621,20 @@ std::string effect_size(const CaseConfig& c, Effect e) {
       return fmt::format("{:.2f} mm, {:.3f} deg (1 sigma)", c.cell.robot.dh_length_sigma_m * 1e3,
                          rad_to_deg(c.cell.robot.dh_angle_sigma_rad));
     case Effect::kLdbbForceError:
-      return fmt::format("{:+.0f} % ({:+.0f} % recalibrated), pivot {:.1f} mm, friction {:.2f}",
-                         c.cell.ldbb.force_bias * 100, c.cell.ldbb.force_bias_recalibrated * 100,
-                         c.cell.ldbb.pivot_error_m.norm() * 1e3, c.cell.ldbb.ball_friction);
+      return fmt::format("pivot {:.1f} mm, ball friction {:.2f}", c.cell.ldbb.pivot_error_m.norm() * 1e3,
+                         c.cell.ldbb.ball_friction);
     case Effect::kLdbbRipple:
       return fmt::format("{:.1f} % at {:.1f} Hz", c.cell.ldbb.ripple * 100, c.cell.ldbb.ripple_hz);
     case Effect::kSensorErrors:
       return fmt::format("crosstalk {:.1f} %, noise {:.2f} N", c.cell.sensor.crosstalk * 100, c.cell.sensor.noise_n);
     case Effect::kTrackerNoise:
       return fmt::format("{:.1f} um (1 sigma)", c.cell.tracker.noise_m * 1e6);
-    case Effect::kCalibrationNoise:
-      return fmt::format(
-          "LDBB force {:.1f} % (1 sigma){} at calibration, force from the {}", c.calibration.ldbb_force_error * 100,
-          c.calibration.ldbb_force_bias != 0.0 ? fmt::format(" {:+.0f} % bias", c.calibration.ldbb_force_bias * 100)
-                                               : std::string(),
-          c.calibration.force_from_sensor ? "sensor when mounted" : "LDBB set-point");
+    case Effect::kLdbbSealFriction:
+      return fmt::format("{:.0f} % of the force (+-{:.0f} % run to run), pre-sliding {:.2f} mm; calibration force "
+                         "from the {}",
+                         c.cell.ldbb.seal_friction * 100, c.cell.ldbb.seal_friction_spread * 100,
+                         c.cell.ldbb.seal_presliding_m * 1e3,
+                         c.calibration.force_from_sensor ? "sensor when mounted" : "LDBB's report");
     case Effect::kLatency:
       return fmt::format("dead time {:.0f} ms, filter {:.0f} Hz", c.cell.controller.egm_dead_time_s * 1e3,
                          c.cell.controller.egm_lowpass_hz);
@@ -635,6 +665,13 @@ std::string effect_size(const CaseConfig& c, Effect e) {
     case Effect::kLdbbStickSlip:
       return fmt::format("{:.1f} % per {:.1f} mm of travel", c.cell.ldbb.stick_slip * 100,
                          c.cell.ldbb.stick_slip_travel_m * 1e3);
+    case Effect::kSensorMoment:
+      return fmt::format("up to {:.1f} % of {:.0f} N per {:.0f} N m, +{:.0f} % per nominal moment beyond it",
+                         c.cell.sensor.moment_crosstalk * 100, c.cell.sensor.nominal_lateral_force_n,
+                         c.cell.sensor.nominal_moment_nm, c.cell.sensor.moment_overload_growth * 100);
+    case Effect::kTrackerClock:
+      return fmt::format("trigger {:.1f} ms, rate {:.0f} ppm (1 sigma)", c.cell.tracker.trigger_jitter_s * 1e3,
+                         c.cell.tracker.clock_rate_error * 1e6);
   }
   return "";
 }
@@ -703,8 +740,6 @@ void clear_cell_effect(CaseConfig& c, Effect e) {
       c.cell.sensor.rotational_compliance_rad_per_nm = 0.0;
       break;
     case Effect::kLdbbForceError:
-      c.cell.ldbb.force_bias = 0.0;
-      c.cell.ldbb.force_bias_recalibrated = 0.0;
       c.cell.ldbb.pivot_error_m.setZero();
       c.cell.ldbb.ball_friction = 0.0;
       break;
@@ -722,9 +757,9 @@ void clear_cell_effect(CaseConfig& c, Effect e) {
     case Effect::kTrackerNoise:
       c.cell.tracker.noise_m = 0.0;
       break;
-    case Effect::kCalibrationNoise:
-      c.calibration.ldbb_force_error = 0.0;
-      c.calibration.ldbb_force_bias = 0.0;
+    case Effect::kLdbbSealFriction:
+      c.cell.ldbb.seal_friction = 0.0;
+      c.cell.ldbb.seal_friction_spread = 0.0;
       break;
     case Effect::kLatency:
       c.cell.controller.network_latency_s = 0.0;
@@ -751,6 +786,13 @@ void clear_cell_effect(CaseConfig& c, Effect e) {
       break;
     case Effect::kLdbbStickSlip:
       c.cell.ldbb.stick_slip = 0.0;
+      break;
+    case Effect::kSensorMoment:
+      c.cell.sensor.moment_crosstalk = 0.0;
+      break;
+    case Effect::kTrackerClock:
+      c.cell.tracker.trigger_jitter_s = 0.0;
+      c.cell.tracker.clock_rate_error = 0.0;
       break;
   }
 }

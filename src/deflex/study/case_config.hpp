@@ -71,15 +71,10 @@ struct CalibrationConfig {
   double load_n = 500.0;    ///< LDBB set-point during the loaded passes
   int points_per_arc = 15;  ///< measurements along each arc
   double window_s = 0.2;    ///< tracker samples averaged per measurement (time-synchronous)
-  /// The LDBB's force against its set-point at calibration time, relative 1-sigma, drawn per seed: a
-  /// setup without the force sensor knows only the set-point (a setup with it measures the force).
-  double ldbb_force_error = 0.0;
-  /// The LDBB's systematic force error at calibration time (true force = set-point x (1 + bias)),
-  /// on top of the random one.
-  double ldbb_force_bias = 0.0;
-  /// With the sensor mounted, take the calibration's force from the sensor (true) or, as a setup
-  /// without it must, from the LDBB's set-point (false).
-  bool force_from_sensor = true;
+  /// Where the calibration's force comes from: the LDBB's report (its set-point along the nominal
+  /// bar, as the paper's LDBB-based procedure takes it; false) or, with the sensor mounted, the
+  /// sensor's conditioned reading (true).
+  bool force_from_sensor = false;
 };
 
 struct CircleConfig {
@@ -138,11 +133,11 @@ enum class Effect {
   kSensorCompliance,
   kLostMotion,
   kKinematicErrors,
-  kLdbbForceError,  ///< magnitude bias, pivot error, ball friction
+  kLdbbForceError,  ///< the bar's pivot error and ball friction (the force model's geometry)
   kLdbbRipple,      ///< ripple and noise of the pneumatic force
   kSensorErrors,    ///< crosstalk, noise, bias, gravity-compensation error
   kTrackerNoise,
-  kCalibrationNoise,   ///< load error of the calibration experiment
+  kLdbbSealFriction,   ///< the cylinder seal's friction, in the calibration and the tests alike
   kLatency,            ///< the controller's EGM dead time and filter, network and DAQ latency
   kPathDrift,          ///< run-to-run drift and path repeatability
   kGearHardening,      ///< torque-dependent gear stiffness
@@ -153,14 +148,16 @@ enum class Effect {
   kSensorDrift,        ///< the force sensor's zero drifting after the tare
   kThermalLoadDrift,   ///< the extra warming of a loaded run
   kLdbbStickSlip,      ///< the cylinder seal's stick-slip
+  kSensorMoment,       ///< the force sensor's response to bending moments (a 3-component sensor cannot remove it)
+  kTrackerClock,       ///< the tracker's own clock: its trigger jitter and rate error
 };
-inline constexpr std::array<Effect, 21> kAllEffects = {
+inline constexpr std::array<Effect, 23> kAllEffects = {
     Effect::kStiffnessMismatch, Effect::kJointCoupling,   Effect::kLinkBending,       Effect::kSensorCompliance,
     Effect::kLostMotion,        Effect::kKinematicErrors, Effect::kLdbbForceError,    Effect::kLdbbRipple,
-    Effect::kSensorErrors,      Effect::kTrackerNoise,    Effect::kCalibrationNoise,  Effect::kLatency,
+    Effect::kSensorErrors,      Effect::kTrackerNoise,    Effect::kLdbbSealFriction,  Effect::kLatency,
     Effect::kPathDrift,         Effect::kGearHardening,   Effect::kSensorCalibration, Effect::kBaseCompliance,
     Effect::kMotionStiffness,   Effect::kServo,           Effect::kSensorDrift,       Effect::kThermalLoadDrift,
-    Effect::kLdbbStickSlip};
+    Effect::kLdbbStickSlip,     Effect::kSensorMoment,    Effect::kTrackerClock};
 [[nodiscard]] const char* to_string(Effect e);
 /// Short description of the effect's size in `config` (for the error budget table).
 [[nodiscard]] std::string effect_size(const CaseConfig& config, Effect e);

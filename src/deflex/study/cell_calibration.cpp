@@ -25,8 +25,8 @@ namespace {
 
 // One calibration arc: the LDBB's bar inclination (which sets the arc's radius, r = L cos phi, and
 // the force's vertical part), the arc's height above the test circle, push or pull, and where it
-// starts. Six of them span the operating space and the force directions; more repeat the pattern
-// with turned starts.
+// starts. Six of them span the operating space and the force directions, none on the test circle
+// (each is at least 30 mm above or below it); more repeat the pattern with turned starts.
 struct Arc {
   double phi_rad;
   double dz_m;
@@ -37,7 +37,7 @@ struct Arc {
 Arc arc_of(int k) {
   static const Arc kArcs[6] = {{deg_to_rad(15), 0.05, true, 0.0},  {deg_to_rad(15), -0.05, false, 2.1},
                                {deg_to_rad(50), 0.05, false, 4.2}, {deg_to_rad(50), -0.05, true, 1.0},
-                               {deg_to_rad(-30), 0.0, true, 3.1},  {deg_to_rad(-30), 0.03, false, 5.2}};
+                               {deg_to_rad(-30), -0.03, true, 3.1}, {deg_to_rad(-30), 0.03, false, 5.2}};
   Arc a = kArcs[k % 6];
   const int round = k / 6;  // the round of six arcs
   a.start_rad += 0.37 * round;
@@ -70,9 +70,6 @@ struct CalibrationRig {
         dt(cc.controller.servo_period_s),
         hold_s(std::max(1.5, 5.0 * cc.ldbb.time_constant_s)),
         seed_q(6) {
-    std::mt19937_64 rng(seed);
-    std::normal_distribution<double> normal(0.0, 1.0);
-    ldbb_config.force_bias = cal.ldbb_force_bias + cal.ldbb_force_error * normal(rng);
     seed_q << 0.0, deg_to_rad(20.0), deg_to_rad(10.0), 0.0, deg_to_rad(60.0), 0.0;
   }
 
@@ -82,11 +79,11 @@ struct CalibrationRig {
   const cell::TrueRobot& robot;
   const RobotModel& nominal;
   std::uint64_t seed;
-  // The LDBB's force against its set-point today (the setup without the sensor knows only the
-  // set-point; with the sensor the force is measured and this does not enter the estimate).
+  // The bar: the same physical model as in the tests (its seal friction drawn afresh for every
+  // pressurised pass); the calibration knows only what it reports, its set-point.
   cell::LdbbConfig ldbb_config;
-  // Where the calibration's force comes from: the sensor when it is mounted (unless the user
-  // chose the LDBB's set-point), else the set-point.
+  // Where the calibration's force comes from: the LDBB's report (its set-point along the nominal
+  // bar), or the sensor when it is mounted and the case asks for it.
   bool force_from_sensor;
   // The sensor and what its sheet says (the same physical sensor as in the runs).
   cell::ForceSensorDaq sensor;
@@ -259,7 +256,10 @@ CellCalibration identify_from_measurements(const CalibrationRig& rig, const std:
   // outliers, and a robust re-weighting would throw good measurements away for it.
   IdentificationOptions id_options;
   id_options.robust = false;
-  CellCalibration out{nominal, identify_stiffness(nominal, data, id_options), static_cast<int>(data.size()), {}};
+  double force_sum = 0.0;
+  for (const auto& m : data) force_sum += m.wrench_base.head<3>().norm();
+  CellCalibration out{nominal, identify_stiffness(nominal, data, id_options), static_cast<int>(data.size()),
+                      force_sum / static_cast<double>(data.size()), {}};
   std::vector<double> k(static_cast<std::size_t>(nominal.dof()));
   for (int j = 0; j < nominal.dof(); ++j) {
     const double kj = out.estimate.stiffness_nm_per_rad[static_cast<std::size_t>(j)];
@@ -289,6 +289,7 @@ CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robo
     return CellCalibration{robot.nominal_model().with_stiffness(kv, "exact true stiffness (model-consistent cell)"),
                            {},
                            0,
+                           0.0,
                            {"exact stiffness given: model-consistent cell"}};
   }
   CalibrationRig rig(c, robot, seed);

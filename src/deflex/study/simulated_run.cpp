@@ -336,10 +336,8 @@ DeflexSide start_deflex_session(const RunPlan& plan, RunNetwork& net, const cell
 RunInstruments make_run_instruments(const RunPlan& plan) {
   const cell::CellConfig& c = plan.c;
   const RunSpec& spec = plan.spec;
-  // The bar was serviced and recalibrated before the online tests (paper, section 3): the runs with
-  // the sensor mounted see its recalibrated force error, the offline runs its earlier one.
-  cell::LdbbConfig bar = c.ldbb;
-  if (plan.robot.sensor_mounted()) bar.force_bias = c.ldbb.force_bias_recalibrated;
+  // The same bar as in the calibration: its seal friction drawn afresh when it is pressurised.
+  const cell::LdbbConfig& bar = c.ldbb;
   return RunInstruments{
       cell::LdbbDevice(bar, plan.config.pivot_m(), spec.load_n, component_seed(spec.seed, Component::kLdbb)),
       cell::PathDrift(c.drift, component_seed(spec.seed, Component::kDrift), plan.loaded ? spec.load_n : 0.0),

@@ -18,6 +18,9 @@ struct CellCalibration {
   RobotModel identified;  ///< nominal kinematics and tool, identified joint stiffness
   StiffnessEstimate estimate;
   int measurements = 0;
+  /// Mean magnitude of the forces the identification was given (N): what the bar reported or the
+  /// sensor read, never the force the cell applied.
+  double mean_force_n = 0.0;
   std::vector<std::string> notes;  ///< joints kept at the assumed value, warnings
 };
 
