@@ -7,6 +7,7 @@
 
 #include "deflex/cell/cell_config.hpp"
 #include "deflex/cell/force_sensor.hpp"
+#include "deflex/cell/laser_tracker.hpp"
 #include "deflex/cell/ldbb_device.hpp"
 #include "deflex/cell/true_robot.hpp"
 #include "deflex/model/compliance.hpp"
@@ -208,6 +209,76 @@ TEST(ForceSensorDaq, DecouplingUndoesTheCrosstalkUpToTheCalibrationResidual) {
   EXPECT_GT((daq.crosstalk() - Matrix3::Identity()).norm(), 1e-3);
   const Vector3 raw = daq.sample(Vector3(100.0, -50.0, 20.0), Matrix3::Identity());
   EXPECT_NEAR((daq.calibration().decoupling * raw - Vector3(100.0, -50.0, 20.0)).norm(), 0.0, 1e-9);
+}
+
+
+TEST(ForceSensorDaq, ForceChannelsAnswerToTheMomentAboutTheSensorsOrigin) {
+  // A lateral force at the TCP, 250 mm beyond a 60 mm sensor, bends the sensor about its centre
+  // with M = 0.28 m x F. The force channels read the force plus the unit's moment crosstalk times
+  // M (at most 1 % of 1 kN per 50 N m: 0.2 N per N m); beyond 50 N m the response grows by 50 % per
+  // nominal moment over it.
+  SensorConfig s;
+  s.crosstalk = 0.0;
+  s.noise_n = 0.0;
+  s.height_m = 0.06;
+  s.moment_crosstalk = 0.01;
+  s.nominal_moment_nm = 50.0;
+  s.nominal_lateral_force_n = 1000.0;
+  s.moment_overload_growth = 0.5;
+  ToolConfig tool;
+  tool.ee_length_m = 0.25;
+  ForceSensorDaq daq(s, tool, 3, 11);
+  const Matrix3& X = daq.moment_crosstalk();
+  EXPECT_GT(X.cwiseAbs().maxCoeff(), 0.01);
+  EXPECT_LE(X.cwiseAbs().maxCoeff(), 0.2);
+  // 100 N along x: My = 0.28 * 100 = 28 N m, inside the nominal.
+  const Vector3 small = daq.sample(Vector3(100.0, 0.0, 0.0), Matrix3::Identity());
+  EXPECT_NEAR((small - Vector3(100.0, 0.0, 0.0) - X.col(1) * 28.0).norm(), 0.0, 1e-9);
+  // 300 N: My = 84 N m, 0.68 nominal moments over: the response is 84 x 1.34.
+  const Vector3 large = daq.sample(Vector3(300.0, 0.0, 0.0), Matrix3::Identity());
+  EXPECT_NEAR((large - Vector3(300.0, 0.0, 0.0) - X.col(1) * 84.0 * 1.34).norm(), 0.0, 1e-9);
+  // An axial force has no lever: nothing.
+  const Vector3 axial = daq.sample(Vector3(0.0, 0.0, 500.0), Matrix3::Identity());
+  EXPECT_NEAR((axial - Vector3(0.0, 0.0, 500.0)).norm(), 0.0, 1e-9);
+  // The same physical sensor (unit seed) has the same crosstalk in every run.
+  EXPECT_TRUE(ForceSensorDaq(s, tool, 99, 11).moment_crosstalk().isApprox(X));
+}
+
+TEST(LaserTracker, StampsOnItsOwnClockStartedByAJitteryTrigger) {
+  // A tracker whose trigger lands 1 ms late or early (1 sigma) and whose clock runs 50 ppm fast or
+  // slow (1 sigma). The reflector moves along x at 1 m per simulated second, so each sample's x is
+  // the simulated time it was taken at. Its stamps step by exactly its own 1 ms; stamp against x
+  // gives its rate (1 + r) and, at the first sample, its trigger offset.
+  TrackerConfig c;
+  c.noise_m = 0.0;
+  c.rate_hz = 1000.0;
+  c.trigger_jitter_s = 1e-3;
+  c.clock_rate_error = 50e-6;
+  double sum_d = 0.0, sum_d2 = 0.0, sum_r = 0.0, sum_r2 = 0.0;
+  const int runs = 300;
+  for (int seed = 1; seed <= runs; ++seed) {
+    LaserTracker tracker(c, static_cast<std::uint64_t>(seed), 1.0, 21.0, 1.0);
+    TrackerTrace trace;
+    for (int k = 0; k < 5500; ++k) {
+      const double t0 = k * 0.004, t1 = (k + 1) * 0.004;
+      tracker.observe(t0, Vector3(t0, 0.0, 0.0), t1, Vector3(t1, 0.0, 0.0), trace);
+    }
+    ASSERT_GT(trace.size(), 19900u);
+    for (std::size_t i = 1; i < trace.size(); ++i) {
+      ASSERT_NEAR(trace[i].t_s - trace[i - 1].t_s, 1e-3, 1e-9);
+    }
+    const double rate = (trace.back().t_s - trace.front().t_s) / (trace.back().p_m.x() - trace.front().p_m.x());
+    const double trigger = trace.front().p_m.x() - 1.0 - trace.front().t_s / rate;
+    sum_r += rate - 1.0;
+    sum_r2 += (rate - 1.0) * (rate - 1.0);
+    sum_d += trigger;
+    sum_d2 += trigger * trigger;
+  }
+  const double mean_d = sum_d / runs, mean_r = sum_r / runs;
+  EXPECT_NEAR(mean_d, 0.0, 2.5e-4);
+  EXPECT_NEAR(std::sqrt(sum_d2 / runs - mean_d * mean_d), 1e-3, 1.5e-4);
+  EXPECT_NEAR(mean_r, 0.0, 12e-6);
+  EXPECT_NEAR(std::sqrt(sum_r2 / runs - mean_r * mean_r), 50e-6, 7.5e-6);
 }
 
 }  // namespace
