@@ -99,6 +99,11 @@ struct SensorConfig {
   /// moment_overload_growth per nominal moment beyond the nominal (the spring body leaves the range
   /// it was calibrated in).
   double moment_crosstalk = 0.0;
+  /// What the user's sheet gets wrong about the mounting: the end effector's centre of gravity (from
+  /// CAD, 1-sigma per axis) and the sensor's height (measured by hand, 1-sigma). The sheet gives no
+  /// bias: the user tares with the arm still (deflex's tare, study/simulated_run.cpp).
+  double sheet_cog_error_m = 0.0;
+  double sheet_height_error_m = 0.0;
   double nominal_moment_nm = 50.0;
   double nominal_lateral_force_n = 1000.0;
   double moment_overload_growth = 0.0;

@@ -32,12 +32,15 @@ ForceSensorDaq::ForceSensorDaq(const SensorConfig& sensor, const ToolConfig& too
   }
   // The point of origin is the sensor's centre; the end effector's length counts from its top.
   lever_m_ = Vector3(0.0, 0.0, tool.ee_length_m + 0.5 * sensor.height_m);
+  // What the drawings and a hand measurement say about the mounting.
+  Vector3 cog_error;
+  for (int i = 0; i < 3; ++i) cog_error[i] = normal_(rng_);
+  calibration_.ee_cog_m = tool.ee_cog_m + sensor.sheet_cog_error_m * cog_error;
+  calibration_.height_m = sensor.height_m + sensor.sheet_height_error_m * normal_(rng_);
   rng_.seed(seed);  // noise and zero drift: this run's own
   normal_.reset();
   for (int i = 0; i < 3; ++i) zero_drift_n_per_s_[i] = sensor.zero_drift_n / 600.0 * normal_(rng_);
-  calibration_.bias_n = sensor.bias_n;  // tared at a static pose: the bias itself is known
   calibration_.ee_mass_kg = tool.ee_mass_kg * (1.0 + sensor.gravity_mass_error);
-  calibration_.ee_cog_m = tool.ee_cog_m;
 }
 
 Vector3 ForceSensorDaq::sample(const Vector3& process_force_base_n, const Matrix3& base_R_flange, double t_s) {

@@ -14,12 +14,13 @@
 
 namespace deflex::cell {
 
-/// What the sensor's calibration gives the online strategy (close to, never exactly, the truth).
+/// What the sensor's sheet and the mounting's drawings give the user (close to, never exactly, the
+/// truth). No bias: the user tares the mounted sensor (its zero moves when it is bolted down).
 struct SensorCalibration {
   Matrix3 decoupling = Matrix3::Identity();  ///< measured -> decoupled, sensor frame
-  Vector3 bias_n = Vector3::Zero();
   double ee_mass_kg = 0.0;
   Vector3 ee_cog_m = Vector3::Zero();
+  double height_m = 0.0;  ///< flange to the sensor's top, as measured
 };
 
 /// Thread safety: one thread at a time (sample() draws from its own random generator).

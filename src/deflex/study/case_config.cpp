@@ -313,8 +313,13 @@ void read_case_tool_and_sensor(const yaml::Field& root, CaseConfig& c) {
                "rotational_compliance_urad_per_Nm", "crosstalk_pct", "crosstalk_calibration_residual_pct", "noise_N",
                "bias_N", "rate_Hz", "gravity_mass_error_pct", "sensitivity_error_pct", "misalignment_deg",
                "daq_latency_ms", "zero_drift_N_per_10min", "moment_crosstalk_pct", "nominal_moment_Nm",
-               "nominal_lateral_force_N", "moment_overload_growth_pct"});
+               "nominal_lateral_force_N", "moment_overload_growth_pct", "sheet_cog_error_mm",
+               "sheet_height_error_mm"});
   auto& f = c.cell.sensor;
+  f.sheet_cog_error_m =
+      case_number(s, "sheet_cog_error_mm", non_negative, 0.0, from_milli, at_most(0.05, "must be within 0..50 mm"));
+  f.sheet_height_error_m =
+      case_number(s, "sheet_height_error_mm", non_negative, 0.0, from_milli, at_most(0.01, "must be within 0..10 mm"));
   f.moment_crosstalk =
       case_number(s, "moment_crosstalk_pct", non_negative, 0.0, from_pct, at_most(0.2, "must be within 0..20 %"));
   f.nominal_moment_nm = case_number(s, "nominal_moment_Nm", positive, 50.0, unscaled,
@@ -579,7 +584,7 @@ const char* to_string(Effect e) {
     case Effect::kGearHardening:
       return "torque-dependent gear stiffness";
     case Effect::kSensorCalibration:
-      return "sensor sensitivity error, misalignment";
+      return "sensor sheet: sensitivity, misalignment, mount";
     case Effect::kBaseCompliance:
       return "foundation and base tilt";
     case Effect::kMotionStiffness:
@@ -647,8 +652,9 @@ std::string effect_size(const CaseConfig& c, Effect e) {
       return fmt::format("up to {:.1f}x softer near zero torque", 1.0 + m);
     }
     case Effect::kSensorCalibration:
-      return fmt::format("{:.1f} % sensitivity, {:.2f} deg", c.cell.sensor.sensitivity_error * 100,
-                         rad_to_deg(c.cell.sensor.misalignment_rad));
+      return fmt::format("{:.1f} % sensitivity, {:.2f} deg, centre of gravity {:.0f} mm, height {:.1f} mm",
+                         c.cell.sensor.sensitivity_error * 100, rad_to_deg(c.cell.sensor.misalignment_rad),
+                         c.cell.sensor.sheet_cog_error_m * 1e3, c.cell.sensor.sheet_height_error_m * 1e3);
     case Effect::kBaseCompliance:
       return fmt::format("{:.2f} nrad/Nm", c.cell.robot.base_tilt_compliance_rad_per_nm * 1e9);
     case Effect::kMotionStiffness:
@@ -777,6 +783,8 @@ void clear_cell_effect(CaseConfig& c, Effect e) {
     case Effect::kSensorCalibration:
       c.cell.sensor.sensitivity_error = 0.0;
       c.cell.sensor.misalignment_rad = 0.0;
+      c.cell.sensor.sheet_cog_error_m = 0.0;
+      c.cell.sensor.sheet_height_error_m = 0.0;
       break;
     case Effect::kSensorDrift:
       c.cell.sensor.zero_drift_n = 0.0;

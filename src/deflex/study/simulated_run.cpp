@@ -22,6 +22,7 @@
 #include "deflex/paths/circle_path.hpp"
 #include "deflex/runtime/session.hpp"
 #include "deflex/sensors/datagram_force_source.hpp"
+#include "deflex/sensors/wrench_tare.hpp"
 #include "deflex/study/detail/cell_arm.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/transport/memory_network.hpp"
@@ -155,16 +156,50 @@ deflex::SensorConfig sensor_config_from_sheet(const CaseConfig& config, const ce
   sc.components = 3;
   sc.crosstalk.topLeftCorner<3, 3>() = sheet.decoupling;
   sc.flange_T_sensor = Pose::Identity();
-  sc.flange_T_sensor.translation() = Vector3(0, 0, config.cell.sensor.height_m);
+  sc.flange_T_sensor.translation() = Vector3(0, 0, sheet.height_m);
   sc.payload_mass_kg = sheet.ee_mass_kg;
   sc.payload_cog_sensor_m = sheet.ee_cog_m;
-  sc.bias_sensor.head<3>() = sheet.bias_n;
   sc.gravity_base_m_s2 = Vector3(0, 0, -cell::kGravity);
   sc.lowpass_cutoff_hz = config.online.lowpass_hz;
   sc.sample_rate_hz = config.cell.sensor.rate_hz;
   sc.dead_band_N = config.online.dead_band_n;
   sc.fault_threshold_N = config.online.fault_threshold_n;
   return sc;
+}
+
+double tare_limit_n(const cell::SensorConfig& sensor) { return 0.1 + 3.0 * sensor.noise_n; }
+
+deflex::SensorConfig tare_sensor(deflex::SensorConfig sheet_config, cell::ForceSensorDaq& sensor,
+                                 const cell::TrueRobot& robot, const JointVector& q_tare, double max_std_n) {
+  // Where the flange truly points (the arm standing unloaded) and where deflex thinks the sensor
+  // points (nominal kinematics, the sheet's mount).
+  const RobotModel& nominal = robot.nominal_model();
+  Workspace ws_true(robot.true_model());
+  Workspace ws_nominal(nominal);
+  forward_kinematics(robot.true_model(), ws_true, q_tare);
+  forward_kinematics(nominal, ws_nominal, q_tare);
+  const Matrix3 base_R_flange = ws_true.base_T_flange.linear();
+  const Matrix3 base_R_sensor = ws_nominal.base_T_flange.linear() * sheet_config.flange_T_sensor.linear();
+  TareSettings settings;
+  settings.max_std_force_n = max_std_n;
+  settings.expected_wrench_sensor = payload_wrench_sensor(
+      sheet_config.payload_mass_kg, sheet_config.payload_cog_sensor_m, sheet_config.gravity_base_m_s2, base_R_sensor);
+  settings.expected_wrench_sensor.tail<3>().setZero();  // a 3-component sensor reads no moments
+  WrenchTare tare;
+  tare.start(settings, sheet_config.sample_rate_hz);
+  const Matrix3 decoupling = sheet_config.crosstalk.topLeftCorner<3, 3>();
+  for (int i = 0; tare.result().state == TareState::kCollecting && i < 100000; ++i) {
+    ForceSample fs;
+    fs.t_s = i / sheet_config.sample_rate_hz;
+    // Read before the tare's own clock starts: the sensor's zero drift counts from the tare's end.
+    fs.wrench_sensor.head<3>() = decoupling * sensor.sample(Vector3::Zero(), base_R_flange, 0.0);
+    tare.add(fs);
+  }
+  if (tare.result().state != TareState::kDone) {
+    throw Error("run: the sensor's tare was refused: " + describe(tare.result(), settings));
+  }
+  sheet_config.bias_sensor.head<3>() = tare.result().offset_sensor.head<3>();
+  return sheet_config;
 }
 
 namespace {
@@ -285,7 +320,7 @@ std::unique_ptr<cell::RobotController> make_run_controller(const RunPlan& plan, 
 // deflex's side, run as `deflex online` runs it: a session of the runtime on the cell's network, from
 // the sensor's calibration sheet and identified payload, the identified robot model, the user's
 // settings, the strategy and the link. Empty when the run has no link.
-DeflexSide start_deflex_session(const RunPlan& plan, RunNetwork& net, const cell::ForceSensorDaq& sensor) {
+DeflexSide start_deflex_session(const RunPlan& plan, RunNetwork& net, cell::ForceSensorDaq& sensor) {
   DeflexSide side;
   if (!plan.linked) return side;
   const CaseConfig& config = plan.config;
@@ -326,7 +361,9 @@ DeflexSide start_deflex_session(const RunPlan& plan, RunNetwork& net, const cell
   endpoints.motion = &net.motion_stream.client();
   endpoints.state = &net.state_stream.client();
   side.session = std::make_unique<runtime::Session>(
-      sc, plan.setup.calibration.identified, sensor_config_from_sheet(config, sensor.calibration()),
+      sc, plan.setup.calibration.identified,
+      tare_sensor(sensor_config_from_sheet(config, sensor.calibration()), sensor, plan.robot,
+                  plan.program->points().front(), tare_limit_n(c.sensor)),
       spec.link == LinkKind::kEgmPath ? nullptr : plan.program, side.force_model.get(), side.force_source.get(),
       net.clock, endpoints);
   return side;

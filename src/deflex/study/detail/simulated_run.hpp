@@ -88,9 +88,22 @@ struct RunOutput {
                                             double* scale = nullptr);
 
 /// What a user's sensor file would hold for the cell's sensor: its calibration sheet (decoupling,
-/// bias, payload), the mount, and deflex's conditioning settings from the case.
+/// payload, the mount as measured), deflex's conditioning settings from the case, and no bias yet.
 [[nodiscard]] deflex::SensorConfig sensor_config_from_sheet(const CaseConfig& config,
                                                             const cell::SensorCalibration& sheet);
+
+/// The spread a user's tare accepts for the cell's sensor (N): three times its noise and a little.
+[[nodiscard]] double tare_limit_n(const cell::SensorConfig& sensor);
+
+/// The user's tare before a run (deflex's WrenchTare, as `deflex online --tare` takes it): the arm
+/// stands unloaded at `q_tare` (rad) for half a second while the sensor is read; the mean of the
+/// decoupled readings less the payload's weight as the sheet predicts it there (nominal orientation)
+/// becomes the file's bias. Returns the configuration with that bias. Throws Error when the tare is
+/// refused (the arm did not stand still: a broken setup). `max_std_n`: the tare's limit on the
+/// window's spread (N), set from the sensor's noise as a user would.
+[[nodiscard]] deflex::SensorConfig tare_sensor(deflex::SensorConfig sheet_config, cell::ForceSensorDaq& sensor,
+                                               const cell::TrueRobot& robot, const JointVector& q_tare,
+                                               double max_std_n);
 
 /// Runs one protocol run. Throws Error when the run cannot be done (an online strategy without the
 /// sensor, a refused start or a controller that timed out: a broken setup, never a result).
