@@ -44,6 +44,8 @@ std::vector<std::pair<std::string, std::string>> every_figure() {
           {"path (laps)", svg_path_plot(laps)},
           {"polar (laps)", svg_polar_deviation(laps)},
           {"laps (laps)", svg_lap_overlay(laps)},
+          {"signed", svg_signed_error(r.path_plots.front())},
+          {"signed (laps)", svg_signed_error(laps)},
           {"budget", svg_error_budget(r.study.error_budgets.front())}};
 }
 

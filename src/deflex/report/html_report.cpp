@@ -509,6 +509,7 @@ std::string html_report(const ReportContent& content) {
       }
       h += "<div class=\"fig pair\">\n" + svg_path_plot(p) + svg_polar_deviation(p) + "</div>\n";
       h += "<div class=\"fig\">\n" + svg_lap_overlay(p) + "</div>\n";
+      h += "<div class=\"fig\">\n" + svg_signed_error(p) + "</div>\n";
     }
     h += "<p class=\"caption\">Left: the last lap of the uncompensated (UC) and compensated (C) runs in the plane of "
          "the reference (the unloaded laps' mean path), each point drawn at its nearest reference point plus its "
@@ -517,7 +518,10 @@ std::string html_report(const ReportContent& content) {
          "of a direction averaged in 5 deg sectors. Below: every lap of each run, clockwise and anticlockwise in "
          "their own colours, against the angle about the circle's centre (0 deg: the base's +x direction from the "
          "centre; angles grow anticlockwise seen from above), with an arrowhead in each lap's direction of travel. "
-         "All from the first seed's runs.</p>\n";
+         "Last: the compensated run's signed error, its deviation from the reference along the direction the "
+         "uncompensated run deviated at the same angle (that run's laps of the same direction of travel, averaged "
+         "in 5 deg sectors): above 0 under-compensated (still deflected the way the load pushes), below 0 "
+         "over-compensated, which the distances above cannot tell apart. All from the first seed's runs.</p>\n";
   }
   h += budget_tables(study);
   if (!study.speed_sweep.empty()) {
@@ -591,6 +595,7 @@ void write_report(const ReportContent& content, const std::string& out_dir, Outp
     write_text(fmt::format("path_{}.svg", i + 1), svg_path_plot(p));
     write_text(fmt::format("polar_{}.svg", i + 1), svg_polar_deviation(p));
     write_text(fmt::format("laps_{}.svg", i + 1), svg_lap_overlay(p));
+    write_text(fmt::format("signed_{}.svg", i + 1), svg_signed_error(p));
   }
   for (std::size_t i = 0; i < study.error_budgets.size(); ++i) {
     write_text(fmt::format("budget_{}.svg", i + 1), svg_error_budget(study.error_budgets[i]));

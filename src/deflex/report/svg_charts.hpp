@@ -66,6 +66,13 @@ std::string svg_path_plot(const PathPlot& plot);
 /// own colours, each with an arrow in its direction of travel. Laps: plot.uc_laps and plot.c_laps.
 std::string svg_lap_overlay(const PathPlot& plot);
 
+/// Signed error of the compensated run along the path: for each sample of a C lap, its deviation from
+/// the reference projected on the direction of the UC run's deviation at the same angle (the UC
+/// laps of the same direction of travel averaged in 5 deg sectors), so + is under-compensated
+/// (still deflected the way the load pushes) and - over-compensated; per direction of travel the
+/// sector means against the angle (as in svg_lap_overlay), in mm.
+std::string svg_signed_error(const PathPlot& plot);
+
 /// Polar deviation plot: around the circle (angle as in svg_lap_overlay), the distance from the
 /// reference drawn outward from a ring that stands for 0 mm, magnified, with rings labelled in mm;
 /// UC and C, clockwise and anticlockwise laps each averaged in 5 deg sectors.
