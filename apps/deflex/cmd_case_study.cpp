@@ -20,6 +20,7 @@
 #include "deflex/study/case_study.hpp"
 #include "deflex/study/study_tables.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/text/input_file.hpp"
 #include "deflex/text/output_file.hpp"
 
 namespace deflex::cli {
@@ -96,8 +97,10 @@ void run(const CaseStudyOpts& o, int& exit_code) {
   const study::CaseStudyOutput result = study::run_case_study(config, options);
   if (!o.no_progress) std::cerr << "\n";
 
-  const ReportContent report =
-      study::case_report(config, result, o.case_file.empty() ? study::paper_case_yaml() : std::string());
+  // The case file's text goes into the report as it is, and its notes read what it marks as tuned.
+  const ReportContent report = study::case_report(
+      config, result,
+      o.case_file.empty() ? study::paper_case_yaml() : read_input_file(o.case_file, InputKind::kConfig));
   write_report(report, o.out_dir, outputs);
   outputs.commit();
 

@@ -512,7 +512,7 @@ TEST(HtmlReport, SaysWhatTheFiguresAreOf) {
   const std::string html = html_report(test::synthetic_report());
   for (const char* needle :
        {// Method: the reference, the second metric, the seeds.
-        "laps (3 clockwise and 3 anticlockwise in the protocol) averaged into one closed path",
+        "laps (clockwise and anticlockwise, as many as the protocol runs) averaged into one closed path",
         "Time-synchronous error: for every tracker point", "Seeds: 3 seeds (11, 12, 13)",
         // ISO: against the unloaded laps' mean, RT_p of the compensated laps, means over the seeds.
         "with the mean of the unloaded laps at the same speed as the reference path",

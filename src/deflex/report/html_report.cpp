@@ -541,8 +541,9 @@ std::string html_report(const ReportContent& content) {
   }
   h += fmt::format(
       "<h2 id=\"method\">How the figures are computed</h2>\n<ul>\n"
-      "<li>Reference path: the unloaded run at the same speed, its laps (3 clockwise and 3 anticlockwise in the "
-      "protocol) averaged into one closed path: the samples binned by their angle about the centre (3600 sectors) "
+      "<li>Reference path: the unloaded run at the same speed, its laps (clockwise and anticlockwise, as many as "
+      "the protocol runs) averaged into one closed path: the samples binned by their angle about the centre (3600 "
+      "sectors) "
       "and each sector's positions averaged. Measuring to every unloaded sample instead would bias the distance low "
       "by the unloaded trace's own noise.</li>\n"
       "<li>Mean deformation (the paper's figure, \"nearest-point\"): for every tracker point of a loaded run, the "
@@ -556,9 +557,9 @@ std::string html_report(const ReportContent& content) {
       "each speed with that speed's UC, unrounded).</li>\n"
       "<li>Seeds: {}. Each seed is its own cell (true robot, sensor, calibration) and its own runs; tables and "
       "figures give the mean over the seeds; the tables add &#177; the sample standard deviation, the figures "
-      "whiskers from the smallest to the largest seed's value. The path, polar and lap figures show the first "
-      "seed's runs at each setup's highest load and lowest speed; the error budget uses the first seed's table "
-      "runs.</li>\n"
+      "whiskers from the smallest to the largest seed's value. The path, polar, lap and signed-error figures show "
+      "the first seed's runs at each setup's highest load and the protocol's first speed (each figure's title "
+      "names them); the error budget uses the first seed's table runs.</li>\n"
       "<li>ISO 9283 path accuracy AT<sub>p</sub> and repeatability RT<sub>p</sub>: section 7.2 of the standard, "
       "positions only, against the same reference (see docs/evaluation.md).</li>\n</ul>\n",
       seeds_text(study));

@@ -689,11 +689,10 @@ std::string describe_cell(const StudyContext& x, int f) {
   std::string text = fmt::format(
       "Setup {} the force sensor (seed {}): true joint stiffness (diagonal, Nm/rad) [{}]; identified from {} "
       "calibration measurements taken while moving along {} arcs in the operating space [{}] (residual {:.1f} um "
-      "RMS). The identified values absorb what the lumped model lacks ({}).",
+      "RMS). The identified values are the lumped joint model's best fit to those measurements: what the cell has "
+      "beyond that model (the error budget lists its effects) is folded into them or left in the residual.",
       f == 1 ? "with" : "without", config.seed, k_true, cell.calibration.measurements, config.calibration.arcs, k_id,
-      cell.calibration.estimate.residual_rms_m * 1e6,
-      f == 1 ? "sensor compliance, joint coupling, link bending, base tilt, lost motion"
-             : "joint coupling, link bending, base tilt, lost motion");
+      cell.calibration.estimate.residual_rms_m * 1e6);
   for (const auto& note : cell.calibration.notes) {
     if (note.find("kept the assumed") != std::string::npos || note.find("poorly") != std::string::npos) {
       text += " Calibration: " + note + ".";
