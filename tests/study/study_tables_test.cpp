@@ -137,7 +137,8 @@ TEST(StudyTables, TextTableShowsOursBesideThePapers) {
 TEST(StudyTables, MarkdownAndCsv) {
   const StudyResult s = example_study();
   const std::string md = study_tables_markdown(s);
-  EXPECT_NE(md.find("| load | UC mm | C1 10 mm/s | C2 30 mm/s | C3 50 mm/s | compensation |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| load | UC mm | C1 10 mm/s | C2 30 mm/s | C3 50 mm/s | compensation % |"), std::string::npos)
+      << md;
   EXPECT_NE(md.find("| 125 N | 0.121 (0.12) |"), std::string::npos) << md;
   const auto path = (std::filesystem::temp_directory_path() / "deflex_study.csv").string();
   write_study_csv(s, path);

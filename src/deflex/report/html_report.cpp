@@ -121,9 +121,9 @@ std::string results_tables(const StudyResult& study) {
       h += fmt::format("<th>C{} at {} mm/s (mm)</th>", i + 1, speeds[i]);
     }
     for (const int v : speeds) {
-      h += fmt::format("<th>comp. {} mm/s</th>", v);
+      h += fmt::format("<th>comp. {} mm/s (%)</th>", v);
     }
-    h += pt != nullptr ? "<th>UC vs paper</th><th>C vs paper (mean over speeds)</th></tr>\n" : "</tr>\n";
+    h += pt != nullptr ? "<th>UC vs paper (%)</th><th>C vs paper, mean over speeds (%)</th></tr>\n" : "</tr>\n";
     for (const auto& l : s.loads) {
       const PaperRow* pr = pt != nullptr ? pt->row_for(l.load_N) : nullptr;
       h += fmt::format("<tr><td class=\"l\">{:g} N</td><td>{}</td>", l.load_N,
@@ -220,18 +220,18 @@ std::string sync_table(const StudyResult& study) {
 std::string compensation_table(const StudyResult& study) {
   const PaperFigures paper = paper_reference();
   const std::vector<int> speeds = study_speeds_mm_s(study);
-  std::string h = "<table>\n<tr><th class=\"l\">setup</th><th>load</th><th>ours, mean over the speeds</th>";
+  std::string h = "<table>\n<tr><th class=\"l\">setup</th><th>load</th><th>ours, mean over the speeds (%)</th>";
   if (study.seed_count() > 1) {
-    h += "<th>seeds: min to max</th>";
+    h += "<th>seeds: min to max (%)</th>";
   }
   for (const int v : speeds) {
-    h += fmt::format("<th>ours at {} mm/s</th>", v);
+    h += fmt::format("<th>ours at {} mm/s (%)</th>", v);
   }
-  h += "<th>the paper's, mean over the speeds</th><th class=\"l\">the paper's at ";
+  h += "<th>the paper's, mean over the speeds (%)</th><th class=\"l\">the paper's at ";
   for (std::size_t i = 0; i < speeds.size(); ++i) {
     h += fmt::format("{}{}", i == 0 ? "" : " / ", speeds[i]);
   }
-  h += " mm/s</th></tr>\n";
+  h += " mm/s (%)</th></tr>\n";
   for (const auto& s : study.setups) {
     const PaperTable* pt = paper_table_of(paper, s);
     for (const auto& l : s.loads) {

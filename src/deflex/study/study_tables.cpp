@@ -118,7 +118,7 @@ Grid setup_grid(const SetupResult& s, const std::vector<int>& speeds, const Pape
   for (std::size_t i = 0; i < speeds.size(); ++i) {
     g.header.push_back(fmt::format("C{} {} mm/s", i + 1, speeds[i]));
   }
-  g.header.push_back("compensation");
+  g.header.push_back("compensation %");
   for (const auto& l : s.loads) {
     const PaperRow* pr = paper != nullptr ? paper->row_for(l.load_N) : nullptr;
     Row r;
