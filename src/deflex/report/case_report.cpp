@@ -49,7 +49,12 @@ std::vector<std::string> tuned_values(const std::string& case_text) {
     std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char ch) { return std::tolower(ch); });
     if (lower.rfind("tuned", 0) != 0) continue;  // the case file's own mark: "# tuned: why"
     const std::string value = trim(body.substr(colon + 1));
-    const std::string name = section.empty() || section == key ? key : section + "." + key;
+    std::string name = section;
+    if (name.empty() || section == key) {
+      name = key;
+    } else {
+      name.append(".").append(key);
+    }
     out.push_back(value.empty() ? fmt::format("{} ({})", name, comment)
                                 : fmt::format("{} = {} ({})", name, value, comment));
   }

@@ -192,6 +192,53 @@ double read_number(const nlohmann::json& j, const char* key, const std::string& 
   return j.at(key).get<double>();
 }
 
+// One entry of results.json's "error_budget" (`bw` names it in errors); each sensitivity
+// recomputed from the residuals.
+ErrorBudget read_error_budget(const nlohmann::json& jb, const std::string& bw) {
+  ErrorBudget b;
+  if (!jb.contains("setup") || !jb.at("setup").is_string()) {
+    throw DataError(fmt::format("{}: missing string field 'setup'", bw));
+  }
+  b.setup = jb.at("setup").get<std::string>();
+  b.load_N = read_number(jb, "load_N", bw);
+  b.speed_mm_s = read_number(jb, "speed_mm_s", bw);
+  b.residual_mm_all = jb.contains("residual_mm_all") && jb.at("residual_mm_all").is_null()
+                          ? kNaN
+                          : read_number(jb, "residual_mm_all", bw);
+  b.uc_mm = jb.contains("uc_mm") && jb.at("uc_mm").is_null() ? kNaN : read_number(jb, "uc_mm", bw, false);
+  if (jb.contains("residual_mm_all_off") && !jb.at("residual_mm_all_off").is_null()) {
+    b.residual_mm_all_off = read_number(jb, "residual_mm_all_off", bw);
+  }
+  if (jb.contains("seed")) {
+    if (!jb.at("seed").is_number_unsigned()) throw DataError(fmt::format("{}: seed: not a seed", bw));
+    b.seed = jb.at("seed").get<std::uint64_t>();
+  }
+  if (jb.contains("laps")) {
+    const double laps = read_number(jb, "laps", bw);
+    if (laps < 0 || laps > 1e6 || laps != std::floor(laps))
+      throw DataError(fmt::format("{}: laps: not a lap count", bw));
+    b.laps = static_cast<int>(laps);
+  }
+  if (jb.contains("entries")) {
+    std::size_t ei = 0;
+    for (const auto& je : jb.at("entries")) {
+      const std::string ew = fmt::format("{}.entries[{}]", bw, ei++);
+      ErrorBudgetEntry e;
+      if (!je.contains("effect") || !je.at("effect").is_string()) {
+        throw DataError(fmt::format("{}: missing string field 'effect'", ew));
+      }
+      e.effect = je.at("effect").get<std::string>();
+      e.size = je.contains("size") && je.at("size").is_string() ? je.at("size").get<std::string>() : "";
+      e.residual_mm_without_it = je.contains("residual_mm_without_it") && je.at("residual_mm_without_it").is_null()
+                                     ? kNaN
+                                     : read_number(je, "residual_mm_without_it", ew);
+      e.sensitivity = one_at_a_time_sensitivity(b.residual_mm_all, e.residual_mm_without_it);
+      b.entries.push_back(e);
+    }
+  }
+  return b;
+}
+
 }  // namespace
 
 std::vector<int> study_speeds_mm_s(const StudyResult& study) {
@@ -557,8 +604,9 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
     if (js.contains("description") && js.at("description").is_string()) {
       s.description = js.at("description").get<std::string>();
     }
-    for (const auto& [key, field] :
-         {std::pair{"paper_table", &s.paper_table}, std::pair{"paper_label", &s.paper_label}}) {
+    const std::pair<const char*, std::string*> text_fields[] = {{"paper_table", &s.paper_table},
+                                                                {"paper_label", &s.paper_label}};
+    for (const auto& [key, field] : text_fields) {
       if (!js.contains(key)) continue;
       if (!js.at(key).is_string()) throw DataError(fmt::format("{}.{}: not a string", where, key));
       *field = js.at(key).get<std::string>();
@@ -653,49 +701,7 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
   if (doc.contains("error_budget")) {
     std::size_t bi = 0;
     for (const auto& jb : doc.at("error_budget")) {
-      const std::string bw = fmt::format("{}: error_budget[{}]", source, bi++);
-      ErrorBudget b;
-      if (!jb.contains("setup") || !jb.at("setup").is_string()) {
-        throw DataError(fmt::format("{}: missing string field 'setup'", bw));
-      }
-      b.setup = jb.at("setup").get<std::string>();
-      b.load_N = read_number(jb, "load_N", bw);
-      b.speed_mm_s = read_number(jb, "speed_mm_s", bw);
-      b.residual_mm_all = jb.contains("residual_mm_all") && jb.at("residual_mm_all").is_null()
-                              ? kNaN
-                              : read_number(jb, "residual_mm_all", bw);
-      b.uc_mm = jb.contains("uc_mm") && jb.at("uc_mm").is_null() ? kNaN : read_number(jb, "uc_mm", bw, false);
-      if (jb.contains("residual_mm_all_off") && !jb.at("residual_mm_all_off").is_null()) {
-        b.residual_mm_all_off = read_number(jb, "residual_mm_all_off", bw);
-      }
-      if (jb.contains("seed")) {
-        if (!jb.at("seed").is_number_unsigned()) throw DataError(fmt::format("{}: seed: not a seed", bw));
-        b.seed = jb.at("seed").get<std::uint64_t>();
-      }
-      if (jb.contains("laps")) {
-        const double laps = read_number(jb, "laps", bw);
-        if (laps < 0 || laps > 1e6 || laps != std::floor(laps))
-          throw DataError(fmt::format("{}: laps: not a lap count", bw));
-        b.laps = static_cast<int>(laps);
-      }
-      if (jb.contains("entries")) {
-        std::size_t ei = 0;
-        for (const auto& je : jb.at("entries")) {
-          const std::string ew = fmt::format("{}.entries[{}]", bw, ei++);
-          ErrorBudgetEntry e;
-          if (!je.contains("effect") || !je.at("effect").is_string()) {
-            throw DataError(fmt::format("{}: missing string field 'effect'", ew));
-          }
-          e.effect = je.at("effect").get<std::string>();
-          e.size = je.contains("size") && je.at("size").is_string() ? je.at("size").get<std::string>() : "";
-          e.residual_mm_without_it = je.contains("residual_mm_without_it") && je.at("residual_mm_without_it").is_null()
-                                         ? kNaN
-                                         : read_number(je, "residual_mm_without_it", ew);
-          e.sensitivity = one_at_a_time_sensitivity(b.residual_mm_all, e.residual_mm_without_it);
-          b.entries.push_back(e);
-        }
-      }
-      study.error_budgets.push_back(b);
+      study.error_budgets.push_back(read_error_budget(jb, fmt::format("{}: error_budget[{}]", source, bi++)));
     }
   }
   return study;
