@@ -92,13 +92,13 @@ std::vector<std::string> honest_notes(const CaseConfig& /*config*/, const StudyR
       const double uc = uc_over_paper(l, *pr), c = c_over_paper(l, *pr);
       std::vector<std::string> outside;
       if (std::isfinite(uc) && std::abs(uc - 1.0) > kUcTarget) {
-        outside.push_back(fmt::format("UC {:.3f} mm is {} of the paper's {:.2f} mm (target: within {})",
-                                      as_printed(l.uc_mean_spread().mean), percent_text(uc), pr->uc_mm,
+        outside.push_back(fmt::format("UC {:.3f} mm against the paper's {:.2f} mm, {} (target: within {})",
+                                      as_printed(l.uc_mean_spread().mean), pr->uc_mm, signed_percent_text(uc - 1.0),
                                       percent_text(kUcTarget)));
       }
       if (std::isfinite(c) && std::abs(c - 1.0) > kCTarget) {
-        outside.push_back(fmt::format("C over the paper's speeds is {} of the paper's (target: within {})",
-                                      percent_text(c), percent_text(kCTarget)));
+        outside.push_back(fmt::format("C over the paper's speeds {} against the paper's (target: within {})",
+                                      signed_percent_text(c - 1.0), percent_text(kCTarget)));
       }
       if (outside.empty()) continue;
       std::string text = fmt::format("{} {:g} N against the paper's {}: ", s.setup, l.load_N, table_name(*pt));
