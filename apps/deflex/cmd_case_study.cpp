@@ -12,6 +12,7 @@
 
 #include "cli_util.hpp"
 #include "command.hpp"
+#include "deflex/evaluate/path_metrics.hpp"
 #include "deflex/evaluate/tracker_files.hpp"
 #include "deflex/model/tracker_trace.hpp"
 #include "deflex/report/case_report.hpp"
@@ -19,6 +20,7 @@
 #include "deflex/study/case_study.hpp"
 #include "deflex/study/study_tables.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/text/input_file.hpp"
 #include "deflex/text/output_file.hpp"
 
 namespace deflex::cli {
@@ -95,8 +97,10 @@ void run(const CaseStudyOpts& o, int& exit_code) {
   const study::CaseStudyOutput result = study::run_case_study(config, options);
   if (!o.no_progress) std::cerr << "\n";
 
-  const ReportContent report =
-      study::case_report(config, result, o.case_file.empty() ? study::paper_case_yaml() : std::string());
+  // The case file's text goes into the report as it is, and its notes read what it marks as tuned.
+  const ReportContent report = study::case_report(
+      config, result,
+      o.case_file.empty() ? study::paper_case_yaml() : read_input_file(o.case_file, InputKind::kConfig));
   write_report(report, o.out_dir, outputs);
   outputs.commit();
 
@@ -108,27 +112,34 @@ void run(const CaseStudyOpts& o, int& exit_code) {
       std::cout << "\nSpeed sweep (beyond the paper): mean distance from the unloaded path, mm\n"
                 << "  setup            load    speed mm/s  UC mm   C mm    compensation\n";
       for (const auto& p : result.study.speed_sweep) {
-        std::cout << fmt::format("  {:<15} {:>5.0f} N  {:>10.0f}  {:.3f}   {:.3f}   {:.0f}%\n", p.setup, p.load_N,
-                                 p.speed_mm_s, p.uc_mm, p.c_mm, 100.0 * p.compensation);
+        // The compensation from the two figures as printed beside it.
+        std::cout << fmt::format("  {:<15} {:>5.0f} N  {:>10.0f}  {:.3f}   {:.3f}   {}\n", p.setup, p.load_N,
+                                 p.speed_mm_s, p.uc_mm, p.c_mm,
+                                 percent_text(compensation_ratio(as_printed(p.uc_mm), as_printed(p.c_mm))));
       }
     }
     for (const auto& b : result.study.error_budgets) {
       std::cout << fmt::format(
-          "\nError budget, {} {:.0f} N at {:.0f} mm/s (seed {}, the table's runs, {} laps each): C = {:.3f} mm with "
-          "every effect (UC {:.3f} mm)\n",
-          b.setup, b.load_N, b.speed_mm_s, b.seed, b.laps, b.residual_mm_all, b.uc_mm);
+          "\nError budget, one effect at a time, {} {:.0f} N at {:.0f} mm/s (seed {}, the table's runs, {} laps each): "
+          "C = {:.3f} mm with every effect (UC {:.3f} mm){}\n",
+          b.setup, b.load_N, b.speed_mm_s, b.seed, b.laps, b.residual_mm_all, b.uc_mm,
+          std::isfinite(b.residual_mm_all_off)
+              ? fmt::format(", {:.3f} mm with every effect off at once", b.residual_mm_all_off)
+              : std::string());
       // Columns as wide as their longest entry, so a long size never runs into the figures.
       std::size_t effect_w = 6, size_w = 4;
       for (const auto& e : b.entries) {
         effect_w = std::max(effect_w, e.effect.size());
         size_w = std::max(size_w, e.size.size());
       }
-      std::cout << fmt::format("  {:<{}}  {:<{}}  {:>18}  {:>7}\n", "effect", effect_w, "size", size_w,
-                               "C without it (mm)", "share");
+      std::cout << fmt::format("  {:<{}}  {:<{}}  {:>18}  {:>11}\n", "effect", effect_w, "size", size_w,
+                               "C without it (mm)", "sensitivity");
       for (const auto& e : b.entries) {
-        std::cout << fmt::format("  {:<{}}  {:<{}}  {:>18.3f}  {:>+6.0f}%\n", e.effect, effect_w, e.size, size_w,
-                                 e.residual_mm_without_it, 100.0 * e.share_of_residual);
+        std::cout << fmt::format("  {:<{}}  {:<{}}  {:>18.3f}  {:>11}\n", e.effect, effect_w, e.size, size_w,
+                                 e.residual_mm_without_it, percent_text(printed_sensitivity(b, e)));
       }
+      std::cout << "  sensitivity: (C with every effect - C without it alone) / C with every effect, from the printed "
+                   "figures; one effect at a time, so they need not add up to 100%\n";
     }
     if (!result.links.empty()) {
       std::cout << "\nThe online setups' controller links (deflex's deployable link code, over the cell's network):\n";

@@ -43,7 +43,10 @@ std::vector<std::pair<std::string, std::string>> every_figure() {
           {"laps", svg_lap_overlay(r.path_plots.front())},
           {"path (laps)", svg_path_plot(laps)},
           {"polar (laps)", svg_polar_deviation(laps)},
-          {"laps (laps)", svg_lap_overlay(laps)}};
+          {"laps (laps)", svg_lap_overlay(laps)},
+          {"signed", svg_signed_error(r.path_plots.front())},
+          {"signed (laps)", svg_signed_error(laps)},
+          {"budget", svg_error_budget(r.study.error_budgets.front())}};
 }
 
 TEST(Figures, EveryTextAtLeast11PxAndEveryFigureWithinThePage) {
@@ -161,17 +164,25 @@ TEST(Compensation, OursPerLoadWithTheSeedsRangeAndThePapers) {
     if (!attribute(r, "data-value").empty()) bars.push_back(r);
   }
   ASSERT_EQ(bars.size(), 9u);  // 3 setups x 3 loads
-  // Ours: per seed the mean over the speeds of 1 - C/UC, then their mean and range.
+  // Ours as the tables print it: 1 - (mean over the speeds of C) / (UC, the mean over the speeds),
+  // from the figures rounded to 3 decimals; per seed the same quantity for the range.
   const LoadResult& l = s.setups[1].loads[2];  // online 650 N
+  auto round3 = [](double v) { return std::round(v * 1000.0) / 1000.0; };
+  double c_printed = 0.0, uc_mean = 0.0;
+  for (const int v : s.speeds_mm_s) {
+    c_printed += round3(l.c_mm.at(v)) / 3.0;
+    uc_mean += l.uc_mm.at(v) / 3.0;
+  }
+  const double mean = 1.0 - c_printed / round3(uc_mean);
   std::vector<double> per_seed;
   for (std::size_t seed = 0; seed < 3; ++seed) {
-    double sum = 0.0;
+    double c_sum = 0.0, uc_sum = 0.0;
     for (const int v : s.speeds_mm_s) {
-      sum += 1.0 - l.c_mm_by_seed.at(v)[seed] / l.uc_mm_by_seed.at(v)[seed];
+      c_sum += l.c_mm_by_seed.at(v)[seed];
+      uc_sum += l.uc_mm_by_seed.at(v)[seed];
     }
-    per_seed.push_back(sum / 3.0);
+    per_seed.push_back(1.0 - c_sum / uc_sum);
   }
-  const double mean = (per_seed[0] + per_seed[1] + per_seed[2]) / 3.0;
   const auto [lo, hi] = std::minmax_element(per_seed.begin(), per_seed.end());
   const std::string& bar = bars[5];
   EXPECT_NEAR(std::stod(attribute(bar, "data-value")), mean, 1e-5);
@@ -179,7 +190,7 @@ TEST(Compensation, OursPerLoadWithTheSeedsRangeAndThePapers) {
   EXPECT_NEAR(std::stod(attribute(bar, "data-max")), *hi, 1e-5);
   // The whisker in pixels: the axis runs from the bar's baseline (0%) at the same scale as the bar.
   const Bar b = bar_of(bar);
-  const double px_per_unit = (b.bottom - b.top) / mean;
+  const double px_per_unit = (b.bottom - b.top) / std::stod(attribute(bar, "data-value"));
   const std::string w = whisker_at(svg, b.x_mid);
   ASSERT_FALSE(w.empty());
   EXPECT_NEAR(std::min(number(w, "y1"), number(w, "y2")), b.bottom - *hi * px_per_unit, 0.05);
@@ -260,12 +271,14 @@ TEST(Parity, PointsAndBandsAtTheirCoordinates) {
     if (pt == nullptr) continue;
     for (const auto& l : setup.loads) {
       const PaperRow* pr = pt->row_for(l.load_N);
-      for (const auto& [v, pc] : pr->c_mm) c_in += std::abs(l.c_mm.at(v) / pc - 1.0) <= 0.35 ? 1 : 0;
-      uc_in += std::abs(l.uc_mean_mm() / pr->uc_mm - 1.0) <= 0.25 ? 1 : 0;
+      // Ours as printed (3 decimals) against the paper's; the targets of issue 27: C 35%, UC 15%.
+      auto round3 = [](double v) { return std::round(v * 1000.0) / 1000.0; };
+      for (const auto& [v, pc] : pr->c_mm) c_in += std::abs(round3(l.c_mm.at(v)) / pc - 1.0) <= 0.35 ? 1 : 0;
+      uc_in += std::abs(round3(l.uc_mean_mm()) / pr->uc_mm - 1.0) <= 0.15 ? 1 : 0;
     }
   }
   EXPECT_NE(svg.find(fmt::format("C per load and speed within 35%: {} of 18", c_in)), std::string::npos);
-  EXPECT_NE(svg.find(fmt::format("UC per load within 25%: {} of 6", uc_in)), std::string::npos);
+  EXPECT_NE(svg.find(fmt::format("UC per load within 15%: {} of 6", uc_in)), std::string::npos);
 }
 
 TEST(SpeedSweep, FittedRangesWhiskersAndTheLabelOffTheData) {
@@ -499,7 +512,7 @@ TEST(HtmlReport, SaysWhatTheFiguresAreOf) {
   const std::string html = html_report(test::synthetic_report());
   for (const char* needle :
        {// Method: the reference, the second metric, the seeds.
-        "laps (3 clockwise and 3 anticlockwise in the protocol) averaged into one closed path",
+        "laps (clockwise and anticlockwise, as many as the protocol runs) averaged into one closed path",
         "Time-synchronous error: for every tracker point", "Seeds: 3 seeds (11, 12, 13)",
         // ISO: against the unloaded laps' mean, RT_p of the compensated laps, means over the seeds.
         "with the mean of the unloaded laps at the same speed as the reference path",

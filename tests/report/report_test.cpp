@@ -195,9 +195,9 @@ TEST(HtmlReport, SelfContainedWellFormedAndComplete) {
     EXPECT_NE(html.find(needle), std::string::npos) << needle;
   }
   // Figure 5 (the paper's setups), its companion (hybrid), compensation, parity, for the one path
-  // plot its path, polar and per-lap figures, and the sweep.
-  EXPECT_EQ(test::count_of(html, "<svg "), 8u);
-  // Budget shares: (0.20 - 0.12) / 0.20 = 40%; a share of -0.2% rounds to 0%, never "-0%".
+  // plot its path, polar, per-lap and signed-error figures, the budget's chart and the sweep.
+  EXPECT_EQ(test::count_of(html, "<svg "), 10u);
+  // Budget sensitivities: (0.20 - 0.12) / 0.20 = 40%; 0.2004 prints as 0.200, so 0%, never "-0%".
   EXPECT_NE(html.find("<td>0.120</td><td>40%</td>"), std::string::npos);
   // Tables give the spread over the seeds: 625 N offline, C at 10 mm/s: mean m = 0.6125 * 1.02 *
   // 0.34 = 0.21242, seeds m * (0.88, 1.024, 1.096): sample sd 0.12 m sqrt(0.84) = 0.0234.
@@ -221,7 +221,8 @@ TEST(HtmlReport, WritesTheReportAndFigures) {
   const ReportContent content = test::synthetic_report();
   write_report(content, dir.string());
   for (const char* f : {"report.html", "figure5.svg", "figure5_beyond.svg", "compensation.svg", "parity.svg",
-                        "speed_sweep.svg", "path_1.svg", "polar_1.svg", "laps_1.svg", "tables.md", "tables.csv"}) {
+                        "speed_sweep.svg", "path_1.svg", "polar_1.svg", "laps_1.svg", "signed_1.svg", "budget_1.svg",
+                        "tables.md", "tables.csv", "error_budget.csv"}) {
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
   }
   std::ifstream in(dir / "report.html");
@@ -235,10 +236,10 @@ TEST(HtmlReport, WritesTheReportAndFigures) {
   EXPECT_THROW(write_report(content, "/proc/deflex-cannot-write-here"), Error);
 }
 
-TEST(ErrorBudget, ResidualShare) {
-  EXPECT_NEAR(residual_share(0.20, 0.12), 0.4, 1e-15);
-  EXPECT_NEAR(residual_share(0.20, 0.25), -0.25, 1e-15);  // switching it off made things worse
-  EXPECT_TRUE(std::isnan(residual_share(0.0, 0.1)));
+TEST(ErrorBudget, OneAtATimeSensitivity) {
+  EXPECT_NEAR(one_at_a_time_sensitivity(0.20, 0.12), 0.4, 1e-15);
+  EXPECT_NEAR(one_at_a_time_sensitivity(0.20, 0.25), -0.25, 1e-15);  // switching it off made things worse
+  EXPECT_TRUE(std::isnan(one_at_a_time_sensitivity(0.0, 0.1)));
 }
 
 }  // namespace

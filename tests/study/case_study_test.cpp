@@ -264,6 +264,9 @@ TEST(CaseStudy, TheErrorBudgetsEveryEffectFigureIsTheTablesOwnRun) {
     EXPECT_EQ(b.seed, c.seed);
     EXPECT_EQ(b.laps, 1);
     EXPECT_GT(b.entries.size(), 10u);
+    // Every effect off at once, on a cell calibrated as the others are: far below C with every effect.
+    EXPECT_TRUE(std::isfinite(b.residual_mm_all_off)) << b.setup;
+    EXPECT_LT(b.residual_mm_all_off, b.residual_mm_all) << b.setup;
     bool tracker = false;
     for (const auto& e : b.entries) {
       EXPECT_TRUE(std::isfinite(e.residual_mm_without_it)) << e.effect;

@@ -127,8 +127,8 @@ TEST(StudyTables, TextTableShowsOursBesideThePapers) {
   // UC is the mean over speeds (0.121), beside the paper's 0.12; C at 10 mm/s beside 0.04.
   EXPECT_NE(text.find("0.121 (0.12)"), std::string::npos) << text;
   EXPECT_NE(text.find("0.041 (0.04)"), std::string::npos) << text;
-  // Compensation: mean over speeds of 1 - C/UC, beside the paper's 1 - 0.04/0.12 = 67%.
-  const double ours = ((1 - 0.041 / 0.118) + (1 - 0.040 / 0.121) + (1 - 0.043 / 0.124)) / 3.0;
+  // Compensation: 1 - (mean of the printed C) / printed UC, as the paper's 1 - 0.04/0.12 = 67% is.
+  const double ours = 1.0 - (0.041 + 0.040 + 0.043) / 3.0 / 0.121;
   EXPECT_NE(text.find(fmt::format("{:.0f}% (67%)", ours * 100.0)), std::string::npos) << text;
   EXPECT_NE(text.find("125 N +1%"), std::string::npos) << text;  // 0.121 / 0.12 - 1
   EXPECT_NE(text.find("90%"), std::string::npos) << text;        // hybrid, no paper figure
@@ -137,7 +137,8 @@ TEST(StudyTables, TextTableShowsOursBesideThePapers) {
 TEST(StudyTables, MarkdownAndCsv) {
   const StudyResult s = example_study();
   const std::string md = study_tables_markdown(s);
-  EXPECT_NE(md.find("| load | UC mm | C1 10 mm/s | C2 30 mm/s | C3 50 mm/s | compensation |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| load | UC mm | C1 10 mm/s | C2 30 mm/s | C3 50 mm/s | compensation % |"), std::string::npos)
+      << md;
   EXPECT_NE(md.find("| 125 N | 0.121 (0.12) |"), std::string::npos) << md;
   const auto path = (std::filesystem::temp_directory_path() / "deflex_study.csv").string();
   write_study_csv(s, path);
@@ -173,6 +174,12 @@ TEST(StudyTables, SpeedColumnsValueLookupAndPercentText) {
   EXPECT_EQ(percent_text(-0.004), "0%");            // rounds to zero: no "-0%"
   EXPECT_EQ(percent_text(-0.25), "-25%");
   EXPECT_EQ(percent_text(std::nan("")), "n/a");
+  // Halves away from zero, as a reader rounds them, though the binary quotient falls a hair short:
+  // 1 - 0.051 / 0.120 = 57.5% and (0.043 + 0.041 + 0.051) / 0.12 - 1 = +12.5%.
+  EXPECT_EQ(percent_text(1.0 - 0.051 / 0.120), "58%");
+  EXPECT_EQ(signed_percent_text((0.043 + 0.041 + 0.051) / (0.04 + 0.04 + 0.04) - 1.0), "+13%");
+  EXPECT_EQ(signed_percent_text(-0.125), "-13%");
+  EXPECT_EQ(signed_percent_text(0.004), "0%");
 }
 
 }  // namespace
@@ -216,7 +223,8 @@ TEST(StudyTables, MeansAndSpreadOverSeedsAndTheirJsonAndCsv) {
   b.uc_mm = 1.1;
   b.seed = 7;
   b.laps = 6;
-  b.entries = {{"lost motion", "40 urad", 0.15, residual_share(0.2, 0.15)}};
+  b.entries = {{"lost motion", "40 urad", 0.15, one_at_a_time_sensitivity(0.2, 0.15)}};
+  b.residual_mm_all_off = 0.04;
   study.error_budgets = {b};
   const StudyResult back = study_from_json(study_to_json(study), "test");
   EXPECT_EQ(back.seeds, study.seeds);
@@ -225,7 +233,14 @@ TEST(StudyTables, MeansAndSpreadOverSeedsAndTheirJsonAndCsv) {
   EXPECT_EQ(back.error_budgets[0].entries[0].effect, "lost motion");
   EXPECT_EQ(back.error_budgets[0].seed, 7u);
   EXPECT_EQ(back.error_budgets[0].laps, 6);
-  EXPECT_NEAR(back.error_budgets[0].entries[0].share_of_residual, 0.25, 1e-12);
+  EXPECT_NEAR(back.error_budgets[0].entries[0].sensitivity, 0.25, 1e-12);
+  EXPECT_EQ(back.error_budgets[0].residual_mm_all_off, 0.04);
+  // Not run: null in the JSON, NaN again when read back.
+  StudyResult not_run = study;
+  not_run.error_budgets[0].residual_mm_all_off = std::nan("");
+  const nlohmann::json not_run_json = study_to_json(not_run);
+  EXPECT_TRUE(not_run_json.at("error_budget")[0].at("residual_mm_all_off").is_null());
+  EXPECT_TRUE(std::isnan(study_from_json(not_run_json, "test").error_budgets[0].residual_mm_all_off));
   // The text table carries the spread: "0.200 ±0.100 (0.25)" for C at 10 mm/s.
   const std::string text = study_tables_text(study);
   EXPECT_NE(text.find("0.200 ±0.100 (0.25)"), std::string::npos) << text;
@@ -237,9 +252,9 @@ TEST(StudyTables, MeansAndSpreadOverSeedsAndTheirJsonAndCsv) {
   std::getline(in, header);
   std::getline(in, row);
   EXPECT_EQ(header,
-            "setup,load_N,speed_mm_s,seed,laps,residual_mm_all,uc_mm,effect,size,residual_mm_without_it,"
-            "share_of_residual");
-  EXPECT_EQ(row, "online,650,50,7,6,0.2,1.1,lost motion,40 urad,0.15,0.25");
+            "setup,load_N,speed_mm_s,seed,laps,residual_mm_all,residual_mm_all_off,uc_mm,effect,size,"
+            "residual_mm_without_it,sensitivity_one_at_a_time");
+  EXPECT_EQ(row, "online,650,50,7,6,0.2,0.04,1.1,lost motion,40 urad,0.15,0.25");
 }
 
 }  // namespace

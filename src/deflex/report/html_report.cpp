@@ -60,12 +60,6 @@ std::string percent_spread(const Spread& s) {
   return fmt::format("{} <span class=\"sd\">&#177;{:.0f}</span>", percent_text(s.mean), s.sd * 100.0);
 }
 
-// "+18%", "-7%", and "0%" (never "-0%") for a relative difference.
-std::string signed_percent(double fraction) {
-  const double r = std::round(fraction * 100.0);
-  return r == 0.0 ? "0%" : fmt::format("{:+.0f}%", r);
-}
-
 std::string with_paper(const std::string& ours, double paper_value, int decimals = 2) {
   if (!std::isfinite(paper_value)) {
     return ours;
@@ -84,18 +78,37 @@ std::string seeds_text(const StudyResult& study) {
   return fmt::format("{} seeds ({})", study.seeds.size(), list);
 }
 
+// The setups compared with a paper table of another name, in a sentence ("" when none).
+std::string paper_link_sentence(const StudyResult& study) {
+  const PaperFigures paper = paper_reference();
+  std::string out;
+  for (const auto& s : study.setups) {
+    const PaperTable* pt = paper.table_for(s.paper_table);
+    if (s.paper_table.empty() || paper.table_for(s.setup) != nullptr || pt == nullptr) continue;
+    out += fmt::format(
+        " The setup {}, {}, is set beside the paper's {}, as is the setup {}: the paper measured that "
+        "table over such a link.",
+        esc(s.setup), esc(s.paper_label), esc(pt->caption.substr(0, pt->caption.find('.'))), esc(s.paper_table));
+  }
+  return out;
+}
+
 std::string results_tables(const StudyResult& study) {
   const PaperFigures paper = paper_reference();
   const std::vector<int> speeds = study_speeds_mm_s(study);
   std::string h;
   int next = 3;
   for (const auto& s : study.setups) {
-    const PaperTable* pt = paper.table_for(s.setup);
+    const PaperTable* pt = paper_table_of(paper, s);
     std::string title;
     if (s.setup == "offline") {
       title = "Table 1: offline compensation";
     } else if (s.setup == "online") {
       title = "Table 2: online compensation (force sensor mounted)";
+    } else if (pt != nullptr) {
+      title = fmt::format("Table {}: {}, {}, beside the paper's {}", next++, s.setup,
+                          s.paper_label.empty() ? "compared with the paper" : s.paper_label,
+                          pt->caption.substr(0, pt->caption.find('.')));
     } else {
       title = fmt::format("Table {}: {} (beyond the paper)", next++, s.setup);
     }
@@ -108,9 +121,9 @@ std::string results_tables(const StudyResult& study) {
       h += fmt::format("<th>C{} at {} mm/s (mm)</th>", i + 1, speeds[i]);
     }
     for (const int v : speeds) {
-      h += fmt::format("<th>comp. {} mm/s</th>", v);
+      h += fmt::format("<th>comp. {} mm/s (%)</th>", v);
     }
-    h += pt != nullptr ? "<th>UC vs paper</th><th>C vs paper (mean over speeds)</th></tr>\n" : "</tr>\n";
+    h += pt != nullptr ? "<th>UC vs paper (%)</th><th>C vs paper, mean over speeds (%)</th></tr>\n" : "</tr>\n";
     for (const auto& l : s.loads) {
       const PaperRow* pr = pt != nullptr ? pt->row_for(l.load_N) : nullptr;
       h += fmt::format("<tr><td class=\"l\">{:g} N</td><td>{}</td>", l.load_N,
@@ -122,36 +135,23 @@ std::string results_tables(const StudyResult& study) {
       for (const int v : speeds) {
         const double paper_comp = pr != nullptr ? compensation_ratio(pr->uc_mm, value_at_speed(pr->c_mm, v))
                                                 : kNaN;  // its UC: the speeds' mean
-        const std::string ours = percent_text(value_at_speed(l.compensation, v));
-        h += fmt::format("<td>{}</td>",
-                         std::isfinite(paper_comp)
-                             ? fmt::format("{} <span class=\"paper\">({:.0f}%)</span>", ours, paper_comp * 100.0)
-                             : ours);
+        // Ours the same way, from the figures printed in this row.
+        const std::string ours = percent_text(printed_compensation(l, v));
+        h += fmt::format("<td>{}</td>", std::isfinite(paper_comp) ? fmt::format("{} <span class=\"paper\">({})</span>",
+                                                                                ours, percent_text(paper_comp))
+                                                                  : ours);
       }
       if (pt != nullptr) {
-        if (pr != nullptr && std::isfinite(l.uc_mean_mm())) {
-          const double rel = l.uc_mean_mm() / pr->uc_mm - 1.0;
-          h += fmt::format("<td class=\"{}\">{}</td>", std::abs(rel) <= 0.25 ? "good" : "bad", signed_percent(rel));
-        } else {
-          h += "<td>n/a</td>";
-        }
-        double ours = 0.0, theirs = 0.0;
-        int n = 0;
-        if (pr != nullptr) {
-          for (const auto& [v, pc] : pr->c_mm) {
-            const double o = value_at_speed(l.c_mm, v);
-            if (std::isfinite(o)) {
-              ours += o;
-              theirs += pc;
-              ++n;
-            }
+        // Both from the printed figures of this row, so a reader's own division gives the same.
+        const double uc_rel = pr != nullptr ? uc_over_paper(l, *pr) - 1.0 : kNaN;
+        const double c_rel = pr != nullptr ? c_over_paper(l, *pr) - 1.0 : kNaN;
+        for (const auto& [rel, target] : {std::pair{uc_rel, kUcTarget}, std::pair{c_rel, kCTarget}}) {
+          if (std::isfinite(rel)) {
+            h += fmt::format("<td class=\"{}\">{}</td>", std::abs(rel) <= target ? "good" : "bad",
+                             signed_percent_text(rel));
+          } else {
+            h += "<td>n/a</td>";
           }
-        }
-        if (n > 0 && theirs > 0.0) {
-          const double rel = ours / theirs - 1.0;
-          h += fmt::format("<td class=\"{}\">{}</td>", std::abs(rel) <= 0.35 ? "good" : "bad", signed_percent(rel));
-        } else {
-          h += "<td>n/a</td>";
         }
       }
       h += "</tr>\n";
@@ -161,10 +161,12 @@ std::string results_tables(const StudyResult& study) {
   h += fmt::format(
       "<p class=\"caption\">Mean distance of the loaded runs' tracker points from the unloaded laps' mean path at the "
       "same speed (the paper's metric), in mm: the mean over {}{}; the paper's figures in brackets (grey). UC is the "
-      "mean over the speeds, as in the paper. Compensation = 1 - C/UC: ours with UC at the same speed, the paper's "
-      "with its mean UC. \"UC vs paper\" is green within 25% and \"C vs paper\" (C averaged over the speeds) within "
-      "35%: the fidelity targets.</p>\n",
-      seeds_text(study), study.seed_count() > 1 ? ", &#177; the sample standard deviation over the seeds" : "");
+      "mean over the speeds, as in the paper. Compensation = 1 - C/UC with that UC, ours and the paper's alike, "
+      "and every percentage here is computed from the figures as printed beside it. \"UC vs paper\" is green "
+      "within {} and \"C vs paper\" (C summed over the paper's speeds against the paper's sum) within {}: the "
+      "fidelity targets.{}</p>\n",
+      seeds_text(study), study.seed_count() > 1 ? ", &#177; the sample standard deviation over the seeds" : "",
+      percent_text(kUcTarget), percent_text(kCTarget), paper_link_sentence(study));
   return h;
 }
 
@@ -218,30 +220,31 @@ std::string sync_table(const StudyResult& study) {
 std::string compensation_table(const StudyResult& study) {
   const PaperFigures paper = paper_reference();
   const std::vector<int> speeds = study_speeds_mm_s(study);
-  std::string h = "<table>\n<tr><th class=\"l\">setup</th><th>load</th><th>ours, mean over the speeds</th>";
+  std::string h = "<table>\n<tr><th class=\"l\">setup</th><th>load</th><th>ours, mean over the speeds (%)</th>";
   if (study.seed_count() > 1) {
-    h += "<th>seeds: min to max</th>";
+    h += "<th>seeds: min to max (%)</th>";
   }
   for (const int v : speeds) {
-    h += fmt::format("<th>ours at {} mm/s</th>", v);
+    h += fmt::format("<th>ours at {} mm/s (%)</th>", v);
   }
-  h += "<th>the paper's, mean over the speeds</th><th class=\"l\">the paper's at ";
+  h += "<th>the paper's, mean over the speeds (%)</th><th class=\"l\">the paper's at ";
   for (std::size_t i = 0; i < speeds.size(); ++i) {
     h += fmt::format("{}{}", i == 0 ? "" : " / ", speeds[i]);
   }
-  h += " mm/s</th></tr>\n";
+  h += " mm/s (%)</th></tr>\n";
   for (const auto& s : study.setups) {
-    const PaperTable* pt = paper.table_for(s.setup);
+    const PaperTable* pt = paper_table_of(paper, s);
     for (const auto& l : s.loads) {
       const PaperRow* pr = pt != nullptr ? pt->row_for(l.load_N) : nullptr;
-      Spread comp = l.compensation_spread();
+      // As the results tables print it, from their printed figures.
+      const Spread comp = printed_compensation_spread(l, speeds);
       h += fmt::format("<tr><td class=\"l\">{}</td><td>{:g} N</td><td>{}</td>", esc(s.setup), l.load_N,
                        percent_spread(comp));
       if (study.seed_count() > 1) {
         h += fmt::format("<td>{} to {}</td>", percent_text(comp.min), percent_text(comp.max));
       }
       for (const int v : speeds) {
-        h += fmt::format("<td>{}</td>", percent_text(value_at_speed(l.compensation, v)));
+        h += fmt::format("<td>{}</td>", percent_text(printed_compensation(l, v)));
       }
       if (pr != nullptr) {
         std::string per_speed;
@@ -314,19 +317,31 @@ const LoadResult* load_of(const StudyResult& study, const std::string& setup, do
   return nullptr;
 }
 
+// ", while switching every effect off at once lowers C by 78%" ("" when that run is missing).
+std::string all_off_text(const ErrorBudget& b) {
+  const double s = one_at_a_time_sensitivity(as_printed(b.residual_mm_all), as_printed(b.residual_mm_all_off));
+  if (!std::isfinite(s)) return "";
+  return fmt::format(", while switching every effect off at once {} C by {}", s >= 0.0 ? "lowers" : "raises",
+                     percent_text(std::abs(s)));
+}
+
 std::string budget_tables(const StudyResult& study) {
   const std::vector<ErrorBudget>& budgets = study.error_budgets;
   if (budgets.empty()) {
     return "";
   }
   std::string h =
-      "<h2 id=\"budget\">Error budget</h2>\n<p class=\"caption\">Each effect of the simulated cell that the "
-      "compensators' model "
-      "lacks, its size, and the compensated residual when that effect alone is switched off. Its share is "
-      "(residual with all effects - residual without it) / residual with all effects; shares need not add up to "
-      "100% (effects interact, and tracker noise stays in every run). The residual with every effect on is one "
-      "seed's run, the very run the tables average with the other seeds'; the table's mean over the seeds is "
-      "given beside it, and the two differ by that seed's scatter.</p>\n";
+      "<h2 id=\"budget\">Error budget: one effect at a time</h2>\n<p class=\"caption\">Each effect of the simulated "
+      "cell that the compensators' model lacks, its size, and the compensated residual C when that effect alone is "
+      "switched off (a cell built without it, calibrated anew, running the same runs with the same seeds). The "
+      "sensitivity is (C with every effect - C without it) / C with every effect: how much C falls when that one "
+      "effect is gone. It is not a share of the residual, and the effects' sensitivities do not add up to 100%: "
+      "effects interact (one can hide or offset another, so switching it off can even raise C), the calibration "
+      "absorbs part of each effect and absorbs it differently when another is gone, and C does not grow linearly "
+      "with the effects. C with every effect off at once (its own calibration too) shows what is left when none "
+      "of them is there. The run with every effect on is one seed's, the very run the tables average with the "
+      "other seeds'; the table's mean over the seeds is given beside it, and the two differ by that seed's "
+      "scatter. Every percentage is computed from the figures as printed (3 decimals).</p>\n";
   for (const auto& b : budgets) {
     std::string origin;
     if (b.seed != 0 || b.laps > 0) {
@@ -342,27 +357,72 @@ std::string budget_tables(const StudyResult& study) {
                              : fmt::format("; the table's C: {} mm", mm(s.mean));
       }
     }
-    h += fmt::format("<h3>{}, {:g} N, {:g} mm/s{}: residual {} mm with every effect on{}{}</h3>\n", esc(b.setup),
-                     b.load_N, b.speed_mm_s, origin, mm(b.residual_mm_all),
+    h += fmt::format("<h3>{}, {:g} N, {:g} mm/s{}: C {} mm with every effect on{}{}</h3>\n", esc(b.setup), b.load_N,
+                     b.speed_mm_s, origin, mm(b.residual_mm_all),
                      b.uc_mm > 0.0 ? fmt::format(" (UC {} mm)", mm(b.uc_mm)) : "", table_mean);
-    h += "<table>\n<tr><th class=\"l\">effect</th><th class=\"l\">size</th><th>residual without it (mm)</th>"
-         "<th>share of the residual</th><th class=\"l\"></th></tr>\n";
+    h += "<div class=\"fig\">\n" + svg_error_budget(b) + "</div>\n";
+    h += "<table>\n<tr><th class=\"l\">effect</th><th class=\"l\">size</th><th>C without it alone (mm)</th>"
+         "<th>sensitivity, one effect at a time: (C<sub>every effect</sub> - C<sub>without it</sub>) / "
+         "C<sub>every effect</sub> (%)</th></tr>\n";
+    double sum = 0.0;
+    int n = 0;
     for (const auto& e : b.entries) {
-      const double share = e.share_of_residual;
-      const double w = std::isfinite(share) ? std::clamp(share, 0.0, 1.0) * 160.0 : 0.0;
+      const double sensitivity = printed_sensitivity(b, e);
+      if (std::isfinite(sensitivity)) {
+        sum += whole_percent(sensitivity);
+        ++n;
+      }
+      h += fmt::format("<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td></tr>\n", esc(e.effect),
+                       esc(e.size), mm(e.residual_mm_without_it), percent_text(sensitivity));
+    }
+    h += fmt::format("<tr><td class=\"l\"><b>every effect on</b></td><td class=\"l\"></td><td>{}</td><td></td></tr>\n",
+                     mm(b.residual_mm_all));
+    if (std::isfinite(b.residual_mm_all_off)) {
       h += fmt::format(
-          "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td>"
-          "<td class=\"l\"><span class=\"bar\" style=\"width:{:.0f}px\"></span></td></tr>\n",
-          esc(e.effect), esc(e.size), mm(e.residual_mm_without_it), percent_text(share), w);
+          "<tr><td class=\"l\"><b>every effect off at once</b></td><td class=\"l\">its own calibration</td>"
+          "<td>{}</td><td>{}</td></tr>\n",
+          mm(b.residual_mm_all_off),
+          percent_text(one_at_a_time_sensitivity(as_printed(b.residual_mm_all), as_printed(b.residual_mm_all_off))));
     }
     h += "</table>\n";
+    if (n > 0) {
+      h += fmt::format(
+          "<p class=\"caption\">The {} sensitivities above add up to {:.0f}%{}: they are not shares of one "
+          "residual.</p>\n",
+          n, sum, all_off_text(b));
+    }
   }
   return h;
 }
 
 bool any_setup(const StudyResult& study, bool with_paper) {
   return std::any_of(study.setups.begin(), study.setups.end(),
-                     [&](const SetupResult& s) { return paper_has_setup(s.setup) == with_paper; });
+                     [&](const SetupResult& s) { return paper_has_setup(s) == with_paper; });
+}
+
+// The paper's compensation per table, from its own figures: ": offline 67% at every load, online 69%
+// to 80%, rising with the load" (each row's 1 - mean C / UC).
+std::string paper_compensation_text() {
+  std::string out;
+  for (const auto& t : paper_reference().tables) {
+    std::vector<std::string> per_row;
+    double lo = kNaN, hi = kNaN;
+    bool rising = true;
+    double last = -1.0;
+    for (const auto& r : t.rows) {
+      const double p = whole_percent(r.mean_compensation());
+      lo = std::isfinite(lo) ? std::min(lo, p) : p;
+      hi = std::isfinite(hi) ? std::max(hi, p) : p;
+      rising = rising && p > last;
+      last = p;
+    }
+    if (!std::isfinite(lo)) continue;
+    const std::string range = lo == hi
+                                  ? fmt::format("{:.0f}% at every load", lo)
+                                  : fmt::format("{:.0f}% to {:.0f}%{}", lo, hi, rising ? ", rising with the load" : "");
+    out += fmt::format("{} {} {}", out.empty() ? ":" : ";", esc(t.setup), range);
+  }
+  return out;
 }
 
 std::string figures_html(const StudyResult& study) {
@@ -380,17 +440,17 @@ std::string figures_html(const StudyResult& study) {
        "</div>\n";
   h += "<p class=\"caption\">Upper panel: our residual after compensation (C) per load and speed; lower panel: the "
        "uncompensated deviation (UC, pale), the mean over the speeds as in the paper. Outlined bars: the paper's "
-       "values (Tables 1 and 2) beside ours. " +
-       whiskers + "</p>\n";
+       "values (Tables 1 and 2) beside ours." +
+       paper_link_sentence(study) + " " + whiskers + "</p>\n";
   if (paper_setups && other_setups) {
     h += "<div class=\"fig\">\n" + svg_figure5(study, SetupSelection::kBeyondPaper) + "</div>\n";
     h +=
         "<p class=\"caption\">The same, on the same axes, for the setups the paper did not run. " + whiskers + "</p>\n";
   }
   h += "<h2 id=\"compensation\">Compensation per load</h2>\n";
-  h += "<p class=\"caption\">The figure the paper quotes: offline about 67% at every load, online 69% to 80%, "
-       "rising with the load. Ours: 1 - C/UC at each speed, averaged over the speeds, per seed; the paper's: 1 - "
-       "C/UC with its UC (the mean over its speeds), averaged over the speeds. " +
+  h += "<p class=\"caption\">The figure the paper quotes" + paper_compensation_text() +
+       ". Ours and the paper's alike: 1 - (C averaged over the speeds) / UC (the mean over the speeds), from the "
+       "figures as the tables print them; whiskers: the same per seed. " +
        whiskers + "</p>\n";
   h += "<div class=\"fig\">\n" + svg_compensation(study) + "</div>\n";
   h += compensation_table(study);
@@ -398,8 +458,10 @@ std::string figures_html(const StudyResult& study) {
     h += "<h2 id=\"parity\">Parity with the paper</h2>\n<div class=\"fig\">\n" + svg_parity(study) + "</div>\n";
     h += "<p class=\"caption\">Every figure of the paper's Tables 1 and 2 against ours: C per load and speed "
          "(dots) and UC per load (squares, the mean over the speeds). Log axes, so equal ratios are equal "
-         "distances. Shaded: within 35% of the paper's (the fidelity target for C, judged per load on the mean "
-         "over the speeds); dashed: 25% either side (the target for UC). " +
+         "distances. Shaded: within " +
+         percent_text(kCTarget) +
+         " of the paper's (the fidelity target for C, judged per load on the mean over the speeds); dashed: " +
+         percent_text(kUcTarget) + " either side (the target for UC)." + paper_link_sentence(study) + " " +
          whiskers_of("Ours") + "</p>\n";
   }
   return h;
@@ -447,6 +509,7 @@ std::string html_report(const ReportContent& content) {
       }
       h += "<div class=\"fig pair\">\n" + svg_path_plot(p) + svg_polar_deviation(p) + "</div>\n";
       h += "<div class=\"fig\">\n" + svg_lap_overlay(p) + "</div>\n";
+      h += "<div class=\"fig\">\n" + svg_signed_error(p) + "</div>\n";
     }
     h += "<p class=\"caption\">Left: the last lap of the uncompensated (UC) and compensated (C) runs in the plane of "
          "the reference (the unloaded laps' mean path), each point drawn at its nearest reference point plus its "
@@ -455,7 +518,10 @@ std::string html_report(const ReportContent& content) {
          "of a direction averaged in 5 deg sectors. Below: every lap of each run, clockwise and anticlockwise in "
          "their own colours, against the angle about the circle's centre (0 deg: the base's +x direction from the "
          "centre; angles grow anticlockwise seen from above), with an arrowhead in each lap's direction of travel. "
-         "All from the first seed's runs.</p>\n";
+         "Last: the compensated run's signed error, its deviation from the reference along the direction the "
+         "uncompensated run deviated at the same angle (that run's laps of the same direction of travel, averaged "
+         "in 5 deg sectors): above 0 under-compensated (still deflected the way the load pushes), below 0 "
+         "over-compensated, which the distances above cannot tell apart. All from the first seed's runs.</p>\n";
   }
   h += budget_tables(study);
   if (!study.speed_sweep.empty()) {
@@ -475,8 +541,9 @@ std::string html_report(const ReportContent& content) {
   }
   h += fmt::format(
       "<h2 id=\"method\">How the figures are computed</h2>\n<ul>\n"
-      "<li>Reference path: the unloaded run at the same speed, its laps (3 clockwise and 3 anticlockwise in the "
-      "protocol) averaged into one closed path: the samples binned by their angle about the centre (3600 sectors) "
+      "<li>Reference path: the unloaded run at the same speed, its laps (clockwise and anticlockwise, as many as "
+      "the protocol runs) averaged into one closed path: the samples binned by their angle about the centre (3600 "
+      "sectors) "
       "and each sector's positions averaged. Measuring to every unloaded sample instead would bias the distance low "
       "by the unloaded trace's own noise.</li>\n"
       "<li>Mean deformation (the paper's figure, \"nearest-point\"): for every tracker point of a loaded run, the "
@@ -485,13 +552,14 @@ std::string html_report(const ReportContent& content) {
       "<li>Time-synchronous error: for every tracker point of a loaded run, the distance to the unloaded run's "
       "position at the same time since the start of motion (interpolated); the mean over the points. It sees lag "
       "and lead along the path too, so it judges latency and the predictive strategy.</li>\n"
-      "<li>Compensation = 1 - C/UC, ours with UC at the same speed, the paper's with its UC column (the mean over "
-      "its speeds).</li>\n"
+      "<li>Compensation = 1 - C/UC with UC the mean over the speeds (the paper's UC column), ours and the paper's "
+      "alike, computed from the figures as the tables print them (results.json and tables.csv keep 1 - C/UC at "
+      "each speed with that speed's UC, unrounded).</li>\n"
       "<li>Seeds: {}. Each seed is its own cell (true robot, sensor, calibration) and its own runs; tables and "
       "figures give the mean over the seeds; the tables add &#177; the sample standard deviation, the figures "
-      "whiskers from the smallest to the largest seed's value. The path, polar and lap figures show the first "
-      "seed's runs at each setup's highest load and lowest speed; the error budget uses the first seed's table "
-      "runs.</li>\n"
+      "whiskers from the smallest to the largest seed's value. The path, polar, lap and signed-error figures show "
+      "the first seed's runs at each setup's highest load and the protocol's first speed (each figure's title "
+      "names them); the error budget uses the first seed's table runs.</li>\n"
       "<li>ISO 9283 path accuracy AT<sub>p</sub> and repeatability RT<sub>p</sub>: section 7.2 of the standard, "
       "positions only, against the same reference (see docs/evaluation.md).</li>\n</ul>\n",
       seeds_text(study));
@@ -528,6 +596,10 @@ void write_report(const ReportContent& content, const std::string& out_dir, Outp
     write_text(fmt::format("path_{}.svg", i + 1), svg_path_plot(p));
     write_text(fmt::format("polar_{}.svg", i + 1), svg_polar_deviation(p));
     write_text(fmt::format("laps_{}.svg", i + 1), svg_lap_overlay(p));
+    write_text(fmt::format("signed_{}.svg", i + 1), svg_signed_error(p));
+  }
+  for (std::size_t i = 0; i < study.error_budgets.size(); ++i) {
+    write_text(fmt::format("budget_{}.svg", i + 1), svg_error_budget(study.error_budgets[i]));
   }
   write_text("tables.md", study_tables_markdown(study));
   write_text("tables.csv", study_csv_text(study));

@@ -28,8 +28,9 @@ std::string html_report(const ReportContent& content);
 /// Writes out_dir/report.html, figure5.svg (the paper's setups; all when none is the paper's),
 /// figure5_beyond.svg (the other setups, when there are both), compensation.svg, parity.svg (when a
 /// setup is the paper's), speed_sweep.svg and sweep.csv (when there is a sweep), per path plot
-/// path_<n>.svg, polar_<n>.svg and laps_<n>.svg, tables.md, tables.csv, error_budget.csv (when there
-/// is a budget) and results.json (the study's JSON, study_to_json); creates out_dir if needed. The
+/// path_<n>.svg, polar_<n>.svg, laps_<n>.svg and signed_<n>.svg, per error budget budget_<n>.svg,
+/// tables.md, tables.csv, error_budget.csv (when there is a budget) and results.json (the study's
+/// JSON, study_to_json); creates out_dir if needed. The
 /// files are outputs of `outputs` (output_file.hpp), written when it commits. Throws Error when the
 /// folder cannot be made, InputError when a file cannot be an output.
 void write_report(const ReportContent& content, const std::string& out_dir, OutputTransaction& outputs);

@@ -14,11 +14,14 @@
 
 namespace deflex {
 
-/// Which setups a study figure draws: those the paper has a table for (offline, online), the others
-/// (beyond the paper), or all.
+/// Which setups a study figure draws: those compared with a table of the paper (offline, online, and
+/// a setup on the paper's own kind of link: SetupResult::paper_table), the others (beyond the
+/// paper), or all.
 enum class SetupSelection { kPaper, kBeyondPaper, kAll };
-/// True when the paper has a table for the setup.
+/// True when the paper has a table of the setup's name.
 [[nodiscard]] bool paper_has_setup(const std::string& setup);
+/// True when the setup is compared with a table of the paper (its own name's or its paper_table).
+[[nodiscard]] bool paper_has_setup(const SetupResult& setup);
 
 /// Figure 5 of the paper: mean deformation after compensation per setup, load and speed (upper
 /// panel, one bar per speed), and before it (lower panel, pale bars: UC, mean over the speeds); the
@@ -30,9 +33,16 @@ std::string svg_figure5(const StudyResult& study, SetupSelection which = SetupSe
 std::string svg_compensation(const StudyResult& study);
 
 /// Parity plot: ours (y) against the paper's (x) for every figure of Tables 1 and 2 (C per load and
-/// speed, UC per load), log axes, the line y = x, the band +-35% (the fidelity target for C) and the
-/// lines +-25% (the target for UC); whiskers: min to max over the seeds.
+/// speed, UC per load), every setup compared with a table (a setup on the paper's own kind of link
+/// against Table 2, marked with its paper_label), log axes, the line y = x, the band of C's fidelity
+/// target (kCTarget) and the lines of UC's (kUcTarget); whiskers: min to max over the seeds.
 std::string svg_parity(const StudyResult& study);
+
+/// The error budget as what it is, a one-effect-at-a-time sensitivity: one horizontal bar per effect,
+/// C with that effect alone off (mm), with reference lines at C with every effect on and C with
+/// every effect off at once (when run); each bar labelled with its value and its sensitivity
+/// computed from the printed figures.
+std::string svg_error_budget(const ErrorBudget& budget);
 
 /// A path in the plane of best fit of the reference (the unloaded laps' mean, else the last
 /// unloaded lap): the reference, the last lap of the loaded uncompensated (UC) and compensated (C)
@@ -55,6 +65,13 @@ std::string svg_path_plot(const PathPlot& plot);
 /// per lap of the UC runs (left) and the C runs (right), clockwise and anticlockwise laps in their
 /// own colours, each with an arrow in its direction of travel. Laps: plot.uc_laps and plot.c_laps.
 std::string svg_lap_overlay(const PathPlot& plot);
+
+/// Signed error of the compensated run along the path: for each sample of a C lap, its deviation from
+/// the reference projected on the direction of the UC run's deviation at the same angle (the UC
+/// laps of the same direction of travel averaged in 5 deg sectors), so + is under-compensated
+/// (still deflected the way the load pushes) and - over-compensated; per direction of travel the
+/// sector means against the angle (as in svg_lap_overlay), in mm.
+std::string svg_signed_error(const PathPlot& plot);
 
 /// Polar deviation plot: around the circle (angle as in svg_lap_overlay), the distance from the
 /// reference drawn outward from a ring that stands for 0 mm, magnified, with rings labelled in mm;

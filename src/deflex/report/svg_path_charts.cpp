@@ -219,6 +219,46 @@ void titles(Canvas& c, const std::string& title, const std::string& of) {
 
 void no_data(Canvas& c, const std::string& why) { c.text(c.width() / 2.0, c.height() / 2.0, why, 14.0, "middle"); }
 
+// The laps to use: the given ones, else the last lap with its direction from the trace.
+std::vector<DirectedLap> laps_or_last(const std::vector<DirectedLap>& laps, const TrackerTrace& last_lap,
+                                      const Reference& ref) {
+  if (!laps.empty() || last_lap.size() < 2) return laps;
+  return {{last_lap, turns_clockwise(finite_only(last_lap), ref)}};
+}
+
+std::size_t sector_of(double deg) {
+  return static_cast<std::size_t>(std::clamp(static_cast<int>(deg / (360.0 / kSectors)), 0, kSectors - 1));
+}
+
+// Per direction of travel (index 1: clockwise) and 5 deg sector, the sum and count of a run's
+// deviation vectors from the reference (sample minus its nearest reference point), in m.
+struct SectorVectors {
+  std::vector<Vector3> sum[2] = {std::vector<Vector3>(kSectors, Vector3::Zero()),
+                                 std::vector<Vector3>(kSectors, Vector3::Zero())};
+  std::vector<int> n[2] = {std::vector<int>(kSectors, 0), std::vector<int>(kSectors, 0)};
+  // The direction's mean in the sector, else the other direction's; zero when neither has a sample.
+  [[nodiscard]] Vector3 mean(bool clockwise, std::size_t s) const {
+    for (const int d : {clockwise ? 1 : 0, clockwise ? 0 : 1}) {
+      if (n[d][s] > 0) return sum[d][s] / n[d][s];
+    }
+    return Vector3::Zero();
+  }
+};
+
+SectorVectors sector_vectors(const std::vector<DirectedLap>& laps, const Reference& ref) {
+  SectorVectors v;
+  for (const auto& lap : laps) {
+    const int d = lap.clockwise ? 1 : 0;
+    for (const auto& sample : lap.trace) {
+      if (!sample.p_m.allFinite()) continue;
+      const std::size_t s = sector_of(angle_deg(ref, sample.p_m));
+      v.sum[d][s] += sample.p_m - ref.index->nearest(sample.p_m).point_m;
+      ++v.n[d][s];
+    }
+  }
+  return v;
+}
+
 }  // namespace
 
 std::string svg_path_plot(const PathPlot& plot) {
@@ -613,6 +653,123 @@ std::string svg_polar_deviation(const PathPlot& plot) {
          R"(fill="#444")");
   c.text(cx, cy + r_out + 60.0, fmt::format("(1 mm = {:.0f} px); angle as in the per-lap figure", px_per_mm), 12.0,
          "middle", R"(fill="#444")");
+  return c.str();
+}
+
+std::string svg_signed_error(const PathPlot& plot) {
+  const double width = svg::kMaxWidth, height = 470.0;
+  Canvas c(width, height);
+  titles(c, "Signed error of the compensated run along the uncompensated deflection", plot.title);
+  const std::optional<Reference> ref = reference_of(plot);
+  if (!ref || !ref->closed) {
+    no_data(c, !ref ? "no unloaded path to plot (fewer than 2 samples)" : "the path is not closed: no angle to plot");
+    return c.str();
+  }
+  // The direction the load pushed the arm, per direction of travel and sector: the UC laps' mean
+  // deviation there. Each C sample's deviation is projected on it.
+  const SectorVectors uc = sector_vectors(laps_or_last(plot.uc_laps, plot.uc, *ref), *ref);
+  const std::vector<DirectedLap> c_laps = laps_or_last(plot.c_laps, plot.c, *ref);
+  std::vector<double> sum[2] = {std::vector<double>(kSectors, 0.0), std::vector<double>(kSectors, 0.0)};
+  std::vector<int> n[2] = {std::vector<int>(kSectors, 0), std::vector<int>(kSectors, 0)};
+  for (const auto& lap : c_laps) {
+    const int d = lap.clockwise ? 1 : 0;
+    for (const auto& sample : lap.trace) {
+      if (!sample.p_m.allFinite()) continue;
+      const std::size_t s = sector_of(angle_deg(*ref, sample.p_m));
+      const Vector3 along = uc.mean(lap.clockwise, s);
+      if (!(along.norm() > 0.0)) continue;
+      const Vector3 dev = sample.p_m - ref->index->nearest(sample.p_m).point_m;
+      sum[d][s] += dev.dot(along.normalized()) * 1e3;
+      ++n[d][s];
+    }
+  }
+  // Sector means (NaN where no sample fell) and each direction's mean over its samples.
+  std::vector<double> means[2];
+  double overall[2] = {kNaN, kNaN}, max_abs = 0.0;
+  for (int d = 0; d < 2; ++d) {
+    means[d].assign(kSectors, kNaN);
+    double total = 0.0;
+    int count = 0;
+    for (std::size_t s = 0; s < kSectors; ++s) {
+      if (n[d][s] == 0) continue;
+      means[d][s] = sum[d][s] / n[d][s];
+      max_abs = std::max(max_abs, std::abs(means[d][s]));
+      total += sum[d][s];
+      count += n[d][s];
+    }
+    if (count > 0) overall[d] = total / count;
+  }
+  if (!std::isfinite(overall[0]) && !std::isfinite(overall[1])) {
+    no_data(c, "no compensated lap with an uncompensated one to compare with");
+    return c.str();
+  }
+  // UC's own size along its direction, for scale.
+  double uc_sum = 0.0;
+  int uc_n = 0;
+  for (int d = 0; d < 2; ++d) {
+    for (std::size_t s = 0; s < kSectors; ++s) {
+      if (uc.n[d][s] > 0) {
+        uc_sum += (uc.sum[d][s] / uc.n[d][s]).norm() * 1e3;
+        ++uc_n;
+      }
+    }
+  }
+  double ly = 70.0;
+  for (const bool cw : {true, false}) {
+    const int d = cw ? 1 : 0;
+    if (!std::isfinite(overall[d])) continue;
+    c.line(80.0, ly - 4.0, 98.0, ly - 4.0, direction_colour(cw), 2.4, direction_dash(cw));
+    c.text(104.0, ly, fmt::format("C, {} laps (5 deg sector means): mean {:+.3f} mm", direction_name(cw), overall[d]),
+           12.0);
+    ly += 18.0;
+  }
+  if (uc_n > 0) {
+    c.text(590.0, 70.0, fmt::format("for scale: the UC deflection itself, {:.3f} mm on average", uc_sum / uc_n), 12.0,
+           "start", R"(fill="#444")");
+  }
+  const double left = 90.0, right = width - 30.0, top = std::max(ly + 14.0, 118.0), bottom = height - 96.0;
+  const double r = svg::nice_ceiling(std::max(max_abs, 1e-6) * 1.1);
+  const Scale x{0.0, 360.0, left, right};
+  const Scale y{-r, r, bottom, top};
+  c.rect(left, top, right - left, y(0.0) - top, "#fdecea");
+  c.rect(left, y(0.0), right - left, bottom - y(0.0), "#e8f1fb");
+  svg::value_axis(c, y, left, right, "C along the UC deflection (mm)", 1.0, 56.0);
+  c.line(left, y(0.0), right, y(0.0), "#444", 1.4);
+  c.text(left + 8.0, top + 15.0, "+ under-compensated: still deflected the way the load pushes", 12.0, "start",
+         R"(fill="#8a1c1c")");
+  c.text(left + 8.0, bottom - 8.0, "- over-compensated: pushed past the unloaded path, against the load", 12.0, "start",
+         R"(fill="#1c4f8a")");
+  c.line(left, bottom, right, bottom, "#444", 1.0);
+  for (int deg = 0; deg <= 360; deg += 45) {
+    c.line(x(deg), bottom, x(deg), bottom + 5.0, "#444", 1.0);
+    c.text(x(deg), bottom + 18.0, fmt::format("{}", deg), kMinFont, "middle");
+    if (ref->horizontal && deg % 90 == 0) {
+      c.text(x(deg), bottom + 32.0, compass(deg % 360), kMinFont, "middle", R"(fill="#666")");
+    }
+  }
+  c.text((left + right) / 2.0, bottom + 50.0, "angle about the circle's centre (deg)", 12.0, "middle");
+  for (const bool cw : {true, false}) {
+    const int d = cw ? 1 : 0;
+    if (!std::isfinite(overall[d])) continue;
+    std::string path;
+    bool pen = false;
+    for (std::size_t s = 0; s < kSectors; ++s) {
+      if (!std::isfinite(means[d][s])) {
+        pen = false;
+        continue;
+      }
+      path += fmt::format("{}{:.1f},{:.1f}", pen ? " L" : (path.empty() ? "M" : " M"), x(sector_centre_deg(s)),
+                          y(means[d][s]));
+      pen = true;
+    }
+    c.path(path, direction_colour(cw), 2.2,
+           fmt::format(R"({} class="signed-error" data-direction="{}" data-mean-mm="{:.6g}")", direction_dash(cw),
+                       cw ? "cw" : "ccw", overall[d]));
+  }
+  c.text(width / 2.0, height - 18.0,
+         "Each C sample's deviation from the reference projected on the UC laps' mean deviation in its 5 deg sector "
+         "(same direction of travel).",
+         12.0, "middle", R"(fill="#444")");
   return c.str();
 }
 

@@ -18,7 +18,7 @@ using svg::Canvas;
 using svg::kMinFont;
 using svg::Scale;
 
-bool selected(const std::string& setup, SetupSelection which) {
+bool selected(const SetupResult& setup, SetupSelection which) {
   switch (which) {
     case SetupSelection::kPaper:
       return paper_has_setup(setup);
@@ -83,10 +83,10 @@ struct Group {
 std::vector<Group> groups_of(const StudyResult& study, SetupSelection which, const PaperFigures& paper) {
   std::vector<Group> groups;
   for (std::size_t si = 0; si < study.setups.size(); ++si) {
-    if (!selected(study.setups[si].setup, which)) {
+    if (!selected(study.setups[si], which)) {
       continue;
     }
-    const PaperTable* pt = paper.table_for(study.setups[si].setup);
+    const PaperTable* pt = paper_table_of(paper, study.setups[si]);
     for (const auto& l : study.setups[si].loads) {
       groups.push_back({si, &l, pt != nullptr ? pt->row_for(l.load_N) : nullptr});
     }
@@ -105,8 +105,24 @@ void group_labels(Canvas& c, const StudyResult& study, const std::vector<Group>&
     if (last_of_setup) {
       const double x_first = left + group_w * static_cast<double>(setup_start);
       const double x_last = left + group_w * static_cast<double>(g + 1);
-      c.text((x_first + x_last) / 2.0, labels_y + 20.0, svg::short_setup_name(study.setups[groups[g].setup].setup),
-             13.0, "middle", R"(font-weight="bold")");
+      const SetupResult& setup = study.setups[groups[g].setup];
+      c.text((x_first + x_last) / 2.0, labels_y + 20.0, svg::short_setup_name(setup.setup), 13.0, "middle",
+             R"(font-weight="bold")");
+      // A setup compared with a paper table of another name says so under its name (two lines when
+      // one is wider than its groups).
+      if (!setup.paper_label.empty()) {
+        const double span = x_last - x_first;
+        const auto cut = setup.paper_label.find(" (");
+        if (svg::text_width(setup.paper_label, kMinFont) <= span - 6.0 || cut == std::string::npos) {
+          c.text((x_first + x_last) / 2.0, labels_y + 35.0, setup.paper_label, kMinFont, "middle",
+                 R"(class="paper-label" fill="#444")");
+        } else {
+          c.text((x_first + x_last) / 2.0, labels_y + 35.0, setup.paper_label.substr(0, cut), kMinFont, "middle",
+                 R"(class="paper-label" fill="#444")");
+          c.text((x_first + x_last) / 2.0, labels_y + 48.0, setup.paper_label.substr(cut + 1), kMinFont, "middle",
+                 R"(class="paper-label" fill="#444")");
+        }
+      }
       if (g + 1 != groups.size()) {
         c.line(x_last, sep_top, x_last, labels_y + 26.0, "#999", 1.0, R"(stroke-dasharray="4 4")");
       }
@@ -119,11 +135,13 @@ void group_labels(Canvas& c, const StudyResult& study, const std::vector<Group>&
 
 bool paper_has_setup(const std::string& setup) { return paper_reference().table_for(setup) != nullptr; }
 
+bool paper_has_setup(const SetupResult& setup) { return paper_table_of(paper_reference(), setup) != nullptr; }
+
 std::string svg_figure5(const StudyResult& study, SetupSelection which) {
   const std::vector<int> speeds = study_speeds_mm_s(study);
   const PaperFigures paper = paper_reference();
   const std::vector<Group> groups = groups_of(study, which, paper);
-  const double width = svg::kMaxWidth, height = 640.0;
+  const double width = svg::kMaxWidth, height = 668.0;
   const double left = 84.0, right = 16.0;
   Canvas c(width, height);
   c.title(which == SetupSelection::kBeyondPaper
@@ -234,10 +252,11 @@ std::string svg_compensation(const StudyResult& study) {
     c.text(width / 2.0, height / 2.0, "no results to plot", 14.0, "middle");
     return c.str();
   }
+  const std::vector<int> speeds = study_speeds_mm_s(study);
   std::vector<double> values{0.0, 1.0};
   bool any_paper = false;
   for (const auto& g : groups) {
-    const Spread s = g.load->compensation_spread();
+    const Spread s = printed_compensation_spread(*g.load, speeds);
     values.insert(values.end(), {s.mean, s.min});
     any_paper = any_paper || g.paper != nullptr;
   }
@@ -265,11 +284,12 @@ std::string svg_compensation(const StudyResult& study) {
     const double ours_w = std::min(30.0, group_w * (with_paper ? 0.4 : 0.5));
     const double paper_w = ours_w * 0.6;
     const double x0 = xc - (with_paper ? ours_w + 1.5 + paper_w : ours_w) / 2.0;
-    Spread s = l.compensation_spread();
+    // As the tables print it: from the printed figures, 1 - mean C / UC, the paper's own way.
+    const Spread s = printed_compensation_spread(l, speeds);
     const double pc = with_paper ? groups[g].paper->mean_compensation() : kNaN;
     const std::string& setup = study.setups[groups[g].setup].setup;
     c.group_begin(fmt::format("{} {:g} N: compensation {}{}", setup, l.load_N, spread_text(s, 100.0, "%", 0),
-                              std::isfinite(pc) ? fmt::format("; the paper's {:.0f}%", pc * 100.0) : ""));
+                              std::isfinite(pc) ? fmt::format("; the paper's {}", percent_text(pc)) : ""));
     value_bar(c, y, x0, ours_w, s.mean, svg::colour(groups[g].setup),
               fmt::format(R"(data-value="{:.6g}" data-min="{:.6g}" data-max="{:.6g}")", s.mean, s.min, s.max));
     spread_whisker(c, y, x0 + ours_w / 2.0, s);
@@ -278,14 +298,15 @@ std::string svg_compensation(const StudyResult& study) {
     }
     if (std::isfinite(s.mean)) {
       const double label_at = std::isfinite(s.max) && s.n > 1 ? std::max(s.max, s.mean) : s.mean;
-      c.text(x0 + ours_w / 2.0, y(label_at) - 5.0, fmt::format("{:.0f}%", s.mean * 100.0), kMinFont, "middle");
+      c.text(x0 + ours_w / 2.0, y(label_at) - 5.0, percent_text(s.mean), kMinFont, "middle");
     }
     c.group_end();
   }
   c.line(left, y(0.0), width - right, y(0.0), "#444", 1.0);
   group_labels(c, study, groups, left, group_w, top, bottom + 20.0);
   c.text(left + plot_w / 2.0, height - 12.0,
-         "load |F| (N), per strategy setup; ours: 1 - C/UC at each speed, averaged over the speeds", 12.0, "middle");
+         "load |F| (N), per strategy setup; 1 - (mean C over the speeds) / UC, from the tables' printed figures", 12.0,
+         "middle");
   return c.str();
 }
 
@@ -299,24 +320,31 @@ struct ParityPoint {
   int speed;  // 0 for UC
   double paper;
   Spread ours;
+  std::string label;  // the setup's paper_label: how it is compared with a table of another name
+  std::string table;  // then the paper's table it is compared with ("Table 2")
 };
+
+// "Table 2" from the paper table's caption ("Table 2. Online compensation ...").
+std::string table_name(const PaperTable& t) { return t.caption.substr(0, t.caption.find('.')); }
 
 /// Every load of the study the paper's tables have: UC, then C at each of the paper's speeds.
 std::vector<ParityPoint> parity_points(const StudyResult& study, const PaperFigures& paper) {
   std::vector<ParityPoint> points;
   for (std::size_t si = 0; si < study.setups.size(); ++si) {
-    const PaperTable* pt = paper.table_for(study.setups[si].setup);
+    const SetupResult& setup = study.setups[si];
+    const PaperTable* pt = paper_table_of(paper, setup);
     if (pt == nullptr) {
       continue;
     }
-    for (const auto& l : study.setups[si].loads) {
+    for (const auto& l : setup.loads) {
       const PaperRow* pr = pt->row_for(l.load_N);
       if (pr == nullptr) {
         continue;
       }
-      points.push_back({study.setups[si].setup, si, l.load_N, 0, pr->uc_mm, l.uc_mean_spread()});
+      const std::string table = setup.paper_table.empty() ? std::string() : table_name(*pt);
+      points.push_back({setup.setup, si, l.load_N, 0, pr->uc_mm, l.uc_mean_spread(), setup.paper_label, table});
       for (const auto& [v, pc] : pr->c_mm) {
-        points.push_back({study.setups[si].setup, si, l.load_N, v, pc, l.c_spread(v)});
+        points.push_back({setup.setup, si, l.load_N, v, pc, l.c_spread(v), setup.paper_label, table});
       }
     }
   }
@@ -358,7 +386,7 @@ void parity_axes(Canvas& c, const ParityFrame& f) {
          fmt::format(R"svg(transform="rotate(-90 {:.2f} {:.2f})")svg", pl - 50.0, ymid));
 }
 
-/// The bands, clipped to the plot: +-35% (C's target) shaded, +-25% (UC's) dashed, y = x solid.
+/// The bands, clipped to the plot: C's target shaded, UC's dashed, y = x solid.
 void parity_bands(Canvas& c, const ParityFrame& f) {
   const svg::LogScale& xs = f.xs;
   const svg::LogScale& ys = f.ys;
@@ -367,8 +395,9 @@ void parity_bands(Canvas& c, const ParityFrame& f) {
       "\n<g clip-path=\"url(#deflex-parity-area)\">\n",
       f.pl, f.pt, f.ps, f.ps));
   const double e0 = f.d0 / 2.0, e1 = f.d1 * 2.0;  // beyond the plot, clipped
-  c.polygon({xs(e0), ys(e0 * 0.65), xs(e1), ys(e1 * 0.65), xs(e1), ys(e1 * 1.35), xs(e0), ys(e0 * 1.35)}, "#dcefd8");
-  for (const double k : {0.75, 1.25}) {
+  const double lo = 1.0 - kCTarget, hi = 1.0 + kCTarget;
+  c.polygon({xs(e0), ys(e0 * lo), xs(e1), ys(e1 * lo), xs(e1), ys(e1 * hi), xs(e0), ys(e0 * hi)}, "#dcefd8");
+  for (const double k : {1.0 - kUcTarget, 1.0 + kUcTarget}) {
     c.line(xs(e0), ys(e0 * k), xs(e1), ys(e1 * k), "#2e7d32", 1.2, R"(stroke-dasharray="5 4")");
   }
   c.line(xs(e0), ys(e0), xs(e1), ys(e1), "#444", 1.3);
@@ -387,12 +416,14 @@ ParityCounts parity_markers(Canvas& c, const ParityFrame& f, const std::vector<P
     if (!std::isfinite(p.ours.mean) || !(p.ours.mean > 0.0) || !(p.paper > 0.0)) {
       continue;
     }
-    const double ratio = p.ours.mean / p.paper;
+    // From the figure as printed beside it (3 decimals), so the tooltip's percentage is the reader's.
+    const double ratio = as_printed(p.ours.mean) / p.paper;
     const std::string col = svg::colour(p.setup_index);
     const double x = f.xs(p.paper), yv = f.ys(p.ours.mean);
     const std::string what = p.speed == 0 ? "UC" : fmt::format("C at {} mm/s", p.speed);
-    c.group_begin(fmt::format("{} {:g} N, {}: ours {} against the paper's {:.2f} mm ({:+.0f}%)", p.setup, p.load_N,
-                              what, spread_text(p.ours, 1.0, " mm", 3), p.paper, (ratio - 1.0) * 100.0));
+    c.group_begin(fmt::format("{}{} {:g} N, {}: ours {} against the paper's {:.2f} mm ({})", p.setup,
+                              p.label.empty() ? "" : " (" + p.label + ")", p.load_N, what,
+                              spread_text(p.ours, 1.0, " mm", 3), p.paper, signed_percent_text(ratio - 1.0)));
     if (p.ours.n > 1 && std::isfinite(p.ours.min) && p.ours.min > 0.0) {
       svg::whisker(c, x, f.ys(p.ours.min), f.ys(p.ours.max), col, 5.0);
     }
@@ -400,11 +431,11 @@ ParityCounts parity_markers(Canvas& c, const ParityFrame& f, const std::vector<P
     if (p.speed == 0) {
       c.rect(x - 5.0, yv - 5.0, 10.0, 10.0, "white", fmt::format(R"(stroke="{}" stroke-width="2" {})", col, data));
       ++n.uc_n;
-      n.uc_in += std::abs(ratio - 1.0) <= 0.25 ? 1 : 0;
+      n.uc_in += std::abs(ratio - 1.0) <= kUcTarget ? 1 : 0;
     } else {
       c.circle(x, yv, 4.5, col, fmt::format(R"(stroke="white" stroke-width="0.8" {})", data));
       ++n.c_n;
-      n.c_in += std::abs(ratio - 1.0) <= 0.35 ? 1 : 0;
+      n.c_in += std::abs(ratio - 1.0) <= kCTarget ? 1 : 0;
     }
     c.group_end();
   }
@@ -413,12 +444,18 @@ ParityCounts parity_markers(Canvas& c, const ParityFrame& f, const std::vector<P
 
 /// The legend (the setups' colours, the markers, the lines and bands) from (rx, ry) down; ry ends below it.
 void parity_legend(Canvas& c, const StudyResult& study, const std::vector<ParityPoint>& points, double rx, double& ry) {
-  std::map<std::size_t, std::string> setups;
+  std::map<std::size_t, const ParityPoint*> setups;
   for (const auto& p : points) {
-    setups.emplace(p.setup_index, p.setup);
+    setups.emplace(p.setup_index, &p);
   }
-  for (const auto& [si, name] : setups) {
-    svg::legend_entry(c, rx, ry, "dot", svg::colour(si), svg::short_setup_name(name));
+  for (const auto& [si, p] : setups) {
+    svg::legend_entry(
+        c, rx, ry, "dot", svg::colour(si),
+        svg::short_setup_name(p->setup) + (p->table.empty() ? "" : fmt::format(": against the paper's {}", p->table)));
+    if (!p->label.empty()) {
+      ry += 16.0;
+      c.text(rx + 24.0, ry, p->label, 12.0, "start", R"(class="paper-label" fill="#444")");
+    }
     ry += 20.0;
   }
   c.circle(rx + 8.0, ry - 4.0, 4.5, "#666");
@@ -429,9 +466,11 @@ void parity_legend(Canvas& c, const StudyResult& study, const std::vector<Parity
   ry += 20.0;
   svg::legend_entry(c, rx, ry, "line", "#444", "y = x: ours equal to the paper's");
   ry += 20.0;
-  svg::legend_entry(c, rx, ry, "band", "#dcefd8", "within 35% of the paper's (the target for C)");
+  svg::legend_entry(c, rx, ry, "band", "#dcefd8",
+                    fmt::format("within {} of the paper's (the target for C)", percent_text(kCTarget)));
   ry += 20.0;
-  svg::legend_entry(c, rx, ry, "dash", "#2e7d32", "25% either side (the target for UC)");
+  svg::legend_entry(c, rx, ry, "dash", "#2e7d32",
+                    fmt::format("{} either side (the target for UC)", percent_text(kUcTarget)));
   ry += 20.0;
   c.text(rx, ry, whisker_note(study), 12.0, "start", R"(fill="#444")");
 }
@@ -442,15 +481,15 @@ void parity_summary(Canvas& c, const StudyResult& study, const PaperFigures& pap
                     double ry, double height) {
   c.text(rx, ry, "Against the targets", 13.0, "start", R"(font-weight="bold")");
   ry += 20.0;
-  c.text(rx, ry, fmt::format("C per load and speed within 35%: {} of {}", n.c_in, n.c_n), 12.0);
+  c.text(rx, ry, fmt::format("C per load and speed within {}: {} of {}", percent_text(kCTarget), n.c_in, n.c_n), 12.0);
   ry += 18.0;
-  c.text(rx, ry, fmt::format("UC per load within 25%: {} of {}", n.uc_in, n.uc_n), 12.0);
+  c.text(rx, ry, fmt::format("UC per load within {}: {} of {}", percent_text(kUcTarget), n.uc_in, n.uc_n), 12.0);
   ry += 24.0;
   // Per setup and load: C as the issue judges it (mean over the speeds), and UC.
   c.text(rx, ry, "ours / the paper's, per load:", 12.0, "start", R"(fill="#444")");
   ry += 18.0;
   for (std::size_t si = 0; si < study.setups.size(); ++si) {
-    const PaperTable* table = paper.table_for(study.setups[si].setup);
+    const PaperTable* table = paper_table_of(paper, study.setups[si]);
     if (table == nullptr) {
       continue;
     }
@@ -459,19 +498,10 @@ void parity_summary(Canvas& c, const StudyResult& study, const PaperFigures& pap
       if (pr == nullptr || ry > height - 10.0) {
         continue;
       }
-      double ours = 0.0, theirs = 0.0;
-      int k = 0;
-      for (const auto& [v, pc] : pr->c_mm) {
-        const double o = value_at_speed(l.c_mm, v);
-        if (std::isfinite(o)) {
-          ours += o;
-          theirs += pc;
-          ++k;
-        }
-      }
-      const double c_ratio = k > 0 ? ours / theirs : kNaN;
-      const double uc_ratio = l.uc_mean_mm() / pr->uc_mm;
-      const bool c_ok = std::abs(c_ratio - 1.0) <= 0.35, uc_ok = std::abs(uc_ratio - 1.0) <= 0.25;
+      // The tables' "vs paper" figures: from our printed figures.
+      const double c_ratio = c_over_paper(l, *pr);
+      const double uc_ratio = uc_over_paper(l, *pr);
+      const bool c_ok = std::abs(c_ratio - 1.0) <= kCTarget, uc_ok = std::abs(uc_ratio - 1.0) <= kUcTarget;
       c.text(rx, ry,
              fmt::format("{} {:g} N: C \u00d7{:.2f} {}, UC \u00d7{:.2f} {}", study.setups[si].setup, l.load_N, c_ratio,
                          c_ok ? "(in)" : "(out)", uc_ratio, uc_ok ? "(in)" : "(out)"),
@@ -486,7 +516,7 @@ void parity_summary(Canvas& c, const StudyResult& study, const PaperFigures& pap
 std::string svg_parity(const StudyResult& study) {
   const PaperFigures paper = paper_reference();
   const std::vector<ParityPoint> points = parity_points(study, paper);
-  const double width = svg::kMaxWidth, height = 580.0;
+  const double width = svg::kMaxWidth, height = 600.0;
   const double pl = 96.0, pt = 70.0, ps = 430.0;
   Canvas c(width, height);
   c.title("Parity: ours against the paper's Tables 1 and 2");

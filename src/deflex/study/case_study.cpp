@@ -127,7 +127,7 @@ double calibration_cost(const CaseConfig& c) {
          (hold_s + c.calibration.arc_rad * c.cell.ldbb.bar_length_m / c.calibration.speed_m_s);
 }
 
-const char* describe(Strategy s, LinkKind link) {
+std::string describe(Strategy s, LinkKind link, double stream_period_s) {
   switch (s) {
     case Strategy::kOffline:
       return "offline compensation from the LDBB force model (paper, Figure 2): the controller runs the compensated "
@@ -137,8 +137,10 @@ const char* describe(Strategy s, LinkKind link) {
         case LinkKind::kEgmPath:
           return "online compensation from the force sensor (paper, Figure 3) over ABB EGM path correction";
         case LinkKind::kSimpleMessage:
-          return "online compensation from the force sensor (paper, Figure 3) streamed every 100 ms over TCP to the "
-                 "robot program (simple message): the paper's own kind of link";
+          return fmt::format(
+              "online compensation from the force sensor (paper, Figure 3) streamed every {:g} ms over TCP to the "
+              "robot program (simple message): the paper's own kind of link",
+              stream_period_s * 1e3);
         default:
           return "online compensation from the force sensor (paper, Figure 3) over ABB EGM position guidance";
       }
@@ -167,12 +169,15 @@ struct LoadedJob {
   double max_deviation_rad = 0.0, max_tcp_m = 0.0, delay_s = 0.0;
 };
 
-// A run of the error budget: a setup's compensated run on a cell built without one effect.
+// A run of the error budget: a setup's compensated run on a cell built without one effect, or
+// (no effect named) without every effect at once.
 struct BudgetJob {
   int setup;
-  Effect off;
+  std::optional<Effect> off;
   double residual_mm = NAN;
 };
+
+std::string budget_label(const BudgetJob& bj) { return bj.off ? to_string(*bj.off) : "every effect off"; }
 
 // What the steps of one case study share: the case per seed, the physical setups and families of
 // runs, the runs planned and their results, the cells, the unloaded references and the progress.
@@ -369,6 +374,8 @@ void plan_error_budget(StudyContext& x) {
       if ((e == Effect::kSensorErrors || e == Effect::kSensorCalibration || e == Effect::kLatency) && offline) continue;
       x.budget_jobs.push_back(BudgetJob{static_cast<int>(i), e});
     }
+    // And every effect off at once, so the reader sees what the one-at-a-time figures do not add up to.
+    x.budget_jobs.push_back(BudgetJob{static_cast<int>(i), std::nullopt});
   }
 }
 
@@ -462,20 +469,30 @@ void run_loaded_job(StudyContext& x, LoadedJob& j) {
                   j.kind == RunKind::kUncompensated ? "UC" : to_string(j.strategy), j.load_n, mm_s(j.speed)));
 }
 
+// The first seed's case without the budget job's effect, or without every effect of the cell (the
+// ones a setup's budget does not list act on no run of that setup). The calibration is kept: the
+// compensators still get a model identified on that cell, not the exact one.
+CaseConfig budget_case(const StudyContext& x, const BudgetJob& bj) {
+  if (bj.off) return without_effect(x.cfg_of(0), *bj.off);
+  CaseConfig cfg = x.cfg_of(0);
+  for (Effect e : kAllEffects) cfg = without_effect(cfg, e);
+  return cfg;
+}
+
 // One run of the error budget: a cell built without the effect (its own calibration), its unloaded
 // reference and the setup's compensated run at the budget's load and speed.
 void run_budget_job(StudyContext& x, BudgetJob& bj) {
   const CaseConfig& config = x.config;
   const SetupConfig& sc = config.setups[static_cast<std::size_t>(bj.setup)];
   const Family& fam = x.families[static_cast<std::size_t>(x.family_of(sc))];
-  const CaseConfig cfg = without_effect(x.cfg_of(0), bj.off);
+  const CaseConfig cfg = budget_case(x, bj);
   const SetupCell cell = build_setup_cell(cfg, sc.sensor_mounted);
   const double load = sc.loads_n[static_cast<std::size_t>(config.budget.load_index)];
   const double v = config.budget.speed_m_s;
   const Reference reference = make_reference(simulate_run(cfg, cell, x.unloaded_spec(0, fam, v)));
   const RunSpec c_spec = x.loaded_spec(0, fam, RunKind::kCompensated, sc.strategy, load, v);
   bj.residual_mm = evaluate_run(simulate_run(cfg, cell, c_spec), reference).mean_mm;
-  x.progress.add(x.cal_cost + 2.0 * run_cost(config, v, x.laps), fmt::format("budget: {}", to_string(bj.off)));
+  x.progress.add(x.cal_cost + 2.0 * run_cost(config, v, x.laps), fmt::format("budget: {}", budget_label(bj)));
 }
 
 // Phase 3: the loaded runs (slowest first so both cores finish together) and the error budget's runs.
@@ -612,7 +629,15 @@ void assemble_setups(const StudyContext& x, CaseStudyOutput& out) {
     const int fam = x.family_of(s);
     SetupResult sr;
     sr.setup = s.name;
-    sr.description = describe(s.strategy, s.link);
+    sr.description = describe(s.strategy, s.link, x.config.online.stream_period_s);
+    // Online compensation streamed over TCP is the paper's own kind of link: its Table 2 is what such
+    // a setup compares with, beside the EGM setup that carries the table's figures.
+    if (s.strategy == Strategy::kOnline && s.link == LinkKind::kSimpleMessage && s.sensor_mounted &&
+        s.paper_uc_mm.empty() && paper_reference().table_for(s.name) == nullptr) {
+      sr.paper_table = "online";
+      sr.paper_label =
+          fmt::format("simple message, {:g} ms (the paper's kind of link)", x.config.online.stream_period_s * 1e3);
+    }
     if (const auto ls = summarize_link(x, s, fam)) out.links.push_back(*ls);
     for (double load : s.loads_n) sr.loads.push_back(load_result(x, s, fam, load));
     out.study.setups.push_back(sr);
@@ -638,8 +663,12 @@ void assemble_error_budgets(const StudyContext& x, StudyResult& study) {
     b.uc_mm = x.find(0, fam, RunKind::kUncompensated, sc.strategy, b.load_N, config.budget.speed_m_s)->figures.mean_mm;
     for (const auto& bj : x.budget_jobs) {
       if (bj.setup != si) continue;
-      b.entries.push_back(ErrorBudgetEntry{to_string(bj.off), effect_size(config, bj.off), bj.residual_mm,
-                                           residual_share(b.residual_mm_all, bj.residual_mm)});
+      if (!bj.off) {
+        b.residual_mm_all_off = bj.residual_mm;
+        continue;
+      }
+      b.entries.push_back(ErrorBudgetEntry{to_string(*bj.off), effect_size(config, *bj.off), bj.residual_mm,
+                                           one_at_a_time_sensitivity(b.residual_mm_all, bj.residual_mm)});
     }
     study.error_budgets.push_back(std::move(b));
   }
@@ -660,11 +689,10 @@ std::string describe_cell(const StudyContext& x, int f) {
   std::string text = fmt::format(
       "Setup {} the force sensor (seed {}): true joint stiffness (diagonal, Nm/rad) [{}]; identified from {} "
       "calibration measurements taken while moving along {} arcs in the operating space [{}] (residual {:.1f} um "
-      "RMS). The identified values absorb what the lumped model lacks ({}).",
+      "RMS). The identified values are the lumped joint model's best fit to those measurements: what the cell has "
+      "beyond that model (the error budget lists its effects) is folded into them or left in the residual.",
       f == 1 ? "with" : "without", config.seed, k_true, cell.calibration.measurements, config.calibration.arcs, k_id,
-      cell.calibration.estimate.residual_rms_m * 1e6,
-      f == 1 ? "sensor compliance, joint coupling, link bending, base tilt, lost motion"
-             : "joint coupling, link bending, base tilt, lost motion");
+      cell.calibration.estimate.residual_rms_m * 1e6);
   for (const auto& note : cell.calibration.notes) {
     if (note.find("kept the assumed") != std::string::npos || note.find("poorly") != std::string::npos) {
       text += " Calibration: " + note + ".";

@@ -6,7 +6,7 @@
 
 namespace deflex {
 
-double residual_share(double residual_all_mm, double residual_without_mm) {
+double one_at_a_time_sensitivity(double residual_all_mm, double residual_without_mm) {
   if (!(residual_all_mm > 0.0) || !std::isfinite(residual_all_mm) || !std::isfinite(residual_without_mm)) {
     return std::numeric_limits<double>::quiet_NaN();
   }

@@ -2,6 +2,7 @@
 #include "deflex/study/study_tables.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 
 #include <fmt/format.h>
@@ -54,6 +55,7 @@ int speed_key(const std::string& key, const std::string& where) {
 
 // The table number a setup gets: the paper's own numbers for its two, then 3, 4, ... in order.
 std::vector<std::string> table_titles(const StudyResult& study) {
+  const PaperFigures paper = paper_reference();
   std::vector<std::string> titles;
   int next = 3;
   for (const auto& s : study.setups) {
@@ -61,24 +63,16 @@ std::vector<std::string> table_titles(const StudyResult& study) {
       titles.push_back("Table 1 (offline compensation)");
     } else if (s.setup == "online") {
       titles.push_back("Table 2 (online compensation, force sensor mounted)");
+    } else if (!s.paper_table.empty()) {
+      const PaperTable* pt = paper.table_for(s.paper_table);
+      titles.push_back(fmt::format("Table {} ({}: {}; beside the paper's {})", next++, s.setup,
+                                   s.paper_label.empty() ? "beyond the paper" : s.paper_label,
+                                   pt != nullptr ? pt->caption.substr(0, pt->caption.find('.')) : s.paper_table));
     } else {
       titles.push_back(fmt::format("Table {} ({}, beyond the paper)", next++, s.setup));
     }
   }
   return titles;
-}
-
-double mean_over(const std::map<int, double>& m, const std::vector<int>& speeds) {
-  double sum = 0.0;
-  int n = 0;
-  for (const int v : speeds) {
-    const double x = value_at_speed(m, v);
-    if (std::isfinite(x)) {
-      sum += x;
-      ++n;
-    }
-  }
-  return n > 0 ? sum / n : kNaN;
 }
 
 // Compensation of a paper row: 1 - mean C / UC, as the paper's 67% and 69-80% are stated.
@@ -124,7 +118,7 @@ Grid setup_grid(const SetupResult& s, const std::vector<int>& speeds, const Pape
   for (std::size_t i = 0; i < speeds.size(); ++i) {
     g.header.push_back(fmt::format("C{} {} mm/s", i + 1, speeds[i]));
   }
-  g.header.push_back("compensation");
+  g.header.push_back("compensation %");
   for (const auto& l : s.loads) {
     const PaperRow* pr = paper != nullptr ? paper->row_for(l.load_N) : nullptr;
     Row r;
@@ -134,8 +128,7 @@ Grid setup_grid(const SetupResult& s, const std::vector<int>& speeds, const Pape
       const double pc = pr != nullptr ? value_at_speed(pr->c_mm, v) : kNaN;
       r.cells.push_back(cell_with_paper(mm_spread(l.c_spread(v)), paper_mm(pc)));
     }
-    Spread comp = l.compensation_spread();
-    if (comp.n <= 1) comp.mean = mean_over(l.compensation, speeds);
+    const Spread comp = printed_compensation_spread(l, speeds);
     r.cells.push_back(
         cell_with_paper(percent_spread(comp), pr != nullptr ? percent_text(paper_compensation(*pr)) : ""));
     g.rows.push_back(r);
@@ -199,6 +192,53 @@ double read_number(const nlohmann::json& j, const char* key, const std::string& 
   return j.at(key).get<double>();
 }
 
+// One entry of results.json's "error_budget" (`bw` names it in errors); each sensitivity
+// recomputed from the residuals.
+ErrorBudget read_error_budget(const nlohmann::json& jb, const std::string& bw) {
+  ErrorBudget b;
+  if (!jb.contains("setup") || !jb.at("setup").is_string()) {
+    throw DataError(fmt::format("{}: missing string field 'setup'", bw));
+  }
+  b.setup = jb.at("setup").get<std::string>();
+  b.load_N = read_number(jb, "load_N", bw);
+  b.speed_mm_s = read_number(jb, "speed_mm_s", bw);
+  b.residual_mm_all = jb.contains("residual_mm_all") && jb.at("residual_mm_all").is_null()
+                          ? kNaN
+                          : read_number(jb, "residual_mm_all", bw);
+  b.uc_mm = jb.contains("uc_mm") && jb.at("uc_mm").is_null() ? kNaN : read_number(jb, "uc_mm", bw, false);
+  if (jb.contains("residual_mm_all_off") && !jb.at("residual_mm_all_off").is_null()) {
+    b.residual_mm_all_off = read_number(jb, "residual_mm_all_off", bw);
+  }
+  if (jb.contains("seed")) {
+    if (!jb.at("seed").is_number_unsigned()) throw DataError(fmt::format("{}: seed: not a seed", bw));
+    b.seed = jb.at("seed").get<std::uint64_t>();
+  }
+  if (jb.contains("laps")) {
+    const double laps = read_number(jb, "laps", bw);
+    if (laps < 0 || laps > 1e6 || laps != std::floor(laps))
+      throw DataError(fmt::format("{}: laps: not a lap count", bw));
+    b.laps = static_cast<int>(laps);
+  }
+  if (jb.contains("entries")) {
+    std::size_t ei = 0;
+    for (const auto& je : jb.at("entries")) {
+      const std::string ew = fmt::format("{}.entries[{}]", bw, ei++);
+      ErrorBudgetEntry e;
+      if (!je.contains("effect") || !je.at("effect").is_string()) {
+        throw DataError(fmt::format("{}: missing string field 'effect'", ew));
+      }
+      e.effect = je.at("effect").get<std::string>();
+      e.size = je.contains("size") && je.at("size").is_string() ? je.at("size").get<std::string>() : "";
+      e.residual_mm_without_it = je.contains("residual_mm_without_it") && je.at("residual_mm_without_it").is_null()
+                                     ? kNaN
+                                     : read_number(je, "residual_mm_without_it", ew);
+      e.sensitivity = one_at_a_time_sensitivity(b.residual_mm_all, e.residual_mm_without_it);
+      b.entries.push_back(e);
+    }
+  }
+  return b;
+}
+
 }  // namespace
 
 std::vector<int> study_speeds_mm_s(const StudyResult& study) {
@@ -225,12 +265,101 @@ double value_at_speed(const std::map<int, double>& m, int speed_mm_s) {
   return it == m.end() ? kNaN : it->second;
 }
 
+double whole_percent(double fraction) {
+  if (!std::isfinite(fraction)) return kNaN;
+  // Halves away from zero as a reader rounds them: 1 - 0.051 / 0.120 is 57.5 %, so 58 %, though it
+  // comes out a hair under 0.575 in binary. Figures printed to 3 or 4 digits never lie within the
+  // nudge of a half unless they are on it.
+  const double p = fraction * 100.0;
+  return std::round(p + std::copysign(1e-9 * std::max(1.0, std::abs(p)), p));
+}
+
 std::string percent_text(double fraction) {
   if (!std::isfinite(fraction)) {
     return "n/a";
   }
-  const double p = std::round(fraction * 100.0);
+  const double p = whole_percent(fraction);
   return fmt::format("{:.0f}%", p == 0.0 ? 0.0 : p);
+}
+
+std::string signed_percent_text(double fraction) {
+  if (!std::isfinite(fraction)) return "n/a";
+  const double p = whole_percent(fraction);
+  return p == 0.0 ? "0%" : fmt::format("{:+.0f}%", p);
+}
+
+const PaperTable* paper_table_of(const PaperFigures& paper, const SetupResult& setup) {
+  if (const PaperTable* own = paper.table_for(setup.setup)) return own;
+  return setup.paper_table.empty() ? nullptr : paper.table_for(setup.paper_table);
+}
+
+double as_printed(double value, int decimals) {
+  if (!std::isfinite(value)) return kNaN;
+  // The very text the tables print, read back: the same rounding as the printing, ties included.
+  return std::strtod(fmt::format("{:.{}f}", value, decimals).c_str(), nullptr);
+}
+
+double printed_compensation(const LoadResult& load, int speed_mm_s) {
+  return compensation_ratio(as_printed(load.uc_mean_spread().mean), as_printed(load.c_spread(speed_mm_s).mean));
+}
+
+Spread printed_compensation_spread(const LoadResult& load, const std::vector<int>& speeds) {
+  double c_sum = 0.0;
+  int n = 0;
+  for (const int v : speeds) {
+    const double c = as_printed(load.c_spread(v).mean);
+    if (std::isfinite(c)) {
+      c_sum += c;
+      ++n;
+    }
+  }
+  const double mean = n > 0 ? compensation_ratio(as_printed(load.uc_mean_spread().mean), c_sum / n) : kNaN;
+  // Per seed the same quantity, for the spread: 1 - (that seed's C over the speeds) / (its UC).
+  std::vector<double> per_seed;
+  const int seeds = load.seeds();
+  if (seeds > 1 && !load.uc_mm_by_seed.empty()) {
+    for (int k = 0; k < seeds; ++k) {
+      const auto at = [k](const std::vector<double>& list) {
+        return static_cast<std::size_t>(k) < list.size() ? list[static_cast<std::size_t>(k)] : kNaN;
+      };
+      std::vector<double> uc, c;
+      for (const auto& [v, list] : load.uc_mm_by_seed) uc.push_back(at(list));
+      for (const int v : speeds) {
+        const auto it = load.c_mm_by_seed.find(v);
+        if (it != load.c_mm_by_seed.end()) c.push_back(at(it->second));
+      }
+      per_seed.push_back(compensation_ratio(spread_of(uc).mean, spread_of(c).mean));
+    }
+  }
+  Spread s = per_seed.empty() ? spread_of({mean}) : spread_of(per_seed);
+  s.mean = mean;
+  if (per_seed.empty()) {
+    s.min = s.max = mean;
+  }
+  return s;
+}
+
+double printed_sensitivity(const ErrorBudget& budget, const ErrorBudgetEntry& entry) {
+  return one_at_a_time_sensitivity(as_printed(budget.residual_mm_all), as_printed(entry.residual_mm_without_it));
+}
+
+double uc_over_paper(const LoadResult& load, const PaperRow& paper) {
+  const double ours = as_printed(load.uc_mean_spread().mean);
+  return paper.uc_mm > 0.0 && std::isfinite(ours) ? ours / paper.uc_mm : kNaN;
+}
+
+double c_over_paper(const LoadResult& load, const PaperRow& paper) {
+  double ours = 0.0, theirs = 0.0;
+  int n = 0;
+  for (const auto& [v, pc] : paper.c_mm) {
+    const double o = as_printed(load.c_spread(v).mean);
+    if (std::isfinite(o) && std::isfinite(pc)) {
+      ours += o;
+      theirs += pc;
+      ++n;
+    }
+  }
+  return n > 0 && theirs > 0.0 ? ours / theirs : kNaN;
 }
 
 double LoadResult::uc_mean_mm() const {
@@ -389,6 +518,10 @@ nlohmann::json study_to_json(const StudyResult& study) {
     if (!s.description.empty()) {
       js["description"] = s.description;
     }
+    if (!s.paper_table.empty()) {
+      js["paper_table"] = s.paper_table;
+      js["paper_label"] = s.paper_label;
+    }
     setups.push_back(js);
   }
   nlohmann::json doc{{"setups", setups}, {"speeds_mm_s", study_speeds_mm_s(study)}};
@@ -419,12 +552,13 @@ nlohmann::json study_to_json(const StudyResult& study) {
         entries.push_back({{"effect", e.effect},
                            {"size", e.size},
                            {"residual_mm_without_it", number(e.residual_mm_without_it)},
-                           {"share_of_residual", number(e.share_of_residual)}});
+                           {"sensitivity_one_at_a_time", number(e.sensitivity)}});
       }
       budgets.push_back({{"setup", b.setup},
                          {"load_N", b.load_N},
                          {"speed_mm_s", b.speed_mm_s},
                          {"residual_mm_all", number(b.residual_mm_all)},
+                         {"residual_mm_all_off", number(b.residual_mm_all_off)},
                          {"uc_mm", number(b.uc_mm)},
                          {"seed", b.seed},
                          {"laps", b.laps},
@@ -469,6 +603,13 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
     s.setup = js.at("setup").get<std::string>();
     if (js.contains("description") && js.at("description").is_string()) {
       s.description = js.at("description").get<std::string>();
+    }
+    const std::pair<const char*, std::string*> text_fields[] = {{"paper_table", &s.paper_table},
+                                                                {"paper_label", &s.paper_label}};
+    for (const auto& [key, field] : text_fields) {
+      if (!js.contains(key)) continue;
+      if (!js.at(key).is_string()) throw DataError(fmt::format("{}.{}: not a string", where, key));
+      *field = js.at(key).get<std::string>();
     }
     if (!js.contains("loads") || !js.at("loads").is_array()) {
       throw DataError(fmt::format("{}: missing array 'loads'", where));
@@ -560,46 +701,7 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
   if (doc.contains("error_budget")) {
     std::size_t bi = 0;
     for (const auto& jb : doc.at("error_budget")) {
-      const std::string bw = fmt::format("{}: error_budget[{}]", source, bi++);
-      ErrorBudget b;
-      if (!jb.contains("setup") || !jb.at("setup").is_string()) {
-        throw DataError(fmt::format("{}: missing string field 'setup'", bw));
-      }
-      b.setup = jb.at("setup").get<std::string>();
-      b.load_N = read_number(jb, "load_N", bw);
-      b.speed_mm_s = read_number(jb, "speed_mm_s", bw);
-      b.residual_mm_all = jb.contains("residual_mm_all") && jb.at("residual_mm_all").is_null()
-                              ? kNaN
-                              : read_number(jb, "residual_mm_all", bw);
-      b.uc_mm = jb.contains("uc_mm") && jb.at("uc_mm").is_null() ? kNaN : read_number(jb, "uc_mm", bw, false);
-      if (jb.contains("seed")) {
-        if (!jb.at("seed").is_number_unsigned()) throw DataError(fmt::format("{}: seed: not a seed", bw));
-        b.seed = jb.at("seed").get<std::uint64_t>();
-      }
-      if (jb.contains("laps")) {
-        const double laps = read_number(jb, "laps", bw);
-        if (laps < 0 || laps > 1e6 || laps != std::floor(laps))
-          throw DataError(fmt::format("{}: laps: not a lap count", bw));
-        b.laps = static_cast<int>(laps);
-      }
-      if (jb.contains("entries")) {
-        std::size_t ei = 0;
-        for (const auto& je : jb.at("entries")) {
-          const std::string ew = fmt::format("{}.entries[{}]", bw, ei++);
-          ErrorBudgetEntry e;
-          if (!je.contains("effect") || !je.at("effect").is_string()) {
-            throw DataError(fmt::format("{}: missing string field 'effect'", ew));
-          }
-          e.effect = je.at("effect").get<std::string>();
-          e.size = je.contains("size") && je.at("size").is_string() ? je.at("size").get<std::string>() : "";
-          e.residual_mm_without_it = je.contains("residual_mm_without_it") && je.at("residual_mm_without_it").is_null()
-                                         ? kNaN
-                                         : read_number(je, "residual_mm_without_it", ew);
-          e.share_of_residual = residual_share(b.residual_mm_all, e.residual_mm_without_it);
-          b.entries.push_back(e);
-        }
-      }
-      study.error_budgets.push_back(b);
+      study.error_budgets.push_back(read_error_budget(jb, fmt::format("{}: error_budget[{}]", source, bi++)));
     }
   }
   return study;
@@ -643,7 +745,7 @@ std::string study_tables_text(const StudyResult& study) {
   std::string out;
   for (std::size_t si = 0; si < study.setups.size(); ++si) {
     const SetupResult& s = study.setups[si];
-    const PaperTable* pt = paper.table_for(s.setup);
+    const PaperTable* pt = paper_table_of(paper, s);
     const Grid g = setup_grid(s, speeds, pt);
     out += fmt::format("{}: mean distance from the unloaded path, mm{}\n", titles[si],
                        pt != nullptr ? "; ours (paper's)" : "");
@@ -676,13 +778,15 @@ std::string study_tables_text(const StudyResult& study) {
     for (const auto& r : g.rows) {
       out += line(r.cells);
     }
+    out += "  compensation: 1 - (mean of the printed C columns) / printed UC, as the paper states its own\n";
     if (pt != nullptr) {
       std::string diffs;
       for (const auto& l : s.loads) {
         const PaperRow* pr = pt->row_for(l.load_N);
         if (pr != nullptr && std::isfinite(l.uc_mean_mm())) {
-          diffs += fmt::format("{}{:g} N {:+.0f}%", diffs.empty() ? "" : ", ", l.load_N,
-                               (l.uc_mean_mm() / pr->uc_mm - 1.0) * 100.0);
+          // From the printed figures, so the reader's own division gives the same percentage.
+          diffs += fmt::format("{}{:g} N {}", diffs.empty() ? "" : ", ", l.load_N,
+                               signed_percent_text(uc_over_paper(l, *pr) - 1.0));
         }
       }
       if (!diffs.empty()) {
@@ -713,10 +817,12 @@ std::string study_tables_markdown(const StudyResult& study) {
   std::string out;
   for (std::size_t si = 0; si < study.setups.size(); ++si) {
     const SetupResult& s = study.setups[si];
-    const PaperTable* pt = paper.table_for(s.setup);
+    const PaperTable* pt = paper_table_of(paper, s);
     const Grid g = setup_grid(s, speeds, pt);
-    out += fmt::format("### {}\n\nMean distance from the unloaded path in mm{}.", titles[si],
-                       pt != nullptr ? "; ours (the paper's in brackets)" : "");
+    out += fmt::format(
+        "### {}\n\nMean distance from the unloaded path in mm{}; compensation 1 - (mean of the C columns) / UC, "
+        "from the printed figures, as the paper states its own.",
+        titles[si], pt != nullptr ? "; ours (the paper's in brackets)" : "");
     if (!s.description.empty()) {
       out += " " + s.description;
     }
@@ -765,7 +871,7 @@ std::string study_csv_text(const StudyResult& study) {
        "iso_accuracy_uc_mm,iso_accuracy_c_mm,iso_repeatability_mm,uc_sync_mm,c_sync_mm,seeds,c_mm_seed_sd,"
        "c_mm_seed_min,c_mm_seed_max,paper_uc_mm,paper_c_mm\n";
   for (const auto& s : study.setups) {
-    const PaperTable* pt = paper.table_for(s.setup);
+    const PaperTable* pt = paper_table_of(paper, s);
     for (const auto& l : s.loads) {
       const PaperRow* pr = pt != nullptr ? pt->row_for(l.load_N) : nullptr;
       for (const int v : study_speeds_mm_s(study)) {
@@ -799,12 +905,14 @@ std::string sweep_csv_text(const StudyResult& study) {
 std::string error_budget_csv_text(const StudyResult& study) {
   std::string f;
   auto cell = [](double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : std::string(); };
-  f += "setup,load_N,speed_mm_s,seed,laps,residual_mm_all,uc_mm,effect,size,residual_mm_without_it,share_of_residual\n";
+  f += "setup,load_N,speed_mm_s,seed,laps,residual_mm_all,residual_mm_all_off,uc_mm,effect,size,"
+       "residual_mm_without_it,sensitivity_one_at_a_time\n";
   for (const auto& b : study.error_budgets) {
     for (const auto& e : b.entries) {
-      f += fmt::format("{},{:g},{:g},{},{},{},{},{},{},{},{}\n", csv_text_cell(b.setup), b.load_N, b.speed_mm_s, b.seed,
-                       b.laps, cell(b.residual_mm_all), cell(b.uc_mm), csv_text_cell(e.effect), csv_text_cell(e.size),
-                       cell(e.residual_mm_without_it), cell(e.share_of_residual));
+      f += fmt::format("{},{:g},{:g},{},{},{},{},{},{},{},{},{}\n", csv_text_cell(b.setup), b.load_N, b.speed_mm_s,
+                       b.seed, b.laps, cell(b.residual_mm_all), cell(b.residual_mm_all_off), cell(b.uc_mm),
+                       csv_text_cell(e.effect), csv_text_cell(e.size), cell(e.residual_mm_without_it),
+                       cell(e.sensitivity));
     }
   }
   return f;

@@ -68,6 +68,12 @@ struct SetupResult {
   std::string setup;
   std::string description;
   std::vector<LoadResult> loads;
+  /// The paper's table (PaperFigures::table_for's key) this setup is compared with when its own name
+  /// is not one of the paper's: "online" for online compensation over the paper's own kind of link.
+  /// Empty: the setup is compared by its name, or not at all.
+  std::string paper_table = {};
+  /// How the report marks that comparison: "simple message, 100 ms (the paper's kind of link)".
+  std::string paper_label = {};
 };
 
 /// One point of a speed sweep (beyond the paper's 10-50 mm/s).
@@ -101,8 +107,10 @@ struct StudyResult {
 ///  "c_mm_by_seed":{"10":[..],..}), "spread":{"uc_mm":{mean,sd,min,max,n},"c_mm":{"10":{..}},
 ///  "compensation":{..}}}, ...]}, ...], "speeds_mm_s":[..], "seeds":[..],
 ///  "speed_sweep":[{"setup","load_N","speed_mm_s","uc_mm","c_mm","compensation","c_sync_mm",
-///  "c_mm_by_seed":[..]}], "error_budget":[{"setup","load_N","speed_mm_s","residual_mm_all","uc_mm",
-///  "entries":[{"effect","size","residual_mm_without_it","share_of_residual"}]}], "paper":{...}}.
+///  "c_mm_by_seed":[..]}], "error_budget":[{"setup","load_N","speed_mm_s","residual_mm_all",
+///  "residual_mm_all_off","uc_mm","entries":[{"effect","size","residual_mm_without_it",
+///  "sensitivity_one_at_a_time"}]}], "paper":{...}}; a setup compared with a paper table of another
+///  name carries "paper_table" and "paper_label".
 /// NaN values are written as null.
 nlohmann::json study_to_json(const StudyResult& study);
 /// The inverse of study_to_json (for `deflex report` from a saved JSON). Throws DataError naming the
@@ -112,8 +120,42 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
 /// The speed columns of the tables (mm/s): study.speeds_mm_s when given, else every speed any load
 /// reports, ascending. The report module lays its tables and charts out by the same columns.
 [[nodiscard]] std::vector<int> study_speeds_mm_s(const StudyResult& study);
+/// The paper's table a setup is compared with: the one of its own name (offline, online), else the
+/// one its paper_table names; nullptr when neither.
+[[nodiscard]] const PaperTable* paper_table_of(const PaperFigures& paper, const SetupResult& setup);
+
+/// The fidelity targets (issue 27): our UC within 15 % of the paper's, our C (the mean over the
+/// speeds) within 35 %, at every load.
+inline constexpr double kUcTarget = 0.15;
+inline constexpr double kCTarget = 0.35;
+
+/// Decimals of a length in mm as the tables print ours (the paper prints 2).
+inline constexpr int kPrintedMmDecimals = 3;
+/// `value` as printed with `decimals` decimals and read back: the number a reader recomputing a
+/// percentage from the printed tables starts from. NaN stays NaN.
+[[nodiscard]] double as_printed(double value, int decimals = kPrintedMmDecimals);
+/// A load's compensation as the tables print it beside its figures: 1 - C / UC from the printed
+/// figures, UC the mean over the speeds (the paper's UC column, so ours is stated the way the
+/// paper's is) and C at `speed_mm_s`; NaN without both.
+[[nodiscard]] double printed_compensation(const LoadResult& load, int speed_mm_s);
+/// The same over `speeds`: 1 - (mean of the printed C) / printed UC as the mean; the spread over the
+/// seeds of the same quantity per seed (1 - mean C / mean UC of that seed's runs) as sd, min and max.
+[[nodiscard]] Spread printed_compensation_spread(const LoadResult& load, const std::vector<int>& speeds);
+/// Our printed UC over the paper's, and our printed C summed over the paper's speeds over the paper's
+/// C summed over the same speeds (C "averaged over the speeds"); NaN when there is nothing to compare.
+[[nodiscard]] double uc_over_paper(const LoadResult& load, const PaperRow& paper);
+[[nodiscard]] double c_over_paper(const LoadResult& load, const PaperRow& paper);
+/// An error budget entry's one-effect-at-a-time sensitivity from the printed figures (C with every
+/// effect and C without this one, 3 decimals each), as the report and the terminal print it.
+[[nodiscard]] double printed_sensitivity(const ErrorBudget& budget, const ErrorBudgetEntry& entry);
+/// A relative difference as whole percent with its sign ("+18%", "-7%"; "0%", never "-0%"); "n/a"
+/// when not finite.
+[[nodiscard]] std::string signed_percent_text(double fraction);
+
 /// m[speed_mm_s], NaN when the map has no value at that speed.
 [[nodiscard]] double value_at_speed(const std::map<int, double>& m, int speed_mm_s);
+/// A fraction in whole percent as percent_text prints it (halves away from zero); NaN if not finite.
+[[nodiscard]] double whole_percent(double fraction);
 /// A fraction as whole percent ("67%"); one that rounds to zero prints "0%", not "-0%"; "n/a" if not finite.
 [[nodiscard]] std::string percent_text(double fraction);
 
@@ -128,7 +170,8 @@ std::string study_tables_markdown(const StudyResult& study);
 [[nodiscard]] std::string study_csv_text(const StudyResult& study);
 /// The speed sweep, one row per setup and speed (means and spread over the seeds).
 [[nodiscard]] std::string sweep_csv_text(const StudyResult& study);
-/// The error budget, one row per setup and effect.
+/// The error budget, one row per setup and effect: C without that effect alone and the one-effect-at-
+/// a-time sensitivity (not a share: they need not add up), beside C with every effect on and off.
 [[nodiscard]] std::string error_budget_csv_text(const StudyResult& study);
 /// The three as files of their own (output_file.hpp). Throw InputError or OutputError naming the file.
 void write_study_csv(const StudyResult& study, const std::string& path);
