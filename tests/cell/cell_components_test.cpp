@@ -67,12 +67,12 @@ TEST(LdbbDevice, TheSealHoldsItsFrictionAgainstThePistonsLastMotion) {
   d.settle();
   EXPECT_DOUBLE_EQ(d.seal_friction(), 0.15);
   auto push_at = [&](double length_m) { return d.wrench(Vector3(0, 0, length_m), Vector3::Zero())[2]; };
-  EXPECT_NEAR(push_at(0.15), 400.0, 1e-9);               // first contact: nothing held yet
-  EXPECT_NEAR(push_at(0.15 + 0.5e-4), 370.0, 1e-6);      // half the pre-sliding: half of 60 N
-  EXPECT_NEAR(push_at(0.15 + 3e-4), 340.0, 1e-6);        // sliding out: -15 %
-  EXPECT_NEAR(push_at(0.15 + 3e-4), 340.0, 1e-6);        // standing: held
-  EXPECT_NEAR(push_at(0.15 + 2e-4), 400.0, 1e-6);        // 0.1 mm back: through zero
-  EXPECT_NEAR(push_at(0.15 + 0.5e-4), 460.0, 1e-6);      // sliding in: +15 %
+  EXPECT_NEAR(push_at(0.15), 400.0, 1e-9);           // first contact: nothing held yet
+  EXPECT_NEAR(push_at(0.15 + 0.5e-4), 370.0, 1e-6);  // half the pre-sliding: half of 60 N
+  EXPECT_NEAR(push_at(0.15 + 3e-4), 340.0, 1e-6);    // sliding out: -15 %
+  EXPECT_NEAR(push_at(0.15 + 3e-4), 340.0, 1e-6);    // standing: held
+  EXPECT_NEAR(push_at(0.15 + 2e-4), 400.0, 1e-6);    // 0.1 mm back: through zero
+  EXPECT_NEAR(push_at(0.15 + 0.5e-4), 460.0, 1e-6);  // sliding in: +15 %
   c.push = false;
   LdbbDevice pull(c, Vector3::Zero(), 400.0, 1);
   pull.settle();
@@ -210,7 +210,6 @@ TEST(ForceSensorDaq, DecouplingUndoesTheCrosstalkUpToTheCalibrationResidual) {
   const Vector3 raw = daq.sample(Vector3(100.0, -50.0, 20.0), Matrix3::Identity());
   EXPECT_NEAR((daq.calibration().decoupling * raw - Vector3(100.0, -50.0, 20.0)).norm(), 0.0, 1e-9);
 }
-
 
 TEST(ForceSensorDaq, ForceChannelsAnswerToTheMomentAboutTheSensorsOrigin) {
   // A lateral force at the TCP, 250 mm beyond a 60 mm sensor, bends the sensor about its centre

@@ -177,7 +177,8 @@ TEST(CaseConfig, OutOfRangeEffectSizesAndSeedsAreRefusedByName) {
   const std::string bias = error_of(paper_with("  force_from: ldbb", "  force_from: ldbb\n  ldbb_force_bias_pct: -15"));
   EXPECT_NE(bias.find("calibration.ldbb_force_bias_pct"), std::string::npos) << bias;
   EXPECT_NE(bias.find("seal_friction_pct"), std::string::npos) << bias;
-  const std::string old_bias = error_of(paper_with("  seal_friction_pct: 25", "  force_bias_pct: -15\n  seal_friction_pct: 25"));
+  const std::string old_bias =
+      error_of(paper_with("  seal_friction_pct: 25", "  force_bias_pct: -15\n  seal_friction_pct: 25"));
   EXPECT_NE(old_bias.find("ldbb.force_bias_pct"), std::string::npos) << old_bias;
   const std::string seal = error_of(paper_with("  seal_friction_pct: 25", "  seal_friction_pct: 70"));
   EXPECT_NE(seal.find("ldbb.seal_friction_pct"), std::string::npos) << seal;

@@ -116,7 +116,7 @@ struct LdbbConfig {
   double time_constant_s = 0.3;  ///< pneumatic first-order response
   double ripple = 0.0;           ///< relative amplitude
   double ripple_hz = 2.0;
-  double noise = 0.0;       ///< relative 1-sigma per servo cycle
+  double noise = 0.0;  ///< relative 1-sigma per servo cycle
   /// The cylinder's seal friction (one physical model for the calibration and the tests): the seal
   /// carries up to seal_friction x the pneumatic force against the piston's last motion: less force
   /// reaches the TCP while the piston last moved with the load (as when the arm yields to it), more

@@ -309,11 +309,25 @@ void read_case_tool_and_sensor(const yaml::Field& root, CaseConfig& c) {
   c.cell.tool.ee_cog_m = t.at("ee_cog_mm").as_vector3() * kMm;
 
   const auto s = root.at("sensor");
-  s.only_keys({"height_mm", "lateral_compliance_um_per_N", "axial_compliance_um_per_N",
-               "rotational_compliance_urad_per_Nm", "crosstalk_pct", "crosstalk_calibration_residual_pct", "noise_N",
-               "bias_N", "rate_Hz", "gravity_mass_error_pct", "sensitivity_error_pct", "misalignment_deg",
-               "daq_latency_ms", "zero_drift_N_per_10min", "moment_crosstalk_pct", "nominal_moment_Nm",
-               "nominal_lateral_force_N", "moment_overload_growth_pct", "sheet_cog_error_mm",
+  s.only_keys({"height_mm",
+               "lateral_compliance_um_per_N",
+               "axial_compliance_um_per_N",
+               "rotational_compliance_urad_per_Nm",
+               "crosstalk_pct",
+               "crosstalk_calibration_residual_pct",
+               "noise_N",
+               "bias_N",
+               "rate_Hz",
+               "gravity_mass_error_pct",
+               "sensitivity_error_pct",
+               "misalignment_deg",
+               "daq_latency_ms",
+               "zero_drift_N_per_10min",
+               "moment_crosstalk_pct",
+               "nominal_moment_Nm",
+               "nominal_lateral_force_N",
+               "moment_overload_growth_pct",
+               "sheet_cog_error_mm",
                "sheet_height_error_mm"});
   auto& f = c.cell.sensor;
   f.sheet_cog_error_m =
@@ -322,10 +336,10 @@ void read_case_tool_and_sensor(const yaml::Field& root, CaseConfig& c) {
       case_number(s, "sheet_height_error_mm", non_negative, 0.0, from_milli, at_most(0.01, "must be within 0..10 mm"));
   f.moment_crosstalk =
       case_number(s, "moment_crosstalk_pct", non_negative, 0.0, from_pct, at_most(0.2, "must be within 0..20 %"));
-  f.nominal_moment_nm = case_number(s, "nominal_moment_Nm", positive, 50.0, unscaled,
-                                    at_most(1e5, "must be at most 100000 N m"));
-  f.nominal_lateral_force_n = case_number(s, "nominal_lateral_force_N", positive, 1000.0, unscaled,
-                                          at_most(1e6, "must be at most 1000000 N"));
+  f.nominal_moment_nm =
+      case_number(s, "nominal_moment_Nm", positive, 50.0, unscaled, at_most(1e5, "must be at most 100000 N m"));
+  f.nominal_lateral_force_n =
+      case_number(s, "nominal_lateral_force_N", positive, 1000.0, unscaled, at_most(1e6, "must be at most 1000000 N"));
   f.moment_overload_growth = case_number(s, "moment_overload_growth_pct", non_negative, 0.0, from_pct,
                                          at_most(5.0, "must be within 0..500 %"));
   f.zero_drift_n =
@@ -396,9 +410,9 @@ void read_case_tracker_and_controller(const yaml::Field& root, CaseConfig& c) {
   c.cell.tracker.noise_m = non_negative(tr.at("noise_um")) * kUm;
   c.cell.tracker.trigger_jitter_s =
       case_number(tr, "trigger_jitter_ms", non_negative, 0.0, from_milli, at_most(0.1, "must be within 0..100 ms"));
-  c.cell.tracker.clock_rate_error = case_number(tr, "clock_rate_ppm", non_negative, 0.0, unscaled,
-                                                at_most(1000.0, "must be within 0..1000 ppm")) *
-                                    1e-6;
+  c.cell.tracker.clock_rate_error =
+      case_number(tr, "clock_rate_ppm", non_negative, 0.0, unscaled, at_most(1000.0, "must be within 0..1000 ppm")) *
+      1e-6;
   // The cell simulates every sample: beyond 10 kHz a study takes minutes and gigabytes.
   c.cell.tracker.rate_hz =
       case_number(tr, "rate_Hz", positive, kRequired, unscaled,
@@ -635,11 +649,11 @@ std::string effect_size(const CaseConfig& c, Effect e) {
     case Effect::kTrackerNoise:
       return fmt::format("{:.1f} um (1 sigma)", c.cell.tracker.noise_m * 1e6);
     case Effect::kLdbbSealFriction:
-      return fmt::format("{:.0f} % of the force (+-{:.0f} % run to run), pre-sliding {:.2f} mm; calibration force "
-                         "from the {}",
-                         c.cell.ldbb.seal_friction * 100, c.cell.ldbb.seal_friction_spread * 100,
-                         c.cell.ldbb.seal_presliding_m * 1e3,
-                         c.calibration.force_from_sensor ? "sensor when mounted" : "LDBB's report");
+      return fmt::format(
+          "{:.0f} % of the force (+-{:.0f} % run to run), pre-sliding {:.2f} mm; calibration force "
+          "from the {}",
+          c.cell.ldbb.seal_friction * 100, c.cell.ldbb.seal_friction_spread * 100, c.cell.ldbb.seal_presliding_m * 1e3,
+          c.calibration.force_from_sensor ? "sensor when mounted" : "LDBB's report");
     case Effect::kLatency:
       return fmt::format("dead time {:.0f} ms, filter {:.0f} Hz", c.cell.controller.egm_dead_time_s * 1e3,
                          c.cell.controller.egm_lowpass_hz);

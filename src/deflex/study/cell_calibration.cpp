@@ -35,8 +35,8 @@ struct Arc {
 };
 
 Arc arc_of(int k) {
-  static const Arc kArcs[6] = {{deg_to_rad(15), 0.05, true, 0.0},  {deg_to_rad(15), -0.05, false, 2.1},
-                               {deg_to_rad(50), 0.05, false, 4.2}, {deg_to_rad(50), -0.05, true, 1.0},
+  static const Arc kArcs[6] = {{deg_to_rad(15), 0.05, true, 0.0},   {deg_to_rad(15), -0.05, false, 2.1},
+                               {deg_to_rad(50), 0.05, false, 4.2},  {deg_to_rad(50), -0.05, true, 1.0},
                                {deg_to_rad(-30), -0.03, true, 3.1}, {deg_to_rad(-30), 0.03, false, 5.2}};
   Arc a = kArcs[k % 6];
   const int round = k / 6;  // the round of six arcs
@@ -265,8 +265,11 @@ CellCalibration identify_from_measurements(const CalibrationRig& rig, const std:
   id_options.robust = false;
   double force_sum = 0.0;
   for (const auto& m : data) force_sum += m.wrench_base.head<3>().norm();
-  CellCalibration out{nominal, identify_stiffness(nominal, data, id_options), static_cast<int>(data.size()),
-                      force_sum / static_cast<double>(data.size()), {}};
+  CellCalibration out{nominal,
+                      identify_stiffness(nominal, data, id_options),
+                      static_cast<int>(data.size()),
+                      force_sum / static_cast<double>(data.size()),
+                      {}};
   std::vector<double> k(static_cast<std::size_t>(nominal.dof()));
   for (int j = 0; j < nominal.dof(); ++j) {
     const double kj = out.estimate.stiffness_nm_per_rad[static_cast<std::size_t>(j)];
