@@ -370,7 +370,9 @@ void plan_error_budget(StudyContext& x) {
     have_online = have_online || online;
     x.budget_setups.push_back(static_cast<int>(i));
     for (Effect e : kAllEffects) {
-      if ((e == Effect::kSensorCompliance || e == Effect::kSensorDrift) && !sc.sensor_mounted) continue;
+      const bool sensor_only =
+          e == Effect::kSensorCompliance || e == Effect::kSensorDrift || e == Effect::kSensorMoment;
+      if (sensor_only && !sc.sensor_mounted) continue;
       if ((e == Effect::kSensorErrors || e == Effect::kSensorCalibration || e == Effect::kLatency) && offline) continue;
       x.budget_jobs.push_back(BudgetJob{static_cast<int>(i), e});
     }
