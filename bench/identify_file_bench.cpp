@@ -31,7 +31,7 @@ std::string data_file() {
   if (const char* env = std::getenv("DEFLEX_IDENTIFY_DATA")) {
     return env;
   }
-  const std::string path = "/tmp/deflex_scale_identify_" + std::to_string(kRows) + ".csv";
+  std::string path = "/tmp/deflex_scale_identify_" + std::to_string(kRows) + ".csv";
   if (!std::filesystem::exists(path)) {
     std::ifstream in(source_path("examples/identify/kr210_synthetic_measurements.csv"));
     std::string header, line;

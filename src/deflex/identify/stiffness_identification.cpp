@@ -439,7 +439,7 @@ template <int W>
 void add_weighted_products(const double* block, int rows, int runtime_width, double omega, double* upper) {
   const int width = W > 0 ? W : runtime_width;
   for (int r = 0; r < rows; ++r) {
-    const double* x = block + r * width;
+    const double* x = block + static_cast<std::ptrdiff_t>(r) * width;
     int at = 0;
 #pragma GCC unroll 8
     for (int k = 0; k < width; ++k) {
@@ -459,7 +459,7 @@ double residual_norm(const double* block, int rows, int runtime_width, const dou
   const int n = width - 1;
   double sum = 0.0;
   for (int r = 0; r < rows; ++r) {
-    const double* x = block + r * width;
+    const double* x = block + static_cast<std::ptrdiff_t>(r) * width;
     double ac = 0.0;
 #pragma GCC unroll 8
     for (int j = 0; j < n; ++j) {
@@ -708,7 +708,7 @@ WeightedResidualSums summarise_residuals(const RowStore& s, const WeightedFit& f
     std::array<double, 6> e{};
     double d2 = 0.0;
     for (int r = 0; r < rows; ++r) {
-      const double* x = block + r * width;
+      const double* x = block + static_cast<std::ptrdiff_t>(r) * width;
       double ac = 0.0;
       for (int j = 0; j < n; ++j) {
         ac += x[j] * fit.c_full[j];
