@@ -445,12 +445,12 @@ TEST(IdentifyStiffness, RowsKeptInAScratchFileGiveTheSameEstimateBitForBit) {
   const StiffnessEstimate a = run(std::size_t{1} << 30, in_memory_scratch);
   const StiffnessEstimate b = run(0, spilled_scratch);
   EXPECT_EQ(in_memory_scratch, 0U);
-  // Everything but the chunk still filling (at most 64k rows of 7 doubles) went to the file.
+  // Everything but the chunk still filling (at most 16k rows of 7 doubles) went to the file.
   std::uint64_t row_bytes = 0;
   for (const StiffnessMeasurement& m : data) {
     row_bytes += (m.drot_rad ? 6U : 3U) * 7U * sizeof(double);
   }
-  EXPECT_GE(spilled_scratch + 65536U * 7U * sizeof(double), row_bytes);
+  EXPECT_GE(spilled_scratch + 16384U * 7U * sizeof(double), row_bytes);
   EXPECT_LT(spilled_scratch, row_bytes);
   EXPECT_GT(a.iterations, 2);
   EXPECT_FALSE(a.rejected_lines.empty());
@@ -499,6 +499,90 @@ TEST(IdentifyStiffness, AScratchFileThatCannotBeMadeIsAnErrorNamingTheDirectory)
   EXPECT_NE(message.find("identification rows"), std::string::npos) << message;
   EXPECT_NE(message.find("/proc"), std::string::npos) << message;
   EXPECT_NE(message.find("TMPDIR"), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace deflex
+
+namespace deflex {
+namespace {
+
+// The robust fit ends with a solve at its final weights: it must be the dense weighted least squares of the whole
+// stack (KDL's Jacobians, every measurement's rows times sqrt(weight * robust weight)) at those weights, with the
+// residual figures of that solve, and it must name the rejected measurements by the lines they came from (lines
+// with gaps, as comments in a file leave, and weights that differ from 1 from the start or only from the middle).
+void expect_dense_solve_at_final_weights(std::size_t first_weighted) {
+  const RobotModel model = kr210_model();
+  std::vector<StiffnessMeasurement> data = deflected_data(model, 3000, 20e-6, 77);
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    data[i].line = static_cast<int>(i + 2 + i / 100);
+    data[i].weight = i < first_weighted ? 1.0 : 0.5 + static_cast<double>(i % 5) * 0.25;
+    if (i % 50 == 0) {
+      data[i].dp_m.x() += 1e-3;  // a gross outlier: 50 noise sigmas
+    }
+  }
+  const StiffnessEstimate est = identify_stiffness(model, data);
+  ASSERT_EQ(est.robust_weights.size(), data.size());
+  ASSERT_GT(est.iterations, 2);
+
+  const KDL::Chain chain = test::kdl_chain_from_dh(model);
+  KDL::ChainJntToJacSolver solver(chain);
+  Eigen::MatrixXd A(3 * static_cast<Eigen::Index>(data.size()), 6);
+  Eigen::VectorXd b(A.rows());
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const StiffnessMeasurement& m = data[i];
+    KDL::JntArray qk(6);
+    for (unsigned j = 0; j < 6; ++j) {
+      qk(j) = m.q[j];
+    }
+    KDL::Jacobian jk(6);
+    ASSERT_GE(solver.JntToJac(qk, jk), 0);
+    const Eigen::MatrixXd J = jk.data;
+    const Eigen::VectorXd tau = J.transpose() * m.wrench_base;
+    const double sw = std::sqrt(m.weight * est.robust_weights[i]);
+    const auto r = 3 * static_cast<Eigen::Index>(i);
+    A.middleRows(r, 3) = sw * J.topRows(3) * tau.asDiagonal();
+    b.segment(r, 3) = sw * m.dp_m;
+  }
+  const Eigen::VectorXd c = A.colPivHouseholderQr().solve(b);
+  for (std::size_t j = 0; j < 6; ++j) {
+    EXPECT_NEAR(est.compliance_rad_per_nm[j], c[static_cast<Eigen::Index>(j)], 1e-9 * c[static_cast<Eigen::Index>(j)])
+        << "joint " << j + 1;
+  }
+  // The residual RMS of the measurements kept, in the measured unit (each row divided by sqrt(weight)).
+  double pos2 = 0.0;
+  int kept = 0;
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    if (est.robust_weights[i] > 0.0) {
+      const StiffnessMeasurement& m = data[i];
+      KDL::JntArray qk(6);
+      for (unsigned j = 0; j < 6; ++j) {
+        qk(j) = m.q[j];
+      }
+      KDL::Jacobian jk(6);
+      ASSERT_GE(solver.JntToJac(qk, jk), 0);
+      const Eigen::MatrixXd J = jk.data;
+      const Eigen::VectorXd tau = J.transpose() * m.wrench_base;
+      pos2 += (m.dp_m - J.topRows(3) * tau.asDiagonal() * c).squaredNorm();
+      ++kept;
+    }
+  }
+  EXPECT_NEAR(est.residual_rms_m, std::sqrt(pos2 / (3.0 * kept)), 1e-9 * est.residual_rms_m);
+
+  // Every outlier rejected, named by its own line.
+  ASSERT_EQ(est.rejected_lines.size(), est.rejected_measurements.size());
+  for (std::size_t k = 0; k < est.rejected_measurements.size(); ++k) {
+    const auto i = static_cast<std::size_t>(est.rejected_measurements[k]);
+    EXPECT_EQ(est.rejected_lines[k], data[i].line);
+  }
+  for (std::size_t i = 0; i < data.size(); i += 50) {
+    EXPECT_EQ(est.robust_weights[i], 0.0) << "outlier " << i;
+  }
+}
+
+TEST(IdentifyStiffness, TheRobustFitIsTheDenseSolveAtItsFinalWeights) {
+  expect_dense_solve_at_final_weights(0);     // weights other than 1 from the first measurement
+  expect_dense_solve_at_final_weights(1500);  // only from the middle on
 }
 
 }  // namespace

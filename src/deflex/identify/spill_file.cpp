@@ -2,6 +2,7 @@
 #include "deflex/identify/detail/spill_file.hpp"
 
 #include <fcntl.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -87,6 +88,27 @@ void SpillFile::read_at(std::uint64_t offset, double* values, std::size_t count)
     p += n;
     left -= static_cast<std::size_t>(n);
     at += n;
+  }
+}
+
+SpillFile::View::View(const SpillFile& file, std::uint64_t offset, std::size_t count) {
+  const auto page = static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE));
+  const std::uint64_t start = offset / page * page;
+  length_ = static_cast<std::size_t>(offset - start) + count * sizeof(double);
+  // MAP_POPULATE: the pages are in the page cache (just written); mapping them all at once is cheaper than a
+  // fault per page.
+  map_ = ::mmap(nullptr, length_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, file.fd_, static_cast<off_t>(start));
+  if (map_ == MAP_FAILED) {
+    map_ = nullptr;
+    throw Error(fmt::format("{}: reading back the scratch file in {} failed ({})", file.what_, file.directory_,
+                            std::strerror(errno)));
+  }
+  data_ = reinterpret_cast<const double*>(static_cast<const char*>(map_) + (offset - start));
+}
+
+SpillFile::View::~View() {
+  if (map_ != nullptr) {
+    ::munmap(map_, length_);
   }
 }
 

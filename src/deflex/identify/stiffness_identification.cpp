@@ -2,16 +2,20 @@
 #include "deflex/identify/stiffness_identification.hpp"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
 
 #include "deflex/identify/detail/nonnegative_least_squares.hpp"
+#include "deflex/identify/detail/robust_median.hpp"
 #include "deflex/identify/detail/spill_file.hpp"
 #include "deflex/model/linear_algebra.hpp"
 #include "deflex/text/errors.hpp"
@@ -44,20 +48,6 @@ std::string where(const StiffnessMeasurement& m, std::size_t i) {
   return m.line > 0 ? fmt::format("measurement {} (line {})", i + 1, m.line) : fmt::format("measurement {}", i + 1);
 }
 
-// The median of v, which it reorders (the caller's scratch: no copy of a million values).
-double median_in_place(std::vector<double>& v) {
-  if (v.empty()) {
-    return 0.0;
-  }
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  double m = *mid;
-  if (v.size() % 2 == 0) {
-    m = 0.5 * (m + *std::max_element(v.begin(), mid));
-  }
-  return m;
-}
-
 std::string joint_list(const std::vector<int>& joints) {
   std::vector<std::string> s;
   for (int j : joints) {
@@ -71,16 +61,46 @@ std::string joint_list(const std::vector<int>& joints) {
 // Not in the anonymous namespace: StiffnessIdentifier::RowStoreHolder (declared in the header) holds one.
 namespace identify_detail {
 
+// Each measurement's file line, as runs of consecutive lines (a file's rows, a comment between them starting a new
+// run): a few bytes for a million measurements instead of 4 MB.
+class MeasurementLines {
+ public:
+  void push_back(int line) {
+    if (runs_.empty() || line != last_ + 1) {
+      runs_.push_back({size_, line});
+    }
+    last_ = line;
+    ++size_;
+  }
+  [[nodiscard]] int operator[](std::size_t i) const {
+    const auto run = std::prev(std::upper_bound(runs_.begin(), runs_.end(), i,
+                                                [](std::size_t index, const Run& r) { return index < r.first; }));
+    return run->line + static_cast<int>(i - run->first);
+  }
+  [[nodiscard]] std::size_t size() const { return size_; }
+
+ private:
+  struct Run {
+    std::size_t first;  // measurement index
+    int line;           // its line
+  };
+  std::vector<Run> runs_;
+  std::size_t size_ = 0;
+  int last_ = 0;
+};
+
 // The stacked problem in compact form: per measurement its 3 (or 6) rows [A_i | b_i], already
-// multiplied by sqrt(weight) (rotation rows also by rotation_scale_m), in chunks of 64k rows so that
+// multiplied by sqrt(weight) (rotation rows also by rotation_scale_m), in chunks of 16k rows so that
 // growing never copies what is stored (a doubling vector would hold up to three times the data at
 // its peak). That is what the robust re-weighting needs: each measurement's residual against every
 // new estimate; recomputing the regressor instead (FK and two Jacobians) would cost about 0.3 us a
 // measurement an iteration. 8 (dof + 1) bytes a row: 168 bytes for a 6-joint position measurement.
 // Chunks beyond IdentificationOptions::rows_in_memory_bytes go to an unlinked scratch file and are
-// read back a chunk at a time on every pass: the same doubles in the same order, so the results are
-// bit for bit those of an all-in-memory store, with memory bounded by the budget (plus two chunks)
-// and the per-measurement scalars the re-weighting keeps (37 bytes: weights, residual norms, lines).
+// seen in place a chunk at a time on every pass (a read-only map, no copy; for_each_mutable reads and
+// writes them back): the same doubles in the same order, so the results are bit for bit those of an
+// all-in-memory store, with memory bounded by the budget (plus two chunks) and the per-measurement
+// scalars the re-weighting keeps (17 bytes: robust weight, residual norm, row count; the sqrt of the
+// given weight only once one differs from 1, the file lines as runs).
 class RowStore {
  public:
   RowStore(int dof, std::size_t memory_bytes) : width_(dof + 1), memory_budget_(memory_bytes) {}
@@ -106,7 +126,11 @@ class RowStore {
   void for_each(F&& f) const {
     std::size_t i = 0;
     for (const Chunk& c : chunks_) {
-      const double* data = c.on_disk() ? load(c) : c.values.data();
+      std::optional<SpillFile::View> view;
+      if (c.on_disk()) {
+        view.emplace(spill_, static_cast<std::uint64_t>(c.offset), c.size);
+      }
+      const double* data = c.on_disk() ? view->data() : c.values.data();
       for (std::size_t at = 0; at < c.count(); ++i) {
         const int rows = rows_[i];
         f(i, rows, data + at);
@@ -143,7 +167,8 @@ class RowStore {
     [[nodiscard]] bool on_disk() const { return offset >= 0; }
     [[nodiscard]] std::size_t count() const { return on_disk() ? size : values.size(); }  // doubles held
   };
-  static constexpr std::size_t kChunkRows = 65536;
+  static constexpr std::size_t kChunkRows =
+      16384;  // 0.9 MB of 7-wide rows: two of them (one filling, one seen from the file) in the peak
   [[nodiscard]] std::size_t chunk_capacity() const { return kChunkRows * static_cast<std::size_t>(width_); }
   // A chunk is full: keep it while the budget lasts, else write it out and free it.
   void retire(Chunk& c) {
@@ -189,8 +214,11 @@ struct Triangular {
   Eigen::VectorXd qty;
   Eigen::Index rows = 0;  // min(equations, p): fewer equations than unknowns leave R short
 };
+// `visit(i, rows, block)` sees each measurement first, so a pass that needs the rows anyway (the residuals
+// of the previous fit) rides on this one instead of reading every row again.
+template <typename Visit>
 Triangular blocked_qr(const RowStore& s, const std::vector<int>& cols, const Eigen::VectorXd& scale,
-                      const std::vector<double>& omega) {
+                      const std::vector<double>& omega, Visit&& visit) {
   const auto p = static_cast<Eigen::Index>(cols.size());
   const Eigen::Index w = p + 1;
   constexpr Eigen::Index kSlab = 512;
@@ -205,6 +233,7 @@ Triangular blocked_qr(const RowStore& s, const std::vector<int>& cols, const Eig
     fill = top;
   };
   s.for_each([&](std::size_t i, int rows, const double* block) {
+    visit(i, rows, block);
     const RowBlock B(block, rows, s.width());
     const double sw = std::sqrt(omega[i]);
     for (int r = 0; r < rows; ++r) {
@@ -229,12 +258,9 @@ Triangular blocked_qr(const RowStore& s, const std::vector<int>& cols, const Eig
   t.rows = k;
   return t;
 }
-
-// Singular values (descending) and right singular vectors of the scaled, weighted columns `cols`.
-Svd svd_of(const RowStore& s, const std::vector<int>& cols, const Eigen::VectorXd& scale,
-           const std::vector<double>& omega) {
-  const Triangular t = blocked_qr(s, cols, scale, omega);
-  return Svd(t.R.topRows(t.rows));
+Triangular blocked_qr(const RowStore& s, const std::vector<int>& cols, const Eigen::VectorXd& scale,
+                      const std::vector<double>& omega) {
+  return blocked_qr(s, cols, scale, omega, [](std::size_t, int, const double*) {});
 }
 
 // The estimate before anything is known: every joint's values NaN, the measurement count set.
@@ -288,18 +314,6 @@ std::vector<int> hold_fixed_joints(RowStore& s, const IdentificationOptions& opt
   return free_joints;
 }
 
-// The norm of each regressor column over all stored rows (weighted, as stored).
-Eigen::VectorXd regressor_column_norms(const RowStore& s) {
-  const int width = s.width();
-  const int n = width - 1;
-  Eigen::VectorXd col_norm = Eigen::VectorXd::Zero(n);
-  s.for_each([&](std::size_t, int rows, const double* block) {
-    const RowBlock B(block, rows, width);
-    col_norm += B.leftCols(n).colwise().squaredNorm().transpose();
-  });
-  return col_norm.cwiseSqrt();
-}
-
 // Identifiability before fitting, first check: a free joint the loads never turn (or whose turning never moves
 // the measured point) has a (near) zero column; it joins left_out with a warning. Returns the excited joints.
 std::vector<int> excited_joints(const Eigen::VectorXd& col_norm, const std::vector<int>& free_joints,
@@ -333,17 +347,22 @@ std::vector<int> excited_joints(const Eigen::VectorXd& col_norm, const std::vect
 // Identifiability before fitting, second check: a group of joints whose scaled columns are collinear (or that
 // fewer equations than unknowns leave undetermined) can only be identified as a combination; each such group
 // moves from `estimated` to left_out with a warning, until the rest are well conditioned.
+// `accepted_qr` ends as the QR of the set accepted (when the check ran on it), for the first fit to reuse.
 void drop_collinear_joint_groups(const RowStore& s, const Eigen::VectorXd& col_norm, const std::vector<double>& omega,
                                  double min_relative_singular_value, std::vector<int>& estimated,
-                                 std::vector<int>& left_out, std::vector<std::string>& warnings) {
+                                 std::vector<int>& left_out, std::vector<std::string>& warnings,
+                                 std::optional<Triangular>& accepted_qr) {
+  accepted_qr.reset();
   while (estimated.size() > 1) {
-    const auto svd = svd_of(s, estimated, col_norm, omega);
+    Triangular qr = blocked_qr(s, estimated, col_norm, omega);
+    const Svd svd(qr.R.topRows(qr.rows));
     const Eigen::VectorXd& sv = svd.values();
     const Eigen::Index last = sv.size() - 1;
     // Fewer equations than joints: the SVD has fewer singular values than columns, and V's trailing
     // columns span a null space the smallest singular value does not show.
     const bool underdetermined = sv.size() < static_cast<Eigen::Index>(estimated.size());
     if (!underdetermined && sv[last] >= min_relative_singular_value * sv[0]) {
+      accepted_qr = std::move(qr);
       break;
     }
     // The joints in the unobservable direction: the smallest singular value's vector or, with fewer
@@ -376,11 +395,14 @@ void drop_collinear_joint_groups(const RowStore& s, const Eigen::VectorXd& col_n
 
 // A joint left out still deflects: with a value from the robot file it is held there, so the
 // others are not biased; without one it is taken as rigid, which the warning says. Sorts left_out.
-void hold_left_out_joints(RowStore& s, const RobotModel& model, std::vector<int>& left_out,
+// Returns whether the stored rows changed.
+bool hold_left_out_joints(RowStore& s, const RobotModel& model, std::vector<int>& left_out,
                           std::vector<std::string>& warnings) {
   std::sort(left_out.begin(), left_out.end());
+  bool changed = false;
   for (int j : left_out) {
     if (model.has_stiffness()) {
+      changed = true;
       const double k = model.stiffness()[j];
       move_known_compliance_to_rhs(s, j, 1.0 / k);
       warnings.push_back(
@@ -394,13 +416,70 @@ void hold_left_out_joints(RowStore& s, const RobotModel& model, std::vector<int>
           j + 1));
     }
   }
+  return changed;
 }
 
-// The scaled normal equations a re-weighting iteration sums, and one measurement's scaled rows: fixed capacity,
-// so the pass over the stored rows does not allocate.
-using GramMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxJoints, kMaxJoints>;
-using GramVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJoints, 1>;
-using ScaledRows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, kMaxJoints>;
+// The weighted sums of one pass, upper triangle of [A b]^T diag(omega) [A b] over every stored column (dof + 1),
+// unscaled: the fit picks its columns and scales them afterwards, G_kl = S_kl / (norm_k norm_l). Our own loop
+// instead of Eigen's small dynamic products of each measurement's copied, divided columns, because it measured
+// faster: perf of a million-row run, 2.7 s of 7.2 s CPU in that product before (37 %, under load), the passes
+// with this loop (sums, residuals and weights together) 1.2 s of 3.2 s after. The sums differ from the per-row
+// scaled ones by rounding only (docs/identify.md, "Exactness").
+struct WeightedSums {
+  std::array<double, static_cast<std::size_t>((kMaxJoints + 1) * (kMaxJoints + 2) / 2)> upper{};
+  void clear() { upper.fill(0.0); }
+};
+
+// Index of (k, l), k <= l, in the packed upper triangle of a width x width matrix.
+constexpr int packed(int width, int k, int l) { return k * width - k * (k - 1) / 2 + (l - k); }
+
+// S += omega [A b]^T [A b] for one measurement's `rows` rows of `width` values. W > 0: the width known at compile
+// time (a 6-joint arm: 7), so the compiler unrolls and vectorises the 28 products; W == 0: any width.
+template <int W>
+void add_weighted_products(const double* block, int rows, int runtime_width, double omega, double* upper) {
+  const int width = W > 0 ? W : runtime_width;
+  for (int r = 0; r < rows; ++r) {
+    const double* x = block + static_cast<std::ptrdiff_t>(r) * width;
+    int at = 0;
+#pragma GCC unroll 8
+    for (int k = 0; k < width; ++k) {
+      const double wx = omega * x[k];
+#pragma GCC unroll 8
+      for (int l = k; l < width; ++l) {
+        upper[at++] += wx * x[l];
+      }
+    }
+  }
+}
+
+// |b - A c| over one measurement's rows (c: one compliance per stored column, 0 where not estimated).
+template <int W>
+double residual_norm(const double* block, int rows, int runtime_width, const double* c) {
+  const int width = W > 0 ? W : runtime_width;
+  const int n = width - 1;
+  double sum = 0.0;
+  for (int r = 0; r < rows; ++r) {
+    const double* x = block + static_cast<std::ptrdiff_t>(r) * width;
+    double ac = 0.0;
+#pragma GCC unroll 8
+    for (int j = 0; j < n; ++j) {
+      ac += x[j] * c[j];
+    }
+    const double e = x[n] - ac;
+    sum += e * e;
+  }
+  return std::sqrt(sum);
+}
+
+// Calls f.template operator()<W>() with W the width when it is the common 7 (six joints), else 0.
+template <typename F>
+void with_width(int width, F&& f) {
+  if (width == 7) {
+    f.template operator()<7>();
+  } else {
+    f.template operator()<0>();
+  }
+}
 
 // The current fit of the estimated joints.
 struct WeightedFit {
@@ -408,53 +487,39 @@ struct WeightedFit {
   Eigen::Array<bool, Eigen::Dynamic, 1> at_bound;  // per estimated joint: held at c = 0 by the constraint
   Eigen::VectorXd c_full;                          // compliance per joint, 0 where not estimated
   std::vector<double> d;                           // per measurement: d_i = |b_i - A_i c| over its stored rows
+  std::optional<Triangular> qr;                    // the QR of the last exact fit (the final weights)
 };
 
-// One re-weighting iteration's NNLS by the normal equations G s = h, G = sum omega_i A_i^T A_i and
-// h = sum omega_i A_i^T b_i over the compact rows: one pass over the stored rows instead of a QR of the tall
-// system. False (r untouched) when G is not positive definite.
-bool nnls_by_normal_equations(const RowStore& s, const std::vector<int>& estimated, const Eigen::VectorXd& col_norm,
-                              const std::vector<double>& omega, NnlsResult& r) {
+// The NNLS of the estimated joints from the weighted sums, by the normal equations G s = h with the columns scaled
+// to unit norm. False (r untouched) when G is not positive definite.
+bool nnls_from_sums(const WeightedSums& sums, int width, const std::vector<int>& estimated,
+                    const Eigen::VectorXd& col_norm, NnlsResult& r) {
   const auto p = static_cast<Eigen::Index>(estimated.size());
-  const int width = s.width();
   const int n = width - 1;
-  GramMatrix G = GramMatrix::Zero(p, p);
-  GramVector h = GramVector::Zero(p);
-  ScaledRows Ai;
-  s.for_each([&](std::size_t i, int rows, const double* block) {
-    if (omega[i] == 0.0) {
-      return;
+  Eigen::MatrixXd G(p, p);
+  Eigen::VectorXd h(p);
+  for (Eigen::Index a = 0; a < p; ++a) {
+    const int j = estimated[static_cast<std::size_t>(a)];
+    for (Eigen::Index b = a; b < p; ++b) {
+      const int l = estimated[static_cast<std::size_t>(b)];
+      G(a, b) = G(b, a) = sums.upper[static_cast<std::size_t>(packed(width, j, l))] / (col_norm[j] * col_norm[l]);
     }
-    const RowBlock B(block, rows, width);
-    Ai.resize(rows, p);
-    for (Eigen::Index k = 0; k < p; ++k) {
-      const int j = estimated[static_cast<std::size_t>(k)];
-      Ai.col(k) = B.col(j) / col_norm[j];
-    }
-    G.noalias() += omega[i] * (Ai.transpose() * Ai);
-    h.noalias() += omega[i] * (Ai.transpose() * B.col(n));
-  });
-  const Eigen::LLT<Eigen::MatrixXd> llt{Eigen::MatrixXd(G)};
+    h[a] = sums.upper[static_cast<std::size_t>(packed(width, j, n))] / col_norm[j];
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(G);
   if (llt.info() != Eigen::Success) {
     return false;
   }
   // min ||R s - y|| with R = L^T, y = L^-1 h has the normal equations G s = h.
   const Eigen::MatrixXd R = llt.matrixU();
-  const Eigen::VectorXd y = llt.matrixL().solve(Eigen::VectorXd(h));
+  const Eigen::VectorXd y = llt.matrixL().solve(h);
   r = nonnegative_least_squares(R, y);
   return true;
 }
 
-// Fits the estimated joints' compliances (c >= 0) to the rows weighted by omega, by QR when `exact` (or when the
-// normal equations fail), else by the normal equations; then each measurement's residual norm d_i.
-void fit_weighted_nnls(const RowStore& s, const std::vector<int>& estimated, const Eigen::VectorXd& col_norm,
-                       const std::vector<double>& omega, bool exact, WeightedFit& fit) {
-  NnlsResult r;
-  if (exact || !nnls_by_normal_equations(s, estimated, col_norm, omega, r)) {
-    // One QR of the tall system reduces NNLS to a p x p triangular problem with the same solution.
-    const Triangular t = blocked_qr(s, estimated, col_norm, omega);
-    r = nonnegative_least_squares(t.R, t.qty);
-  }
+// The fit from an NNLS result: scaled and full compliances.
+void take_solution(const NnlsResult& r, const std::vector<int>& estimated, const Eigen::VectorXd& col_norm,
+                   WeightedFit& fit) {
   fit.scaled = r.x;
   fit.at_bound = r.at_bound;
   fit.c_full.setZero();
@@ -462,74 +527,162 @@ void fit_weighted_nnls(const RowStore& s, const std::vector<int>& estimated, con
     const int j = estimated[static_cast<std::size_t>(k)];
     fit.c_full[j] = fit.scaled[k] / col_norm[j];
   }
-  const int width = s.width();
-  const int n = width - 1;
-  s.for_each([&](std::size_t i, int rows, const double* block) {
-    const RowBlock B(block, rows, width);
-    fit.d[i] = (B.col(n) - B.leftCols(n) * fit.c_full).norm();
-  });
+}
+
+// The exact fit by one QR of the tall system (a p x p triangular NNLS with the same solution); `qr` when the
+// caller has it already (the identifiability check's, same rows and weights), else a pass that also lets
+// `visit` see each measurement. Keeps the QR for the condition number and the standard errors.
+template <typename Visit>
+void fit_by_qr(const RowStore& s, const std::vector<int>& estimated, const Eigen::VectorXd& col_norm,
+               const std::vector<double>& omega, std::optional<Triangular> qr, WeightedFit& fit, Visit&& visit) {
+  if (!qr) {
+    qr = blocked_qr(s, estimated, col_norm, omega, visit);
+  }
+  take_solution(nonnegative_least_squares(qr->R, qr->qty), estimated, col_norm, fit);
+  fit.qr = std::move(qr);
 }
 
 // The robust weight of a measurement whose residual norm is u noise sigmas, with k = rows degrees of freedom:
 // stage 0 Huber's (full weight up to the chi quantile at z = 1.645), stage 1 Tukey's bisquare (zero beyond 1.42
 // times the chi quantile at z = 3.090).
-double irls_measurement_weight(int stage, int rows, double u) {
+// The thresholds depend only on the row count (3 or 6): computed once, not per measurement and pass (that
+// was 10 % of a million-row run).
+struct RobustThresholds {
+  std::array<double, 7> huber{}, tukey{}, chi_median{};
+  RobustThresholds() {
+    for (int k : {3, 6}) {
+      const auto ku = static_cast<std::size_t>(k);
+      huber[ku] = std::sqrt(chi_square_quantile(k, 1.645));
+      tukey[ku] = 1.42 * std::sqrt(chi_square_quantile(k, 3.090));
+      chi_median[ku] = std::sqrt(chi_square_quantile(k, 0.0));
+    }
+  }
+};
+const RobustThresholds& robust_thresholds() {
+  static const RobustThresholds t;
+  return t;
+}
+
+double irls_measurement_weight(int stage, int rows, double u, const RobustThresholds& th = robust_thresholds()) {
   if (stage == 0) {
-    const double h = std::sqrt(chi_square_quantile(rows, 1.645));
+    const double h = th.huber[static_cast<std::size_t>(rows)];
     return u <= h ? 1.0 : h / u;
   }
-  const double c = 1.42 * std::sqrt(chi_square_quantile(rows, 3.090));
+  const double c = th.tukey[static_cast<std::size_t>(rows)];
   const double t = u / c;
   return t < 1.0 ? (1.0 - t * t) * (1.0 - t * t) : 0.0;
+}
+
+// One pass over the rows for the robust loop: each measurement's residual norm against the fit into d and, with
+// `tukey_sigma` > 0 (stage 1, scale frozen), its new weight into omega and the weighted sums of the next fit.
+// The residuals of one fit and the sums of the next are one read of the rows instead of two.
+void residual_pass(const RowStore& s, const Eigen::VectorXd& c_full, std::vector<double>& d, double tukey_sigma,
+                   std::vector<double>& omega, WeightedSums* next, double* b2) {
+  const int width = s.width();
+  if (next != nullptr) {
+    next->clear();
+  }
+  const RobustThresholds& th = robust_thresholds();
+  with_width(width, [&]<int W>() {
+    s.for_each([&](std::size_t i, int rows, const double* block) {
+      d[i] = residual_norm<W>(block, rows, width, c_full.data());
+      if (b2 != nullptr) {
+        for (int r = 0; r < rows; ++r) {
+          *b2 += block[r * width + width - 1] * block[r * width + width - 1];
+        }
+      }
+      if (next != nullptr) {
+        omega[i] = irls_measurement_weight(1, rows, d[i] / tukey_sigma, th);
+        if (omega[i] != 0.0) {
+          add_weighted_products<W>(block, rows, width, omega[i], next->upper.data());
+        }
+      }
+    });
+  });
+}
+
+// The weighted sums of the current weights (a pass of its own: stage 0, whose weights need every residual's
+// median first).
+void sums_pass(const RowStore& s, const std::vector<double>& omega, WeightedSums& sums) {
+  const int width = s.width();
+  sums.clear();
+  with_width(width, [&]<int W>() {
+    s.for_each([&](std::size_t i, int rows, const double* block) {
+      if (omega[i] != 0.0) {
+        add_weighted_products<W>(block, rows, width, omega[i], sums.upper.data());
+      }
+    });
+  });
 }
 
 // Robust NNLS: Huber IRLS (convex, from the least-squares start), then Tukey's bisquare from the
 // Huber solution with the scale frozen (rejects gross outliers outright). Each measurement is
 // weighted as a whole by its residual norm d_i, which is chi-distributed with k_i = 3 (or 6)
-// degrees of freedom in units of the noise sigma. The first and the final solve are by QR; omega ends as the
-// final weights, `iterations` counts the re-weightings.
+// degrees of freedom in units of the noise sigma. The first and the final solve are by QR (the first reuses
+// `first_qr`, the identifiability check's, when given); omega ends as the final weights, `iterations` counts the
+// re-weightings. The passes over the rows: the QR, the first residuals, per Huber iteration the sums and the
+// residuals, per Tukey iteration one (residuals, weights and the next sums together), and the final QR.
 WeightedFit fit_robustly(const RowStore& s, const std::vector<int>& estimated, const Eigen::VectorXd& col_norm,
-                         const IdentificationOptions& options, std::vector<double>& omega, int& iterations) {
+                         const IdentificationOptions& options, std::vector<double>& omega, int& iterations,
+                         std::optional<Triangular> first_qr) {
   const std::size_t m = s.size();
-  const int width = s.width();
-  const int n = width - 1;
+  const int n = s.width() - 1;
+  const auto none = [](std::size_t, int, const double*) {};
   WeightedFit fit;
   fit.c_full = Eigen::VectorXd::Zero(n);
-  fit.d.assign(m, 0.0);
-  const auto chi_median = [](int k) { return std::sqrt(chi_square_quantile(k, 0.0)); };
-  fit_weighted_nnls(s, estimated, col_norm, omega, true, fit);
+  fit_by_qr(s, estimated, col_norm, omega, std::move(first_qr), fit, none);
   if (!options.robust) {
     return fit;
   }
+  fit.d.assign(m, 0.0);
   double b2 = 0.0;
-  s.for_each(
-      [&](std::size_t, int rows, const double* block) { b2 += RowBlock(block, rows, width).col(n).squaredNorm(); });
+  residual_pass(s, fit.c_full, fit.d, 0.0, omega, nullptr, &b2);
   const double rhs_scale = std::sqrt(b2 / static_cast<double>(s.total_rows()));
-  std::vector<double> d_over(m);
+  const auto& chi_median = robust_thresholds().chi_median;
   double sigma = 0.0;
+  WeightedSums sums;
+  bool sums_ready = false;  // the Tukey weights and their sums came with the last residual pass
   for (int stage = 0; stage < 2; ++stage) {
     for (int it = 0; it < options.max_robust_iterations; ++it) {
       if (stage == 0) {
-        for (std::size_t i = 0; i < m; ++i) {
-          d_over[i] = fit.d[i] / chi_median(s.rows(i));
-        }
-        sigma = median_in_place(d_over);
+        sigma = median_of_nonnegative(
+            m, [&](std::size_t i) { return fit.d[i] / chi_median[static_cast<std::size_t>(s.rows(i))]; });
       }
       if (!(sigma > 1e-12 * rhs_scale)) {
         break;  // an exact fit: nothing to re-weight
       }
-      for (std::size_t i = 0; i < m; ++i) {
-        omega[i] = irls_measurement_weight(stage, s.rows(i), fit.d[i] / sigma);
+      if (!sums_ready) {
+        const RobustThresholds& th = robust_thresholds();
+        for (std::size_t i = 0; i < m; ++i) {
+          omega[i] = irls_measurement_weight(stage, s.rows(i), fit.d[i] / sigma, th);
+        }
+        sums_pass(s, omega, sums);
       }
       const Eigen::VectorXd before = fit.scaled;
-      fit_weighted_nnls(s, estimated, col_norm, omega, false, fit);
+      NnlsResult r;
+      if (nnls_from_sums(sums, s.width(), estimated, col_norm, r)) {
+        take_solution(r, estimated, col_norm, fit);
+      } else {
+        fit_by_qr(s, estimated, col_norm, omega, std::nullopt, fit, none);
+      }
       ++iterations;
-      if ((fit.scaled - before).norm() <= 1e-10 * fit.scaled.norm()) {
+      const bool converged = (fit.scaled - before).norm() <= 1e-10 * fit.scaled.norm();
+      // What reads the residuals of this fit next: another Huber iteration (their median first), a Tukey
+      // iteration (weights from them at once: one pass), or nothing (the final QR needs only the weights).
+      const bool last_of_stage = converged || it + 1 == options.max_robust_iterations;
+      const bool tukey_next = stage == 0 ? last_of_stage : !last_of_stage;
+      if (tukey_next) {
+        residual_pass(s, fit.c_full, fit.d, sigma, omega, &sums, nullptr);
+      } else if (!last_of_stage) {
+        residual_pass(s, fit.c_full, fit.d, 0.0, omega, nullptr, nullptr);
+      }
+      sums_ready = tukey_next;
+      if (converged) {
         break;
       }
     }
   }
-  fit_weighted_nnls(s, estimated, col_norm, omega, true, fit);
+  fit_by_qr(s, estimated, col_norm, omega, std::nullopt, fit, none);
   return fit;
 }
 
@@ -542,25 +695,39 @@ struct WeightedResidualSums {
 // Into est, the figures of the measurements kept (position residual RMS and largest norm, orientation RMS, in
 // the measured units) and the measurements rejected (weight 0) with their lines; returns the weighted sums.
 WeightedResidualSums summarise_residuals(const RowStore& s, const WeightedFit& fit, const std::vector<double>& omega,
-                                         const std::vector<double>& sqrt_weight, const std::vector<int>& lines,
-                                         double rotation_scale_m, StiffnessEstimate& est) {
+                                         const std::vector<double>& sqrt_weight,
+                                         const identify_detail::MeasurementLines& lines, double rotation_scale_m,
+                                         StiffnessEstimate& est) {
   const int width = s.width();
   const int n = width - 1;
   WeightedResidualSums sums;
   double pos2 = 0.0, rot2 = 0.0;
   int kept = 0, kept_rot = 0;
   s.for_each([&](std::size_t i, int rows, const double* block) {
-    sums.wr2 += omega[i] * fit.d[i] * fit.d[i];
+    // The residual rows, weighted as stored, then in the measured units.
+    std::array<double, 6> e{};
+    double d2 = 0.0;
+    for (int r = 0; r < rows; ++r) {
+      const double* x = block + static_cast<std::ptrdiff_t>(r) * width;
+      double ac = 0.0;
+      for (int j = 0; j < n; ++j) {
+        ac += x[j] * fit.c_full[j];
+      }
+      e[static_cast<std::size_t>(r)] = x[n] - ac;
+      d2 += e[static_cast<std::size_t>(r)] * e[static_cast<std::size_t>(r)];
+    }
+    const double d = std::sqrt(d2);
+    sums.wr2 += omega[i] * d * d;
     sums.wdof += omega[i] * rows;
     if (omega[i] > 0.0) {
-      const RowBlock B(block, rows, width);
-      const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1> r =
-          (B.col(n) - B.leftCols(n) * fit.c_full) / sqrt_weight[i];
-      pos2 += r.head<3>().squaredNorm();
-      est.residual_max_m = std::max(est.residual_max_m, r.head<3>().norm());
+      const double sw = sqrt_weight.empty() ? 1.0 : sqrt_weight[i];
+      const Vector3 p(e[0] / sw, e[1] / sw, e[2] / sw);
+      pos2 += p.squaredNorm();
+      est.residual_max_m = std::max(est.residual_max_m, p.norm());
       ++kept;
       if (rows == 6) {
-        rot2 += r.tail<3>().squaredNorm() / (rotation_scale_m * rotation_scale_m);
+        const Vector3 q(e[3] / sw, e[4] / sw, e[5] / sw);
+        rot2 += q.squaredNorm() / (rotation_scale_m * rotation_scale_m);
         ++kept_rot;
       }
     } else {
@@ -599,21 +766,24 @@ double residual_variance(const WeightedResidualSums& sums, std::size_t passive_j
 }
 
 // Condition number of the weighted regressor of the estimated joints, columns scaled to unit norm.
-double scaled_condition_number(const RowStore& s, const std::vector<int>& estimated, const Eigen::VectorXd& col_norm,
-                               const std::vector<double>& omega) {
-  const auto svd = svd_of(s, estimated, col_norm, omega);
+// From the QR of the final fit (the estimated joints, the final weights).
+double scaled_condition_number(const Triangular& final_qr) {
+  const Svd svd(final_qr.R.topRows(final_qr.rows));
   const Eigen::VectorXd& sv = svd.values();
   return sv[sv.size() - 1] > 0.0 ? sv[0] / sv[sv.size() - 1] : std::numeric_limits<double>::infinity();
 }
 
 // Variance of each scaled compliance of the joints off the bound: sigma^2 times the diagonal of (R^T R)^-1.
-Eigen::VectorXd scaled_compliance_variances(const RowStore& s, const std::vector<int>& passive,
+// When every estimated joint is off the bound, the final fit's QR is this one (the same rows, columns and
+// weights): no pass.
+Eigen::VectorXd scaled_compliance_variances(const RowStore& s, const std::vector<int>& estimated,
+                                            const std::vector<int>& passive, const Triangular& final_qr,
                                             const Eigen::VectorXd& col_norm, const std::vector<double>& omega,
                                             double sigma2) {
   Eigen::VectorXd var_scaled = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(passive.size()));
   if (!passive.empty()) {
     const auto pp = static_cast<Eigen::Index>(passive.size());
-    const Eigen::MatrixXd R = blocked_qr(s, passive, col_norm, omega).R;
+    const Eigen::MatrixXd R = passive == estimated ? final_qr.R : blocked_qr(s, passive, col_norm, omega).R;
     // (R^T R)^-1 = R^-1 R^-T: diagonal = squared row norms of R^-1.
     const Eigen::MatrixXd Rinv = R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(pp, pp));
     var_scaled = sigma2 * Rinv.rowwise().squaredNorm();
@@ -659,7 +829,8 @@ void report_estimated_joints(const std::vector<int>& estimated, const WeightedFi
 
 // The joints not identified into est (1-based, sorted), and a warning naming the measurements rejected as
 // outliers (file line where known; the first ten). `lines` has one entry per measurement.
-void list_unidentified_and_rejected(std::vector<int>& left_out, const std::vector<int>& lines, StiffnessEstimate& est) {
+void list_unidentified_and_rejected(std::vector<int>& left_out, const identify_detail::MeasurementLines& lines,
+                                    StiffnessEstimate& est) {
   std::sort(left_out.begin(), left_out.end());
   for (int j : left_out) {
     est.unidentifiable_joints.push_back(j + 1);
@@ -713,10 +884,11 @@ StiffnessIdentifier::StiffnessIdentifier(const RobotModel& model, const Identifi
 StiffnessIdentifier::~StiffnessIdentifier() = default;
 
 struct StiffnessIdentifier::RowStoreHolder {
-  RowStoreHolder(int n, std::size_t memory_bytes) : rows(n, memory_bytes) {}
+  RowStoreHolder(int n, std::size_t memory_bytes) : rows(n, memory_bytes), col_sq(Eigen::VectorXd::Zero(n)) {}
   RowStore rows;
-  std::vector<double> sqrt_weight;
-  std::vector<int> lines;
+  Eigen::VectorXd col_sq;           // sum of squares of each stored regressor column (fixed joints move only b)
+  std::vector<double> sqrt_weight;  // empty while every weight is 1 (8 bytes a measurement saved)
+  identify_detail::MeasurementLines lines;
 };
 
 void StiffnessIdentifier::add(const StiffnessMeasurement& m) {
@@ -753,7 +925,25 @@ void StiffnessIdentifier::add(const StiffnessMeasurement& m) {
       out[(3 + r) * width + n] = f * (*m.drot_rad)[r];
     }
   }
-  store_->sqrt_weight.push_back(sw);
+  // Each column's squares summed over the measurement's rows, in the order Eigen 3.4's column-wise squaredNorm
+  // sums them (packetwise_redux: the first, then four at a time in pairs, then the rest one by one), which a pass
+  // of its own over the stored rows did before: the same bits, without the pass.
+  const auto sq = [&](int r, int j) { return out[r * width + j] * out[r * width + j]; };
+  for (int j = 0; j < n; ++j) {
+    double sum = sq(0, j);
+    int r = 1;
+    for (; r < ((rows - 1) & ~3); r += 4) {
+      sum = sum + ((sq(r, j) + sq(r + 1, j)) + (sq(r + 2, j) + sq(r + 3, j)));
+    }
+    for (; r < rows; ++r) {
+      sum = sum + sq(r, j);
+    }
+    store_->col_sq[j] += sum;
+  }
+  if (sw != 1.0 || !store_->sqrt_weight.empty()) {
+    store_->sqrt_weight.resize(i, 1.0);  // the measurements before the first weight other than 1
+    store_->sqrt_weight.push_back(sw);
+  }
   store_->lines.push_back(m.line);
 }
 
@@ -784,26 +974,30 @@ StiffnessEstimate StiffnessIdentifier::solve() {
   const std::size_t m = s.size();
   StiffnessEstimate est = estimate_without_values(model_.dof(), m);
   const std::vector<int> free_joints = hold_fixed_joints(s, options_, est);
-  const Eigen::VectorXd col_norm = regressor_column_norms(s);
+  const Eigen::VectorXd col_norm = store_->col_sq.cwiseSqrt();
   std::vector<int> left_out;
   std::vector<int> estimated = excited_joints(col_norm, free_joints, options_, left_out, est.warnings);
   std::vector<double> omega(m, 1.0);
+  std::optional<Triangular> accepted_qr;
   drop_collinear_joint_groups(s, col_norm, omega, options_.min_relative_singular_value, estimated, left_out,
-                              est.warnings);
-  hold_left_out_joints(s, model_, left_out, est.warnings);
+                              est.warnings, accepted_qr);
+  if (hold_left_out_joints(s, model_, left_out, est.warnings)) {
+    accepted_qr.reset();  // its Q^T b is of the rows before
+  }
   if (estimated.empty()) {
     throw InputError(fmt::format("identify_stiffness: no joint can be identified from these data: {}",
                                  fmt::join(est.warnings, "; ")));
   }
 
   // The fit, its figures and the standard errors.
-  const WeightedFit fit = fit_robustly(s, estimated, col_norm, options_, omega, est.iterations);
+  const WeightedFit fit = fit_robustly(s, estimated, col_norm, options_, omega, est.iterations, std::move(accepted_qr));
   const WeightedResidualSums sums =
       summarise_residuals(s, fit, omega, store_->sqrt_weight, store_->lines, options_.rotation_scale_m, est);
   const std::vector<int> passive = joints_off_bound(estimated, fit.at_bound);
   const double sigma2 = residual_variance(sums, passive.size(), est);
-  est.condition_number = scaled_condition_number(s, estimated, col_norm, omega);
-  const Eigen::VectorXd var_scaled = scaled_compliance_variances(s, passive, col_norm, omega, sigma2);
+  est.condition_number = scaled_condition_number(*fit.qr);
+  const Eigen::VectorXd var_scaled =
+      scaled_compliance_variances(s, estimated, passive, *fit.qr, col_norm, omega, sigma2);
   report_estimated_joints(estimated, fit, passive, var_scaled, col_norm, options_.max_relative_std_error, left_out,
                           est);
   list_unidentified_and_rejected(left_out, store_->lines, est);

@@ -46,9 +46,10 @@ struct IdentificationOptions {
   double max_relative_std_error = 0.5;
   int max_robust_iterations = 50;
   /// Bytes of stacked measurement rows (8 (dof + 1) a row, 3 or 6 rows a measurement) held in
-  /// memory; the rest go to an unlinked scratch file in TMPDIR and are read back on each pass, with
-  /// results bit for bit the same. 32 MiB holds about 200,000 six-joint position measurements.
-  std::size_t rows_in_memory_bytes = std::size_t{32} << 20;
+  /// memory; the rest go to an unlinked scratch file in TMPDIR and are seen in place (a read-only
+  /// map, a chunk at a time) on each pass, with results bit for bit the same. 8 MiB holds about
+  /// 50,000 six-joint position measurements (a million: 41 MB in all, under the 50 MB goal).
+  std::size_t rows_in_memory_bytes = std::size_t{8} << 20;
 };
 
 struct StiffnessEstimate {
