@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -364,17 +365,19 @@ void read_case_tool_and_sensor(const yaml::Field& root, CaseConfig& c) {
   case_checked(s, "misalignment_deg", f.misalignment_rad, inside(deg_to_rad(10.0), "must be within +-10 deg"));
 }
 
+// Refuses a key an older case file may still have, saying what replaced it.
+void refuse_retired_keys(const yaml::Field& section, std::initializer_list<const char*> keys, const char* instead) {
+  for (const char* key : keys) {
+    if (section.has(key)) section.at(key).fail(std::string("is no longer a key: ") + instead);
+  }
+}
+
 // The case file's "ldbb": the loading device (bar, pneumatic force and its errors).
 void read_case_ldbb(const yaml::Field& root, CaseConfig& c) {
   const auto l = root.at("ldbb");
-  for (const char* gone : {"force_bias_pct", "force_bias_recalibrated_pct"}) {
-    if (l.has(gone)) {
-      l.at(gone).fail(
-          "is no longer a key: the bar's force error is its seal friction (seal_friction_pct, "
-          "seal_friction_spread_pct, seal_presliding_mm), the same in the calibration and the tests "
-          "(docs/error-budget.md)");
-    }
-  }
+  refuse_retired_keys(l, {"force_bias_pct", "force_bias_recalibrated_pct"},
+                      "the bar's force error is its seal friction (seal_friction_pct, seal_friction_spread_pct, "
+                      "seal_presliding_mm), the same in the calibration and the tests (docs/error-budget.md)");
   l.only_keys({"bar_length_mm", "inclination_deg", "push", "time_constant_s", "ripple_pct", "ripple_Hz", "noise_pct",
                "seal_friction_pct", "seal_friction_spread_pct", "seal_presliding_mm", "pivot_error_mm", "ball_friction",
                "ball_radius_mm", "settle_s", "stick_slip_pct", "stick_slip_travel_mm"});
@@ -469,13 +472,9 @@ void read_case_online(const yaml::Field& root, CaseConfig& c) {
 // The case file's "calibration": the moving calibration run that identifies the stiffness.
 void read_case_calibration(const yaml::Field& root, CaseConfig& c) {
   const auto cal = root.at("calibration");
-  for (const char* gone : {"ldbb_force_error_pct", "ldbb_force_bias_pct"}) {
-    if (cal.has(gone)) {
-      cal.at(gone).fail(
-          "is no longer a key: the calibration takes the bar's own force error (its seal friction, "
-          "ldbb.seal_friction_pct) from the same bar model as the tests (docs/error-budget.md)");
-    }
-  }
+  refuse_retired_keys(cal, {"ldbb_force_error_pct", "ldbb_force_bias_pct"},
+                      "the calibration takes the bar's own force error (its seal friction, ldbb.seal_friction_pct) "
+                      "from the same bar model as the tests (docs/error-budget.md)");
   cal.only_keys({"arcs", "arc_deg", "speed_mm_s", "load_N", "points_per_arc", "window_ms", "force_from"});
   auto& b = c.calibration;
   const std::string force_from = cal.get("force_from", std::string("ldbb"));

@@ -44,13 +44,6 @@ Arc arc_of(int k) {
   return a;
 }
 
-// Where the arm stands before the calibration: its seed configuration.
-JointVector standing_pose(const cell::TrueRobot& arm) {
-  JointVector q = JointVector::Zero(arm.nominal_model().dof());
-  if (q.size() == 6) q << 0.0, deg_to_rad(20.0), deg_to_rad(10.0), 0.0, deg_to_rad(60.0), 0.0;
-  return q;
-}
-
 struct Pass {
   TrackerTrace trace;
   std::vector<double> force_t;      // times of the conditioned force samples (sensor mounted)
@@ -70,15 +63,17 @@ struct CalibrationRig {
         ldbb_config(config.cell.ldbb),
         force_from_sensor(arm.sensor_mounted() && config.calibration.force_from_sensor),
         sensor(cc.sensor, cc.tool, splitmix(seed ^ 0x5e5ULL), splitmix(c.seed ^ 0x5e5503ULL)),
-        // The user tares the sensor once, the arm standing unloaded where the session starts.
-        sheet(tare_sensor(sensor_config_from_sheet(c, sensor.calibration()), sensor, arm, standing_pose(arm),
-                          tare_limit_n(config.cell.sensor))),
+        // With the sensor's force, the user tares it once, the arm standing unloaded where the session
+        // starts; without, the sheet is not used.
+        sheet(force_from_sensor ? tare_sensor(sensor_config_from_sheet(c, sensor.calibration()), sensor, arm,
+                                              standing_pose(arm.nominal_model()), tare_limit_n(config.cell.sensor))
+                                : sensor_config_from_sheet(c, sensor.calibration())),
         sensor_T_wap(sheet.flange_T_sensor.inverse() * nominal.flange_T_wap()),
         ws(arm.true_model()),
         ws_nominal(nominal),
         dt(cc.controller.servo_period_s),
         hold_s(std::max(1.5, 5.0 * cc.ldbb.time_constant_s)),
-        seed_q(standing_pose(arm)) {}
+        seed_q(standing_pose(arm.nominal_model())) {}
 
   const CaseConfig& c;
   const cell::CellConfig& cc;

@@ -76,11 +76,7 @@ SetupCell build_setup_cell(const CaseConfig& config, bool sensor_mounted) {
   circle.points = config.circle.points;
   std::vector<Pose> poses = sample_circle(circle, Eigen::Quaterniond(config.circle.tcp_orientation.linear()));
   IkRequest first;
-  if (calibration.identified.dof() == 6) {
-    JointVector seed(6);
-    seed << 0.0, deg_to_rad(20.0), deg_to_rad(10.0), 0.0, deg_to_rad(60.0), 0.0;
-    first.seed = seed;
-  }
+  if (calibration.identified.dof() == 6) first.seed = standing_pose(calibration.identified);
   JointPath path = solve_path_ik(calibration.identified, poses, first);
   return SetupCell{std::move(robot), std::move(calibration), std::move(poses), std::move(path)};
 }
@@ -148,6 +144,12 @@ double identified_model_error(const CaseConfig& config, const SetupCell& setup, 
   }
   if (scale != nullptr) *scale = n > 0 ? scale_sum / n : NAN;
   return n > 0 ? error_sum / n : NAN;
+}
+
+JointVector standing_pose(const RobotModel& model) {
+  JointVector q = JointVector::Zero(model.dof());
+  if (q.size() == 6) q << 0.0, deg_to_rad(20.0), deg_to_rad(10.0), 0.0, deg_to_rad(60.0), 0.0;
+  return q;
 }
 
 deflex::SensorConfig sensor_config_from_sheet(const CaseConfig& config, const cell::SensorCalibration& sheet) {

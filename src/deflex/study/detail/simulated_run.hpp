@@ -87,6 +87,10 @@ struct RunOutput {
 [[nodiscard]] double identified_model_error(const CaseConfig& config, const SetupCell& setup, double load_n,
                                             double* scale = nullptr);
 
+/// Where the arm stands before a calibration and seeds the circle's IK (rad): a fixed configuration
+/// in front of the robot for a 6-joint arm, zeros for any other.
+[[nodiscard]] JointVector standing_pose(const RobotModel& model);
+
 /// What a user's sensor file would hold for the cell's sensor: its calibration sheet (decoupling,
 /// payload, the mount as measured), deflex's conditioning settings from the case, and no bias yet.
 [[nodiscard]] deflex::SensorConfig sensor_config_from_sheet(const CaseConfig& config,
