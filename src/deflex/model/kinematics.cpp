@@ -1,10 +1,13 @@
 // Forward kinematics and geometric Jacobian: one pass over the chain, rotation-about-z fast path.
 #include "deflex/model/kinematics.hpp"
 
+#include <array>
 #include <cmath>
+#include <cstdint>
 
 #include <fmt/format.h>
 
+#include "deflex/model/detail/joint_sincos.hpp"
 #include "deflex/text/errors.hpp"
 
 namespace deflex {
@@ -26,49 +29,110 @@ Workspace::Workspace(const RobotModel& model) : dof(model.dof()) {
   jacobian = Jacobian::Zero(6, dof);
 }
 
+namespace {
+
+// A frame as forward kinematics carries it: the columns of its rotation and its origin, base frame.
+struct Frame {
+  Vector3 x, y, z, p;
+};
+
+// frame <- frame * step: the translation first (in the frame before the step's turn), then the turn.
+[[gnu::always_inline]] inline void apply(const detail::FoldedStep& step, Frame& f) {
+  const std::uint8_t mask = step.translation_mask;
+  if ((mask & 1U) != 0) f.p += step.translation[0] * f.x;
+  if ((mask & 2U) != 0) f.p += step.translation[1] * f.y;
+  if ((mask & 4U) != 0) f.p += step.translation[2] * f.z;
+  switch (step.turn) {
+    case detail::FoldedStep::Turn::kIdentity:
+      break;
+    case detail::FoldedStep::Turn::kAboutX: {
+      const Vector3 y = f.y;
+      f.y = step.c * y + step.s * f.z;
+      f.z = step.c * f.z - step.s * y;
+      break;
+    }
+    case detail::FoldedStep::Turn::kPermutation: {
+      const std::array<Vector3, 3> cols{f.x, f.y, f.z};
+      f.x = step.sign[0] * cols[step.perm[0]];
+      f.y = step.sign[1] * cols[step.perm[1]];
+      f.z = step.sign[2] * cols[step.perm[2]];
+      break;
+    }
+    case detail::FoldedStep::Turn::kGeneral: {
+      Matrix3 r;
+      r << f.x, f.y, f.z;
+      const Matrix3 turned = r * step.rotation;
+      f.x = turned.col(0);
+      f.y = turned.col(1);
+      f.z = turned.col(2);
+      break;
+    }
+  }
+}
+
+// The pose of a frame.
+inline void store(const Frame& f, Pose& out) {
+  out.linear().col(0) = f.x;
+  out.linear().col(1) = f.y;
+  out.linear().col(2) = f.z;
+  out.translation() = f.p;
+}
+
+}  // namespace
+
 void forward_kinematics(const RobotModel& model, Workspace& ws, const JointVector& q) {
   if (q.size() != model.dof() || ws.dof != model.dof()) [[unlikely]] {
     wrong_size(model, ws, q);
   }
-  const RobotDescription& d = model.description();
-  const int n = model.dof();
+  const detail::FoldedChain& chain = model.folded_chain();
+  const int n = chain.dof;
   ws.q = q;
-  // Running pose as rotation R and translation p (cheaper than general 4x4 products).
-  Matrix3 R = d.base_T_chain.linear();
-  Vector3 p = d.base_T_chain.translation();
-  const bool z_only = model.z_axes_only();
+  // One sin/cos pass over the joints first, then the walk: every joint turns about its frame's z.
+  std::array<double, kMaxJoints> angle{};
   for (int i = 0; i < n; ++i) {
-    const JointSpec& j = d.joints[static_cast<std::size_t>(i)];
-    p += R * j.parent_T_joint.translation();
-    R = R * j.parent_T_joint.linear();
-    const double angle = q[i] + j.offset_rad;
-    const double c = std::cos(angle);
-    const double s = std::sin(angle);
-    if (z_only) {
-      ws.axis_base[static_cast<std::size_t>(i)] = R.col(2);
-      // R * Rz(angle): only the first two columns change.
-      const Vector3 c0 = R.col(0);
-      const Vector3 c1 = R.col(1);
-      R.col(0) = c * c0 + s * c1;
-      R.col(1) = -s * c0 + c * c1;
-    } else {
-      ws.axis_base[static_cast<std::size_t>(i)] = R * j.axis;
-      R = R * Eigen::AngleAxisd(angle, j.axis).toRotationMatrix();
-    }
-    ws.origin_base[static_cast<std::size_t>(i)] = p;
+    angle[static_cast<std::size_t>(i)] = q[i] + chain.offset_rad[static_cast<std::size_t>(i)];
   }
-  ws.base_T_flange.linear() = R * d.last_T_flange.linear();
-  ws.base_T_flange.translation() = p + R * d.last_T_flange.translation();
-  ws.base_T_tcp = ws.base_T_flange * d.flange_T_tcp;
-  ws.base_T_wap = ws.base_T_flange * model.flange_T_wap();
+  std::array<double, kMaxJoints> c{};
+  std::array<double, kMaxJoints> s{};
+  detail::joint_sincos(angle, n, c, s);
+  Frame f{chain.first_rotation.col(0), chain.first_rotation.col(1), chain.first_rotation.col(2), chain.first_origin};
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (i > 0) apply(chain.steps[k], f);
+    ws.axis_base[k] = f.z;
+    ws.origin_base[k] = f.p;
+    // frame * Rz(angle): only the first two columns change.
+    const Vector3 x = f.x;
+    f.x = c[k] * x + s[k] * f.y;
+    f.y = c[k] * f.y - s[k] * x;
+  }
+  apply(chain.last_to_flange, f);
+  store(f, ws.base_T_flange);
+  Frame end = f;
+  apply(chain.flange_to_tcp, end);
+  store(end, ws.base_T_tcp);
+  if (model.wap_is_tcp()) {
+    ws.base_T_wap = ws.base_T_tcp;
+  } else {
+    apply(chain.flange_to_wap, f);
+    store(f, ws.base_T_wap);
+  }
 }
 
 void point_jacobian(const Workspace& ws, const Vector3& point_base, Jacobian& J) {
   J.resize(6, ws.dof);
-  for (int i = 0; i < ws.dof; ++i) {
+  double* col = J.data();  // column-major, 6 rows: a column is 6 doubles in a row
+  const double px = point_base.x(), py = point_base.y(), pz = point_base.z();
+  for (int i = 0; i < ws.dof; ++i, col += 6) {
     const Vector3& z = ws.axis_base[static_cast<std::size_t>(i)];
-    J.col(i).head<3>() = z.cross(point_base - ws.origin_base[static_cast<std::size_t>(i)]);
-    J.col(i).tail<3>() = z;
+    const Vector3& o = ws.origin_base[static_cast<std::size_t>(i)];
+    const double rx = px - o.x(), ry = py - o.y(), rz = pz - o.z();
+    col[0] = z.y() * rz - z.z() * ry;
+    col[1] = z.z() * rx - z.x() * rz;
+    col[2] = z.x() * ry - z.y() * rx;
+    col[3] = z.x();
+    col[4] = z.y();
+    col[5] = z.z();
   }
 }
 
