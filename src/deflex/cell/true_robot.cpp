@@ -114,6 +114,10 @@ TrueRobotState TrueRobot::initial_state(const JointVector& q_cmd) const {
     if (k < config_.robot.gravity_torque_nm.size()) s.gravity_torque_nm[i] = config_.robot.gravity_torque_nm[k];
     s.lost_motion[k].update(s.gravity_torque_nm[i]);  // the arm settled under its own weight
   }
+  s.gravity_equivalent_nm = JointVector::Zero(true_->dof());
+  for (int i = 0; i < true_->dof(); ++i) {
+    s.gravity_equivalent_nm[i] = hardening_[static_cast<std::size_t>(i)].equivalent_torque(s.gravity_torque_nm[i]);
+  }
   return s;
 }
 
@@ -208,7 +212,9 @@ Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd_in, const Wrenc
       return;
     }
     for (int i = 0; i < n; ++i) {
-      tau_eff[i] = hardening_[static_cast<std::size_t>(i)].increment(state.gravity_torque_nm[i], t[i]);
+      // GearHardening::increment() with the preload's half kept from initial_state().
+      tau_eff[i] = hardening_[static_cast<std::size_t>(i)].equivalent_torque(state.gravity_torque_nm[i] + t[i]) -
+                   state.gravity_equivalent_nm[i];
     }
   };
   for (int i = 0; i < n; ++i) {

@@ -53,6 +53,8 @@ struct TrueRobotState {
   JointVector deflection, deflection_step;
   std::array<LostMotion, kMaxJoints> lost_motion{};
   JointVector gravity_torque_nm;  ///< preload of the lost motion (constant)
+  /// The gears' equivalent torque at that preload (constant: every solve's hardening starts from it).
+  JointVector gravity_equivalent_nm;
   JointVector torque_lowpass_nm;  ///< the servo's integral action: the process torque it has taken over
   bool have_torque_lowpass = false;
 };

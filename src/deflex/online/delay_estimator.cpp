@@ -31,7 +31,11 @@ void DelayEstimator::record_reference(double t_s, const JointVector& q_ref) noex
   }
   const auto h = static_cast<std::size_t>(head_);
   const auto prev = static_cast<std::size_t>((head_ + kRing - 1) % kRing);
-  travel_[h] = count_ > 0 && q_[prev].size() == q_ref.size() ? travel_[prev] + (q_ref - q_[prev]).norm() : 0.0;
+  const bool joined = count_ > 0 && q_[prev].size() == q_ref.size();
+  // The segment from the previous reference to this one, kept for every match against it.
+  segment_[h] = joined ? JointVector(q_ref - q_[prev]) : JointVector::Zero(q_ref.size());
+  segment_len2_[h] = segment_[h].squaredNorm();
+  travel_[h] = joined ? travel_[prev] + std::sqrt(segment_len2_[h]) : 0.0;
   t_[h] = t_s;
   q_[h] = q_ref;
   head_ = (head_ + 1) % kRing;
@@ -59,23 +63,36 @@ void DelayEstimator::observe_feedback(double t_s, const JointVector& q_feedback)
   // The reference must be moving now (at rest, or after it stopped, every recent reference matches
   // the feedback equally), and the matched piece of it must be moving too.
   if ((q_[at(0)] - q_[at(1)]).norm() < kMinStepRad) return;
-  double best = std::numeric_limits<double>::infinity();
+  double best2 = std::numeric_limits<double>::infinity();  // squared joint distance of the best match
   double best_t = 0.0;
   double best_step = 0.0;
   double best_dt = 0.0;
   int best_k = -1;
-  const auto scan = [&](int k_from, int k_to) {  // segments k in [k_from, k_to], k back from the newest
+  const int n = static_cast<int>(q_feedback.size());
+  const double* const f = q_feedback.data();
+  // Segments k in [k_from, k_to], k back from the newest. Plain loops over the joints on the segment
+  // kept when its reference was recorded: this runs for every feedback sample of a link.
+  const auto scan = [&](int k_from, int k_to) {
     for (int k = std::max(1, k_from); k <= k_to && k < count_; ++k) {
       const std::size_t i1 = at(k - 1), i0 = at(k);  // segment from the older i0 to the newer i1
       if (t_s - t_[i0] > window_s_) break;
-      if (q_[i0].size() != q_feedback.size() || q_[i1].size() != q_feedback.size()) return;
-      const JointVector d = q_[i1] - q_[i0];
-      const double len2 = d.squaredNorm();
+      if (q_[i0].size() != n || q_[i1].size() != n) return;
+      const double* const a = q_[i0].data();
+      const double* const d = segment_[i1].data();
+      const double len2 = segment_len2_[i1];
       double s = 0.0;
-      if (len2 > 0.0) s = std::clamp((q_feedback - q_[i0]).dot(d) / len2, 0.0, 1.0);
-      const double dist = (q_[i0] + s * d - q_feedback).norm();
-      if (dist < best) {
-        best = dist;
+      if (len2 > 0.0) {
+        double along = 0.0;
+        for (int j = 0; j < n; ++j) along += (f[j] - a[j]) * d[j];
+        s = std::clamp(along / len2, 0.0, 1.0);
+      }
+      double dist2 = 0.0;
+      for (int j = 0; j < n; ++j) {
+        const double e = a[j] + s * d[j] - f[j];
+        dist2 += e * e;
+      }
+      if (dist2 < best2) {
+        best2 = dist2;
         best_t = t_[i0] + s * (t_[i1] - t_[i0]);
         best_step = std::sqrt(len2);
         best_dt = t_[i1] - t_[i0];
@@ -91,7 +108,7 @@ void DelayEstimator::observe_feedback(double t_s, const JointVector& q_feedback)
     scan(last_k_ - kNear, last_k_ + kNear);
   }
   if (full || best_k <= std::max(1, last_k_ - kNear) || best_k >= last_k_ + kNear) {
-    best = std::numeric_limits<double>::infinity();
+    best2 = std::numeric_limits<double>::infinity();
     best_k = -1;
     scan(1, count_ - 1);
     since_full_ = 0;
@@ -102,7 +119,7 @@ void DelayEstimator::observe_feedback(double t_s, const JointVector& q_feedback)
   const double travel = travel_[at(0)] - travel_[at(best_k)];
   // Ambiguous: the feedback is not on the reference's recent path, or the reference has hardly moved
   // since the match (it rested there).
-  if (!(best_step > kMinStepRad) || !(best < 0.1 * travel)) {
+  if (!(best_step > kMinStepRad) || !(std::sqrt(best2) < 0.1 * travel)) {
     return;
   }
   // A delay line keeps the speed: the arm moves now as fast as the reference did where it matched.
