@@ -39,16 +39,23 @@ std::vector<TrackerTrace> laps_of(const TrackerTrace& trace) { return split_laps
 // An unloaded run prepared once for every loaded run compared with it: its raw trace (for the
 // time-synchronous metric) and the mean of its laps, indexed (for the nearest-point metric: a dense,
 // noisy reference would bias that distance low by its own noise).
+// An unloaded reference: its run (the time-synchronous error needs the whole trace) and the mean of
+// its laps, indexed. Once every run of its seed has been measured against it, the run's trace and
+// the index are released (release_references()); what a plot needs of it is kept thinned.
 struct Reference {
   RunOutput run;
   TrackerTrace mean;
   std::shared_ptr<const PolylineIndex> index;
+  TrackerTrace plot_lap;  // its last lap, thinned (only the plotted runs' references)
 };
 
-Reference make_reference(RunOutput run) {
+TrackerTrace thin_lap(const RunOutput& run, std::size_t max_points);
+
+Reference make_reference(RunOutput run, bool plotted) {
   Reference r;
   r.mean = mean_closed_path(run.trace);
   r.index = std::make_shared<const PolylineIndex>(r.mean);
+  if (plotted) r.plot_lap = thin_lap(run, 1500);
   r.run = std::move(run);
   return r;
 }
@@ -161,7 +168,8 @@ struct LoadedJob {
   Strategy strategy;
   double load_n;
   double speed;
-  RunOutput keep;  // only for the plotted runs
+  TrackerTrace plot_lap;                  // the plotted runs' last lap, thinned
+  std::vector<DirectedLap> plot_all_laps;  // and every lap of theirs, thinned
   Figures figures;
   bool plot = false;
   bool write_trace = false;
@@ -309,7 +317,7 @@ void plan_seeds_and_families(StudyContext& x) {
 // Plans a loaded run unless it is planned already (a family's setups share their uncompensated runs).
 void add_loaded_run(StudyContext& x, int si, int fam, RunKind kind, Strategy strategy, double load, double speed) {
   if (x.find(si, fam, kind, strategy, load, speed) != nullptr) return;
-  LoadedJob j{si, fam, kind, strategy, load, speed, {}, {}};
+  LoadedJob j{si, fam, kind, strategy, load, speed, {}, {}, {}};
   x.loaded.push_back(std::move(j));
 }
 
@@ -419,31 +427,41 @@ int run_calibrations(StudyContext& x) {
   return calibrations;
 }
 
-// Phase 2: the unloaded runs, the references of every seed, family and speed.
-void run_unloaded_references(StudyContext& x) {
-  for (int si = 0; si < x.n_seeds; ++si) {
-    for (std::size_t f = 0; f < x.families.size(); ++f) {
-      for (double v : x.speeds) x.unloaded[{si, static_cast<int>(f), mm_s(v)}];  // slots before the threads start
-    }
+// Phase 2 of a seed: its unloaded runs, the references of every family and speed (slowest first so
+// both cores finish together).
+void run_unloaded_references(StudyContext& x, int si) {
+  for (std::size_t f = 0; f < x.families.size(); ++f) {
+    for (double v : x.speeds) x.unloaded[{si, static_cast<int>(f), mm_s(v)}];  // slots before the threads start
   }
+  std::vector<double> speeds = x.speeds;
+  std::stable_sort(speeds.begin(), speeds.end());
   std::vector<std::function<void()>> jobs;
-  for (int si = 0; si < x.n_seeds; ++si) {
+  for (double v : speeds) {
     for (std::size_t f = 0; f < x.families.size(); ++f) {
-      for (double v : x.speeds) {
-        jobs.emplace_back([&x, si, f, v] {
-          const Family& fam = x.families[f];
-          RunOutput run = simulate_run(x.cfg_of(si), x.cell_of(si, fam.sensor), x.unloaded_spec(si, fam, v));
-          if (si == 0 && x.options.trace_sink && mm_s(v) == mm_s(x.config.budget.speed_m_s)) {
-            x.sink(fmt::format("{}_unloaded_{}mm_s", family_label(fam), mm_s(v)), run.trace);
-          }
-          x.unloaded.at({si, static_cast<int>(f), mm_s(v)}) = make_reference(std::move(run));
-          x.progress.add(run_cost(x.config, v, x.laps),
-                         fmt::format("seed {}: unloaded {} mm/s", x.cfg_of(si).seed, mm_s(v)));
-        });
-      }
+      jobs.emplace_back([&x, si, f, v] {
+        const Family& fam = x.families[f];
+        RunOutput run = simulate_run(x.cfg_of(si), x.cell_of(si, fam.sensor), x.unloaded_spec(si, fam, v));
+        if (si == 0 && x.options.trace_sink && mm_s(v) == mm_s(x.config.budget.speed_m_s)) {
+          x.sink(fmt::format("{}_unloaded_{}mm_s", family_label(fam), mm_s(v)), run.trace);
+        }
+        const bool plotted = si == 0 && mm_s(v) == mm_s(x.config.speeds_m_s.front());
+        x.unloaded.at({si, static_cast<int>(f), mm_s(v)}) = make_reference(std::move(run), plotted);
+        x.progress.add(run_cost(x.config, v, x.laps),
+                       fmt::format("seed {}: unloaded {} mm/s", x.cfg_of(si).seed, mm_s(v)));
+      });
     }
   }
   run_parallel(jobs, x.options.threads);
+}
+
+// After a seed's runs: its references' traces and indexes are no longer needed (the tables keep
+// figures, the plots thinned laps), so the study holds one seed's references at a time.
+void release_references(StudyContext& x, int si) {
+  for (auto& [key, ref] : x.unloaded) {
+    if (std::get<0>(key) != si) continue;
+    ref.run.trace = TrackerTrace();
+    ref.index.reset();
+  }
 }
 
 // One loaded run: simulated, evaluated against its unloaded reference, what its link did kept, and
@@ -464,7 +482,10 @@ void run_loaded_job(StudyContext& x, LoadedJob& j) {
                        j.kind == RunKind::kUncompensated ? "uc" : to_string(j.strategy), j.load_n, mm_s(j.speed)),
            run.trace);
   }
-  if (j.plot) j.keep = std::move(run);
+  if (j.plot) {
+    j.plot_lap = thin_lap(run, 1500);
+    j.plot_all_laps = plot_laps(run, 720);
+  }
   x.progress.add(
       run_cost(x.config, j.speed, x.laps),
       fmt::format("seed {}: {} {} N {} mm/s", x.cfg_of(j.seed).seed,
@@ -491,21 +512,26 @@ void run_budget_job(StudyContext& x, BudgetJob& bj) {
   const SetupCell cell = build_setup_cell(cfg, sc.sensor_mounted);
   const double load = sc.loads_n[static_cast<std::size_t>(config.budget.load_index)];
   const double v = config.budget.speed_m_s;
-  const Reference reference = make_reference(simulate_run(cfg, cell, x.unloaded_spec(0, fam, v)));
+  const Reference reference = make_reference(simulate_run(cfg, cell, x.unloaded_spec(0, fam, v)), false);
   const RunSpec c_spec = x.loaded_spec(0, fam, RunKind::kCompensated, sc.strategy, load, v);
   bj.residual_mm = evaluate_run(simulate_run(cfg, cell, c_spec), reference).mean_mm;
   x.progress.add(x.cal_cost + 2.0 * run_cost(config, v, x.laps), fmt::format("budget: {}", budget_label(bj)));
 }
 
-// Phase 3: the loaded runs (slowest first so both cores finish together) and the error budget's runs.
-void run_loaded_and_budget_runs(StudyContext& x) {
-  std::vector<std::size_t> order(x.loaded.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+// Phase 3 of a seed: its loaded runs (slowest first so both cores finish together) and, with the
+// first seed, the error budget's runs.
+void run_loaded_and_budget_runs(StudyContext& x, int si) {
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < x.loaded.size(); ++i) {
+    if (x.loaded[i].seed == si) order.push_back(i);
+  }
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t a, std::size_t b) { return x.loaded[a].speed < x.loaded[b].speed; });
   std::vector<std::function<void()>> jobs;
   for (std::size_t i : order) jobs.emplace_back([&x, i] { run_loaded_job(x, x.loaded[i]); });
-  for (auto& bj : x.budget_jobs) jobs.emplace_back([&x, &bj] { run_budget_job(x, bj); });
+  if (si == 0) {
+    for (auto& bj : x.budget_jobs) jobs.emplace_back([&x, &bj] { run_budget_job(x, bj); });
+  }
   run_parallel(jobs, x.options.threads);
 }
 
@@ -609,19 +635,19 @@ void add_plot_traces(const StudyContext& x, const SetupConfig& s, int fam, CaseS
   const double v0 = x.config.speeds_m_s.front();
   const LoadedJob* uc = x.find(0, fam, RunKind::kUncompensated, s.strategy, s.loads_n.back(), v0);
   const LoadedJob* c = x.find(0, fam, RunKind::kCompensated, s.strategy, s.loads_n.back(), v0);
-  if (!uc || !c || uc->keep.trace.empty() || c->keep.trace.empty()) return;
+  if (!uc || !c || uc->plot_lap.empty() || c->plot_lap.empty()) return;
   const Reference& ref = x.unloaded.at({0, fam, mm_s(v0)});
   PlotTraces pt;
   pt.setup = s.name;
   pt.load_n = s.loads_n.back();
   pt.speed_mm_s = mm_s(v0);
   pt.title = fmt::format("{}: {:.0f} N at {} mm/s (seed {})", s.name, s.loads_n.back(), mm_s(v0), x.config.seed);
-  pt.unloaded = thin_lap(ref.run, 1500);
+  pt.unloaded = ref.plot_lap;
   pt.unloaded_mean = thin(ref.mean, 1500);
-  pt.uc = thin_lap(uc->keep, 1500);
-  pt.c = thin_lap(c->keep, 1500);
-  pt.uc_laps = plot_laps(uc->keep, 720);
-  pt.c_laps = plot_laps(c->keep, 720);
+  pt.uc = uc->plot_lap;
+  pt.c = c->plot_lap;
+  pt.uc_laps = uc->plot_all_laps;
+  pt.c_laps = c->plot_all_laps;
   out.plots.push_back(std::move(pt));
 }
 
@@ -781,8 +807,12 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
   plan_error_budget(x);
   weigh_progress(x);
   out.calibrations = run_calibrations(x);
-  run_unloaded_references(x);
-  run_loaded_and_budget_runs(x);
+  // Seed by seed, so that only one seed's unloaded references are held at a time.
+  for (int si = 0; si < x.n_seeds; ++si) {
+    run_unloaded_references(x, si);
+    run_loaded_and_budget_runs(x, si);
+    release_references(x, si);
+  }
 
   // Assemble the study: per setup, load and speed the seeds' figures, their means and spread.
   StudyResult& study = out.study;
