@@ -98,7 +98,10 @@ const JointVector& EgmPathCorrectionController::tick(double t_s) {
   // The TCP moves by the offset, its orientation stays: solve J dq = [offset; 0].
   Eigen::Matrix<double, 6, 1> twist;
   twist << applied_m_, Vector3::Zero();
-  const JointVector dq = jac_.colPivHouseholderQr().solve(twist);
+  // A 6-joint arm's Jacobian is square: LU (a quarter of the QR's cost, every servo tick); a longer
+  // chain takes the least-squares answer.
+  const JointVector dq = jac_.cols() == 6 ? JointVector(Matrix6(jac_).partialPivLu().solve(twist))
+                                          : JointVector(jac_.colPivHouseholderQr().solve(twist));
   position_ = planned_ + dq;
 
   if (t_s + 1e-12 >= next_send_s_) {

@@ -38,10 +38,9 @@ std::vector<TrackerTrace> laps_of(const TrackerTrace& trace) { return split_laps
 
 // An unloaded run prepared once for every loaded run compared with it: its raw trace (for the
 // time-synchronous metric) and the mean of its laps, indexed (for the nearest-point metric: a dense,
-// noisy reference would bias that distance low by its own noise).
-// An unloaded reference: its run (the time-synchronous error needs the whole trace) and the mean of
-// its laps, indexed. Once every run of its seed has been measured against it, the run's trace and
-// the index are released (release_references()); what a plot needs of it is kept thinned.
+// noisy reference would bias that distance low by its own noise). Once every run of its seed has been
+// measured against it, the trace and the index are released (release_references()); what a plot
+// needs of it is kept thinned.
 struct Reference {
   RunOutput run;
   TrackerTrace mean;
