@@ -17,23 +17,14 @@ namespace {
 
 constexpr std::uint32_t kLeafSize = 4;
 
-// Closest point of segment [a, b] to p, as the fraction along it.
-double segment_fraction(const Vector3& a, const Vector3& b, const Vector3& p) {
-  const Vector3 ab = b - a;
-  const double len2 = ab.squaredNorm();
-  if (len2 <= 0.0) {
-    return 0.0;
-  }
-  return std::clamp((p - a).dot(ab) / len2, 0.0, 1.0);
-}
-
 }  // namespace
 
 // A bounding-volume hierarchy over the segments: each node holds the box around its segments, and
 // a query descends nearer child first, skipping every node whose box is farther than the best
 // distance found so far. Boxes bound the segments exactly, so the answer is exact, whatever the mix
-// of segment lengths (dense tracker laps, sparse commanded points, drop-outs). Seeding the search
-// with the previous query's segment (consecutive tracker points are close) prunes from the start.
+// of segment lengths (dense tracker laps, sparse commanded points, drop-outs). A query seeded with
+// the previous query's segment (consecutive tracker points are close) starts at that segment's leaf
+// and climbs, so the bound is tight from the start.
 struct PolylineIndex::Impl {
   struct Segment {
     std::uint32_t a, b;  // vertex indices; a == b for a piece of a single sample
@@ -46,6 +37,13 @@ struct PolylineIndex::Impl {
   std::vector<Vector3> vertices;
   std::vector<Segment> segments;
   std::vector<Node> nodes;
+  // Per segment, in the order of `segments` (leaf by leaf): its start, its direction and its squared
+  // length, so a leaf's segments are read in a row and none is rebuilt from its vertices.
+  std::vector<Vector3> seg_a, seg_ab;
+  std::vector<double> seg_len2;
+  std::vector<std::uint32_t> parent;   // per node (the root's is itself)
+  std::vector<std::uint32_t> leaf_of;  // per vertex that starts a segment: the leaf holding that segment
+  static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
   std::uint32_t build(std::uint32_t start, std::uint32_t end) {
     Node node;
@@ -61,6 +59,7 @@ struct PolylineIndex::Impl {
     if (end - start <= kLeafSize) {
       nodes[index].start = start;
       nodes[index].end = end;
+      for (std::uint32_t i = start; i < end; ++i) leaf_of[segments[i].a] = index;
       return index;
     }
     int dim = 0;
@@ -82,24 +81,40 @@ struct PolylineIndex::Impl {
     return d.squaredNorm();
   }
 
-  void consider(const Segment& s, const Vector3& q, Nearest& best, double& best2) const {
-    const Vector3& a = vertices[s.a];
-    const Vector3& b = vertices[s.b];
-    const double f = segment_fraction(a, b, q);
-    const Vector3 c = a + f * (b - a);
+  // Segment i (of `segments`) against the best so far: its closest point to q, as the fraction
+  // along it (0 for a segment of one sample), from the kept start, direction and squared length.
+  void consider(std::uint32_t i, const Vector3& q, Nearest& best, double& best2) const {
+    const Vector3& a = seg_a[i];
+    const Vector3& ab = seg_ab[i];
+    const double len2 = seg_len2[i];
+    const double f = len2 <= 0.0 ? 0.0 : std::clamp((q - a).dot(ab) / len2, 0.0, 1.0);
+    const Vector3 c = a + f * ab;
     const double d2 = (c - q).squaredNorm();
     if (d2 < best2) {
       best2 = d2;
       best.point_m = c;
-      best.segment = s.a;
-      best.fraction = s.a == s.b ? 0.0 : f;
+      best.segment = segments[i].a;
+      best.fraction = segments[i].a == segments[i].b ? 0.0 : f;
     }
   }
 
-  void search(const Vector3& q, Nearest& best, double& best2) const {
+  // Starting at the leaf that holds the hint's segment: its segments first (a tight bound at once),
+  // then, up to the root, each sibling's subtree wherever its box is nearer than the best so far.
+  // Every segment lies in the leaf or in one of those subtrees, so the answer stays exact, and the
+  // descent from the root to the leaf (twice the box tests) is saved.
+  void search_from_leaf(std::uint32_t leaf, const Vector3& q, Nearest& best, double& best2) const {
+    for (std::uint32_t i = nodes[leaf].start; i < nodes[leaf].end; ++i) consider(i, q, best, best2);
+    for (std::uint32_t node = leaf; node != 0;) {
+      const std::uint32_t up = parent[node];
+      search(nodes[up].left == node ? nodes[up].right : nodes[up].left, q, best, best2);
+      node = up;
+    }
+  }
+
+  void search(std::uint32_t root, const Vector3& q, Nearest& best, double& best2) const {
     std::uint32_t stack[128];
     int top = 0;
-    stack[top++] = 0;
+    stack[top++] = root;
     while (top > 0) {
       const Node& n = nodes[stack[--top]];
       if (box_distance2(n, q) >= best2) {
@@ -107,7 +122,7 @@ struct PolylineIndex::Impl {
       }
       if (n.left == 0) {
         for (std::uint32_t i = n.start; i < n.end; ++i) {
-          consider(segments[i], q, best, best2);
+          consider(i, q, best, best2);
         }
         continue;
       }
@@ -167,7 +182,23 @@ void PolylineIndex::init(const std::vector<const TrackerTrace*>& piece_ptrs) {
     }
   }
   m.nodes.reserve(m.segments.size() + 1);  // a balanced tree with leaves of 2-4 segments has fewer nodes
+  m.leaf_of.assign(m.vertices.size(), Impl::kNone);
   m.build(0, static_cast<std::uint32_t>(m.segments.size()));
+  m.parent.assign(m.nodes.size(), 0);
+  for (std::uint32_t i = 0; i < m.nodes.size(); ++i) {
+    if (m.nodes[i].left != 0) {
+      m.parent[m.nodes[i].left] = i;
+      m.parent[m.nodes[i].right] = i;
+    }
+  }
+  m.seg_a.reserve(m.segments.size());
+  m.seg_ab.reserve(m.segments.size());
+  m.seg_len2.reserve(m.segments.size());
+  for (const auto& sg : m.segments) {
+    m.seg_a.push_back(m.vertices[sg.a]);
+    m.seg_ab.push_back(m.vertices[sg.b] - m.vertices[sg.a]);
+    m.seg_len2.push_back(m.seg_ab.back().squaredNorm());
+  }
   impl_ = owner.release();
 }
 
@@ -190,12 +221,11 @@ PolylineIndex::Nearest PolylineIndex::nearest(const Vector3& p_m, const Nearest*
     best.distance_m = std::numeric_limits<double>::quiet_NaN();
     return best;
   }
-  if (hint != nullptr && hint->segment < m.vertices.size()) {
-    // The hint's vertex is a point of the path, so its distance bounds the answer. Inflated a hair,
-    // so the search still finds (and records) a point at least as near, even the vertex itself.
-    best2 = (m.vertices[hint->segment] - p_m).squaredNorm() * (1.0 + 1e-9) + 1e-30;
+  if (hint != nullptr && hint->segment < m.leaf_of.size() && m.leaf_of[hint->segment] != Impl::kNone) {
+    m.search_from_leaf(m.leaf_of[hint->segment], p_m, best, best2);
+  } else {
+    m.search(0, p_m, best, best2);
   }
-  m.search(p_m, best, best2);
   best.distance_m = std::sqrt(best2);
   return best;
 }
@@ -223,6 +253,9 @@ PathDeviationStats stats_of_distances(const std::vector<double>& d) {
 
 PathDeviationStats stats_of(const std::vector<const TrackerTrace*>& loaded, const PolylineIndex& index) {
   std::vector<double> d;
+  std::size_t total = 0;
+  for (const auto* trace_ptr : loaded) total += trace_ptr->size();
+  d.reserve(total);
   PolylineIndex::Nearest hint;
   for (const auto* trace_ptr : loaded) {
     const TrackerTrace& trace = *trace_ptr;
