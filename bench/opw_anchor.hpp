@@ -60,8 +60,8 @@ inline void opw_anchor_ik(const OpwGeometry& g, const Pose& opw_T_end, OpwAnchor
     const double s23 = std::sin(t2[p] + t3[p]);
     const double c23 = std::cos(t2[p] + t3[p]);
     const double m = e(0, 2) * s23 * c1p + e(1, 2) * s23 * s1p + e(2, 2) * c23;
-    const double t4 = std::atan2(e(1, 2) * c1p - e(0, 2) * s1p,
-                                 e(0, 2) * c23 * c1p + e(1, 2) * c23 * s1p - e(2, 2) * s23);
+    const double t4 =
+        std::atan2(e(1, 2) * c1p - e(0, 2) * s1p, e(0, 2) * c23 * c1p + e(1, 2) * c23 * s1p - e(2, 2) * s23);
     const double t5 = std::atan2(std::sqrt(1.0 - m * m), m);
     const double t6 = std::atan2(e(0, 1) * s23 * c1p + e(1, 1) * s23 * s1p + e(2, 1) * c23,
                                  -e(0, 0) * s23 * c1p - e(1, 0) * s23 * s1p - e(2, 0) * c23);
