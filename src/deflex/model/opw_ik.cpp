@@ -46,7 +46,7 @@ inline double ceil_whole_nonnegative(double x) {
 /// predictable, takes the slow way. (A seed exactly half a turn away rounds to even.)
 [[gnu::always_inline]] inline bool fit_turn(double q, double ref, double lo, double hi, double& out) {
   double t = q + kTwoPi * nearest_whole((ref - q) * (1.0 / kTwoPi));
-  if (t > hi + kLimitSlack || t < lo - kLimitSlack) [[unlikely]] {
+  if (t > hi || t < lo) [[unlikely]] {
     if (t > hi + kLimitSlack) {
       t -= kTwoPi * ceil_whole_nonnegative((t - hi - kLimitSlack) * (1.0 / kTwoPi));
     }
@@ -56,8 +56,9 @@ inline double ceil_whole_nonnegative(double x) {
     if (t > hi + kLimitSlack || t < lo - kLimitSlack) {
       return false;
     }
+    t = t < lo ? lo : (t > hi ? hi : t);
   }
-  out = t < lo ? lo : (t > hi ? hi : t);
+  out = t;
   return true;
 }
 
@@ -394,7 +395,13 @@ void opw_solutions(const RobotModel& model, const Pose& base_T_tcp, const JointV
     out.status = IkStatus::kInvalidInput;
     return;
   }
-  const Pose target = g->opw_T_base * base_T_tcp * g->tcp_T_end;
+  // opw_T_base * base_T_tcp * tcp_T_end as plain 3x3 products, inlined (Eigen's product of two
+  // isometries is a call and a tenth of this function's instructions).
+  Pose target;
+  const Matrix3 opw_R_tcp = g->opw_T_base.linear() * base_T_tcp.linear();
+  target.linear() = opw_R_tcp * g->tcp_T_end.linear();
+  target.translation() = opw_R_tcp * g->tcp_T_end.translation() + g->opw_T_base.linear() * base_T_tcp.translation() +
+                         g->opw_T_base.translation();
   OpwBranches branches;
   const OpwJointFit fit{model.lower_limits(), model.upper_limits(), seed};
   opw_branches(*g, target, g->theta(3, seed != nullptr ? (*seed)[3] : 0.0), near_singular_threshold, &fit, branches,
