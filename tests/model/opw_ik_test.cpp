@@ -274,7 +274,9 @@ TEST(OpwIk, TheHotPathAllocatesNothing) {
     test::AllocationGuard guard;
     for (int i = 0; i < 100; ++i) {
       opw_solutions(m, target, &q, sols);
+      opw_solutions(m, target, &q, sols, 1e-2, 1U << static_cast<unsigned>(i % 4));  // one arm
     }
+    opw_solutions(m, target, &q, sols);
     allocations = guard.allocations();
   }
   EXPECT_EQ(allocations, 0u);

@@ -13,6 +13,7 @@
 #include "deflex/paths/path_spec.hpp"
 #include "deflex/text/errors.hpp"
 #include "model/kdl_chain.hpp"
+#include "support/allocation_guard.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex {
@@ -190,6 +191,24 @@ TEST(PathIk, OneArmShortcutGivesTheFullSolvesAnswerOnRandomPaths) {
     }
     EXPECT_GT(compared, 10000U);
   }
+}
+
+// The one-arm shortcut, like the full solve, allocates nothing a point (offline streams millions).
+TEST(PathIk, APointAfterTheFirstAllocatesNothing) {
+  const RobotModel model = builtin_irb6700();
+  const auto poses = sample_circle(default_circle(), kToolDown);
+  PathIkSolver solver(model, IkRequest{});
+  (void)solver.next(poses[0]);
+  std::size_t allocations = 0;
+  {
+    test::AllocationGuard guard;
+    for (std::size_t i = 1; i < poses.size(); ++i) {
+      (void)solver.next(poses[i]);
+    }
+    allocations = guard.allocations();
+  }
+  EXPECT_EQ(allocations, 0U);
+  EXPECT_EQ(solver.points(), poses.size());
 }
 
 TEST(PosePathCsv, ReadsMillimetresAndQuaternions) {
