@@ -1,18 +1,15 @@
 // Model hot paths against KDL on the same 1000 IRB6700 configurations:
-// FK, FK + Jacobian, the full deflection (FK + J + dtheta = K^-1 J^T W), and inverse kinematics
-// (every analytic solution of a pose against KDL's numerical Levenberg-Marquardt solver).
+// FK, FK + Jacobian and the full deflection (FK + J + dtheta = K^-1 J^T W). Inverse kinematics is
+// in ik_bench.cpp.
 // Run: build/bench/model_bench --benchmark_min_time=1
 #include <vector>
 
 #include <benchmark/benchmark.h>
 #include <kdl/chainfksolverpos_recursive.hpp>
-#include <kdl/chainiksolverpos_lma.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 
 #include "bench_robot.hpp"
 #include "deflex/model/compliance.hpp"
-#include "deflex/model/inverse_kinematics.hpp"
-#include "deflex/model/opw_ik.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "model/kdl_chain.hpp"
 
@@ -140,79 +137,6 @@ void BM_Deflex_CompensatedConfiguration(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_Deflex_CompensatedConfiguration);
-
-void BM_Deflex_AnalyticIK(benchmark::State& state) {
-  Workspace ws(robot());
-  std::vector<Pose> targets;
-  for (const auto& q : configurations()) {
-    targets.push_back(tcp_pose(robot(), ws, q));
-  }
-  std::size_t i = 0;
-  for (auto _ : state) {
-    IkRequest req;
-    req.seed = configurations()[i % targets.size()];
-    const IkResult r = inverse_kinematics(robot(), ws, targets[i++ % targets.size()], req);
-    benchmark::DoNotOptimize(r.q.data());
-  }
-}
-BENCHMARK(BM_Deflex_AnalyticIK);
-
-std::vector<Pose> tcp_targets() {
-  Workspace ws(robot());
-  std::vector<Pose> targets;
-  for (const auto& q : configurations()) {
-    targets.push_back(tcp_pose(robot(), ws, q));
-  }
-  return targets;
-}
-
-// The hot-path IK: every solution of one pose (up to 8 branches), each joint at the 2*pi turn
-// nearest the seed inside the joint limits, every solution checked by FK, ABB and KUKA
-// configuration, no heap allocation.
-void BM_Deflex_OpwAllSolutions(benchmark::State& state) {
-  const std::vector<Pose> targets = tcp_targets();
-  const auto& qs = configurations();
-  OpwSolutions solutions;
-  std::size_t i = 0;
-  int found = 0;
-  for (auto _ : state) {
-    const std::size_t k = i++ % targets.size();
-    opw_solutions(robot(), targets[k], &qs[k], solutions);
-    found += solutions.count;
-    benchmark::DoNotOptimize(solutions.solution[0].q.data());
-  }
-  state.counters["solutions_per_pose"] = benchmark::Counter(found, benchmark::Counter::kAvgIterations);
-}
-BENCHMARK(BM_Deflex_OpwAllSolutions);
-
-// KDL's numerical IK (Levenberg-Marquardt) from a seed 0.05 rad off the answer on every joint, as
-// along a path: one solution, no limits.
-void BM_KDL_NumericIK(benchmark::State& state) {
-  const KDL::Chain chain = test::kdl_chain_from_dh(robot());
-  KDL::ChainFkSolverPos_recursive fk(chain);
-  KDL::ChainIkSolverPos_LMA ik(chain, 1e-10, 500, 1e-15);
-  const auto qs = kdl_configurations();
-  std::vector<KDL::Frame> targets(qs.size());
-  std::vector<KDL::JntArray> seeds;
-  for (std::size_t k = 0; k < qs.size(); ++k) {
-    fk.JntToCart(qs[k], targets[k]);
-    KDL::JntArray seed = qs[k];
-    for (unsigned j = 0; j < 6; ++j) {
-      seed(j) += 0.05;
-    }
-    seeds.push_back(seed);
-  }
-  KDL::JntArray out(6);
-  std::size_t i = 0;
-  int failed = 0;
-  for (auto _ : state) {
-    const std::size_t k = i++ % targets.size();
-    failed += ik.CartToJnt(seeds[k], targets[k], out) < 0 ? 1 : 0;
-    benchmark::DoNotOptimize(out.data.data());
-  }
-  state.counters["failed"] = failed;
-}
-BENCHMARK(BM_KDL_NumericIK);
 
 }  // namespace
 

@@ -274,11 +274,82 @@ TEST(OpwIk, TheHotPathAllocatesNothing) {
     test::AllocationGuard guard;
     for (int i = 0; i < 100; ++i) {
       opw_solutions(m, target, &q, sols);
+      opw_solutions(m, target, &q, sols, 1e-2, 1U << static_cast<unsigned>(i % 4));  // one arm
     }
+    opw_solutions(m, target, &q, sols);
     allocations = guard.allocations();
   }
   EXPECT_EQ(allocations, 0u);
   EXPECT_GE(sols.count, 1);
+}
+
+// Asking for some arms (shoulder and elbow) gives exactly those arms' solutions of the full solve.
+TEST(OpwIk, ArmsGiveTheirOwnSolutionsOfTheFullSolve) {
+  for (const TestRobot& r : test_robots()) {
+    Workspace ws(r.model);
+    std::mt19937_64 rng(11);
+    for (int n = 0; n < 300; ++n) {
+      JointVector q(6);
+      for (int i = 0; i < 6; ++i) {
+        q[i] = std::uniform_real_distribution<double>(std::max(-3.0, r.model.lower_limits()[i]),
+                                                      std::min(3.0, r.model.upper_limits()[i]))(rng);
+      }
+      const Pose target = tcp_pose(r.model, ws, q);
+      OpwSolutions all;
+      opw_solutions(r.model, target, &q, all);
+      for (unsigned arms = 1; arms < kOpwAllArms; ++arms) {
+        OpwSolutions some;
+        opw_solutions(r.model, target, &q, some, 1e-2, arms);
+        int expected = 0;
+        for (int k = 0; k < all.count; ++k) {
+          const OpwSolution& a = all.solution[static_cast<std::size_t>(k)];
+          if (((arms >> (a.branch >> 1U)) & 1U) == 0) {
+            continue;
+          }
+          ASSERT_LT(expected, some.count) << r.label << " pose " << n << " arms " << arms;
+          const OpwSolution& b = some.solution[static_cast<std::size_t>(expected++)];
+          EXPECT_EQ(a.branch, b.branch) << r.label << " pose " << n << " arms " << arms;
+          EXPECT_LT((a.q - b.q).cwiseAbs().maxCoeff(), 1e-12) << r.label << " pose " << n << " arms " << arms;
+          EXPECT_EQ(a.configuration, b.configuration) << r.label << " pose " << n;
+          EXPECT_EQ(a.singularity, b.singularity) << r.label << " pose " << n;
+        }
+        EXPECT_EQ(expected, some.count) << r.label << " pose " << n << " arms " << arms;
+      }
+    }
+  }
+}
+
+// What path IK's one-arm shortcut relies on: away from the shoulder and elbow singularities, cfx
+// names the arm. Bit 2 is the back shoulder; bit 1 is the second elbow, or the first when axis 2
+// turns against the canonical y axis.
+TEST(OpwIk, CfxNamesTheArmAwayFromTheSingularities) {
+  for (const TestRobot& r : test_robots()) {
+    const OpwGeometry& g = *r.model.opw();
+    Workspace ws(r.model);
+    std::mt19937_64 rng(12);
+    int checked = 0;
+    for (int n = 0; n < 300; ++n) {
+      JointVector q(6);
+      for (int i = 0; i < 6; ++i) {
+        q[i] = std::uniform_real_distribution<double>(std::max(-3.0, r.model.lower_limits()[i]),
+                                                      std::min(3.0, r.model.upper_limits()[i]))(rng);
+      }
+      OpwSolutions all;
+      opw_solutions(r.model, tcp_pose(r.model, ws, q), &q, all);
+      for (int k = 0; k < all.count; ++k) {
+        const OpwSolution& s = all.solution[static_cast<std::size_t>(k)];
+        if (s.singularity == Singularity::kShoulder || s.singularity == Singularity::kElbow) {
+          continue;
+        }
+        const int shoulder = (s.branch >> 2) & 1;
+        const int elbow = (s.branch >> 1) & 1;
+        EXPECT_EQ((s.configuration.cfx >> 2) & 1, shoulder) << r.label << " pose " << n;
+        EXPECT_EQ((s.configuration.cfx >> 1) & 1, elbow ^ (g.sign[1] < 0.0 ? 1 : 0)) << r.label << " pose " << n;
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 300) << r.label;
+  }
 }
 
 TEST(OpwIk, SeedPicksTheNearestTurnInsideTheLimits) {

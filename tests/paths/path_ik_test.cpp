@@ -1,12 +1,19 @@
-// Path inverse kinematics (FK round trip, configuration kept, errors naming the point) and the pose
-// path CSV reader.
+// Path inverse kinematics (FK round trip, configuration kept, errors naming the point, the one-arm
+// shortcut against the full solve and KDL's forward kinematics) and the pose path CSV reader.
+#include <algorithm>
+#include <cmath>
+#include <random>
+
 #include <gtest/gtest.h>
+#include <kdl/chainfksolverpos_recursive.hpp>
 
 #include "deflex/model/robot_io.hpp"
 #include "deflex/paths/detail/pose_path_csv.hpp"
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/path_spec.hpp"
 #include "deflex/text/errors.hpp"
+#include "model/kdl_chain.hpp"
+#include "support/allocation_guard.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex {
@@ -101,6 +108,107 @@ TEST(PathIk, JointJumpIsNamed) {
   relaxed.max_joint_step_rad = deg_to_rad(90.0);
   EXPECT_EQ(solve_path_ik(model, {a, b}, IkRequest{}, relaxed).q.size(), 2u);
   EXPECT_THROW((void)solve_path_ik(model, {}, IkRequest{}), InputError);
+}
+
+/// The path IK before the one-arm shortcut: every point by inverse_kinematics() with the first
+/// point's configuration and the previous joints as the seed, up to the first point where the path
+/// would stop (a failure, a near-singular point or a step above the default 30 deg).
+std::vector<JointVector> path_by_full_solve(const RobotModel& model, const std::vector<Pose>& poses,
+                                            const IkRequest& first) {
+  Workspace ws(model);
+  IkRequest request = first;
+  std::vector<JointVector> out;
+  for (const Pose& pose : poses) {
+    const IkResult r = inverse_kinematics(model, ws, pose, request);
+    if (r.status != IkStatus::kOk ||
+        (!out.empty() && (r.q - out.back()).cwiseAbs().maxCoeff() > PathIkOptions{}.max_joint_step_rad)) {
+      break;
+    }
+    if (out.empty()) {
+      request.configuration = r.configuration;
+      request.match_quadrants = false;
+    }
+    out.push_back(r.q);
+    request.seed = r.q;
+  }
+  return out;
+}
+
+// After the first point the solver solves only the arm of the path's configuration: on random walks
+// in joint space (every configuration, both shoulders and elbows, singularities crossed on the way)
+// it gives exactly what solving every branch gives, point for point, and its joints reproduce the
+// poses through KDL's forward kinematics.
+TEST(PathIk, OneArmShortcutGivesTheFullSolvesAnswerOnRandomPaths) {
+  std::vector<RobotModel> robots{builtin_irb6700(),
+                                 load_robot(std::string(DEFLEX_SOURCE_DIR) + "/examples/robots/kuka_kr210_r2700.yaml")};
+  for (const RobotModel& model : robots) {
+    Workspace ws(model);
+    const KDL::Chain chain = test::kdl_chain_from_dh(model);
+    KDL::ChainFkSolverPos_recursive kdl_fk(chain);
+    std::mt19937_64 rng(28);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    std::size_t compared = 0;
+    for (int p = 0; p < 150; ++p) {
+      JointVector q(6);
+      for (int i = 0; i < 6; ++i) {
+        const double lo = std::max(-3.0, model.lower_limits()[i] + 0.2);
+        const double hi = std::min(3.0, model.upper_limits()[i] - 0.2);
+        q[i] = std::uniform_real_distribution<double>(lo, hi)(rng);
+      }
+      IkRequest first;
+      first.seed = q;  // the start's own branch: any configuration
+      std::vector<Pose> poses;
+      for (int k = 0; k < 150; ++k) {
+        poses.push_back(tcp_pose(model, ws, q));
+        for (int i = 0; i < 6; ++i) {
+          q[i] = std::clamp(q[i] + deg_to_rad(1.0) * unit(rng), model.lower_limits()[i], model.upper_limits()[i]);
+        }
+      }
+      const std::vector<JointVector> want = path_by_full_solve(model, poses, first);
+      PathIkSolver solver(model, first);
+      for (std::size_t i = 0; i < want.size(); ++i) {
+        JointVector got;
+        ASSERT_NO_THROW(got = solver.next(poses[i])) << "path " << p << " point " << i;
+        ASSERT_LT((got - want[i]).cwiseAbs().maxCoeff(), 1e-12) << "path " << p << " point " << i;
+        KDL::JntArray k(6);
+        for (unsigned j = 0; j < 6; ++j) {
+          k(j) = got[static_cast<int>(j)];
+        }
+        KDL::Frame f;
+        kdl_fk.JntToCart(k, f);
+        // KDL's chain holds the base and tool frames: its end frame is the TCP in the base frame.
+        double rotation_error = 0.0;
+        for (int r = 0; r < 3; ++r) {
+          for (int c = 0; c < 3; ++c) {
+            rotation_error = std::max(rotation_error, std::abs(f.M(r, c) - poses[i].linear()(r, c)));
+          }
+        }
+        EXPECT_LT((Vector3(f.p.x(), f.p.y(), f.p.z()) - poses[i].translation()).norm(), 1e-9)
+            << "path " << p << " point " << i;
+        EXPECT_LT(rotation_error, 1e-9) << "path " << p << " point " << i;
+        ++compared;
+      }
+    }
+    EXPECT_GT(compared, 10000U);
+  }
+}
+
+// The one-arm shortcut, like the full solve, allocates nothing a point (offline streams millions).
+TEST(PathIk, APointAfterTheFirstAllocatesNothing) {
+  const RobotModel model = builtin_irb6700();
+  const auto poses = sample_circle(default_circle(), kToolDown);
+  PathIkSolver solver(model, IkRequest{});
+  (void)solver.next(poses[0]);
+  std::size_t allocations = 0;
+  {
+    test::AllocationGuard guard;
+    for (std::size_t i = 1; i < poses.size(); ++i) {
+      (void)solver.next(poses[i]);
+    }
+    allocations = guard.allocations();
+  }
+  EXPECT_EQ(allocations, 0U);
+  EXPECT_EQ(solver.points(), poses.size());
 }
 
 TEST(PosePathCsv, ReadsMillimetresAndQuaternions) {

@@ -25,30 +25,40 @@ double round_whole(double x) {
   return f >= 0.5 ? r + 1.0 : (f <= -0.5 ? r - 1.0 : r);
 }
 
-/// Smallest whole number >= x (|x| < 2^52).
-double ceil_whole(double x) {
-  const double r = static_cast<double>(static_cast<long long>(x));
+/// Nearest whole number of x (|x| < 2^51, halves to even) with two additions and no branch: adding
+/// 1.5 * 2^52 leaves no bits below the units, so the addition itself rounds (to nearest, the
+/// default mode, which deflex never changes).
+inline double nearest_whole(double x) {
+  constexpr double kShift = 6755399441055744.0;  // 1.5 * 2^52
+  return (x + kShift) - kShift;
+}
+
+/// Smallest whole number >= x for 0 <= x < 2^51, without a call into libm.
+inline double ceil_whole_nonnegative(double x) {
+  const double r = nearest_whole(x);
   return r < x ? r + 1.0 : r;
 }
 
-/// The 2*pi turn of q nearest `ref` inside [lo, hi]; false when no turn fits. Rounds only when the
-/// turn differs from q (the common case along a path is no rounding at all).
-inline bool fit_turn(double q, double ref, double lo, double hi, double& out) {
-  double t = q;
-  const double d = ref - t;
-  if (d > kPi || d < -kPi) {
-    t += kTwoPi * round_whole(d * (1.0 / kTwoPi));
+/// The 2*pi turn of q nearest `ref` inside [lo, hi]; false when no turn fits. The turn nearest
+/// `ref` is taken without a branch: whether it differs from q depends on the branch and the seed
+/// (the other wrist's joints 4 and 6 are half a turn from this one's), a guess no predictor makes
+/// well, and a wrong one waits for the angle before it. A turn outside the limits, rarer and
+/// predictable, takes the slow way. (A seed exactly half a turn away rounds to even.)
+[[gnu::always_inline]] inline bool fit_turn(double q, double ref, double lo, double hi, double& out) {
+  double t = q + kTwoPi * nearest_whole((ref - q) * (1.0 / kTwoPi));
+  if (t > hi || t < lo) [[unlikely]] {
+    if (t > hi + kLimitSlack) {
+      t -= kTwoPi * ceil_whole_nonnegative((t - hi - kLimitSlack) * (1.0 / kTwoPi));
+    }
+    if (t < lo - kLimitSlack) {
+      t += kTwoPi * ceil_whole_nonnegative((lo - kLimitSlack - t) * (1.0 / kTwoPi));
+    }
+    if (t > hi + kLimitSlack || t < lo - kLimitSlack) {
+      return false;
+    }
+    t = t < lo ? lo : (t > hi ? hi : t);
   }
-  if (t > hi + kLimitSlack) {
-    t -= kTwoPi * ceil_whole((t - hi - kLimitSlack) * (1.0 / kTwoPi));
-  }
-  if (t < lo - kLimitSlack) {
-    t += kTwoPi * ceil_whole((lo - kLimitSlack - t) * (1.0 / kTwoPi));
-  }
-  if (t > hi + kLimitSlack || t < lo - kLimitSlack) {
-    return false;
-  }
-  out = t < lo ? lo : (t > hi ? hi : t);
+  out = t;
   return true;
 }
 
@@ -69,24 +79,21 @@ int abb_cfx(const OpwGeometry& g, double wrist_x_a1, double lower_arm_cross, dou
   return (wrist_x_a1 < 0.0 ? 4 : 0) + (g.sign[1] * lower_arm_cross < 0.0 ? 2 : 0) + (negative_joint(q5) ? 1 : 0);
 }
 
-/// The limits and seed of an OpwJointFit, copied once so the per-joint test reads no pointers.
+/// The limits and seed of an OpwJointFit as plain arrays, so the per-joint test reads no Eigen
+/// object (JointVector stores its values contiguously).
 struct OpwFitLimits {
-  bool any = false;  // false: no fit, the joints are not computed
-  std::array<double, 6> lo{}, hi{}, ref{};
+  const double* lo = nullptr;  // null: no fit, the joints are not computed
+  const double* hi = nullptr;
+  const double* ref = nullptr;
 };
 
-/// Copies `fit`'s limits and seed (zero without a seed); without `fit`, an empty OpwFitLimits.
+/// `fit`'s limits and seed (zero without a seed); without `fit`, an empty OpwFitLimits.
 inline OpwFitLimits opw_fit_limits(const OpwJointFit* fit) {
-  OpwFitLimits f;
-  if (fit != nullptr) {
-    f.any = true;
-    for (int i = 0; i < 6; ++i) {
-      f.lo[static_cast<std::size_t>(i)] = fit->lower[i];
-      f.hi[static_cast<std::size_t>(i)] = fit->upper[i];
-      f.ref[static_cast<std::size_t>(i)] = fit->reference != nullptr ? (*fit->reference)[i] : 0.0;
-    }
+  static constexpr std::array<double, kMaxJoints> kZero{};
+  if (fit == nullptr) {
+    return {};
   }
-  return f;
+  return {fit->lower.data(), fit->upper.data(), fit->reference != nullptr ? fit->reference->data() : kZero.data()};
 }
 
 /// What every branch of one target shares.
@@ -100,8 +107,9 @@ struct OpwTarget {
 };
 
 /// Joint i of the model for canonical angle theta at the turn the fit asks for; false when no turn fits.
-inline bool opw_fit_joint(const OpwTarget& t, std::size_t i, double theta, double& q) {
-  return !t.fit.any || fit_turn(t.g.sign[i] * (theta - t.g.offset[i]), t.fit.ref[i], t.fit.lo[i], t.fit.hi[i], q);
+[[gnu::always_inline]] inline bool opw_fit_joint(const OpwTarget& t, std::size_t i, double theta, double& q) {
+  return t.fit.lo == nullptr ||
+         fit_turn(t.g.sign[i] * (theta - t.g.offset[i]), t.fit.ref[i], t.fit.lo[i], t.fit.hi[i], q);
 }
 
 /// One shoulder: theta1 as (cos, sin) and the planar two-link problem from axis 2 to the wrist centre.
@@ -159,7 +167,7 @@ inline bool opw_elbow(const OpwGeometry& g, const OpwShoulder& s, double gamma, 
   e.s2 = (s.dx * ex - s.dz * ey) * inv_nrm;
   e.c3 = s.cg * g.psi_cos + e.sg * g.psi_sin;
   e.s3 = e.sg * g.psi_cos - s.cg * g.psi_sin;
-  e.t2 = fast_atan2(e.s2, e.c2);
+  e.t2 = unit_vector_angle(e.s2, e.c2);
   e.t3 = (elbow == 0 ? gamma : -gamma) - g.psi;
   return true;
 }
@@ -229,9 +237,9 @@ inline OpwWrist opw_wrist_angles(const Matrix3& m, double h, bool singular, doub
   const double r10 = -r.s4 * m(0, 0) + r.c4 * m(1, 0);
   r.c6 = r.c5 * r00 - r.s5 * m(2, 0);
   r.s6 = r10;
-  r.t4 = fast_atan2(r.s4, r.c4);
-  r.t5 = fast_atan2(r.s5, r.c5);
-  r.t6 = fast_atan2(r.s6, r.c6);
+  r.t4 = unit_vector_angle(r.s4, r.c4);
+  r.t5 = unit_vector_angle(r.s5, r.c5);
+  r.t6 = unit_vector_angle(r.s6, r.c6);
   return r;
 }
 
@@ -256,60 +264,87 @@ inline double opw_rotation_error(const OpwWrist& r, const Matrix3& m) {
                    e22 * e22);
 }
 
+/// Appends one branch that passed its fit and the FK check to `out`.
+inline void opw_emit_branch(const OpwShoulder& s, const OpwElbow& e, const OpwWrist& r, int bits, Singularity sing,
+                            double pos_err, double rot_err, const std::array<double, 6>& q, OpwBranches& out) {
+  OpwBranch& b = out.branch[static_cast<std::size_t>(out.count++)];
+  b.theta = {s.t1, e.t2, e.t3, r.t4, r.t5, r.t6};
+  b.wrist_x_a1 = s.X;
+  b.lower_arm_cross = e.c2 * s.dx - e.s2 * s.dz;
+  b.branch = static_cast<std::uint8_t>(bits);
+  b.singularity = sing;
+  b.position_error_m = pos_err;
+  b.orientation_error = rot_err;
+  b.q = q;
+}
+
 /// Both wrists of one shoulder and elbow (one when exactly singular): joints 4 to 6 fitted, the FK
-/// check, and each branch that passes appended to `out`. `arm_bits` are the branch's shoulder and elbow bits.
+/// check, and each branch that passes appended to `out`. `arm_bits` are the branch's shoulder and
+/// elbow bits. Both wrists are fitted before either is kept, so the only branches taken on the
+/// fits are the two that keep a wrist.
 inline void opw_wrist_branches(const OpwTarget& t, const OpwShoulder& s, const OpwElbow& e, const Matrix3& m,
-                               int arm_bits, std::array<double, 6>& q, OpwBranches& out) {
+                               int arm_bits, const std::array<double, 6>& q_arm, OpwBranches& out) {
   const double pos_err = opw_wrist_centre_error(t.g, t.w, s, e);
   const double h = std::sqrt(m(0, 2) * m(0, 2) + m(1, 2) * m(1, 2));  // |sin theta5|
   const Singularity sing = opw_singularity(s.X, e.sg, h, t.near_singular_threshold);
   const bool wrist_singular = h < 1e-12;
-  OpwWrist r = opw_wrist_angles(m, h, wrist_singular, t.theta4_when_singular);
+  const OpwWrist first = opw_wrist_angles(m, h, wrist_singular, t.theta4_when_singular);
   // Only signs flip between the two wrists, so the check's products are bit for bit the same:
-  // computed once, before either wrist meets the joint limits (the flipped wrist of a first wrist
-  // outside its limits is checked as well; it used to report 0).
-  const double rot_err = opw_rotation_error(r, m);
-  for (int wrist = 0; wrist < (wrist_singular ? 1 : 2); ++wrist) {
-    if (wrist == 1) {
-      opw_flip_wrist(r);
-    }
-    if (!opw_fit_joint(t, 3, r.t4, q[3]) || !opw_fit_joint(t, 4, r.t5, q[4]) || !opw_fit_joint(t, 5, r.t6, q[5])) {
-      continue;
-    }
-    if (!(pos_err < kFkCheck && rot_err < kFkCheck)) {
-      continue;  // the FK is the judge: a branch that does not reproduce the target is dropped
-    }
-    OpwBranch& b = out.branch[static_cast<std::size_t>(out.count++)];
-    b.theta = {s.t1, e.t2, e.t3, r.t4, r.t5, r.t6};
-    b.wrist_x_a1 = s.X;
-    b.lower_arm_cross = e.c2 * s.dx - e.s2 * s.dz;
-    b.branch = static_cast<std::uint8_t>(arm_bits | wrist);
-    b.singularity = sing;
-    b.position_error_m = pos_err;
-    b.orientation_error = rot_err;
-    b.q = q;
+  // computed once, for both wrists.
+  const double rot_err = opw_rotation_error(first, m);
+  if (!(pos_err < kFkCheck && rot_err < kFkCheck)) {
+    return;  // the FK is the judge: a branch that does not reproduce the target is dropped
+  }
+  OpwWrist second = first;
+  opw_flip_wrist(second);
+  std::array<double, 6> q_first = q_arm;
+  std::array<double, 6> q_second = q_arm;
+  const bool f4 = opw_fit_joint(t, 3, first.t4, q_first[3]);
+  const bool f5 = opw_fit_joint(t, 4, first.t5, q_first[4]);
+  const bool f6 = opw_fit_joint(t, 5, first.t6, q_first[5]);
+  const bool g4 = opw_fit_joint(t, 3, second.t4, q_second[3]);
+  const bool g5 = opw_fit_joint(t, 4, second.t5, q_second[4]);
+  const bool g6 = opw_fit_joint(t, 5, second.t6, q_second[5]);
+  if (f4 && f5 && f6) {
+    opw_emit_branch(s, e, first, arm_bits, sing, pos_err, rot_err, q_first, out);
+  }
+  if (!wrist_singular && g4 && g5 && g6) {
+    opw_emit_branch(s, e, second, arm_bits | 1, sing, pos_err, rot_err, q_second, out);
   }
 }
 
-/// Both elbows of shoulder s (whose theta1 fits): joints 2 and 3 fitted, then the wrists.
-inline void opw_elbow_branches(const OpwTarget& t, const OpwShoulder& s, int shoulder, std::array<double, 6>& q,
-                               OpwBranches& out) {
-  const double gamma = fast_atan2(s.sg_abs, s.cg);
-  for (int elbow = 0; elbow < 2; ++elbow) {
-    OpwElbow e;
-    if (!opw_elbow(t.g, s, gamma, elbow, e) || !opw_fit_joint(t, 1, e.t2, q[1]) || !opw_fit_joint(t, 2, e.t3, q[2])) {
+/// Both elbows of shoulder s (whose theta1 fits) that `arms` asks for: joints 2 and 3 of both
+/// fitted, then the wrists of each that fits.
+inline void opw_elbow_branches(const OpwTarget& t, const OpwShoulder& s, int shoulder, unsigned arms,
+                               const std::array<double, 6>& q_shoulder, OpwBranches& out) {
+  const double gamma = unit_vector_angle(s.sg_abs, s.cg);
+  std::array<OpwElbow, 2> e{};
+  std::array<std::array<double, 6>, 2> q{q_shoulder, q_shoulder};
+  std::array<bool, 2> fits{false, false};
+  for (std::size_t elbow = 0; elbow < 2; ++elbow) {
+    const int bit = 2 * shoulder + static_cast<int>(elbow);
+    if (((arms >> bit) & 1U) != 0 && opw_elbow(t.g, s, gamma, static_cast<int>(elbow), e[elbow])) {
+      const bool f2 = opw_fit_joint(t, 1, e[elbow].t2, q[elbow][1]);
+      const bool f3 = opw_fit_joint(t, 2, e[elbow].t3, q[elbow][2]);
+      fits[elbow] = f2 && f3;
+    }
+  }
+  for (std::size_t elbow = 0; elbow < 2; ++elbow) {
+    if (!fits[elbow]) {
       continue;
     }
-    e.cp = e.c2 * e.c3 - e.s2 * e.s3;
-    e.sp = e.s2 * e.c3 + e.c2 * e.s3;
-    opw_wrist_branches(t, s, e, opw_wrist_rotation(s, e, t.Re), (shoulder << 2) | (elbow << 1), q, out);
+    OpwElbow& el = e[elbow];
+    el.cp = el.c2 * el.c3 - el.s2 * el.s3;
+    el.sp = el.s2 * el.c3 + el.c2 * el.s3;
+    opw_wrist_branches(t, s, el, opw_wrist_rotation(s, el, t.Re), (shoulder << 2) | (static_cast<int>(elbow) << 1),
+                       q[elbow], out);
   }
 }
 
 }  // namespace
 
 void opw_branches(const OpwGeometry& g, const Pose& opw_T_end, double theta4_when_singular,
-                  double near_singular_threshold, const OpwJointFit* fit, OpwBranches& out) {
+                  double near_singular_threshold, const OpwJointFit* fit, OpwBranches& out, unsigned arms) {
   std::array<double, 6> q{};
   out.count = 0;
   out.reachable = false;
@@ -330,33 +365,47 @@ void opw_branches(const OpwGeometry& g, const Pose& opw_T_end, double theta4_whe
   double t1_front = 0.0;
   bool front_done = false;
   for (int shoulder = 0; shoulder < 2; ++shoulder) {
+    const unsigned shoulder_arms = (arms >> (2 * shoulder)) & 3U;
+    // A front shoulder not asked for is still solved when the back one takes its theta1 from it,
+    // so the back shoulder's answer is the same whichever arms are asked for.
+    const bool feeds_back = shoulder == 0 && g.b == 0.0 && ((arms >> 2U) & 3U) != 0;
     OpwShoulder s;
-    if (!opw_shoulder(t, rho2, x_abs, shoulder, s)) {
+    if ((shoulder_arms == 0 && !feeds_back) || !opw_shoulder(t, rho2, x_abs, shoulder, s)) {
+      continue;
+    }
+    // Without a lateral offset the back shoulder is the front one turned by pi.
+    s.t1 = shoulder == 1 && front_done && g.b == 0.0 && rho2 > 1e-24 ? flip(t1_front) : unit_vector_angle(s.s1, s.c1);
+    t1_front = s.t1;
+    front_done = true;
+    if (shoulder_arms == 0) {
       continue;
     }
     out.reachable = true;
-    // Without a lateral offset the back shoulder is the front one turned by pi.
-    s.t1 = shoulder == 1 && front_done && g.b == 0.0 && rho2 > 1e-24 ? flip(t1_front) : fast_atan2(s.s1, s.c1);
-    t1_front = s.t1;
-    front_done = true;
     if (opw_fit_joint(t, 0, s.t1, q[0])) {
-      opw_elbow_branches(t, s, shoulder, q, out);
+      opw_elbow_branches(t, s, shoulder, arms, q, out);
     }
   }
 }
 
 void opw_solutions(const RobotModel& model, const Pose& base_T_tcp, const JointVector* seed, OpwSolutions& out,
-                   double near_singular_threshold) {
+                   double near_singular_threshold, unsigned arms) {
   out.count = 0;
   const OpwGeometry* g = model.opw();
   if (g == nullptr || (seed != nullptr && seed->size() != 6)) {
     out.status = IkStatus::kInvalidInput;
     return;
   }
-  const Pose target = g->opw_T_base * base_T_tcp * g->tcp_T_end;
+  // opw_T_base * base_T_tcp * tcp_T_end as plain 3x3 products, inlined (Eigen's product of two
+  // isometries is a call and a tenth of this function's instructions).
+  Pose target;
+  const Matrix3 opw_R_tcp = g->opw_T_base.linear() * base_T_tcp.linear();
+  target.linear() = opw_R_tcp * g->tcp_T_end.linear();
+  target.translation() = opw_R_tcp * g->tcp_T_end.translation() + g->opw_T_base.linear() * base_T_tcp.translation() +
+                         g->opw_T_base.translation();
   OpwBranches branches;
   const OpwJointFit fit{model.lower_limits(), model.upper_limits(), seed};
-  opw_branches(*g, target, g->theta(3, seed != nullptr ? (*seed)[3] : 0.0), near_singular_threshold, &fit, branches);
+  opw_branches(*g, target, g->theta(3, seed != nullptr ? (*seed)[3] : 0.0), near_singular_threshold, &fit, branches,
+               arms);
   if (!branches.reachable) {
     out.status = IkStatus::kUnreachable;
     return;

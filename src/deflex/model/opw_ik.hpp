@@ -40,14 +40,22 @@ struct OpwJointFit {
   const JointVector* reference;  ///< the seed; zero when null
 };
 
+/// The arms (a shoulder and an elbow each) opw_branches() and opw_solutions() solve: bit
+/// 2 * shoulder + elbow (shoulder 1: back, elbow 1: the second elbow, as OpwBranch::branch), all four
+/// by default. A caller that knows which arm it wants (path IK, which keeps one configuration) asks
+/// for that one and pays for no other.
+inline constexpr unsigned kOpwAllArms = 0xFU;
+
 /// Solves the canonical pose `opw_T_end` (the target already moved into the canonical frame).
 /// `theta4_when_singular` is the theta4 kept when the wrist is exactly singular (only theta4 +
 /// theta6 is fixed there). Branches that fail the FK check (1e-8 m, 1e-8) are dropped. With `fit`,
 /// each branch also gets its joint values (OpwBranch::q), and those where some joint has no turn
 /// inside its limits are dropped, joint by joint as the branch is built, so the work for the rest
-/// of it is saved. `reachable` tells an unreachable pose from one whose branches all left the limits.
+/// of it is saved. `reachable` tells an unreachable pose from one whose branches all left the limits
+/// (of the shoulders `arms` asks for). Only the arms in `arms` are solved.
 void opw_branches(const OpwGeometry& g, const Pose& opw_T_end, double theta4_when_singular,
-                  double near_singular_threshold, const OpwJointFit* fit, OpwBranches& out);
+                  double near_singular_threshold, const OpwJointFit* fit, OpwBranches& out,
+                  unsigned arms = kOpwAllArms);
 
 /// One solution in the model's joints.
 struct OpwSolution {
@@ -71,9 +79,10 @@ struct OpwSolutions {
 
 /// Every solution of the TCP pose `base_T_tcp` (robot base frame): one per branch, each joint at
 /// its 2*pi turn nearest `seed` (or zero without one) that fits the joint limits, FK-checked, with
-/// its ABB and KUKA configuration. Allocation-free.
+/// its ABB and KUKA configuration. Allocation-free. With `arms`, only those arms' branches (status
+/// kUnreachable then says that none of their shoulders reaches the pose).
 void opw_solutions(const RobotModel& model, const Pose& base_T_tcp, const JointVector* seed, OpwSolutions& out,
-                   double near_singular_threshold = 1e-2);
+                   double near_singular_threshold = 1e-2, unsigned arms = kOpwAllArms);
 
 /// ABB and KUKA configuration of joint values of an OPW arm, from the canonical geometry (no FK).
 void opw_configuration(const OpwGeometry& g, const JointVector& q, ArmConfiguration& abb, KukaConfiguration& kuka);

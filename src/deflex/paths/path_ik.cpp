@@ -1,8 +1,12 @@
 // Inverse kinematics along a path with one configuration kept.
 #include "deflex/paths/path_ik.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include <fmt/format.h>
 
+#include "deflex/model/opw_ik.hpp"
 #include "deflex/text/errors.hpp"
 
 namespace deflex {
@@ -35,6 +39,31 @@ namespace {
   throw InputError(fmt::format("path point {}: {} ({})", index, reason, r.message));
 }
 
+/// The one-arm shortcut needs the path's arm to be told apart from the others by cfx: the shoulder
+/// by the sign of the wrist centre's x in the A1 frame, the elbow by the sign of sin(gamma), both at
+/// least the near-singular threshold away from zero in a solution that is not near a singularity.
+/// Below this threshold (a caller asking to hear of no singularity) the shortcut is not taken.
+constexpr double kArmMarginThreshold = 1e-6;
+
+/// The opw_solutions() arm mask of the arm whose branches have cfx `cfx` away from the singularities:
+/// cfx bit 2 is the back shoulder; bit 1 is set for the first elbow (sin gamma > 0) exactly when
+/// axis 2 turns against the canonical y axis (opw_ik.cpp, abb_cfx: the lower arm cross product has
+/// the sign of sin gamma).
+unsigned arm_of_configuration(const OpwGeometry& g, int cfx) {
+  const unsigned shoulder = (static_cast<unsigned>(cfx) >> 2U) & 1U;
+  const unsigned bit1 = (static_cast<unsigned>(cfx) >> 1U) & 1U;
+  const unsigned elbow = bit1 ^ (g.sign[1] < 0.0 ? 1U : 0U);
+  return 1U << (2U * shoulder + elbow);
+}
+
+double max_abs_diff(const Eigen::Matrix<double, 6, 1>& a, const JointVector& b) {
+  double m = 0.0;
+  for (int j = 0; j < 6; ++j) {
+    m = std::max(m, std::abs(a[j] - b[j]));
+  }
+  return m;
+}
+
 }  // namespace
 
 JointPath solve_path_ik(const RobotModel& model, const std::vector<Pose>& poses, const IkRequest& first) {
@@ -50,8 +79,45 @@ PathIkSolver::PathIkSolver(const RobotModel& model, const IkRequest& first, cons
   }
 }
 
+bool PathIkSolver::next_on_path_arm(const Pose& base_T_tcp) {
+  // The full solve refuses these with its message.
+  if (!base_T_tcp.matrix().allFinite() ||
+      (base_T_tcp.linear().transpose() * base_T_tcp.linear() - Matrix3::Identity()).norm() > 1e-6) {
+    return false;
+  }
+  OpwSolutions solutions;
+  opw_solutions(model_, base_T_tcp, &q_, solutions, request_.near_singular_threshold, arm_);
+  // As inverse_kinematics() chooses among the branches of the path's cfx: the nearest to the
+  // previous point (largest joint difference), the first of equals.
+  int best = -1;
+  double best_step = HUGE_VAL;
+  for (int k = 0; k < solutions.count; ++k) {
+    const OpwSolution& s = solutions.solution[static_cast<std::size_t>(k)];
+    if (s.configuration.cfx != configuration_.cfx) {
+      continue;
+    }
+    const double step = max_abs_diff(s.q, q_);
+    if (step < best_step) {
+      best_step = step;
+      best = k;
+    }
+  }
+  // Near a singularity another arm may share the cfx, and the point may stop the path: the full solve decides.
+  if (best < 0 || solutions.solution[static_cast<std::size_t>(best)].singularity != Singularity::kNone ||
+      !(best_step <= options_.max_joint_step_rad)) {
+    return false;
+  }
+  q_ = solutions.solution[static_cast<std::size_t>(best)].q;
+  request_.seed = q_;
+  return true;
+}
+
 const JointVector& PathIkSolver::next(const Pose& base_T_tcp) {
   const std::size_t i = index_;
+  if (arm_ != 0 && next_on_path_arm(base_T_tcp)) {
+    ++index_;
+    return q_;
+  }
   const IkResult r = inverse_kinematics(model_, ws_, base_T_tcp, request_);
   if (!r.ok() || (r.status == IkStatus::kNearSingular && !options_.allow_near_singular)) {
     fail_point(i, r);
@@ -62,6 +128,10 @@ const JointVector& PathIkSolver::next(const Pose& base_T_tcp) {
     // the joints continuously instead of being forced.
     request_.configuration = r.configuration;
     request_.match_quadrants = false;
+    if (const OpwGeometry* g = model_.opw();
+        g != nullptr && !request_.kuka_configuration && request_.near_singular_threshold >= kArmMarginThreshold) {
+      arm_ = arm_of_configuration(*g, r.configuration.cfx);
+    }
   } else {
     for (int j = 0; j < model_.dof(); ++j) {
       const double step = std::abs(r.q[j] - q_[j]);

@@ -39,7 +39,10 @@ struct PathIkOptions {
 [[nodiscard]] JointPath solve_path_ik(const RobotModel& model, const std::vector<Pose>& poses, const IkRequest& first);
 
 /// The same, a pose at a time, for paths too long to hold (deflex offline streams them): next()
-/// gives exactly what solve_path_ik gives for that point, and throws the same InputError.
+/// gives exactly what solve_path_ik gives for that point, and throws the same InputError. After the
+/// first point of an ortho-parallel arm, next() solves only the arm (shoulder and elbow) the path's
+/// configuration allows, which no other arm shares away from the shoulder and elbow singularities;
+/// near them, and whenever that arm gives no usable answer, it solves every branch as the first point does.
 /// Thread safety: one thread at a time (its own Workspace); solvers on different threads may share
 /// the model.
 class PathIkSolver {
@@ -55,6 +58,10 @@ class PathIkSolver {
   [[nodiscard]] const ArmConfiguration& configuration() const { return configuration_; }
 
  private:
+  /// The next point from the one arm `arm_` (an opw_solutions() arm mask; 0: not applicable); false
+  /// when that does not settle it (the full solve then decides, and reports any failure).
+  bool next_on_path_arm(const Pose& base_T_tcp);
+
   const RobotModel& model_;
   PathIkOptions options_;
   Workspace ws_;
@@ -62,6 +69,7 @@ class PathIkSolver {
   ArmConfiguration configuration_;
   JointVector q_;
   std::size_t index_ = 0;
+  unsigned arm_ = 0;
 };
 
 }  // namespace deflex
