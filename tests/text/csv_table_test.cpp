@@ -85,11 +85,43 @@ TEST(CsvTable, BadCellsAreNamedByLineAndColumn) {
 // way a cell means what parse_double makes of it, trimmed, inside its column's range, or the row is refused with
 // that path's message.
 TEST(CsvTable, EveryCellMeansWhatParseDoubleMakesOfIt) {
-  const std::vector<std::string> cells{
-      "1.5", "  +1.5\t", "+.5", "5.", "-0", "00012", "1e+3", "1E-3", "-2.5e-12", "4.9e-324", "1e-400", "1e400",
-      "3.14159265358979323846264338327950288", "100000", "-1e5", "100000.0000001", "1e", "1.2.3", "0x10", "inf",
-      "-inf", "nan", "NaN", "infinity", "+", "-", "", " ", "1 2", "+-1", "++1", "-+1", "1_000", ".", "e5", "1e5x",
-      "\t-7\t"};
+  const std::vector<std::string> cells{"1.5",
+                                       "  +1.5\t",
+                                       "+.5",
+                                       "5.",
+                                       "-0",
+                                       "00012",
+                                       "1e+3",
+                                       "1E-3",
+                                       "-2.5e-12",
+                                       "4.9e-324",
+                                       "1e-400",
+                                       "1e400",
+                                       "3.14159265358979323846264338327950288",
+                                       "100000",
+                                       "-1e5",
+                                       "100000.0000001",
+                                       "1e",
+                                       "1.2.3",
+                                       "0x10",
+                                       "inf",
+                                       "-inf",
+                                       "nan",
+                                       "NaN",
+                                       "infinity",
+                                       "+",
+                                       "-",
+                                       "",
+                                       " ",
+                                       "1 2",
+                                       "+-1",
+                                       "++1",
+                                       "-+1",
+                                       "1_000",
+                                       ".",
+                                       "e5",
+                                       "1e5x",
+                                       "\t-7\t"};
   const auto trimmed = [](const std::string& s) {
     const auto b = s.find_first_not_of(" \t");
     return b == std::string::npos ? std::string() : s.substr(b, s.find_last_not_of(" \t") - b + 1);

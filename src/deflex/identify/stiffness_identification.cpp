@@ -451,26 +451,30 @@ void add_weighted_products(const double* block, int runtime_rows, int runtime_wi
       std::memcpy(&v, p, sizeof v);
       return v;
     };
+    std::array<const double*, static_cast<std::size_t>(R)> x{};
+    for (std::size_t r = 0; r < x.size(); ++r) {
+      x[r] = block + static_cast<std::ptrdiff_t>(r) * W;
+    }
     int at = 0;
 #pragma GCC unroll 8
     for (int k = 0; k < W; ++k) {
       std::array<double, static_cast<std::size_t>(R)> wx{};
-      for (int r = 0; r < R; ++r) {
-        wx[static_cast<std::size_t>(r)] = omega * block[r * W + k];
+      for (std::size_t r = 0; r < x.size(); ++r) {
+        wx[r] = omega * x[r][k];
       }
       int l = k;
 #pragma GCC unroll 4
       for (; l + 1 < W; l += 2, at += 2) {
         Pair sum = load(upper + at);
-        for (int r = 0; r < R; ++r) {
-          sum += wx[static_cast<std::size_t>(r)] * load(block + r * W + l);
+        for (std::size_t r = 0; r < x.size(); ++r) {
+          sum += wx[r] * load(x[r] + l);
         }
         std::memcpy(upper + at, &sum, sizeof sum);
       }
       if (l < W) {
         double sum = upper[at];
-        for (int r = 0; r < R; ++r) {
-          sum += wx[static_cast<std::size_t>(r)] * block[r * W + l];
+        for (std::size_t r = 0; r < x.size(); ++r) {
+          sum += wx[r] * x[r][l];
         }
         upper[at++] = sum;
       }
