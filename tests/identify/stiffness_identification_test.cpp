@@ -587,3 +587,142 @@ TEST(IdentifyStiffness, TheRobustFitIsTheDenseSolveAtItsFinalWeights) {
 
 }  // namespace
 }  // namespace deflex
+
+namespace deflex {
+namespace {
+
+// The re-weighting solves its steps from the weighted sums of the rows' products (the normal equations), summed a
+// measurement at a time and two sums at a time; only its last solve is a QR of the rows. Every step must be the
+// dense weighted least squares of the whole stack at that step's weights (KDL's Jacobians; 3- and 6-row
+// measurements, uneven weights, rows in the scratch file): the robust weights it ends with come from the residuals
+// of those steps, so they must be the weights the dense steps give. Two Huber and two Tukey iterations, with
+// outliers that Huber only down-weights and outliers that Tukey rejects.
+TEST(IdentifyStiffness, EveryReweightingStepIsTheDenseSolveAtItsWeights) {
+  const RobotModel model = kr210_model();
+  const JointVector k_true = model.stiffness();
+  std::vector<StiffnessMeasurement> data = kdl_linear_data(model, k_true, 2500, true, false, 61);
+  const auto with_rotation = kdl_linear_data(model, k_true, 500, true, true, 62);
+  data.insert(data.begin() + 1200, with_rotation.begin(), with_rotation.end());
+  std::mt19937 rng(63);
+  std::normal_distribution<double> noise(0.0, 20e-6);
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    StiffnessMeasurement& m = data[i];
+    m.dp_m += Vector3(noise(rng), noise(rng), noise(rng));
+    if (m.drot_rad) {
+      *m.drot_rad += Vector3(noise(rng), noise(rng), noise(rng));  // rad, weighed like m (rotation_scale_m 1)
+    }
+    m.weight = 0.5 + static_cast<double>(i % 4) * 0.5;
+    if (i % 40 == 0) {
+      m.dp_m.x() += 1e-3;  // 50 sigmas: Tukey rejects it
+    } else if (i % 40 == 20) {
+      m.dp_m.y() += 80e-6;  // 4 sigmas: Huber down-weights it
+    }
+  }
+  IdentificationOptions options;
+  options.max_robust_iterations = 2;
+  options.rows_in_memory_bytes = 0;
+  const StiffnessEstimate est = identify_stiffness(model, data, options);
+  ASSERT_EQ(est.iterations, 4);  // neither stage converged in two: every step below ran
+  ASSERT_EQ(est.robust_weights.size(), data.size());
+
+  // The dense stack: sqrt(weight) [J diag(J^T W)] and sqrt(weight) [dp; drot], each measurement's rows in turn.
+  const KDL::Chain chain = test::kdl_chain_from_dh(model);
+  KDL::ChainJntToJacSolver solver(chain);
+  std::vector<Eigen::Index> first, count;
+  Eigen::Index rows = 0;
+  for (const auto& m : data) {
+    first.push_back(rows);
+    count.push_back(m.drot_rad ? 6 : 3);
+    rows += count.back();
+  }
+  Eigen::MatrixXd A(rows, 6);
+  Eigen::VectorXd b(rows);
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const StiffnessMeasurement& m = data[i];
+    KDL::JntArray qk(6);
+    for (unsigned j = 0; j < 6; ++j) {
+      qk(j) = m.q[j];
+    }
+    KDL::Jacobian jk(6);
+    ASSERT_GE(solver.JntToJac(qk, jk), 0);
+    const Eigen::MatrixXd J = jk.data;
+    const Eigen::VectorXd tau = J.transpose() * m.wrench_base;
+    const double sw = std::sqrt(m.weight);
+    A.middleRows(first[i], count[i]) = sw * J.topRows(count[i]) * tau.asDiagonal();
+    b.segment(first[i], 3) = sw * m.dp_m;
+    if (m.drot_rad) {
+      b.segment(first[i] + 3, 3) = sw * *m.drot_rad;
+    }
+  }
+  const auto solve = [&](const std::vector<double>& w) {
+    Eigen::MatrixXd Aw = A;
+    Eigen::VectorXd bw = b;
+    for (std::size_t i = 0; i < data.size(); ++i) {
+      Aw.middleRows(first[i], count[i]) *= std::sqrt(w[i]);
+      bw.segment(first[i], count[i]) *= std::sqrt(w[i]);
+    }
+    return Eigen::VectorXd(Aw.colPivHouseholderQr().solve(bw));
+  };
+  const auto residuals = [&](const Eigen::VectorXd& c) {
+    std::vector<double> d(data.size());
+    for (std::size_t i = 0; i < data.size(); ++i) {
+      d[i] = (b.segment(first[i], count[i]) - A.middleRows(first[i], count[i]) * c).norm();
+    }
+    return d;
+  };
+  // The estimator's thresholds (docs/identify.md): Wilson-Hilferty chi quantiles for k = 3 or 6 rows.
+  const auto chi = [](Eigen::Index k, double z) {
+    const double a = 2.0 / (9.0 * static_cast<double>(k));
+    const double t = 1.0 - a + z * std::sqrt(a);
+    return std::sqrt(static_cast<double>(k) * t * t * t);
+  };
+  const auto huber = [&](const std::vector<double>& d, double sigma) {
+    std::vector<double> w(d.size());
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      const double u = d[i] / sigma, h = chi(count[i], 1.645);
+      w[i] = u <= h ? 1.0 : h / u;
+    }
+    return w;
+  };
+  const auto tukey = [&](const std::vector<double>& d, double sigma) {
+    std::vector<double> w(d.size());
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      const double t = d[i] / sigma / (1.42 * chi(count[i], 3.090));
+      w[i] = t < 1.0 ? (1.0 - t * t) * (1.0 - t * t) : 0.0;
+    }
+    return w;
+  };
+  const auto scale = [&](const std::vector<double>& d) {  // median of d_i / chi median, an even count
+    std::vector<double> u(d.size());
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      u[i] = d[i] / chi(count[i], 0.0);
+    }
+    std::sort(u.begin(), u.end());
+    return 0.5 * (u[u.size() / 2 - 1] + u[u.size() / 2]);
+  };
+  std::vector<double> d = residuals(solve(std::vector<double>(data.size(), 1.0)));
+  double sigma = 0.0;
+  for (int it = 0; it < 2; ++it) {  // Huber, the scale from each step's residuals
+    sigma = scale(d);
+    d = residuals(solve(huber(d, sigma)));
+  }
+  std::vector<double> omega = tukey(d, sigma);  // Tukey, the scale frozen
+  omega = tukey(residuals(solve(omega)), sigma);
+
+  int down = 0, rejected = 0;
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    EXPECT_NEAR(est.robust_weights[i], omega[i], 1e-9) << "measurement " << i;
+    down += static_cast<int>(omega[i] > 0.0 && omega[i] < 0.5);
+    rejected += static_cast<int>(omega[i] == 0.0);
+  }
+  EXPECT_GE(rejected, 75);  // the 50-sigma outliers, at least
+  EXPECT_GT(down, 0);
+  const Eigen::VectorXd c = solve(omega);
+  for (std::size_t j = 0; j < 6; ++j) {
+    EXPECT_NEAR(est.compliance_rad_per_nm[j], c[static_cast<Eigen::Index>(j)], 1e-9 * c[static_cast<Eigen::Index>(j)])
+        << "joint " << j + 1;
+  }
+}
+
+}  // namespace
+}  // namespace deflex

@@ -1,16 +1,23 @@
 // CSV reading and writing: the streaming reader against the whole-table reader, line endings, byte
 // order marks, separators, chunk boundaries, locale independence, and the writer's %.10g text.
+#include <algorithm>
+#include <bit>
 #include <clocale>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/text/parse_number.hpp"
 
 namespace deflex {
 namespace {
@@ -72,6 +79,74 @@ TEST(CsvTable, BadCellsAreNamedByLineAndColumn) {
   EXPECT_NE(message_of("# only a comment\n").find("no header row"), std::string::npos);
   EXPECT_NE(message_of("a,b\n1,+-2\n").find("'+-2' is not a number"), std::string::npos);
   EXPECT_NE(message_of("a,b\n1,2x\n").find("'2x' is not a number"), std::string::npos);
+}
+
+// The reader takes a row of plain numbers in one scan and leaves anything else to the cell-by-cell path; either
+// way a cell means what parse_double makes of it, trimmed, inside its column's range, or the row is refused with
+// that path's message.
+TEST(CsvTable, EveryCellMeansWhatParseDoubleMakesOfIt) {
+  const std::vector<std::string> cells{"1.5",
+                                       "  +1.5\t",
+                                       "+.5",
+                                       "5.",
+                                       "-0",
+                                       "00012",
+                                       "1e+3",
+                                       "1E-3",
+                                       "-2.5e-12",
+                                       "4.9e-324",
+                                       "1e-400",
+                                       "1e400",
+                                       "3.14159265358979323846264338327950288",
+                                       "100000",
+                                       "-1e5",
+                                       "100000.0000001",
+                                       "1e",
+                                       "1.2.3",
+                                       "0x10",
+                                       "inf",
+                                       "-inf",
+                                       "nan",
+                                       "NaN",
+                                       "infinity",
+                                       "+",
+                                       "-",
+                                       "",
+                                       " ",
+                                       "1 2",
+                                       "+-1",
+                                       "++1",
+                                       "-+1",
+                                       "1_000",
+                                       ".",
+                                       "e5",
+                                       "1e5x",
+                                       "\t-7\t"};
+  const auto trimmed = [](const std::string& s) {
+    const auto b = s.find_first_not_of(" \t");
+    return b == std::string::npos ? std::string() : s.substr(b, s.find_last_not_of(" \t") - b + 1);
+  };
+  for (const std::string& cell : cells) {
+    const std::optional<double> v = parse_double(trimmed(cell));
+    const bool ok = v && *v >= -1e5 && *v <= 1e5;  // x_mm's range
+    // The cell first, last, and between two others: (header, row, its column).
+    const std::vector<std::tuple<std::string, std::string, std::size_t>> rows{
+        {"x_mm,b_mm", cell + ",2", 0}, {"a_mm,x_mm", "2," + cell, 1}, {"a_mm,x_mm,c_mm", "2," + cell + ",3", 1}};
+    for (const auto& [header, row, column] : rows) {
+      const std::string text = header + "\n" + row + "\n";
+      if (ok) {
+        const CsvTable t = CsvTable::parse(text, "f.csv");
+        ASSERT_EQ(t.rows(), 1U) << text;
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(t.at(0, column)), std::bit_cast<std::uint64_t>(*v)) << text;
+      } else {
+        EXPECT_THROW((void)CsvTable::parse(text, "f.csv"), DataError) << text;
+      }
+    }
+  }
+  // The cell-by-cell path's message for a row the one scan leaves to it, after good cells.
+  EXPECT_NE(message_of("x_mm,y_mm\n1,2\n1, 1e6 \n").find("f.csv:3: column 'y_mm': 1e+06 mm is outside"),
+            std::string::npos)
+      << message_of("x_mm,y_mm\n1,2\n1, 1e6 \n");
 }
 
 TEST(CsvTable, NumbersMeanTheSameInEveryLocale) {

@@ -6,9 +6,11 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <optional>
+#include <span>
 
 #include <fmt/format.h>
 #include <Eigen/Cholesky>
@@ -121,6 +123,40 @@ class RowStore {
     total_rows_ += rows;
     return c.data() + at;
   }
+  // One measurement's rows as for_each hands them over.
+  struct Measurement {
+    std::size_t i;
+    int rows;
+    const double* block;
+  };
+  static constexpr std::size_t kBatch = 64;
+  // f(batch): the measurements in order, up to kBatch at a time (never across a chunk: its rows are seen only while
+  // it is), so a pass can work out every measurement's weight before it uses any of them.
+  template <typename F>
+  void for_each_batch(F&& f) const {
+    std::array<Measurement, kBatch> batch{};
+    std::size_t i = 0;
+    for (const Chunk& c : chunks_) {
+      std::optional<SpillFile::View> view;
+      if (c.on_disk()) {
+        view.emplace(spill_, static_cast<std::uint64_t>(c.offset), c.size);
+      }
+      const double* data = c.on_disk() ? view->data() : c.values.data();
+      std::size_t n = 0;
+      for (std::size_t at = 0; at < c.count(); ++i) {
+        const int rows = rows_[i];
+        batch[n++] = {i, rows, data + at};
+        if (n == kBatch) {
+          f(std::span<const Measurement>(batch.data(), n));
+          n = 0;
+        }
+        at += static_cast<std::size_t>(rows * width_);
+      }
+      if (n > 0) {
+        f(std::span<const Measurement>(batch.data(), n));
+      }
+    }
+  }
   // f(i, rows, block): block is rows x (dof + 1), row-major, A_i then b_i in the last column.
   template <typename F>
   void for_each(F&& f) const {
@@ -205,6 +241,10 @@ using identify_detail::RowStore;
 
 using RowBlock = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
 
+// Two doubles in one register (GCC's vector extension: SSE2 on x86-64, NEON on ARM). Each lane's arithmetic is the
+// scalar operation's, so a loop that takes its values two at a time gives the same bits.
+using DoublePair = double __attribute__((vector_size(16)));
+
 // R (p x p, upper) and Q^T y (p) of the tall system whose rows are measurement i's rows, columns
 // `cols` of A divided by scale[col], and b, all multiplied by sqrt(omega_i): Householder QR of the
 // rows a slab at a time, each slab stacked under the R found so far (the same R, up to the signs of
@@ -226,6 +266,10 @@ Triangular blocked_qr(const RowStore& s, const std::vector<int>& cols, const Eig
   Eigen::Index top = 0;   // rows of R so far (at most w)
   Eigen::Index fill = 0;  // rows in the buffer
   const Eigen::Index bcol = s.width() - 1;
+  std::vector<double> col_scale;  // the scale of each column taken
+  for (const int j : cols) {
+    col_scale.push_back(scale[j]);
+  }
   const auto reduce = [&]() {
     const Eigen::HouseholderQR<Eigen::MatrixXd> qr(buf.topRows(fill));
     top = std::min(fill, w);
@@ -236,10 +280,18 @@ Triangular blocked_qr(const RowStore& s, const std::vector<int>& cols, const Eig
     visit(i, rows, block);
     const RowBlock B(block, rows, s.width());
     const double sw = std::sqrt(omega[i]);
+    // sw * a / scale two columns at a time: the division was most of what filling the slab cost (perf: 5 % of a
+    // million-row identification), and two lanes divide in about the time of one.
     for (int r = 0; r < rows; ++r) {
-      for (Eigen::Index k = 0; k < p; ++k) {
-        const int j = cols[static_cast<std::size_t>(k)];
-        buf(fill, k) = sw * B(r, j) / scale[j];
+      std::size_t k = 0;
+      for (; k + 1 < col_scale.size(); k += 2) {
+        const DoublePair a{B(r, cols[k]), B(r, cols[k + 1])};
+        const DoublePair v = sw * a / DoublePair{col_scale[k], col_scale[k + 1]};
+        buf(fill, static_cast<Eigen::Index>(k)) = v[0];
+        buf(fill, static_cast<Eigen::Index>(k) + 1) = v[1];
+      }
+      if (k < col_scale.size()) {
+        buf(fill, static_cast<Eigen::Index>(k)) = sw * B(r, cols[k]) / col_scale[k];
       }
       buf(fill, p) = sw * B(r, bcol);
       ++fill;
@@ -434,21 +486,75 @@ struct WeightedSums {
 constexpr int packed(int width, int k, int l) { return k * width - k * (k - 1) / 2 + (l - k); }
 
 // S += omega [A b]^T [A b] for one measurement's `rows` rows of `width` values. W > 0: the width known at compile
-// time (a 6-joint arm: 7), so the compiler unrolls and vectorises the 28 products; W == 0: any width.
-template <int W>
-void add_weighted_products(const double* block, int rows, int runtime_width, double omega, double* upper) {
-  const int width = W > 0 ? W : runtime_width;
-  for (int r = 0; r < rows; ++r) {
-    const double* x = block + static_cast<std::ptrdiff_t>(r) * width;
+// time (a 6-joint arm: 7), R > 0 the rows (3 or 6), so the compiler unrolls the 28 sums of products. Each sum is
+// loaded once, takes the rows' products in row order and is stored once: the same operations in the same order as
+// adding a row at a time, but a row at a time stored every sum after every row, as the compiler must when the sums
+// may share memory with the rows (perf of a million-row identification: 84 stores a measurement, a quarter of the
+// run in the passes that sum).
+template <int W, int R>
+void add_weighted_products(const double* block, int runtime_rows, int runtime_width, double omega, double* upper) {
+  if constexpr (W > 0 && R > 0) {
+    // Two sums at a time (DoublePair): each lane does what the scalar loop below does to its sum.
+    using Pair = DoublePair;
+    const auto load = [](const double* p) {
+      Pair v;
+      std::memcpy(&v, p, sizeof v);
+      return v;
+    };
+    std::array<const double*, static_cast<std::size_t>(R)> x{};
+    for (std::size_t r = 0; r < x.size(); ++r) {
+      x[r] = block + static_cast<std::ptrdiff_t>(r) * W;
+    }
     int at = 0;
 #pragma GCC unroll 8
-    for (int k = 0; k < width; ++k) {
-      const double wx = omega * x[k];
-#pragma GCC unroll 8
-      for (int l = k; l < width; ++l) {
-        upper[at++] += wx * x[l];
+    for (int k = 0; k < W; ++k) {
+      std::array<double, static_cast<std::size_t>(R)> wx{};
+      for (std::size_t r = 0; r < x.size(); ++r) {
+        wx[r] = omega * x[r][k];
+      }
+      int l = k;
+#pragma GCC unroll 4
+      for (; l + 1 < W; l += 2, at += 2) {
+        Pair sum = load(upper + at);
+        for (std::size_t r = 0; r < x.size(); ++r) {
+          sum += wx[r] * load(x[r] + l);
+        }
+        std::memcpy(upper + at, &sum, sizeof sum);
+      }
+      if (l < W) {
+        double sum = upper[at];
+        for (std::size_t r = 0; r < x.size(); ++r) {
+          sum += wx[r] * x[r][l];
+        }
+        upper[at++] = sum;
       }
     }
+  } else {
+    const int width = W > 0 ? W : runtime_width;
+    const int rows = R > 0 ? R : runtime_rows;
+    int at = 0;
+    for (int k = 0; k < width; ++k) {
+      for (int l = k; l < width; ++l) {
+        double sum = upper[at];
+        for (int r = 0; r < rows; ++r) {
+          const double* x = block + static_cast<std::ptrdiff_t>(r) * width;
+          sum += omega * x[k] * x[l];  // (omega x_k) x_l, as the row-at-a-time loop had it
+        }
+        upper[at++] = sum;
+      }
+    }
+  }
+}
+
+// The same for any row count, the common 3 and 6 unrolled.
+template <int W>
+void add_weighted_products(const double* block, int rows, int runtime_width, double omega, double* upper) {
+  if (rows == 3) {
+    add_weighted_products<W, 3>(block, rows, runtime_width, omega, upper);
+  } else if (rows == 6) {
+    add_weighted_products<W, 6>(block, rows, runtime_width, omega, upper);
+  } else {
+    add_weighted_products<W, 0>(block, rows, runtime_width, omega, upper);
   }
 }
 
@@ -583,18 +689,28 @@ void residual_pass(const RowStore& s, const Eigen::VectorXd& c_full, std::vector
     next->clear();
   }
   const RobustThresholds& th = robust_thresholds();
+  // A batch of measurements at a time: first every residual norm and weight (a square root and two divisions each,
+  // independent from one measurement to the next, so they overlap), then the products of those kept. A measurement
+  // at a time, its products waited for its weight: perf of a million-row identification showed the pass stalled on
+  // the square root and the divisions. The same operations in the same order, so the same bits.
   with_width(width, [&]<int W>() {
-    s.for_each([&](std::size_t i, int rows, const double* block) {
-      d[i] = residual_norm<W>(block, rows, width, c_full.data());
-      if (b2 != nullptr) {
-        for (int r = 0; r < rows; ++r) {
-          *b2 += block[r * width + width - 1] * block[r * width + width - 1];
+    s.for_each_batch([&](std::span<const RowStore::Measurement> batch) {
+      for (const RowStore::Measurement& m : batch) {
+        d[m.i] = residual_norm<W>(m.block, m.rows, width, c_full.data());
+        if (b2 != nullptr) {
+          for (int r = 0; r < m.rows; ++r) {
+            *b2 += m.block[r * width + width - 1] * m.block[r * width + width - 1];
+          }
+        }
+        if (next != nullptr) {
+          omega[m.i] = irls_measurement_weight(1, m.rows, d[m.i] / tukey_sigma, th);
         }
       }
       if (next != nullptr) {
-        omega[i] = irls_measurement_weight(1, rows, d[i] / tukey_sigma, th);
-        if (omega[i] != 0.0) {
-          add_weighted_products<W>(block, rows, width, omega[i], next->upper.data());
+        for (const RowStore::Measurement& m : batch) {
+          if (omega[m.i] != 0.0) {
+            add_weighted_products<W>(m.block, m.rows, width, omega[m.i], next->upper.data());
+          }
         }
       }
     });

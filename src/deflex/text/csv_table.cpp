@@ -7,9 +7,11 @@
 #include "deflex/text/csv_table.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
+#include <system_error>
 
 #include "deflex/text/errors.hpp"
 #include "deflex/text/format_number.hpp"
@@ -71,9 +73,12 @@ bool CsvReader::next_line(std::string_view& out) {
     }
     const char* data = buffer_.data();
     const std::size_t size = buffer_.size();
-    std::size_t end = begin_;
-    while (end < size && data[end] != '\n' && data[end] != '\r') {
-      ++end;
+    // The line ends at its first '\n' or '\r': memchr for each (the library's vector search) instead of a test
+    // of every byte, which was 3 % of a million-row identification.
+    const void* nl = std::memchr(data + begin_, '\n', size - begin_);
+    std::size_t end = nl != nullptr ? static_cast<std::size_t>(static_cast<const char*>(nl) - data) : size;
+    if (const void* cr = std::memchr(data + begin_, '\r', end - begin_)) {
+      end = static_cast<std::size_t>(static_cast<const char*>(cr) - data);
     }
     if (end < size) {
       out = std::string_view(data + begin_, end - begin_);
@@ -149,6 +154,55 @@ void CsvReader::read_header() {
   throw DataError(fmt::format("{}: no header row (the file is empty)", source_));
 }
 
+// A row of plain numbers (each cell an optional blank, an optional '+', what std::from_chars reads as a finite
+// number, an optional blank; as many cells as the header has; each value inside its column's range) in one scan of
+// the line: no search for the commas first, no trimming, no check of each character before from_chars. parse_row
+// spends twice this on such a row (perf of a million-row identification: 17 % of the run in the splitting and the
+// checks, 9 % in from_chars itself). False at the first thing that is not so, with nothing decided: parse_row then
+// reads the row again and gives the message. It accepts only rows parse_row accepts, with the same values: a cell
+// it takes is, trimmed, exactly the text from_chars read (a comma or the line's end follows it), and the only texts
+// from_chars reads that parse_row's character check refuses are NaN and the infinities, which are not finite.
+bool CsvReader::parse_plain_row(std::string_view line) {
+  const char* p = line.data();
+  const char* const end = p + line.size();
+  const auto blanks = [&] {
+    while (p != end && (*p == ' ' || *p == '\t')) {
+      ++p;
+    }
+  };
+  const std::size_t width = columns_.size();
+  for (std::size_t i = 0; i < width; ++i) {
+    blanks();
+    if (p != end && *p == '+') {
+      ++p;
+      if (p != end && (*p == '+' || *p == '-')) {
+        return false;
+      }
+    }
+    double v = 0.0;
+    const auto r = std::from_chars(p, end, v, std::chars_format::general);
+    if (r.ec != std::errc() || !std::isfinite(v)) {
+      return false;
+    }
+    p = r.ptr;
+    blanks();
+    if (i + 1 < width) {
+      if (p == end || *p != ',') {
+        return false;
+      }
+      ++p;
+    } else if (p != end) {
+      return false;
+    }
+    const InputRange& range = *ranges_[i];
+    if (!(v >= range.min && v <= range.max)) {  // range_violation's test
+      return false;
+    }
+    row_[i] = v;
+  }
+  return true;
+}
+
 void CsvReader::parse_row(std::string_view line) {
   std::size_t i = 0;
   const std::size_t width = columns_.size();
@@ -192,7 +246,9 @@ bool CsvReader::next() {
     if (tl.empty() || tl[0] == '#') {
       continue;
     }
-    parse_row(tl);
+    if (!parse_plain_row(tl)) {
+      parse_row(tl);
+    }
     line_of_row_ = line_;
     return true;
   }

@@ -68,6 +68,7 @@ class CsvReader {
   bool next_line(std::string_view& out);  // the next line (without its ending), false at the end
   void read_header();
   void parse_row(std::string_view line);
+  bool parse_plain_row(std::string_view line);  // the common row in one scan; false: leave it to parse_row
 
   std::string source_;
   std::unique_ptr<InputFile> file_;  // null when reading text held in memory
