@@ -1,4 +1,4 @@
-// The folded forward-kinematics kernel (model/detail/folded_chain.hpp, joint_sincos.hpp) on every robot
+// The folded forward-kinematics kernel (model/folded_chain.hpp, detail/joint_sincos.hpp) on every robot
 // deflex ships (the built-in DH arm, the DH examples, the ROS-Industrial URDFs) and on chains built to
 // reach each of its paths (joint axes off z, general fixed rotations, a WAP off the TCP): the poses
 // and Jacobians against Orocos KDL built from the robot's joints one by one (KDL's own frame products,
@@ -14,7 +14,7 @@
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 
-#include "deflex/model/detail/folded_chain.hpp"
+#include "deflex/model/folded_chain.hpp"
 #include "deflex/model/detail/joint_sincos.hpp"
 #include "deflex/model/kinematics.hpp"
 #include "deflex/model/robot_io.hpp"
@@ -151,13 +151,13 @@ TEST(KinematicsKernel, AxesOffZAndGeneralRotationsMatchKdl) {
   expect_matches_kdl("folding test arm", m, EndPoint::kTcp, m.description().flange_T_tcp);
   expect_matches_kdl("folding test arm", m, EndPoint::kWap, *m.description().flange_T_wap);
   // The test arm reaches every kind of fixed step the kernel has.
-  const detail::FoldedChain& c = m.folded_chain();
-  std::vector<detail::FoldedStep::Turn> kinds;
+  const FoldedChain& c = m.folded_chain();
+  std::vector<FoldedStep::Turn> kinds;
   for (int i = 1; i < c.dof; ++i) kinds.push_back(c.steps[static_cast<std::size_t>(i)].turn);
   kinds.push_back(c.last_to_flange.turn);
   kinds.push_back(c.flange_to_tcp.turn);
   kinds.push_back(c.flange_to_wap.turn);
-  for (const auto kind : {detail::FoldedStep::Turn::kPermutation, detail::FoldedStep::Turn::kGeneral}) {
+  for (const auto kind : {FoldedStep::Turn::kPermutation, FoldedStep::Turn::kGeneral}) {
     EXPECT_NE(std::find(kinds.begin(), kinds.end(), kind), kinds.end()) << static_cast<int>(kind);
   }
 }
@@ -193,17 +193,17 @@ TEST(KinematicsKernel, JacobiansMatchCentralDifferencesOfFkOnEveryShippedRobot) 
 
 TEST(KinematicsKernel, DhTwistsFoldToPermutationsAndTurnsAboutX) {
   // The built-in arm's twists are 0 and +-90 degrees: permutations (the identity for 0).
-  const detail::FoldedChain& c = builtin_irb6700().folded_chain();
+  const FoldedChain& c = builtin_irb6700().folded_chain();
   for (int i = 1; i < c.dof; ++i) {
-    EXPECT_NE(c.steps[static_cast<std::size_t>(i)].turn, detail::FoldedStep::Turn::kGeneral) << i;
-    EXPECT_NE(c.steps[static_cast<std::size_t>(i)].turn, detail::FoldedStep::Turn::kAboutX) << i;
+    EXPECT_NE(c.steps[static_cast<std::size_t>(i)].turn, FoldedStep::Turn::kGeneral) << i;
+    EXPECT_NE(c.steps[static_cast<std::size_t>(i)].turn, FoldedStep::Turn::kAboutX) << i;
   }
   // A twist off 90 degrees (a calibrated arm's) is a turn about x with its own cos and sin.
   Pose twisted = Pose::Identity();
   twisted.linear() = Eigen::AngleAxisd(deg_to_rad(-89.99), Vector3::UnitX()).toRotationMatrix();
   twisted.translation() = Vector3(0.32, 0.0, 0.0);
-  const detail::FoldedStep step = detail::fold_step(twisted);
-  EXPECT_EQ(step.turn, detail::FoldedStep::Turn::kAboutX);
+  const FoldedStep step = fold_step(twisted);
+  EXPECT_EQ(step.turn, FoldedStep::Turn::kAboutX);
   EXPECT_DOUBLE_EQ(step.c, std::cos(deg_to_rad(-89.99)));
   EXPECT_DOUBLE_EQ(step.s, std::sin(deg_to_rad(-89.99)));
   EXPECT_EQ(step.translation_mask, 1U);

@@ -22,6 +22,7 @@ ForceSensorDaq::ForceSensorDaq(const SensorConfig& sensor, const ToolConfig& too
   // The sheet's sensitivities are off by the calibration's uncertainty; the user decouples with the
   // sheet, so the reading keeps this error (drawn whatever its size: the other draws stay the same).
   for (int i = 0; i < 3; ++i) sensitivity_[i] = 1.0 + sensor.sensitivity_error * normal_(rng_);
+  response_ = crosstalk_ * sensitivity_.asDiagonal();
   flange_R_sensor_ = Eigen::AngleAxisd(sensor.misalignment_rad, Vector3::UnitZ()).toRotationMatrix();
   calibration_.decoupling = crosstalk_.inverse() * (Matrix3::Identity() + residual);
   // The force channels' response to moments: a property of the spring body, drawn after the other
@@ -45,14 +46,13 @@ ForceSensorDaq::ForceSensorDaq(const SensorConfig& sensor, const ToolConfig& too
 
 Vector3 ForceSensorDaq::sample(const Vector3& process_force_base_n, const Matrix3& base_R_flange, double t_s) {
   const Vector3 weight_base(0.0, 0.0, -tool_.ee_mass_kg * kGravity);
-  const Vector3 f_sensor = (base_R_flange * flange_R_sensor_).transpose() * (process_force_base_n + weight_base);
+  const Matrix3 sensor_R_base = (base_R_flange * flange_R_sensor_).transpose();
+  const Vector3 f_sensor = sensor_R_base * (process_force_base_n + weight_base);
   Vector3 noise(normal_(rng_), normal_(rng_), normal_(rng_));
-  Vector3 reading = crosstalk_ * sensitivity_.asDiagonal() * f_sensor + config_.bias_n + zero_drift_n_per_s_ * t_s +
-                    config_.noise_n * noise;
+  Vector3 reading = response_ * f_sensor + config_.bias_n + zero_drift_n_per_s_ * t_s + config_.noise_n * noise;
   if (config_.moment_crosstalk > 0.0) {
     // The moments about the point of origin of the process force (at the TCP) and of the end
     // effector's weight (at its centre of gravity); beyond the nominal moment the response grows.
-    const Matrix3 sensor_R_base = (base_R_flange * flange_R_sensor_).transpose();
     const Vector3 cog = tool_.ee_cog_m + Vector3(0.0, 0.0, 0.5 * config_.height_m);
     Vector3 m = lever_m_.cross(sensor_R_base * process_force_base_n) + cog.cross(sensor_R_base * weight_base);
     for (int j = 0; j < 3; ++j) {

@@ -50,6 +50,7 @@ class ForceSensorDaq {
   ToolConfig tool_;
   Matrix3 crosstalk_;
   Vector3 sensitivity_ = Vector3::Ones();
+  Matrix3 response_;  // crosstalk_ times the sensitivities: what a force in the sensor frame reads as
   Matrix3 flange_R_sensor_ = Matrix3::Identity();
   Vector3 zero_drift_n_per_s_ = Vector3::Zero();
   Matrix3 moment_crosstalk_ = Matrix3::Zero();  // N of each force channel per N m of each moment, at nominal

@@ -1,11 +1,11 @@
-// Folding a serial chain for forward kinematics (see detail/folded_chain.hpp).
-#include "deflex/model/detail/folded_chain.hpp"
+// Folding a serial chain for forward kinematics (see folded_chain.hpp).
+#include "deflex/model/folded_chain.hpp"
 
 #include <cmath>
 
 #include "deflex/model/robot_model.hpp"
 
-namespace deflex::detail {
+namespace deflex {
 namespace {
 
 constexpr double kExact = 1e-15;
@@ -103,4 +103,4 @@ FoldedChain fold_chain(const RobotDescription& d, const Pose& flange_T_wap) {
   return chain;
 }
 
-}  // namespace deflex::detail
+}  // namespace deflex

@@ -37,28 +37,28 @@ struct Frame {
 };
 
 // frame <- frame * step: the translation first (in the frame before the step's turn), then the turn.
-[[gnu::always_inline]] inline void apply(const detail::FoldedStep& step, Frame& f) {
+[[gnu::always_inline]] inline void apply(const FoldedStep& step, Frame& f) {
   const std::uint8_t mask = step.translation_mask;
   if ((mask & 1U) != 0) f.p += step.translation[0] * f.x;
   if ((mask & 2U) != 0) f.p += step.translation[1] * f.y;
   if ((mask & 4U) != 0) f.p += step.translation[2] * f.z;
   switch (step.turn) {
-    case detail::FoldedStep::Turn::kIdentity:
+    case FoldedStep::Turn::kIdentity:
       break;
-    case detail::FoldedStep::Turn::kAboutX: {
+    case FoldedStep::Turn::kAboutX: {
       const Vector3 y = f.y;
       f.y = step.c * y + step.s * f.z;
       f.z = step.c * f.z - step.s * y;
       break;
     }
-    case detail::FoldedStep::Turn::kPermutation: {
+    case FoldedStep::Turn::kPermutation: {
       const std::array<Vector3, 3> cols{f.x, f.y, f.z};
       f.x = step.sign[0] * cols[step.perm[0]];
       f.y = step.sign[1] * cols[step.perm[1]];
       f.z = step.sign[2] * cols[step.perm[2]];
       break;
     }
-    case detail::FoldedStep::Turn::kGeneral: {
+    case FoldedStep::Turn::kGeneral: {
       Matrix3 r;
       r << f.x, f.y, f.z;
       const Matrix3 turned = r * step.rotation;
@@ -84,7 +84,7 @@ void forward_kinematics(const RobotModel& model, Workspace& ws, const JointVecto
   if (q.size() != model.dof() || ws.dof != model.dof()) [[unlikely]] {
     wrong_size(model, ws, q);
   }
-  const detail::FoldedChain& chain = model.folded_chain();
+  const FoldedChain& chain = model.folded_chain();
   const int n = chain.dof;
   ws.q = q;
   // One sin/cos pass over the joints first, then the walk: every joint turns about its frame's z.

@@ -129,7 +129,7 @@ RobotModel::RobotModel(RobotDescription desc) : desc_(std::move(desc)) {
       compliance_[static_cast<int>(i)] = 1.0 / k;
     }
   }
-  chain_ = detail::fold_chain(d, flange_T_wap_);
+  chain_ = fold_chain(d, flange_T_wap_);
   // Last: the derivation runs FK on this (otherwise complete) model to check itself.
   opw_ = derive_opw_geometry(*this, opw_note_);
 }

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "deflex/model/detail/folded_chain.hpp"
+#include "deflex/model/folded_chain.hpp"
 #include "deflex/model/opw_geometry.hpp"
 #include "deflex/model/types.hpp"
 
@@ -108,8 +108,8 @@ class RobotModel {
 
   /// True when every joint axis is its frame's z axis (DH chains), which FK exploits.
   [[nodiscard]] bool z_axes_only() const { return z_axes_only_; }
-  /// The chain as forward kinematics walks it, folded once here (detail/folded_chain.hpp).
-  [[nodiscard]] const detail::FoldedChain& folded_chain() const { return chain_; }
+  /// The chain as forward kinematics walks it, folded once here (folded_chain.hpp).
+  [[nodiscard]] const FoldedChain& folded_chain() const { return chain_; }
 
   /// The ortho-parallel (OPW) geometry the analytic inverse kinematics uses, derived once from the
   /// chain (DH or URDF) and checked against its FK; null for arms outside that family.
@@ -133,7 +133,7 @@ class RobotModel {
   JointVector max_speed_;
   Pose flange_T_wap_ = Pose::Identity();
   bool z_axes_only_ = true;
-  detail::FoldedChain chain_;
+  FoldedChain chain_;
   std::optional<OpwGeometry> opw_;
   std::string opw_note_;
 };

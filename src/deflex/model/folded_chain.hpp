@@ -15,16 +15,15 @@
 #include "deflex/model/types.hpp"
 
 namespace deflex {
-struct RobotDescription;
-}
 
-namespace deflex::detail {
+struct RobotDescription;
 
 /// One constant rigid transform [R t] of the folded chain, with what applying it costs.
+/// Thread safety: plain data, immutable once built.
 struct FoldedStep {
   enum class Turn : std::uint8_t {
     kIdentity,     ///< R = I
-    kPermutation,  ///< column j of R is sign[j] times unit vector perm[j]: R' = R R only moves columns
+    kPermutation,  ///< column j of R is sign[j] times unit vector perm[j]: a product with it only moves columns
     kAboutX,       ///< R = Rx(angle): columns 1 and 2 turn by (c, s)
     kGeneral,      ///< any rotation: a 3x3 product
   };
@@ -38,6 +37,7 @@ struct FoldedStep {
 };
 
 /// The whole chain, folded (see the file's comment). Built by fold_chain(); immutable after.
+/// Thread safety: immutable once built (part of a RobotModel): any number of threads may read it.
 struct FoldedChain {
   int dof = 0;
   /// The first joint's frame in the base frame, before its turn: constant (mounting and first fixed
@@ -61,4 +61,4 @@ struct FoldedChain {
 /// application point `flange_T_wap`.
 [[nodiscard]] FoldedChain fold_chain(const RobotDescription& description, const Pose& flange_T_wap);
 
-}  // namespace deflex::detail
+}  // namespace deflex
