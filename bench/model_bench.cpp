@@ -60,7 +60,8 @@ struct PlainDhAnchor {
         o[i][k] = t[k];
       }
       const double th = q[static_cast<int>(i)] + rows[i].theta_offset_rad;
-      const double ct = std::cos(th), st = std::sin(th), ca = std::cos(rows[i].alpha_rad), sa = std::sin(rows[i].alpha_rad);
+      const double ct = std::cos(th), st = std::sin(th), ca = std::cos(rows[i].alpha_rad),
+                   sa = std::sin(rows[i].alpha_rad);
       // The DH step's rotation and translation, then r <- r * step.
       const double a[3][3] = {{ct, -st * ca, st * sa}, {st, ct * ca, -ct * sa}, {0, sa, ca}};
       const double d[3] = {rows[i].a_m * ct, rows[i].a_m * st, rows[i].d_m};

@@ -14,8 +14,8 @@
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 
-#include "deflex/model/folded_chain.hpp"
 #include "deflex/model/detail/joint_sincos.hpp"
+#include "deflex/model/folded_chain.hpp"
 #include "deflex/model/kinematics.hpp"
 #include "deflex/model/robot_io.hpp"
 #include "test_robots.hpp"
@@ -40,9 +40,11 @@ KDL::Chain kdl_chain_of_joints(const RobotModel& m, const Pose& flange_T_end) {
   for (const JointSpec& j : d.joints) {
     // The offset as a fixed turn about the same axis before the joint's own (turns about one axis commute).
     const KDL::Vector axis(j.axis.x(), j.axis.y(), j.axis.z());
-    chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::None),
-                                  frame_to_kdl(j.parent_T_joint) * KDL::Frame(KDL::Rotation::Rot2(axis, j.offset_rad))));
-    chain.addSegment(KDL::Segment(KDL::Joint(j.name, KDL::Vector::Zero(), axis, KDL::Joint::RotAxis), KDL::Frame::Identity()));
+    chain.addSegment(
+        KDL::Segment(KDL::Joint(KDL::Joint::None),
+                     frame_to_kdl(j.parent_T_joint) * KDL::Frame(KDL::Rotation::Rot2(axis, j.offset_rad))));
+    chain.addSegment(
+        KDL::Segment(KDL::Joint(j.name, KDL::Vector::Zero(), axis, KDL::Joint::RotAxis), KDL::Frame::Identity()));
   }
   chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::None), frame_to_kdl(d.last_T_flange * flange_T_end)));
   return chain;
@@ -69,19 +71,19 @@ std::vector<std::pair<std::string, RobotModel>> every_shipped_robot() {
 RobotModel folded_paths_arm() {
   RobotDescription d;
   d.name = "folding test arm";
-  const std::vector<Vector3> axes{Vector3::UnitZ(),  Vector3::UnitX(), -Vector3::UnitY(),
+  const std::vector<Vector3> axes{Vector3::UnitZ(),       Vector3::UnitX(), -Vector3::UnitY(),
                                   Vector3(1, 2, 2) / 3.0, Vector3::UnitY(), -Vector3::UnitZ()};
-  const std::vector<Vector3> rpy{{0, 0, 0}, {0.3, -0.2, 0.1}, {kPi / 2, 0, 0}, {0, 0, 0}, {0.0, kPi / 2, -kPi / 2},
-                                 {-0.4, 0.7, 0.2}};
+  const std::vector<Vector3> rpy{{0, 0, 0}, {0.3, -0.2, 0.1},         {kPi / 2, 0, 0},
+                                 {0, 0, 0}, {0.0, kPi / 2, -kPi / 2}, {-0.4, 0.7, 0.2}};
   for (std::size_t i = 0; i < axes.size(); ++i) {
     JointSpec j;
     j.name = "j" + std::to_string(i + 1);
     j.axis = axes[i];
     j.offset_rad = 0.1 * static_cast<double>(i) - 0.2;
-    j.parent_T_joint.linear() = (Eigen::AngleAxisd(rpy[i].z(), Vector3::UnitZ()) *
-                                 Eigen::AngleAxisd(rpy[i].y(), Vector3::UnitY()) *
-                                 Eigen::AngleAxisd(rpy[i].x(), Vector3::UnitX()))
-                                    .toRotationMatrix();
+    j.parent_T_joint.linear() =
+        (Eigen::AngleAxisd(rpy[i].z(), Vector3::UnitZ()) * Eigen::AngleAxisd(rpy[i].y(), Vector3::UnitY()) *
+         Eigen::AngleAxisd(rpy[i].x(), Vector3::UnitX()))
+            .toRotationMatrix();
     j.parent_T_joint.translation() = Vector3(0.1 * static_cast<double>(i), 0.05, i == 0 ? 0.4 : 0.3);
     d.joints.push_back(j);
   }

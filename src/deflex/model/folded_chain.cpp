@@ -38,7 +38,9 @@ FoldedStep fold_step(const Pose& transform) {
   step.rotation = r;
   step.translation = transform.translation();
   for (int k = 0; k < 3; ++k) {
-    if (step.translation[k] != 0.0) step.translation_mask = static_cast<std::uint8_t>(step.translation_mask | (1U << k));
+    if (step.translation[k] != 0.0) {
+      step.translation_mask = static_cast<std::uint8_t>(step.translation_mask | (1U << k));
+    }
   }
   // A signed permutation: one entry of +-1 in each column, the rest zero.
   bool permutation = true;

@@ -46,9 +46,9 @@ class DelayEstimator {
   static constexpr int kRing = 256;
   std::array<double, kRing> t_{};
   std::array<JointVector, kRing> q_{};
-  std::array<double, kRing> travel_{};  // cumulative path length of the references, rad
-  std::array<JointVector, kRing> segment_{};     // from the previous reference to this one, rad
-  std::array<double, kRing> segment_len2_{};     // its squared length, rad^2
+  std::array<double, kRing> travel_{};        // cumulative path length of the references, rad
+  std::array<JointVector, kRing> segment_{};  // from the previous reference to this one, rad
+  std::array<double, kRing> segment_len2_{};  // its squared length, rad^2
   int head_ = 0, count_ = 0;
   double window_s_;
   double delay_s_;

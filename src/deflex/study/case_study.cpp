@@ -167,7 +167,7 @@ struct LoadedJob {
   Strategy strategy;
   double load_n;
   double speed;
-  TrackerTrace plot_lap;                  // the plotted runs' last lap, thinned
+  TrackerTrace plot_lap;                   // the plotted runs' last lap, thinned
   std::vector<DirectedLap> plot_all_laps;  // and every lap of theirs, thinned
   Figures figures;
   bool plot = false;
