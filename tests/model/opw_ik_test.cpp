@@ -18,6 +18,7 @@
 #include "kdl_chain.hpp"
 #include "kdl_reference_chain.hpp"
 #include "support/allocation_guard.hpp"
+#include "test_robots.hpp"
 
 namespace deflex {
 namespace {
@@ -468,6 +469,48 @@ TEST(OpwIk, SingularitiesOfAUrdfArmAreReported) {
   ASSERT_TRUE(r.ok()) << r.message;
   EXPECT_EQ(r.singularity, Singularity::kWrist);
   EXPECT_LT((r.q - q).cwiseAbs().maxCoeff(), 1e-9);  // joints 4 and 6 kept as the seed splits them
+}
+
+}  // namespace
+}  // namespace deflex
+
+namespace deflex {
+namespace {
+
+// A tool that only moves the TCP and a base without a turn make the solver's frame change additions
+// only; a tilted tool keeps the products. Both reproduce their poses and find the configuration.
+TEST(OpwIk, TheFrameChangeIsAdditionsOnlyWhenNeitherFrameTurns) {
+  Pose shifted = Pose::Identity();
+  shifted.translation() = Vector3(0.02, -0.01, 0.31);
+  const RobotModel plain = builtin_irb6700();
+  const RobotModel tool = plain.with_tool(shifted);
+  const RobotModel tilted = test::irb6700_with_tool();
+  EXPECT_TRUE(plain.opw()->frames_unrotated);
+  EXPECT_TRUE(tool.opw()->frames_unrotated);
+  EXPECT_FALSE(tilted.opw()->frames_unrotated);
+  std::mt19937_64 rng(77);
+  for (const RobotModel* m : {&tool, &tilted}) {
+    Workspace ws(*m);
+    OpwSolutions sol;
+    for (int s = 0; s < 200; ++s) {
+      JointVector q(6);
+      for (int i = 0; i < 6; ++i) {
+        q[i] = std::uniform_real_distribution<double>(m->lower_limits()[i], m->upper_limits()[i])(rng);
+      }
+      const Pose target = tcp_pose(*m, ws, q);
+      opw_solutions(*m, target, &q, sol);
+      ASSERT_GT(sol.count, 0) << "sample " << s;
+      bool found = false;
+      for (int k = 0; k < sol.count; ++k) {
+        const JointVector qk = sol.solution[static_cast<std::size_t>(k)].q;
+        const Pose got = tcp_pose(*m, ws, qk);
+        EXPECT_LT((got.translation() - target.translation()).norm(), 1e-10) << "sample " << s;
+        EXPECT_LT((got.linear() - target.linear()).norm(), 1e-10) << "sample " << s;
+        found = found || (qk - q).cwiseAbs().maxCoeff() < 1e-9;
+      }
+      EXPECT_TRUE(found) << "sample " << s;
+    }
+  }
 }
 
 }  // namespace

@@ -398,10 +398,16 @@ void opw_solutions(const RobotModel& model, const Pose& base_T_tcp, const JointV
   // opw_T_base * base_T_tcp * tcp_T_end as plain 3x3 products, inlined (Eigen's product of two
   // isometries is a call and a tenth of this function's instructions).
   Pose target;
-  const Matrix3 opw_R_tcp = g->opw_T_base.linear() * base_T_tcp.linear();
-  target.linear() = opw_R_tcp * g->tcp_T_end.linear();
-  target.translation() = opw_R_tcp * g->tcp_T_end.translation() + g->opw_T_base.linear() * base_T_tcp.translation() +
-                         g->opw_T_base.translation();
+  if (g->frames_unrotated) {
+    target.linear() = base_T_tcp.linear();
+    target.translation() =
+        base_T_tcp.linear() * g->tcp_T_end.translation() + base_T_tcp.translation() + g->opw_T_base.translation();
+  } else {
+    const Matrix3 opw_R_tcp = g->opw_T_base.linear() * base_T_tcp.linear();
+    target.linear() = opw_R_tcp * g->tcp_T_end.linear();
+    target.translation() = opw_R_tcp * g->tcp_T_end.translation() + g->opw_T_base.linear() * base_T_tcp.translation() +
+                           g->opw_T_base.translation();
+  }
   OpwBranches branches;
   const OpwJointFit fit{model.lower_limits(), model.upper_limits(), seed};
   opw_branches(*g, target, g->theta(3, seed != nullptr ? (*seed)[3] : 0.0), near_singular_threshold, &fit, branches,
