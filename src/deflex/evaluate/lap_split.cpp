@@ -61,9 +61,9 @@ LapSplit split_laps(const TrackerTrace& trace, double min_turn_rad, double rever
     const Vector3 r = p - pl.centroid_m;
     return std::atan2(r.dot(pl.v), r.dot(pl.u));
   };
-  // Unwrapped angle of every sample.
-  // Each sample's angle once; the step between two angles of [-pi, pi] lies in [-2 pi, 2 pi] and is
-  // brought into [-pi, pi] by one exact subtraction of 2 pi (as std::remainder would, without its cost).
+  // Unwrapped angle of every sample, each sample's angle taken once. The step between two angles
+  // of [-pi, pi] lies in [-2 pi, 2 pi]; one exact subtraction of 2 pi brings it into [-pi, pi], as
+  // std::remainder would, without its cost.
   std::vector<double> theta(trace.size());
   double previous = angle_of(trace[0].p_m);
   theta[0] = previous;

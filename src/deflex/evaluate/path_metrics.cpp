@@ -94,7 +94,7 @@ struct PolylineIndex::Impl {
       best2 = d2;
       best.point_m = c;
       best.segment = segments[i].a;
-      best.fraction = segments[i].a == segments[i].b ? 0.0 : f;
+      best.fraction = f;  // 0 for a piece of one sample: its length is 0
     }
   }
 

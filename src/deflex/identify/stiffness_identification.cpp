@@ -160,19 +160,9 @@ class RowStore {
   // f(i, rows, block): block is rows x (dof + 1), row-major, A_i then b_i in the last column.
   template <typename F>
   void for_each(F&& f) const {
-    std::size_t i = 0;
-    for (const Chunk& c : chunks_) {
-      std::optional<SpillFile::View> view;
-      if (c.on_disk()) {
-        view.emplace(spill_, static_cast<std::uint64_t>(c.offset), c.size);
-      }
-      const double* data = c.on_disk() ? view->data() : c.values.data();
-      for (std::size_t at = 0; at < c.count(); ++i) {
-        const int rows = rows_[i];
-        f(i, rows, data + at);
-        at += static_cast<std::size_t>(rows * width_);
-      }
-    }
+    for_each_batch([&](std::span<const Measurement> batch) {
+      for (const Measurement& m : batch) f(m.i, m.rows, m.block);
+    });
   }
   template <typename F>
   void for_each_mutable(F&& f) {

@@ -1,4 +1,4 @@
-// Forward kinematics and geometric Jacobian: one pass over the chain, rotation-about-z fast path.
+// Forward kinematics and geometric Jacobian: one pass over the chain folded at load (folded_chain.hpp).
 #include "deflex/model/kinematics.hpp"
 
 #include <array>

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "deflex/model/folded_chain.hpp"
 #include "deflex/model/kinematics.hpp"
 #include "deflex/model/robot_model.hpp"
 
@@ -179,8 +180,8 @@ std::optional<OpwGeometry> derive_opw_geometry(const RobotModel& model, std::str
   g.q3_stretched = g.joint(2, -std::atan2(g.a2, g.c3));
   g.opw_T_base = (d.base_T_chain * g.chain_T_opw).inverse();
   g.tcp_T_end = (g.end_T_flange * d.flange_T_tcp).inverse();
-  g.frames_unrotated = (g.opw_T_base.linear() - Matrix3::Identity()).cwiseAbs().maxCoeff() <= 1e-15 &&
-                       (g.tcp_T_end.linear() - Matrix3::Identity()).cwiseAbs().maxCoeff() <= 1e-15;
+  g.frames_unrotated = fold_step(g.opw_T_base).turn == FoldedStep::Turn::kIdentity &&
+                       fold_step(g.tcp_T_end).turn == FoldedStep::Turn::kIdentity;
 
   // The judge: the canonical arm must reproduce the model's flange, joint signs and offsets included.
   Workspace ws(model);

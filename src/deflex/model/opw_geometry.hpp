@@ -34,8 +34,8 @@ struct OpwGeometry {
   /// canonical end frame = opw_T_base * base_T_tcp * tcp_T_end.
   Pose opw_T_base = Pose::Identity();
   Pose tcp_T_end = Pose::Identity();
-  /// Both rotations above are the identity (within 1e-15: a tool that only moves the TCP, a base
-  /// frame without a turn): the solver's frame change is then additions only.
+  /// Both rotations above are the identity, as fold_step() classifies it (a tool that only moves the
+  /// TCP, a base frame without a turn): the solver's frame change is then additions only.
   bool frames_unrotated = false;
 
   /// sqrt(a2^2 + c3^2) and the angle of the forearm vector (a2, c3) from the z axis.

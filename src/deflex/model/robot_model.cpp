@@ -91,9 +91,6 @@ RobotModel::RobotModel(RobotDescription desc) : desc_(std::move(desc)) {
     max_speed_[static_cast<int>(i)] = j.max_speed_rad_s;
     lower_[static_cast<int>(i)] = j.lower_rad;
     upper_[static_cast<int>(i)] = j.upper_rad;
-    if ((j.axis - Vector3::UnitZ()).norm() > 1e-12) {
-      z_axes_only_ = false;
-    }
   }
   if (!finite_pose(d.last_T_flange) || !finite_pose(d.base_T_chain) || !finite_pose(d.flange_T_tcp)) {
     fail(d, "base_frame/tool_frame", "not a finite rigid transform");

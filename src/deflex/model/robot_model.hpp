@@ -106,8 +106,6 @@ class RobotModel {
   [[nodiscard]] const Pose& flange_T_wap() const { return flange_T_wap_; }
   [[nodiscard]] bool wap_is_tcp() const { return !desc_.flange_T_wap.has_value(); }
 
-  /// True when every joint axis is its frame's z axis (DH chains), which FK exploits.
-  [[nodiscard]] bool z_axes_only() const { return z_axes_only_; }
   /// The chain as forward kinematics walks it, folded once here (folded_chain.hpp).
   [[nodiscard]] const FoldedChain& folded_chain() const { return chain_; }
 
@@ -132,7 +130,6 @@ class RobotModel {
   JointVector upper_;
   JointVector max_speed_;
   Pose flange_T_wap_ = Pose::Identity();
-  bool z_axes_only_ = true;
   FoldedChain chain_;
   std::optional<OpwGeometry> opw_;
   std::string opw_note_;

@@ -36,6 +36,23 @@ struct Figures {
 // (by the angle turned about the path's centre), not from the simulator's schedule.
 std::vector<TrackerTrace> laps_of(const TrackerTrace& trace) { return split_laps(trace).laps; }
 
+TrackerTrace thin(const TrackerTrace& lap, std::size_t max_points) {
+  const std::size_t step = std::max<std::size_t>(1, lap.size() / max_points);
+  TrackerTrace out;
+  for (std::size_t i = 0; i < lap.size(); i += step) out.push_back(lap[i]);
+  return out;
+}
+
+TrackerTrace thin_lap(const RunOutput& run, std::size_t max_points) {
+  const auto laps = laps_of(run.trace);
+  if (laps.empty()) return {};
+  return thin(laps.back(), max_points);
+}
+
+// Points a plotted lap keeps: the path plots' laps, and each lap of the lap-by-lap plots.
+constexpr std::size_t kPlotPoints = 1500;
+constexpr std::size_t kPlotLapPoints = 720;
+
 // An unloaded run prepared once for every loaded run compared with it: its raw trace (for the
 // time-synchronous metric) and the mean of its laps, indexed (for the nearest-point metric: a dense,
 // noisy reference would bias that distance low by its own noise). Once every run of its seed has been
@@ -48,13 +65,11 @@ struct Reference {
   TrackerTrace plot_lap;  // its last lap, thinned (only the plotted runs' references)
 };
 
-TrackerTrace thin_lap(const RunOutput& run, std::size_t max_points);
-
 Reference make_reference(RunOutput run, bool plotted) {
   Reference r;
   r.mean = mean_closed_path(run.trace);
   r.index = std::make_shared<const PolylineIndex>(r.mean);
-  if (plotted) r.plot_lap = thin_lap(run, 1500);
+  if (plotted) r.plot_lap = thin_lap(run, kPlotPoints);
   r.run = std::move(run);
   return r;
 }
@@ -77,19 +92,6 @@ Figures evaluate_run(const RunOutput& loaded, const Reference& reference) {
     }
   }
   return f;
-}
-
-TrackerTrace thin(const TrackerTrace& lap, std::size_t max_points) {
-  const std::size_t step = std::max<std::size_t>(1, lap.size() / max_points);
-  TrackerTrace out;
-  for (std::size_t i = 0; i < lap.size(); i += step) out.push_back(lap[i]);
-  return out;
-}
-
-TrackerTrace thin_lap(const RunOutput& run, std::size_t max_points) {
-  const auto laps = laps_of(run.trace);
-  if (laps.empty()) return {};
-  return thin(laps.back(), max_points);
 }
 
 // Every lap of a run, thinned, with its direction of travel.
@@ -218,6 +220,9 @@ struct StudyContext {
 
   // The case of seed `si`.
   const CaseConfig& cfg_of(int si) const { return seed_config[static_cast<std::size_t>(si)]; }
+
+  // The path plots show the first seed's runs at the first speed of the tables.
+  bool plotted(int si, double v) const { return si == 0 && mm_s(v) == mm_s(config.speeds_m_s.front()); }
 
   // The family a setup's runs belong to, -1 before it is planned.
   int family_of(const SetupConfig& s) const {
@@ -355,7 +360,7 @@ void plan_loaded_runs(StudyContext& x) {
     for (const auto& s : config.setups) {
       if (x.family_of(s) != j.family || j.load_n != s.loads_n.back()) continue;
       if (j.kind == RunKind::kUncompensated || j.strategy == s.strategy) {
-        if (mm_s(j.speed) == mm_s(config.speeds_m_s.front())) j.plot = true;
+        if (x.plotted(j.seed, j.speed)) j.plot = true;
         if (mm_s(j.speed) == mm_s(config.budget.speed_m_s) && x.options.trace_sink) j.write_trace = true;
       }
     }
@@ -443,8 +448,7 @@ void run_unloaded_references(StudyContext& x, int si) {
         if (si == 0 && x.options.trace_sink && mm_s(v) == mm_s(x.config.budget.speed_m_s)) {
           x.sink(fmt::format("{}_unloaded_{}mm_s", family_label(fam), mm_s(v)), run.trace);
         }
-        const bool plotted = si == 0 && mm_s(v) == mm_s(x.config.speeds_m_s.front());
-        x.unloaded.at({si, static_cast<int>(f), mm_s(v)}) = make_reference(std::move(run), plotted);
+        x.unloaded.at({si, static_cast<int>(f), mm_s(v)}) = make_reference(std::move(run), x.plotted(si, v));
         x.progress.add(run_cost(x.config, v, x.laps),
                        fmt::format("seed {}: unloaded {} mm/s", x.cfg_of(si).seed, mm_s(v)));
       });
@@ -482,8 +486,8 @@ void run_loaded_job(StudyContext& x, LoadedJob& j) {
            run.trace);
   }
   if (j.plot) {
-    j.plot_lap = thin_lap(run, 1500);
-    j.plot_all_laps = plot_laps(run, 720);
+    j.plot_lap = thin_lap(run, kPlotPoints);
+    j.plot_all_laps = plot_laps(run, kPlotLapPoints);
   }
   x.progress.add(
       run_cost(x.config, j.speed, x.laps),
@@ -642,7 +646,7 @@ void add_plot_traces(const StudyContext& x, const SetupConfig& s, int fam, CaseS
   pt.speed_mm_s = mm_s(v0);
   pt.title = fmt::format("{}: {:.0f} N at {} mm/s (seed {})", s.name, s.loads_n.back(), mm_s(v0), x.config.seed);
   pt.unloaded = ref.plot_lap;
-  pt.unloaded_mean = thin(ref.mean, 1500);
+  pt.unloaded_mean = thin(ref.mean, kPlotPoints);
   pt.uc = uc->plot_lap;
   pt.c = c->plot_lap;
   pt.uc_laps = uc->plot_all_laps;
