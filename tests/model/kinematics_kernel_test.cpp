@@ -193,13 +193,30 @@ TEST(KinematicsKernel, JacobiansMatchCentralDifferencesOfFkOnEveryShippedRobot) 
   }
 }
 
-TEST(KinematicsKernel, DhTwistsFoldToPermutationsAndTurnsAboutX) {
-  // The built-in arm's twists are 0 and +-90 degrees: permutations (the identity for 0).
-  const FoldedChain& c = builtin_irb6700().folded_chain();
+TEST(KinematicsKernel, DhTwistsFoldToQuarterTurnsAndTurnsAboutX) {
+  // The built-in arm's twists are 0 and +-90 degrees: the identity, or a quarter turn about x whose
+  // sign is the twist's.
+  const RobotModel& arm = builtin_irb6700();
+  const FoldedChain& c = arm.folded_chain();
   for (int i = 1; i < c.dof; ++i) {
-    EXPECT_NE(c.steps[static_cast<std::size_t>(i)].turn, FoldedStep::Turn::kGeneral) << i;
-    EXPECT_NE(c.steps[static_cast<std::size_t>(i)].turn, FoldedStep::Turn::kAboutX) << i;
+    const FoldedStep& step = c.steps[static_cast<std::size_t>(i)];
+    const double twist = arm.description().joints[static_cast<std::size_t>(i)].parent_T_joint.linear()(2, 1);
+    if (std::abs(twist) < 0.5) {
+      EXPECT_EQ(step.turn, FoldedStep::Turn::kIdentity) << i;
+    } else {
+      EXPECT_EQ(step.turn, FoldedStep::Turn::kQuarterX) << i;
+      EXPECT_EQ(step.s, twist > 0.0 ? 1.0 : -1.0) << i;
+    }
   }
+  // Rx(90): y' = z, z' = -y, as the rotation's own columns say.
+  Pose quarter = Pose::Identity();
+  quarter.linear() << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+  EXPECT_EQ(fold_step(quarter).turn, FoldedStep::Turn::kQuarterX);
+  EXPECT_EQ(fold_step(quarter).s, 1.0);
+  // A permutation that is not a turn about x stays a general permutation.
+  Pose swap_xy = Pose::Identity();
+  swap_xy.linear() << 0, 1, 0, 1, 0, 0, 0, 0, -1;
+  EXPECT_EQ(fold_step(swap_xy).turn, FoldedStep::Turn::kPermutation);
   // A twist off 90 degrees (a calibrated arm's) is a turn about x with its own cos and sin.
   Pose twisted = Pose::Identity();
   twisted.linear() = Eigen::AngleAxisd(deg_to_rad(-89.99), Vector3::UnitX()).toRotationMatrix();

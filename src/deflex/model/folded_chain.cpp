@@ -61,6 +61,14 @@ FoldedStep fold_step(const Pose& transform) {
     const bool identity = step.perm[0] == 0 && step.perm[1] == 1 && step.perm[2] == 2 && step.sign[0] > 0.0 &&
                           step.sign[1] > 0.0 && step.sign[2] > 0.0;
     step.turn = identity ? FoldedStep::Turn::kIdentity : FoldedStep::Turn::kPermutation;
+    // The most common permutation, a DH twist of +-90 degrees, gets its own two-column form.
+    const bool quarter_x = step.perm[0] == 0 && step.perm[1] == 2 && step.perm[2] == 1 && step.sign[0] > 0.0 &&
+                           step.sign[1] == -step.sign[2];
+    if (quarter_x) {
+      step.turn = FoldedStep::Turn::kQuarterX;
+      step.c = 0.0;
+      step.s = step.sign[1];
+    }
     return step;
   }
   if (near(r(0, 0), 1.0) && near(r(1, 0), 0.0) && near(r(2, 0), 0.0) && near(r(0, 1), 0.0) && near(r(0, 2), 0.0) &&

@@ -23,6 +23,7 @@ struct RobotDescription;
 struct FoldedStep {
   enum class Turn : std::uint8_t {
     kIdentity,     ///< R = I
+    kQuarterX,     ///< R = Rx(+-90 deg), a DH twist of +-90: y' = s z, z' = -s y (s = +-1), x kept
     kPermutation,  ///< column j of R is sign[j] times unit vector perm[j]: a product with it only moves columns
     kAboutX,       ///< R = Rx(angle): columns 1 and 2 turn by (c, s)
     kGeneral,      ///< any rotation: a 3x3 product
@@ -30,7 +31,7 @@ struct FoldedStep {
   Turn turn = Turn::kIdentity;
   std::array<std::uint8_t, 3> perm{0, 1, 2};
   std::array<double, 3> sign{1.0, 1.0, 1.0};
-  double c = 1.0, s = 0.0;  ///< kAboutX: cos and sin of the turn
+  double c = 1.0, s = 0.0;  ///< kAboutX: cos and sin of the turn; kQuarterX: s = +-1
   Matrix3 rotation = Matrix3::Identity();
   Vector3 translation = Vector3::Zero();
   std::uint8_t translation_mask = 0;  ///< bit k set: component k of the translation is non-zero

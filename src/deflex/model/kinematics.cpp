@@ -51,6 +51,13 @@ struct Frame {
       f.z = step.c * f.z - step.s * y;
       break;
     }
+    case FoldedStep::Turn::kQuarterX: {
+      // The permutation's products by +-1 are exact, so this is the same as its general form.
+      const Vector3 y = f.y;
+      f.y = step.s * f.z;
+      f.z = -step.s * y;
+      break;
+    }
     case FoldedStep::Turn::kPermutation: {
       const std::array<Vector3, 3> cols{f.x, f.y, f.z};
       f.x = step.sign[0] * cols[step.perm[0]];
