@@ -1,14 +1,16 @@
 // Evaluation hot paths on tracker-sized data: the paper's mean distance of 6 noisy loaded laps
 // (10 mm/s on a 100 mm circle at 1000 Hz: 377k points) from 6 unloaded laps (377k points), and
-// ISO 9283 over 6 laps at 81 planes.
+// ISO 9283 over 6 laps at 81 planes, and the laps of one 377k-point run split by angle.
 // Run: build/bench/evaluate_bench --benchmark_min_time=1
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <vector>
 
 #include <benchmark/benchmark.h>
 
 #include "deflex/evaluate/iso9283_path.hpp"
+#include "deflex/evaluate/lap_split.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
 
 namespace {
@@ -68,6 +70,27 @@ void BM_Iso9283SixLaps81Planes(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_Iso9283SixLaps81Planes)->Unit(benchmark::kMillisecond);
+
+// The case study splits every run's trace into laps (a plane fit, then an angle a sample).
+void BM_SplitLaps377k(benchmark::State& state) {
+  TrackerTrace run;
+  for (const auto& lap : loaded()) run.insert(run.end(), lap.begin(), lap.end());
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(split_laps(run).laps.size());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(run.size()));
+}
+BENCHMARK(BM_SplitLaps377k)->Unit(benchmark::kMillisecond);
+
+void BM_PlaneFit377k(benchmark::State& state) {
+  TrackerTrace run;
+  for (const auto& lap : loaded()) run.insert(run.end(), lap.begin(), lap.end());
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(best_fit_plane(run).normal);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(run.size()));
+}
+BENCHMARK(BM_PlaneFit377k)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 BENCHMARK_MAIN();
