@@ -2,11 +2,12 @@
 // joint turns about the z axis of its own frame (a joint about another axis gets a constant rotation
 // that carries z onto its axis, and the inverse of that rotation is folded into the next fixed
 // transform), the mounting is folded into the first joint's fixed transform, and each fixed rotation
-// is classified by the work it needs (none, a signed permutation of the columns, a turn about x as in
-// every Denavit-Hartenberg row, or a general 3x3 product). A translation keeps a mask of its non-zero
-// components. Forward kinematics then costs, per joint of a DH arm, one sin/cos pair, a 2-column turn
-// for the joint, a 2-column turn (or a permutation) for the link twist and one or two scaled column
-// additions for the link's lengths, instead of two general 3x3 products and a 3x3 times vector.
+// is classified by the work it needs (none, a quarter turn about x as a DH twist of +-90 degrees is,
+// a signed permutation of the columns, a turn about x as in every other Denavit-Hartenberg row, or a
+// general 3x3 product). A translation keeps a mask of its non-zero components. Forward kinematics
+// then costs, per joint of a DH arm, one sin/cos pair, a 2-column turn for the joint, a 2-column turn
+// (or a swap of two columns) for the link twist and one or two scaled column additions for the
+// link's lengths, instead of two general 3x3 products and a 3x3 times vector.
 #pragma once
 
 #include <array>
