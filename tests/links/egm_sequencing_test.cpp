@@ -132,5 +132,47 @@ TEST(EgmSequencing, ArrivalDiagnosticsFollowTheControllersTimeStamps) {
   EXPECT_GT(w.link.counters().jitter_s, 0.0);
 }
 
+TEST(EgmSequencing, PacketsOvertakenInTheNetworkAreLateButARestartFromTheFirstNumberIsNot) {
+  Wire w;
+  for (std::uint64_t s = 1; s <= 8; ++s) ASSERT_TRUE(w.cycle(w.next(s)));
+  // 9, 10 and 11 are overtaken by 12: they arrive behind it with their own (older) time stamps, and
+  // continue each other, which before made them a confirmed new sequence.
+  const auto stamped = [&](std::uint64_t seqno, double sent_s) {
+    return egm_robot(seqno, static_cast<std::uint32_t>(std::lround(sent_s * 1000.0)), pose_deg());
+  };
+  const double t8 = w.t;  // what 8 carried (next() stamps the time its cycle reaches)
+  EXPECT_TRUE(w.cycle(stamped(12, t8 + 0.016)));
+  for (std::uint64_t s = 9; s <= 11; ++s) EXPECT_FALSE(w.cycle(stamped(s, t8 + 0.004 * static_cast<double>(s - 8))));
+  EXPECT_TRUE(w.cycle(stamped(13, t8 + 0.020)));
+  EXPECT_EQ(w.link.counters().out_of_order, 3u);
+  EXPECT_EQ(w.link.counters().restarts, 0u);
+  // A controller restarted early in its session: its first number again, a newer time stamp, no
+  // silence. A restart at once, though 1 is within the reordering window of 13 (whether the link
+  // resumes then is the re-anchor's rule: its offset against the last one sent).
+  (void)w.cycle(w.next(1));
+  EXPECT_EQ(w.link.counters().restarts, 1u);
+  EXPECT_EQ(w.link.counters().out_of_order, 3u);
+}
+
+TEST(EgmSequencing, AControllerClockSetBackIsAJumpOfItsClockNotJitter) {
+  // The controller's clock goes back 5 s (set by hand, NTP): before, its 32-bit step read as 4.29e9 ms
+  // and the jitter showed 268,435,145 ms.
+  Wire w;
+  for (std::uint64_t s = 1; s <= 20; ++s) ASSERT_TRUE(w.cycle(w.next(s)));
+  const auto at = [&](std::uint64_t seqno, double shift_s) {
+    return egm_robot(seqno, static_cast<std::uint32_t>(std::lround((w.t + 0.004 + shift_s) * 1000.0)), pose_deg());
+  };
+  for (std::uint64_t s = 21; s <= 40; ++s) EXPECT_TRUE(w.cycle(at(s, -5.0))) << s;
+  EXPECT_EQ(w.link.counters().clock_jumps, 1u);
+  EXPECT_LT(w.link.counters().jitter_s, 0.001);
+  EXPECT_LT(w.link.counters().max_arrival_delay_s, 0.001);
+  EXPECT_EQ(w.link.counters().late, 0u);
+  EXPECT_EQ(w.link.counters().restarts, 0u);
+  // And forward by an hour: the same.
+  for (std::uint64_t s = 41; s <= 60; ++s) EXPECT_TRUE(w.cycle(at(s, 3600.0))) << s;
+  EXPECT_EQ(w.link.counters().clock_jumps, 2u);
+  EXPECT_LT(w.link.counters().jitter_s, 0.001);
+}
+
 }  // namespace
 }  // namespace deflex

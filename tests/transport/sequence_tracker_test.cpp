@@ -87,6 +87,27 @@ TEST(SequenceTracker, ThirtyTwoBitNumbersWrapAndSixtyFourBitOnesDoNot) {
   EXPECT_EQ(i.observe(start + 12 + 5000), V::kFarAhead);
 }
 
+TEST(SequenceTracker, A64BitCounterThatWrapsAt32BitsGoesOnAcrossTheWrap) {
+  // RSI's IPOC: the drivers read it as 64 bits; a controller counting in 32 wraps at 2^32 ms.
+  SequenceRules ipoc;
+  ipoc.bits = 64;
+  ipoc.max_ahead = 1000;
+  ipoc.restart_max = 0;
+  ipoc.wraps_at_32 = true;
+  SequenceTracker i(ipoc);
+  i.observe(0xFFFF'FFF8ULL);
+  EXPECT_EQ(i.observe(0xFFFF'FFFCULL), V::kNext);
+  EXPECT_EQ(i.observe(0), V::kNext);  // across the wrap
+  EXPECT_EQ(i.observe(4), V::kNext);
+  EXPECT_EQ(i.observe(0xFFFF'FFFCULL), V::kOutOfOrder);  // a late one from before the wrap
+  EXPECT_EQ(SequenceTracker::distance(ipoc, 0xFFFF'FFFCULL, 4), 8);
+  EXPECT_EQ(SequenceTracker::distance(ipoc, 4, 0xFFFF'FFFCULL), -8);
+  // A 64-bit counter past 2^32 is plain 64-bit arithmetic: nothing wraps.
+  EXPECT_EQ(SequenceTracker::distance(ipoc, 0x1'0000'0004ULL, 4), -static_cast<std::int64_t>(0x1'0000'0000ULL));
+  // Far apart within 32 bits, no wrap is nearer: the plain difference.
+  EXPECT_EQ(SequenceTracker::distance(ipoc, 1000, 0x8000'0000ULL), 0x8000'0000LL - 1000);
+}
+
 TEST(SequenceTracker, RulesOutOfRangeAreRefused) {
   SequenceRules r;
   r.bits = 16;

@@ -34,7 +34,8 @@ RsiController::RsiController(const RsiControllerConfig& config, const RobotModel
   const bool ok = std::isfinite(config_.cycle_s) && config_.cycle_s > 0.0 && config_.timeout >= 1 &&
                   config_.lower_limit_deg <= 0.0 && config_.upper_limit_deg >= 0.0 &&
                   config_.max_correction_deg > 0.0 && config_.correction_dead_time_s >= 0.0 && config_.precision >= 0 &&
-                  config_.precision <= 12 && valid_rsi_sentype(config_.sentype);
+                  config_.precision <= 12 && valid_rsi_sentype(config_.sentype) &&
+                  (config_.ipoc_bits == 32 || config_.ipoc_bits == 64);
   if (!ok) throw InputError(fmt::format("RSI controller: bad configuration (SENTYPE '{}')", config_.sentype));
   if (program_->dof() != model_.dof()) throw InputError("RSI controller: the program is for another robot");
   const int n = model_.dof();
@@ -56,6 +57,7 @@ void RsiController::restart(std::uint64_t ipoc_jump_ms) {
   pending_count_ = 0;
   awaiting_ = false;
   next_ipoc_ += ipoc_jump_ms;
+  if (config_.ipoc_bits == 32) next_ipoc_ &= 0xFFFFFFFFULL;
 }
 
 void RsiController::pause(double from_s, double to_s) {
@@ -144,6 +146,7 @@ const JointVector& RsiController::tick(double t_s) {
     if (running()) {
       robot_.ipoc = next_ipoc_;
       next_ipoc_ += static_cast<std::uint64_t>(std::llround(config_.cycle_s * 1e3));
+      if (config_.ipoc_bits == 32) next_ipoc_ &= 0xFFFFFFFFULL;
       robot_.delay = counters_.late;
       for (int i = 0; i < n; ++i) {
         robot_.actual_deg[i] = rad_to_deg(position_[i]);

@@ -39,6 +39,9 @@ struct RsiControllerConfig {
   double correction_dead_time_s = 0.008;  ///< from an answer taken to the axes moving by it
   int precision = 4;                      ///< ETHERNET Precision: decimals of the numbers it sends
   std::uint64_t first_ipoc = 1000000;     ///< IPOC of the first cycle
+  /// The IPOC counter's width: 64, or 32 (it wraps at 2^32 ms). No public source states the KR C4's
+  /// own; the drivers read it as an unsigned 64-bit number, so deflex is tried against both.
+  int ipoc_bits = 64;
 };
 
 enum class RsiStop {

@@ -5,6 +5,13 @@
 // SequenceTracker (duplicates, late ones and strays far ahead refused); a silence, a change of sender
 // or a jump confirmed by the messages after it begins a new session; every message taken is timed
 // against its time stamp (LinkTiming). Counts what it refuses. Never allocates, locks or throws.
+//
+// A restart is told from reordering by the time stamp: a message a little behind the running number
+// (within the reorder window) whose time stamp is not newer than the newest taken was overtaken in the
+// network and is refused as late, however many such come in a row; a controller that restarted numbers
+// from its first again but its clock goes on, so its message is newer. A time stamp that goes back, or
+// moves by far more than the cycles the sequence says passed, is a jump of the controller's clock: the
+// timing starts afresh (counted in clock_jumps) instead of reading the jump as delay or jitter.
 #pragma once
 
 #include <cstdint>
@@ -24,6 +31,9 @@ struct ControllerGateConfig {
   /// for a millisecond time stamp (RSI IPOC). Gives the cycles missed between two messages.
   double numbers_per_cycle = 1.0;
   int stamp_bits = 32;  ///< width of the millisecond time stamp: 32 wraps (EGM tm), 64 (IPOC)
+  /// Messages this many numbers behind the running one, or fewer, whose time stamp is not newer than
+  /// the newest taken, are late (overtaken), never the start of a new sequence.
+  std::uint64_t reorder_window = 32;
   /// Throws InputError naming the setting.
   void validate() const;
 };
@@ -55,6 +65,7 @@ class ControllerGate {
   DatagramAddress sender_;
   double last_heard_s_ = 0.0;
   std::uint64_t last_stamp_ms_ = 0;
+  [[nodiscard]] std::int64_t stamp_step_ms(std::uint64_t stamp_ms) const noexcept;
 };
 
 }  // namespace deflex

@@ -35,6 +35,7 @@ struct LinkCounters {
   std::uint64_t late = 0;                   ///< messages received more than a period later than the quickest ones
   std::uint64_t controller_late = 0;  ///< answers the controller itself counted late (RSI <Delay>, its last value)
   std::uint64_t silences = 0;         ///< silences longer than two controller cycles that were ridden through
+  std::uint64_t clock_jumps = 0;      ///< the controller's time stamp went back or jumped: the timing started again
   double max_arrival_delay_s = 0.0;   ///< the largest LinkArrival::arrival_delay_s so far
   double jitter_s = 0.0;              ///< interarrival jitter now (RFC 3550 estimator)
   double longest_silence_s = 0.0;     ///< the longest gap between two usable messages ridden through

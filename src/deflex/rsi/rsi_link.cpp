@@ -41,11 +41,14 @@ void RsiLinkConfig::validate() const {
 }
 
 namespace {
-// The IPOC is both the sequence number and the time stamp: 64 bits of milliseconds, growing by the
-// period every cycle, never starting again from a small number.
+// The IPOC is both the sequence number and the time stamp: milliseconds, growing by the period every
+// cycle, never starting again from a small number. The drivers read it as an unsigned 64-bit number
+// and no public source states the controller's own width, so both are taken: a 64-bit counter, and a
+// 32-bit one across its wrap at 2^32 ms (49.7 days), which is the next cycle and not a restart.
 ControllerGateConfig rsi_gate(const RsiLinkConfig& c, double period_s) {
   ControllerGateConfig g;
   g.sequence.bits = 64;
+  g.sequence.wraps_at_32 = true;
   g.sequence.max_ahead = c.ipoc_max_ahead_ms;
   g.sequence.restart_max = 0;
   g.sequence.confirm = c.confirm_jump;
@@ -53,6 +56,7 @@ ControllerGateConfig rsi_gate(const RsiLinkConfig& c, double period_s) {
   g.period_s = period_s;
   g.numbers_per_cycle = period_s * 1e3;
   g.stamp_bits = 64;
+  g.reorder_window = static_cast<std::uint64_t>(std::ceil(32.0 * period_s * 1e3));  // 32 cycles of IPOC
   return g;
 }
 const RsiLinkConfig& validated(const RsiLinkConfig& c) {
@@ -215,8 +219,12 @@ LinkPollResult RsiLink::poll(double timeout_s) noexcept {
   const bool session_start = restarted || state_ == LinkState::kWaiting;
   if (session_start) {
     // A new RSI session: the controller's AXISCORR starts again from zero offset, so must deflex's
-    // correction (it then ramps at the rate bound), or the first answer would step the arm.
-    cycle_.restart_from_zero();
+    // correction (it then ramps at the rate bound), or the first answer would step the arm. Without a
+    // silence before it the controller may still apply the last offset sent: the next must step from both.
+    if (stop_if_anchor_unreachable(cycle_.reanchor_gap(JointVector(JointVector::Zero(feedback_.size()))), "RSI")) {
+      return announce_terminal();
+    }
+    cycle_.restart_from_zero(after_silence());
     have_previous_ = false;
     state_ = LinkState::kRunning;
   }
@@ -251,6 +259,7 @@ LinkPollResult RsiLink::poll(double timeout_s) noexcept {
   rq.delay_s = delay_.delay_s();
   rq.lead_s = lead;
   rq.session_start = session_start;
+  rq.hold = ramping_down_;  // a planned stop ramps the correction out
   rq.arrival = arrival_;
   const LinkCycle::Verdict verdict = cycle_.run(rq);
   const auto compute = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_read).count(); };
@@ -266,6 +275,7 @@ LinkPollResult RsiLink::poll(double timeout_s) noexcept {
   }
   ++counters_.replies;
   cycle_.sent(compute(), receipt_age_s_ + (clock_.now_s() - taken_at_s_));
+  stop_when_correction_gone();
   return LinkPollResult::kAnswered;
 }
 

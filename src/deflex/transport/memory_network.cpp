@@ -99,6 +99,28 @@ bool MemoryNetwork::route(const unsigned char* data, std::size_t size, const Dat
       return true;
     }
   }
+  for (Reordering& r : reorderings_) {
+    if (now < r.from_s || !(r.from == from) || (r.count == 0 && r.held.empty())) continue;
+    if (r.count > 0) {  // held back: the next datagram overtakes it
+      --r.count;
+      r.held.push_back(Held{std::vector<unsigned char>(data, data + size), from, to, latency_s});
+      return true;
+    }
+    const bool routed = deliver(data, size, from, to, latency_s);
+    for (const Held& h : r.held) (void)deliver(h.bytes.data(), h.bytes.size(), h.from, h.to, h.latency_s);
+    r.held.clear();
+    return routed;
+  }
+  return deliver(data, size, from, to, latency_s);
+}
+
+void MemoryNetwork::add_reordering(double from_s, int count, const DatagramAddress& from) {
+  if (count < 1 || !std::isfinite(from_s)) throw InputError("memory network: a reordering needs a count >= 1");
+  reorderings_.push_back(Reordering{from_s, count, from, {}});
+}
+
+bool MemoryNetwork::deliver(const unsigned char* data, std::size_t size, const DatagramAddress& from,
+                            const DatagramAddress& to, double latency_s) noexcept {
   for (const auto& e : endpoints_) {
     if (e->local_address() == to) {
       // Like UDP, a datagram the receiver has no room for is lost after it was sent: the sender

@@ -81,6 +81,11 @@ class MemoryNetwork {
   /// Throws InputError on an empty or non-finite window.
   void add_outage(double from_s, double to_s, const DatagramAddress& address = {});
 
+  /// A fault for tests: the next `count` datagrams `from` sends at or after `from_s` are overtaken in
+  /// the network by the one sent after them: it arrives first, they arrive right behind it, in order
+  /// (what a switch with several paths, or a Wi-Fi bridge, does). Throws InputError unless count >= 1.
+  void add_reordering(double from_s, int count, const DatagramAddress& from);
+
   [[nodiscard]] const Clock& clock() const { return clock_; }
   [[nodiscard]] const MemoryNetworkCounters& counters() const { return counters_; }
 
@@ -98,6 +103,20 @@ class MemoryNetwork {
     DatagramAddress address;
   };
   std::vector<Outage> outages_;
+  struct Held {
+    std::vector<unsigned char> bytes;
+    DatagramAddress from, to;
+    double latency_s;
+  };
+  struct Reordering {
+    double from_s = 0.0;
+    int count = 0;  // datagrams still to hold back
+    DatagramAddress from;
+    std::vector<Held> held;
+  };
+  std::vector<Reordering> reorderings_;
+  bool deliver(const unsigned char* data, std::size_t size, const DatagramAddress& from, const DatagramAddress& to,
+               double latency_s) noexcept;
   MemoryNetworkCounters counters_;
 };
 

@@ -1,6 +1,8 @@
 // The order of one sender's numbered datagrams (see sequence_tracker.hpp).
 #include "deflex/transport/sequence_tracker.hpp"
 
+#include <cstdlib>
+
 #include "deflex/text/errors.hpp"
 
 namespace deflex {
@@ -14,16 +16,24 @@ void SequenceRules::validate() const {
 }
 
 namespace {
-// How far `to` is ahead of `from` (negative: behind), wrapping in the numbers' width.
-std::int64_t ahead(int bits, std::uint64_t from, std::uint64_t to) {
-  if (bits == 32) return static_cast<std::int32_t>(static_cast<std::uint32_t>(to) - static_cast<std::uint32_t>(from));
-  return static_cast<std::int64_t>(to - from);
+constexpr std::uint64_t k32 = std::uint64_t{1} << 32;
+std::int64_t ahead32(std::uint64_t from, std::uint64_t to) {
+  return static_cast<std::int32_t>(static_cast<std::uint32_t>(to) - static_cast<std::uint32_t>(from));
 }
 }  // namespace
 
-std::int64_t SequenceTracker::distance(std::uint64_t number) const noexcept {
-  return ahead(rules_.bits, last_, number);
+std::int64_t SequenceTracker::distance(const SequenceRules& rules, std::uint64_t from, std::uint64_t to) noexcept {
+  if (rules.bits == 32) return ahead32(from, to);
+  const auto plain = static_cast<std::int64_t>(to - from);
+  // A 32-bit counter read as 64 bits: across its wrap the plain difference is about -2^32.
+  if (rules.wraps_at_32 && from < k32 && to < k32) {
+    const std::int64_t wrapped = ahead32(from, to);
+    if (std::llabs(wrapped) < std::llabs(plain)) return wrapped;
+  }
+  return plain;
 }
+
+std::int64_t SequenceTracker::distance(std::uint64_t number) const noexcept { return distance(rules_, last_, number); }
 
 SequenceVerdict SequenceTracker::observe(std::uint64_t number) noexcept {
   if (!have_) {
@@ -45,7 +55,7 @@ SequenceVerdict SequenceTracker::observe(std::uint64_t number) noexcept {
     return SequenceVerdict::kRestart;
   }
   // A jump: does it continue the previous jump?
-  const std::int64_t from_candidate = ahead(rules_.bits, candidate_, number);
+  const std::int64_t from_candidate = distance(rules_, candidate_, number);
   if (candidates_ > 0 && from_candidate > 0 && static_cast<std::uint64_t>(from_candidate) <= rules_.max_ahead) {
     ++candidates_;
   } else {

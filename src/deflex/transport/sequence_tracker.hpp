@@ -17,6 +17,10 @@ struct SequenceRules {
   std::uint64_t max_ahead = 250;   ///< a step forward larger than this is a jump
   std::uint64_t restart_max = 16;  ///< a jump back to a number <= this is a restart (0: no such rule)
   int confirm = 3;                 ///< datagrams in a row that make a jump a new sequence
+  /// 64-bit numbers that may still wrap at 2^32 (RSI's IPOC: the drivers read it as 64 bits, no public
+  /// source states the controller's own width): while the running number and the new one both fit in
+  /// 32 bits, a step across 2^32 to a small number is the next one, not a jump back.
+  bool wraps_at_32 = false;
   /// Throws InputError when a value is out of its range.
   void validate() const;
 };
@@ -48,6 +52,8 @@ class SequenceTracker {
   [[nodiscard]] std::uint64_t last() const { return last_; }
   /// How far `number` is ahead of the running one (negative: behind), in the numbers' own width.
   [[nodiscard]] std::int64_t distance(std::uint64_t number) const noexcept;
+  /// How far `to` is ahead of `from` under these rules (the 32-bit wrap, wraps_at_32).
+  [[nodiscard]] static std::int64_t distance(const SequenceRules& rules, std::uint64_t from, std::uint64_t to) noexcept;
   [[nodiscard]] const SequenceRules& rules() const { return rules_; }
 
  private:
