@@ -46,6 +46,7 @@ const JointVector& EgmPositionGuidanceController::tick(double t_s) {
       speed_ref_.setZero();
     }
   }
+  if (reset_pending_) reset_reference();
   if (!stopped_ && t_s - last_answer_s_ > config_.egm_comm_timeout_s) {
     stopped_ = true;  // EGM stops: the arm holds where it is
     counters_.timed_out = true;
@@ -82,13 +83,19 @@ void EgmPositionGuidanceController::restart(double t_s, bool reset_reference) {
   robot_.mci_state = 3;
   last_answer_s_ = t_s;
   next_send_s_ = t_s;
-  if (reset_reference) {
-    target_ = filtered_target_ = have_encoders_ ? encoders_ : position_;
-    speed_ref_.setZero();
-    filtered_speed_.setZero();
-    for (auto& q : delay_target_) q = target_;
-    for (auto& v : delay_speed_) v.setZero();
-  }
+  // The new EGMRunJoint takes the arm's position as its reference once the sensor's answers already on
+  // the way have been read: its first message reports the arm, not deflex's last command (a controller
+  // that let an in-flight answer set the new reference would be kinder than one may assume).
+  reset_pending_ = reset_reference;
+}
+
+void EgmPositionGuidanceController::reset_reference() {
+  reset_pending_ = false;
+  target_ = filtered_target_ = have_encoders_ ? encoders_ : position_;
+  speed_ref_.setZero();
+  filtered_speed_.setZero();
+  for (auto& q : delay_target_) q = target_;
+  for (auto& v : delay_speed_) v.setZero();
 }
 
 void EgmPositionGuidanceController::end_session(int mci_state) {

@@ -58,6 +58,7 @@ class EgmPositionGuidanceController final : public RobotController {
   void motors_off();
 
  private:
+  void reset_reference();
   ControllerConfig config_;
   DatagramTransport& transport_;
   DatagramAddress sensor_;
@@ -75,6 +76,7 @@ class EgmPositionGuidanceController final : public RobotController {
   std::uint32_t seqno_ = 0;
   bool stopped_ = false;
   bool streaming_after_stop_ = false;  // EGM ended by the program: the state goes on being sent
+  bool reset_pending_ = false;         // a restart's reference reset, after the answers already in flight
   EgmControllerCounters counters_;
 };
 

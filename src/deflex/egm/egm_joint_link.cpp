@@ -117,17 +117,15 @@ LinkPollResult EgmJointLink::poll(double timeout_s) noexcept {
   // A session (the first message, a restart) starts from the reference the controller holds. A
   // controller that kept following deflex's stream reports one of its last commands: the stream goes
   // on from the last one sent, as if nothing happened. One that reset its reference (a new EGMRunJoint)
-  // reports where it now is: the stream goes on from there.
+  // reports where it now is: after a silence (its previous session ended) the stream goes on from there;
+  // without one it may still be following the last command sent, and a reference more than two step
+  // limits from it leaves no command that steps from both: the session is not resumed.
   const bool session_start = restarted || state_ == LinkState::kWaiting;
   if (session_start) {
     const JointVector* anchor = &planned_;
-    if (cycle_.has_sent()) {
-      double ratio = 0.0;
-      for (int j = 0; j < planned_.size(); ++j) {
-        ratio = std::max(ratio, std::abs(planned_[j] - cycle_.last_command()[j]) / cycle_.limits().joint_step_rad[j]);
-      }
-      if (ratio <= 2.0) anchor = &cycle_.last_command();
-    }
+    const double gap = cycle_.reanchor_gap(planned_);
+    if (cycle_.has_sent() && gap <= 2.0) anchor = &cycle_.last_command();
+    if (stop_if_anchor_unreachable(gap, "the controller (EGM)")) return announce_terminal();
     nominal_ = *anchor;  // begin() and anchor_joints() must not see the cycle's own buffer change
     if (!stream_.begin(nominal_, cycle_.correction())) {
       if (state_ == LinkState::kWaiting) {
@@ -142,9 +140,10 @@ LinkPollResult EgmJointLink::poll(double timeout_s) noexcept {
       }
       return announce_terminal();
     }
-    cycle_.anchor_joints(nominal_);
+    cycle_.anchor_joints(nominal_, after_silence());
     if (state_ == LinkState::kWaiting || state_ == LinkState::kRunning) state_ = LinkState::kRunning;
   }
+  if (ramping_down_) stream_.begin_stop(ramp_down_s_);
   stream_.sample(program_, program_velocity_, blend_, blend_velocity_);
   nominal_ = program_ + blend_;
 
@@ -184,6 +183,14 @@ LinkPollResult EgmJointLink::poll(double timeout_s) noexcept {
   cycle_.sent(compute(), receiver_.answer_time_s(clock_.now_s()));
   delay_.record_reference(now, command);
   stream_.consumed(period_s_);
+  if (ramping_down_ && stream_.at_standstill()) {
+    stop_link(LinkStopCause::kRequested,
+              "stopped on request: the program was brought to a standstill on its path over %.2f s, at program time "
+              "%.3f s; deflex then stopped answering (the controller holds its last reference until its EGM "
+              "times out)",
+              ramp_down_s_, stream_.program_time_s() - stream_.trajectory().start_time_s());
+    return LinkPollResult::kAnswered;
+  }
   if (stream_.finished() && state_ == LinkState::kRunning) state_ = LinkState::kFinished;
   return LinkPollResult::kAnswered;
 }

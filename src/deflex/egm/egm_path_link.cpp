@@ -142,8 +142,12 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
   const bool session_start = restarted || state_ == LinkState::kWaiting;
   if (session_start) {
     // A path-correction session on the controller starts from no offset: so does deflex's correction
-    // (it then ramps in at the rate bound), or the first answer would step the path.
-    cycle_.restart_from_zero();
+    // (it then ramps in at the rate bound), or the first answer would step the path. Without a silence
+    // before it the controller may still apply the last offset sent: the next one must step from both.
+    if (stop_if_anchor_unreachable(cycle_.reanchor_gap(Vector3(Vector3::Zero())), "the controller's path correction")) {
+      return announce_terminal();
+    }
+    cycle_.restart_from_zero(after_silence());
     have_previous_ = false;  // the direction of travel is kept: the path is the same program
     state_ = LinkState::kRunning;
   }
@@ -198,7 +202,7 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
   rq.lead_s = lead;
   // No frame yet (path coordinates before the arm moved): nothing can be expressed, the correction
   // is held at zero. Later, a moment without a frame keeps the last one.
-  rq.hold = !have_frame_;
+  rq.hold = !have_frame_ || ramping_down_;  // a planned stop ramps the correction out
   rq.session_start = session_start;
   rq.arrival = receiver_.arrival();
   const LinkCycle::Verdict verdict = cycle_.run(rq);
@@ -235,6 +239,7 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
       if (dq.allFinite()) sent_offset_joints_ = dq;
     }
   }
+  stop_when_correction_gone();
   return LinkPollResult::kAnswered;
 }
 

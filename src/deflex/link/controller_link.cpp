@@ -97,9 +97,11 @@ void ControllerLink::refuse_start(const JointVector& distance) noexcept {
 }
 
 void ControllerLink::heard(double now) noexcept {
+  after_silence_ = true;
   if (std::isfinite(last_message_s_)) {
     const double gap = now - last_message_s_;
-    if (gap > 2.0 * cycle_.compensator().config().period_s) {
+    after_silence_ = gap > 2.0 * cycle_.compensator().config().period_s;
+    if (after_silence_) {
       ++counters_.silences;
       counters_.longest_silence_s = std::max(counters_.longest_silence_s, gap);
     }
@@ -107,11 +109,29 @@ void ControllerLink::heard(double now) noexcept {
   last_message_s_ = now;
 }
 
+bool ControllerLink::stop_if_anchor_unreachable(double gap, const char* what) noexcept {
+  if (after_silence_ || gap <= 2.0) return false;
+  stop_link(LinkStopCause::kController,
+            "%s restarted without a silence, holding %.1f per-cycle step limits from deflex's last command: no command "
+            "can be within the step limit of both, so the session was not resumed (restart it with the arm at rest)",
+            what, gap);
+  return true;
+}
+
 bool ControllerLink::apply_silence_rules(double now) noexcept {
   if ((state_ != LinkState::kRunning && state_ != LinkState::kFinished) || !std::isfinite(last_message_s_)) {
     return false;
   }
   const double silent = now - last_message_s_;
+  // A stop ramp needs the controller to take its commands: one that fell silent meanwhile has nothing
+  // to ramp (it holds its last reference or offset), so the planned stop ends there.
+  if (ramping_down_ && silent > std::max(0.05, 10.0 * cycle_.compensator().config().period_s)) {
+    stop_link(LinkStopCause::kRequested,
+              "stopped on request: the controller fell silent for %.3f s during the stop ramp, so deflex stopped "
+              "there",
+              silent);
+    return true;
+  }
   if (state_ == LinkState::kFinished) {
     if (silent <= rules_.end_silence_s) return false;
     stop_link(LinkStopCause::kEnded, "the program ended and the controller went quiet (%.2f s): the session is over",
@@ -131,6 +151,30 @@ bool ControllerLink::apply_silence_rules(double now) noexcept {
         silent, rules_.stop_silence_s, counters_.rejected());
   }
   return true;
+}
+
+void ControllerLink::request_planned_stop(double ramp_s) noexcept {
+  if (ramping_down_ || state_ != LinkState::kRunning) {
+    stop();
+    return;
+  }
+  ramping_down_ = true;
+  ramp_down_s_ = ramp_s;
+}
+
+void ControllerLink::stop_when_correction_gone() noexcept {
+  if (!ramping_down_) return;
+  ++ramp_cycles_;
+  // What went on the wire: the TCP offset, or the joint offset (the correction's last cycle may be
+  // zero while the step limit still holds the offset sent back).
+  const bool gone = cycle_.limits().form == CommandForm::kTcpOffset
+                        ? cycle_.tcp_offset_m().norm() == 0.0
+                        : cycle_.joint_command().cwiseAbs().maxCoeff() == 0.0;
+  if (!gone) return;
+  stop_link(LinkStopCause::kRequested,
+            "stopped on request: the correction ramped to zero at the rate bound over %llu cycles, then deflex "
+            "stopped answering",
+            static_cast<unsigned long long>(ramp_cycles_));
 }
 
 LinkPollResult ControllerLink::cycle_not_passed(LinkCycle::Verdict verdict, double compute_s) noexcept {

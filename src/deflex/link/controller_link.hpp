@@ -85,6 +85,14 @@ class ControllerLink {
   /// motion first: simple message sends STOP_TRAJECTORY). Links whose controller stops on its own when
   /// answers stop (EGM, RSI) have nothing else to do. Never allocates or throws.
   virtual void stop() noexcept { stop_link(LinkStopCause::kRequested, "stop requested"); }
+  /// A planned stop while the arm may be moving (SIGINT, SIGTERM, a session's time limit): a streaming
+  /// link brings its program to a standstill on its own path over `ramp_s` (the correction kept), a link
+  /// that corrects the controller's own program ramps its correction to zero at the rate bound; then
+  /// the link stops (kRequested) with a sentence saying so. A link that has nothing to ramp (not
+  /// started, the program ended) stops at once; so does stop() at any time. Never allocates or throws.
+  virtual void request_planned_stop(double ramp_s) noexcept;
+  /// True from request_planned_stop() until the link stopped.
+  [[nodiscard]] bool ramping_down() const { return ramping_down_ && state_ != LinkState::kStopped; }
 
   [[nodiscard]] LinkState state() const { return state_; }
   [[nodiscard]] const LinkCounters& counters() const { return counters_; }
@@ -129,6 +137,13 @@ class ControllerLink {
   void refuse_start(const JointVector& distance) noexcept;
   /// A usable controller message was taken at `now`.
   void heard(double now) noexcept;
+  /// Whether the controller was silent (more than two of its cycles) before the message just heard, or
+  /// nothing was heard before it: a session it starts then follows the end of its previous one.
+  [[nodiscard]] bool after_silence() const { return after_silence_; }
+  /// A session start without a silence whose anchor is more than two step limits from the last command
+  /// sent (reanchor_gap()): no command can step from both, so the link stops (kController) naming it.
+  /// True when it stopped.
+  bool stop_if_anchor_unreachable(double gap, const char* what) noexcept;
   /// The stop rules when nothing usable came: a silence longer than the link allows stops it (kSilent,
   /// or kEnded when the silence is the planned end). True when the link stopped now.
   bool apply_silence_rules(double now) noexcept;
@@ -142,8 +157,15 @@ class ControllerLink {
   /// correct the controller's program; RSI: its late count below the Timeout).
   [[nodiscard]] virtual bool silence_is_planned_end() const { return rules_.end_on_silence; }
 
+  /// Links that correct the controller's program: during a planned stop the correction ramps to zero;
+  /// once a sent command carries none, the link stops. Call after a command was sent.
+  void stop_when_correction_gone() noexcept;
+
   LinkCycle cycle_;
   const Clock& clock_;
+  bool ramping_down_ = false;
+  double ramp_down_s_ = 0.0;       // the stop ramp asked for (streaming links)
+  std::uint64_t ramp_cycles_ = 0;  // cycles answered during the ramp
   LinkCounters counters_;
   LinkState state_ = LinkState::kWaiting;
   LinkStopRules rules_;
@@ -153,6 +175,7 @@ class ControllerLink {
   LinkStopCause stop_cause_ = LinkStopCause::kNone;
   std::array<char, 320> stop_reason_{};
   double last_message_s_;
+  bool after_silence_ = true;
   bool announced_ = false;
 };
 

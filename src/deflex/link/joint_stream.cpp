@@ -53,6 +53,7 @@ void JointStream::sample(JointVector& program, JointVector& program_velocity, Jo
                          JointVector& blend_velocity) const noexcept {
   trajectory_->sample(program_t_s_, program, &program_velocity);
   if (finished()) program_velocity.setZero();
+  if (stopping()) program_velocity *= speed_factor();
   // Smoothstep from 1 to 0 over the ramp: the first command is the anchor, and the blend adds no
   // velocity step at either end.
   if (config_.ramp_in_s > 0.0 && blend_t_s_ < config_.ramp_in_s) {
@@ -67,11 +68,31 @@ void JointStream::sample(JointVector& program, JointVector& program_velocity, Jo
 
 void JointStream::consumed(double period_s) noexcept {
   if (!started_ || !(period_s > 0.0)) return;
-  if (program_t_s_ < trajectory_->end_time_s()) ++cycles_;
   ++blend_cycles_;
+  blend_t_s_ = static_cast<double>(blend_cycles_) * period_s;
+  if (stopping()) {
+    // The program moves by the integral of the speed factor 1 - t/T over this cycle.
+    const double t0 = std::min(stop_elapsed_s_, stop_ramp_s_);
+    const double t1 = std::min(stop_elapsed_s_ + period_s, stop_ramp_s_);
+    stop_elapsed_s_ += period_s;
+    program_t_s_ =
+        std::min(program_t_s_ + (t1 - t0) - (t1 * t1 - t0 * t0) / (2.0 * stop_ramp_s_), trajectory_->end_time_s());
+    return;
+  }
+  if (program_t_s_ < trajectory_->end_time_s()) ++cycles_;
   program_t_s_ =
       std::min(trajectory_->start_time_s() + static_cast<double>(cycles_) * period_s, trajectory_->end_time_s());
-  blend_t_s_ = static_cast<double>(blend_cycles_) * period_s;
+}
+
+void JointStream::begin_stop(double ramp_s) noexcept {
+  if (stopping() || !(ramp_s > 0.0) || !std::isfinite(ramp_s)) return;
+  stop_ramp_s_ = ramp_s;
+  stop_elapsed_s_ = 0.0;
+}
+
+double JointStream::speed_factor() const {
+  if (!stopping()) return 1.0;
+  return std::max(0.0, 1.0 - stop_elapsed_s_ / stop_ramp_s_);
 }
 
 }  // namespace deflex

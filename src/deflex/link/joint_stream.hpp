@@ -12,6 +12,10 @@
 //     ramp time, so the first command equals the anchor and the correction is applied once. The
 //     offset must be within the start tolerance on every joint, or the session is refused.
 //   - The blend has its own clock (it goes on after the program's end); the end's last point is held.
+//   - A planned stop while the program moves (begin_stop(): SIGINT, SIGTERM, a time limit) brings it to
+//     a standstill on its own path: the program's clock slows from one period a cycle to none over the
+//     ramp (speed factor 1 - t/ramp), so every joint's speed only falls (within its limits and the
+//     per-cycle step limit) and it decelerates at most its peak program speed over the ramp.
 #pragma once
 
 #include <cstdint>
@@ -43,8 +47,19 @@ class JointStream {
   /// The program at the stream's time and its velocity (rad, rad/s), the blend now and its velocity.
   void sample(JointVector& program, JointVector& program_velocity, JointVector& blend,
               JointVector& blend_velocity) const noexcept;
-  /// One controller cycle consumed (an answer went out): the program and the blend move on by period_s.
+  /// One controller cycle consumed (an answer went out): the program and the blend move on by period_s
+  /// (during a stop ramp, the program by the ramp's share of it).
   void consumed(double period_s) noexcept;
+  /// A planned stop: the program slows to a standstill over `ramp_s` (> 0) of consumed cycles. Once
+  /// begun, later calls change nothing.
+  void begin_stop(double ramp_s) noexcept;
+  [[nodiscard]] bool stopping() const { return stop_ramp_s_ > 0.0; }
+  /// The stop ramp has brought the program to rest (or the program had ended).
+  [[nodiscard]] bool at_standstill() const {
+    return finished() || (stopping() && stop_elapsed_s_ >= stop_ramp_s_ - 1e-12);
+  }
+  /// The program's speed factor now: 1 while it runs, falling to 0 over a stop ramp.
+  [[nodiscard]] double speed_factor() const;
 
   [[nodiscard]] bool started() const { return started_; }
   [[nodiscard]] bool finished() const { return program_t_s_ >= trajectory_->end_time_s(); }
@@ -65,7 +80,9 @@ class JointStream {
   // Cycles consumed, counted: the times are start + n x period, so thousands of cycles add no
   // rounding (a sum of 0.1 s steps would miss the program's end by an ulp).
   std::uint64_t cycles_ = 0, blend_cycles_ = 0;
-  JointVector offset_;  // the blend's offset at its start
+  double stop_ramp_s_ = 0.0;     // > 0: a stop ramp of this length runs
+  double stop_elapsed_s_ = 0.0;  // consumed time since it began
+  JointVector offset_;           // the blend's offset at its start
   JointVector distance_;
   mutable JointVector scratch_, scratch_velocity_;
 };

@@ -141,28 +141,71 @@ LinkCycle::LinkCycle(OnlineCompensator& compensator, OnlineStrategy& strategy, F
   const int n = compensator.model().dof();
   limits_.validate(n);
   for (JointVector* q : {&input_.q_planned, &input_.q_feedback, &command_, &previous_command_, &reference_,
-                         &last_dtheta_, &out_.dtheta, &out_.q_command}) {
+                         &last_dtheta_, &last_sent_, &out_.dtheta, &out_.q_command}) {
     *q = JointVector::Zero(n);
   }
   record_ = history_.blank();
 }
 
-void LinkCycle::anchor_joints(const JointVector& q) noexcept {
+void LinkCycle::anchor_joints(const JointVector& q, bool after_silence) noexcept {
   previous_command_ = q;
   have_previous_ = true;
+  hold_last_sent_ = !after_silence && has_sent();
 }
 
-void LinkCycle::anchor_tcp(const Vector3& offset_m) noexcept {
+void LinkCycle::anchor_tcp(const Vector3& offset_m, bool after_silence) noexcept {
   previous_offset_m_ = offset_m;
   have_previous_ = true;
+  hold_last_sent_ = !after_silence && has_sent();
 }
 
-void LinkCycle::restart_from_zero() noexcept {
+void LinkCycle::restart_from_zero(bool after_silence) noexcept {
   comp_.reset();
   last_dtheta_.setZero();
   previous_command_.setZero();
   previous_offset_m_.setZero();
   have_previous_ = true;
+  hold_last_sent_ = !after_silence && has_sent();
+}
+
+double LinkCycle::reanchor_gap(const JointVector& q) const noexcept {
+  if (!has_sent() || limits_.form == CommandForm::kTcpOffset) return 0.0;
+  return ((q - last_sent_).cwiseAbs().array() / limits_.joint_step_rad.array()).maxCoeff();
+}
+
+double LinkCycle::reanchor_gap(const Vector3& offset_m) const noexcept {
+  if (!has_sent() || limits_.form != CommandForm::kTcpOffset) return 0.0;
+  return (offset_m - last_sent_offset_m_).norm() / limits_.tcp_step_m;
+}
+
+// After a re-anchor without a silence the controller may hold either the anchor or the last command
+// sent: the command is moved to the nearest point within the step limit of both (per joint an
+// interval; for the TCP offset the meet of two balls, by alternating projections). Where the two are
+// more than two limits apart there is no such point; the guard then refuses the command.
+void LinkCycle::hold_near_last_sent() noexcept {
+  if (!hold_last_sent_) return;
+  if (limits_.form == CommandForm::kTcpOffset) {
+    const double r = limits_.tcp_step_m;
+    for (int k = 0; k < 32; ++k) {
+      for (const Vector3* centre : {&previous_offset_m_, &last_sent_offset_m_}) {
+        const Vector3 d = offset_m_ - *centre;
+        if (d.norm() > r) {
+          offset_m_ = *centre + d * (r / d.norm());
+          record_.step_limited = true;
+        }
+      }
+    }
+    return;
+  }
+  for (int j = 0; j < command_.size(); ++j) {
+    const double s = limits_.joint_step_rad[j];
+    const double lo = std::max(previous_command_[j], last_sent_[j]) - s;
+    const double hi = std::min(previous_command_[j], last_sent_[j]) + s;
+    if (lo <= hi && (command_[j] < lo || command_[j] > hi)) {
+      command_[j] = std::clamp(command_[j], lo, hi);
+      record_.step_limited = true;
+    }
+  }
 }
 
 LinkCycle::Verdict LinkCycle::run(const CycleRequest& rq) noexcept {
@@ -238,6 +281,7 @@ void LinkCycle::form_joint_command(const JointVector& reference) noexcept {
       ++counters_.step_limited;
     }
   }
+  hold_near_last_sent();
   for (int j = 0; j < command_.size(); ++j) command_[j] = limits_.round(command_[j]);
 }
 
@@ -251,6 +295,7 @@ void LinkCycle::form_tcp_offset() noexcept {
       ++counters_.step_limited;
     }
   }
+  hold_near_last_sent();
 }
 
 bool LinkCycle::guard(const JointVector* reference) noexcept {
@@ -269,6 +314,17 @@ bool LinkCycle::guard(const JointVector* reference) noexcept {
       return refuse("the TCP offset moved %.6f mm in one cycle, beyond the step limit %.6f mm: nothing sent",
                     r.step_m * 1e3, limits_.tcp_step_m * 1e3);
     }
+    if (hold_last_sent_) {
+      const double from_sent = (offset_m_ - last_sent_offset_m_).norm();
+      r.step_m = std::max(r.step_m, from_sent);
+      if (from_sent > limits_.tcp_step_m * kRel + 1e-12) {
+        return refuse(
+            "re-anchored without a silence, the TCP offset would move %.6f mm from the last offset sent, beyond the "
+            "step limit %.6f mm: nothing sent",
+            from_sent * 1e3, limits_.tcp_step_m * 1e3);
+      }
+    }
+    r.step_fraction = r.step_m / limits_.tcp_step_m;
     return true;
   }
   double fraction = 0.0;
@@ -290,6 +346,17 @@ bool LinkCycle::guard(const JointVector* reference) noexcept {
         return refuse(
             "joint %d of the command moved %.6f deg in one cycle, beyond the step limit %.6f deg: nothing sent", j + 1,
             rad_to_deg(step), rad_to_deg(limits_.joint_step_rad[j]));
+      }
+    }
+    if (hold_last_sent_) {
+      const double from_sent = std::abs(c - last_sent_[j]);
+      r.step_rad = std::max(r.step_rad, from_sent);
+      fraction = std::max(fraction, from_sent / limits_.joint_step_rad[j]);
+      if (from_sent > limits_.joint_step_rad[j] * kRel + 2.0 * res + 1e-12) {
+        return refuse(
+            "re-anchored without a silence, joint %d of the command would move %.6f deg from the last command sent, "
+            "beyond the step limit %.6f deg: nothing sent",
+            j + 1, rad_to_deg(from_sent), rad_to_deg(limits_.joint_step_rad[j]));
       }
     }
   }
@@ -318,12 +385,13 @@ void LinkCycle::finish(bool sent, double compute_s, double answer_s) noexcept {
   record_.answer_s = answer_s;
   if (sent) {
     ++stats_.sent;
+    hold_last_sent_ = false;
     if (limits_.form == CommandForm::kTcpOffset) {
-      previous_offset_m_ = offset_m_;
+      previous_offset_m_ = last_sent_offset_m_ = offset_m_;
       stats_.max_step_m = std::max(stats_.max_step_m, record_.step_m);
       stats_.max_step_fraction = std::max(stats_.max_step_fraction, record_.step_m / limits_.tcp_step_m);
     } else {
-      previous_command_ = command_;
+      previous_command_ = last_sent_ = command_;
       stats_.max_deviation_rad = std::max(stats_.max_deviation_rad, record_.deviation_rad);
       stats_.max_step_rad = std::max(stats_.max_step_rad, record_.step_rad);
       stats_.max_step_fraction = std::max(stats_.max_step_fraction, step_fraction_);

@@ -12,7 +12,10 @@
 //      limit of the previous command. A command that fails is not sent; the link stops (kSafety);
 //   7. the record goes to the history ring.
 // A session start anchors the step reference to what the controller holds then (its reference, or
-// zero offset for a controller that starts its correction afresh), so no first command steps.
+// zero offset for a controller that starts its correction afresh), so no first command steps. Unless
+// the controller fell silent first (its previous session then ended on its own), it may still hold
+// what deflex last sent: the first command after such a re-anchor is held within the step limit of
+// both, and the guard refuses one that is not (the links stop when no command can be: reanchor_gap()).
 // The limits are derived once, at the session's start (command_limits), from the bounds, the rate
 // bound, the period, the program's own speeds and the ramp-in: the loop only computes and checks.
 // Never allocates, locks or throws after construction.
@@ -147,13 +150,21 @@ class LinkCycle {
   /// The cycle's answer did not go out (guard, encoding, a full socket): the record is kept.
   void not_sent(double compute_s) noexcept;
   /// A session starts with the controller holding `q` (joint target: its reference; joint offset:
-  /// the offset it applies): the next command is measured from it.
-  void anchor_joints(const JointVector& q) noexcept;
-  /// A session starts with the controller applying `offset_m` (TCP form).
-  void anchor_tcp(const Vector3& offset_m) noexcept;
+  /// the offset it applies): the next command is measured from it. `after_silence`: the controller was
+  /// silent before (its previous session ended on its own); otherwise the next command is also held
+  /// within the step limit of the last command sent.
+  void anchor_joints(const JointVector& q, bool after_silence) noexcept;
+  /// A session starts with the controller applying `offset_m` (TCP form); `after_silence` as above.
+  void anchor_tcp(const Vector3& offset_m, bool after_silence) noexcept;
   /// The controller starts its correction afresh (a new RSI or path-correction session): the
-  /// compensator starts from zero correction, and the step reference is zero offset.
-  void restart_from_zero() noexcept;
+  /// compensator starts from zero correction, and the step reference is zero offset; `after_silence`
+  /// as above.
+  void restart_from_zero(bool after_silence) noexcept;
+  /// How far a re-anchor on `q` (joint forms) or `offset_m` (TCP form) is from the last command sent,
+  /// in per-cycle step limits (the largest joint's); 0 before anything was sent. Beyond 2 no command can
+  /// be within the step limit of both.
+  [[nodiscard]] double reanchor_gap(const JointVector& q) const noexcept;
+  [[nodiscard]] double reanchor_gap(const Vector3& offset_m) const noexcept;
 
   /// The TCP rotation the model predicts and the link cannot correct this cycle (recorded; rad).
   void note_uncorrected_rotation(double rad) noexcept { record_.rotation_uncorrected_rad = rad; }
@@ -176,6 +187,7 @@ class LinkCycle {
  private:
   void form_joint_command(const JointVector& nominal_plus_blend) noexcept;
   void form_tcp_offset() noexcept;
+  void hold_near_last_sent() noexcept;
   bool guard(const JointVector* nominal_plus_blend) noexcept;
   bool refuse(const char* format, ...) noexcept __attribute__((format(printf, 2, 3)));
   void finish(bool sent, double compute_s, double answer_s) noexcept;
@@ -189,8 +201,10 @@ class LinkCycle {
   CycleInput input_;
   CycleOutput out_;
   JointVector command_, previous_command_, reference_, last_dtheta_;
-  Vector3 offset_m_ = Vector3::Zero(), previous_offset_m_ = Vector3::Zero();
+  JointVector last_sent_;  // the last joint command that went on the wire (no anchor replaces it)
+  Vector3 offset_m_ = Vector3::Zero(), previous_offset_m_ = Vector3::Zero(), last_sent_offset_m_ = Vector3::Zero();
   bool have_previous_ = false;
+  bool hold_last_sent_ = false;  // re-anchored without a silence: the next command steps from both
   bool fault_pending_ = false;
   double step_fraction_ = 0.0;  // this cycle's largest step over its limit
   LinkCycleRecord record_;

@@ -417,6 +417,13 @@ LinkPollResult SimpleMessageLink::poll(double timeout_s) noexcept {
       return announce_terminal();
     }
   }
+  if (state_ == LinkState::kFinished && ramping_down_ && now - finished_at_s_ > config_.buffer_depth * period_s_) {
+    fault(LinkStopCause::kRequested,
+          "stopped on request: the program was brought to a standstill on its path over %.2f s and the controller "
+          "ran out its queue; STOP_TRAJECTORY sent",
+          ramp_down_s_);
+    return announce_terminal();
+  }
   if (state_ == LinkState::kFinished && now - finished_at_s_ > rules_.end_silence_s) {
     // The program's last point was taken: the session is over (the controller runs out its queue).
     stop_link(LinkStopCause::kEnded, "the program's last point was taken %.2f s ago: the session is over",
@@ -434,7 +441,7 @@ LinkPollResult SimpleMessageLink::poll(double timeout_s) noexcept {
       refuse_start(stream_.distance());
       return announce_terminal();
     }
-    cycle_.anchor_joints(feedback_);
+    cycle_.anchor_joints(feedback_, true);  // the first session: nothing was sent before
     state_ = LinkState::kRunning;
     schedule_origin_s_ = first_origin_s_ = now;
   }
@@ -465,9 +472,12 @@ LinkPollResult SimpleMessageLink::send_point(double now) noexcept {
     return announce_terminal();
   }
   const double due_at_send = next_due_s();
+  if (ramping_down_) stream_.begin_stop(ramp_down_s_);
   stream_.sample(program_, program_velocity_, blend_, blend_velocity_);
   nominal_ = program_ + blend_;
-  const bool last = stream_.finished();
+  // A planned stop: the point at rest after the ramp is the last, and what is queued is run out as at
+  // the program's end.
+  const bool last = stream_.finished() || (ramping_down_ && stream_.at_standstill());
   // The point is executed buffer_depth cycles from now: the strategy is told the measured delay and
   // the configuration the point is for.
   CycleRequest rq;

@@ -187,6 +187,8 @@ void StandInSession::run_for(double seconds) {
 
 void StandInSession::outage(double seconds) { network_.add_outage(t_s_, t_s_ + seconds); }
 
+void StandInSession::reorder(int count) { network_.add_reordering(t_s_, count, kController); }
+
 void StandInSession::restart(bool reset_reference, double off_s) {
   if (egm_ != nullptr) egm_->restart(t_s_, reset_reference);
   if (path_ != nullptr) path_->restart();

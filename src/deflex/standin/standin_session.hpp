@@ -84,6 +84,8 @@ class StandInSession {
   // The faults of a cell.
   /// Every datagram in [now, now + seconds) is lost, both ways.
   void outage(double seconds);
+  /// The controller's next `count` messages are overtaken in the network by the one after them.
+  void reorder(int count);
   /// deflex stops reading (a stalled PC, SIGSTOP) / goes on; the controller goes on either way.
   void stall(bool stalled) { stalled_ = stalled; }
   /// The controller starts a new session now: EGM (EGMRunJoint again, with its reference reset to
