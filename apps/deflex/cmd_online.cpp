@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -32,8 +33,13 @@ namespace {
 
 using runtime::LinkKind;
 
-std::atomic<bool> g_stop{false};
-extern "C" void on_stop_signal(int /*signal*/) { g_stop.store(true); }
+// The session a stop signal goes to: request_stop() is an atomic counter, safe in a signal handler, so
+// the loop sees the request at its next cycle (a planned stop ramps down first; a second signal ends
+// the session at once).
+std::atomic<runtime::Session*> g_session{nullptr};
+extern "C" void on_stop_signal(int /*signal*/) {
+  if (runtime::Session* s = g_session.load()) s->request_stop();
+}
 
 struct OnlineOpts {
   std::string link, robot, sensor, force_source, program, strategy = "online", force_model, log, fault_dump,
@@ -42,7 +48,7 @@ struct OnlineOpts {
   static constexpr runtime::SessionOptionDefaults kShared = runtime::kSessionOptionDefaults;
   double period_ms = 0.0, max_joint_deg = kShared.max_joint_correction_deg, max_tcp_mm = kShared.max_tcp_correction_mm,
          max_rate_deg_s = kShared.max_rate_deg_s, max_tcp_rate_mm_s = kShared.max_tcp_rate_mm_s, watchdog_ms = 50.0;
-  double end_silence_s = 2.0, stop_silence_s = 0.0, duration_s = 0.0, status_s = 1.0;
+  double end_silence_s = 2.0, stop_silence_s = 0.0, duration_s = 0.0, status_s = 1.0, stop_ramp_s = 0.5;
   bool loop = false, json = false, end_on_silence = false;
   // The live monitor page.
   std::string monitor;
@@ -298,6 +304,7 @@ runtime::SessionConfig session_config(const OnlineOpts& o, const CLI::App& sub) 
   c.end_silence_s = o.end_silence_s;
   c.end_on_silence = o.end_on_silence;
   c.duration_s = o.duration_s;
+  c.stop_ramp_s = o.stop_ramp_s;
   c.status_interval_s = o.status_s;
   c.log_path = o.log;
   c.fault_dump_path = o.fault_dump;
@@ -434,7 +441,8 @@ void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
   if (!o.program.empty())
     program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o.program, model));
   check_sensor_options(sub, o);
-  const auto log = make_field_logger("online", o.log_options);
+  const auto log_health = std::make_shared<FieldLogHealth>();
+  const auto log = make_field_logger("online", o.log_options, log_health);
   ForceSourceOptions fo;
   fo.loop = o.loop;
   fo.bind_address = o.bind;
@@ -484,7 +492,14 @@ void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
   log->info("deflex online: {}; robot {}; sensor {}; force from {}. Stop with Ctrl-C.", session.describe(),
             model.name(), sensor.source, force.description);
 
-  g_stop = false;
+  g_session.store(&session);
+  // A field log that cannot be written ends the session as the cycle log's failure does (exit 1).
+  log_health->on_failure([](const std::string& text) {
+    if (runtime::Session* s = g_session.load()) s->report_output_failure(text);
+  });
+  struct Unhook {  // the handlers never see a session that is gone, however this function is left
+    ~Unhook() { g_session.store(nullptr); }
+  } unhook;
   struct sigaction sa {};
   sa.sa_handler = on_stop_signal;
   sigemptyset(&sa.sa_mask);
@@ -492,10 +507,7 @@ void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
   sigaction(SIGTERM, &sa, nullptr);
   (void)session.run(0.0);  // real time is asked for (and refused, exit 2) before anything is answered
   if (config.realtime.enabled) log->info("real time: {}", session.realtime_text());
-  while (!session.ended()) {
-    if (g_stop.load()) session.request_stop();
-    (void)session.run(0.1);
-  }
+  while (!session.ended()) (void)session.run(0.1);
   const runtime::SessionSummary& summary = session.finish();
   const bool planned = summary.exit_code == 0;
   for (std::string_view text = summary.text; !text.empty();) {
@@ -516,6 +528,11 @@ void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
   exit_code = summary.exit_code;
   // A session that ended as planned but whose cycle log could not be written failed all the same.
   if (!summary.output_error.empty() && exit_code == 0) exit_code = 1;
+  if (log_health->failed()) {
+    // The summary's lines may not have reached the file: say so where they did arrive.
+    std::fprintf(stderr, "deflex online: %s: the lines after it are on stderr only\n", log_health->error().c_str());
+    if (exit_code == 0) exit_code = 1;
+  }
   if (o.log_report && summary.output_error.empty()) {
     const std::string report = log_report_path(o.log);
     write_output_file(report,
@@ -581,6 +598,10 @@ void setup_online(CLI::App& sub, int& exit_code) {
                  "writability at start)");
   sub.add_flag("--json", o->json, "At the end, print one JSON document of the counters and timing on stdout");
   add_log_options(sub, o->log_options);
+  sub.add_option("--stop-ramp-s", o->stop_ramp_s,
+                 "A planned stop (SIGINT, SIGTERM, --duration-s) while moving: streamed programs come to rest on "
+                 "their path over this long, corrections ramp out at the rate bound; a second signal stops at once, "
+                 "0.05..10 s");
   sub.add_option("--duration-s", o->duration_s, "Stop after this many seconds (0: run until SIGINT/SIGTERM)")
       ->capture_default_str();
   sub.add_option("--status-interval-s", o->status_s, "Live status on stderr every this many seconds")

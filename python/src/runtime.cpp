@@ -65,6 +65,7 @@ const std::map<std::string, Setter>& settings() {
     real("end_silence_s", [](C& c) -> double& { return c.end_silence_s; });
     flag("end_on_silence", [](C& c) -> bool& { return c.end_on_silence; });
     real("duration_s", [](C& c) -> double& { return c.duration_s; });
+    real("stop_ramp_s", [](C& c) -> double& { return c.stop_ramp_s; });
     real("status_interval_s", [](C& c) -> double& { return c.status_interval_s; });
     text("log_path", [](C& c) -> std::string& { return c.log_path; });
     text("fault_dump_path", [](C& c) -> std::string& { return c.fault_dump_path; });
@@ -207,10 +208,11 @@ runtime::StopReason run_releasing(runtime::Session& session, double seconds) {
     }
     ran += chunk;
     if (PyErr_CheckSignals() != 0) {
+      // A user stop as SIGINT is in `deflex online`: the arm brought to rest over the stop ramp first.
       session.request_stop();
       {
         py::gil_scoped_release release;
-        (void)session.run(0.0);
+        (void)session.run(session.config().stop_ramp_s + 2.0);
       }
       throw py::error_already_set();
     }
@@ -256,7 +258,9 @@ void bind_runtime(py::module_& m) {
           "Runs the loop until the session ends (the stop reason is returned) or `seconds` pass ('running'). "
           "Ctrl-C stops it as a user stop and raises KeyboardInterrupt.")
       .def(
-          "stop", [](PySession& s) { s.session->request_stop(); }, "Asks the loop to end the session (a user stop).")
+          "stop", [](PySession& s) { s.session->request_stop(); },
+          "Asks the loop to end the session (a user stop): the arm is brought to rest over stop_ramp_s first; a "
+          "second call ends it at once.")
       .def(
           "finish", [](PySession& s) { return summary_of(s.session->finish()); },
           "Ends the session and returns its summary (the dict of `deflex online --json`, plus 'text').")
@@ -273,7 +277,8 @@ void bind_runtime(py::module_& m) {
       m, "StandIn",
       "A session against an in-memory stand-in of the controller (the simulated cell's, with the real controller's "
       "behaviour, dead time included), on a clock it advances itself, with the faults of a cell on request: "
-      "outage(), stall(), restart(), end_session(), motors_off(), sensor_silent(). force_base_N: the process force "
+      "outage(), reorder(), stall(), restart(), end_session(), motors_off(), sensor_silent(), stop(). force_base_N: "
+      "the process force "
       "at the TCP in the base frame; server_read_period_s: simple message, the robot program takes a point at most "
       "this "
       "often (a slow consumer); comm_timeout_s: EGM's \\CommTimeout, s. Settings as deflex.Session's.")
@@ -301,6 +306,11 @@ void bind_runtime(py::module_& m) {
       .def("run_for", &standin::StandInSession::run_for, "seconds"_a,
            "Ticks the stand-in for `seconds` of its own clock (or until the session ended).")
       .def("outage", &standin::StandInSession::outage, "seconds"_a, "Every datagram of the next `seconds` is lost.")
+      .def("reorder", &standin::StandInSession::reorder, "count"_a,
+           "The controller's next `count` messages are overtaken in the network by the one after them.")
+      .def(
+          "stop", [](standin::StandInSession& s) { s.session().request_stop(); },
+          "Asks for a planned stop, as SIGINT does (the stop ramp first; a second call stops at once).")
       .def("stall", &standin::StandInSession::stall, "stalled"_a, "deflex stops reading (a stalled PC) or goes on.")
       .def("restart", &standin::StandInSession::restart, "reset_reference"_a = true, "off_s"_a = 0.0,
            "The controller starts a new session (EGM, path correction; RSI after off_s of RSI_OFF).")

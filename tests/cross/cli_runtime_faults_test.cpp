@@ -100,6 +100,95 @@ TEST(CliRuntimeFaults, AStoppedAndContinuedProcessNeverStepsTheTarget) {
   EXPECT_NE(err.find("the controller was silent for 0.4"), std::string::npos) << err;
 }
 
+TEST(CliRuntimeFaults, SigintWhileMovingBringsTheProgramToRestThenEndsAsPlanned) {
+  // Before, the loop saw the signal only every 0.1 s: 25 more answers at full speed, then nothing.
+  const std::string dir = ::testing::TempDir() + "/cli_sigint_ramp";
+  fs::create_directories(dir);
+  const std::string program_path = test::nominal_program(dir, 50.0, 0.2);
+  const RobotModel robot = builtin_irb6700();
+  const JointTrajectory program = JointTrajectory::read_csv(program_path, robot);
+  const std::string log = dir + "/log.csv";
+  Child deflex;
+  test::spawn(deflex,
+              {kDeflex, "online", "--link", "egm-joint", "--program", program_path, "--egm-port", "0", "--force-source",
+               "csv:" + test::kForceReplay, "--loop", "--log", log, "--stop-ramp-s", "0.4"},
+              dir + "/stderr.txt");
+  const int port = test::port_of(deflex, "EGM on 127.0.0.1:");
+  ASSERT_GT(port, 0) << test::slurp(deflex.stderr_path);
+  UdpTransport transport("127.0.0.1", 0);
+  cell::ControllerConfig cc;
+  cell::EgmPositionGuidanceController controller(cc, program.points().front(), transport,
+                                                 make_datagram_address("127.0.0.1", static_cast<std::uint16_t>(port)));
+  double signalled_at = -1.0;
+  run_with(controller, 3.0, [&](double t) {
+    if (signalled_at < 0.0 && t > 1.5) {
+      ::kill(deflex.pid, SIGINT);
+      signalled_at = t;
+    }
+  });
+  const int code = deflex.wait();
+  const std::string err = test::slurp(deflex.stderr_path);
+  EXPECT_EQ(code, 0) << err;
+  EXPECT_NE(err.find("user-stop (exit code 0): stopped on request (SIGINT, SIGTERM or the caller): the program was "
+                     "brought to a standstill on its path over 0.40 s"),
+            std::string::npos)
+      << err;
+  // The log: the program's clock slowed to a stop over the ramp, and no step on the wire beyond the
+  // per-cycle limit (computed here from the program).
+  const CsvTable table = CsvTable::read_file(log);
+  const JointVector limit_deg = test::cli_step_limit_deg(program);
+  double worst = 0.0, last_advance = 1.0, first_advance = 0.0;
+  std::size_t replied = 0;
+  for (std::size_t r = 1; r < table.rows(); ++r) {
+    if (table.at(r, "replied") == 0.0 || table.at(r - 1, "replied") == 0.0) continue;
+    ++replied;
+    for (int j = 1; j <= 6; ++j) {
+      const std::string c = "q_command" + std::to_string(j) + "_deg";
+      worst = std::max(worst, std::abs(table.at(r, c) - table.at(r - 1, c)) / limit_deg[j - 1]);
+    }
+    const double advance = table.at(r, "program_t_s") - table.at(r - 1, "program_t_s");
+    if (first_advance == 0.0) first_advance = advance;
+    last_advance = advance;
+  }
+  EXPECT_GT(replied, 300u);
+  EXPECT_LE(worst, 1.0);
+  EXPECT_NEAR(first_advance, 0.004, 1e-9);  // the program ran at its own speed before
+  EXPECT_LT(last_advance, 0.0004);          // and at under a tenth of it in the ramp's last cycle
+}
+
+TEST(CliRuntimeFaults, ALogOnAFullDiskEndsTheRunWithExit1NamingItAndTheSummary) {
+  // /dev/full fails every write with ENOSPC, as a full disk does. Before, the cycle log aborted the
+  // process (SIGABRT, exit 134) mid-session, and --log-file lost the field log silently with exit 0.
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this machine";
+  const std::string dir = ::testing::TempDir() + "/cli_full_disk";
+  fs::create_directories(dir);
+  const std::string program_path = test::nominal_program(dir, 50.0, 0.2);
+  const RobotModel robot = builtin_irb6700();
+  const JointTrajectory program = JointTrajectory::read_csv(program_path, robot);
+  for (const char* option : {"--log", "--log-file"}) {
+    Child deflex;
+    test::spawn(
+        deflex,
+        {kDeflex, "online", "--link", "egm-joint", "--program", program_path, "--egm-port", "0", "--force-source",
+         "csv:" + test::kForceReplay, "--loop", option, "/dev/full", "--status-interval-s", "0.2"},
+        dir + "/stderr.txt");
+    const int port = test::port_of(deflex, "EGM on 127.0.0.1:");
+    ASSERT_GT(port, 0) << test::slurp(deflex.stderr_path);
+    UdpTransport transport("127.0.0.1", 0);
+    cell::ControllerConfig cc;
+    cell::EgmPositionGuidanceController controller(
+        cc, program.points().front(), transport, make_datagram_address("127.0.0.1", static_cast<std::uint16_t>(port)));
+    run_with(controller, 4.0, [](double) {});
+    const int code = deflex.wait();  // it ends by itself
+    const std::string err = test::slurp(deflex.stderr_path);
+    EXPECT_EQ(code, 1) << option << ": " << err;
+    EXPECT_NE(err.find("session ended: output-failed (exit code 1)"), std::string::npos) << option << ": " << err;
+    EXPECT_NE(err.find("/dev/full"), std::string::npos) << option << ": " << err;
+    EXPECT_NE(err.find("on the wire: largest"), std::string::npos) << option << ": the summary: " << err;
+    EXPECT_EQ(err.find("terminate called"), std::string::npos) << option << ": " << err;
+  }
+}
+
 TEST(CliRuntimeFaults, AStoppedRsiControllerEndsTheRunWithANonZeroCodeNamingIt) {
   const std::string dir = ::testing::TempDir() + "/cli_rsi_stop";
   fs::create_directories(dir);

@@ -132,18 +132,140 @@ TEST(Session, TheExitCodesAreTheDocumentedTable) {
     std::smatch m;
     if (std::regex_search(line, m, row)) documented[m[2]] = std::stoi(m[1]);
   }
-  for (int r = 1; r <= 9; ++r) {
+  for (int r = 1; r <= 10; ++r) {
     const auto reason = static_cast<runtime::StopReason>(r);
     ASSERT_TRUE(documented.count(runtime::to_string(reason))) << runtime::to_string(reason) << " is not in the table";
     EXPECT_EQ(documented[runtime::to_string(reason)], runtime::exit_code(reason)) << runtime::to_string(reason);
   }
   // Only the planned ends exit 0.
-  for (int r = 1; r <= 9; ++r) {
+  for (int r = 1; r <= 10; ++r) {
     const auto reason = static_cast<runtime::StopReason>(r);
     const bool planned = reason == runtime::StopReason::kProgramEnd || reason == runtime::StopReason::kUserStop ||
                          reason == runtime::StopReason::kDuration;
     EXPECT_EQ(runtime::exit_code(reason) == 0, planned) << runtime::to_string(reason);
   }
+}
+
+// A position-guidance session against the cell's EGM controller, stepped: the harness of the tests below.
+struct SteppedEgm {
+  RobotModel robot = test::bench_robot();
+  JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  std::shared_ptr<const JointTrajectory> program = test::sweep_program(robot, q0, pose_deg(8, -3, 4, 10, -5, 12), 10.0);
+  ManualClock clock;
+  MemoryNetwork network{clock};
+  MemoryTransport& deflex_port = network.add_endpoint(test::kSensorAddress, 0.0002);
+  MemoryTransport& controller_port = network.add_endpoint(test::kControllerAddress, 0.0002);
+  std::vector<std::string> lines;
+  std::unique_ptr<runtime::Session> session;
+  std::unique_ptr<cell::EgmPositionGuidanceController> controller;
+  double t = 0.0;
+
+  SteppedEgm(const runtime::SessionConfig& c, ForceSource& force) {
+    session = std::make_unique<runtime::Session>(
+        c, robot, test::bench_sensor(), program, nullptr, &force, clock, runtime::SessionEndpoints{&deflex_port},
+        [this](runtime::LogLevel, const std::string& text) { lines.push_back(text); });
+    controller = std::make_unique<cell::EgmPositionGuidanceController>(cell::ControllerConfig{}, q0, controller_port,
+                                                                       test::kSensorAddress);
+  }
+  void run_for(double seconds) {
+    for (const double end = t + seconds; t < end && !session->ended();) {
+      t += 0.004;
+      clock.set(t);
+      controller->tick(t);
+      clock.set(t + 0.0002);
+      while (session->poll(0.0) != LinkPollResult::kIdle) {
+      }
+      session->service();
+    }
+  }
+  [[nodiscard]] bool logged(const std::string& part) const {
+    for (const std::string& l : lines) {
+      if (l.find(part) != std::string::npos) return true;
+    }
+    return false;
+  }
+};
+
+TEST(Session, ACycleLogThatCannotBeWrittenEndsTheSessionWithExit1NamingItAndTheSummary) {
+  // /dev/full fails every write with ENOSPC, as a full disk does: before, the reporter's thread threw
+  // and the process aborted (exit 134) mid-session with no summary.
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this machine";
+  runtime::SessionConfig c;
+  c.link = runtime::LinkKind::kEgmJoint;
+  c.online = test::bench_online();
+  c.log_path = "/dev/full";
+  c.status_interval_s = 0.0;
+  test::ConstantForce force;
+  SteppedEgm b(c, force);
+  force.reading = test::reading_at(b.robot, b.q0, Vector3(0, 0, -500));
+  b.run_for(5.0);
+  ASSERT_TRUE(b.session->ended());
+  const runtime::SessionSummary& s = b.session->finish();
+  EXPECT_EQ(s.reason, runtime::StopReason::kOutputFailed);
+  EXPECT_EQ(s.exit_code, 1);
+  EXPECT_NE(s.reason_text.find("/dev/full"), std::string::npos) << s.reason_text;
+  EXPECT_NE(s.reason_text.find("standstill"), std::string::npos) << s.reason_text;  // ramped down, then ended
+  EXPECT_NE(s.output_error.find("/dev/full"), std::string::npos) << s.output_error;
+  EXPECT_EQ(s.text.rfind("deflex online: the egm-joint session ended: output-failed (exit code 1)", 0), 0u) << s.text;
+  EXPECT_TRUE(b.logged("/dev/full"));
+  EXPECT_GT(s.answers, 100u);  // it ran until the first failed write, and the loop kept answering
+}
+
+TEST(Session, AnOutputFailureReportedFromOutsideEndsTheSessionTheSameWay) {
+  // The program around the session (the CLI's field log) reports its own file's failure.
+  runtime::SessionConfig c;
+  c.link = runtime::LinkKind::kEgmJoint;
+  c.online = test::bench_online();
+  c.status_interval_s = 0.0;
+  test::ConstantForce force;
+  SteppedEgm b(c, force);
+  b.run_for(2.0);
+  b.session->report_output_failure("the field log /var/log/cell.log could not be written (No space left on device)");
+  b.session->report_output_failure("a second failure is not the reason");
+  b.run_for(2.0);
+  ASSERT_TRUE(b.session->ended());
+  const runtime::SessionSummary& s = b.session->finish();
+  EXPECT_EQ(s.exit_code, 1);
+  EXPECT_EQ(s.reason_text.rfind("the field log /var/log/cell.log could not be written", 0), 0u) << s.reason_text;
+}
+
+// A force source that reports what an RDT sensor reports: samples it flagged faulty, and a stream it had
+// to request again.
+class FlaggingForce final : public ForceSource {
+ public:
+  bool latest(ForceSample& out) noexcept override { return inner.latest(out); }
+  [[nodiscard]] ForceSourceStats stats() const noexcept override { return s; }
+  test::ConstantForce inner;
+  ForceSourceStats s;
+};
+
+TEST(Session, SensorFaultsAndStreamReRequestsAreNamedInTheLogAndTheSummary) {
+  runtime::SessionConfig c;
+  c.link = runtime::LinkKind::kEgmJoint;
+  c.online = test::bench_online();
+  c.status_interval_s = 0.0;
+  FlaggingForce force;
+  SteppedEgm b(c, force);
+  b.run_for(1.0);
+  EXPECT_FALSE(b.logged("faulty"));
+  force.s.faulty = 3;
+  force.s.saturated = 1;
+  force.s.last_status = 0x80010000u;
+  b.run_for(0.5);
+  force.s.re_requests = 2;
+  force.s.restarts = 2;
+  b.run_for(0.5);
+  EXPECT_TRUE(
+      b.logged("the force sensor flagged 3 samples faulty so far (1 at its range limits; last status word "
+               "0x80010000)"));
+  EXPECT_TRUE(b.logged("the force stream stopped or never came: requested again (2 re-requests so far"));
+  const runtime::SessionSummary& s = b.session->finish();
+  EXPECT_NE(s.text.find("3 flagged faulty by the sensor (1 at its range limits, last status word 0x80010000)"),
+            std::string::npos)
+      << s.text;
+  EXPECT_NE(s.text.find("2 stream re-requests"), std::string::npos) << s.text;
+  EXPECT_EQ(s.json["force_source"]["re_requests"], 2);
+  EXPECT_EQ(s.json["force_source"]["faulty"], 3);
 }
 
 }  // namespace

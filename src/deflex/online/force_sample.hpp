@@ -30,6 +30,9 @@ struct ForceSourceStats {
   std::uint64_t lost = 0;          ///< samples the sequence numbers say were sent but never arrived
   std::uint64_t faulty = 0;        ///< samples the sensor itself flagged (status bits, saturation): handed on invalid
   std::uint64_t restarts = 0;      ///< the sender's sequence restarted, or the stream was requested again
+  std::uint64_t re_requests = 0;   ///< of those, the stream requested again because it stopped or never came
+  std::uint64_t saturated = 0;     ///< of the faulty ones, those at the sensor's range limits
+  std::uint32_t last_status = 0;   ///< the last non-zero status word the sensor sent (0: none)
 };
 
 /// A source of force samples. `latest` is non-blocking and never allocates: it returns true with a

@@ -26,6 +26,7 @@ struct SessionEntry {
   LinkCycleRecord record;
   LinkCounters counters;  ///< the link's counters after this entry
   CompensatorCounters compensator;
+  ForceSourceStats force;  ///< the force source's counts after this entry (zero when the caller pushes samples)
 };
 
 /// Thread safety: push() from one producer thread while pop() runs on one consumer thread, without

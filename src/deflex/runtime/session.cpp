@@ -32,6 +32,9 @@ void check_config(const SessionConfig& c, const LinkKindInfo& kind, const JointT
   };
   non_negative(c.duration_s, "--duration-s");
   non_negative(c.status_interval_s, "--status-interval-s");
+  if (!std::isfinite(c.stop_ramp_s) || c.stop_ramp_s < 0.05 || c.stop_ramp_s > 10.0) {
+    throw InputError(fmt::format("option --stop-ramp-s: 0.05..10 s (got {})", c.stop_ramp_s));
+  }
   if (c.monitor && !(c.monitor_window_s >= 1.0 && c.monitor_window_s <= 3600.0)) {
     throw InputError(fmt::format("option --monitor-window-s: 1..3600 s (got {})", c.monitor_window_s));
   }
@@ -64,6 +67,7 @@ Session::Session(const SessionConfig& config, const RobotModel& robot, const Sen
   check_config(config_, info, program.get());
   compensator_ = std::make_unique<OnlineCompensator>(robot, sensor, config_.online);
   strategy_ = std::make_unique<OnlineStrategy>(robot, config_.strategy, force_model);
+  force_ = force;
   open_link(endpoints, force, std::move(program));
 
   reporting_ = !config_.log_path.empty() || !config_.fault_dump_path.empty() || static_cast<bool>(sink_) ||
@@ -87,6 +91,7 @@ Session::Session(const SessionConfig& config, const RobotModel& robot, const Sen
     setup.status_interval_s = config_.status_interval_s > 0.0 ? config_.status_interval_s : 1e300;
     setup.collect = config_.collect_cycles;
     setup.sink = sink_;
+    setup.on_output_failure = [this](const std::string& text) { report_output_failure(text); };
     if (config_.monitor) {
       MonitorSetup ms;
       ms.link = info.name;
@@ -212,6 +217,7 @@ void Session::push(SessionEntry::Kind kind, double now) noexcept {
   if (kind == SessionEntry::Kind::kCycle) entry_.record = link_->last_cycle();
   entry_.counters = link_->counters();
   entry_.compensator = compensator_->counters();
+  if (force_ != nullptr) entry_.force = force_->stats();
   if (!queue_->push(entry_)) dropped_.fetch_add(1, std::memory_order_relaxed);
   last_push_s_ = now;
 }
@@ -234,15 +240,41 @@ LinkPollResult Session::poll(double timeout_s) noexcept {
   if (r == LinkPollResult::kRefused) {
     end(StopReason::kStartRefused);
   } else if (r == LinkPollResult::kStopped) {
-    end(stop_reason_of(link_->stop_cause()));
-  } else if (stop_requested_.load()) {
-    link_->stop();
-    end(StopReason::kUserStop);
-  } else if (config_.duration_s > 0.0 && now - start_s_ >= config_.duration_s) {
-    link_->stop();
-    end(StopReason::kDuration);
+    const bool asked = link_->stop_cause() == LinkStopCause::kRequested && planned_stop_ != StopReason::kRunning;
+    end(asked ? planned_stop_ : stop_reason_of(link_->stop_cause()));
+  } else {
+    const int requests = stop_requests_.load();
+    if (output_failed_.load(std::memory_order_acquire) && planned_stop_ == StopReason::kRunning) {
+      planned_stop(StopReason::kOutputFailed, now);
+      return r;
+    }
+    if (requests >= 2) {  // asked again: at once
+      link_->stop();
+      end(planned_stop_ != StopReason::kRunning ? planned_stop_ : StopReason::kUserStop);
+    } else if (requests == 1 && planned_stop_ == StopReason::kRunning) {
+      planned_stop(StopReason::kUserStop, now);
+    } else if (config_.duration_s > 0.0 && now - start_s_ >= config_.duration_s &&
+               planned_stop_ == StopReason::kRunning) {
+      planned_stop(StopReason::kDuration, now);
+    }
   }
   return r;
+}
+
+void Session::report_output_failure(const std::string& text) {
+  {
+    const std::lock_guard<std::mutex> lock(output_failure_mutex_);
+    if (output_failure_.empty()) output_failure_ = text;
+  }
+  output_failed_.store(true, std::memory_order_release);
+}
+
+void Session::planned_stop(StopReason why, double now) noexcept {
+  planned_stop_ = why;
+  link_->request_planned_stop(config_.stop_ramp_s);
+  if (reporting_) push(SessionEntry::Kind::kHeartbeat, now);
+  // A link with nothing to ramp (not started, the program over) stopped at once.
+  if (link_->state() == LinkState::kStopped) end(why);
 }
 
 void Session::drain_reporter(double now) {
@@ -285,6 +317,14 @@ const std::vector<LinkCycleRecord>& Session::collected() const {
   return reporter_ ? reporter_->collected() : none;
 }
 
+std::string Session::ramp_text() const {
+  // The link's own sentence when it ramped down (request_planned_stop) before it stopped.
+  constexpr std::string_view kRamped = "stopped on request: ";
+  const std::string_view said = link_->stop_reason();
+  if (link_->stop_cause() != LinkStopCause::kRequested || said.substr(0, kRamped.size()) != kRamped) return {};
+  return fmt::format(": {}", said.substr(kRamped.size()));
+}
+
 const SessionSummary& Session::finish() {
   if (finished_) return summary_;
   finished_ = true;
@@ -300,10 +340,10 @@ const SessionSummary& Session::finish() {
   // Why, in a sentence.
   switch (reason_) {
     case StopReason::kUserStop:
-      reason_text_ = "stopped on request (SIGINT, SIGTERM or the caller)";
+      reason_text_ = "stopped on request (SIGINT, SIGTERM or the caller)" + ramp_text();
       break;
     case StopReason::kDuration:
-      reason_text_ = fmt::format("the session's time limit of {:g} s passed", config_.duration_s);
+      reason_text_ = fmt::format("the session's time limit of {:g} s passed", config_.duration_s) + ramp_text();
       break;
     case StopReason::kStartRefused: {
       std::string joints;
@@ -320,6 +360,11 @@ const SessionSummary& Session::finish() {
           "refusing to start: the controller reports the arm more than {:g} deg from where the program {} is ({}). "
           "Move the robot to the program's start first; nothing was sent to the controller",
           rad_to_deg(tolerance), program_ ? program_->source() : std::string("?"), joints);
+      break;
+    }
+    case StopReason::kOutputFailed: {
+      const std::lock_guard<std::mutex> lock(output_failure_mutex_);
+      reason_text_ = output_failure_ + ramp_text();
       break;
     }
     default:
@@ -356,6 +401,7 @@ void Session::build_summary() {
   const DelayEstimator* delay = l.delay_estimator();
   s.measured_delay_s = delay != nullptr ? delay->mean_s() : std::numeric_limits<double>::quiet_NaN();
   s.log_dropped = dropped_.load();
+  if (force_ != nullptr) s.force_source = force_->stats();
   if (reporter_) {
     s.fault_episodes = reporter_->episodes();
     s.faulted_cycles = reporter_->faulted_cycles();
@@ -364,6 +410,10 @@ void Session::build_summary() {
   }
   if (program_) s.program_time_s = l.last_cycle().program_time_s - program_->start_time_s();
   if (reporter_) s.output_error = reporter_->log_error();
+  if (s.output_error.empty() && output_failed_.load()) {
+    const std::lock_guard<std::mutex> lock(output_failure_mutex_);
+    s.output_error = output_failure_;
+  }
 
   const bool tcp = s.limits.form == CommandForm::kTcpOffset;
   const std::string invariants =
@@ -387,21 +437,33 @@ void Session::build_summary() {
       "  {} cycles, {} answers in {:.1f} s; rejected datagrams {} (malformed {}, truncated {}, oversized {}, empty {}, "
       "missing header {}, missing joints {}, missing required {}, non-finite {}, duplicate {}, out of order {}, far "
       "ahead {}, sequence out of range {}, beyond limits {}, other sender {}, foreign document {}); superseded {}; "
-      "restarts {}; silences ridden through {} (longest {:.3f} s); guard trips {}; step-limited cycles {}\n"
+      "restarts {}; silences ridden through {} (longest {:.3f} s); controller clock jumps {}; guard trips {}; "
+      "step-limited cycles {}\n"
       "  on the wire: {}\n",
       s.link, to_string(s.reason), s.exit_code, s.reason_text, s.cycles, s.answers, s.duration_s, c.rejected(),
       c.malformed, c.truncated, c.oversized, c.empty, c.missing_header, c.missing_joints, c.missing_required,
       c.non_finite, c.duplicate, c.out_of_order, c.far_ahead, c.sequence_out_of_range, c.out_of_limits,
-      c.foreign_sender, c.foreign_document, c.superseded, c.restarts, c.silences, c.longest_silence_s, c.guard_trips,
-      c.step_limited, invariants);
+      c.foreign_sender, c.foreign_document, c.superseded, c.restarts, c.silences, c.longest_silence_s, c.clock_jumps,
+      c.guard_trips, c.step_limited, invariants);
   if (reporter_) text += fmt::format("  timing: {}\n", reporter_->timing_text());
   if (const std::string protocol = l.protocol_summary(); !protocol.empty()) text += fmt::format("  {}\n", protocol);
   text += fmt::format(
-      "  measured delay {:.1f} ms; force samples ok {}, fault {}, invalid {}, dropped {}; fault episodes {} ({} "
-      "faulted "
+      "  measured delay {}; force samples ok {}, fault {}, invalid {}, dropped {}; fault episodes {} ({} faulted "
       "cycles)\n",
-      s.measured_delay_s * 1e3, s.compensator.samples_ok, s.compensator.samples_fault, s.compensator.samples_invalid,
+      std::isfinite(s.measured_delay_s)
+          ? fmt::format("{:.1f} ms", s.measured_delay_s * 1e3)
+          : std::string("not measured (the controller reported no setpoint to time its feedback against)"),
+      s.compensator.samples_ok, s.compensator.samples_fault, s.compensator.samples_invalid,
       s.compensator.samples_dropped, s.fault_episodes, s.faulted_cycles);
+  if (force_ != nullptr) {
+    const ForceSourceStats& f = s.force_source;
+    text += fmt::format(
+        "  force source: {} samples received, {} accepted; {} flagged faulty by the sensor ({} at its range limits, "
+        "last status word 0x{:08X}); {} lost, {} out of order, {} duplicates, {} malformed; {} stream re-requests, "
+        "{} restarts\n",
+        f.received, f.accepted, f.faulty, f.saturated, f.last_status, f.lost, f.out_of_order, f.duplicates, f.malformed,
+        f.re_requests, f.restarts);
+  }
   if (program_) {
     text += fmt::format("  program {:.2f} of {:.2f} s streamed, {:.2f} s behind real time\n", s.program_time_s,
                         program_->duration_s(), s.program_behind_s);
@@ -447,6 +509,13 @@ void Session::build_summary() {
                       {"log_dropped", s.log_dropped},
                       {"realtime", realtime_.text}};
   if (reporter_) j["timing"] = reporter_->timing_json();
+  if (force_ != nullptr) {
+    const ForceSourceStats& f = s.force_source;
+    j["force_source"] = {{"received", f.received},         {"accepted", f.accepted},       {"faulty", f.faulty},
+                         {"saturated", f.saturated},       {"last_status", f.last_status}, {"lost", f.lost},
+                         {"out_of_order", f.out_of_order}, {"duplicates", f.duplicates},   {"malformed", f.malformed},
+                         {"re_requests", f.re_requests},   {"restarts", f.restarts}};
+  }
   if (program_) {
     j["program"] = {
         {"time_s", s.program_time_s}, {"duration_s", program_->duration_s()}, {"behind_s", s.program_behind_s}};

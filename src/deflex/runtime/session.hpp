@@ -17,6 +17,7 @@
 
 #include <atomic>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
@@ -58,7 +59,11 @@ struct SessionConfig {
   EgmPathLinkConfig egm_path;
   RsiLinkConfig rsi;
   SimpleMessageLinkConfig simple_message;
-  double duration_s = 0.0;            ///< > 0: the session ends (planned) after this long
+  double duration_s = 0.0;  ///< > 0: the session ends (planned) after this long
+  /// A planned stop (request_stop(), the time limit) while the arm moves: a streaming link brings the
+  /// program to rest on its path over this long, a correcting link ramps its correction out at the rate
+  /// bound; then the session ends. s, 0.05..10.
+  double stop_ramp_s = 0.5;
   double status_interval_s = 1.0;     ///< a status line this often (0: none)
   std::string log_path;               ///< the cycle log CSV ("" none)
   std::string fault_dump_path;        ///< the fault dump CSV ("" none)
@@ -91,6 +96,7 @@ struct SessionSummary {
   CycleStats stats;  ///< the command against its invariants, on the wire values
   CommandLimits limits;
   CompensatorCounters compensator;
+  ForceSourceStats force_source;  ///< the force source's counts (zero when the caller pushed the samples)
   double measured_delay_s = 0.0;  ///< the mean of the link's delay measurements (NaN before one)
   std::uint64_t log_dropped = 0;  ///< entries the reporter never saw (a full ring: the log has gaps)
   std::uint64_t fault_episodes = 0, faulted_cycles = 0;
@@ -127,9 +133,14 @@ class Session {
   /// it returns kRunning and can be called again). The first call makes its thread real-time when
   /// asked (InputError naming the missing permission when refused) and starts the reporter's thread.
   StopReason run(double max_s = std::numeric_limits<double>::infinity());
-  /// Asks the loop to end the session (planned: a user stop). Safe from another thread or a signal
-  /// handler (an atomic flag).
-  void request_stop() noexcept { stop_requested_.store(true); }
+  /// Asks the loop to end the session (planned: a user stop): the link ramps down first (stop_ramp_s;
+  /// ControllerLink::request_planned_stop), then the session ends. A second request ends it at once.
+  /// Safe from another thread or a signal handler (an atomic counter).
+  void request_stop() noexcept { stop_requests_.fetch_add(1); }
+  /// An output of the session (its cycle log, the field log of the program around it, a fault dump)
+  /// could not be written: the loop ramps down and ends the session (StopReason::kOutputFailed, exit 1)
+  /// with `text` as its reason (the first such text is kept). Safe from any thread but the loop's.
+  void report_output_failure(const std::string& text);
   /// Ends the session (a running link is stopped: simple message sends STOP_TRAJECTORY), drains the
   /// reporter, writes the fault dump when the end was a fault, closes the cycle log, and builds the
   /// summary. Idempotent.
@@ -170,12 +181,19 @@ class Session {
   std::unique_ptr<DatagramTransport> own_datagram_;
   std::unique_ptr<StreamTransport> own_motion_, own_state_;
   std::unique_ptr<ControllerLink> link_;
+  ForceSource* force_ = nullptr;
   std::shared_ptr<const JointTrajectory> program_;
   std::string where_;
   StopReason reason_ = StopReason::kRunning;
   std::string reason_text_;
   double start_s_ = 0.0, last_push_s_ = -1.0;
-  std::atomic<bool> stop_requested_{false};
+  std::atomic<int> stop_requests_{0};
+  std::atomic<bool> output_failed_{false};
+  std::mutex output_failure_mutex_;  // never taken on the loop's thread
+  std::string output_failure_;
+  StopReason planned_stop_ = StopReason::kRunning;  // a planned stop under way: its reason
+  void planned_stop(StopReason why, double now) noexcept;
+  [[nodiscard]] std::string ramp_text() const;
   // Loop -> reporter.
   bool reporting_ = false;  // anything consumes the entries (a log, a dump, a sink, collection)
   std::unique_ptr<SpscRing<SessionEntry>> queue_;

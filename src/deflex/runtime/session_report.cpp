@@ -52,6 +52,7 @@ void SessionReporter::consume(const SessionEntry& e) {
     next_status_s_ = e.t_s + setup_.status_interval_s;
   }
   if (e.kind == SessionEntry::Kind::kCycle) on_cycle(e);
+  on_force_source(e);
   if (setup_.monitor) {
     setup_.monitor->add(e);
     if (!have_last_ || last_.state != e.state) setup_.monitor->set_state(to_string(e.state));
@@ -60,11 +61,43 @@ void SessionReporter::consume(const SessionEntry& e) {
   have_last_ = true;
 }
 
+// What the force source flagged, named in the log when it happens: samples the sensor marked faulty
+// (its status word), and a stream that stopped or never came and was requested again. At most a line
+// a second each, with the counts so far.
+void SessionReporter::on_force_source(const SessionEntry& e) {
+  const ForceSourceStats& f = e.force;
+  if (f.faulty > force_logged_.faulty && e.t_s - faulty_logged_s_ >= 1.0) {
+    log(LogLevel::kWarn,
+        fmt::format("the force sensor flagged {} sample{} faulty so far ({} at its range limits; last status word "
+                    "0x{:08X}): the compensator does not move the robot on them",
+                    f.faulty, f.faulty == 1 ? "" : "s", f.saturated, f.last_status));
+    force_logged_.faulty = f.faulty;
+    faulty_logged_s_ = e.t_s;
+  }
+  if (f.re_requests > force_logged_.re_requests && e.t_s - re_request_logged_s_ >= 1.0) {
+    log(LogLevel::kWarn, fmt::format("the force stream stopped or never came: requested again ({} re-request{} so "
+                                     "far, {} samples accepted)",
+                                     f.re_requests, f.re_requests == 1 ? "" : "s", f.accepted));
+    force_logged_.re_requests = f.re_requests;
+    re_request_logged_s_ = e.t_s;
+  }
+}
+
 void SessionReporter::on_cycle(const SessionEntry& e) {
   const LinkCycleRecord& r = e.record;
   ++cycles_;
   ++window_cycles_;
-  if (log_) log_->write(e);
+  if (log_) {
+    try {
+      log_->write(e);
+    } catch (const std::exception& ex) {
+      // A half-written log is never put in place: its temporary file goes, the path stays as it was.
+      log_error_ =
+          fmt::format("{} (the cycle log was not put in place: its path is as it was before the session)", ex.what());
+      log_.reset();
+      output_failed(log_error_);
+    }
+  }
   if (setup_.collect) collected_.push_back(r);
   ring_[ring_head_] = e;
   ring_head_ = (ring_head_ + 1) % ring_.size();
@@ -165,11 +198,17 @@ void SessionReporter::write_dump(const std::string& why) {
     append_cycle_row(text, ring_[(first + k) % ring_.size()], setup_.joints, bounds());
   try {
     write_fault_dump(setup_.dump_path, text);
-  } catch (const Error& e) {
+  } catch (const std::exception& e) {
     log(LogLevel::kError, fmt::format("{}: {}", why, e.what()));
+    output_failed(fmt::format("the fault dump could not be written: {}", e.what()));
     return;
   }
   log(LogLevel::kWarn, fmt::format("{}: the last {} cycles written to {}", why, ring_count_, setup_.dump_path));
+}
+
+void SessionReporter::output_failed(const std::string& text) {
+  log(LogLevel::kError, text);
+  if (setup_.on_output_failure) setup_.on_output_failure(text);
 }
 
 void SessionReporter::end(double now_s, StopReason reason, const std::string& reason_text) {
@@ -297,6 +336,7 @@ nlohmann::json counters_json(const LinkCounters& c) {
           {"late", c.late},
           {"controller_late", c.controller_late},
           {"silences", c.silences},
+          {"clock_jumps", c.clock_jumps},
           {"longest_silence_s", c.longest_silence_s},
           {"invalid_cycles", c.invalid_cycles},
           {"guard_trips", c.guard_trips},

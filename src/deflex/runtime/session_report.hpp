@@ -58,6 +58,9 @@ struct ReportSetup {
   bool collect = false;  ///< keep every cycle's record (Python's cycle log)
   LogSink sink;
   std::shared_ptr<MonitorFeed> monitor;  ///< the live page's data (null: no monitor)
+  /// Called (on the reporter's thread) when an output of the session fails while it runs: the cycle
+  /// log or a fault dump could not be written. The sentence names the file and why.
+  std::function<void(const std::string&)> on_output_failure;
 };
 
 /// Thread safety: one thread at a time (the session's reporter thread, or the caller's service()
@@ -106,6 +109,7 @@ class SessionReporter {
   ReportSetup setup_;
   std::unique_ptr<CycleLogFile> log_;
   std::string log_error_;
+  void output_failed(const std::string& text);
   // The last cycles, for the fault dump (a ring of entries).
   std::vector<SessionEntry> ring_;
   std::size_t ring_head_ = 0, ring_count_ = 0;
@@ -129,6 +133,9 @@ class SessionReporter {
   double window_program_start_s_ = 0.0, window_t_start_s_ = 0.0;
   LinkCounters at_window_start_;
   SessionEntry last_;
+  void on_force_source(const SessionEntry& e);
+  ForceSourceStats force_logged_;  // the counts last named in the log
+  double faulty_logged_s_ = -1e300, re_request_logged_s_ = -1e300;
   bool have_last_ = false, have_cycle_ = false;
   std::vector<LinkCycleRecord> collected_;
 };

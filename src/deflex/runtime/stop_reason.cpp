@@ -25,6 +25,8 @@ const char* to_string(StopReason r) {
       return "safety";
     case StopReason::kTooSlow:
       return "too-slow";
+    case StopReason::kOutputFailed:
+      return "output-failed";
   }
   return "unknown";
 }
@@ -48,6 +50,8 @@ int exit_code(StopReason r) {
       return 7;
     case StopReason::kTooSlow:
       return 8;
+    case StopReason::kOutputFailed:
+      return 1;
   }
   return 1;
 }

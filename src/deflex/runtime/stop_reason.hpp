@@ -18,10 +18,13 @@ enum class StopReason : int {
   kProtocol = 7,           ///< the controller sent what its protocol does not allow
   kSafety = 8,             ///< deflex's final guard refused a command (bound, step limit, invalid cycle)
   kTooSlow = 9,            ///< the controller falls behind the program past the stated limit
+  kOutputFailed = 10,      ///< an output of the session (the cycle log, the field log, a fault dump) could not be
+                           ///< written: the session ramped down and ended, naming the file
 };
 
 [[nodiscard]] const char* to_string(StopReason r);
-/// 0 planned end (program end, user stop, duration); 2 the controller's messages out of protocol (bad
+/// 0 planned end (program end, user stop, duration); 1 an output could not be written (the job failed);
+/// 2 the controller's messages out of protocol (bad
 /// input); 4 start refused; 5 controller silent; 6 controller stopped or faulted; 7 deflex's safety
 /// guard; 8 controller too slow. (1 and 3 keep their meaning for every deflex command: the job failed,
 /// an internal error.)

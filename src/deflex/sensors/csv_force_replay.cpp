@@ -68,6 +68,7 @@ bool CsvForceReplay::latest(ForceSample& out) noexcept {
   out = s;
   out.t_s = s.t_s + lap_offset_s_;
   ++next_;
+  ++served_;
   return true;
 }
 

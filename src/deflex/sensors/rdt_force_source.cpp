@@ -159,6 +159,9 @@ ForceSourceStats RdtForceSource::stats() const noexcept {
   s.lost = counters_.lost;
   s.faulty = counters_.faulty;
   s.restarts = counters_.re_requests + counters_.sequence_restarts + counters_.ft_restarts;
+  s.re_requests = counters_.re_requests;
+  s.saturated = counters_.saturated;
+  s.last_status = counters_.last_status;
   return s;
 }
 

@@ -406,6 +406,13 @@ LinkPollResult SimpleMessageLink::poll(double timeout_s) noexcept {
   if (!read_port(Port::kState, now) || !read_port(Port::kMotion, now)) return announce_terminal();
 
   if (state_ == LinkState::kRunning) {
+    // A stop ramp needs the controller to take points: one that fell silent meanwhile has nothing to ramp.
+    if (ramping_down_ && now - last_state_s_ > std::max(0.25, 2.5 * period_s_)) {
+      fault(LinkStopCause::kRequested,
+            "stopped on request: the controller fell silent for %.2f s during the stop ramp, so deflex stopped there",
+            now - last_state_s_);
+      return announce_terminal();
+    }
     if (now - last_state_s_ > config_.state_timeout_s) {
       fault(LinkStopCause::kSilent, "no JOINT_POSITION on the state connection for %.2f s (timeout %.2f s)",
             now - last_state_s_, config_.state_timeout_s);

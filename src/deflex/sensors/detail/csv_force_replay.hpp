@@ -24,11 +24,19 @@ class CsvForceReplay final : public ForceSource {
   [[nodiscard]] std::size_t size() const { return samples_.size(); }
   [[nodiscard]] const std::vector<ForceSample>& samples() const { return samples_; }
   [[nodiscard]] bool finished() const { return !loop_ && next_ >= samples_.size(); }
+  /// Samples read and handed on (every one is: a file has no sequence to lose, and its invalid rows
+  /// are refused when it is loaded).
+  [[nodiscard]] ForceSourceStats stats() const noexcept override {
+    ForceSourceStats s;
+    s.received = s.accepted = served_;
+    return s;
+  }
 
  private:
   std::vector<ForceSample> samples_;
   bool loop_ = false;
   std::size_t next_ = 0;
+  std::uint64_t served_ = 0;
   double duration_s_ = 0.0;
   double lap_offset_s_ = 0.0;
   bool manual_ = false;
