@@ -58,11 +58,13 @@ def measure(link, name, faults, settle_s=3.0, after_s=3.0, **settings):
     summary = s.finish()
     inv = summary["invariants"]
     # The steps from the fault on, on the wire: consecutive commands of one controller session. At a
-    # restart the controller takes a new reference (the arm, or zero offset) and deflex's first command
-    # of the new session is measured from it (the log's step at that cycle), not from the last command
-    # of the old session, which the controller no longer holds.
+    # restart after a silence the controller takes a new reference (the arm, or zero offset) and deflex's
+    # first command of the new session is measured from it (the log's step at that cycle), not from the
+    # last command of the old session, which the controller no longer holds. A restart without a silence
+    # is not excepted: the controller may still hold the last command.
     t_wire = wire["t_s"]
     starts = log["t_s"][(log["session_start"] == 1.0) & (log["t_s"] > t_fault)]
+    starts = [t0 for t0 in starts if t_wire[np.searchsorted(t_wire, t0) - 1] < t0 - 0.1]
     pairs = np.arange(1, len(t_wire))
     pairs = pairs[t_wire[pairs] > t_fault]
     for t0 in starts:
@@ -139,17 +141,22 @@ cases = [
     ("egm-joint", "outage 2 s, CommTimeout 1 s", outage(2.0), {"after_s": 6.0}),
     ("egm-joint", "deflex stalled 0.45 s", stall(0.45), {}),
     ("egm-joint", "restart after 1.2 s silence", silence_then_restart(1.2), {}),
-    ("egm-joint", "restart, no silence", lambda s: s.restart(True), {}),
+    ("egm-joint", "restart, no silence, reference kept", lambda s: s.restart(False), {}),
+    ("egm-joint", "restart, no silence, onto the arm", lambda s: s.restart(True), {}),
+    ("egm-joint", "3 datagrams overtaken", lambda s: s.reorder(3), {}),
+    ("egm-joint", "stop request while moving", lambda s: s.stop(), {}),
     ("egm-joint", "EGM stopped early", lambda s: s.end_session(2), {}),
     ("egm-joint", "motors off", lambda s: s.motors_off(), {}),
     ("egm-joint", "silent for good", outage(100.0), {"after_s": 4.0}),
     ("egm-joint", "force stale 1 s", sensor_gap(1.0), {}),
     ("egm-path", "outage 0.45 s", outage(0.45), {}),
-    ("egm-path", "restart", lambda s: s.restart(True), {}),
+    ("egm-path", "restart behind a 1 s outage", lambda s: (s.restart(True), s.outage(1.0)), {}),
+    ("egm-path", "restart, no silence", lambda s: s.restart(True), {}),
     ("egm-path", "force stale 1 s", sensor_gap(1.0), {}),
     ("rsi", "outage 0.2 s", outage(0.2), {}),
     ("rsi", "deflex stalled 1 s (RSI Timeout)", stall(1.0), {}),
     ("rsi", "RSI_OFF 0.3 s, RSI_ON", lambda s: s.restart(True, 0.3), {}),
+    ("rsi", "stop request", lambda s: s.stop(), {}),
     ("rsi", "force stale 1 s", sensor_gap(1.0), {}),
     ("simple-message", "force stale 1 s", sensor_gap(1.0), {}),
 ]
@@ -191,7 +198,7 @@ for r in rows:
     assert r["step_fraction_whole_run"] <= 1.0 + 1e-9, r
     assert r["bound_fraction"] <= 1.0 + 1e-9, r
 expected_end = {"EGM stopped early": 6, "motors off": 6, "silent for good": 5, "deflex stalled 1 s (RSI Timeout)": 6,
-                "outage 2 s, CommTimeout 1 s": 5,
+                "outage 2 s, CommTimeout 1 s": 5, "restart, no silence, onto the arm": 6, "restart, no silence": 6,
                 "server takes a point every 150 ms": 8}
 for r in rows:
     assert r["exit_code"] == expected_end.get(r["fault"], 0), r
