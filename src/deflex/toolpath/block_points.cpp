@@ -66,9 +66,9 @@ std::optional<std::string> arc_by_radius(const Vector3& start_m, const Vector3& 
   if (r < half) {
     if (half - r > radius_tolerance_m) {
       return fmt::format(
-          "R {} does not reach the end point: the chord is {}, longer than 2 R by {}, more than the arc radius "
+          "R {} does not reach the end point: half the chord is {}, longer than R by {}, more than the arc radius "
           "tolerance of {}",
-          block_mm(radius_m), block_mm(length), block_mm(length - 2.0 * r), block_mm(radius_tolerance_m));
+          block_mm(radius_m), block_mm(half), block_mm(half - r), block_mm(radius_tolerance_m));
     }
   } else {
     h = std::sqrt(r * r - half * half);

@@ -186,7 +186,6 @@ std::string GcodeWriteBack::Impl::first_line(const ToolpathPoint& p, const Vecto
   std::vector<LineEdit> edits;
   const int desired = facts.motion_g == 0 ? 0 : 1;
   const GcodeWord* motion_word = nullptr;
-  const GcodeWord* last_axis = nullptr;
   const GcodeWord* axis[3] = {};
   const GcodeWord* distance_word = nullptr;
   const bool arc = facts.motion_g == 2 || facts.motion_g == 3;
@@ -197,7 +196,6 @@ std::string GcodeWriteBack::Impl::first_line(const ToolpathPoint& p, const Vecto
       if (c == 910) distance_word = &w;
     } else if (w.index == 0 && w.letter >= 'X' && w.letter <= 'Z') {
       axis[w.letter - 'X'] = &w;
-      last_axis = &w;
     } else if (arc && w.index == 0 && ((w.letter >= 'I' && w.letter <= 'K') || w.letter == 'R')) {
       // The arc's centre or radius goes with its G2/G3; the word and the blanks before it are removed.
       std::size_t b = w.begin;
@@ -233,21 +231,26 @@ std::string GcodeWriteBack::Impl::first_line(const ToolpathPoint& p, const Vecto
   if (!leading.empty()) edits.push_back({lead, lead, leading});
   out_motion = desired;
   out_incremental = false;
-  std::string missing;
+  // A missing coordinate goes before the next present one, else after the previous one, else where
+  // the motion's words begin: "Y5" becomes "X1.000 Y5.000 Z-2.000".
   for (int k = 0; k < 3; ++k) {
     const std::string value = wb_number(comp[k] / scale(facts.units), digits_for(static_cast<char>('X' + k), axis[k]));
     if (axis[k] != nullptr) {
       edits.push_back({axis[k]->number_begin, axis[k]->end, value});
+      continue;
+    }
+    const std::string word = static_cast<char>('X' + k) + value;
+    const GcodeWord* after = k + 1 < 3 && axis[k + 1] != nullptr ? axis[k + 1] : k + 2 < 3 ? axis[k + 2] : nullptr;
+    const GcodeWord* before = k > 0 && axis[k - 1] != nullptr ? axis[k - 1] : k > 1 ? axis[k - 2] : nullptr;
+    if (after != nullptr) {
+      edits.push_back({after->begin, after->begin, word + sep});
+    } else if (before != nullptr) {
+      edits.push_back({before->end, before->end, sep + word});
+    } else if (motion_word != nullptr) {
+      edits.push_back({motion_word->end, motion_word->end, sep + word});
     } else {
-      missing += sep + static_cast<char>('X' + k) + value;
+      edits.push_back({lead, lead, word + sep});
     }
-  }
-  if (!missing.empty()) {
-    std::size_t at = last_axis != nullptr ? last_axis->end : motion_word != nullptr ? motion_word->end : lead;
-    if (last_axis == nullptr && motion_word == nullptr) {
-      missing = missing.substr(sep.size()) + sep;  // at the front of the words
-    }
-    edits.push_back({at, at, missing});
   }
   if (facts.orientation_changes && t < 1.0) {
     const auto values = orientation_at(p, t);
