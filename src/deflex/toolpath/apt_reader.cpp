@@ -12,14 +12,16 @@ namespace deflex {
 
 AptReader::AptReader(const std::string& path, const ToolpathOptions& options)
     : machine_(std::make_unique<detail::AptInterpreter>(path, options)),
-      block_(std::make_unique<detail::BlockPoints>()) {
+      block_(std::make_unique<detail::BlockPoints>()),
+      record_(std::make_unique<detail::AptRecord>()) {
   lines_ = std::make_unique<detail::LineReader>(path);  // after the options are checked
   records_ = std::make_unique<detail::AptRecordReader>(*lines_);
 }
 
 AptReader::AptReader(std::string text, std::string source, const ToolpathOptions& options)
     : machine_(std::make_unique<detail::AptInterpreter>(source, options)),
-      block_(std::make_unique<detail::BlockPoints>()) {
+      block_(std::make_unique<detail::BlockPoints>()),
+      record_(std::make_unique<detail::AptRecord>()) {
   lines_ = std::make_unique<detail::LineReader>(std::move(text), std::move(source));
   records_ = std::make_unique<detail::AptRecordReader>(*lines_);
 }
@@ -34,8 +36,7 @@ bool AptReader::next(ToolpathPoint& out) {
       machine_->count_point(out);
       return true;
     }
-    detail::AptRecord record;
-    if (!records_->next(record)) {
+    if (!records_->next(*record_)) {
       ended_ = true;
       machine_->finish();
       if (machine_->summary().points == 0) {
@@ -43,7 +44,7 @@ bool AptReader::next(ToolpathPoint& out) {
       }
       break;
     }
-    machine_->interpret(record, *block_);
+    machine_->interpret(*record_, *block_);
   }
   return false;
 }

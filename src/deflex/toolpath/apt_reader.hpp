@@ -12,6 +12,7 @@ namespace deflex {
 namespace detail {
 class LineReader;
 class AptRecordReader;
+struct AptRecord;
 class AptInterpreter;
 class BlockPoints;
 }  // namespace detail
@@ -34,6 +35,7 @@ class AptReader final : public ToolpathReader {
   std::unique_ptr<detail::AptRecordReader> records_;
   std::unique_ptr<detail::AptInterpreter> machine_;
   std::unique_ptr<detail::BlockPoints> block_;
+  std::unique_ptr<detail::AptRecord> record_;
   bool ended_ = false;
 };
 

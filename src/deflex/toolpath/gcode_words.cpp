@@ -2,6 +2,9 @@
 #include "deflex/toolpath/detail/gcode_words.hpp"
 
 #include <cctype>
+#include <charconv>
+#include <cmath>
+#include <system_error>
 
 #include <fmt/format.h>
 
@@ -138,12 +141,14 @@ class LineSplitter {
     if (digits == 0) {
       fail(begin, fmt::format("the letter '{}' without a number", text_[begin]));
     }
-    const std::string_view number = text_.substr(w.number_begin, i - w.number_begin);
-    const std::optional<double> v = parse_double(number);
-    if (!v) {
+    // The text is a sign, digits and a point, which std::from_chars reads (without the '+') as a
+    // finite number unless it has hundreds of digits.
+    std::string_view number = text_.substr(w.number_begin, i - w.number_begin);
+    if (number.front() == '+') number.remove_prefix(1);
+    const auto r = std::from_chars(number.data(), number.data() + number.size(), w.value);
+    if (r.ec != std::errc() || r.ptr != number.data() + number.size() || !std::isfinite(w.value)) {
       fail(begin, not_a_number(number));
     }
-    w.value = *v;
     w.end = static_cast<std::uint32_t>(i);
     out_.words.push_back(w);
     return i;

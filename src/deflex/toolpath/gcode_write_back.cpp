@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <vector>
@@ -30,13 +31,14 @@ struct LineEdit {
   std::string text;
 };
 
-std::string wb_apply(std::string_view line, std::vector<LineEdit>& edits) {
+/// Writes `line` with `edits` applied into `out` (cleared first).
+void wb_apply(std::string_view line, std::vector<LineEdit>& edits, std::string& out) {
   // By position; at one position the insertions first, so that a removal starting there follows them.
   std::stable_sort(edits.begin(), edits.end(), [](const LineEdit& a, const LineEdit& b) {
     if (a.begin != b.begin) return a.begin < b.begin;
     return (a.begin == a.end) && (b.begin != b.end);
   });
-  std::string out;
+  out.clear();
   std::size_t at = 0;
   for (const LineEdit& e : edits) {
     out.append(line.substr(at, e.begin - at));
@@ -44,16 +46,17 @@ std::string wb_apply(std::string_view line, std::vector<LineEdit>& edits) {
     at = e.end;
   }
   out.append(line.substr(at));
-  return out;
 }
 
 /// A value with `decimals` digits after the point, never "-0.000".
 std::string wb_number(double v, int decimals) {
-  std::string s = fmt::format("{:.{}f}", v, decimals);
-  if (s.front() == '-' && s.find_first_not_of("-0.") == std::string::npos) {
-    s.erase(0, 1);
+  char buffer[128];
+  const auto r = std::to_chars(buffer, buffer + sizeof buffer, v, std::chars_format::fixed, decimals);
+  std::string_view s(buffer, static_cast<std::size_t>(r.ptr - buffer));  // |v| <= 1e5 in 100 decimals at most
+  if (s.front() == '-' && s.find_first_not_of("-0.") == std::string_view::npos) {
+    s.remove_prefix(1);
   }
-  return s;
+  return std::string(s);
 }
 
 }  // namespace
@@ -81,6 +84,8 @@ struct GcodeWriteBack::Impl {
   int out_motion = -1;
   bool out_incremental = false;
   std::array<int, 26> decimals{};  // digits of the last number seen for each letter; 0: none seen
+  std::vector<LineEdit> edits;     // reused from line to line
+  std::string line_out;
 
   Impl(const std::string& src, const ToolpathOptions& o) : source(src), options(o), lines(src), machine(src, o) {}
 
@@ -176,14 +181,14 @@ struct GcodeWriteBack::Impl {
     return o;
   }
 
-  std::string first_line(const ToolpathPoint& p, const Vector3& comp, double t);
+  const std::string& first_line(const ToolpathPoint& p, const Vector3& comp, double t);
   std::string extra_line(const ToolpathPoint& p, const Vector3& comp, double t) const;
   void add(const ToolpathPoint& point, const Vector3& comp);
   void finish();
 };
 
-std::string GcodeWriteBack::Impl::first_line(const ToolpathPoint& p, const Vector3& comp, double t) {
-  std::vector<LineEdit> edits;
+const std::string& GcodeWriteBack::Impl::first_line(const ToolpathPoint& p, const Vector3& comp, double t) {
+  edits.clear();
   const int desired = facts.motion_g == 0 ? 0 : 1;
   const GcodeWord* motion_word = nullptr;
   const GcodeWord* axis[3] = {};
@@ -259,7 +264,8 @@ std::string GcodeWriteBack::Impl::first_line(const ToolpathPoint& p, const Vecto
       if (o[k] != nullptr) edits.push_back({o[k]->number_begin, o[k]->end, wb_number(values[k], 6)});
     }
   }
-  return wb_apply(text, edits);
+  wb_apply(text, edits, line_out);
+  return line_out;
 }
 
 std::string GcodeWriteBack::Impl::extra_line(const ToolpathPoint& p, const Vector3& comp, double t) const {
