@@ -106,6 +106,15 @@ TEST(GcodeReader, CompactBlanksAndLowerCaseWordsReadAlike) {
   EXPECT_NEAR((pa[1].position_m - mm(4.5, -0.5, 3)).norm(), 0.0, kExact);
 }
 
+TEST(GcodeReader, ByteOrderMarkAndEveryLineEndingRead) {
+  const auto p = gcode_points("\xEF\xBB\xBFG0 X1 Y2 Z3\rG0 X2\r\nG0 X3\nG0 X4");
+  ASSERT_EQ(p.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(p[i].line, i + 1);
+    EXPECT_NEAR(p[i].position_m.x(), static_cast<double>(i + 1) * 1e-3, kExact);
+  }
+}
+
 TEST(GcodeReader, ToolChangeNeedsM6AndToolsAreListedInOrder) {
   const auto p = gcode_points("T3\nS100 M3\nG0 X0 Y0 Z0\nM6\nG0 X1\nT7 M6\nG0 X2\nT3 M6\nG0 X3\n", {}, nullptr);
   ASSERT_EQ(p.size(), 4u);

@@ -58,6 +58,7 @@ std::vector<Malformed> gcode_cases() {
       {"K in G17", kG + "G2 X10 Y0 I5 J0 K1\n", "t.nc:5: word 'K1': K is not an arc offset in the G17 plane"},
       {"J in G18", kG + "G18 G2 X10 Z0 I5 J1\n", "t.nc:5: word 'J1': J is not an arc offset in the G18 plane"},
       {"R zero", kG + "G2 X10 Y0 R0\n", "t.nc:5: word 'R0': an arc of radius 0"},
+      {"R huge", kG + "G2 X10 Y0 R-200000\n", "t.nc:5: word 'R-200000': an arc radius beyond 100 m"},
       {"R and I", kG + "G2 X10 Y0 R5 I5\n", "t.nc:5: word 'R5': an arc by R and by I, J, K at once"},
       {"R end at start", kG + "G2 X0 Y0 R10\n", "t.nc:5: word 'R10': an arc by R whose end is its start"},
       {"arc without centre", kG + "G2 X10 Y0\n", "t.nc:5: word 'G2': an arc with neither"},

@@ -178,6 +178,13 @@ TEST(GcodeWriteBack, CompactLinesStayCompactAndToolAxisWordsFollowTheChords) {
   }
 }
 
+TEST(GcodeWriteBack, ByteOrderMarkAndCarriageReturnEndingsAreKept) {
+  const std::string src = scratch("bom.nc"), out = scratch("bom_out.nc");
+  put(src, "\xEF\xBB\xBF(BOM)\rS100 M3\rG0 X1 Y2 Z3\r");
+  write_shifted(src, out, Vector3::Zero());
+  EXPECT_EQ(slurp(out), "\xEF\xBB\xBF(BOM)\rS100 M3\rG0 X1.000 Y2.000 Z3.000\r");
+}
+
 TEST(GcodeWriteBack, RefusesToOverwriteItsSourceWhateverTheSpelling) {
   const std::string src = scratch("self.nc");
   put(src, kProgram);

@@ -50,6 +50,37 @@ std::size_t GcodeInterpreter::block_count(double count, const std::string& what)
   return static_cast<std::size_t>(count);
 }
 
+Vector3 GcodeInterpreter::block_target(const Block& b, std::array<bool, 3>& known_after) const {
+  Vector3 target = position_m_;
+  for (int k = 0; k < 3; ++k) {
+    const GcodeWord* w = b.axis[k];
+    if (w == nullptr) continue;
+    const double v = w->value * length_scale();
+    if (incremental_ && !known_[k]) {
+      fail(w, "an incremental move (G91) on an axis whose position is not known yet");
+    }
+    target[k] = incremental_ ? position_m_[k] + v : v;
+    known_after[k] = true;
+    if (std::abs(target[k]) > toolpath_limits::kMaxCoordinateM) {
+      fail(w, fmt::format("a coordinate of {} m is farther than {} m from the workpiece origin", number_text(target[k]),
+                          number_text(toolpath_limits::kMaxCoordinateM)));
+    }
+  }
+  return target;
+}
+
+PointContext GcodeInterpreter::point_context() const {
+  PointContext ctx;
+  ctx.feed_m_s = motion_ == 0 ? 0.0 : feed_m_s_;
+  ctx.spindle_rpm = spindle_rpm_;
+  ctx.spindle = spindle_;
+  ctx.tool = active_tool_;
+  ctx.motion = static_cast<MotionKind>(motion_);
+  ctx.line = line_.number;
+  ctx.segment = static_cast<std::uint32_t>(segments_);
+  return ctx;
+}
+
 bool GcodeInterpreter::plan_motion(const Block& b, BlockPoints& points) {
   const bool arc = motion_ == 2 || motion_ == 3;
   if (!arc && gm_any(b.offset) && !tcp_vector_) {
@@ -68,22 +99,8 @@ bool GcodeInterpreter::plan_motion(const Block& b, BlockPoints& points) {
   if (end_line_ != 0) {
     fail(first_moving_word(b), fmt::format("a motion after the program's end (M2/M30 on line {})", end_line_));
   }
-  Vector3 target = position_m_;
   std::array<bool, 3> known_after = known_;
-  for (int k = 0; k < 3; ++k) {
-    const GcodeWord* w = b.axis[k];
-    if (w == nullptr) continue;
-    const double v = w->value * length_scale();
-    if (incremental_ && !known_[k]) {
-      fail(w, "an incremental move (G91) on an axis whose position is not known yet");
-    }
-    target[k] = incremental_ ? position_m_[k] + v : v;
-    known_after[k] = true;
-    if (std::abs(target[k]) > toolpath_limits::kMaxCoordinateM) {
-      fail(w, fmt::format("a coordinate of {} m is farther than {} m from the workpiece origin", number_text(target[k]),
-                          number_text(toolpath_limits::kMaxCoordinateM)));
-    }
-  }
+  const Vector3 target = block_target(b, known_after);
   AxisPath path;
   Vector3 abc_end_deg;
   orientation_end(b, !arc, path, abc_end_deg);
@@ -114,14 +131,7 @@ bool GcodeInterpreter::plan_motion(const Block& b, BlockPoints& points) {
   if (segments_ > std::numeric_limits<std::uint32_t>::max()) {
     fail_text("more than 4294967296 motion blocks");
   }
-  PointContext ctx;
-  ctx.feed_m_s = motion_ == 0 ? 0.0 : feed_m_s_;
-  ctx.spindle_rpm = spindle_rpm_;
-  ctx.spindle = spindle_;
-  ctx.tool = active_tool_;
-  ctx.motion = static_cast<MotionKind>(motion_);
-  ctx.line = line_.number;
-  ctx.segment = static_cast<std::uint32_t>(segments_);
+  const PointContext ctx = point_context();
   facts_.motion_g = motion_;
   facts_.incremental = incremental_;
   facts_.units = units_;
@@ -253,6 +263,9 @@ void GcodeInterpreter::plan_arc(const Block& b, int motion, const Vector3& targe
     }
     if (b.r->value == 0.0) {
       fail(b.r, "an arc of radius 0");
+    }
+    if (std::abs(b.r->value * length_scale()) > toolpath_limits::kMaxCoordinateM) {
+      fail(b.r, "an arc radius beyond 100 m");
     }
     error = arc_by_radius(position_m_, target, b.r->value * length_scale(), normal, options_.arc_radius_tolerance_m, g);
   } else {

@@ -136,7 +136,7 @@ class LineSplitter {
         ++after;
       }
       digits += after;
-      w.decimals = static_cast<std::int8_t>(after > 100 ? 100 : after);
+      w.decimals = static_cast<std::int16_t>(after > 100 ? 100 : after);
     }
     if (digits == 0) {
       fail(begin, fmt::format("the letter '{}' without a number", text_[begin]));

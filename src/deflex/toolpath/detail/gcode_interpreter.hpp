@@ -94,6 +94,8 @@ class GcodeInterpreter {
   void apply_modes(const Block& b);
   void apply_keywords();
   bool plan_motion(const Block& b, BlockPoints& points);
+  [[nodiscard]] Vector3 block_target(const Block& b, std::array<bool, 3>& known_after) const;
+  [[nodiscard]] PointContext point_context() const;
   void orientation_end(const Block& b, bool linear, AxisPath& path, Vector3& abc_end_deg);
   void check_cutting(const Block& b, int motion) const;
   void plan_arc(const Block& b, int motion, const Vector3& target, const PointContext& context, const AxisPath& axis,

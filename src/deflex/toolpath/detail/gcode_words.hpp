@@ -17,7 +17,7 @@ struct GcodeWord {
   std::uint32_t begin = 0;         ///< first byte of the word in the line (its letter)
   std::uint32_t end = 0;           ///< one past its number's last byte
   std::uint32_t number_begin = 0;  ///< first byte of its number
-  std::int8_t decimals = -1;       ///< digits after the decimal point; -1 without one
+  std::int16_t decimals = -1;      ///< digits after the decimal point; -1 without one
   /// The word as written ("G01", "X 10.5", "A3=0.5"), for messages.
   [[nodiscard]] std::string_view text(std::string_view line) const { return line.substr(begin, end - begin); }
 };
