@@ -57,6 +57,8 @@ const InputKindInfo& input_kind_info(InputKind kind) {
   static const InputKindInfo kProgram{"robot program", 64 * kMiB};
   static const InputKindInfo kTable{"data file", 1024 * kMiB};
   static const InputKindInfo kStream{"data file", 16384 * kMiB};  // streamed: memory is not the bound
+  // Streamed too; a CAM program of ten million blocks is some 300 MB.
+  static const InputKindInfo kToolpath{"toolpath", 4096 * kMiB};
   switch (kind) {
     case InputKind::kRobotFile:
       return kRobot;
@@ -70,6 +72,8 @@ const InputKindInfo& input_kind_info(InputKind kind) {
       return kTable;
     case InputKind::kCsvStream:
       return kStream;
+    case InputKind::kToolpath:
+      return kToolpath;
   }
   return kConfig;
 }

@@ -24,6 +24,7 @@ enum class InputKind {
   kProgram,    ///< RAPID module, KRL .src and .dat
   kCsvTable,   ///< a CSV file read whole (tracker, wrench table, payload poses, trajectories)
   kCsvStream,  ///< a CSV file streamed a row at a time (measurements, pose paths)
+  kToolpath,   ///< a CAM toolpath (G-code, APT/CL data) streamed a line at a time
 };
 
 struct InputKindInfo {
