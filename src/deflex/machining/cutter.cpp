@@ -22,7 +22,7 @@ void validate_cutter(const Cutter& cutter, const std::string& what) {
   const double d_mm = cutter.diameter_m * 1e3;
   if (!std::isfinite(d_mm) || d_mm < kMinDiameterMm || d_mm > kMaxDiameterMm) {
     throw InputError(
-        fmt::format("{}: diameter_mm: {} mm is outside {}..{} mm", what, d_mm, kMinDiameterMm, kMaxDiameterMm));
+        fmt::format("{}: diameter_mm: {:g} mm is outside {:g}..{:g} mm", what, d_mm, kMinDiameterMm, kMaxDiameterMm));
   }
   if (cutter.flutes < 1 || cutter.flutes > kMaxFlutes) {
     throw InputError(fmt::format("{}: flutes: {} is not 1..{} (a cutter without flutes does not cut)", what,
@@ -30,12 +30,12 @@ void validate_cutter(const Cutter& cutter, const std::string& what) {
   }
   const double helix_deg = rad_to_deg(cutter.helix_rad);
   if (!std::isfinite(helix_deg) || helix_deg < 0.0 || helix_deg > kMaxHelixDeg) {
-    throw InputError(fmt::format("{}: helix_deg: {} deg is outside 0..{} deg", what, helix_deg, kMaxHelixDeg));
+    throw InputError(fmt::format("{}: helix_deg: {:g} deg is outside 0..{:g} deg", what, helix_deg, kMaxHelixDeg));
   }
   const double r_mm = cutter.corner_radius_m * 1e3;
   if (!std::isfinite(r_mm) || r_mm < 0.0 || r_mm > 0.5 * d_mm * (1.0 + 1e-12)) {
     throw InputError(
-        fmt::format("{}: corner_radius_mm: {} mm is outside 0..{} mm (half the diameter)", what, r_mm, 0.5 * d_mm));
+        fmt::format("{}: corner_radius_mm: {:g} mm is outside 0..{:g} mm (half the diameter)", what, r_mm, 0.5 * d_mm));
   }
 }
 
