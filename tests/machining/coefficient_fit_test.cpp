@@ -223,6 +223,28 @@ TEST(CoefficientFit, ANegativeCoefficientWithinItsErrorIsWrittenAsZero) {
   EXPECT_NE(fit.warnings.back().find("Kae_N_mm fitted -"), std::string::npos);
 }
 
+TEST(SlotLog, TheWindowIsShortenedToWholeRevolutions) {
+  // 1 + sin(revolution angle) at 600 rpm (10 Hz), sampled at 1 kHz over 0.2349 s: 2.349 revolutions,
+  // whose mean is 1.05; over the 2 whole ones it is 1.
+  const std::string path = ::testing::TempDir() + "rev.csv";
+  {
+    std::ofstream f(path);
+    f << "t_s,fx_N,fy_N,fz_N\n";
+    for (int i = 0; i <= 234; ++i) {
+      const double t = i * 1e-3;
+      f << fmt::format("{:.4f},{:.12f},0,0\n", t, 1.0 + std::sin(2 * kPi * 10.0 * t));
+    }
+  }
+  SlotLogOptions o;
+  const SlotLogMean all = read_slot_log(path, o);
+  EXPECT_GT(std::abs(all.mean_force_n.x() - 1.0), 0.02);
+  o.spindle_rpm = 600.0;
+  const SlotLogMean whole = read_slot_log(path, o);
+  EXPECT_EQ(whole.revolutions, 2.0);
+  EXPECT_EQ(whole.samples, 200);
+  EXPECT_NEAR(whole.mean_force_n.x(), 1.0, 1e-9);
+}
+
 TEST(SlotLog, BadLogsAreRefusedNamingTheFileAndLine) {
   const std::string dir = ::testing::TempDir();
   auto write = [&](const std::string& name, const std::string& text) {

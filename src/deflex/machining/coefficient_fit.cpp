@@ -175,7 +175,23 @@ SlotLogMean read_slot_log(const std::string& path, const SlotLogOptions& o) {
     return Vector3(sum / count);
   };
   SlotLogMean out;
-  Vector3 mean = mean_over(o.window_from_s, o.window_to_s, "cut window", out.samples, out.duration_s);
+  std::optional<double> to = o.window_to_s;
+  if (o.spindle_rpm && *o.spindle_rpm > 0.0) {
+    // The window's first and last samples, then its end moved back to the last whole revolution.
+    std::optional<double> first, last;
+    for (std::size_t r = 0; r < t.rows(); ++r) {
+      const double ts = t.at(r, ct);
+      if ((o.window_from_s && ts < *o.window_from_s) || (o.window_to_s && ts > *o.window_to_s)) continue;
+      if (!first) first = ts;
+      last = ts;
+    }
+    if (first && last) {
+      const double period = 60.0 / *o.spindle_rpm;
+      out.revolutions = std::floor((*last - *first) / period + 1e-9);
+      if (out.revolutions >= 1.0) to = *first + out.revolutions * period - 1e-9 * period;
+    }
+  }
+  Vector3 mean = mean_over(o.window_from_s, to, "cut window", out.samples, out.duration_s);
   if (o.air_from_s || o.air_to_s) {
     double air_duration = 0.0;
     mean -= mean_over(o.air_from_s, o.air_to_s, "air window", out.air_samples, air_duration);

@@ -70,12 +70,16 @@ struct SlotLogOptions {
   bool force_on_workpiece = false;
   std::optional<double> window_from_s, window_to_s;  ///< the steady cut; default the whole log
   std::optional<double> air_from_s, air_to_s;        ///< spindle on, not cutting: its mean is subtracted
+  /// When given (rpm), the cut window is shortened to whole revolutions from its first sample, so its
+  /// mean holds no part revolution of the force's ripple.
+  std::optional<double> spindle_rpm;
 };
 
 struct SlotLogMean {
   Vector3 mean_force_n = Vector3::Zero();  ///< on the tool, cut frame
   int samples = 0;
-  double duration_s = 0.0;  ///< of the window
+  double duration_s = 0.0;   ///< of the window, first to last sample
+  double revolutions = 0.0;  ///< whole revolutions the window was shortened to (0 without spindle_rpm)
   int air_samples = 0;
 };
 
