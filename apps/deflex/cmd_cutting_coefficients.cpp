@@ -161,7 +161,7 @@ void run(const CoeffOpts& o, int& exit_code) {
   set.tool = o.tool.empty() ? describe_cutter(cutter) : o.tool;
   std::string comment = fmt::format(
       "Cutting coefficients fitted by deflex cutting-coefficients (docs/machining.md) from {} full-slot cuts with a "
-      "{} cutter.\nfeed per tooth {:g}..{:g} mm; residual RMS of the mean forces {:.2f} {:.2f} {:.2f} N (feed, "
+      "{} cutter.\nfeed per tooth {:.4g}..{:.4g} mm; residual RMS of the mean forces {:.2f} {:.2f} {:.2f} N (feed, "
       "normal, axis).\nCut: fz_mm, ap_mm, mean force on the tool along the feed, normal, axis (N):",
       fit.cuts, describe_cutter(cutter), fit.fz_min_m * 1e3, fit.fz_max_m * 1e3, fit.residual_rms_n[0],
       fit.residual_rms_n[1], fit.residual_rms_n[2]);
@@ -195,7 +195,7 @@ void run(const CoeffOpts& o, int& exit_code) {
                 {"warnings", notes},
                 {"output", o.out}});
   } else {
-    std::cout << fmt::format("{} full-slot cuts, feed per tooth {:g}..{:g} mm, cutter {}:\n", fit.cuts,
+    std::cout << fmt::format("{} full-slot cuts, feed per tooth {:.4g}..{:.4g} mm, cutter {}:\n", fit.cuts,
                              fit.fz_min_m * 1e3, fit.fz_max_m * 1e3, describe_cutter(cutter));
     for (int i = 0; i < 6; ++i) std::cout << coefficient_line(fit, i) << "\n";
     std::cout << fmt::format("residual RMS of the mean forces: {:.2f} {:.2f} {:.2f} N (feed, normal, axis)\nwrote {}\n",

@@ -24,6 +24,47 @@ double profile(double d, double radius, double rc) noexcept {
   return rc - std::sqrt(std::max(0.0, rc * rc - u * u));
 }
 
+/// The x-interval of the line at height y (in the plane) within `radius` of the segment a..b (a
+/// stadium, convex, so one interval): the two end discs and the band along the segment. False when
+/// the line misses it.
+bool stadium_row(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double radius, double y, double& xl,
+                 double& xr) noexcept {
+  if (radius < 0.0) return false;
+  xl = std::numeric_limits<double>::infinity();
+  xr = -xl;
+  for (const Eigen::Vector2d& c : {a, b}) {
+    const double dy = y - c.y(), w2 = radius * radius - dy * dy;
+    if (w2 >= 0.0) {
+      const double w = std::sqrt(w2);
+      xl = std::min(xl, c.x() - w);
+      xr = std::max(xr, c.x() + w);
+    }
+  }
+  // The band: 0 <= t(x) <= 1 and |distance to the segment's line| <= radius, both linear in x.
+  const Eigen::Vector2d d = b - a;
+  const double len = d.norm();
+  if (len > 0.0) {
+    double lo = -std::numeric_limits<double>::infinity(), hi = -lo;
+    auto clip = [&](double slope, double offset, double min, double max) {  // min <= slope x + offset <= max
+      if (std::abs(slope) < 1e-300) {
+        if (offset < min || offset > max) hi = lo - 1.0;
+        return;
+      }
+      const double x1 = (min - offset) / slope, x2 = (max - offset) / slope;
+      lo = std::max(lo, std::min(x1, x2));
+      hi = std::min(hi, std::max(x1, x2));
+    };
+    const double ry = y - a.y();
+    clip(d.x() / (len * len), (-a.x() * d.x() + ry * d.y()) / (len * len), 0.0, 1.0);
+    clip(d.y() / len, (-a.x() * d.y() - ry * d.x()) / len, -radius, radius);
+    if (hi >= lo) {
+      xl = std::min(xl, lo);
+      xr = std::max(xr, hi);
+    }
+  }
+  return xr >= xl;
+}
+
 bool vertical(const Vector3& axis) noexcept {
   const double n = axis.norm();
   return axis.allFinite() && n > 0.0 && axis.z() / n >= std::cos(ZMapStock::kMaxTiltRad);
@@ -161,29 +202,69 @@ StockStatus ZMapStock::remove_swept(const Cutter& cutter, const Vector3& from_m,
                                     const Vector3& axis) noexcept {
   if (!vertical(axis)) return StockStatus::kUnsupportedAxis;
   if (!from_m.allFinite() || !to_m.allFinite()) return StockStatus::kInAir;
-  const double r = cutter.radius_m();
-  const int i0 = std::max(0, static_cast<int>(std::floor((std::min(from_m.x(), to_m.x()) - r - x0_m_) / cell_m_)));
-  const int i1 = std::min(nx_ - 1, static_cast<int>(std::ceil((std::max(from_m.x(), to_m.x()) + r - x0_m_) / cell_m_)));
-  const int j0 = std::max(0, static_cast<int>(std::floor((std::min(from_m.y(), to_m.y()) - r - y0_m_) / cell_m_)));
-  const int j1 = std::min(ny_ - 1, static_cast<int>(std::ceil((std::max(from_m.y(), to_m.y()) + r - y0_m_) / cell_m_)));
+  const double r = cutter.radius_m(), rc = cutter.corner_radius_m;
+  const bool level = std::abs(to_m.z() - from_m.z()) <= 1e-12;
+  const Eigen::Vector2d a = from_m.head<2>(), b = to_m.head<2>();
+  const int j0 = std::max(0, static_cast<int>(std::floor((std::min(a.y(), b.y()) - r - y0_m_) / cell_m_)));
+  const int j1 = std::min(ny_ - 1, static_cast<int>(std::ceil((std::max(a.y(), b.y()) + r - y0_m_) / cell_m_)));
   const double lowest_tip = std::min(from_m.z(), to_m.z());
+  const bool continues =
+      level && last_level_end_ && *last_level_end_ == from_m && last_corner_m_ == rc && last_radius_m_ == r;
   double removed = 0.0;
+  auto lower = [&](float& node, double cut) {
+    if (cut < node) {
+      const float lowered = static_cast<float>(std::max(cut, bottom_m_));
+      removed += node - lowered;
+      node = lowered;
+    }
+  };
+  auto node_range = [&](double xl, double xr, int& i0, int& i1) {
+    i0 = std::max(0, static_cast<int>(std::ceil((xl - x0_m_) / cell_m_)));
+    i1 = std::min(nx_ - 1, static_cast<int>(std::floor((xr - x0_m_) / cell_m_)));
+  };
   for (int j = j0; j <= j1; ++j) {
     float* row = heights_m_.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(nx_);
     const double y = y0_m_ + j * cell_m_;
-    for (int i = i0; i <= i1; ++i) {
-      const double h = row[i];
-      if (h <= lowest_tip) continue;  // already below anything the cutter reaches
-      const double cut = lowest_cutter_surface_m(cutter, from_m, to_m, x0_m_ + i * cell_m_, y);
-      if (cut < h) {
-        const float lowered = static_cast<float>(std::max(cut, bottom_m_));
-        removed += h - lowered;
-        row[i] = lowered;
+    double xl = 0.0, xr = 0.0;
+    if (!stadium_row(a, b, r, y, xl, xr)) continue;
+    int i0 = 0, i1 = -1;
+    node_range(xl, xr, i0, i1);
+    if (level) {
+      // The flat part of the end at the tip's height over the inner stadium, the corner node by node.
+      // When the last move ended here at this height, its end disc is already down to the tip's height.
+      double il = 0.0, ir = -1.0;
+      const bool inner = stadium_row(a, b, r - rc, y, il, ir);
+      int k0 = i1 + 1, k1 = i1;
+      if (inner) node_range(il, ir, k0, k1);
+      int s0 = k1 + 1, s1 = k1;
+      double dl = 0.0, dr = -1.0;
+      if (continues && stadium_row(a, a, r - rc, y, dl, dr)) node_range(dl, dr, s0, s1);
+      for (int i = k0; i <= k1; ++i) {
+        if (i == s0 && s0 <= s1) i = s1 + 1;
+        if (i > k1) break;
+        lower(row[i], from_m.z());
       }
+      for (int i = i0; i <= i1; ++i) {
+        if (i == k0 && k0 <= k1) i = k1 + 1;
+        if (i > i1) break;
+        if (row[i] > lowest_tip) lower(row[i], lowest_cutter_surface_m(cutter, from_m, to_m, x0_m_ + i * cell_m_, y));
+      }
+      continue;
+    }
+    for (int i = i0; i <= i1; ++i) {
+      if (row[i] <= lowest_tip) continue;  // already below anything the cutter reaches
+      lower(row[i], lowest_cutter_surface_m(cutter, from_m, to_m, x0_m_ + i * cell_m_, y));
     }
   }
   removed *= cell_m_ * cell_m_;
   removed_m3_ += removed;
+  if (level) {
+    last_level_end_ = to_m;
+    last_radius_m_ = r;
+    last_corner_m_ = rc;
+  } else {
+    last_level_end_.reset();
+  }
   return removed > 0.0 ? StockStatus::kCut : StockStatus::kInAir;
 }
 

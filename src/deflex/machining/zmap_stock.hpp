@@ -13,6 +13,7 @@
 //   direction, so a wall's position is exact whatever the spacing.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "deflex/machining/detail/engagement_sampling.hpp"
@@ -61,6 +62,10 @@ class ZMapStock final : public Stock {
   std::vector<float> heights_m_;
   double removed_m3_ = 0.0;
   detail::SamplingOptions sampling_;
+  // The end of the last level move and its cutter: a move that starts there at that height skips the
+  // flat of its start disc, which that move left at the tip's height.
+  std::optional<Vector3> last_level_end_;
+  double last_radius_m_ = 0.0, last_corner_m_ = 0.0;
 };
 
 /// The lowest point of the cutter's surface over (px, py) while its tip moves from a to b with a
