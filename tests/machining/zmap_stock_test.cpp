@@ -108,6 +108,35 @@ TEST(ZMapStock, M4TurnsConventionalIntoClimb) {
   EXPECT_NEAR(r.last.exit_rad, kPi, 1e-12);  // the teeth leave the material where the chip is thinnest
 }
 
+TEST(ZMapStock, AMoveInStepsCutsWhatTheWholeMoveCuts) {
+  // Level moves that continue one another skip their start disc's flat; the surface must be the same
+  // as one move's, for a flat end and a bull nose, along x and diagonally, cell-aligned or not.
+  for (double corner_mm : {0.0, 2.0}) {
+    for (const Vector3& to_mm : {Vector3(90.0, 25.03, 15.0), Vector3(80.0, 41.0, 12.5)}) {
+      const Cutter c = end_mill(corner_mm);
+      const Vector3 from_mm(3.0, 8.0, to_mm.z());
+      ZMapStock whole = block(), steps = block();
+      ASSERT_EQ(whole.remove_swept(c, from_mm * 1e-3, to_mm * 1e-3, Vector3::UnitZ()), StockStatus::kCut);
+      Vector3 prev = from_mm * 1e-3;
+      for (int i = 1; i <= 37; ++i) {
+        const Vector3 p = (from_mm + (to_mm - from_mm) * (i / 37.0)) * 1e-3;
+        (void)steps.remove_swept(c, prev, p, Vector3::UnitZ());
+        prev = p;
+      }
+      double worst = 0.0;
+      for (int j = 0; j <= 500; ++j) {
+        for (int i = 0; i <= 1000; ++i) {
+          worst = std::max(worst, std::abs(whole.height_m(i * 1e-4, j * 1e-4) - steps.height_m(i * 1e-4, j * 1e-4)));
+        }
+      }
+      // A node's closest point on the whole move lies on one of the steps: the same surface, to the
+      // float heights' rounding.
+      EXPECT_LT(worst, 1e-8) << corner_mm << " " << to_mm.transpose();
+      EXPECT_NEAR(whole.removed_volume_m3(), steps.removed_volume_m3(), 1e-3 * whole.removed_volume_m3());
+    }
+  }
+}
+
 TEST(ZMapStock, APassInAirTouchesNothingAndSaysSo) {
   ZMapStock stock = block();
   const PassResult above = pass(stock, end_mill(), {-10, 25, 21}, {110, 25, 21}, 50.0);

@@ -238,7 +238,8 @@ StockStatus ZMapStock::remove_swept(const Cutter& cutter, const Vector3& from_m,
       if (inner) node_range(il, ir, k0, k1);
       int s0 = k1 + 1, s1 = k1;
       double dl = 0.0, dr = -1.0;
-      if (continues && stadium_row(a, a, r - rc, y, dl, dr)) node_range(dl, dr, s0, s1);
+      // (1 nm inside it: a node on its rim may have fallen outside the last move's band by rounding)
+      if (continues && stadium_row(a, a, r - rc - 1e-9, y, dl, dr)) node_range(dl, dr, s0, s1);
       for (int i = k0; i <= k1; ++i) {
         if (i == s0 && s0 <= s1) i = s1 + 1;
         if (i > k1) break;
