@@ -4,6 +4,7 @@
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
+#include "deflex/machining/dexel_stock.hpp"
 #include "deflex/machining/milling_force.hpp"
 #include "deflex/machining/zmap_stock.hpp"
 
@@ -96,6 +97,34 @@ void BM_SideCutPoint(benchmark::State& state) {
   state.SetLabel(fmt::format("cell {:g} mm, step {:g} mm", cell_m * 1e3, step_m * 1e3));
 }
 BENCHMARK(BM_SideCutPoint)->Args({500, 1000})->Args({100, 1000})->Args({50, 1000})->Args({100, 100});
+
+/// The same pass on the dexel stock: cell and layer spacing from the first argument (um).
+void BM_DexelSideCutPoint(benchmark::State& state) {
+  const double cell_m = static_cast<double>(state.range(0)) * 1e-6, step_m = 1e-3;
+  DexelStock fresh = DexelStock::box(Vector3(0, 0, 0), Vector3(0.2, 0.1, 0.03), cell_m, cell_m);
+  const MillingCut c = cut();
+  (void)fresh.remove_swept(c.cutter, Vector3(-0.01, 0.05, 0.025), Vector3(0.21, 0.05, 0.025), Vector3::UnitZ());
+  DexelStock stock = fresh;
+  CutFrame frame;
+  (void)make_cut_frame(Vector3::UnitZ(), Vector3::UnitX(), frame);
+  Engagement e;
+  Vector3 at(0.02, 0.053, 0.025);
+  for (auto _ : state) {
+    const Vector3 next = at + Vector3(step_m, 0, 0);
+    (void)stock.engagement(c.cutter, frame, next, SpindleTurn::kClockwise, e);
+    benchmark::DoNotOptimize(average_milling_force(c, e));
+    (void)stock.remove_swept(c.cutter, at, next, Vector3::UnitZ());
+    at = next;
+    if (at.x() > 0.18) {
+      state.PauseTiming();
+      stock = fresh;
+      at = Vector3(0.02, 0.053, 0.025);
+      state.ResumeTiming();
+    }
+  }
+  state.SetLabel(fmt::format("cell and layer {:g} mm, step 1 mm", cell_m * 1e3));
+}
+BENCHMARK(BM_DexelSideCutPoint)->Arg(500)->Arg(250)->Arg(100);
 
 }  // namespace
 

@@ -7,69 +7,16 @@
 
 #include <fmt/format.h>
 
+#include "deflex/machining/detail/cutter_sweep.hpp"
 #include "deflex/text/errors.hpp"
 
 namespace deflex {
+using detail::kInf;
+using detail::profile;
+using detail::stadium_row;
+
 namespace {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
-/// The cutter's lower surface above its tip at distance d from its axis: 0 on the flat part, the
-/// corner's arc beyond R - rc, +inf outside the cutter.
-double profile(double d, double radius, double rc) noexcept {
-  if (d > radius) return kInf;
-  const double flat = radius - rc;
-  if (d <= flat) return 0.0;
-  const double u = d - flat;
-  return rc - std::sqrt(std::max(0.0, rc * rc - u * u));
-}
-
-/// The x-interval of the line at height y (in the plane) within `radius` of the segment a..b (a
-/// stadium, convex, so one interval): the two end discs and the band along the segment. False when
-/// the line misses it.
-bool stadium_row(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double radius, double y, double& xl,
-                 double& xr) noexcept {
-  if (radius < 0.0) return false;
-  xl = std::numeric_limits<double>::infinity();
-  xr = -xl;
-  for (const Eigen::Vector2d& c : {a, b}) {
-    const double dy = y - c.y(), w2 = radius * radius - dy * dy;
-    if (w2 >= 0.0) {
-      const double w = std::sqrt(w2);
-      xl = std::min(xl, c.x() - w);
-      xr = std::max(xr, c.x() + w);
-    }
-  }
-  // The band: 0 <= t(x) <= 1 and |distance to the segment's line| <= radius, both linear in x.
-  const Eigen::Vector2d d = b - a;
-  const double len = d.norm();
-  if (len > 0.0) {
-    double lo = -std::numeric_limits<double>::infinity(), hi = -lo;
-    auto clip = [&](double slope, double offset, double min, double max) {  // min <= slope x + offset <= max
-      if (std::abs(slope) < 1e-300) {
-        if (offset < min || offset > max) hi = lo - 1.0;
-        return;
-      }
-      const double x1 = (min - offset) / slope, x2 = (max - offset) / slope;
-      lo = std::max(lo, std::min(x1, x2));
-      hi = std::min(hi, std::max(x1, x2));
-    };
-    const double ry = y - a.y();
-    clip(d.x() / (len * len), (-a.x() * d.x() + ry * d.y()) / (len * len), 0.0, 1.0);
-    clip(d.y() / len, (-a.x() * d.y() - ry * d.x()) / len, -radius, radius);
-    if (hi >= lo) {
-      xl = std::min(xl, lo);
-      xr = std::max(xr, hi);
-    }
-  }
-  return xr >= xl;
-}
-
-bool vertical(const Vector3& axis) noexcept {
-  const double n = axis.norm();
-  return axis.allFinite() && n > 0.0 && axis.z() / n >= std::cos(ZMapStock::kMaxTiltRad);
-}
-
+bool vertical(const Vector3& axis) noexcept { return detail::vertical(axis, ZMapStock::kMaxTiltRad); }
 }  // namespace
 
 double lowest_cutter_surface_m(const Cutter& cutter, const Vector3& a, const Vector3& b, double px,
@@ -178,6 +125,14 @@ double ZMapStock::height_m(double x, double y) const noexcept {
   const float* row = heights_m_.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(nx_) + i;
   const double h00 = row[0], h10 = row[1], h01 = row[nx_], h11 = row[nx_ + 1];
   return (1.0 - fv) * ((1.0 - fu) * h00 + fu * h10) + fv * ((1.0 - fu) * h01 + fu * h11);
+}
+
+double ZMapStock::max_node_height_m(double x, double y) const noexcept {
+  if (!(x >= x0_m_ && x <= x1_m_ && y >= y0_m_ && y <= y1_m_)) return bottom_m_;
+  const int i = std::clamp(static_cast<int>((x - x0_m_) / cell_m_), 0, nx_ - 2);
+  const int j = std::clamp(static_cast<int>((y - y0_m_) / cell_m_), 0, ny_ - 2);
+  const float* row = heights_m_.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(nx_) + i;
+  return std::max({row[0], row[1], row[nx_], row[nx_ + 1]});
 }
 
 StockStatus ZMapStock::engagement(const Cutter& cutter, const CutFrame& frame, const Vector3& tip_m, SpindleTurn turn,

@@ -46,6 +46,8 @@ class ZMapStock final : public Stock {
 
   /// The top of the material at (x, y), bilinear between nodes; the bottom outside the footprint.
   [[nodiscard]] double height_m(double x, double y) const noexcept;
+  /// The highest of the four nodes around (x, y); the bottom outside the footprint.
+  [[nodiscard]] double max_node_height_m(double x, double y) const noexcept;
   [[nodiscard]] double bottom_m() const noexcept { return bottom_m_; }
   [[nodiscard]] double cell_m() const noexcept { return cell_m_; }
   [[nodiscard]] int nx() const noexcept { return nx_; }
