@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 
 #include "deflex/machining/detail/cutter_sweep.hpp"
+#include "deflex/machining/detail/engagement_sampling.hpp"
 #include "deflex/text/errors.hpp"
 
 namespace deflex {
@@ -51,10 +52,10 @@ DexelStock DexelStock::box(const Vector3& min_m, const Vector3& max_m, double ce
   full_y.ends[1] = static_cast<float>(max_m.y());
   for (int k = 0; k < nz; ++k) {
     for (int j = 0; j < s.ny_; ++j) {
-      if (min_m.y() + j * cell_m <= max_m.y() + 1e-12) s.along_x_[static_cast<std::size_t>(k * s.ny_ + j)] = full_x;
+      if (min_m.y() + j * cell_m <= max_m.y() + 1e-12) s.along_x_[index(k, s.ny_, j)] = full_x;
     }
     for (int i = 0; i < s.nx_; ++i) {
-      if (min_m.x() + i * cell_m <= max_m.x() + 1e-12) s.along_y_[static_cast<std::size_t>(k * s.nx_ + i)] = full_y;
+      if (min_m.x() + i * cell_m <= max_m.x() + 1e-12) s.along_y_[index(k, s.nx_, i)] = full_y;
     }
   }
   return s;
@@ -74,45 +75,40 @@ DexelStock::DexelStock(ZMapStock top, double min_x, double min_y, double min_z, 
       along_y_(static_cast<std::size_t>(nz) * static_cast<std::size_t>(nx_)) {}
 
 void DexelStock::subtract(Line& line, double lo, double hi) noexcept {
-  std::array<double, 2 * kMaxIntervals + 2> out{};
-  int n = 0;
+  std::array<double, 2 * static_cast<std::size_t>(kMaxIntervals) + 2> out{};
+  std::size_t n = 0;
   bool changed = false;
   for (int i = 0; i < line.count; ++i) {
-    const double a = line.ends[static_cast<std::size_t>(2 * i)], b = line.ends[static_cast<std::size_t>(2 * i + 1)];
+    const double a = line.lo(i), b = line.hi(i);
     if (b <= lo || a >= hi) {
-      out[static_cast<std::size_t>(n++)] = a;
-      out[static_cast<std::size_t>(n++)] = b;
+      out[n++] = a;
+      out[n++] = b;
       continue;
     }
     changed = true;
     if (a < lo) {
-      out[static_cast<std::size_t>(n++)] = a;
-      out[static_cast<std::size_t>(n++)] = lo;
+      out[n++] = a;
+      out[n++] = lo;
     }
     if (b > hi) {
-      out[static_cast<std::size_t>(n++)] = hi;
-      out[static_cast<std::size_t>(n++)] = b;
+      out[n++] = hi;
+      out[n++] = b;
     }
   }
   if (!changed) return;
-  int count = n / 2;
-  if (count > kMaxIntervals) {
+  if (n / 2 > static_cast<std::size_t>(kMaxIntervals)) {
     // Keep the material of the narrowest gap: the line then holds a sliver too much, never too little.
     ++overflows_;
-    int best = 0;
-    for (int g = 1; g + 1 < count; ++g) {
-      if (out[static_cast<std::size_t>(2 * g + 2)] - out[static_cast<std::size_t>(2 * g + 1)] <
-          out[static_cast<std::size_t>(2 * best + 2)] - out[static_cast<std::size_t>(2 * best + 1)]) {
-        best = g;
-      }
+    std::size_t best = 0;  // gap g lies between out[2 g + 1] and out[2 g + 2]
+    for (std::size_t g = 1; g + 1 < n / 2; ++g) {
+      if (out[2 * g + 2] - out[2 * g + 1] < out[2 * best + 2] - out[2 * best + 1]) best = g;
     }
-    std::copy(out.begin() + 2 * best + 3, out.begin() + n, out.begin() + 2 * best + 1);
+    std::copy(out.begin() + static_cast<std::ptrdiff_t>(2 * best + 3), out.begin() + static_cast<std::ptrdiff_t>(n),
+              out.begin() + static_cast<std::ptrdiff_t>(2 * best + 1));
     n -= 2;
-    count = n / 2;
   }
-  line.count = static_cast<std::uint8_t>(count);
-  for (int i = 0; i < n; ++i)
-    line.ends[static_cast<std::size_t>(i)] = static_cast<float>(out[static_cast<std::size_t>(i)]);
+  line.count = static_cast<std::uint8_t>(n / 2);
+  for (std::size_t i = 0; i < n; ++i) line.ends[i] = static_cast<float>(out[i]);
 }
 
 /// Removes from layers k0..k1 - 1 the stadium of radius `radius` around the segment a..b (the
@@ -127,7 +123,7 @@ void DexelStock::cut_layers(int k0, int k1, const Eigen::Vector2d& a, const Eige
   for (int j = j0; j <= j1; ++j) {
     double lo = 0.0, hi = 0.0;
     if (detail::stadium_row(a, b, radius, min_y_ + j * cell_, lo, hi)) {
-      for (int k = k0; k < k1; ++k) subtract(along_x_[static_cast<std::size_t>(k * ny_ + j)], lo, hi);
+      for (int k = k0; k < k1; ++k) subtract(along_x_[index(k, ny_, j)], lo, hi);
     }
   }
   const Eigen::Vector2d at(a.y(), a.x()), bt(b.y(), b.x());  // the same with x and y swapped
@@ -136,7 +132,7 @@ void DexelStock::cut_layers(int k0, int k1, const Eigen::Vector2d& a, const Eige
   for (int i = i0; i <= i1; ++i) {
     double lo = 0.0, hi = 0.0;
     if (detail::stadium_row(at, bt, radius, min_x_ + i * cell_, lo, hi)) {
-      for (int k = k0; k < k1; ++k) subtract(along_y_[static_cast<std::size_t>(k * nx_ + i)], lo, hi);
+      for (int k = k0; k < k1; ++k) subtract(along_y_[index(k, nx_, i)], lo, hi);
     }
   }
 }
@@ -195,12 +191,12 @@ DexelStock::WallProbe DexelStock::probe(const std::vector<Line>& lines, int line
   const double w = std::clamp(v - j0, 0.0, 1.0);
   double signed_distance[2] = {0.0, 0.0}, end[2] = {0.0, 0.0};
   for (int s = 0; s < 2; ++s) {
-    const Line& line = lines[static_cast<std::size_t>(k * lines_per_layer + j0 + s)];
+    const Line& line = lines[index(k, lines_per_layer, j0 + s)];
     if (line.count == 0) return p;
     double nearest = 1e300;
     bool in = false;
     for (int i = 0; i < line.count; ++i) {
-      const double lo = line.ends[static_cast<std::size_t>(2 * i)], hi = line.ends[static_cast<std::size_t>(2 * i + 1)];
+      const double lo = line.lo(i), hi = line.hi(i);
       in = in || (along >= lo && along <= hi);
       for (double e : {lo, hi}) {
         if (std::abs(along - e) < nearest) {
@@ -256,19 +252,19 @@ StockStatus DexelStock::engagement(const Cutter& cutter, const CutFrame& frame, 
 DexelStock::Intervals DexelStock::intervals(const Line& line) const {
   Intervals out;
   for (int i = 0; i < line.count; ++i) {
-    out.emplace_back(line.ends[static_cast<std::size_t>(2 * i)], line.ends[static_cast<std::size_t>(2 * i + 1)]);
+    out.emplace_back(line.lo(i), line.hi(i));
   }
   return out;
 }
 
 DexelStock::Intervals DexelStock::along_x(double y_m, double z_m) const {
   const int j = std::clamp(static_cast<int>(std::lround((y_m - min_y_) / cell_)), 0, ny_ - 1);
-  return intervals(along_x_[static_cast<std::size_t>(layer_of(z_m) * ny_ + j)]);
+  return intervals(along_x_[index(layer_of(z_m), ny_, j)]);
 }
 
 DexelStock::Intervals DexelStock::along_y(double x_m, double z_m) const {
   const int i = std::clamp(static_cast<int>(std::lround((x_m - min_x_) / cell_)), 0, nx_ - 1);
-  return intervals(along_y_[static_cast<std::size_t>(layer_of(z_m) * nx_ + i)]);
+  return intervals(along_y_[index(layer_of(z_m), nx_, i)]);
 }
 
 std::string DexelStock::describe() const {

@@ -60,7 +60,9 @@ class DexelStock final : public Stock {
  private:
   struct Line {
     std::uint8_t count = 0;
-    std::array<float, 2 * kMaxIntervals> ends{};  // lo0, hi0, lo1, hi1, ... sorted, disjoint
+    [[nodiscard]] double lo(int i) const { return ends[2 * static_cast<std::size_t>(i)]; }
+    [[nodiscard]] double hi(int i) const { return ends[2 * static_cast<std::size_t>(i) + 1]; }
+    std::array<float, 2 * static_cast<std::size_t>(kMaxIntervals)> ends{};  // lo0, hi0, lo1, hi1, ... sorted, disjoint
   };
   /// The signed distance to the wall at a point of a layer, from one family of lines (see .cpp).
   struct WallProbe {
@@ -77,6 +79,10 @@ class DexelStock final : public Stock {
                                 double across) const noexcept;
   [[nodiscard]] double inside_m(int k, double x, double y, bool& ok) const noexcept;
   [[nodiscard]] int layer_of(double z) const noexcept;
+  /// The line along x on row j of layer k, along y on column i of layer k.
+  [[nodiscard]] static std::size_t index(int k, int per_layer, int j) noexcept {
+    return static_cast<std::size_t>(k) * static_cast<std::size_t>(per_layer) + static_cast<std::size_t>(j);
+  }
   [[nodiscard]] Intervals intervals(const Line& line) const;
 
   ZMapStock top_;
@@ -85,7 +91,7 @@ class DexelStock final : public Stock {
   std::vector<Line> along_x_;  // row j of layer k at k * ny_ + j
   std::vector<Line> along_y_;  // column i of layer k at k * nx_ + i
   std::size_t overflows_ = 0;
-  detail::SamplingOptions sampling_{64, 20, 10e-6, 1e-6};  // arc ends to pi / 64 / 2^20
+  EngagementSampling sampling_{64, 20, 10e-6, 1e-6};  // arc ends to pi / 64 / 2^20
 };
 
 }  // namespace deflex

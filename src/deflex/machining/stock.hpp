@@ -24,6 +24,17 @@ enum class StockStatus {
   kUnsupportedAxis,  ///< this representation cannot follow the tool axis (a height map: 3-axis only)
 };
 
+/// How a stock's engagement query samples the cutter's circle (detail/engagement_sampling.hpp): the
+/// front half at `samples` + 1 angles (4..256), each arc's ends bisected `refine_steps` times; samples
+/// whose material extents agree within `depth_tolerance_m` (or 1 % of the depth) share a patch;
+/// material thinner than `min_depth_m` is air (a floor the tip rides on).
+struct EngagementSampling {
+  int samples = 64;
+  int refine_steps = 12;
+  double depth_tolerance_m = 10e-6;
+  double min_depth_m = 1e-6;
+};
+
 /// Thread safety: queries are const and may run on several threads at once; a move (remove_swept)
 /// needs the stock to itself.
 class Stock {

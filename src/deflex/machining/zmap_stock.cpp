@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "deflex/machining/detail/cutter_sweep.hpp"
+#include "deflex/machining/detail/engagement_sampling.hpp"
 #include "deflex/text/errors.hpp"
 
 namespace deflex {

@@ -16,7 +16,6 @@
 #include <optional>
 #include <vector>
 
-#include "deflex/machining/detail/engagement_sampling.hpp"
 #include "deflex/machining/stock.hpp"
 
 namespace deflex {
@@ -52,9 +51,9 @@ class ZMapStock final : public Stock {
   [[nodiscard]] double cell_m() const noexcept { return cell_m_; }
   [[nodiscard]] int nx() const noexcept { return nx_; }
   [[nodiscard]] int ny() const noexcept { return ny_; }
-  /// The engagement query's sampling (detail/engagement_sampling.hpp); the defaults resolve an arc's
+  /// The engagement query's sampling (stock.hpp); the defaults resolve an arc's
   /// ends to 0.001 deg and take 65 samples.
-  void set_sampling(const detail::SamplingOptions& options) noexcept { sampling_ = options; }
+  void set_sampling(const EngagementSampling& options) noexcept { sampling_ = options; }
 
  private:
   double x0_m_, y0_m_, cell_m_;
@@ -63,7 +62,7 @@ class ZMapStock final : public Stock {
   double bottom_m_;
   std::vector<float> heights_m_;
   double removed_m3_ = 0.0;
-  detail::SamplingOptions sampling_;
+  EngagementSampling sampling_;
   // The end of the last level move and its cutter: a move that starts there at that height skips the
   // flat of its start disc, which that move left at the tip's height.
   std::optional<Vector3> last_level_end_;

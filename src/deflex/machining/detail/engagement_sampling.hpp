@@ -14,16 +14,10 @@
 
 #include "deflex/machining/engagement.hpp"
 #include "deflex/machining/milling_force.hpp"
+#include "deflex/machining/stock.hpp"
 #include "deflex/model/types.hpp"
 
 namespace deflex::detail {
-
-struct SamplingOptions {
-  int samples = 64;                  ///< angles over the front half (pi / samples apart)
-  int refine_steps = 12;             ///< bisection steps at each arc end (pi / samples / 2^steps)
-  double depth_tolerance_m = 10e-6;  ///< extents closer than this (or 1 % of the depth) share a patch
-  double min_depth_m = 1e-6;         ///< thinner material than this is air (a floor the tip rides on)
-};
 
 inline constexpr int kMaxSamples = 256;
 
@@ -50,7 +44,7 @@ inline const AngleTable& angle_table(int samples) {
 /// stock's z (3-axis), the frame's feed and normal lie in its xy plane.
 template <class Extent>
 void sample_engagement(double radius_m, const CutFrame& frame, const Vector3& tip_m, SpindleTurn turn,
-                       const SamplingOptions& opt, const Extent& extent, Engagement& out) noexcept {
+                       const EngagementSampling& opt, const Extent& extent, Engagement& out) noexcept {
   out.clear();
   const int k = std::clamp(opt.samples, 4, kMaxSamples);
   const AngleTable& table = angle_table(k);
@@ -85,7 +79,7 @@ void sample_engagement(double radius_m, const CutFrame& frame, const Vector3& ti
       continue;
     }
     int first = i;
-    while (i + 1 <= k && in[static_cast<std::size_t>(i + 1)]) ++i;
+    while (i + 1 <= k && in[static_cast<std::size_t>(i) + 1]) ++i;
     int last = i++;
     // An arc ends where the material is half as deep as next to it: a sample on a wall's ramp (a
     // height map's last cell) belongs to neither side, so it is left out of the arc and its patches.
@@ -103,8 +97,8 @@ void sample_engagement(double radius_m, const CutFrame& frame, const Vector3& ti
       int end = start;
       const auto u0 = static_cast<std::size_t>(start);
       const double tol = std::max(opt.depth_tolerance_m, 0.01 * (hi[u0] - lo[u0]));
-      while (end + 1 <= last && std::abs(hi[static_cast<std::size_t>(end + 1)] - hi[u0]) <= tol &&
-             std::abs(lo[static_cast<std::size_t>(end + 1)] - lo[u0]) <= tol) {
+      while (end + 1 <= last && std::abs(hi[static_cast<std::size_t>(end) + 1] - hi[u0]) <= tol &&
+             std::abs(lo[static_cast<std::size_t>(end) + 1] - lo[u0]) <= tol) {
         ++end;
       }
       for (int j = start; j <= end; ++j) {
