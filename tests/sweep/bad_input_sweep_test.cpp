@@ -275,6 +275,32 @@ std::vector<BadInput> file_cases() {
                  "online --link egm-path --egm-port 0 --force-source csv:{F} --duration-s 0.1", "fx_N", true},
                 cases);
 
+  // A slot-cut log of `cutting-coefficients`, beside a good second cut.
+  const std::string slot_cut =
+      " --cut log={S}/examples/machining/slot_cuts/slot_1800.csv,F_mm_min=1800,S_rpm=9000,ap_mm=4";
+  add_csv_cases({"slot_log", read("examples/machining/slot_cuts/slot_900.csv"),
+                 "cutting-coefficients --cutter diameter_mm=10,flutes=3 -o {D}/k.yaml --cut "
+                 "log={F},F_mm_min=900,S_rpm=9000,ap_mm=4" +
+                     slot_cut,
+                 "fy_N", true},
+                cases);
+  for (const auto& [tag, cut, cutter, says] :
+       std::vector<std::tuple<std::string, std::string, std::string, std::string>>{
+           {"zero_feed", "F_mm_min=0,S_rpm=9000,ap_mm=4", "diameter_mm=10,flutes=3", "'F_mm_min': 0 mm/min"},
+           {"zero_spindle", "F_mm_min=900,S_rpm=0,ap_mm=4", "diameter_mm=10,flutes=3", "'S_rpm': 0 rpm"},
+           {"no_flutes", "F_mm_min=900,S_rpm=9000,ap_mm=4", "diameter_mm=10,flutes=0", "flutes: 0 is not 1..32"},
+           {"same_feed", "F_mm_min=1800,S_rpm=9000,ap_mm=4", "diameter_mm=10,flutes=3", "two different feeds"},
+           {"tool_axis_twice", "F_mm_min=900,S_rpm=9000,ap_mm=4,feed_axis=z", "diameter_mm=10,flutes=3",
+            "two different axes"}}) {
+    cases.push_back({"slot_cut_" + tag,
+                     "cutting-coefficients --cutter " + cutter +
+                         " -o {D}/k.yaml --cut log={S}/examples/machining/"
+                         "slot_cuts/slot_900.csv," +
+                         cut + slot_cut,
+                     {},
+                     {says}});
+  }
+
   {
     // In-range forces 10,000 times the example's: a payload of some 85 t, which online would refuse,
     // so identify-payload must not write it.
