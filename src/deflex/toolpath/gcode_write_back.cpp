@@ -18,18 +18,23 @@
 #include "deflex/toolpath/toolpath_reader.hpp"
 
 namespace deflex {
-namespace {
 
-using detail::GcodeWord;
-
-int wb_code(const GcodeWord& w) { return static_cast<int>(std::lround(w.value * 10.0)); }
-
-/// One change to a line: bytes [begin, end) become `text` (an insertion when begin == end).
-struct LineEdit {
+namespace detail {
+/// One change to a line: bytes [begin, end) become `text` (an insertion when begin == end). Outside the
+/// anonymous namespace: GcodeWriteBack::Impl keeps a vector of them.
+struct GcodeLineEdit {
   std::size_t begin;
   std::size_t end;
   std::string text;
 };
+}  // namespace detail
+
+namespace {
+
+using detail::GcodeWord;
+using LineEdit = detail::GcodeLineEdit;
+
+int wb_code(const GcodeWord& w) { return static_cast<int>(std::lround(w.value * 10.0)); }
 
 /// Writes `line` with `edits` applied into `out` (cleared first).
 void wb_apply(std::string_view line, std::vector<LineEdit>& edits, std::string& out) {
