@@ -46,8 +46,21 @@ std::string first_matching(std::vector<std::string> paths, const std::string& pa
   return paths.empty() ? std::string() : paths.front();
 }
 
-// A one-line progress bar on stderr, redrawn in place.
+// Progress on stderr: on a terminal a bar redrawn in place; into a log or a pipe a plain line at each
+// tenth of the way (a carriage-return bar would leave one line of some 50 kB there). Called under the
+// study's progress lock.
 void draw_progress(double fraction, const std::string& label) {
+  static const bool terminal = ::isatty(STDERR_FILENO) != 0;
+  if (!terminal) {
+    static int tenths_shown = -1;
+    const int tenths = static_cast<int>(std::floor(fraction * 10.0 + 1e-9));
+    if (tenths > tenths_shown) {
+      tenths_shown = tenths;
+      std::fprintf(stderr, "deflex case-study: %3d %% %s\n", tenths * 10, label.c_str());
+      std::fflush(stderr);
+    }
+    return;
+  }
   constexpr int kWidth = 32;
   const int filled = static_cast<int>(std::lround(fraction * kWidth));
   std::string bar(static_cast<std::size_t>(filled), '#');
@@ -94,7 +107,7 @@ void run(const CaseStudyOpts& o, int& exit_code) {
   std::cerr << fmt::format("deflex case-study: {} ({} seed{} from {}{})\n", config.name, seeds, seeds == 1 ? "" : "s",
                            config.seed, o.quick ? ", quick" : "");
   const study::CaseStudyOutput result = study::run_case_study(config, options);
-  if (!o.no_progress) std::cerr << "\n";
+  if (!o.no_progress && ::isatty(STDERR_FILENO) != 0) std::cerr << "\n";
 
   // The case file's text goes into the report as it is, and its notes read what it marks as tuned.
   const ReportContent report = study::case_report(
