@@ -231,7 +231,7 @@ std::vector<BadInput> output_cases() {
                    "case-study --quick --seeds 1 --no-sweep --no-budget --no-progress "
                    "--out {D}/report.txt",
                    {{"report.txt", "a user's file\n"}},
-                   {"option --out", "cannot create the folder"}});
+                   {"option --out", "report.txt' is not a directory"}});
   // stdout that cannot be written: the job failed, said on stderr.
   for (const auto& [tag, args] : std::vector<std::pair<std::string, std::string>>{
            {"fk", "fk --joints-deg 0,30,10,0,50,0"},
