@@ -347,6 +347,70 @@ void check_position(const TrackerPoint& p, const Layout& l, const std::array<std
   }
 }
 
+// One point of an SA export from its fields in the file's layout: names joined with "::", the time
+// (seconds or a date and time), the position in m, checked against the length range.
+TrackerPoint read_point(const std::vector<std::string>& f, int line, const Layout& l, double length, double angle,
+                        const TrackerFile& file, int unit_line, const std::string& source) {
+  TrackerPoint p;
+  p.line = line;
+  std::array<double, 4> v{kNaN, kNaN, kNaN, 0.0};
+  std::array<std::size_t, 3> field_of{};  // the field each of v[0..2] came from
+  for (std::size_t k = 0; k < f.size(); ++k) {
+    const Col c = l.cols[k];
+    const std::string col_name = k < l.names.size() ? l.names[k] : fmt::format("field {}", k + 1);
+    if (c == Col::kName) {
+      if (f[k].empty()) fail_at(source, line, fmt::format("field {} (a name) is empty", k + 1));
+      p.name += (p.name.empty() ? "" : "::") + f[k];
+      continue;
+    }
+    if (c == Col::kIgnored) continue;
+    if (c == Col::kTime) {
+      if (const auto dt = date_time(f[k])) {
+        p.t_s = *dt;
+        continue;
+      }
+    }
+    const auto value = parse_double(f[k]);
+    if (!value) {
+      fail_at(source, line,
+              fmt::format("field {} ({}): {}", k + 1, col_name,
+                          c == Col::kTime ? fmt::format("'{}' is neither seconds nor a date and time", f[k])
+                                          : not_a_number(f[k])));
+    }
+    switch (c) {
+      case Col::kX:
+      case Col::kR:
+        v[0] = *value;
+        field_of[0] = k;
+        break;
+      case Col::kY:
+      case Col::kAzimuth:
+        v[1] = *value;
+        field_of[1] = k;
+        break;
+      case Col::kZ:
+        if (l.coordinates == "cartesian" || l.coordinates == "cylindrical") {
+          v[2] = *value;
+          field_of[2] = k;
+        }
+        break;
+      case Col::kZenith:
+      case Col::kElevation:
+        v[2] = *value;
+        field_of[2] = k;
+        break;
+      case Col::kTime:
+        p.t_s = *value;
+        break;
+      default:
+        break;
+    }
+  }
+  p.p_m = to_cartesian(l, v, length, angle);
+  check_position(p, l, field_of, file, unit_line, source);
+  return p;
+}
+
 TrackerFile parse_sa(const std::string& text, const std::string& source, const TrackerReadOptions& options) {
   TrackerFile out;
   out.source = source;
@@ -442,64 +506,7 @@ TrackerFile parse_sa(const std::string& text, const std::string& source, const T
                           options.columns.empty() && h.columns.empty() ? "inferred from the first point" : "declared",
                           expected_fields, first_data_line, expected_fields));
     }
-    TrackerPoint p;
-    p.line = line_no;
-    std::array<double, 4> v{kNaN, kNaN, kNaN, 0.0};
-    std::array<std::size_t, 3> field_of{};  // the field each of v[0..2] came from
-    for (std::size_t k = 0; k < f.size(); ++k) {
-      const Col c = layout->cols[k];
-      const std::string col_name = k < layout->names.size() ? layout->names[k] : fmt::format("field {}", k + 1);
-      if (c == Col::kName) {
-        if (f[k].empty()) fail_at(source, line_no, fmt::format("field {} (a name) is empty", k + 1));
-        p.name += (p.name.empty() ? "" : "::") + f[k];
-        continue;
-      }
-      if (c == Col::kIgnored) continue;
-      if (c == Col::kTime) {
-        if (const auto dt = date_time(f[k])) {
-          p.t_s = *dt;
-          continue;
-        }
-      }
-      const auto value = parse_double(f[k]);
-      if (!value) {
-        fail_at(source, line_no,
-                fmt::format("field {} ({}): {}", k + 1, col_name,
-                            c == Col::kTime ? fmt::format("'{}' is neither seconds nor a date and time", f[k])
-                                            : not_a_number(f[k])));
-      }
-      switch (c) {
-        case Col::kX:
-        case Col::kR:
-          v[0] = *value;
-          field_of[0] = k;
-          break;
-        case Col::kY:
-        case Col::kAzimuth:
-          v[1] = *value;
-          field_of[1] = k;
-          break;
-        case Col::kZ:
-          if (layout->coordinates == "cartesian" || layout->coordinates == "cylindrical") {
-            v[2] = *value;
-            field_of[2] = k;
-          }
-          break;
-        case Col::kZenith:
-        case Col::kElevation:
-          v[2] = *value;
-          field_of[2] = k;
-          break;
-        case Col::kTime:
-          p.t_s = *value;
-          break;
-        default:
-          break;
-      }
-    }
-    p.p_m = to_cartesian(*layout, v, length, angle);
-    check_position(p, *layout, field_of, out, h.unit_line, source);
-    out.points.push_back(std::move(p));
+    out.points.push_back(read_point(f, line_no, *layout, length, angle, out, h.unit_line, source));
     if (end == text.size()) break;
   }
   if (out.points.empty()) fail_at(source, 0, "no points (only comments or blank lines)");
