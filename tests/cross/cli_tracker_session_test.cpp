@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <sstream>
 
@@ -129,7 +130,7 @@ TEST(CliTrackerSession, TheAlignmentGivesEverythingToRebuildTheTimeMapping) {
   const double t_end = std::stod(last.substr(0, last.find(',')));
   EXPECT_NEAR(program_time(clock_s), 0.0, 0.02);
   EXPECT_NEAR(program_time(clock_s + t_end * (1.0 + drift)), t_end, 0.02);
-  EXPECT_NEAR(ppm, 50.0, 5.0);
+  EXPECT_NEAR(ppm, -50.0, 5.0);  // a tracker clock 50 ppm fast: program time runs 50 ppm slower
   EXPECT_GT(reference, clock_s);
   EXPECT_LT(reference, clock_s + t_end * (1.0 + drift));
   // In text the uncertainty has two significant digits, however small (not "+- 0.0000 s").
@@ -142,6 +143,32 @@ TEST(CliTrackerSession, TheAlignmentGivesEverythingToRebuildTheTimeMapping) {
   const auto first = digits.find_first_of("123456789");
   ASSERT_NE(first, std::string::npos) << text.out;
   EXPECT_EQ(digits.size() - first, 2u) << digits;
+}
+
+// SA on Windows exports in Windows-1252: a working frame "Caf\xE9 \xB0" (e-acute, the degree sign)
+// registered and then evaluated with the tracker's own files. The frame file held U+FFFD and
+// evaluate refused the files it came from; now both sides read the same UTF-8 name.
+TEST(CliTrackerSession, AWindows1252FrameNameRegistersAndEvaluates) {
+  TrackerSession s;
+  const std::string session = kTrackerExamples + "session/";
+  const auto cp1252 = [&](const std::string& name) {
+    std::ifstream in(session + name, std::ios::binary);
+    std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const std::string from = "AT960 Tracker";
+    text.replace(text.find(from), from.size(), "Caf\xE9 \xB0");
+    s.write(name, text);
+    return s.path(name);
+  };
+  const auto reg = run_cli("register --tracker " + cp1252("tracker_points.txt") + " --base " + session +
+                           "base_points.txt -o " + s.path("frame.yaml"));
+  ASSERT_EQ(reg.exit_code, 0) << reg.err;
+  std::ifstream frame(s.path("frame.yaml"));
+  const std::string yaml{std::istreambuf_iterator<char>(frame), std::istreambuf_iterator<char>()};
+  EXPECT_NE(yaml.find("tracker_frame: \"Caf\xC3\xA9 \xC2\xB0\""), std::string::npos) << yaml;
+  const auto ev = run_cli("evaluate --json --tracker-frame " + s.path("frame.yaml") + " --unloaded " +
+                          cp1252("unloaded.sa.txt") + " --loaded " + cp1252("loaded_uc.sa.txt"));
+  ASSERT_EQ(ev.exit_code, 0) << ev.err;
+  EXPECT_EQ(nlohmann::json::parse(ev.out)["registration"]["tracker_frame"], "Caf\xC3\xA9 \xC2\xB0");
 }
 
 TEST(CliTrackerSession, BadFilesExitTwoNamingFileAndLine) {
