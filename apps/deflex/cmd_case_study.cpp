@@ -1,4 +1,4 @@
-// `deflex case-study`: the paper's experiment on the simulated cell (issue 7): Tables 1 and 2 beside
+// `deflex case-study`: the paper's experiment on the simulated cell: Tables 1 and 2 beside
 // the paper's, Figure 5, path plots, the error budget and the HTML report.
 #include <fmt/format.h>
 
@@ -9,6 +9,9 @@
 #include <iostream>
 #include <memory>
 #include <mutex>
+#include <optional>
+
+#include <unistd.h>
 
 #include "cli_util.hpp"
 #include "command.hpp"
@@ -43,8 +46,21 @@ std::string first_matching(std::vector<std::string> paths, const std::string& pa
   return paths.empty() ? std::string() : paths.front();
 }
 
-// A one-line progress bar on stderr, redrawn in place.
+// Progress on stderr: on a terminal a bar redrawn in place; into a log or a pipe a plain line at each
+// tenth of the way (a carriage-return bar would leave one line of some 50 kB there). Called under the
+// study's progress lock.
 void draw_progress(double fraction, const std::string& label) {
+  static const bool terminal = ::isatty(STDERR_FILENO) != 0;
+  if (!terminal) {
+    static int tenths_shown = -1;
+    const int tenths = static_cast<int>(std::floor(fraction * 10.0 + 1e-9));
+    if (tenths > tenths_shown) {
+      tenths_shown = tenths;
+      std::fprintf(stderr, "deflex case-study: %3d %% %s\n", tenths * 10, label.c_str());
+      std::fflush(stderr);
+    }
+    return;
+  }
   constexpr int kWidth = 32;
   const int filled = static_cast<int>(std::lround(fraction * kWidth));
   std::string bar(static_cast<std::size_t>(filled), '#');
@@ -55,12 +71,11 @@ void draw_progress(double fraction, const std::string& label) {
 
 void run(const CaseStudyOpts& o, int& exit_code) {
   study::CaseConfig config = o.case_file.empty() ? study::paper_case() : study::load_case(o.case_file);
-  // The report's folder before the study runs, so a path that cannot be one fails at once.
-  std::error_code folder_error;
-  std::filesystem::create_directories(o.out_dir, folder_error);
-  if (folder_error) {
-    throw InputError(fmt::format("option --out '{}': cannot create the folder: {}", o.out_dir, folder_error.message()));
-  }
+  // The report's folder before the study runs, so a path that cannot be one fails at once; made as
+  // every output's folder is, and removed again if the study ends without its report.
+  OutputFolder out_folder(o.out_dir, "option --out");
+  std::optional<OutputFolder> traces_folder;
+  if (!o.traces_dir.empty()) traces_folder.emplace(o.traces_dir, "option --write-traces");
   OutputTransaction outputs;  // the report and the traces: all or none
   if (o.seed >= 0) config.seed = static_cast<std::uint64_t>(o.seed);
   study::CaseStudyOptions options;
@@ -73,9 +88,6 @@ void run(const CaseStudyOpts& o, int& exit_code) {
   std::vector<std::string> traces_written;
   std::mutex trace_mutex;
   if (!o.traces_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(o.traces_dir, ec);
-    if (ec) throw Error(fmt::format("{}: cannot create the directory: {}", o.traces_dir, ec.message()));
     options.trace_sink = [&](const std::string& name, const TrackerTrace& trace) {
       const std::string path = (std::filesystem::path(o.traces_dir) / (name + ".csv")).string();
       // The same run as a Spatial Analyzer ASCII export, as a tracker session leaves it (the simulated
@@ -95,7 +107,7 @@ void run(const CaseStudyOpts& o, int& exit_code) {
   std::cerr << fmt::format("deflex case-study: {} ({} seed{} from {}{})\n", config.name, seeds, seeds == 1 ? "" : "s",
                            config.seed, o.quick ? ", quick" : "");
   const study::CaseStudyOutput result = study::run_case_study(config, options);
-  if (!o.no_progress) std::cerr << "\n";
+  if (!o.no_progress && ::isatty(STDERR_FILENO) != 0) std::cerr << "\n";
 
   // The case file's text goes into the report as it is, and its notes read what it marks as tuned.
   const ReportContent report = study::case_report(
@@ -103,6 +115,8 @@ void run(const CaseStudyOpts& o, int& exit_code) {
       o.case_file.empty() ? study::paper_case_yaml() : read_input_file(o.case_file, InputKind::kConfig));
   write_report(report, o.out_dir, outputs);
   outputs.commit();
+  out_folder.keep();
+  if (traces_folder) traces_folder->keep();
 
   if (o.json) {
     print_json(study_to_json(result.study));

@@ -18,6 +18,7 @@
 #include "deflex/rsi/rsi_link.hpp"
 #include "deflex/runtime/link_table.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/text/output_file.hpp"
 
 namespace deflex::cli {
 namespace {
@@ -45,7 +46,7 @@ void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
   sub.add_option("--sensor-ip", o.sensor_ip,
                  "deflex's IPv4 address as the controller reaches it (the PC on the controller's network)")
       ->required();
-  sub.add_option("-o,--output-dir", o.output_dir, "Directory the files are written to (must exist)")
+  sub.add_option("-o,--output-dir", o.output_dir, "Directory the files are written to (made when missing)")
       ->capture_default_str();
   sub.add_option("--egm-port", o.egm_port, "EGM: deflex online --egm-port")->capture_default_str();
   sub.add_option("--rsi-port", o.rsi_port, "rsi: deflex online --rsi-port (the Ethernet config's PORT)")
@@ -166,10 +167,9 @@ std::vector<ControllerFile> rsi_setup_files(const ControllerSetupOpts& o) {
 
 /// Writes the files into --output-dir and lists them with where each goes (JSON with --json).
 void write_controller_setup_files(const ControllerSetupOpts& o, const std::vector<ControllerFile>& files) {
-  if (!std::filesystem::is_directory(o.output_dir)) {
-    throw InputError(fmt::format("option --output-dir: '{}' is not a directory", o.output_dir));
-  }
+  OutputFolder folder(o.output_dir, "option --output-dir");  // made when missing, as every output's folder
   write_controller_files(files, o.output_dir);
+  folder.keep();
   if (o.json) {
     nlohmann::json list = nlohmann::json::array();
     for (const auto& f : files) {

@@ -84,10 +84,17 @@ std::string iso_text(const std::string& what, const Iso9283Path& iso) {
 }
 
 std::string alignment_text(const std::string& path, const TimeAlignment& a) {
-  std::string out = fmt::format("  {}: offset {:+.4f} s", path, a.offset_s);
-  out += std::isfinite(a.offset_std_s) ? fmt::format(" +- {:.4f} s", a.offset_std_s)
+  // Decimals enough for two significant digits of the uncertainty (12 us: 6), at least 4, at most 9.
+  int decimals = 4;
+  if (std::isfinite(a.offset_std_s) && a.offset_std_s > 0.0) {
+    decimals = std::clamp(static_cast<int>(std::ceil(-std::log10(a.offset_std_s))) + 1, 4, 9);
+  }
+  std::string out = fmt::format("  {}: offset {:+.{}f} s", path, a.offset_s, decimals);
+  out += std::isfinite(a.offset_std_s) ? fmt::format(" +- {:.{}f} s", a.offset_std_s, decimals)
                                        : " (uncertainty n/a: too few moving blocks)";
-  if (a.drift != 0.0) out += fmt::format(", drift {:+.2f} ppm", a.drift * 1e6);
+  if (a.drift != 0.0) {
+    out += fmt::format(", drift {:+.2f} ppm about tracker time {:.6f} s", a.drift * 1e6, a.reference_t_s);
+  }
   out += fmt::format(", RMS from the command {:.4f} mm, {} samples ({:.0f} % moving)\n", a.rms_m * 1e3, a.samples,
                      a.moving_fraction * 100);
   return out;
@@ -211,7 +218,14 @@ std::vector<TrackerTrace> mean_unloaded_reference(const EvaluateOpts& o, const s
     // Bins of about two samples a lap each, at most 3600 (0.1 deg): fewer than that would leave bins
     // empty on a sparse file (50 Hz), more would average too few laps' samples per bin.
     const auto per_lap = static_cast<int>(all.size() / std::max<std::size_t>(1, unloaded.size()));
-    distance_reference.push_back(mean_closed_path(all, std::clamp(per_lap / 2, 36, 3600)));
+    try {
+      distance_reference.push_back(mean_closed_path(all, std::clamp(per_lap / 2, 36, 3600)));
+    } catch (const InputError& e) {
+      std::string files;
+      for (const auto& u : o.unloaded) files += (files.empty() ? "" : ", ") + u;
+      throw InputError(fmt::format("option --mean-reference: the mean of the unloaded laps ({}; {} sample(s)): {}",
+                                   files, all.size(), e.what()));
+    }
   }
   return distance_reference;
 }
@@ -261,7 +275,13 @@ nlohmann::json evaluate_json(const EvaluateOpts& o, const EvaluateRuns& r, const
   if (f.have_commanded) {
     doc["iso9283_unloaded"] = iso_json(f.iso_unloaded, f.ref_name);
   }
-  if (r.reading.have_frame) doc["tracker_frame"] = o.tracker_frame;
+  if (r.reading.have_frame) {
+    const TrackerFrame& fr = r.reading.frame;
+    const auto mm = [](double m) { return std::isfinite(m) ? nlohmann::json(m * 1e3) : nlohmann::json(nullptr); };
+    doc["tracker_frame"] = o.tracker_frame;
+    doc["registration"] = {{"tracker_frame", fr.tracker_frame},  {"rms_mm", mm(fr.rms_m)}, {"max_mm", mm(fr.max_m)},
+                           {"rms_limit_mm", mm(fr.rms_limit_m)}, {"points", fr.points},    {"circles", fr.circles}};
+  }
   if (r.reading.align) {
     nlohmann::json runs = nlohmann::json::array();
     for (std::size_t k = 0; k < r.alignments.size(); ++k) {
@@ -271,6 +291,8 @@ nlohmann::json evaluate_json(const EvaluateOpts& o, const EvaluateRuns& r, const
           {"offset_s", a.offset_s},
           {"offset_std_s", std::isfinite(a.offset_std_s) ? nlohmann::json(a.offset_std_s) : nlohmann::json(nullptr)},
           {"drift_ppm", a.drift * 1e6},
+          // program time = tracker time + offset_s + drift_ppm 1e-6 (tracker time - reference_t_s)
+          {"reference_t_s", a.reference_t_s},
           {"rms_from_command_mm", a.rms_m * 1e3},
           {"samples", a.samples},
           {"synchronous_error_to_command_mm", f.to_command[k].mean_m * 1e3}};

@@ -305,10 +305,15 @@ void setup_plan(CLI::App& sub, int& exit_code) {
     } else {
       std::cout << fmt::format(
           "robot: {}\nplan: {} ({} poses, {} measurements; {} of {} candidate poses reachable)\n"
-          "condition number {:.2f} (columns scaled to unit norm), smallest singular value {:.4f} mm "
+          "condition number {:.2f} (columns scaled to unit norm{}), smallest singular value {:.4f} mm "
           "(columns scaled by the file's compliance)\n",
           model.name(), o->out, plan.points.empty() ? 0 : plan.points.back().pose, plan.points.size(),
-          plan.reachable_poses, plan.candidate_poses, plan.condition_number, plan.min_singular_value_m * 1e3);
+          plan.reachable_poses, plan.candidate_poses, plan.condition_number,
+          std::isfinite(plan.condition_number)
+              ? ""
+              : "; inf: some joint's stiffness cannot be told from this plan's measurements, the warnings say which "
+                "and what to do",
+          plan.min_singular_value_m * 1e3);
       std::cout << fmt::format("predicted relative standard error with {:.3f} mm noise:", opt.noise_m * 1e3);
       for (std::size_t j = 0; j < plan.predicted_relative_std_error.size(); ++j) {
         std::cout << fmt::format(" J{} {:.2f}%", j + 1, 100 * plan.predicted_relative_std_error[j]);
@@ -317,18 +322,6 @@ void setup_plan(CLI::App& sub, int& exit_code) {
     }
     for (const auto& w : plan.warnings) {
       std::cerr << "deflex plan-calibration: warning: " << w << "\n";
-    }
-    // The commonest cause of an infinite condition number: the measured point (the TCP) on the last
-    // axis, so turning that joint never moves it and no load or lever can show its stiffness.
-    const auto last = static_cast<std::size_t>(model.dof() - 1);
-    const Vector3 tcp_in_flange = model.description().flange_T_tcp.translation();
-    if (!std::isfinite(plan.predicted_relative_std_error[last]) && tcp_in_flange.head<2>().norm() < 1e-6) {
-      std::cerr << fmt::format(
-          "deflex plan-calibration: warning: the TCP of '{}' lies on axis {} (tool_frame x = y = 0), so joint {} "
-          "cannot be observed whatever the loads: measure a point off the axis (a tool_frame with x or y of, say, "
-          "60 mm in the robot file, and that point on the tracker), or hold joint {} at a known stiffness with "
-          "deflex identify --fix-stiffness-Nm-per-rad {}=K\n",
-          model.name(), last + 1, last + 1, last + 1, last + 1);
     }
     exit_code = 0;
   });

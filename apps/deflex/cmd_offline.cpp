@@ -79,6 +79,11 @@ void run_program(const OfflineOpts& o, int& exit_code) {
         "options -o, --rapid, --joint-trajectory and --nominal-trajectory write a new path's files; "
         "with --program-in the output is --program-out");
   }
+  if (!o.config.empty()) {
+    throw InputError(
+        "option --config: with --program-in every target carries its own configuration (confdata, Status and "
+        "Turn); --seed-deg gives the arm's joints at the start");
+  }
   OutputTransaction outputs;
   std::vector<OutputFile*> files;
   for (const std::string& path : program_output_paths(o.program_in, o.program_out)) {
@@ -99,6 +104,7 @@ void run_program(const OfflineOpts& o, int& exit_code) {
   ProgramOptions options;
   options.tooldata = o.tooldata;
   options.wobjdata = o.wobjdata;
+  if (!o.seed.empty()) options.start_q = parse_joints_deg(o.seed, model, "--seed-deg");
   const ProgramCompensation result = compensate_program(model, *forces.front(), o.program_in, o.program_out, options);
   for (const ProgramFile& f : result.outputs) {
     for (OutputFile* file : files) {
@@ -427,7 +433,9 @@ void setup_offline(CLI::App& sub, int& exit_code) {
                  "z axis pointing down for the IRB6700's tool0)");
   sub.add_option("--config", o->config,
                  "ABB confdata \"cf1,cf4,cf6,cfx\" at the first point (cfx kept along the path)");
-  sub.add_option("--seed-deg", o->seed, "Preferred joint values at the first point, degrees \"j1,...,j6\"");
+  sub.add_option("--seed-deg", o->seed,
+                 "Preferred joint values at the first point, degrees \"j1,...,j6\"; with --program-in the arm's joints "
+                 "when the program starts (ConfJ\\Off's first target, a KRL point without Status and Turn)");
   sub.add_option("--force", o->forces,
                  "Force model (repeatable): \"ldbb:pivot_mm=X;Y;Z,force_N=F[;F2..],mode=push|pull\", "
                  "\"ldbb:phi_deg=A,force_N=...\" (circle only: pivot on the circle's axis, bar inclined by A), "

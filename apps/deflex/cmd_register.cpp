@@ -20,6 +20,7 @@ namespace {
 struct RegisterOpts {
   std::string tracker, base, out;
   std::vector<std::string> tracker_circles, base_circles;
+  double max_rms_mm = kDefaultMaxRegistrationRmsM * 1e3;
   bool json = false;
   TrackerReadOptions read;
 };
@@ -111,6 +112,11 @@ void setup_register(CLI::App& sub, int& exit_code) {
                  "The same circle in the base frame, in the same direction of travel (e.g. the commanded path); one "
                  "per --tracker-circle, in the same order");
   sub.add_option("-o,--out", o->out, "Frame file to write (YAML), for deflex evaluate --tracker-frame")->required();
+  sub.add_option("--max-rms-mm", o->max_rms_mm,
+                 "The largest registration RMS accepted, mm: above it the frame is refused and not written (pairs "
+                 "mixed up, a unit slip, a nest that moved); raise it for base points known only to a robot's "
+                 "absolute accuracy")
+      ->capture_default_str();
   add_tracker_format_options(sub, o->read);
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code] {
@@ -121,6 +127,7 @@ void setup_register(CLI::App& sub, int& exit_code) {
     }
     OutputFile out(o->out, "option --out");
     RegistrationInput in;
+    in.max_rms_m = o->max_rms_mm * 1e-3;
     std::string tracker_frame;
     TrackerReadOptions base_read = o->read;
     base_read.expect_frame.clear();  // the base files are in the robot's frame, whatever they call it
@@ -149,6 +156,7 @@ void setup_register(CLI::App& sub, int& exit_code) {
     frame.tracker_frame = tracker_frame;
     frame.rms_m = r.rms_m;
     frame.max_m = r.max_m;
+    frame.rms_limit_m = in.max_rms_m;
     frame.points = r.points;
     frame.circles = r.circles;
     write_tracker_frame(frame, out);
@@ -171,6 +179,7 @@ void setup_register(CLI::App& sub, int& exit_code) {
                   {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}},
                   {"rms_mm", r.rms_m * 1e3},
                   {"max_mm", r.max_m * 1e3},
+                  {"rms_limit_mm", in.max_rms_m * 1e3},
                   {"residuals", residuals},
                   {"circles", circles}});
     } else {
@@ -188,7 +197,8 @@ void setup_register(CLI::App& sub, int& exit_code) {
             k + 1, in.tracker_circles[k].radius_m * 1e3, in.base_circles[k].radius_m * 1e3,
             in.tracker_circles[k].rms_m * 1e3, r.circle_axis_error_rad[k] * 1e3);
       }
-      std::cout << fmt::format("  RMS {:.4f} mm, max {:.4f} mm; written to {}\n", r.rms_m * 1e3, r.max_m * 1e3, o->out);
+      std::cout << fmt::format("  RMS {:.4f} mm (limit {:g} mm), max {:.4f} mm; written to {}\n", r.rms_m * 1e3,
+                               in.max_rms_m * 1e3, r.max_m * 1e3, o->out);
     }
     exit_code = 0;
   });

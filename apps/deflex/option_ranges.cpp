@@ -24,7 +24,12 @@ bool ends_with(std::string_view s, std::string_view suffix) {
 // The range of a numeric option, by its long name. Exact names first (where the unit alone is too
 // wide: a period of 1e-9 ms would spin, a count of 1e9 poses would never end), then unit suffixes.
 InputRange option_range(const std::string& name, bool integer) {
-  static const std::array<std::pair<std::string_view, InputRange>, 12> kByName{{
+  // A noise is never negative, a limit on a standard deviation and an averaging window never zero.
+  static constexpr InputRange kNoiseMm{"noise", "mm", 0.0, 1e3};
+  static constexpr InputRange kStdN{"standard deviation", "N", 1e-9, 1e6};
+  static constexpr InputRange kStdNm{"standard deviation", "Nm", 1e-9, 1e6};
+  static constexpr InputRange kWindowS{"averaging window", "s", 1e-3, 3600.0};
+  static const std::array<std::pair<std::string_view, InputRange>, 21> kByName{{
       {"--period-ms", range::kPeriodMs},
       {"--threads", {"thread count", "", 0.0, 256.0}},
       {"--seeds", {"seed count", "", 1.0, 1000.0}},
@@ -37,6 +42,15 @@ InputRange option_range(const std::string& name, bool integer) {
       {"--rsi-monitor-factor", {"factor", "", 0.0, 1000.0}},
       {"--rotation-scale-m", {"length", "m", 1e-6, 100.0}},
       {"--clock-offset-s", range::kTimeS},  // a clock difference: either sign
+      {"--noise-mm", kNoiseMm},
+      {"--synthetic-noise-mm", kNoiseMm},
+      {"--max-std-N", kStdN},
+      {"--tare-max-std-N", kStdN},
+      {"--max-std-Nm", kStdNm},
+      {"--tare-max-std-Nm", kStdNm},
+      {"--window-s", kWindowS},
+      {"--tare-window-s", kWindowS},
+      {"--max-rms-mm", {"RMS limit", "mm", 1e-6, 1e5}},
   }};
   for (const auto& [n, r] : kByName) {
     if (name == n) {
@@ -81,10 +95,27 @@ CLI::Validator range_validator(const InputRange& r, bool integer) {
       "", "deflex range");
 }
 
+// An empty value never means the default: `--robot ""` (a variable that was not set) would otherwise
+// run on the built-in arm, `--expect-frame ""` check nothing.
+CLI::Validator not_empty() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        return trim_view(text).empty() ? "an empty value: give one, or leave the option out for its default"
+                                       : std::string();
+      },
+      "", "not empty");
+}
+
 void add_checks(CLI::App& app) {
   for (CLI::Option* opt : app.get_options()) {
     const std::string type = opt->get_type_name();
     const bool integer = type == "INT" || type == "UINT";
+    if (type == "TEXT" && !opt->get_lnames().empty()) {
+      if (opt->get_expected_min() > 0) {  // `--circle` alone (no value) means its defaults
+        opt->check(not_empty());
+      }
+      continue;
+    }
     if (!(integer || type == "FLOAT") || opt->get_lnames().empty()) {
       continue;
     }

@@ -32,6 +32,10 @@ print(f"robot: {model.name}; nominal stiffness {np.array2string(model.stiffness 
 plan = deflex.plan_calibration(model, [1.5, -0.4, 0.7], [2.1, 0.4, 1.2], load_n=800, poses=12, loads_per_pose=3)
 plan.write_csv(out_dir / "calibration_plan.csv")
 print(f"calibration plan: {len(plan.q)} loads at {len(set(plan.pose))} poses, condition number {plan.condition_number:.1f}")
+# An infinite condition number means some joint's stiffness cannot be told from the planned positions
+# at all (its predicted error is inf too); the plan's warnings say which joint and what to do.
+for warning in plan.warnings:
+    print(f"  plan warning: {warning}")
 
 # %% 3. "Measure": the true arm under each planned load, seen by a 6-DoF tracker probe: the TCP's
 #    displacement dp (m) with 10 um noise a coordinate and its rotation drot (rad) with 20 urad. This

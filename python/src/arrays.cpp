@@ -211,6 +211,18 @@ TrackerTrace tracker_trace(const py::handle& obj, const char* name) {
   return t;
 }
 
+TrackerTrace timed_tracker_trace(const py::handle& obj, const char* name) {
+  const Array a = to_array(obj, name);
+  if (a.ndim() == 2 && a.shape(1) == 3) {
+    throw InputError(fmt::format(
+        "argument {}: (N, 3) positions carry no times, and row numbers are not seconds: give (N, 4) [t_s, x_m, y_m, "
+        "z_m] (read_tracker_file(...)['points'] of a file with time stamps)",
+        name));
+  }
+  if (a.ndim() != 2 || a.shape(1) != 4) wrong_shape(a, name, "(N, 4) [t_s, x_m, y_m, z_m]");
+  return tracker_trace(obj, name);
+}
+
 Array new_array(std::vector<py::ssize_t> shape) { return Array(std::move(shape)); }
 
 Array frozen(Array a) {

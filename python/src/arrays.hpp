@@ -112,6 +112,9 @@ Pose pose(const py::handle& obj, const char* name);
 std::vector<Pose> poses(const py::handle& obj, const char* name);
 /// A tracker trace from (N, 3) positions (m; time = sample index, s) or (N, 4) [t_s, x_m, y_m, z_m].
 TrackerTrace tracker_trace(const py::handle& obj, const char* name);
+/// A trace whose times matter (clock alignment, the time-synchronous error): (N, 4) only, refused for
+/// (N, 3) naming the argument (row numbers are not seconds).
+TrackerTrace timed_tracker_trace(const py::handle& obj, const char* name);
 
 /// New arrays, shape given, C order.
 Array new_array(std::vector<py::ssize_t> shape);

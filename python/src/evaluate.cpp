@@ -90,7 +90,7 @@ void bind_evaluate(py::module_& m) {
   m.def(
       "time_synchronous_deviation",
       [](const ArrayLike& loaded, const ArrayLike& reference) {
-        const TrackerTrace l = tracker_trace(loaded, "loaded"), r = tracker_trace(reference, "reference");
+        const TrackerTrace l = timed_tracker_trace(loaded, "loaded"), r = timed_tracker_trace(reference, "reference");
         return time_synchronous_deviation(l, r);
       },
       "loaded"_a, "reference"_a,
@@ -133,13 +133,14 @@ void bind_evaluate(py::module_& m) {
         d["coordinates"] = f.coordinates;
         d["length_unit"] = f.length_unit;
         d["has_time"] = f.has_time;
+        d["encoding"] = f.encoding;
         return d;
       },
       "path"_a, "length_unit"_a = "", "angle_unit"_a = "", "columns"_a = "", "expect_frame"_a = "",
       "A Spatial Analyzer ASCII export or a CSV with the unit in its header (x_mm or x_m): a dict with 'points' "
       "(N, 4) [t_s (NaN without stamps), x_m, y_m, z_m] in the file's frame, 'names', 'frame', 'format', "
-      "'coordinates', 'length_unit', 'has_time'. Units are never guessed: give length_unit when the header names "
-      "none.");
+      "'coordinates', 'length_unit', 'has_time', 'encoding' ('windows-1252' for a file that is not UTF-8, read as "
+      "SA's ANSI export). Units are never guessed: give length_unit when the header names none.");
   m.def(
       "write_sa_export",
       [](const PathArg& path, const ArrayLike& trace, const std::string& frame) {
@@ -151,10 +152,11 @@ void bind_evaluate(py::module_& m) {
       "Writes an (N, 4) trace [t_s, x_m, y_m, z_m] as a Spatial Analyzer ASCII export (mm, named working frame).");
   m.def(
       "register_frames",
-      [](const ArrayLike& tracker_points, const ArrayLike& base_points) {
+      [](const ArrayLike& tracker_points, const ArrayLike& base_points, double max_rms_m) {
         RegistrationInput in;
         in.tracker_m = points_of(tracker_points, "tracker_points");
         in.base_m = points_of(base_points, "base_points");
+        in.max_rms_m = max_rms_m;
         const FrameRegistration r = register_frames(in);
         std::vector<double> res;
         for (const auto& e : r.residuals) res.push_back(e.distance_m);
@@ -165,13 +167,15 @@ void bind_evaluate(py::module_& m) {
         d["residuals_m"] = from_vector(res);
         return d;
       },
-      "tracker_points"_a, "base_points"_a,
+      "tracker_points"_a, "base_points"_a, "max_rms_m"_a = kDefaultMaxRegistrationRmsM,
       "The tracker-to-base transform (4x4, p_base = T p_tracker) from paired (N, 3) points in m, by Horn's closed "
-      "form, with the residual of each point; refuses fewer than 3 points or points on a line.");
+      "form, with the residual of each point; refuses fewer than 3 points, points on a line, a mirror image (no "
+      "rotation fits it) and an RMS above max_rms_m (default 1 mm: pairs that do not belong together).");
   m.def(
       "align_time",
       [](const ArrayLike& measured, const ArrayLike& commanded, bool fit_drift, double search_s, double centre_s) {
-        const TrackerTrace mt = tracker_trace(measured, "measured"), ct = tracker_trace(commanded, "commanded");
+        const TrackerTrace mt = timed_tracker_trace(measured, "measured");
+        const TrackerTrace ct = timed_tracker_trace(commanded, "commanded");
         TimeAlignmentOptions o;
         o.fit_drift = fit_drift;
         o.search_s = search_s;
@@ -191,8 +195,9 @@ void bind_evaluate(py::module_& m) {
         return d;
       },
       "measured"_a, "commanded"_a, "fit_drift"_a = false, "search_s"_a = 0.0, "centre_s"_a = 0.0,
-      "The clock offset (program time = tracker time + offset_s [+ drift (t - reference_t_s)]) that best puts the "
-      "measured (N, 4) trace on the commanded one, with its uncertainty from the spread over the run's blocks.");
+      "The clock offset (program time = tracker time + offset_s [+ drift (t - reference_t_s)]; reference_t_s the "
+      "tracker time of the run's middle) that best puts the measured (N, 4) trace on the commanded one, with its "
+      "uncertainty from the spread over the run's blocks. Both traces need times: (N, 3) is refused.");
 }
 
 }  // namespace deflex::python

@@ -166,12 +166,15 @@ def test_write_csv_never_leaves_half_a_file(tmp_path):
     out = tmp_path / "out.csv"
     out.write_text("the user's file\n")
     inode = out.stat().st_ino
-    with pytest.raises(deflex.Error, match="the folder"):
-        result.write_csv(str(tmp_path / "missing" / "out.csv"))
+    (tmp_path / "afile").write_text("a user's file\n")
+    with pytest.raises(deflex.Error, match="afile' is not a directory"):
+        result.write_csv(str(tmp_path / "afile" / "out.csv"))
+    result.write_csv(str(tmp_path / "made" / "for" / "it.csv"))  # a missing folder is made, as by the CLI
+    assert (tmp_path / "made" / "for" / "it.csv").read_text().startswith("index,q1_des_deg")
     with pytest.raises(deflex.Error, match="/dev/full"):
         result.write_csv("/dev/full")
     assert os.path.exists("/dev/full") and stat.S_ISCHR(os.lstat("/dev/full").st_mode)
     result.write_csv(str(out))
     assert out.read_text().startswith("index,q1_des_deg")
     assert out.stat().st_ino != inode  # replaced whole by a rename, never truncated in place
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.csv"]  # no temporary file left
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "made", "out.csv"]  # no temporary file left

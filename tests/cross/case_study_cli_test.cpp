@@ -67,7 +67,7 @@ class CaseStudyCli : public ::testing::Test {
 };
 
 TEST_F(CaseStudyCli, JsonHasTheIssueLayoutAndTheReportIsWritten) {
-  const fs::path out = dir_ / "out";
+  const fs::path out = dir_ / "out" / "nested";  // made as every output's folder is
   const Result r = run("case-study --case " + (dir_ / "short.yaml").string() +
                            " --quick --no-sweep --no-budget --json --out " + out.string(),
                        dir_);
@@ -104,6 +104,14 @@ TEST_F(CaseStudyCli, JsonHasTheIssueLayoutAndTheReportIsWritten) {
   EXPECT_EQ(html.find("src=\"http"), std::string::npos);
   EXPECT_EQ(html.find("href=\"http"), std::string::npos);
   EXPECT_NE(r.err.find("deflex case-study"), std::string::npos);  // messages go to stderr
+  // stderr is a file here, not a terminal: progress as plain lines, a tenth of the way each, and no
+  // carriage return (a redrawn bar left one line of some 50 kB in a log).
+  EXPECT_EQ(r.err.find('\r'), std::string::npos);
+  EXPECT_NE(r.err.find("deflex case-study: 100 %"), std::string::npos) << r.err;
+  std::size_t progress_lines = 0;
+  for (std::size_t at = r.err.find(" %"); at != std::string::npos; at = r.err.find(" %", at + 1)) ++progress_lines;
+  EXPECT_LE(progress_lines, 11u) << r.err;
+  EXPECT_LT(r.err.size(), 4000u) << r.err;
 }
 
 TEST_F(CaseStudyCli, TextPrintsThePapersFiguresBesideOurs) {

@@ -254,7 +254,7 @@ TEST(CliRsi, BadOptionsAreRefusedNamingTheOption) {
   expect(base + "--link rsi --rsi-port 0 --rsi-max-document-bytes 10", "--rsi-max-document-bytes");
   expect(base + "--link rsi --rsi-port 0 --log-level loud", "--log-level");
   expect(base + "--link rsi --rsi-port 0 --log-file /nonexistent/dir/field.log", "/nonexistent/dir/field.log");
-  expect(base + "--link rsi --rsi-port 0 --fault-dump /nonexistent/dir/dump.csv", "option --fault-dump");
+  expect(base + "--link rsi --rsi-port 0 --fault-dump /dev/null/dir/dump.csv", "option --fault-dump");
   const std::string setup = "controller-setup -o " + ::testing::TempDir() + " ";
   expect(setup + "--link fanuc --sensor-ip 10.0.0.2", "--link");
   expect(setup + "--link rsi --sensor-ip 0.0.0.0", "--sensor-ip");
@@ -263,7 +263,8 @@ TEST(CliRsi, BadOptionsAreRefusedNamingTheOption) {
   expect(setup + "--link rsi --sensor-ip 10.0.0.2 --period-ms 8", "--period-ms");
   expect(setup + "--link egm-joint --sensor-ip 10.0.0.2 --egm-port 0", "--egm-port");
   expect(setup + "--link egm-path --sensor-ip 10.0.0.2 --path-corr-frame world", "--path-corr-frame");
-  expect("controller-setup --link rsi --sensor-ip 10.0.0.2 -o /nonexistent/dir", "--output-dir");
+  // A missing folder is made (as for every output); one under a device cannot be.
+  expect("controller-setup --link rsi --sensor-ip 10.0.0.2 -o /dev/null/dir", "--output-dir '/dev/null/dir'");
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <sstream>
 
@@ -33,8 +34,8 @@ struct TrackerSession {
   }
   ~TrackerSession() { fs::remove_all(dir); }
   // A base-frame CSV of the examples as an SA export in the tracker's frame (metres), stamped on a
-  // clock `clock_s` ahead of the file's, 3 um noise.
-  std::string export_run(const std::string& name, double clock_s, std::uint32_t seed) const {
+  // clock `clock_s` ahead of the file's and running `drift` fast, 3 um noise.
+  std::string export_run(const std::string& name, double clock_s, std::uint32_t seed, double drift = 0.0) const {
     std::ifstream in(kTrackerExamples + name);
     std::string line;
     std::getline(in, line);
@@ -50,7 +51,7 @@ struct TrackerSession {
       char c;
       std::istringstream(line) >> t >> c >> x >> c >> y >> c >> z;
       const Vector3 p = base_T_tracker.inverse() * (Vector3(x, y, z) * 1e-3) + Vector3(n(rng), n(rng), n(rng));
-      out << fmt::format("P{} {:.12f} {:.12f} {:.12f} {:.6f}\n", ++k, p.x(), p.y(), p.z(), t + clock_s);
+      out << fmt::format("P{} {:.12f} {:.12f} {:.12f} {:.6f}\n", ++k, p.x(), p.y(), p.z(), clock_s + t * (1.0 + drift));
     }
     return out_path.string();
   }
@@ -99,6 +100,75 @@ TEST(CliTrackerSession, RegisteredAndAlignedRunsGiveTheBaseFrameFigures) {
   EXPECT_NEAR(runs[0]["offset_s"].get<double>(), -812.25, 0.02);  // one sample of the 50 Hz example is 0.02 s
   EXPECT_NEAR(runs[1]["offset_s"].get<double>(), -903.5, 0.02);
   EXPECT_GT(t["time_synchronous_mm"]["mean"].get<double>(), 0.3);  // the 625 N deflection, seen in time
+  // The frame the figures were moved with, and how well it was registered.
+  EXPECT_NEAR(t["registration"]["rms_mm"].get<double>(), rdoc["rms_mm"].get<double>(), 1e-6);
+  EXPECT_EQ(t["registration"]["tracker_frame"], "AT960 Tracker");
+  EXPECT_EQ(t["registration"]["rms_limit_mm"].get<double>(), 1.0);
+}
+
+// Calendar stamps (1.7e9 s) on a clock 50 ppm fast: offset_s and drift_ppm alone cannot rebuild the
+// mapping (50 ppm of 1.7e9 s is 85000 s); with reference_t_s, the tracker time they refer to, the
+// first and the last sample come back to the program's 0 s and end within a sample of the 50 Hz file.
+TEST(CliTrackerSession, TheAlignmentGivesEverythingToRebuildTheTimeMapping) {
+  TrackerSession s;
+  Pose identity = Pose::Identity();
+  s.base_T_tracker = identity;
+  const double clock_s = 1.7e9, drift = 50e-6;
+  const std::string run = s.export_run("unloaded.csv", clock_s, 3, drift);
+  const auto r = run_cli("evaluate --json --fit-drift --unloaded " + run + " --loaded " + run + " --align-to " +
+                         kTrackerExamples + "unloaded.csv");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto a = nlohmann::json::parse(r.out)["alignment"]["runs"][0];
+  const double offset = a["offset_s"].get<double>(), ppm = a["drift_ppm"].get<double>();
+  const double reference = a["reference_t_s"].get<double>();
+  const auto program_time = [&](double tracker_t) { return tracker_t + offset + ppm * 1e-6 * (tracker_t - reference); };
+  // The example file's first and last stamps, as the exporter wrote them on the tracker's clock.
+  std::ifstream in(kTrackerExamples + "unloaded.csv");
+  std::string line, last;
+  std::getline(in, line);
+  while (std::getline(in, line)) last = line;
+  const double t_end = std::stod(last.substr(0, last.find(',')));
+  EXPECT_NEAR(program_time(clock_s), 0.0, 0.02);
+  EXPECT_NEAR(program_time(clock_s + t_end * (1.0 + drift)), t_end, 0.02);
+  EXPECT_NEAR(ppm, -50.0, 5.0);  // a tracker clock 50 ppm fast: program time runs 50 ppm slower
+  EXPECT_GT(reference, clock_s);
+  EXPECT_LT(reference, clock_s + t_end * (1.0 + drift));
+  // In text the uncertainty has two significant digits, however small (not "+- 0.0000 s").
+  const auto text =
+      run_cli("evaluate --unloaded " + run + " --loaded " + run + " --align-to " + kTrackerExamples + "unloaded.csv");
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  const auto at = text.out.find(" +- ");
+  ASSERT_NE(at, std::string::npos) << text.out;
+  const std::string digits = text.out.substr(at + 4, text.out.find(" s", at + 4) - at - 4);
+  const auto first = digits.find_first_of("123456789");
+  ASSERT_NE(first, std::string::npos) << text.out;
+  EXPECT_EQ(digits.size() - first, 2u) << digits;
+}
+
+// SA on Windows exports in Windows-1252: a working frame "Caf\xE9 \xB0" (e-acute, the degree sign)
+// registered and then evaluated with the tracker's own files. The frame file held U+FFFD and
+// evaluate refused the files it came from; now both sides read the same UTF-8 name.
+TEST(CliTrackerSession, AWindows1252FrameNameRegistersAndEvaluates) {
+  TrackerSession s;
+  const std::string session = kTrackerExamples + "session/";
+  const auto cp1252 = [&](const std::string& name) {
+    std::ifstream in(session + name, std::ios::binary);
+    std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const std::string from = "AT960 Tracker";
+    text.replace(text.find(from), from.size(), "Caf\xE9 \xB0");
+    s.write(name, text);
+    return s.path(name);
+  };
+  const auto reg = run_cli("register --tracker " + cp1252("tracker_points.txt") + " --base " + session +
+                           "base_points.txt -o " + s.path("frame.yaml"));
+  ASSERT_EQ(reg.exit_code, 0) << reg.err;
+  std::ifstream frame(s.path("frame.yaml"));
+  const std::string yaml{std::istreambuf_iterator<char>(frame), std::istreambuf_iterator<char>()};
+  EXPECT_NE(yaml.find("tracker_frame: \"Caf\xC3\xA9 \xC2\xB0\""), std::string::npos) << yaml;
+  const auto ev = run_cli("evaluate --json --tracker-frame " + s.path("frame.yaml") + " --unloaded " +
+                          cp1252("unloaded.sa.txt") + " --loaded " + cp1252("loaded_uc.sa.txt"));
+  ASSERT_EQ(ev.exit_code, 0) << ev.err;
+  EXPECT_EQ(nlohmann::json::parse(ev.out)["registration"]["tracker_frame"], "Caf\xC3\xA9 \xC2\xB0");
 }
 
 TEST(CliTrackerSession, BadFilesExitTwoNamingFileAndLine) {

@@ -4,6 +4,7 @@
 // tracker frame with noise, registered and evaluated, giving the base-frame figures within the noise.
 #include "deflex/evaluate/frame_registration.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <random>
 
@@ -83,6 +84,60 @@ TEST(Registration, RefusesWhatCannotFixAFrame) {
   EXPECT_THROW(register_frames(nan), InputError);
 }
 
+// The base points mirrored (y negated: a left-handed frame, or a coordinate's sign flipped on export):
+// no rotation maps the tracker's points onto them. Horn's best rotation leaves residuals of the order
+// of the points' spread; the reflection diag(1, -1, 1) T fits them exactly. Refused, both RMS named.
+TEST(Registration, AMirrorImageIsRefusedNotFittedWithAHugeResidual) {
+  const Pose T = known_transform();
+  RegistrationInput in;
+  for (const auto& b : base_points()) {
+    in.tracker_m.push_back(T.inverse() * b);
+    in.base_m.push_back(Vector3(b.x(), -b.y(), b.z()));
+  }
+  in.max_rms_m = 10.0;  // the limit out of the way: the reflection itself is refused
+  try {
+    register_frames(in);
+    FAIL() << "a mirror image was registered";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("mirror image"), std::string::npos) << m;
+    EXPECT_NE(m.find("a reflection would fit them to 0.0000 mm"), std::string::npos) << m;
+  }
+  // Points in one plane (z = 0.5) mirrored in y are the same set turned 180 degrees about the line
+  // y = 0, z = 0.5: a rotation fits them exactly, and nothing can tell the mirror: registered.
+  RegistrationInput planar;
+  for (const auto& b : base_points()) {
+    planar.base_m.push_back(Vector3(b.x(), -b.y(), 0.5));
+    planar.tracker_m.push_back(T.inverse() * Vector3(b.x(), b.y(), 0.5));
+  }
+  EXPECT_LT(register_frames(planar).rms_m, 1e-9);
+}
+
+// A residual far above a tracker's noise means pairs that do not belong together: refused above the
+// limit (1 mm by default), the worst points named; accepted below it, or with the limit raised.
+TEST(Registration, AnRmsAboveTheLimitIsRefusedNamingTheWorstPoints) {
+  const Pose T = known_transform();
+  RegistrationInput in;
+  in.base_m = base_points();
+  for (const auto& b : in.base_m) in.tracker_m.push_back(T.inverse() * b);
+  in.names = {"N1", "N2", "N3", "N4", "N5", "N6", "N7", "N8"};
+  in.base_m[4] += Vector3(0.006, 0.0, 0.0);  // nest N5 6 mm off
+  try {
+    register_frames(in);
+    FAIL() << "a 6 mm misfit was registered";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("above the limit of 1.0000 mm (largest residuals: N5 "), std::string::npos) << m;
+  }
+  in.max_rms_m = 5e-3;
+  const FrameRegistration r = register_frames(in);
+  // One point off by e: the identity fit already leaves an RMS of e / sqrt(8); the best fit only lowers it.
+  EXPECT_LE(r.rms_m, 6e-3 / std::sqrt(8.0) + 1e-12);
+  EXPECT_GT(r.rms_m, 1e-3);
+  in.max_rms_m = 0.0;
+  EXPECT_THROW(register_frames(in), InputError);
+}
+
 std::vector<Vector3> circle_points(const Vector3& c, const Vector3& axis, double r, double arc, int n) {
   const Vector3 u = axis.unitOrthogonal(), v = axis.cross(u);
   std::vector<Vector3> pts;
@@ -155,6 +210,30 @@ TEST(TrackerFrameFile, RoundTripAndBadFiles) {
   } catch (const ModelError& e) {
     EXPECT_NE(std::string(e.what()).find("no rotation"), std::string::npos) << e.what();
   }
+  // A frame whose registration failed (an RMS above the limit it records, or above the default 1 mm
+  // when it records none) is never used.
+  f.rms_m = 1.052;
+  f.max_m = 1.48;
+  {
+    OutputFile out(path, "frame");
+    write_tracker_frame(f, out);
+    out.commit();
+  }
+  try {
+    read_tracker_frame(path);
+    FAIL() << "a failed frame was read";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("field 'registration.rms_mm'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("the frame failed"), std::string::npos) << e.what();
+  }
+  f.rms_m = 2e-3;
+  f.rms_limit_m = 3e-3;  // accepted by a registration whose limit was raised to 3 mm: used
+  {
+    OutputFile out(path, "frame");
+    write_tracker_frame(f, out);
+    out.commit();
+  }
+  EXPECT_NEAR(read_tracker_frame(path).rms_limit_m, 3e-3, 1e-12);
   std::filesystem::remove(path);
 }
 

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "deflex/model/tracker_trace.hpp"
 #include "deflex/text/errors.hpp"
 
 namespace deflex {
@@ -188,8 +189,116 @@ TEST(TrackerFileErrors, TimeBasedWorkNeedsIncreasingStamps) {
   EXPECT_NE(timed_error("x_mm,y_mm,z_mm\n1,2,3\n").find("needs time stamps"), std::string::npos);
   EXPECT_NE(timed_error("t_s,x_mm,y_mm,z_mm\n0,1,2,3\n0,1,2,3\n").find("run.csv:3: time stamp 0 s repeats line 2's"),
             std::string::npos);
-  EXPECT_NE(timed_error("t_s,x_mm,y_mm,z_mm\n1,1,2,3\n0.5,1,2,3\n").find("run.csv:3: time stamp 0.5 s goes back"),
+  // An SA export is read with its points in any order (nests sorted by name); time-based work refuses
+  // a stamp that goes back.
+  EXPECT_NE(timed_error("// Units: mm\n// Columns: Target X Y Z Time\nP1 1 2 3 1\nP2 1 2 3 0.5\n")
+                .find("run.csv:4: time stamp 0.5 s goes back"),
             std::string::npos);
+}
+
+// A tracker CSV's stamps never go back (rows out of order, two runs in one file), as read_tracker_csv
+// has always said and the docs say: refused when read, whatever asks for the file.
+TEST(TrackerFileCsv, TimeGoingBackIsRefusedWhenReadARepeatedStampIsNot) {
+  const std::string e = file_error_of("t_s,x_mm,y_mm,z_mm\n1,1,2,3\n1,1,2,3\n0.5,1,2,3\n");
+  EXPECT_NE(e.find("session.txt:4: column 't_s': time goes backwards (0.5 s after 1 s on line 3)"), std::string::npos)
+      << e;
+  EXPECT_EQ(parse_tracker_file("t_s,x_mm,y_mm,z_mm\n1,1,2,3\n1,1,2,3\n", "r.csv").points.size(), 2u);
+}
+
+// The docs say other columns are ignored: a point's name or a note in text, numbers in any unit.
+TEST(TrackerFileCsv, OtherColumnsTextOrNumbersAreIgnored) {
+  const TrackerFile f = parse_tracker_file(
+      "point,t_s,x_mm,note,y_mm,z_mm,temperature_C\nA1,0,1500,\"seen, twice\",0,2000,21.5\nA2,0.01,1501,,1,2001,x\n",
+      "run.csv");
+  ASSERT_EQ(f.points.size(), 2u);
+  EXPECT_DOUBLE_EQ(f.points[1].t_s, 0.01);
+  EXPECT_DOUBLE_EQ(f.points[1].p_m.x(), 1.501);
+  EXPECT_DOUBLE_EQ(f.points[1].p_m.z(), 2.001);
+  EXPECT_EQ(f.points[1].line, 3);
+  // The columns read are still checked.
+  EXPECT_NE(file_error_of("note,t_s,x_mm,y_mm,z_mm\nok,0,abc,0,1\n").find("session.txt:2: column 'x_mm'"),
+            std::string::npos);
+  // The older reader ignores them the same way.
+  EXPECT_EQ(parse_tracker_csv("name,t_s,x_mm,y_mm,z_mm\nP1,0,1,2,3\n", "old.csv").size(), 1u);
+  // Positions in two units: which is it?
+  EXPECT_NE(file_error_of("t_s,x_mm,y_mm,z_mm,y_m\n0,1,2,3,0.002\n").find("columns 'x_mm' and 'y_m'"),
+            std::string::npos);
+}
+
+// Millimetre numbers under a "Meters" header put a 1.5 m point 1.5 km away; the documented range is
+// +-100 m, named with the line and the column (the old 10 km limit let it through).
+TEST(TrackerFileErrors, CoordinatesBeyondAHundredMetresNameTheirLineAndColumn) {
+  const std::string e = file_error_of("// Units: Meters\n// Columns: Target X Y Z\nP1 1.5 0 0.9\nP2 1500 0 900\n");
+  EXPECT_NE(e.find("session.txt:4: field 2 (x): the point lies 1500 m from the frame's origin along x, outside "
+                   "-100..100 m"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("is the file in another unit than m (the header, line 1)"), std::string::npos) << e;
+  const std::string z = file_error_of("// Units: Meters\nP1 1.5 0 -900\n");
+  EXPECT_NE(z.find("session.txt:2: field 4 (z)"), std::string::npos) << z;
+  // A spherical point 150 m out is named by its radius.
+  const std::string r = file_error_of("// Units: Meters, Degrees\n// Columns: Target R Theta Phi\nP1 150 0 90\n");
+  EXPECT_NE(r.find("session.txt:3: field 2 (r)"), std::string::npos) << r;
+  EXPECT_NEAR(parse_tracker_file("// Units: Meters\nP1 99.5 0 -99.5\n", "s.txt").points[0].p_m.x(), 99.5, 1e-12);
+}
+
+// SA writes its header as "LABEL: VALUE": the label says what a line is, so a working frame named
+// "Column C3" (not a columns line) or "Test Unit in Bay 4" (not inches) keeps its name, and what
+// write_sa_export writes reads back with it.
+TEST(SaExport, FrameNamesHoldingHeaderWordsReadBackAsWritten) {
+  TrackerTrace t;
+  for (int i = 0; i < 5; ++i) t.push_back({0.01 * i, Vector3(1.5 + 0.001 * i, 0.2, 0.9)});
+  for (const char* frame : {"Column C3", "Test Unit in Bay 4", "Frame: Version 2 (Cartesian)", "Café 3°"}) {
+    const auto path = std::filesystem::temp_directory_path() / "deflex_sa_frame_names.txt";
+    SaExportOptions o;
+    o.frame = frame;
+    write_sa_export(t, path.string(), o);
+    TrackerReadOptions ro;
+    ro.expect_frame = frame;
+    const TrackerFile f = read_tracker_file(path.string(), ro);
+    std::filesystem::remove(path);
+    EXPECT_EQ(f.frame, frame);
+    EXPECT_EQ(f.length_unit, "mm") << frame;
+    EXPECT_EQ(f.coordinates, "cartesian") << frame;
+    ASSERT_EQ(f.points.size(), t.size()) << frame;
+    EXPECT_NEAR(f.points[4].p_m.x(), 1.504, 1e-12) << frame;
+  }
+  // A note is a note: neither its words nor a colon in it make it a header line.
+  const TrackerFile f = parse_tracker_file(
+      "// exported for Test Unit in Bay 4, columns as usual\n// Operator note: frame check done\n"
+      "// Units: Millimeters\nP1 1000 0 0\n",
+      "s.txt");
+  EXPECT_EQ(f.length_unit, "mm");
+  EXPECT_EQ(f.frame, "");
+  // Names that could not be read back are refused before anything is written.
+  SaExportOptions bad;
+  bad.frame = "two\nlines";
+  EXPECT_THROW(write_sa_export(t, (std::filesystem::temp_directory_path() / "deflex_sa_bad.txt").string(), bad),
+               InputError);
+  bad = SaExportOptions{};
+  bad.collection = "My Job";
+  EXPECT_THROW(write_sa_export(t, (std::filesystem::temp_directory_path() / "deflex_sa_bad.txt").string(), bad),
+               InputError);
+  EXPECT_FALSE(std::filesystem::exists(std::filesystem::temp_directory_path() / "deflex_sa_bad.txt"));
+}
+
+// SA on Windows exports in the ANSI code page: a frame "Caf\xE9" (0xE9 is e-acute in Windows-1252)
+// and a name with 0xB0 (the degree sign) are read as UTF-8 "Café", "P°1", so the frame compares equal
+// to the same name typed in UTF-8 (the frame file, --expect-frame).
+TEST(SaExport, AWindows1252ExportIsReadAsUtf8) {
+  const std::string text =
+      "// Working Frame: Caf\xE9\n// Units: Millimeters\nP\xB0"
+      "1 1000 0 0\nP\x80 1001 0 0\n";
+  TrackerReadOptions o;
+  o.expect_frame = "Caf\xC3\xA9";  // "Café" in UTF-8
+  const TrackerFile f = parse_tracker_file(text, "s.txt", o);
+  EXPECT_EQ(f.frame, "Caf\xC3\xA9");
+  EXPECT_EQ(f.encoding, "windows-1252");
+  EXPECT_EQ(f.points[0].name,
+            "P\xC2\xB0"
+            "1");
+  EXPECT_EQ(f.points[1].name, "P\xE2\x82\xAC");  // 0x80: the euro sign, U+20AC
+  EXPECT_EQ(parse_tracker_file("// Working Frame: Caf\xC3\xA9\n// Units: mm\nP1 1 0 0\n", "u.txt").encoding, "utf-8");
 }
 
 }  // namespace

@@ -206,6 +206,9 @@ TEST(CalibrationPlanner, ForcesOnTheAxisOfJoint6CannotObserveItAndThePlanSaysSo)
   EXPECT_FALSE(std::isfinite(plan.predicted_relative_std_error[5]));
   ASSERT_FALSE(plan.warnings.empty());
   EXPECT_NE(plan.warnings.back().find("joint 6"), std::string::npos) << plan.warnings.back();
+  // Why, and what to do, in the plan itself (Python prints only its warnings): the TCP on axis 6.
+  EXPECT_FALSE(std::isfinite(plan.condition_number));
+  EXPECT_NE(plan.warnings.back().find("lies on axis 6"), std::string::npos) << plan.warnings.back();
   // A lever loads joint 6, but a TCP (reflector) on its axis still never moves when it turns.
   o.lever_m = 0.3;
   EXPECT_FALSE(std::isfinite(plan_calibration(builtin_irb6700(), o).predicted_relative_std_error[5]));

@@ -170,7 +170,66 @@ TEST(RapidConfOff, FromWhereItStandsATargetTakesTheConfigurationNearestThePrevio
   // The first target has no previous one: its own confdata decides, and the note says so.
   const ProgramCompensation first =
       rapid(module(robtarget("p1", kP1), "    ConfJ\\Off;\n    MoveJ p1, v100, fine, tool0;\n"));
-  EXPECT_EQ(first.targets.at(0).configuration_note, "ConfJ\\Off (line 4), no earlier target: its own confdata");
+  EXPECT_EQ(first.targets.at(0).configuration_note,
+            "ConfJ\\Off (line 4), no earlier target and no --seed-deg: its own confdata");
+}
+
+// A migrated module's first MoveJ under ConfJ\Off with confdata of another cell: the controller takes
+// the configuration nearest the arm, so with the arm's joints at the start (--seed-deg) deflex does
+// too; without them it cannot, and names the option that gives them.
+TEST(RapidConfOff, TheFirstTargetTakesTheConfigurationNearestTheArmAtTheStart) {
+  const std::string text = module(robtarget("pFar", kForeign), "    ConfJ\\Off;\n    MoveJ pFar, v100, fine, tool0;\n");
+  expect_error(text, {"t.mod:5", "MoveJ pFar", "configuration_unavailable", "under ConfJ\\Off (line 4) the controller",
+                      "--seed-deg"});
+  JointVector home(6);
+  home << deg_to_rad(5), deg_to_rad(20), deg_to_rad(25), 0, deg_to_rad(45), 0;
+  ProgramOptions o;
+  o.start_q = home;
+  const ProgramCompensation r = rapid(text, o);
+  ASSERT_EQ(r.targets.size(), 1u);
+  EXPECT_EQ(r.targets[0].configuration_note,
+            "ConfJ\\Off (line 4): the configuration nearest --seed-deg (the arm at the start)");
+  Pose pose = Pose::Identity();
+  pose.linear() = Eigen::Quaterniond(0, 0, 1, 0).toRotationMatrix();
+  pose.translation() = Vector3(1.6, 0.1, 1.2);
+  const ArmConfiguration c = nearest_configuration(pose, home);
+  EXPECT_NE(r.outputs[0].text.find(fmt::format("[{},{},{},{}],", c.cf1, c.cf4, c.cf6, c.cfx) + kExt + "];"),
+            std::string::npos)
+      << r.outputs[0].text;
+  // With ConfJ\On the target's own confdata decides, whatever the start.
+  expect_error(module(robtarget("pFar", kForeign), "    MoveJ pFar, v100, fine, tool0;\n"),
+               {"t.mod:4", "configuration_unavailable"}, o);
+}
+
+// Array elements are numbered from 1: Edge{0} and Edge{-1} stop the controller (they are not an array
+// used whole, nor computed at run time); Edge{1} and Edge{N} are the ends.
+TEST(RapidStrictness, AnIndexOutsideOneToNIsAnError) {
+  const std::string data = "  CONST robtarget Edge{2}:=[" + std::string(kP1) + "," + kP2 + "];\n";
+  for (const char* index : {"0", "-1", "3", "+0"}) {
+    expect_error(module(data, std::string("    MoveL Edge{") + index + "}, v100, fine, tool0;\n"),
+                 {"t.mod:4", "is outside Edge{"});
+  }
+  EXPECT_EQ(rapid(module(data, "    MoveL Edge{1}, v100, fine, tool0;\n    MoveL Edge{+2}, v100, fine, tool0;\n"))
+                .targets.size(),
+            2u);
+  // A variable index is the program's business: listed, left unchanged.
+  const ProgramCompensation listed = rapid(module(
+      data + "  VAR num i:=1;\n", "    MoveL Edge{i}, v100, fine, tool0;\n    MoveL Edge{1}, v100, fine, tool0;\n"));
+  ASSERT_EQ(listed.unresolved.size(), 1u);
+  EXPECT_NE(listed.unresolved[0].reason.find("variable index"), std::string::npos);
+}
+
+// Every routine ends with its own ENDPROC (ENDFUNC, ENDTRAP) before the next begins or the module ends.
+TEST(RapidStrictness, ARoutineWithoutItsEndIsAnError) {
+  const std::string data = robtarget("p1", kP1);
+  expect_error("MODULE T\n" + data + "  PROC main()\n    MoveL p1, v100, fine, tool0;\nENDMODULE\n",
+               {"t.mod:3", "PROC has no ENDPROC before ENDMODULE (line 5)"});
+  expect_error("MODULE T\n" + data +
+                   "  PROC main()\n    MoveL p1, v100, fine, tool0;\n  PROC other()\n  ENDPROC\n"
+                   "ENDMODULE\n",
+               {"t.mod:5", "PROC begins inside the PROC of line 3: its ENDPROC is missing"});
+  expect_error(module(data, "    MoveL p1, v100, fine, tool0;\n  ENDFUNC\n"), {"t.mod:5", "ENDFUNC ends the PROC"});
+  expect_error("MODULE T\n" + data + "  ENDPROC\nENDMODULE\n", {"t.mod:3", "ENDPROC without a routine"});
 }
 
 // --- KRL -----------------------------------------------------------------------------------------
@@ -207,6 +266,59 @@ TEST(KrlStrictness, MalformedDataListsNameTheLineAndTheComponent) {
   expect_krl_error("DEF dxt()\nFDAT_ACT=FP1\nPTP FP1\nEND\n", kDat, {"p.src:3", "'FP1' is a FDAT", "not a point"});
   expect_krl_error("DEF dxt()\nFDAT_ACT=FP1\nEND\n", kDat, {"p.src: no motion instruction"});
   expect_krl_error("", kDat, {"p.src: the program is empty"});
+}
+
+// Declarations where the controller takes them: a DEF's before its first statement, the data list's
+// between DEFDAT and ENDDAT. INTERRUPT DECL is a statement, and fine anywhere.
+TEST(KrlStrictness, DeclarationsAfterAStatementOrOutsideTheDataListAreErrors) {
+  expect_krl_error("DEF dxt()\nFDAT_ACT=FP1\nPTP XP1\nDECL INT n\nEND\n", kDat,
+                   {"p.src:4", "a declaration after the routine's first statement (line 2)"});
+  expect_krl_error("DEF dxt()\nFDAT_ACT=FP1\nPTP XP1\nE6POS pMore\nEND\n", kDat, {"p.src:4", "a declaration after"});
+  expect_krl_error(kPtpXp1, std::string(kDat) + "DECL INT late=1\n", {"p.dat:8", "after ENDDAT (line 7)"});
+  expect_krl_error(kPtpXp1, "DECL INT early=1\n" + std::string(kDat), {"p.dat:1", "a declaration before DEFDAT"});
+  ProgramOptions o;
+  o.tooldata = {"TOOL_DATA[1]={X 250,Y 0,Z 0,A 0,B 0,C 0}"};
+  EXPECT_EQ(krl("DEF dxt()\nDECL INT n\nINT m\nINTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )\nFDAT_ACT=FP1\n"
+                "INTERRUPT DECL 4 WHEN $STOPMESS==TRUE DO IR_STOPM ( )\nPTP XP1\nEND\nDEF sub()\nDECL INT k\nEND\n",
+                kDat, o)
+                .targets.size(),
+            1u);
+}
+
+// A point without Status and Turn as the first target: the configuration is the arm's at the start,
+// given by --seed-deg; without it the target is listed, and the list says which option gives it.
+TEST(KrlStrictness, AFirstPointWithoutStatusAndTurnTakesTheStartJoints) {
+  const std::string dat = dat_with(",S 2,T 10,E1 0.0}", ",E1 0.0}");
+  ProgramOptions o;
+  o.tooldata = {"TOOL_DATA[1]={X 250,Y 0,Z 0,A 0,B 0,C 0}"};
+  const std::string msg = error_of([&] { (void)krl(kPtpXp1, dat, o); });
+  EXPECT_NE(msg.find("--seed-deg"), std::string::npos) << msg;
+  // The arm at the start: 2 degrees a joint from the solution with the point's own Status 2, Turn 10
+  // (found here: KRL's frame R = Rz(A) Ry(B) Rx(C), the tool 250 mm along the flange's x).
+  const RobotModel arm = load_robot(std::string(DEFLEX_SOURCE_DIR) + "/examples/robots/kuka_kr210_r3100_2_flange.yaml");
+  Pose tool = Pose::Identity();
+  tool.translation() = Vector3(0.25, 0, 0);
+  const RobotModel with_tool = arm.with_tool(tool);
+  Pose target = Pose::Identity();
+  target.linear() =
+      (Eigen::AngleAxisd(deg_to_rad(20), Vector3::UnitZ()) * Eigen::AngleAxisd(deg_to_rad(75), Vector3::UnitY()) *
+       Eigen::AngleAxisd(deg_to_rad(15), Vector3::UnitX()))
+          .toRotationMatrix();
+  target.translation() = Vector3(1.8, -0.3, 0.6);
+  Workspace ws(with_tool);
+  IkRequest req;
+  req.kuka_configuration = KukaConfiguration{2, 10};
+  const IkResult own = inverse_kinematics(with_tool, ws, target, req);
+  ASSERT_TRUE(own.ok()) << own.message;
+  o.start_q = JointVector(own.q.array() + deg_to_rad(2.0));
+  const ProgramCompensation r = krl(kPtpXp1, dat, o);
+  ASSERT_EQ(r.targets.size(), 1u);
+  EXPECT_EQ(r.targets[0].configuration_note,
+            "no Status and Turn: the configuration of --seed-deg (the arm at the start)");
+  // The same solution as the point with its Status and Turn: the same correction.
+  ProgramOptions plain;
+  plain.tooldata = o.tooldata;
+  EXPECT_NEAR(r.targets[0].correction_m, krl(kPtpXp1, kDat, plain).targets.at(0).correction_m, 1e-12);
 }
 
 TEST(KrlStrictness, AProgramWithoutItsDataListNamesTheMissingFile) {

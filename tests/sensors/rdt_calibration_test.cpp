@@ -138,6 +138,39 @@ TEST(RdtCalibration, MissingOrNonPositiveCountsAreNamedWithFileLineAndField) {
   EXPECT_NE(text.find("field 'cfgcpf': '1e6 counts' is not a"), std::string::npos) << text;
 }
 
+// A count is an int32 on the wire: 1e300 counts per N would read the sensor's 10 N as 1e-299 N (zero
+// force, the compensation silently off), 1e-300 counts per N every count as 1e300 N. Refused with the
+// page's line and field, as the counts: option is, whatever the unit the counts are in.
+TEST(RdtCalibration, CountsNoSensorHasAreRefusedWithTheirFieldAndLine) {
+  for (const char* counts : {"1e300", "1e-300", "1e11"}) {
+    const std::string e = error_of([&] { (void)parse_netft_xml(page_with({{"cfgcpf", counts}}), "page.xml"); });
+    EXPECT_NE(e.find("page.xml:" + std::to_string(line_of("cfgcpf")) + ": field 'cfgcpf'"), std::string::npos) << e;
+    EXPECT_NE(e.find("counts per N make one count"), std::string::npos) << e;
+  }
+  const std::string torque = error_of([] { (void)parse_netft_xml(page_with({{"cfgcpt", "1e-300"}}), "page.xml"); });
+  EXPECT_NE(torque.find("page.xml:" + std::to_string(line_of("cfgcpt")) + ": field 'cfgcpt'"), std::string::npos)
+      << torque;
+  EXPECT_NE(torque.find("1e+300 Nm"), std::string::npos) << torque;  // 1 Nm / 1e-300 counts
+  // The range is in N a count, so a unit's size counts: 0.2 counts per kN is 5000 N a count (refused),
+  // 0.2 counts per gf 0.049 N a count (a coarse sensor, accepted).
+  EXPECT_NE(error_of([] {
+              (void)parse_netft_xml(page_with({{"cfgcpf", "0.2"}, {"scfgfu", "kN"}, {"cfgfu", "4"}}), "k.xml");
+            }).find("field 'cfgcpf'"),
+            std::string::npos);
+  const RdtCalibration gf = parse_netft_xml(page_with({{"cfgcpf", "0.2"}, {"scfgfu", "gf"}, {"cfgfu", "6"}}), "g.xml");
+  EXPECT_NEAR(gf.force_n_per_count(), 9.80665e-3 / 0.2, 1e-15);
+  // The counts: option and a calibration built in code go through the same range.
+  RdtCalibrationOptions o;
+  o.rate_hz = 1000.0;
+  o.spec = "counts:counts_per_force=1e-300,counts_per_torque=1000000,force_unit=N,torque_unit=Nm";
+  const std::string option = error_of([&] { (void)resolve_rdt_calibration(o, ""); });
+  EXPECT_NE(option.find("--rdt-calibration counts:"), std::string::npos) << option;
+  EXPECT_NE(option.find("counts per force"), std::string::npos) << option;
+  RdtCalibration c = load_netft_xml(kExample);
+  c.counts_per_torque = 1e300;
+  EXPECT_NE(error_of([&] { c.validate(); }).find("counts per torque (cfgcpt)"), std::string::npos);
+}
+
 TEST(RdtCalibration, UnknownOrContradictoryUnitsAreRefused) {
   const std::string unknown = error_of([] {
     (void)parse_netft_xml(page_with({{"scfgfu", "dN"}, {"cfgfu", nullptr}}), "p.xml");

@@ -1,9 +1,9 @@
 // Sweep cases about files themselves: every output option given a path that is an input (the same
-// name, a hard link, a symbolic link), a link to a user's file while the run fails, a missing folder,
-// a folder, a link to nothing, a FIFO nobody reads, /dev/full, two outputs naming one file, and a
-// closed or full stdout; every input option given a FIFO, a device, a folder or a file over its
-// kind's size limit. The runner checks after each case that no file of its folder was deleted,
-// truncated, changed or added.
+// name, a hard link, a symbolic link), a link to a user's file while the run fails, a missing folder
+// while the run fails (made, then removed again), a file where a folder should be, a folder, a link to nothing, a FIFO
+// nobody reads, /dev/full, two outputs naming one file, and a closed or full stdout; every input option given a FIFO, a
+// device, a folder or a file over its kind's size limit. The runner checks after each case that no file of its folder
+// was deleted, truncated, changed or added.
 #include <sys/stat.h>
 
 #include <filesystem>
@@ -118,8 +118,18 @@ void add_output_cases(const OutputUse& u, std::vector<BadInput>& cases) {
       {name + "link_to_input", cmd("{D}/" + o), u.files, {"the same file"}, 2, [input = u.input, o](const fs::path& d) {
          fs::create_symlink(input, d / o);
        }});
+  // A missing folder is made for the output (every command alike), and removed again when the run
+  // fails: the scratch folder holds what it held. A file where a folder should be is named.
   cases.push_back(
-      {name + "missing_folder", cmd("{D}/nodir/" + o), u.files, {u.option, "the folder", "does not exist"}});
+      {name + "missing_folder_run_fails", replace_all(u.failing, "{O}", "{D}/nodir/deeper/" + o), u.files, {}, 2});
+  cases.push_back({name + "file_on_the_way",
+                   cmd("{D}/afile/" + o),
+                   [&] {
+                     auto f = u.files;
+                     f.emplace_back("afile", "a user's file\n");
+                     return f;
+                   }(),
+                   {u.option, "'{D}/afile' is not a directory"}});
   cases.push_back({name + "folder", cmd("{D}/sub"), u.files, {u.option, "is a directory"}, 2, [](const fs::path& d) {
                      fs::create_directories(d / "sub");
                    }});
@@ -184,24 +194,30 @@ std::vector<BadInput> output_cases() {
                    [](const fs::path& d) { fs::create_hard_link(d / "p.dat", d / "q.dat"); }});
   // One output that cannot be written must stop the others too: the o.csv was left behind.
   const std::string square = "offline --path {S}/examples/offline/square_path.csv --force constant:fz_N=-100 ";
-  cases.push_back({"out_all_or_none_rapid_in_missing_folder",
-                   square + "-o {D}/o.csv --rapid {D}/nodir/o.mod",
-                   {},
-                   {"option --rapid", "does not exist"}});
-  cases.push_back({"out_all_or_none_trajectory_in_missing_folder",
-                   square + "-o {D}/o.csv --joint-trajectory {D}/nodir/t.csv",
-                   {},
+  cases.push_back({"out_all_or_none_rapid_under_a_file",
+                   square + "-o {D}/o.csv --rapid {D}/afile/o.mod",
+                   {{"afile", "x\n"}},
+                   {"option --rapid", "is not a directory"}});
+  cases.push_back({"out_all_or_none_trajectory_under_a_file",
+                   square + "-o {D}/o.csv --joint-trajectory {D}/afile/t.csv",
+                   {{"afile", "x\n"}},
                    {"option --joint-trajectory"}});
+  // The folder made for one output goes again when another cannot be written: all or none.
+  cases.push_back({"out_all_or_none_new_folder_removed",
+                   square + "-o {D}/new/deeper/o.csv --rapid /dev/full",
+                   {},
+                   {"'/dev/full'", "No space left on device"},
+                   1});
   cases.push_back({"out_all_or_none_rapid_to_dev_full",
                    square + "-o {D}/o.csv --rapid /dev/full",
                    {},
                    {"'/dev/full'", "No space left on device"},
                    1});
-  cases.push_back({"out_all_or_none_synthetic_in_missing_folder",
+  cases.push_back({"out_all_or_none_synthetic_under_a_file",
                    "plan-calibration --robot builtin --region-mm 1300,1900,-400,400,500,1100 --load-N 800 --poses 3 "
-                   "--grid 2 -o {D}/p.csv --synthetic-measurements {D}/nodir/s.csv",
-                   {},
-                   {"option --synthetic-measurements", "does not exist"}});
+                   "--grid 2 -o {D}/p.csv --synthetic-measurements {D}/afile/s.csv",
+                   {{"afile", "x\n"}},
+                   {"option --synthetic-measurements", "is not a directory"}});
   cases.push_back({"out_all_or_none_krl_dat_unwritable",
                    "offline --robot {S}/examples/robots/kuka_kr210_r3100_2_flange.yaml --program-in "
                    "{S}/examples/programs/deburr_bracket.src --force tool:fx_N=-150 --tooldata 'TOOL_DATA[1]={X 250,Y "
@@ -215,7 +231,7 @@ std::vector<BadInput> output_cases() {
                    "case-study --quick --seeds 1 --no-sweep --no-budget --no-progress "
                    "--out {D}/report.txt",
                    {{"report.txt", "a user's file\n"}},
-                   {"option --out", "cannot create the folder"}});
+                   {"option --out", "report.txt' is not a directory"}});
   // stdout that cannot be written: the job failed, said on stderr.
   for (const auto& [tag, args] : std::vector<std::pair<std::string, std::string>>{
            {"fk", "fk --joints-deg 0,30,10,0,50,0"},

@@ -4,6 +4,7 @@
 // option specs. The expected line is found by the test in the text it wrote, not taken from deflex.
 #include <algorithm>
 #include <cstdio>
+#include <tuple>
 
 #include "sweep/sweep_case.hpp"
 
@@ -99,6 +100,12 @@ void add_rapid_cases(std::vector<BadInput>& cases) {
        "",
        {"'nApproach' is a num", "not a robtarget"}},
       {"index_past_the_end", "MoveL Edge{2}", "MoveL Edge{4}", "", {"index 4 is outside Edge{3}"}},
+      // RAPID numbers elements from 1: Edge{0} and Edge{-1} stop the controller, they are no array used whole.
+      {"index_zero", "MoveL Edge{2}", "MoveL Edge{0}", "", {"index 0 is outside Edge{...}", "from 1"}},
+      {"index_negative", "MoveL Edge{2}", "MoveL Edge{-1}", "", {"index -1 is outside Edge{...}"}},
+      // A routine without its end: the controller refuses the module (main would run into ENDMODULE).
+      {"no_endproc", "    ENDPROC\n", "", "PROC main()", {"PROC has no ENDPROC before ENDMODULE"}},
+      {"endfunc_ends_a_proc", "    ENDPROC\n", "    ENDFUNC\n", "", {"ENDFUNC ends the PROC of line"}},
       {"array_too_short", "CONST robtarget Edge{3}", "CONST robtarget Edge{4}", "", {"3 values for 4 elements"}},
       {"conf_switch_unknown", "ConfL\\On;", "ConfL\\Maybe;", "", {"ConfL takes one switch"}},
       {"declaration_without_semicolon",
@@ -146,6 +153,18 @@ void add_rapid_cases(std::vector<BadInput>& cases) {
                          "'tX=[TRUE,[[0,0,2],[1,0,0,0]],[1,[0,0,0],[1,0,0,0],0,0,0]]'",
                    {{"m.mod", module}},
                    {"option --tooldata", "'tX' is given twice"}});
+  // A migrated RobotStudio module: ConfJ\Off, and its first MoveJ's confdata not one the arm can take.
+  // The controller takes the configuration nearest the arm; without the arm's joints deflex cannot, and
+  // says which option gives them.
+  const std::string migrated =
+      with(with(with(module, "ConfJ\\On;", "ConfJ\\Off;"),
+                "        MoveAbsJ jHome\\NoEOffs,v1000,z50,tDeburr\\WObj:=wobjHousing;\n", ""),
+           "Target_10:=[[0,0,0],[0,1,0,0],[-1,-1,1,0]", "Target_10:=[[0,0,0],[0,1,0,0],[0,0,0,0]");
+  cases.push_back({"rapid_confj_off_first_target_needs_the_start_joints",
+                   cmd,
+                   {{"m.mod", migrated}},
+                   {"{D}/m.mod:" + std::to_string(line_of(migrated, "MoveJ Offs(Target_10")) + ":",
+                    "ConfJ\\Off (line " + std::to_string(line_of(migrated, "ConfJ\\Off")) + ")", "--seed-deg"}});
 }
 
 void add_krl_cases(std::vector<BadInput>& cases) {
@@ -175,6 +194,11 @@ void add_krl_cases(std::vector<BadInput>& cases) {
        "",
        {"component 'S'", "not a number"}},
       {"no_defdat", "DEFDAT  deburr_bracket", "", "&ACCESS", {"not a KRL data list"}},
+      {"declaration_after_enddat",
+       "ENDDAT",
+       "ENDDAT\r\nDECL E6POS XP7={X 1,Y 2,Z 3,A 0,B 0,C 0}",
+       "DECL E6POS XP7",
+       {"after ENDDAT (line"}},
   };
   for (const Mutation& m : dat_mutations) {
     const std::string text = with(dat, m.from, m.to);
@@ -195,6 +219,16 @@ void add_krl_cases(std::vector<BadInput>& cases) {
        {"PTP", "do not close"}},
       {"lin_to_axis_point", "PTP {A1 0,A2 -90", "LIN {A1 0,A2 -90", "", {"PTP only"}},
       {"unknown_keyword", "LIN XP3 C_DIS", "LIN XP3 C_FOO", "", {"unknown 'C_FOO'"}},
+      {"declaration_after_motion",
+       "LIN XP9\r\n",
+       "LIN XP9\r\nDECL INT n\r\n",
+       "DECL INT n",
+       {"a declaration after the routine's first statement (line"}},
+      {"declaration_without_decl_after_motion",
+       "LIN XP9\r\n",
+       "LIN XP9\r\nE6POS pExtra\r\n",
+       "E6POS pExtra",
+       {"a declaration after the routine's first statement"}},
   };
   for (const Mutation& m : src_mutations) {
     const std::string s = m.tag == "missing_component" ? src : with(src, m.from, m.to);
@@ -219,6 +253,47 @@ void add_krl_cases(std::vector<BadInput>& cases) {
                    cmd + " --tooldata 'TOOL_DATA[1]={X 1,Y 0,Z 0,A 0,B 0,C 0}'",
                    {{"p.src", src}, {"p.dat", dat}},
                    {"option --tooldata", "TOOL_DATA[1] is given twice"}});
+}
+
+/// Messages that named no file or option before: each now names its own.
+void add_message_cases(std::vector<BadInput>& cases) {
+  const std::string evaluate =
+      "evaluate --unloaded {S}/examples/evaluate/unloaded.csv --loaded {S}/examples/evaluate/loaded_uc.csv ";
+  const std::string record =
+      "identify-payload --force-source rdt:127.0.0.1:1 --rdt-calibration onrobot-hex "
+      "--joints-deg 0,0,0,0,90,0 --record {D}/p.csv ";
+  const std::string tare = "online --link rsi --force-source rdt:127.0.0.1 --rdt-calibration onrobot-hex --tare ";
+  const std::vector<std::tuple<std::string, std::string, std::vector<std::string>>> options = {
+      // An empty value is never the default: `--robot ""` (an unset variable) ran on the built-in arm.
+      {"empty_robot", "fk --robot '' --joints-deg 0,30,10,0,50,0", {"option --robot", "an empty value"}},
+      {"empty_robot_offline",
+       "offline --robot '' --circle default --force constant:fz_N=-1 -o {D}/o.csv",
+       {"option --robot", "an empty value"}},
+      {"empty_expect_frame", evaluate + "--expect-frame ''", {"option --expect-frame", "an empty value"}},
+      {"synthetic_noise_negative",
+       "plan-calibration --robot builtin --region-mm 1300,1900,-400,400,500,1100 --load-N 800 --poses 3 --grid 2 "
+       "-o {D}/p.csv --synthetic-measurements {D}/s.csv --synthetic-noise-mm -1",
+       {"option --synthetic-noise-mm", "outside 0..1000 mm"}},
+      {"record_max_std_zero", record + "--max-std-N 0", {"option --max-std-N"}},
+      {"record_max_std_nm_negative", record + "--max-std-Nm -0.1", {"option --max-std-Nm"}},
+      {"record_window_zero", record + "--window-s 0", {"option --window-s"}},
+      {"tare_window_zero", tare + "--tare-window-s 0", {"option --tare-window-s"}},
+      {"tare_max_std_negative", tare + "--tare-max-std-N -1", {"option --tare-max-std-N"}},
+  };
+  for (const auto& [tag, args, says] : options) {
+    cases.push_back({"message_" + tag, args, {}, says});
+  }
+  cases.push_back({"message_overlay_empty_urdf_file",
+                   "fk --robot {D}/ov.yaml --joints-deg 0,30,10,0,50,0",
+                   {{"ov.yaml",
+                     "deflex_robot: 1\nunits: {length: m, angle: deg}\n"
+                     "kinematics: {convention: urdf, file: \"\", tip_link: flange}\n"
+                     "joint_stiffness_Nm_per_rad: [3.5e6, 4.0e6, 2.2e6, 4.5e5, 3.5e5, 2.0e5]\n"}},
+                   {"{D}/ov.yaml:3:", "field 'kinematics.file'", "empty"}});
+  cases.push_back({"message_mean_reference_one_point",
+                   "evaluate --unloaded {D}/one.csv --loaded {S}/examples/evaluate/loaded_uc.csv --mean-reference",
+                   {{"one.csv", "t_s,x_mm,y_mm,z_mm\n0,1930,0,900\n"}},
+                   {"option --mean-reference", "{D}/one.csv", "1 sample(s)"}});
 }
 
 }  // namespace
@@ -284,6 +359,12 @@ std::vector<BadInput> limit_cases() {
                      y.command,
                      {{y.file, y.base + "\n? [a, b]\n: 1\n"}},
                      {"{D}/" + y.file + ":", "a key must be a plain name"}});
+    // A tag would change the value's meaning for a reader that honours it; deflex refuses tags.
+    const std::string tagged = with(y.base, y.name_line, "name: !!str " + y.name_line.substr(6));
+    cases.push_back({"yaml_" + y.tag + "_tag",
+                     y.command,
+                     {{y.file, tagged}},
+                     {"{D}/" + y.file + ":" + std::to_string(line_of(tagged, "!!str")) + ":", "YAML tag ('!!str')"}});
     cases.push_back(
         {"yaml_" + y.tag + "_latin1_name",
          y.command,
@@ -398,6 +479,7 @@ std::vector<BadInput> limit_cases() {
   for (const auto& [tag, args, says] : options) {
     cases.push_back({"range_" + tag, args, {}, says});
   }
+  add_message_cases(cases);
   return cases;
 }
 

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -31,6 +32,15 @@ inline std::string replace_all(std::string s, const std::string& from, const std
   return s;
 }
 
+/// The 1-based line of the first `anchor` in `text` (lines counted by '\n'); the anchor must be there.
+inline int line_number_of(const std::string& text, const std::string& anchor) {
+  const auto p = text.find(anchor);
+  if (p == std::string::npos) throw std::runtime_error("sweep: anchor not found: " + anchor);
+  int line = 1;
+  for (std::size_t i = 0; i < p; ++i) line += text[i] == '\n' ? 1 : 0;
+  return line;
+}
+
 /// A file of the source tree.
 inline std::string source_file(const std::string& rel) { return slurp(std::string(DEFLEX_SOURCE_DIR) + "/" + rel); }
 
@@ -39,9 +49,10 @@ inline std::string source_file(const std::string& rel) { return slurp(std::strin
 std::string with(const std::string& text, const std::string& from, const std::string& to);
 
 // The generators, one per class of bad input (file_safety_cases.cpp, program_cases.cpp).
-std::vector<BadInput> output_cases();      ///< outputs that are inputs, links, devices, folders
-std::vector<BadInput> input_file_cases();  ///< FIFOs, devices, folders, oversize files as inputs
-std::vector<BadInput> program_cases();     ///< malformed RAPID modules and KRL programs
-std::vector<BadInput> limit_cases();       ///< URDF limits, YAML rules, value ranges, repeated keys
+std::vector<BadInput> output_cases();          ///< outputs that are inputs, links, devices, folders
+std::vector<BadInput> input_file_cases();      ///< FIFOs, devices, folders, oversize files as inputs
+std::vector<BadInput> program_cases();         ///< malformed RAPID modules and KRL programs
+std::vector<BadInput> limit_cases();           ///< URDF limits, YAML rules, value ranges, repeated keys
+std::vector<BadInput> tracker_sensor_cases();  ///< tracker files, registration, RDT calibration pages
 
 }  // namespace deflex::test

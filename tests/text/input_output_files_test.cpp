@@ -204,11 +204,20 @@ TEST(OutputFile, DevicesAreStreamsNeverRenamedOrRemoved) {
   EXPECT_TRUE(is_char_device("/dev/full"));
 }
 
-TEST(OutputFile, RefusesFoldersMissingFoldersAndFifosNobodyReads) {
+TEST(OutputFile, RefusesFoldersFilesOnTheWayAndFifosNobodyReads) {
   const Scratch s;
   EXPECT_NE(error_of([&] { OutputFile f(s.dir.string(), "option -o"); }).find("is a directory"), std::string::npos);
-  EXPECT_NE(error_of([&] { OutputFile f(s.at("nodir/o.mod"), "option --rapid"); }).find("the folder"),
+  s.write("afile", "a user's file\n");
+  EXPECT_NE(error_of([&] {
+              OutputFile f(s.at("afile/o.mod"), "option --rapid");
+            }).find("option --rapid '" + s.at("afile/o.mod") + "': '" + s.at("afile") + "' is not a directory"),
             std::string::npos);
+  EXPECT_NE(error_of([&] {
+              OutputFile f(s.at("afile/sub/o.mod"), "option --rapid");
+            }).find("'" + s.at("afile") + "' is not a directory"),
+            std::string::npos);
+  EXPECT_EQ(slurp(s.at("afile")), "a user's file\n");
+  fs::remove(s.at("afile"));
   ASSERT_EQ(::mkfifo(s.at("pipe").c_str(), 0600), 0);
   EXPECT_NE(error_of([&] { OutputFile f(s.at("pipe"), "option -o"); }).find("no process reads"), std::string::npos);
   EXPECT_EQ(s.names(), std::set<std::string>{"pipe"});
@@ -227,6 +236,50 @@ TEST(OutputFile, RefusesFoldersMissingFoldersAndFifosNobodyReads) {
   }
   reader.join();
   EXPECT_EQ(got, "through the pipe\n");
+}
+
+// A missing folder is made for an output (every command alike), kept once the output is in place and
+// removed again, deepest first, when it is not; a folder deflex did not make is never removed, nor one
+// that holds anything else by then.
+TEST(OutputFile, MakesMissingFoldersAndRemovesOnlyItsOwnWhenNothingIsWritten) {
+  const Scratch s;
+  {
+    OutputFile f(s.at("new/deeper/o.csv"), "option -o");
+    EXPECT_TRUE(fs::is_directory(s.at("new/deeper")));
+    f.write("x\n");
+  }  // never committed: the folders go with the temporary file
+  EXPECT_EQ(s.names(), std::set<std::string>{});
+  fs::create_directories(s.at("mine"));
+  {
+    OutputTransaction t;
+    t.add(s.at("mine/a/one.csv"), "option -o").write("1\n");
+    t.add(s.at("mine/a/two.csv"), "option --rapid").write("2\n");  // in the folder the first one made
+    s.write("mine/a/note.txt", "another program's file\n");        // appears meanwhile
+  }
+  EXPECT_EQ(slurp(s.at("mine/a/note.txt")), "another program's file\n");  // its folder stays with it
+  fs::remove_all(s.at("mine/a"));
+  {
+    OutputTransaction t;
+    t.add(s.at("mine/b/one.csv"), "option -o").write("1\n");
+    t.add(s.at("mine/b/c/two.csv"), "option --rapid").write("2\n");
+  }
+  EXPECT_TRUE(fs::is_directory(s.at("mine")));  // not made by deflex: stays, empty as it was
+  EXPECT_TRUE(fs::is_empty(s.at("mine")));
+  write_output_file(s.at("kept/x/o.csv"), "o\n", "option -o");
+  EXPECT_EQ(slurp(s.at("kept/x/o.csv")), "o\n");
+  {
+    OutputFolder folder(s.at("report/html"), "option --out");
+    EXPECT_TRUE(fs::is_directory(s.at("report/html")));
+  }  // not kept: removed
+  EXPECT_FALSE(fs::exists(s.at("report")));
+  {
+    OutputFolder folder(s.at("report/html"), "option --out");
+    folder.keep();
+  }
+  EXPECT_TRUE(fs::is_directory(s.at("report/html")));
+  s.write("plain", "x\n");
+  EXPECT_NE(error_of([&] { OutputFolder f(s.at("plain"), "option --out"); }).find("is not a directory"),
+            std::string::npos);
 }
 
 TEST(OutputTransaction, AllOrNoneWhenARenameFails) {
@@ -278,13 +331,14 @@ TEST(OutputFile, AnInterruptedProgramRemovesItsTemporaryFiles) {
     OutputTransaction t;
     t.add(s.at("out.csv"), "option -o").write(std::string(100000, 'x'));
     t.add(s.at("new.csv"), "option --rapid").write("half");
+    t.add(s.at("made/for/it.csv"), "option --joint-trajectory").write("half");  // in folders made for it
     ::raise(SIGINT);
     ::_exit(0);  // not reached
   }
   int status = 0;
   ASSERT_EQ(::waitpid(child, &status, 0), child);
   EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT);  // it died of the signal, as without us
-  EXPECT_EQ(s.names(), std::set<std::string>{"out.csv"});          // no temporary file left
+  EXPECT_EQ(s.names(), std::set<std::string>{"out.csv"});          // no temporary file, no folder left
   EXPECT_EQ(slurp(s.at("out.csv")), "the user's data\n");
 }
 

@@ -50,6 +50,10 @@ CommandedPath read_commanded_path(const std::string& path, const RobotModel* mod
                     "(t_s,q1_deg,...) nor a cycle log (program_t_s,q_nominal1_deg,...)",
                     path));
   }
+  if (mm && m) {
+    throw DataError(fmt::format(
+        "{}: columns 'x_mm' and 'x_m': the path is given in two units (which is the command?); keep one", path));
+  }
   out.kind = "Cartesian path";
   const std::string s = mm ? "_mm" : "_m";
   table.require({"x" + s, "y" + s, "z" + s});

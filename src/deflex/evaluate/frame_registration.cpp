@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
+#include <Eigen/SVD>
 
 #include "deflex/model/linear_algebra.hpp"
 #include "deflex/text/errors.hpp"
@@ -17,6 +18,49 @@ namespace {
 
 bool finite_all(const std::vector<Vector3>& v) {
   return std::all_of(v.begin(), v.end(), [](const Vector3& p) { return p.allFinite(); });
+}
+
+// No rotation maps a mirror image onto its original (the tracker's points against base points whose
+// frame has an axis reversed, or a CSV whose y column was negated): Horn's method still returns its
+// best rotation, with a residual of the order of the point spread. The best orthogonal map of the
+// cross-covariance S = U diag V^T is V U^T; when that is a reflection and it fits at under a third
+// of the rotation's RMS, the pairs are mirrored, not noisy.
+void refuse_mirror_image(const Matrix3& S, const std::vector<Vector3>& a, const std::vector<Vector3>& b,
+                         const Vector3& ca, const Vector3& cb, double rms_rotation_m) {
+  const Eigen::JacobiSVD<Matrix3> svd(S, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Matrix3 q = svd.matrixV() * svd.matrixU().transpose();
+  if (!(q.determinant() < 0.0)) return;
+  double ss = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) ss += (q * (a[i] - ca) - (b[i] - cb)).squaredNorm();
+  const double rms_reflection_m = std::sqrt(ss / static_cast<double>(a.size()));
+  if (!(3.0 * rms_reflection_m < rms_rotation_m)) return;
+  throw InputError(fmt::format(
+      "registration: the base points are a mirror image of the tracker points: the best rotation leaves an RMS of "
+      "{:.4f} mm, a reflection would fit them to {:.4f} mm. No robot base is a reflection of a tracker frame: one "
+      "file's frame is left-handed or has an axis reversed (a coordinate's sign flipped on export), or the points "
+      "are paired with their mirror images",
+      rms_rotation_m * 1e3, rms_reflection_m * 1e3));
+}
+
+// A frame fitted through pairs that do not belong together is a wrong frame, however well its
+// residuals are printed: above the limit it is refused, naming the worst points.
+void refuse_large_rms(const FrameRegistration& r, double max_rms_m) {
+  if (!(max_rms_m > 0.0)) {
+    throw InputError(fmt::format("registration: the RMS limit must be a positive length, not {} m", max_rms_m));
+  }
+  if (r.rms_m <= max_rms_m) return;
+  std::vector<const RegistrationResidual*> worst;
+  for (const auto& e : r.residuals) worst.push_back(&e);
+  std::sort(worst.begin(), worst.end(), [](const auto* x, const auto* y) { return x->distance_m > y->distance_m; });
+  std::string list;
+  for (std::size_t k = 0; k < std::min<std::size_t>(3, worst.size()); ++k) {
+    list += fmt::format("{}{} {:.4f} mm", k == 0 ? "" : ", ", worst[k]->name, worst[k]->distance_m * 1e3);
+  }
+  throw InputError(fmt::format(
+      "registration: RMS {:.4f} mm is above the limit of {:.4f} mm (largest residuals: {}): points paired with the "
+      "wrong partners, a unit slip or a nest that moved; the frame is not written. If the base points are only "
+      "known this well (a robot's absolute accuracy), raise the limit (deflex register --max-rms-mm)",
+      r.rms_m * 1e3, max_rms_m * 1e3, list));
 }
 
 }  // namespace
@@ -177,6 +221,8 @@ FrameRegistration register_frames(const RegistrationInput& in) {
   }
   out.points = np;
   out.circles = nc;
+  refuse_mirror_image(S, a, b, ca, cb, out.rms_m);
+  refuse_large_rms(out, in.max_rms_m);
   return out;
 }
 
@@ -193,6 +239,7 @@ void write_tracker_frame(const TrackerFrame& f, OutputFile& out) {
   text += "registration:\n";
   text += fmt::format("  points: {}\n  circles: {}\n", f.points, f.circles);
   if (std::isfinite(f.rms_m)) text += fmt::format("  rms_mm: {:.6f}\n  max_mm: {:.6f}\n", f.rms_m * 1e3, f.max_m * 1e3);
+  if (std::isfinite(f.rms_limit_m)) text += fmt::format("  rms_limit_mm: {:.6f}\n", f.rms_limit_m * 1e3);
   out.write(text);
 }
 
@@ -207,11 +254,20 @@ TrackerFrame read_tracker_frame(const std::string& path) {
   }
   if (root.has("registration")) {
     const yaml::Field r = root.at("registration");
-    r.only_keys({"points", "circles", "rms_mm", "max_mm"});
+    r.only_keys({"points", "circles", "rms_mm", "max_mm", "rms_limit_mm"});
     f.points = static_cast<std::size_t>(std::max(0, r.get("points", 0)));
     f.circles = static_cast<std::size_t>(std::max(0, r.get("circles", 0)));
     if (r.has("rms_mm")) f.rms_m = r.at("rms_mm").as_double() * 1e-3;
     if (r.has("max_mm")) f.max_m = r.at("max_mm").as_double() * 1e-3;
+    if (r.has("rms_limit_mm")) f.rms_limit_m = r.at("rms_limit_mm").as_in(range::kPositiveLengthMm) * 1e-3;
+    // A frame file written by hand or by an older register with a failed registration in it.
+    const double limit = std::isfinite(f.rms_limit_m) ? f.rms_limit_m : kDefaultMaxRegistrationRmsM;
+    if (r.has("rms_mm") && !(f.rms_m <= limit)) {
+      r.at("rms_mm").fail(fmt::format(
+          "the registration's RMS {:.4f} mm is above its limit of {:.4f} mm: the frame failed and is not used "
+          "(register again, or with deflex register --max-rms-mm if the points are known only this well)",
+          f.rms_m * 1e3, limit * 1e3));
+    }
   }
   return f;
 }

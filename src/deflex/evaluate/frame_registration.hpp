@@ -33,12 +33,19 @@ struct CircleFit {
 /// determined to register a frame with).
 CircleFit fit_circle(const std::vector<Vector3>& points_m, const std::string& what);
 
+/// The largest registration RMS accepted by default (m): a laser tracker measures nests to some 0.01 mm
+/// and a robot reaches a taught point to some 0.1 mm, so 1 mm means pairs that do not belong together
+/// (a name or an order mixed up, a unit slipped, a nest that moved), not noise. `deflex register
+/// --max-rms-mm` raises it, e.g. for base points known only to a robot's absolute accuracy.
+inline constexpr double kDefaultMaxRegistrationRmsM = 1e-3;
+
 /// The measurements a registration is computed from: points paired by index (tracker frame, base
 /// frame; `names` optional, for messages), and circles paired by index.
 struct RegistrationInput {
   std::vector<Vector3> tracker_m, base_m;
   std::vector<std::string> names;
   std::vector<CircleFit> tracker_circles, base_circles;
+  double max_rms_m = kDefaultMaxRegistrationRmsM;  ///< a larger RMS refuses the frame
 };
 
 struct RegistrationResidual {
@@ -61,7 +68,10 @@ struct FrameRegistration {
 /// radius squared: as much as two points a radius apart along it). Throws InputError when the
 /// measurements cannot fix the transform: fewer than 3 points and no circle, points all on one line
 /// (their spread across the line under 1/1000 of their spread along it) with no circle axis off that
-/// line, sizes that do not match, or values that are not finite.
+/// line, sizes that do not match, or values that are not finite; and when the transform found is not
+/// one to use: the base points a mirror image of the tracker points (a reflection fits them at under a
+/// third of the best rotation's RMS: one file's frame is left-handed or has an axis reversed), or an
+/// RMS above `max_rms_m` (the message names the worst points).
 FrameRegistration register_frames(const RegistrationInput& input);
 
 /// The transform and what it came from, as written to and read from a frame YAML file.
@@ -70,13 +80,16 @@ struct TrackerFrame {
   std::string tracker_frame;  ///< the tracker's working frame name, "" when not known
   double rms_m = kNaN;
   double max_m = kNaN;
+  double rms_limit_m = kNaN;  ///< the largest RMS the registration accepted (NaN: the default)
   std::size_t points = 0, circles = 0;
 };
 
 /// Writes the frame file (position in m, quaternion w x y z, the registration's figures as comments and
 /// fields). Throws OutputError when a write fails.
 void write_tracker_frame(const TrackerFrame& frame, OutputFile& out);
-/// Reads it. Throws ModelError naming the file, line and field.
+/// Reads it. Throws ModelError naming the file, line and field, also for a frame whose recorded RMS
+/// exceeds the limit it records (kDefaultMaxRegistrationRmsM when it records none): a registration
+/// that failed is never used.
 TrackerFrame read_tracker_frame(const std::string& path);
 
 }  // namespace deflex

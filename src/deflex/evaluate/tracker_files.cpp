@@ -7,13 +7,16 @@
 #include <cmath>
 #include <optional>
 #include <string_view>
+#include <utility>
 
 #include <fmt/format.h>
 
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/input_file.hpp"
+#include "deflex/text/input_ranges.hpp"
 #include "deflex/text/parse_number.hpp"
+#include "deflex/text/utf8_text.hpp"
 
 namespace deflex {
 namespace {
@@ -63,11 +66,6 @@ std::vector<std::string> words_of(std::string_view text) {
   }
   if (!cur.empty()) out.push_back(cur);
   return out;
-}
-
-std::string after_colon(std::string_view text) {
-  const auto colon = text.find(':');
-  return std::string(trim_view(colon == std::string_view::npos ? text : text.substr(colon + 1)));
 }
 
 // --- Time stamps: seconds, or a calendar date and time of day. ---
@@ -224,27 +222,15 @@ struct Header {
   int coordinates_line = 0, columns_line = 0, frame_line = 0, unit_line = 0;
 };
 
-void read_comment(std::string_view body, int line, const std::string& source, Header& h) {
-  const std::string low = lower(body);
-  if (low.find("column") != std::string::npos) {
-    h.columns = after_colon(body);
-    h.columns_line = line;
-    return;
-  }
-  if (low.find("version") != std::string::npos) {
-    h.version = after_colon(body);
-  }
-  if (low.find("frame") != std::string::npos && h.frame.empty()) {
-    std::string f = after_colon(body);
-    if (f.empty() || f == std::string(trim_view(body))) {
-      const auto at = low.find("frame");
-      f = std::string(trim_view(body.substr(at + 5)));
-    }
-    h.frame = f;
-    h.frame_line = line;
-  }
+bool any_word(const std::vector<std::string>& words, std::initializer_list<const char*> wanted) {
+  return std::any_of(words.begin(), words.end(), [&](const std::string& w) {
+    return std::any_of(wanted.begin(), wanted.end(), [&](const char* k) { return w == k; });
+  });
+}
+
+void read_coordinates(const std::vector<std::string>& words, int line, const std::string& source, Header& h) {
   for (const char* system : {"cartesian", "cylindrical", "spherical"}) {
-    if (low.find(system) == std::string::npos) continue;
+    if (!any_word(words, {system})) continue;
     if (!h.coordinates.empty() && h.coordinates != system) {
       fail_at(source, line,
               fmt::format("mixed coordinate types: this comment names {} coordinates, line {} named {}", system,
@@ -253,18 +239,53 @@ void read_comment(std::string_view body, int line, const std::string& source, He
     h.coordinates = system;
     h.coordinates_line = line;
   }
-  if (low.find("unit") != std::string::npos) {
-    for (const auto& w : words_of(after_colon(body))) {
-      if (const auto lw = length_word(w); !lw.empty()) {
-        if (!h.length_unit.empty() && h.length_unit != lw) {
-          fail_at(source, line, fmt::format("two length units in the header ({} and {})", h.length_unit, lw));
-        }
-        h.length_unit = lw;
-        h.unit_line = line;
-      } else if (const auto aw = angle_word(w); !aw.empty()) {
-        h.angle_unit = aw;
+}
+
+void read_units(const std::string& value, int line, const std::string& source, Header& h) {
+  for (const auto& w : words_of(value)) {
+    if (const auto lw = length_word(w); !lw.empty()) {
+      if (!h.length_unit.empty() && h.length_unit != lw) {
+        fail_at(source, line, fmt::format("two length units in the header ({} and {})", h.length_unit, lw));
       }
+      h.length_unit = lw;
+      h.unit_line = line;
+    } else if (const auto aw = angle_word(w); !aw.empty()) {
+      h.angle_unit = aw;
     }
+  }
+}
+
+// A header comment as SA writes it, "LABEL: VALUE": the label alone says what the line is ("Working
+// Frame", "Units", "Coordinate System", "Columns", "SA Version"), so the value - a frame named
+// "Column C3" or "Test Unit in Bay 4" - may hold any word. A comment without a colon counts only when
+// it is nothing but a coordinate system's name ("// Cartesian"); any other comment is a note.
+void read_comment(std::string_view body, int line, const std::string& source, Header& h) {
+  const auto colon = body.find(':');
+  if (colon == std::string_view::npos) {
+    const auto words = words_of(body);
+    const bool only_system = !words.empty() && std::all_of(words.begin(), words.end(), [](const std::string& w) {
+      return w == "cartesian" || w == "cylindrical" || w == "spherical" || w == "coordinate" || w == "coordinates" ||
+             w == "system";
+    });
+    if (only_system) read_coordinates(words, line, source, h);
+    return;
+  }
+  const auto label = words_of(body.substr(0, colon));
+  const std::string value(trim_view(body.substr(colon + 1)));
+  if (any_word(label, {"column", "columns"})) {
+    h.columns = value;
+    h.columns_line = line;
+  } else if (any_word(label, {"version"})) {
+    h.version = value;
+  } else if (any_word(label, {"frame"})) {
+    if (h.frame_line == 0) {
+      h.frame = value;
+      h.frame_line = line;
+    }
+  } else if (any_word(label, {"unit", "units"})) {
+    read_units(value, line, source, h);
+  } else if (any_word(label, {"coordinate", "coordinates"})) {
+    read_coordinates(words_of(value), line, source, h);
   }
 }
 
@@ -304,6 +325,90 @@ Vector3 to_cartesian(const Layout& l, const std::array<double, 4>& v, double len
   const double r = v[0] * length, a = v[1] * angle;
   const double polar = elevation ? kPi / 2 - v[2] * angle : v[2] * angle;
   return {r * std::sin(polar) * std::cos(a), r * std::sin(polar) * std::sin(a), r * std::cos(polar)};
+}
+
+// Every coordinate within the length range deflex accepts (+-100 m), named by the field it came from:
+// a file in millimetres read as metres puts a point 1.5 m away 1.5 km away instead.
+void check_position(const TrackerPoint& p, const Layout& l, const std::array<std::size_t, 3>& field_of,
+                    const TrackerFile& file, int unit_line, const std::string& source) {
+  for (int axis = 0; axis < 3; ++axis) {
+    const double c = p.p_m[axis];
+    if (std::isfinite(c) && std::abs(c) <= range::kLengthM.max) continue;
+    // The field that put the point there: x/y/z itself, the radius for the other axes of a polar form.
+    const bool own = l.coordinates == "cartesian" || (l.coordinates == "cylindrical" && axis == 2);
+    const std::size_t k = field_of[static_cast<std::size_t>(own ? axis : 0)];
+    const std::string name = k < l.names.size() ? l.names[k] : std::string(1, own ? "xyz"[axis] : 'r');
+    const std::string from =
+        file.unit_from == "header" ? fmt::format("the header, line {}", unit_line) : "--tracker-units";
+    fail_at(source, p.line,
+            fmt::format("field {} ({}): the point lies {:g} m from the frame's origin along {}, outside {:g}..{:g} m "
+                        "(the length range deflex accepts): is the file in another unit than {} ({})?",
+                        k + 1, name, c, "xyz"[axis], range::kLengthM.min, range::kLengthM.max, file.length_unit, from));
+  }
+}
+
+// One point of an SA export from its fields in the file's layout: names joined with "::", the time
+// (seconds or a date and time), the position in m, checked against the length range.
+TrackerPoint read_point(const std::vector<std::string>& f, int line, const Layout& l, double length, double angle,
+                        const TrackerFile& file, int unit_line, const std::string& source) {
+  TrackerPoint p;
+  p.line = line;
+  std::array<double, 4> v{kNaN, kNaN, kNaN, 0.0};
+  std::array<std::size_t, 3> field_of{};  // the field each of v[0..2] came from
+  for (std::size_t k = 0; k < f.size(); ++k) {
+    const Col c = l.cols[k];
+    const std::string col_name = k < l.names.size() ? l.names[k] : fmt::format("field {}", k + 1);
+    if (c == Col::kName) {
+      if (f[k].empty()) fail_at(source, line, fmt::format("field {} (a name) is empty", k + 1));
+      p.name += (p.name.empty() ? "" : "::") + f[k];
+      continue;
+    }
+    if (c == Col::kIgnored) continue;
+    if (c == Col::kTime) {
+      if (const auto dt = date_time(f[k])) {
+        p.t_s = *dt;
+        continue;
+      }
+    }
+    const auto value = parse_double(f[k]);
+    if (!value) {
+      fail_at(source, line,
+              fmt::format("field {} ({}): {}", k + 1, col_name,
+                          c == Col::kTime ? fmt::format("'{}' is neither seconds nor a date and time", f[k])
+                                          : not_a_number(f[k])));
+    }
+    switch (c) {
+      case Col::kX:
+      case Col::kR:
+        v[0] = *value;
+        field_of[0] = k;
+        break;
+      case Col::kY:
+      case Col::kAzimuth:
+        v[1] = *value;
+        field_of[1] = k;
+        break;
+      case Col::kZ:
+        if (l.coordinates == "cartesian" || l.coordinates == "cylindrical") {
+          v[2] = *value;
+          field_of[2] = k;
+        }
+        break;
+      case Col::kZenith:
+      case Col::kElevation:
+        v[2] = *value;
+        field_of[2] = k;
+        break;
+      case Col::kTime:
+        p.t_s = *value;
+        break;
+      default:
+        break;
+    }
+  }
+  p.p_m = to_cartesian(l, v, length, angle);
+  check_position(p, l, field_of, file, unit_line, source);
+  return p;
 }
 
 TrackerFile parse_sa(const std::string& text, const std::string& source, const TrackerReadOptions& options) {
@@ -401,59 +506,7 @@ TrackerFile parse_sa(const std::string& text, const std::string& source, const T
                           options.columns.empty() && h.columns.empty() ? "inferred from the first point" : "declared",
                           expected_fields, first_data_line, expected_fields));
     }
-    TrackerPoint p;
-    p.line = line_no;
-    std::array<double, 4> v{kNaN, kNaN, kNaN, 0.0};
-    for (std::size_t k = 0; k < f.size(); ++k) {
-      const Col c = layout->cols[k];
-      const std::string col_name = k < layout->names.size() ? layout->names[k] : fmt::format("field {}", k + 1);
-      if (c == Col::kName) {
-        if (f[k].empty()) fail_at(source, line_no, fmt::format("field {} (a name) is empty", k + 1));
-        p.name += (p.name.empty() ? "" : "::") + f[k];
-        continue;
-      }
-      if (c == Col::kIgnored) continue;
-      if (c == Col::kTime) {
-        if (const auto dt = date_time(f[k])) {
-          p.t_s = *dt;
-          continue;
-        }
-      }
-      const auto value = parse_double(f[k]);
-      if (!value) {
-        fail_at(source, line_no,
-                fmt::format("field {} ({}): {}", k + 1, col_name,
-                            c == Col::kTime ? fmt::format("'{}' is neither seconds nor a date and time", f[k])
-                                            : not_a_number(f[k])));
-      }
-      switch (c) {
-        case Col::kX:
-        case Col::kR:
-          v[0] = *value;
-          break;
-        case Col::kY:
-        case Col::kAzimuth:
-          v[1] = *value;
-          break;
-        case Col::kZ:
-          if (layout->coordinates == "cartesian" || layout->coordinates == "cylindrical") v[2] = *value;
-          break;
-        case Col::kZenith:
-        case Col::kElevation:
-          v[2] = *value;
-          break;
-        case Col::kTime:
-          p.t_s = *value;
-          break;
-        default:
-          break;
-      }
-    }
-    p.p_m = to_cartesian(*layout, v, length, angle);
-    if (!p.p_m.allFinite() || p.p_m.norm() > 1e4) {
-      fail_at(source, line_no, "the point is not a finite position within 10 km of the frame's origin (wrong unit?)");
-    }
-    out.points.push_back(std::move(p));
+    out.points.push_back(read_point(f, line_no, *layout, length, angle, out, h.unit_line, source));
     if (end == text.size()) break;
   }
   if (out.points.empty()) fail_at(source, 0, "no points (only comments or blank lines)");
@@ -462,17 +515,29 @@ TrackerFile parse_sa(const std::string& text, const std::string& source, const T
   return out;
 }
 
+// The first of `names` the table has, or "".
+std::string first_of(const CsvTable& table, std::initializer_list<const char*> names) {
+  for (const char* n : names) {
+    if (table.has(n)) return n;
+  }
+  return "";
+}
+
 TrackerFile parse_csv(const std::string& text, const std::string& source, const TrackerReadOptions& options) {
-  const CsvTable table = CsvTable::parse(text, source);
+  // Only these columns are read; any other - a point's name, a note, a tracker's status - is left
+  // out, text or number (docs/evaluation.md).
+  const CsvTable table = CsvTable::parse(text, source, {"t_s", "x_mm", "y_mm", "z_mm", "x_m", "y_m", "z_m"});
   TrackerFile out;
   out.source = source;
   out.format = "csv";
   out.coordinates = "cartesian";
   out.unit_from = "column names";
-  const bool mm = table.has("x_mm") || table.has("y_mm") || table.has("z_mm");
-  const bool m = table.has("x_m") || table.has("y_m") || table.has("z_m");
-  if (mm && m) throw DataError(fmt::format("{}: both x_mm-style and x_m-style columns: keep one unit", source));
-  if (!mm && !m) {
+  const std::string mm = first_of(table, {"x_mm", "y_mm", "z_mm"});
+  const std::string m = first_of(table, {"x_m", "y_m", "z_m"});
+  if (!mm.empty() && !m.empty()) {
+    throw DataError(fmt::format("{}: columns '{}' and '{}': positions in two units; keep one", source, mm, m));
+  }
+  if (mm.empty() && m.empty()) {
     std::string have;
     for (const auto& c : table.columns()) have += (have.empty() ? "" : ", ") + c;
     throw DataError(
@@ -480,14 +545,14 @@ TrackerFile parse_csv(const std::string& text, const std::string& source, const 
                     "x_m,y_m,z_m (have: {})",
                     source, have));
   }
-  const std::string suffix = mm ? "_mm" : "_m";
+  const std::string suffix = !mm.empty() ? "_mm" : "_m";
   table.require({"x" + suffix, "y" + suffix, "z" + suffix});
-  out.length_unit = mm ? "mm" : "m";
+  out.length_unit = !mm.empty() ? "mm" : "m";
   if (!options.length_unit.empty() && options.length_unit != out.length_unit) {
     throw DataError(fmt::format("{}: the columns are in {} and --tracker-units says {}", source, out.length_unit,
                                 options.length_unit));
   }
-  const double scale = mm ? 1e-3 : 1.0;
+  const double scale = !mm.empty() ? 1e-3 : 1.0;
   const std::size_t cx = table.column("x" + suffix), cy = table.column("y" + suffix), cz = table.column("z" + suffix);
   out.has_time = table.has("t_s");
   const std::size_t ct = out.has_time ? table.column("t_s") : 0;
@@ -497,6 +562,13 @@ TrackerFile parse_csv(const std::string& text, const std::string& source, const 
     TrackerPoint p;
     p.line = table.line_of(r);
     p.t_s = out.has_time ? table.at(r, ct) : kNaN;
+    // A tracker stamps its samples in order: a stamp before the previous one means rows out of order
+    // or two runs in one file (a repeated stamp is allowed: a tracker may stamp two samples alike).
+    if (r > 0 && out.has_time && p.t_s < out.points.back().t_s) {
+      table.fail(r, "t_s",
+                 fmt::format("time goes backwards ({} s after {} s on line {})", number_text(p.t_s),
+                             number_text(out.points.back().t_s), out.points.back().line));
+    }
     p.p_m = Vector3(table.at(r, cx), table.at(r, cy), table.at(r, cz)) * scale;
     out.points.push_back(std::move(p));
   }
@@ -531,12 +603,41 @@ bool looks_like_csv(const std::string& text, const std::string& source) {
   return source.size() >= ext.size() && lower(source.substr(source.size() - ext.size())) == ext;
 }
 
+bool has_control(const std::string& s) {
+  return std::any_of(s.begin(), s.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F; });
+}
+
+// Names written as they will be read back: a frame on its comment line, trimmed; a collection and a
+// group each one field of a line split at blanks or commas.
+void check_export_names(const SaExportOptions& o) {
+  if (has_control(o.frame) || trim_view(o.frame).size() != o.frame.size() || invalid_utf8_at(o.frame)) {
+    throw InputError(fmt::format(
+        "SA export: working frame '{}': a line break, a control character, blanks at its ends or bytes that are "
+        "not UTF-8 would not read back as the same name",
+        o.frame));
+  }
+  for (const auto& [what, name] : {std::pair{"collection", &o.collection}, std::pair{"group", &o.group}}) {
+    if (name->empty() || has_control(*name) || name->find_first_of(" \t,") != std::string::npos ||
+        invalid_utf8_at(*name) || name->rfind("//", 0) == 0) {
+      throw InputError(fmt::format(
+          "SA export: {} name '{}': must be one word (no blank, comma or control character, not empty) to read "
+          "back as one field",
+          what, *name));
+    }
+  }
+}
+
 }  // namespace
 
 TrackerFile parse_tracker_file(const std::string& text, const std::string& source, const TrackerReadOptions& options) {
   std::string body = text;
   if (body.rfind("\xEF\xBB\xBF", 0) == 0) body.erase(0, 3);
+  // SA on Windows exports in the ANSI code page: a frame "Caf\xE9" would reach the frame file as U+FFFD
+  // and no longer match the tracker's own files. One decoding for every reader of tracker files.
+  const bool windows1252 = invalid_utf8_at(body).has_value();
+  if (windows1252) body = windows1252_to_utf8(body);
   TrackerFile f = looks_like_csv(body, source) ? parse_csv(body, source, options) : parse_sa(body, source, options);
+  if (windows1252) f.encoding = "windows-1252";
   if (!options.expect_frame.empty() && f.frame.empty() && f.format == "sa") {
     // A file that names no frame cannot be checked against the expected one; say so rather than pass.
     throw DataError(
@@ -583,6 +684,7 @@ TrackerTrace untimed_trace(const TrackerFile& file) {
 }
 
 void write_sa_export(const TrackerTrace& trace, OutputFile& out, const SaExportOptions& o) {
+  check_export_names(o);
   const char* sep = o.comma ? "," : " ";
   std::string text;
   text += "// SA Version: written by deflex (Spatial Analyzer ASCII point export layout)\n";

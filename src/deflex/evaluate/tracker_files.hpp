@@ -37,6 +37,10 @@ struct TrackerFile {
   std::string coordinates;  ///< "cartesian", "cylindrical" or "spherical"
   std::string length_unit;  ///< "mm", "m", "cm", "in" or "ft": where it came from is in `unit_from`
   std::string unit_from;    ///< "header", "option" or "column names"
+  /// "utf-8", or "windows-1252" for a file that is not UTF-8 (SA's ANSI export on Windows): its text
+  /// (the frame, the point names) is then converted to UTF-8 as it is read, so a frame named "Cafè"
+  /// compares equal in both encodings.
+  std::string encoding = "utf-8";
   bool has_time = false;
   bool has_names = false;
   std::vector<TrackerPoint> points;
@@ -55,10 +59,11 @@ struct TrackerReadOptions {
 };
 
 /// Reads an SA ASCII export or a plain CSV (`t_s` optional, `x_mm,y_mm,z_mm` or `x_m,y_m,z_m`; other
-/// numeric columns ignored), telling them apart by their first line. Throws DataError naming the file
-/// and line: no length unit, mixed coordinate systems, a frame other than `expect_frame`, a line with
-/// another layout than the file's, a value that is not a finite number, an unknown column name, a
-/// file without points.
+/// columns ignored, text or numbers), telling them apart by their first line. Throws DataError naming
+/// the file and line: no length unit, mixed coordinate systems, a frame other than `expect_frame`, a
+/// line with another layout than the file's, a value that is not a finite number, a coordinate beyond
+/// +-100 m, an unknown column name, a file without points, in a CSV positions in two units or a time
+/// stamp before the previous one.
 TrackerFile read_tracker_file(const std::string& path, const TrackerReadOptions& options = {});
 /// The same from text in memory; `source` names it in messages.
 TrackerFile parse_tracker_file(const std::string& text, const std::string& source,
@@ -84,7 +89,9 @@ struct SaExportOptions {
 };
 /// Writes `trace` as an SA ASCII export: comment lines naming the version, working frame, units
 /// (millimetres) and columns, then "Collection Group Target X Y Z [Time]" a point, targets named
-/// P000001, P000002 ... Throws OutputError when a write fails.
+/// P000001, P000002 ... Throws InputError, before writing, for names read_tracker_file would not read
+/// back as given (a frame with a line break or blanks at its ends, a collection or group that is
+/// empty or holds a blank, a comma or a control character), OutputError when a write fails.
 void write_sa_export(const TrackerTrace& trace, OutputFile& out, const SaExportOptions& options = {});
 void write_sa_export(const TrackerTrace& trace, const std::string& path, const SaExportOptions& options = {});
 

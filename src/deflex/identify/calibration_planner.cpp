@@ -344,6 +344,20 @@ void warn_about_weak_joints(double noise_m, CalibrationPlan& plan) {
   }
 }
 
+// The commonest cause of an infinite condition number: the measured point (the TCP) on the last axis,
+// so turning that joint never moves it and no load or lever can show its stiffness.
+void warn_about_tcp_on_last_axis(const RobotModel& model, CalibrationPlan& plan) {
+  const auto last = static_cast<std::size_t>(model.dof() - 1);
+  const Vector3 tcp_in_flange = model.description().flange_T_tcp.translation();
+  if (std::isfinite(plan.predicted_relative_std_error[last]) || tcp_in_flange.head<2>().norm() >= 1e-6) return;
+  plan.warnings.push_back(fmt::format(
+      "the TCP of '{}' lies on axis {} (tool_frame x = y = 0), so joint {} cannot be observed from positions "
+      "whatever the loads: measure a point off the axis (a tool_frame with x or y of, say, 60 mm in the robot "
+      "file, and that point on the tracker), measure the TCP's rotation too (a 6-DoF probe: drot), or hold joint "
+      "{} at a known stiffness (identify --fix-stiffness-Nm-per-rad {}=K, fixed_stiffness_nm_per_rad in Python)",
+      model.name(), last + 1, last + 1, last + 1, last + 1));
+}
+
 }  // namespace
 
 CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanOptions& o) {
@@ -379,6 +393,7 @@ CalibrationPlan plan_calibration(const RobotModel& model, const CalibrationPlanO
   }
   design_figures(G, o.noise_m, plan);
   warn_about_weak_joints(o.noise_m, plan);
+  warn_about_tcp_on_last_axis(model, plan);
   return plan;
 }
 

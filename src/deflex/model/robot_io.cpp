@@ -192,6 +192,9 @@ RobotModel load_robot_yaml_text(const std::string& text, const std::string& sour
   } else if (convention == "urdf") {
     kin.only_keys({"convention", "file", "base_link", "tip_link"});
     fs::path file = kin.at("file").as_string();
+    if (file.empty()) {
+      kin.at("file").fail("empty: give the URDF's path (relative to this file's folder)");
+    }
     if (file.is_relative()) {
       file = fs::path(base_dir) / file;
     }

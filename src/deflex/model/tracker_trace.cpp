@@ -36,12 +36,17 @@ TrackerTrace from_table(const CsvTable& table) {
   return trace;
 }
 
+// The columns read; any other (a name, a note) is ignored, text or number.
+const std::vector<std::string> kTrackerColumns = {"t_s", "x_mm", "y_mm", "z_mm"};
+
 }  // namespace
 
-TrackerTrace read_tracker_csv(const std::string& path) { return from_table(CsvTable::read_file(path)); }
+TrackerTrace read_tracker_csv(const std::string& path) {
+  return from_table(CsvTable::read_file(path, kTrackerColumns));
+}
 
 TrackerTrace parse_tracker_csv(const std::string& text, const std::string& source) {
-  return from_table(CsvTable::parse(text, source));
+  return from_table(CsvTable::parse(text, source, kTrackerColumns));
 }
 
 void write_tracker_csv(const TrackerTrace& trace, const std::string& path) {

@@ -63,6 +63,7 @@ const char* const kUnsupported[] = {"PTP_REL", "LIN_REL",  "CIRC_REL", "SPTP",  
                                     "SPL",     "SLIN_REL", "SPTP_REL", "SCIRC_REL", "PTP_SPLINE", "SPLINE"};
 const char* const kAxes[6] = {"A1", "A2", "A3", "A4", "A5", "A6"};
 const char* const kFrameNames[6] = {"X", "Y", "Z", "A", "B", "C"};
+const char* const kBuiltinTypes[] = {"INT", "REAL", "BOOL", "CHAR", "FRAME", "POS", "E6POS", "AXIS", "E6AXIS"};
 
 /// Fails unless the file holds `begin` ... `end` (DEF ... END, DEFDAT ... ENDDAT).
 void check_frame(const KrlFile& f, const char* what, std::initializer_list<const char*> begin, const char* end) {
@@ -84,12 +85,13 @@ class KrlReader {
  public:
   KrlReader(const RobotModel& model, const ForceModel& force, const std::string& src_file, const std::string& src_text,
             const std::string& dat_file, const std::string& dat_text, const ProgramOptions& options)
-      : model_(model), force_(force), src_(src_file, src_text), dat_(dat_file, dat_text) {
+      : model_(model), force_(force), src_(src_file, src_text), dat_(dat_file, dat_text), start_q_(options.start_q) {
     if (dat_file.empty()) {
       throw InputError(fmt::format("{}: a KRL program needs its .dat (the data list beside it)", src_file));
     }
     check_frame(src_, "program", {"DEF", "DEFFCT"}, "END");
     check_frame(dat_, "data list", {"DEFDAT"}, "ENDDAT");
+    check_declaration_sections();
     read_frames(options.tooldata, "--tooldata");
     read_frames(options.wobjdata, "--wobjdata");
     read_data();
@@ -100,6 +102,59 @@ class KrlReader {
 
  private:
   // --- reading ---------------------------------------------------------------------------------
+
+  /// Where the controller takes declarations: in a DEF (or DEFFCT) before its first statement, and in
+  /// the data list between DEFDAT and ENDDAT. It refuses to load a program with a declaration after a
+  /// statement or outside DEFDAT ... ENDDAT, and so does deflex, naming the line.
+  void check_declaration_sections() const {
+    int first_statement = 0;  // the line of the current DEF's first statement, 0 before it
+    for (const auto& [b, e] : src_.lines) {
+      const std::string first = to_upper(src_.str(b));
+      const std::string second = e > b + 1 ? to_upper(src_.str(b + 1)) : "";
+      if (first == "DEF" || first == "DEFFCT" || (first == "GLOBAL" && (second == "DEF" || second == "DEFFCT")) ||
+          first == "END" || first == "ENDFCT") {
+        first_statement = 0;
+      } else if (krl_declaration(src_, b, e)) {
+        if (first_statement > 0) {
+          src_.fail(b, fmt::format("a declaration after the routine's first statement (line {}): KRL declares "
+                                   "before the statements, and the controller refuses the program",
+                                   first_statement));
+        }
+      } else if (!src_.is_punct(b, "&") && first_statement == 0) {
+        first_statement = src_.tok[b].line;
+      }
+    }
+    int defdat = 0;
+    int enddat = 0;
+    for (const auto& [b, e] : dat_.lines) {
+      if (enddat > 0) {
+        dat_.fail(b, fmt::format("'{}' after ENDDAT (line {}): the data list ends there, and the controller "
+                                 "refuses anything after it",
+                                 dat_.span(b, e), enddat));
+      }
+      if (dat_.is_ident(b, "DEFDAT") || (dat_.is_ident(b, "PUBLIC") && dat_.is_ident(b + 1, "DEFDAT"))) {
+        defdat = dat_.tok[b].line;
+      } else if (dat_.is_ident(b, "ENDDAT")) {
+        enddat = dat_.tok[b].line;
+      } else if (defdat == 0 && krl_declaration(dat_, b, e)) {
+        dat_.fail(b, "a declaration before DEFDAT: the data list's declarations go between DEFDAT and ENDDAT");
+      }
+    }
+  }
+
+  /// A line that declares (DECL, SIGNAL, ENUM, STRUC, EXT, EXTFCT, or a built-in type then a name, which
+  /// KRL declares without DECL); INTERRUPT DECL is a statement.
+  static bool krl_declaration(const KrlFile& f, std::size_t b, std::size_t e) {
+    std::size_t i = b;
+    if (f.is_ident(i, "GLOBAL")) ++i;
+    if (i >= e) return false;
+    for (const char* k : {"DECL", "SIGNAL", "ENUM", "STRUC", "EXT", "EXTFCT"}) {
+      if (f.is_ident(i, k)) return true;
+    }
+    const bool builtin = std::any_of(std::begin(kBuiltinTypes), std::end(kBuiltinTypes),
+                                     [&](const char* t) { return f.is_ident(i, t); });
+    return builtin && i + 1 < e && f.is_ident(i + 1);
+  }
 
   void read_frames(const std::vector<std::string>& specs, const char* option) {
     for (const std::string& spec : specs) {
@@ -534,10 +589,10 @@ class KrlReader {
         if (s != nullptr && t != nullptr) {
           u.ik.kuka_configuration =
               KukaConfiguration{static_cast<int>(s->number) & 7, static_cast<int>(t->number) & 63};
-        } else if (uses.empty()) {
+        } else if (uses.empty() && !start_q_) {
           result.unresolved.push_back({f.file, f.tok[b].line, f.span(b, e),
                                        "no Status and Turn, and no earlier target: the configuration is the arm's "
-                                       "when the program runs"});
+                                       "when the program runs (give its joints at the start with --seed-deg)"});
           continue;
         } else {
           u.continue_from_previous = true;
@@ -715,6 +770,7 @@ class KrlReader {
   std::set<std::string> assigned_;
   std::map<std::string, Pose> frames_;
   std::vector<std::unique_ptr<KrlAggregate>> inlines_;  // inline targets, at stable addresses
+  std::optional<JointVector> start_q_;                  // the arm's joints at the start (--seed-deg)
 };
 
 ProgramCompensation KrlReader::run(const std::string& output_src) {
@@ -724,7 +780,7 @@ ProgramCompensation KrlReader::run(const std::string& output_src) {
   std::vector<ProgramTargetUse> uses;
   std::vector<KrlUse> info;
   collect(result, uses, info);
-  const std::vector<ProgramTargetResult> results = compensate_program_targets(model_, uses, force_);
+  const std::vector<ProgramTargetResult> results = compensate_program_targets(model_, uses, force_, start_q_);
   compute_numbers(info, results);
   std::vector<std::string> actions;
   std::vector<TextEdit> src_edits;
@@ -735,7 +791,9 @@ ProgramCompensation KrlReader::run(const std::string& output_src) {
     result.targets.push_back(
         target_report(results[x.use_index], src_.file, x.line, x.instruction, x.written, actions[a]));
     if (!uses[x.use_index].joint && uses[x.use_index].continue_from_previous) {
-      result.targets.back().configuration_note = "no Status and Turn: continues from the previous target";
+      result.targets.back().configuration_note =
+          x.use_index == 0 ? "no Status and Turn: the configuration of --seed-deg (the arm at the start)"
+                           : "no Status and Turn: continues from the previous target";
     }
   }
   result.outputs.push_back({output_src, apply_edits(src_.text, src_edits)});

@@ -4,6 +4,7 @@
 // and the writing of the result. Reference: docs/offline.md, "Existing programs".
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,11 @@ namespace deflex {
 struct ProgramOptions {
   std::vector<std::string> tooldata;  ///< RAPID tooldata, KRL TOOL_DATA[n] or $TOOL
   std::vector<std::string> wobjdata;  ///< RAPID wobjdata, KRL BASE_DATA[n] or $BASE
+  /// The arm's joints when the program starts (rad; `--seed-deg`). Where the controller takes the
+  /// configuration nearest the arm - the first target under ConfJ\Off or ConfL\Off, a KRL point
+  /// without Status and Turn - the one nearest these joints is taken; without them such a target keeps
+  /// its own configuration (RAPID) or is listed as left unchanged (KRL).
+  std::optional<JointVector> start_q;
 };
 
 /// One compensated use of a target.

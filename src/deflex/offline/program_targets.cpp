@@ -43,7 +43,8 @@ const RobotModel& model_with_tool(const RobotModel& model, const Pose& tool,
 
 std::vector<ProgramTargetResult> compensate_program_targets(const RobotModel& model,
                                                             const std::vector<ProgramTargetUse>& uses,
-                                                            const ForceModel& force) {
+                                                            const ForceModel& force,
+                                                            const std::optional<JointVector>& start_q) {
   if (const auto n = force.points(); n && !uses.empty()) {
     std::size_t needed = 0;
     for (const ProgramTargetUse& u : uses) {
@@ -73,22 +74,34 @@ std::vector<ProgramTargetResult> compensate_program_targets(const RobotModel& mo
       r.q_desired = u.q;
       r.tcp_desired = tcp_pose(m, ws, u.q);
     } else {
+      // The joints the controller starts from: the previous use's, or the arm's at the start.
+      const std::optional<JointVector> before =
+          previous != nullptr ? std::optional<JointVector>(previous->q_desired) : start_q;
       IkRequest req = u.ik;
-      if (u.nearest_previous && previous != nullptr) {
-        req.seed = previous->q_desired;
+      if (u.nearest_previous && before) {
+        req.seed = *before;
         req.configuration.reset();
         req.kuka_configuration.reset();
       } else if (u.continue_from_previous) {
-        if (previous == nullptr) {
+        if (!before) {
           throw InputError(fmt::format("{}: no configuration given and no earlier target to continue from", where));
         }
-        req.seed = previous->q_desired;
-        req.configuration = arm_configuration(m, ws, previous->q_desired);
+        req.seed = *before;
+        req.configuration = arm_configuration(m, ws, *before);
         req.match_quadrants = false;
       }
       const IkResult ik = inverse_kinematics(m, ws, u.base_T_tcp, req);
       if (!ik.ok()) {
-        throw InputError(fmt::format("{}: {} ({})", where, to_string(ik.status), ik.message));
+        // Under ConfJ\Off the controller would take the configuration nearest the arm, which only
+        // the arm's joints at the start can say for the first target.
+        const std::string hint =
+            u.nearest_previous && !before
+                ? fmt::format(
+                      "; under {} the controller takes the configuration nearest the arm: give the arm's "
+                      "joints at the start with --seed-deg",
+                      u.configuration_rule)
+                : "";
+        throw InputError(fmt::format("{}: {} ({}){}", where, to_string(ik.status), ik.message, hint));
       }
       if (ik.status == IkStatus::kNearSingular) {
         throw InputError(

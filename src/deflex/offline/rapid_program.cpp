@@ -161,7 +161,7 @@ class RapidReader {
  public:
   RapidReader(const RobotModel& model, const ForceModel& force, std::string file, const std::string& text,
               const ProgramOptions& options)
-      : model_(model), force_(force), src_{std::move(file), text, {}} {
+      : model_(model), force_(force), src_{std::move(file), text, {}}, start_q_(options.start_q) {
     src_.tok = lex_rapid(text, src_.file);
     check_module();
     read_external(options.tooldata, "--tooldata", "tooldata", tools_);
@@ -233,17 +233,39 @@ class RapidReader {
     }
   }
 
-  /// Which routine (PROC, FUNC, TRAP) every token belongs to; -1 for the module's data.
+  /// Which routine (PROC, FUNC, TRAP) every token belongs to; -1 for the module's data. Every routine
+  /// must end with its own ENDPROC, ENDFUNC or ENDTRAP before the next begins and before ENDMODULE:
+  /// the controller refuses to load a module that does not (and a routine would run on into the next).
   void read_routines() {
     routine_of_.assign(src_.tok.size(), -1);
     int current = -1;
     int count = 0;
+    std::size_t opened = 0;  // the token that began the current routine
+    const auto end_of = [](const std::string& kind) { return "END" + kind; };
     for (std::size_t i = 0; i < src_.tok.size(); ++i) {
-      if (current < 0 && (src_.is_ident(i, "PROC") || src_.is_ident(i, "FUNC") || src_.is_ident(i, "TRAP"))) {
+      const bool begins = src_.is_ident(i, "PROC") || src_.is_ident(i, "FUNC") || src_.is_ident(i, "TRAP");
+      const bool ends = src_.is_ident(i, "ENDPROC") || src_.is_ident(i, "ENDFUNC") || src_.is_ident(i, "ENDTRAP");
+      if (begins && current >= 0) {
+        src_.fail(i,
+                  fmt::format("{} begins inside the {} of line {}: its {} is missing", to_upper(src_.str(i)),
+                              to_upper(src_.str(opened)), src_.tok[opened].line, end_of(to_upper(src_.str(opened)))));
+      }
+      if (src_.is_ident(i, "ENDMODULE") && current >= 0) {
+        src_.fail(opened, fmt::format("{} has no {} before ENDMODULE (line {})", to_upper(src_.str(opened)),
+                                      end_of(to_upper(src_.str(opened))), src_.tok[i].line));
+      }
+      if (begins) {
         current = count++;
+        opened = i;
       }
       routine_of_[i] = current;
-      if (src_.is_ident(i, "ENDPROC") || src_.is_ident(i, "ENDFUNC") || src_.is_ident(i, "ENDTRAP")) {
+      if (ends) {
+        if (current < 0 || !iequals(src_.str(i), end_of(to_upper(src_.str(opened))))) {
+          src_.fail(i, current < 0 ? fmt::format("{} without a routine it ends", to_upper(src_.str(i)))
+                                   : fmt::format("{} ends the {} of line {} (it needs {})", to_upper(src_.str(i)),
+                                                 to_upper(src_.str(opened)), src_.tok[opened].line,
+                                                 end_of(to_upper(src_.str(opened)))));
+        }
         current = -1;
       }
     }
@@ -518,40 +540,48 @@ class RapidReader {
       why = fmt::format("{}() is computed at run time", src_.str(b));
       return std::nullopt;
     }
-    int index = -1;
-    if (e != b + 1) {
-      if (!(e == b + 4 && src_.is_punct(b + 1, "{") && src_.tok[b + 2].kind == TokenKind::kNumber &&
-            src_.is_punct(b + 3, "}"))) {
+    // name{N}, name{+N} or name{-N}: a literal index (1-based), checked against the array below;
+    // anything else in the braces is computed when the program runs.
+    int index = 0;
+    const bool indexed = e != b + 1;
+    if (indexed) {
+      const bool sign = e == b + 5 && (src_.is_punct(b + 2, "-") || src_.is_punct(b + 2, "+"));
+      if (!((e == b + 4 || sign) && src_.is_punct(b + 1, "{") && src_.is_punct(e - 1, "}") &&
+            src_.tok[e - 2].kind == TokenKind::kNumber)) {
         why = "computed at run time (an expression or a variable index)";
         return std::nullopt;
       }
-      index = token_index(src_, b + 2) - 1;
+      index = token_index(src_, e - 2) * (src_.is_punct(b + 2, "-") ? -1 : 1);
     }
     const Decl* d = find_decl(src_.str(b), type, routine, b, why);
     if (d == nullptr) {
       return std::nullopt;
     }
     const RapidValue* v = &d->value;
-    if (index >= 0 || !d->dims.empty()) {
-      if (index < 0) {
+    if (indexed || !d->dims.empty()) {
+      if (!indexed) {
         why = fmt::format("'{}' is an array used whole", d->name);
         return std::nullopt;
       }
       if (d->dims.empty()) {
-        src_.fail(b, fmt::format("'{}' is not an array: {}{{{}}} has no element", d->name, d->name, index + 1));
+        src_.fail(b, fmt::format("'{}' is not an array: {} has no element", d->name, src_.span(b, e)));
+      }
+      if (index < 1) {  // whatever the size: RAPID arrays are numbered from 1
+        src_.fail(b + 2, fmt::format("index {} is outside {}{{...}}: RAPID numbers an array's elements from 1 "
+                                     "(the controller stops here)",
+                                     index, d->name));
       }
       if (d->dims.size() != 1 || d->dims[0] < 0) {
         why = fmt::format("'{}' has several dimensions or a size given by a name: not resolved", d->name);
         return std::nullopt;
       }
-      if (index < 0 || index >= d->dims[0]) {
-        src_.fail(b + 2,
-                  fmt::format("index {} is outside {}{{{}}} (1..{})", index + 1, d->name, d->dims[0], d->dims[0]));
+      if (index > d->dims[0]) {
+        src_.fail(b + 2, fmt::format("index {} is outside {}{{{}}} (1..{})", index, d->name, d->dims[0], d->dims[0]));
       }
-      v = &v->items[static_cast<std::size_t>(index)];
+      v = &v->items[static_cast<std::size_t>(index - 1)];
     }
     r.decl = d;
-    r.element = index;
+    r.element = indexed ? index - 1 : -1;
     r.value = v;
     return r;
   }
@@ -803,12 +833,12 @@ class RapidReader {
       const int off_line = m.conf == 'J' ? conf.joint_off_line : m.conf == 'L' ? conf.linear_off_line : 0;
       if (off_line > 0) {
         u.nearest_previous = true;
-        x.conf_note = first_use
-                          ? fmt::format("Conf{}\\Off (line {}), no earlier target: its own confdata", m.conf, off_line)
-                          : fmt::format(
-                                "Conf{}\\Off (line {}): the configuration nearest the previous "
-                                "target's",
-                                m.conf, off_line);
+        u.configuration_rule = fmt::format("Conf{}\\Off (line {})", m.conf, off_line);
+        x.conf_note =
+            !first_use ? fmt::format("{}: the configuration nearest the previous target's", u.configuration_rule)
+            : start_q_
+                ? fmt::format("{}: the configuration nearest --seed-deg (the arm at the start)", u.configuration_rule)
+                : fmt::format("{}, no earlier target and no --seed-deg: its own confdata", u.configuration_rule);
       }
     }
     x.ref = *ref;
@@ -996,6 +1026,7 @@ class RapidReader {
   std::set<std::string> assigned_;
   std::map<std::string, ExternalData> tools_, wobjs_;
   mutable std::vector<std::unique_ptr<RapidValue>> literals_;
+  std::optional<JointVector> start_q_;  // the arm's joints at the start (--seed-deg)
 };
 
 ProgramCompensation RapidReader::run(const std::string& output_path) {
@@ -1005,7 +1036,7 @@ ProgramCompensation RapidReader::run(const std::string& output_path) {
   std::vector<ProgramTargetUse> uses;
   std::vector<RapidUse> info;
   collect(result, uses, info);
-  const std::vector<ProgramTargetResult> results = compensate_program_targets(model_, uses, force_);
+  const std::vector<ProgramTargetResult> results = compensate_program_targets(model_, uses, force_, start_q_);
   compute_numbers(info, results);
   std::vector<std::string> actions;
   const std::string text = write_back(info, actions);

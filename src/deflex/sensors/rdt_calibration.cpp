@@ -9,12 +9,14 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "deflex/paths/key_value_spec.hpp"
 #include "deflex/sensors/detail/http_fetch.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/input_file.hpp"
+#include "deflex/text/input_ranges.hpp"
 #include "deflex/text/parse_number.hpp"
 
 namespace deflex {
@@ -67,6 +69,17 @@ std::string names(const std::array<UnitEntry, N>& table) {
   return out;
 }
 
+// Why `counts` per unit (one unit: `si` N or Nm, named `unit`) is not a sensor's count, or nullopt:
+// 1e300 counts per N would read every force as zero, 1e-300 every count as 1e300 N.
+std::optional<std::string> count_problem(double counts, double si, const std::string& unit, const InputRange& r) {
+  const double per_count = si / counts;
+  if (per_count >= r.min && per_count <= r.max) return std::nullopt;
+  return fmt::format(
+      "{} counts per {} make one count {:g} {}, outside {:g}..{:g} {} a count (the range of every force/torque "
+      "sensor deflex accepts): a typo, or not the active calibration's value",
+      number_text(counts), unit, per_count, r.unit, r.min, r.max, r.unit);
+}
+
 [[noreturn]] void fail_at(const std::string& origin, int line, const std::string& what) {
   throw ModelError(line > 0 ? fmt::format("{}:{}: {}", origin, line, what) : fmt::format("{}: {}", origin, what));
 }
@@ -115,6 +128,11 @@ class Page {
     if (!v) fail(f, name, not_a_number(f.text));
     if (!(*v > 0.0)) fail(f, name, fmt::format("{} must be positive, not {}", meaning, f.text));
     return *v;
+  }
+  /// A count per unit (one unit: `si` N or Nm) within the range of a sensor's count, else an error at
+  /// its field's line.
+  void check_counts(const char* name, double counts, double si, const std::string& unit, const InputRange& r) const {
+    if (const auto bad = count_problem(counts, si, unit, r)) fail(field(name), name, *bad);
   }
   /// An optional non-negative number (0 when absent).
   double optional_number(const char* name, const char* meaning) const {
@@ -195,6 +213,15 @@ void RdtCalibration::validate() const {
   if (newton_metres_per_torque_unit(torque_unit) == 0.0) {
     bad("torque unit (scfgtu)", fmt::format("unknown unit '{}' (known: {})", torque_unit, names(kTorqueUnits)));
   }
+  // The same range for every source: the page (checked again with its line as it is read), counts:, a profile.
+  if (const auto p =
+          count_problem(counts_per_force, newtons_per_force_unit(force_unit), force_unit, range::kForcePerCountN)) {
+    bad("counts per force (cfgcpf)", *p);
+  }
+  if (const auto p = count_problem(counts_per_torque, newton_metres_per_torque_unit(torque_unit), torque_unit,
+                                   range::kTorquePerCountNm)) {
+    bad("counts per torque (cfgcpt)", *p);
+  }
   if (!(rate_hz > 0.0) || !std::isfinite(rate_hz)) {
     bad("RDT rate (comrdtrate)",
         rate_hz == 0.0 ? "not known: give the sensor's RDT output rate (--rdt-rate-hz), or a page that states it"
@@ -224,6 +251,10 @@ RdtCalibration parse_netft_xml(const std::string& text, const std::string& origi
   c.counts_per_torque = page.positive("cfgcpt", "counts per torque unit");
   c.force_unit = page.unit("scfgfu", "cfgfu", kForceUnits, "force");
   c.torque_unit = page.unit("scfgtu", "cfgtu", kTorqueUnits, "torque");
+  page.check_counts("cfgcpf", c.counts_per_force, newtons_per_force_unit(c.force_unit), c.force_unit,
+                    range::kForcePerCountN);
+  page.check_counts("cfgcpt", c.counts_per_torque, newton_metres_per_torque_unit(c.torque_unit), c.torque_unit,
+                    range::kTorquePerCountNm);
   c.rate_hz = page.optional_number("comrdtrate", "the RDT output rate (Hz)");
   c.internal_rate_hz = page.optional_number("runrate", "the internal sample rate (Hz)");
   const double buffer = page.optional_number("comrdtbsiz", "the RDT buffer size (records)");

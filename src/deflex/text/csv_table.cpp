@@ -10,6 +10,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <system_error>
 
@@ -149,6 +150,7 @@ void CsvReader::read_header() {
       ranges_.push_back(&range_for_name(columns_.back()));
     });
     row_.resize(columns_.size());
+    skipped_.assign(columns_.size(), false);
     return;
   }
   throw DataError(fmt::format("{}: no header row (the file is empty)", source_));
@@ -163,6 +165,9 @@ void CsvReader::read_header() {
 // it takes is, trimmed, exactly the text from_chars read (a comma or the line's end follows it), and the only texts
 // from_chars reads that parse_row's character check refuses are NaN and the infinities, which are not finite.
 bool CsvReader::parse_plain_row(std::string_view line) {
+  if (std::find(skipped_.begin(), skipped_.end(), true) != skipped_.end()) {
+    return false;  // a skipped column may hold text: parse_row reads such rows
+  }
   const char* p = line.data();
   const char* const end = p + line.size();
   const auto blanks = [&] {
@@ -212,6 +217,10 @@ void CsvReader::parse_row(std::string_view line) {
       return;  // counted, reported below
     }
     const std::string& name = columns_[i];
+    if (skipped_[i]) {
+      row_[i++] = std::numeric_limits<double>::quiet_NaN();
+      return;
+    }
     if (cell.empty()) {
       throw DataError(fmt::format("{}:{}: column '{}': empty cell", source_, line_, name));
     }
@@ -279,6 +288,12 @@ void require_columns(const std::string& source, const std::vector<std::string>& 
 }
 }  // namespace
 
+void CsvReader::read_only(const std::vector<std::string>& used) {
+  for (std::size_t i = 0; i < columns_.size(); ++i) {
+    skipped_[i] = std::find(used.begin(), used.end(), columns_[i]) == used.end();
+  }
+}
+
 void CsvReader::require(const std::vector<std::string>& required) const {
   require_columns(source_, columns_, index_, required);
 }
@@ -303,7 +318,10 @@ void CsvReader::fail(const std::string& name, const std::string& message) const 
   throw DataError(fmt::format("{}:{}: column '{}': {}", source_, line_of_row_, name, message));
 }
 
-CsvTable CsvTable::drain(CsvReader& reader) {
+CsvTable CsvTable::drain(CsvReader& reader, const std::vector<std::string>& only) {
+  if (!only.empty()) {
+    reader.read_only(only);
+  }
   CsvTable t;
   t.source_ = reader.source();
   t.columns_ = reader.columns();
@@ -318,14 +336,14 @@ CsvTable CsvTable::drain(CsvReader& reader) {
   return t;
 }
 
-CsvTable CsvTable::read_file(const std::string& path) {
+CsvTable CsvTable::read_file(const std::string& path, const std::vector<std::string>& only) {
   CsvReader reader(path, InputKind::kCsvTable);
-  return drain(reader);
+  return drain(reader, only);
 }
 
-CsvTable CsvTable::parse(const std::string& text, const std::string& source) {
+CsvTable CsvTable::parse(const std::string& text, const std::string& source, const std::vector<std::string>& only) {
   CsvReader reader(text, source);
-  return drain(reader);
+  return drain(reader, only);
 }
 
 std::size_t CsvTable::column(const std::string& name) const {

@@ -9,6 +9,7 @@
 // '#' comment lines and blank lines skipped, cells trimmed of spaces and tabs.
 #pragma once
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -53,6 +54,10 @@ class CsvReader {
   /// Fails on a column not in `allowed`, suggesting the nearest allowed name ('Index' -> 'index'), so
   /// a misspelt optional column is never silently ignored.
   void allow_only(const std::vector<std::string>& allowed) const;
+  /// Reads only the columns named in `used` from here on: the cells of every other column are counted
+  /// but not parsed (any text, a label or a note, or nothing) and read as NaN. For files whose format
+  /// says other columns are ignored (tracker CSV).
+  void read_only(const std::vector<std::string>& used);
 
   /// Reads the next data row; false at the end of the file. Throws DataError for a bad row.
   bool next();
@@ -82,6 +87,7 @@ class CsvReader {
   std::vector<std::string> columns_;
   std::map<std::string, std::size_t> index_;
   std::vector<const InputRange*> ranges_;  // each column's physical range, from the unit in its name
+  std::vector<bool> skipped_;              // read_only(): columns whose cells are not parsed
   std::vector<double> row_;
 };
 
@@ -89,9 +95,10 @@ class CsvReader {
 /// Thread safety: immutable once read: any number of threads may share one.
 class CsvTable {
  public:
-  /// Reads and checks the whole file (at most 1 GiB, InputKind::kCsvTable). Throws DataError.
-  static CsvTable read_file(const std::string& path);
-  static CsvTable parse(const std::string& text, const std::string& source);
+  /// Reads and checks the whole file (at most 1 GiB, InputKind::kCsvTable). Throws DataError. A
+  /// non-empty `only` reads those columns alone and ignores every other (CsvReader::read_only()).
+  static CsvTable read_file(const std::string& path, const std::vector<std::string>& only = {});
+  static CsvTable parse(const std::string& text, const std::string& source, const std::vector<std::string>& only = {});
 
   [[nodiscard]] const std::string& source() const { return source_; }
   [[nodiscard]] const std::vector<std::string>& columns() const { return columns_; }
@@ -112,7 +119,7 @@ class CsvTable {
   void allow_only(const std::vector<std::string>& allowed) const;
 
  private:
-  static CsvTable drain(CsvReader& reader);
+  static CsvTable drain(CsvReader& reader, const std::vector<std::string>& only);
 
   std::string source_;
   std::vector<std::string> columns_;
@@ -122,8 +129,9 @@ class CsvTable {
 };
 
 /// Calls f(cell) for every comma-separated cell of `line`, trimmed of spaces and tabs (a trailing comma
-/// gives an empty last cell, as a spreadsheet means it). The one splitter of every deflex reader of
-/// comma-separated lines.
+/// gives an empty last cell, as a spreadsheet means it). A cell quoted as csv_text_cell() writes it
+/// ("a, b") keeps its commas and is handed over with its quotes. The one splitter of every deflex
+/// reader of comma-separated lines.
 template <typename F>
 void for_each_csv_cell(std::string_view line, F&& f) {
   const auto trimmed = [](std::string_view s) {
@@ -133,7 +141,15 @@ void for_each_csv_cell(std::string_view line, F&& f) {
   };
   std::size_t start = 0;
   while (true) {
-    const auto comma = line.find(',', start);
+    std::size_t search = start;
+    const auto first = line.find_first_not_of(" \t", start);
+    if (first != std::string_view::npos && line[first] == '"') {
+      search = first + 1;  // the closing quote: a doubled quote "" is one quote inside the cell
+      while (search < line.size() && !(line[search] == '"' && (search + 1 >= line.size() || line[search + 1] != '"'))) {
+        search += line[search] == '"' ? 2 : 1;
+      }
+    }
+    const auto comma = line.find(',', std::min(search, line.size()));
     if (comma == std::string_view::npos) {
       f(trimmed(line.substr(start)));
       return;

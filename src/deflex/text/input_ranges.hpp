@@ -34,6 +34,11 @@ inline constexpr InputRange kJointSpeedRadS{"joint speed", "rad/s", 1e-6, 100.0}
 inline constexpr InputRange kForceN{"force", "N", -1e6, 1e6};
 inline constexpr InputRange kMomentNm{"moment", "Nm", -1e6, 1e6};
 inline constexpr InputRange kMassKg{"mass", "kg", 0.0, 1e4};
+// A force/torque sensor's count (an int32 on the wire: full scale 2^31 counts): from 0.2 N full scale
+// (1e-10 N a count) to 10 N a count, which no sensor fine enough to compensate with comes near; the
+// same for torque from 0.02 Nm full scale.
+inline constexpr InputRange kForcePerCountN{"force a count", "N", 1e-10, 10.0};
+inline constexpr InputRange kTorquePerCountNm{"torque a count", "Nm", 1e-11, 10.0};
 // 1 Nm/rad admits benchtop and toy arms; the stiffest industrial joints are around 1e8.
 inline constexpr InputRange kJointStiffness{"joint stiffness", "Nm/rad", 1.0, 1e10};
 // Time and rates.

@@ -61,11 +61,12 @@ std::atomic<unsigned> g_closed_streams{0};  // bit fd: standard stream fd was cl
 struct TemporarySlot {
   std::atomic<bool> claimed{false};
   std::atomic<bool> live{false};
+  std::atomic<bool> folder{false};  // a folder this process created for an output: rmdir, not unlink
   char path[PATH_MAX] = {};
 };
 TemporarySlot g_temporaries[256];
 
-int claim_slot(const std::string& path) {
+int claim_slot(const std::string& path, bool folder = false) {
   if (path.size() >= PATH_MAX) {
     return -1;
   }
@@ -73,6 +74,7 @@ int claim_slot(const std::string& path) {
     bool free = false;
     if (g_temporaries[i].claimed.compare_exchange_strong(free, true)) {
       std::memcpy(g_temporaries[i].path, path.c_str(), path.size() + 1);
+      g_temporaries[i].folder.store(folder, std::memory_order_relaxed);
       g_temporaries[i].live.store(true, std::memory_order_release);
       return i;
     }
@@ -90,8 +92,17 @@ void release_slot(int& slot) noexcept {
 
 extern "C" void remove_temporaries_and_die(int signal_number) {
   for (TemporarySlot& t : g_temporaries) {
-    if (t.live.load(std::memory_order_acquire)) {
+    if (t.live.load(std::memory_order_acquire) && !t.folder.load(std::memory_order_relaxed)) {
       ::unlink(t.path);
+    }
+  }
+  // Then the folders made for them, emptied now; a nested one first, whatever their slots' order
+  // (rmdir of a folder that is not empty fails and leaves it, as it must).
+  for (int pass = 0; pass < 8; ++pass) {
+    for (TemporarySlot& t : g_temporaries) {
+      if (t.live.load(std::memory_order_acquire) && t.folder.load(std::memory_order_relaxed)) {
+        ::rmdir(t.path);
+      }
     }
   }
   ::signal(signal_number, SIG_DFL);
@@ -102,6 +113,66 @@ const char* special_kind(mode_t mode) {
   if (S_ISBLK(mode)) return "a block device";
   if (S_ISSOCK(mode)) return "a socket";
   return "not a regular file, character device or FIFO";
+}
+
+// The first folder on the way to `path` that is a file (what ENOTDIR means).
+std::string file_on_the_way(const std::string& path) {
+  std::string p = parent_of(path);
+  std::string found = p;
+  for (struct stat st{}; p != parent_of(p); p = parent_of(p)) {
+    if (::stat(p.c_str(), &st) == 0) {
+      if (!S_ISDIR(st.st_mode)) found = p;
+      break;
+    }
+  }
+  return found;
+}
+
+// The folders `made` for an output: removed, deepest first, unless `keep` (the output is in place and
+// they are the user's now). rmdir leaves a folder that holds anything (another program's file).
+void remove_folders(std::vector<std::pair<std::string, int>>& made, bool keep) noexcept {
+  for (auto it = made.rbegin(); it != made.rend(); ++it) {
+    if (!keep) {
+      ::rmdir(it->first.c_str());
+    }
+    release_slot(it->second);
+  }
+  made.clear();
+}
+
+// The folders on the way to `dir` that do not exist, made shallowest first, each with its slot in the
+// signal handler's table. A file where a folder should be (`-o notes.txt/x.csv`) is named; a folder
+// another process makes meanwhile is not ours. `name` starts the messages ("option -o 'a/b.csv'").
+std::vector<std::pair<std::string, int>> make_folders(const std::string& dir, const std::string& name) {
+  std::vector<std::string> missing;
+  std::string p = dir;
+  struct stat st {};
+  while (::stat(p.c_str(), &st) != 0) {
+    if (errno == ENOTDIR) {
+      throw InputError(fmt::format("{}: '{}' is not a directory", name, file_on_the_way(p)));
+    }
+    if (errno != ENOENT) {
+      throw InputError(fmt::format("{}: the folder '{}': {}", name, p, std::strerror(errno)));
+    }
+    missing.push_back(p);
+    const std::string up = parent_of(p);
+    if (up == p) break;
+    p = up;
+  }
+  if (!S_ISDIR(st.st_mode)) {
+    throw InputError(fmt::format("{}: '{}' is not a directory", name, p));
+  }
+  std::vector<std::pair<std::string, int>> made;
+  for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+    if (::mkdir(it->c_str(), 0777) == 0) {
+      made.emplace_back(*it, claim_slot(*it, true));
+    } else if (errno != EEXIST) {
+      const int err = errno;
+      remove_folders(made, false);
+      throw InputError(fmt::format("{}: cannot create the folder '{}': {}", name, *it, std::strerror(err)));
+    }
+  }
+  return made;
 }
 
 }  // namespace
@@ -120,6 +191,9 @@ OutputFile::OutputFile(std::string path, std::string what) : path_(std::move(pat
           fmt::format("{}: a symbolic link to nothing ({}): deflex writes through a link only onto an "
                       "existing file",
                       name, std::strerror(err)));
+    }
+    if (err == ENOTDIR) {
+      throw InputError(fmt::format("{}: '{}' is not a directory", name, file_on_the_way(path_)));
     }
     if (err != ENOENT) {
       throw InputError(fmt::format("{}: cannot be written: {}", name, std::strerror(err)));
@@ -189,11 +263,20 @@ void OutputFile::create_temporary(const std::string& target_path, bool existed, 
   }
   const std::string dir = parent_of(target_path);
   char resolved_dir[PATH_MAX];
+  if (::realpath(dir.c_str(), resolved_dir) == nullptr && errno == ENOENT) {
+    create_missing_folders(dir);
+  }
   if (::realpath(dir.c_str(), resolved_dir) == nullptr) {
-    throw InputError(fmt::format("{} '{}': the folder '{}' {}", what_, path_, dir,
-                                 errno == ENOENT ? "does not exist" : std::strerror(errno)));
+    if (errno == ENOTDIR) {
+      throw InputError(fmt::format("{} '{}': '{}' is not a directory", what_, path_, file_on_the_way(dir + "/x")));
+    }
+    throw InputError(fmt::format("{} '{}': the folder '{}': {}", what_, path_, dir, std::strerror(errno)));
   }
   const std::string folder = resolved_dir;
+  struct stat folder_stat {};
+  if (::stat(folder.c_str(), &folder_stat) == 0 && !S_ISDIR(folder_stat.st_mode)) {
+    throw InputError(fmt::format("{} '{}': '{}' is not a directory", what_, path_, dir));
+  }
   target_ = (folder == "/" ? "" : folder) + "/" + base;
   existed_ = existed;
   for (int attempt = 0; fd_ < 0; ++attempt) {
@@ -213,6 +296,10 @@ void OutputFile::create_temporary(const std::string& target_path, bool existed, 
   }
 }
 
+void OutputFile::create_missing_folders(const std::string& dir) {
+  created_folders_ = make_folders(dir, fmt::format("{} '{}'", what_, path_));
+}
+
 OutputFile::~OutputFile() { discard(); }
 
 void OutputFile::discard() noexcept {
@@ -225,6 +312,7 @@ void OutputFile::discard() noexcept {
     temp_.clear();
   }
   release_slot(slot_);
+  remove_folders(created_folders_, committed_);  // kept once the file is in place
 }
 
 void OutputFile::flush_buffer() {
@@ -372,6 +460,27 @@ void OutputTransaction::commit() {
       sync_folder(parent_of(files_[k]->target_));
     }
   }
+}
+
+OutputTransaction::~OutputTransaction() {
+  // The last added first: a folder made for the first file may hold the later ones' temporary files.
+  while (!files_.empty()) {
+    files_.pop_back();
+  }
+}
+
+OutputFolder::OutputFolder(std::string path, const std::string& what) : path_(std::move(path)) {
+  if (path_.empty()) {
+    throw InputError(fmt::format("{}: no folder name given", what));
+  }
+  created_ = make_folders(path_, fmt::format("{} '{}'", what, path_));
+}
+
+OutputFolder::~OutputFolder() { remove_folders(created_, kept_); }
+
+void OutputFolder::keep() {
+  kept_ = true;
+  remove_folders(created_, true);
 }
 
 void mark_standard_stream_closed(int fd) { g_closed_streams |= 1U << fd; }

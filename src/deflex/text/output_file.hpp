@@ -9,7 +9,9 @@
 //   folder (the link stays a link); a link to nothing is refused;
 // - a character device or a FIFO (/dev/null, /dev/stdout, a pipe) is written in place as a stream,
 //   never renamed, truncated or removed; what was written to a stream cannot be taken back;
-// - a folder, a block device or a socket is refused, as is a missing folder;
+// - a folder, a block device or a socket is refused; a missing folder on the way is created (every
+//   command alike: `-o out/run1/x.csv` needs no mkdir first), and removed again, when still empty,
+//   if the output is not committed: deflex removes only folders it created itself;
 // - a file the same run reads is refused before it is written (run_files.hpp);
 // - interrupted by a signal, a program that called remove_temporaries_on_signals() removes the
 //   temporary files it was writing.
@@ -20,6 +22,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace deflex {
@@ -53,6 +56,7 @@ class OutputFile {
   friend class OutputTransaction;
   void open_stream(int fd_to_dup, const std::string& resolved);
   void create_temporary(const std::string& target_path, bool existed, unsigned mode);
+  void create_missing_folders(const std::string& dir);
   void flush_buffer();
   void rename_into_place();
   [[nodiscard]] std::string keep_previous() const;  // a hard link to the file being replaced, or ""
@@ -69,6 +73,7 @@ class OutputFile {
   bool finished_ = false;
   bool committed_ = false;
   int slot_ = -1;  // in the table the signal handler removes temporary files from
+  std::vector<std::pair<std::string, int>> created_folders_;  // made for this output (shallowest first), slot
   std::string buffer_;
 };
 
@@ -80,6 +85,7 @@ class OutputFile {
 class OutputTransaction {
  public:
   OutputTransaction() = default;
+  ~OutputTransaction();
   OutputTransaction(const OutputTransaction&) = delete;
   OutputTransaction& operator=(const OutputTransaction&) = delete;
 
@@ -93,6 +99,27 @@ class OutputTransaction {
 
  private:
   std::vector<std::unique_ptr<OutputFile>> files_;
+};
+
+/// A folder an option names for several outputs (`case-study --out DIR`): made, with any missing folder
+/// on its way, as OutputFile makes a file's; removed again (the ones made here, when empty) unless
+/// keep() is called once the outputs are in place. Throws InputError naming `what` when a file stands
+/// where a folder should, or a folder cannot be made.
+/// Thread safety: one thread at a time.
+class OutputFolder {
+ public:
+  OutputFolder(std::string path, const std::string& what);
+  ~OutputFolder();
+  OutputFolder(const OutputFolder&) = delete;
+  OutputFolder& operator=(const OutputFolder&) = delete;
+  /// The outputs are in place: the folders stay.
+  void keep();
+  [[nodiscard]] const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::vector<std::pair<std::string, int>> created_;  // shallowest first, with their signal-table slots
+  bool kept_ = false;
 };
 
 /// Tells the output layer that standard stream `fd` (1 or 2) was closed when the program started and

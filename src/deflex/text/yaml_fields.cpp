@@ -26,6 +26,21 @@ std::string where_of(const std::string& file, const YAML::Mark& m) {
   return m.line >= 0 ? fmt::format("{}:{}:{}", file, m.line + 1, m.column + 1) : file;
 }
 
+// A tag ("!!str [1, 2]", "!pose {...}") would change what a value means in a YAML reader that honours
+// it; yaml-cpp reads past it, so the value would mean something else here than the author meant.
+// deflex's files have no use for tags: refused, naming it. "?" and "!" are yaml-cpp's marks of an
+// untagged plain and quoted node.
+void refuse_tag(const YAML::Node& node, const std::string& file, const std::string& path) {
+  const std::string& tag = node.Tag();
+  if (tag.empty() || tag == "?" || tag == "!") {
+    return;
+  }
+  const std::string core = "tag:yaml.org,2002:";
+  const std::string written = tag.rfind(core, 0) == 0 ? "!!" + tag.substr(core.size()) : tag;
+  throw ModelError(fmt::format("{}: field '{}': a YAML tag ('{}'): deflex files take no tags; remove it",
+                               where_of(file, node.Mark()), path.empty() ? "<document>" : path, written));
+}
+
 // yaml-cpp keeps both entries of a key given twice and answers lookups with the first, so a
 // second value would be silently ignored: every map of the document is checked here.
 void refuse_duplicate_keys(const YAML::Node& node, const std::string& file, const std::string& path, int depth,
@@ -37,6 +52,7 @@ void refuse_duplicate_keys(const YAML::Node& node, const std::string& file, cons
   if (depth > 64) {
     throw ModelError(fmt::format("{}: field '{}': nested deeper than 64 levels", where_of(file, node.Mark()), path));
   }
+  refuse_tag(node, file, path);
   if (node.IsScalar()) {
     // Names and notes go into JSON and YAML, which require UTF-8: a Latin-1 byte is named here.
     if (const auto bad = utf8_problem(node.Scalar())) {
@@ -60,6 +76,7 @@ void refuse_duplicate_keys(const YAML::Node& node, const std::string& file, cons
       throw ModelError(fmt::format("{}: field '{}': a key must be a plain name, not a list or a map ('? [a, b]')",
                                    where_of(file, kv.first.Mark()), path.empty() ? "<document>" : path));
     }
+    refuse_tag(kv.first, file, path);
     const std::string key = kv.first.Scalar();
     if (const auto bad = utf8_problem(key)) {
       throw ModelError(fmt::format("{}: a key of field '{}': {}", where_of(file, kv.first.Mark()),

@@ -3,6 +3,7 @@
 // middle of compensating an existing RAPID or KRL program.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,8 @@ struct ProgramTargetUse {
   /// configuration (the controller takes the one closest to where the arm is). `ik` is used for the
   /// first use, which has no previous one.
   bool nearest_previous = false;
+  /// The rule that chose the configuration, for a refusal: "ConfJ\\Off (line 40)" ("" for its own).
+  std::string configuration_rule;
   std::size_t force_index = 0;  ///< the force model's point index of this use
 };
 
@@ -46,12 +49,13 @@ struct ProgramTargetResult {
   double residual_m = 0.0;                         ///< model-consistent check after compensation
 };
 
-/// Compensates every use in order. Throws InputError "FILE:LINE: INSTRUCTION TARGET: REASON" when a
-/// target is out of reach, at or near a singularity, has no solution with its configuration,
-/// compensates out of the joint limits, or the force model has no data for its index.
-[[nodiscard]] std::vector<ProgramTargetResult> compensate_program_targets(const RobotModel& model,
-                                                                          const std::vector<ProgramTargetUse>& uses,
-                                                                          const ForceModel& force);
+/// Compensates every use in order. `start_q` (ProgramOptions::start_q) stands for the previous use of
+/// the first one. Throws InputError "FILE:LINE: INSTRUCTION TARGET: REASON" when a target is out of
+/// reach, at or near a singularity, has no solution with its configuration, compensates out of the
+/// joint limits, or the force model has no data for its index.
+[[nodiscard]] std::vector<ProgramTargetResult> compensate_program_targets(
+    const RobotModel& model, const std::vector<ProgramTargetUse>& uses, const ForceModel& force,
+    const std::optional<JointVector>& start_q = std::nullopt);
 
 /// The report line of one compensated use: where it is and what was done to it (`action`), with
 /// the deflection, correction and wrench of its result. Shared by the RAPID and KRL readers.
