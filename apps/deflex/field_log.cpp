@@ -11,13 +11,16 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <mutex>
+#include <optional>
 
 #include <fmt/format.h>
 #include <spdlog/sinks/base_sink.h>
 #include <spdlog/sinks/stdout_sinks.h>
 
 #include "deflex/text/errors.hpp"
+#include "deflex/text/output_file.hpp"
 
 namespace deflex::cli {
 
@@ -116,11 +119,15 @@ std::shared_ptr<spdlog::logger> make_field_logger(const std::string& name, const
   }
   std::vector<spdlog::sink_ptr> sinks{std::make_shared<spdlog::sinks::stderr_sink_mt>()};
   if (!options.file.empty()) {
-    // Checked with the C library first: spdlog would create missing directories on its own.
+    // A missing folder is made, as for every output of deflex (and kept: the log is appended at once).
+    std::optional<OutputFolder> folder;
+    const std::string parent = std::filesystem::path(options.file).parent_path().string();
+    if (!parent.empty()) folder.emplace(parent, "option --log-file");
     std::FILE* probe = std::fopen(options.file.c_str(), "a");
     if (probe == nullptr) throw Error(fmt::format("option --log-file: {}: cannot append the log to it", options.file));
     std::fclose(probe);
     sinks.push_back(std::make_shared<CheckedFileSink>(options.file));
+    if (folder) folder->keep();
   }
   auto logger = std::make_shared<spdlog::logger>(name, sinks.begin(), sinks.end());
   logger->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%l] %v");

@@ -189,6 +189,23 @@ TEST(CliRuntimeFaults, ALogOnAFullDiskEndsTheRunWithExit1NamingItAndTheSummary) 
   }
 }
 
+TEST(CliRuntimeFaults, AFieldLogInAFolderThatDoesNotExistYetIsMadeThere) {
+  // Every output of deflex makes its missing folders; the field log did not ("cannot append").
+  const std::string dir = ::testing::TempDir() + "/cli_log_folder";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string program_path = test::nominal_program(dir, 50.0, 0.2);
+  const std::string log = dir + "/logs/today/online.log";
+  Child deflex;
+  test::spawn(deflex,
+              {kDeflex, "online", "--link", "egm-joint", "--program", program_path, "--egm-port", "0", "--force-source",
+               "csv:" + test::kForceReplay, "--loop", "--log-file", log, "--duration-s", "0.3"},
+              dir + "/stderr.txt");
+  EXPECT_EQ(deflex.wait(), 0) << test::slurp(deflex.stderr_path);
+  ASSERT_TRUE(fs::exists(log));
+  EXPECT_NE(test::slurp(log).find("the egm-joint session ended: duration"), std::string::npos) << test::slurp(log);
+}
+
 TEST(CliRuntimeFaults, AStoppedRsiControllerEndsTheRunWithANonZeroCodeNamingIt) {
   const std::string dir = ::testing::TempDir() + "/cli_rsi_stop";
   fs::create_directories(dir);
