@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "deflex/runtime/cycle_log.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/input_file.hpp"
@@ -16,10 +17,36 @@
 namespace deflex::monitor {
 namespace {
 
+constexpr std::size_t kNoColumn = static_cast<std::size_t>(-1);
+
 std::vector<std::string_view> cells_of(std::string_view line) {
   std::vector<std::string_view> out;
   for_each_csv_cell(line, [&out](std::string_view cell) { out.push_back(cell); });
   return out;
+}
+
+// "# deflex cycle log: link=rsi period_ms=4 force_components=3" into the setup (a log written before
+// the line existed: the link is not known, nor the cycle its answers are late against).
+void read_preamble(std::string_view line, runtime::MonitorSetup& setup) {
+  line.remove_prefix(std::string_view(runtime::kCycleLogPreamble).size());
+  std::size_t at = 0;
+  while (at < line.size()) {
+    const std::size_t end = std::min(line.find(' ', at), line.size());
+    const std::string_view word = line.substr(at, end - at);
+    at = end + 1;
+    const auto eq = word.find('=');
+    if (eq == std::string_view::npos) continue;
+    const std::string_view key = word.substr(0, eq), value = word.substr(eq + 1);
+    if (key == "link") {
+      setup.link = std::string(value);
+    } else if (key == "period_ms") {
+      const auto v = parse_double(value);
+      if (v && *v > 0.0 && std::isfinite(*v)) setup.period_s = *v * 1e-3;
+    } else if (key == "force_components") {
+      const auto v = parse_int64(value);
+      if (v && (*v == 3 || *v == 6)) setup.force_components = static_cast<int>(*v);
+    }
+  }
 }
 
 }  // namespace
@@ -29,7 +56,9 @@ std::shared_ptr<runtime::MonitorFeed> read_cycle_log_feed(const std::string& pat
   runtime::MonitorSetup setup;
   setup.recorded = true;
   setup.source = path;
-  setup.link = "recorded log";
+  setup.link = "not in the log";
+  setup.force_components = 0;
+  std::string stop_reason;
   std::map<std::string, std::size_t> col;
   std::vector<std::string> header;
   std::shared_ptr<runtime::MonitorFeed> feed;
@@ -45,6 +74,7 @@ std::shared_ptr<runtime::MonitorFeed> read_cycle_log_feed(const std::string& pat
   struct Columns {
     std::size_t t, pt, seq, st, w[6], raw[3], d[kMaxJoints], c[3], delay, answer, arrival, jitter, missed_before, dup,
         sup, rej, rst, late, clate, sil, guard;
+    std::size_t replied = kNoColumn;
   } c{};
   while (pos < text.size()) {
     auto end = text.find('\n', pos);
@@ -54,7 +84,15 @@ std::shared_ptr<runtime::MonitorFeed> read_cycle_log_feed(const std::string& pat
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (trim_view(line).empty()) continue;
-    if (line[0] == '#') continue;
+    if (line[0] == '#') {
+      if (header.empty() &&
+          line.substr(0, std::string_view(runtime::kCycleLogPreamble).size()) == runtime::kCycleLogPreamble) {
+        read_preamble(line, setup);
+      } else if (line.substr(0, std::string_view(runtime::kCycleLogStop).size()) == runtime::kCycleLogStop) {
+        stop_reason = std::string(line.substr(std::string_view(runtime::kCycleLogStop).size()));
+      }
+      continue;
+    }
     const auto cells = cells_of(line);
     if (header.empty()) {
       for (std::size_t i = 0; i < cells.size(); ++i) {
@@ -91,6 +129,7 @@ std::shared_ptr<runtime::MonitorFeed> read_cycle_log_feed(const std::string& pat
       c.clate = need("controller_late");
       c.sil = need("silences");
       c.guard = need("guard_trips");
+      if (col.count("replied") != 0) c.replied = col.at("replied");
       continue;
     }
     if (cells.size() != header.size()) {
@@ -130,6 +169,7 @@ std::shared_ptr<runtime::MonitorFeed> read_cycle_log_feed(const std::string& pat
     r.program_t_s = value(c.pt);
     r.sequence = count(c.seq);
     r.status = static_cast<int>(value(c.st));
+    r.replied = c.replied == kNoColumn || value(c.replied) != 0.0;
     for (int k = 0; k < 6; ++k) r.wrench[k] = value(c.w[k]);
     for (int k = 0; k < 3; ++k) r.raw_force[k] = value(c.raw[k]);
     for (int j = 0; j < setup.joints; ++j) r.dtheta_deg[j] = value(c.d[j]);
@@ -151,8 +191,8 @@ std::shared_ptr<runtime::MonitorFeed> read_cycle_log_feed(const std::string& pat
     feed->add(r);
   }
   if (header.empty()) throw DataError(fmt::format("{}: no header row: not a deflex cycle log", path));
-  if (!feed || feed->rows_added() == 0) throw DataError(fmt::format("{}: no cycles (only the header)", path));
-  feed->set_state("recorded", "");
+  if (!feed) throw DataError(fmt::format("{}: no cycles (only the header)", path));
+  feed->set_state("recorded", stop_reason);
   return feed;
 }
 
