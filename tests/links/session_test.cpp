@@ -6,6 +6,7 @@
 #include <fstream>
 #include <regex>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "support/poses.hpp"
@@ -89,8 +90,9 @@ TEST(Session, ThePollDoesNotAllocateWithTheLogTheDumpASinkAndTheMonitorOn) {
   // line names the link, the cycle and the sensor, the last why the session ended.
   EXPECT_NE(header.find(",joint_bound_deg,tcp_bound_mm"), std::string::npos) << header;
   ASSERT_EQ(comments.size(), 2u);
-  EXPECT_EQ(comments[0], "# deflex cycle log: link=egm-joint period_ms=4 force_components=" +
-                             std::to_string(test::bench_sensor().components));
+  EXPECT_EQ(comments[0], fmt::format("# deflex cycle log: link=egm-joint period_ms=4 force_components={} "
+                                     "force_fault_N={:g}",
+                                     test::bench_sensor().components, test::bench_sensor().fault_threshold_N));
   EXPECT_EQ(comments[1], "# stop: " + s.reason_text);
   ASSERT_TRUE(session.monitor_feed());
   EXPECT_EQ(session.monitor_feed()->rows_added(), s.cycles);  // every cycle reached the page's feed

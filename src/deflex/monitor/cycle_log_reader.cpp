@@ -25,7 +25,7 @@ std::vector<std::string_view> cells_of(std::string_view line) {
   return out;
 }
 
-// "# deflex cycle log: link=rsi period_ms=4 force_components=3" into the setup (a log written before
+// "# deflex cycle log: link=rsi period_ms=4 force_components=3 force_fault_N=2000" into the setup (a log written before
 // the line existed: the link is not known, nor the cycle its answers are late against).
 void read_preamble(std::string_view line, runtime::MonitorSetup& setup) {
   line.remove_prefix(std::string_view(runtime::kCycleLogPreamble).size());
@@ -42,6 +42,9 @@ void read_preamble(std::string_view line, runtime::MonitorSetup& setup) {
     } else if (key == "period_ms") {
       const auto v = parse_double(value);
       if (v && *v > 0.0 && std::isfinite(*v)) setup.period_s = *v * 1e-3;
+    } else if (key == "force_fault_N") {
+      const auto v = parse_double(value);
+      if (v && *v > 0.0 && std::isfinite(*v)) setup.force_fault_n = *v;
     } else if (key == "force_components") {
       const auto v = parse_int64(value);
       if (v && (*v == 3 || *v == 6)) setup.force_components = static_cast<int>(*v);

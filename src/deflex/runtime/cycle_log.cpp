@@ -10,8 +10,9 @@
 namespace deflex::runtime {
 
 std::string cycle_log_preamble(const CycleLogInfo& info) {
-  return fmt::format("{} link={} period_ms={:g} force_components={}\n", kCycleLogPreamble,
-                     info.link.empty() ? "unknown" : info.link, info.period_s * 1e3, info.force_components);
+  return fmt::format("{} link={} period_ms={:g} force_components={} force_fault_N={:g}\n", kCycleLogPreamble,
+                     info.link.empty() ? "unknown" : info.link, info.period_s * 1e3, info.force_components,
+                     info.force_fault_n);
 }
 
 std::string cycle_log_header(int joints) {

@@ -24,13 +24,15 @@ struct CycleLogBounds {
 
 /// What a log's first line says of its session, so a log read back on its own (`deflex monitor --log`)
 /// names its link, the cycle its answers are measured against and what the sensor measures:
-/// "# deflex cycle log: link=egm-joint period_ms=4 force_components=6". Its last line, written when
+/// "# deflex cycle log: link=egm-joint period_ms=4 force_components=6 force_fault_N=5000". Its last
+/// line, written when
 /// the session ends, says why: "# stop: REASON". CSV readers that skip '#' lines (deflex's own,
 /// pandas with comment='#') read the columns alone.
 struct CycleLogInfo {
   std::string link;
   double period_s = 0.0;
   int force_components = 0;
+  double force_fault_n = 0.0;  ///< |F| above this is a force fault (the sensor's threshold)
 };
 inline constexpr char kCycleLogPreamble[] = "# deflex cycle log:";
 inline constexpr char kCycleLogStop[] = "# stop: ";

@@ -75,6 +75,7 @@ Session::Session(const SessionConfig& config, const RobotModel& robot, const Sen
     setup.joints = robot.dof();
     setup.period_s = config_.online.period_s;
     setup.force_components = sensor.components;
+    setup.force_fault_n = sensor.fault_threshold_N;
     setup.limits = link_->limits();
     setup.streams_program = info.streams_program;
     if (program_) {
