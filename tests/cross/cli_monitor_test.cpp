@@ -232,7 +232,7 @@ TEST(CliMonitor, TheRenderedPageShowsTheCycleLogsValues) {
   if (const char* shot = std::getenv("DEFLEX_MONITOR_SCREENSHOT")) {  // the picture in docs/online.md
     (void)std::system(("timeout 120 " + browser +
                        " --headless --no-sandbox --disable-gpu --hide-scrollbars --virtual-time-budget=1500 "
-                       "--window-size=1400,1900 --screenshot=" +
+                       "--window-size=1400,1640 --screenshot=" +
                        std::string(shot) + " " + url + " >/dev/null 2>&1")
                           .c_str());
   }

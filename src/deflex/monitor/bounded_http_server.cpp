@@ -111,6 +111,10 @@ class IdleThreadPool final : public httplib::TaskQueue {
   std::vector<std::thread> threads_;
 };
 
+// The most one send() copies into the kernel: a large answer handed over whole keeps a CPU in the
+// kernel's network code for milliseconds, where the thread's low priority does not count.
+constexpr std::size_t kSendChunk = 16384;
+
 // A connection's bytes with deadlines: every read waits at most until the request's deadline, every
 // write until the answer's, and no more than `max_read` bytes are taken. Reads are buffered (the
 // request parser asks for one byte at a time).
@@ -143,7 +147,7 @@ class DeadlineStream final : public httplib::Stream {
     std::size_t sent = 0;
     while (sent < size) {
       if (!wait(POLLOUT, write_by_)) return -1;
-      const ssize_t n = ::send(fd_, ptr + sent, size - sent, MSG_NOSIGNAL | MSG_DONTWAIT);
+      const ssize_t n = ::send(fd_, ptr + sent, std::min(size - sent, kSendChunk), MSG_NOSIGNAL | MSG_DONTWAIT);
       if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
       if (n <= 0) return -1;
       sent += static_cast<std::size_t>(n);

@@ -251,40 +251,13 @@ void json_events(std::string& out, const std::vector<MonitorEvent>& events) {
 
 }  // namespace
 
-std::string MonitorFeed::json(std::uint64_t since, std::size_t max_rows) const {
-  std::shared_ptr<const Snapshot> snap;
-  {
-    const std::lock_guard lock(mutex_);
-    snap = published_;
-  }
-  const std::uint64_t from = std::min(std::max(since, snap->first), snap->next);
-  const std::uint64_t to = snap->next - from <= max_rows ? snap->next : from + std::max<std::size_t>(max_rows, 1);
-  // The rows [from, to) in order, from the snapshot's blocks.
-  std::vector<const MonitorRow*> rows;
-  rows.reserve(to - from);
-  {
-    auto b = std::upper_bound(snap->blocks.begin(), snap->blocks.end(), from,
-                              [](std::uint64_t v, const std::shared_ptr<Block>& blk) { return v < blk->first; });
-    for (std::uint64_t i = from; i < to; ++i) {
-      while (b != snap->blocks.end() && (*b)->first <= i) ++b;
-      const Block& blk = **(b - 1);
-      rows.push_back(&blk.rows[i - blk.first]);
-    }
-  }
-  std::string out;
-  out.reserve(1024 + rows.size() * 460);
-  fmt::format_to(std::back_inserter(out),
-                 "{{\"link\":\"{}\",\"joints\":{},\"force_components\":{},\"period_ms\":{},\"joint_bound_deg\":{},"
-                 "\"tcp_bound_mm\":{},\"force_fault_n\":{},\"program_duration_s\":{},\"window_s\":{},\"recorded\":{},"
-                 "\"source\":\"{}\",\"first\":{},\"next\":{},\"more\":{},\"state\":\"{}\",\"stop_reason\":\"{}\",",
-                 json_text(setup_.link), setup_.joints, setup_.force_components, setup_.period_s * 1e3,
-                 setup_.joint_bound_deg, setup_.tcp_bound_mm, setup_.force_fault_n, setup_.program_duration_s,
-                 setup_.window_s, setup_.recorded ? "true" : "false", json_text(setup_.source), snap->first, to,
-                 to < snap->next ? "true" : "false", json_text(snap->state), json_text(snap->stop_reason));
-  json_events(out, *snap->events);
+namespace {
+
+// The rows as columns, {"t":[...],"fz":[...],...} (units as MonitorRow's).
+void json_rows(std::string& out, const std::vector<const MonitorRow*>& rows, int joints) {
   out += "\"rows\":{";
-  auto column = [&](const char* name, auto get, bool first = false) {
-    if (!first) out += ',';
+  auto column = [&](const char* name, auto get) {
+    if (out.back() != '{') out += ',';
     fmt::format_to(std::back_inserter(out), "\"{}\":[", name);
     for (std::size_t i = 0; i < rows.size(); ++i) {
       if (i > 0) out += ',';
@@ -292,8 +265,7 @@ std::string MonitorFeed::json(std::uint64_t since, std::size_t max_rows) const {
     }
     out += ']';
   };
-  column(
-      "t", [](const MonitorRow& r) { return r.t_s; }, true);
+  column("t", [](const MonitorRow& r) { return r.t_s; });
   column("pt", [](const MonitorRow& r) { return r.program_t_s; });
   column("seq", [](const MonitorRow& r) { return static_cast<double>(r.sequence); });
   column("st", [](const MonitorRow& r) { return r.status; });
@@ -301,7 +273,7 @@ std::string MonitorFeed::json(std::uint64_t since, std::size_t max_rows) const {
   for (int k = 0; k < 6; ++k) column(kWrench[k], [k](const MonitorRow& r) { return r.wrench[k]; });
   static const char* kRaw[3] = {"rfx", "rfy", "rfz"};
   for (int k = 0; k < 3; ++k) column(kRaw[k], [k](const MonitorRow& r) { return r.raw_force[k]; });
-  for (int j = 0; j < setup_.joints && j < kMaxJoints; ++j) {
+  for (int j = 0; j < joints && j < kMaxJoints; ++j) {
     const std::string name = fmt::format("d{}", j + 1);
     column(name.c_str(), [j](const MonitorRow& r) { return r.dtheta_deg[j]; });
   }
@@ -323,10 +295,46 @@ std::string MonitorFeed::json(std::uint64_t since, std::size_t max_rows) const {
       {"guard_trips", &MonitorRow::guard_trips},
       {"answers", &MonitorRow::answers},
       {"late_answers", &MonitorRow::late_answers}};
-  for (const auto& [name, member] : counts) {
-    column(name, [member](const MonitorRow& r) { return static_cast<double>(r.*member); });
+  for (const auto& count : counts) {
+    const auto member = count.second;
+    column(count.first, [member](const MonitorRow& r) { return static_cast<double>(r.*member); });
   }
-  out += "}}";
+  out += '}';
+}
+
+}  // namespace
+
+std::string MonitorFeed::json(std::uint64_t since, std::size_t max_rows) const {
+  std::shared_ptr<const Snapshot> snap;
+  {
+    const std::lock_guard lock(mutex_);
+    snap = published_;
+  }
+  const std::uint64_t from = std::min(std::max(since, snap->first), snap->next);
+  const std::uint64_t to = snap->next - from <= max_rows ? snap->next : from + std::max<std::size_t>(max_rows, 1);
+  // The rows [from, to) in order, from the snapshot's blocks.
+  std::vector<const MonitorRow*> rows;
+  rows.reserve(to - from);
+  auto b = std::upper_bound(snap->blocks.begin(), snap->blocks.end(), from,
+                            [](std::uint64_t v, const std::shared_ptr<Block>& blk) { return v < blk->first; });
+  for (std::uint64_t i = from; i < to; ++i) {
+    while (b != snap->blocks.end() && (*b)->first <= i) ++b;
+    const Block& blk = **(b - 1);
+    rows.push_back(&blk.rows[i - blk.first]);
+  }
+  std::string out;
+  out.reserve(1024 + rows.size() * 460);
+  fmt::format_to(std::back_inserter(out),
+                 "{{\"link\":\"{}\",\"joints\":{},\"force_components\":{},\"period_ms\":{},\"joint_bound_deg\":{},"
+                 "\"tcp_bound_mm\":{},\"force_fault_n\":{},\"program_duration_s\":{},\"window_s\":{},\"recorded\":{},"
+                 "\"source\":\"{}\",\"first\":{},\"next\":{},\"more\":{},\"state\":\"{}\",\"stop_reason\":\"{}\",",
+                 json_text(setup_.link), setup_.joints, setup_.force_components, setup_.period_s * 1e3,
+                 setup_.joint_bound_deg, setup_.tcp_bound_mm, setup_.force_fault_n, setup_.program_duration_s,
+                 setup_.window_s, setup_.recorded ? "true" : "false", json_text(setup_.source), snap->first, to,
+                 to < snap->next ? "true" : "false", json_text(snap->state), json_text(snap->stop_reason));
+  json_events(out, *snap->events);
+  json_rows(out, rows, setup_.joints);
+  out += '}';
   return out;
 }
 
