@@ -177,8 +177,11 @@ void MonitorFeed::add(MonitorRow row) {
 }
 
 void MonitorFeed::add(const SessionEntry& entry) {
-  if (entry.kind != SessionEntry::Kind::kCycle) return;
-  add(monitor_row(entry));
+  if (entry.kind == SessionEntry::Kind::kCycle) {
+    add(monitor_row(entry));
+  } else if (!setup_.recorded) {
+    publish(false);  // the controller is silent: the last rows go out now, not with the next one
+  }
 }
 
 void MonitorFeed::set_state(const std::string& state, const std::string& stop_reason) {

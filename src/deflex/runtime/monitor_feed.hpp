@@ -67,8 +67,8 @@ struct MonitorSetup {
 /// The rows of the last window_s seconds, the session's state, events and stop reason, as JSON for the
 /// page. Thread safety: add(), set_state() and flush() from one writer thread (the reporter, or a log
 /// reader), never waiting for a reader; json() and rows_added() from any number of threads. Rows
-/// reach readers when published: every 50 ms of the rows' time or 64 rows (a recorded log: at
-/// set_state() or flush()), and at every state change.
+/// reach readers when published: every 50 ms of the rows' time or 64 rows, at a heartbeat (the
+/// controller silent) and at every state change (a recorded log: at set_state() or flush()).
 class MonitorFeed {
  public:
   static constexpr std::size_t kMaxRowsPerAnswer = 5000;  ///< a reader asks again for the rest
