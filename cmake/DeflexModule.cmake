@@ -56,13 +56,23 @@ function(deflex_module name)
 endfunction()
 
 # deflex_embed_text(TARGET FILE SYMBOL)
-# Compiles the text of FILE (relative to the source tree) into TARGET as
-# `extern const char* const deflex::SYMBOL`. The generated source is rewritten only when the text
-# changes, so a re-configure does not force a recompile; editing FILE re-runs the configure.
+# Compiles the text of FILE (relative to the source tree, or an absolute path: a file a Debian package
+# installed) into TARGET as `extern const char* const deflex::SYMBOL`. A source-map comment is left
+# out (the map is not embedded, and a browser would look for it). The generated source is rewritten
+# only when the text changes, so a re-configure does not force a recompile; editing FILE re-runs the
+# configure.
 function(deflex_embed_text target file symbol)
-  set(src ${PROJECT_SOURCE_DIR}/${file})
+  if(IS_ABSOLUTE ${file})
+    set(src ${file})
+  else()
+    set(src ${PROJECT_SOURCE_DIR}/${file})
+  endif()
   set_property(DIRECTORY ${PROJECT_SOURCE_DIR} APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${src})
   file(READ ${src} text)
+  string(REGEX REPLACE "\n?(//# sourceMappingURL=[^\n]*|/\\*# sourceMappingURL=[^\n]*\\*/)" "" text "${text}")
+  if(text MATCHES "\\)deflexembed\"")
+    message(FATAL_ERROR "${src} holds the raw string's delimiter: it cannot be embedded as it is")
+  endif()
   set(out ${PROJECT_BINARY_DIR}/generated/${symbol}.cpp)
   file(CONFIGURE OUTPUT ${out} @ONLY CONTENT
     "// Generated from ${file} by deflex_embed_text (cmake/DeflexModule.cmake).\nnamespace deflex { extern const char* const ${symbol}; const char* const ${symbol} = R\"deflexembed(@text@)deflexembed\"; }\n")

@@ -26,6 +26,8 @@ packages=(
   libcurl4-openssl-dev
   # cpp-httplib: the live monitor page's server (deflex online --monitor, deflex monitor)
   libcpp-httplib-dev
+  # dygraphs: the monitor page's charts, embedded in the program at build time (the page needs no network)
+  libjs-dygraphs
   python3 python3-dev python3-numpy python3-pytest pybind11-dev
   # mypy's stubgen: the Python module's .pyi stubs (typed signatures for editors and type checkers)
   python3-mypy

@@ -40,7 +40,7 @@ python3 - "$OUT/summary.json" "$OUT/online.csv" <<'PY'
 import csv, json, math, sys
 s = json.load(open(sys.argv[1]))
 assert s["exit_code"] == 0 and s["counters"]["replies"] > 300, s
-rows = list(csv.DictReader(open(sys.argv[2])))
+rows = list(csv.DictReader(line for line in open(sys.argv[2]) if not line.startswith("#")))
 f = [math.dist((0, 0, 0), (float(r["meas_fx_N"]), float(r["meas_fy_N"]), float(r["meas_fz_N"]))) for r in rows[len(rows) // 2:]]
 expected = math.dist((0, 0, 0), (20, -10, -90)) * 4.4482216152605
 print(f"measured |F| {min(f):.1f}..{max(f):.1f} N (the sensor streams {expected:.1f} N in lbf counts)")

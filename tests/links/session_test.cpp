@@ -6,6 +6,7 @@
 #include <fstream>
 #include <regex>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "support/poses.hpp"
@@ -76,12 +77,23 @@ TEST(Session, ThePollDoesNotAllocateWithTheLogTheDumpASinkAndTheMonitorOn) {
   std::ifstream log(c.log_path);
   std::size_t rows = 0;
   std::string header;
+  std::vector<std::string> comments;
   for (std::string line; std::getline(log, line);) {
-    if (rows++ == 0) header = line;
+    if (line.rfind('#', 0) == 0) {
+      comments.push_back(line);
+    } else if (rows++ == 0) {
+      header = line;
+    }
   }
   EXPECT_EQ(rows, 1 + s.cycles);  // the header and every cycle
-  // Every row carries the bounds, so deflex monitor --log draws them from the log alone.
+  // Every row carries the bounds, so deflex monitor --log draws them from the log alone; the first
+  // line names the link, the cycle and the sensor, the last why the session ended.
   EXPECT_NE(header.find(",joint_bound_deg,tcp_bound_mm"), std::string::npos) << header;
+  ASSERT_EQ(comments.size(), 2u);
+  EXPECT_EQ(comments[0], fmt::format("# deflex cycle log: link=egm-joint period_ms=4 force_components={} "
+                                     "force_fault_N={:g}",
+                                     test::bench_sensor().components, test::bench_sensor().fault_threshold_N));
+  EXPECT_EQ(comments[1], "# stop: " + s.reason_text);
   ASSERT_TRUE(session.monitor_feed());
   EXPECT_EQ(session.monitor_feed()->rows_added(), s.cycles);  // every cycle reached the page's feed
 }

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "deflex/runtime/cycle_log.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/input_file.hpp"
@@ -16,36 +17,220 @@
 namespace deflex::monitor {
 namespace {
 
+constexpr std::size_t kNoColumn = static_cast<std::size_t>(-1);
+
 std::vector<std::string_view> cells_of(std::string_view line) {
   std::vector<std::string_view> out;
   for_each_csv_cell(line, [&out](std::string_view cell) { out.push_back(cell); });
   return out;
 }
 
+// "# deflex cycle log: link=rsi period_ms=4 force_components=3 force_fault_N=2000" into the setup (a log
+// written before the line existed: the link is not known, nor the cycle its answers are late against).
+void read_preamble(std::string_view line, runtime::MonitorSetup& setup) {
+  line.remove_prefix(std::string_view(runtime::kCycleLogPreamble).size());
+  std::size_t at = 0;
+  while (at < line.size()) {
+    const std::size_t end = std::min(line.find(' ', at), line.size());
+    const std::string_view word = line.substr(at, end - at);
+    at = end + 1;
+    const auto eq = word.find('=');
+    if (eq == std::string_view::npos) continue;
+    const std::string_view key = word.substr(0, eq), value = word.substr(eq + 1);
+    if (key == "link") {
+      setup.link = std::string(value);
+    } else if (key == "period_ms") {
+      const auto v = parse_double(value);
+      if (v && *v > 0.0 && std::isfinite(*v)) setup.period_s = *v * 1e-3;
+    } else if (key == "force_fault_N") {
+      const auto v = parse_double(value);
+      if (v && *v > 0.0 && std::isfinite(*v)) setup.force_fault_n = *v;
+    } else if (key == "force_components") {
+      const auto v = parse_int64(value);
+      if (v && (*v == 3 || *v == 6)) setup.force_components = static_cast<int>(*v);
+    }
+  }
+}
+
+// The log's columns, by index into a row's cells.
+struct Columns {
+  std::size_t t, pt, seq, st, w[6], raw[3], d[kMaxJoints], c[3], delay, answer, arrival, jitter, missed_before, dup,
+      sup, rej, rst, late, clate, sil, guard;
+  std::size_t replied = kNoColumn;  // a log written before the column existed: every cycle answered
+};
+
+// One log read line by line: its first and last comment lines, the header, the rows into the feed.
+class LogReader {
+ public:
+  explicit LogReader(std::string path) : path_(std::move(path)) {
+    setup_.recorded = true;
+    setup_.source = path_;
+    setup_.link = "not in the log";
+    setup_.force_components = 0;
+  }
+
+  void line(std::string_view line, int line_no) {
+    line_no_ = line_no;
+    if (line[0] == '#') {
+      comment(line);
+    } else if (header_.empty()) {
+      header(cells_of(line));
+    } else {
+      row(cells_of(line));
+    }
+  }
+
+  std::shared_ptr<runtime::MonitorFeed> finish() {
+    if (header_.empty()) throw DataError(fmt::format("{}: no header row: not a deflex cycle log", path_));
+    if (!feed_) throw DataError(fmt::format("{}: no cycles (only the header)", path_));
+    feed_->set_state("recorded", stop_reason_);
+    return feed_;
+  }
+
+ private:
+  void comment(std::string_view line) {
+    const std::string_view preamble = runtime::kCycleLogPreamble, stop = runtime::kCycleLogStop;
+    if (header_.empty() && line.substr(0, preamble.size()) == preamble) {
+      read_preamble(line, setup_);
+    } else if (line.substr(0, stop.size()) == stop) {
+      stop_reason_ = std::string(line.substr(stop.size()));
+    }
+  }
+
+  std::size_t need(const std::string& name) const {
+    const auto it = col_.find(name);
+    if (it == col_.end()) throw DataError(fmt::format("{}: not a deflex cycle log: no column '{}'", path_, name));
+    return it->second;
+  }
+
+  void header(const std::vector<std::string_view>& cells) {
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      header_.emplace_back(cells[i]);
+      col_[header_.back()] = i;
+    }
+    Columns& c = c_;
+    c.t = need("t_s");
+    c.pt = need("program_t_s");
+    c.seq = need("sequence");
+    c.st = need("status");
+    const char* wrench[6] = {"fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm"};
+    for (int k = 0; k < 6; ++k) c.w[k] = need(wrench[k]);
+    const char* raw[3] = {"meas_fx_N", "meas_fy_N", "meas_fz_N"};
+    for (int k = 0; k < 3; ++k) c.raw[k] = need(raw[k]);
+    int joints = 0;
+    while (joints < kMaxJoints && col_.count(fmt::format("dtheta{}_deg", joints + 1)) != 0) {
+      c.d[joints] = col_.at(fmt::format("dtheta{}_deg", joints + 1));
+      ++joints;
+    }
+    if (joints == 0) throw DataError(fmt::format("{}: not a deflex cycle log: no column 'dtheta1_deg'", path_));
+    setup_.joints = joints;
+    const char* corr[3] = {"corr_x_mm", "corr_y_mm", "corr_z_mm"};
+    for (int k = 0; k < 3; ++k) c.c[k] = need(corr[k]);
+    const std::pair<std::size_t Columns::*, const char*> named[] = {{&Columns::delay, "delay_ms"},
+                                                                    {&Columns::answer, "answer_ms"},
+                                                                    {&Columns::arrival, "arrival_delay_ms"},
+                                                                    {&Columns::jitter, "jitter_ms"},
+                                                                    {&Columns::missed_before, "missed_before"},
+                                                                    {&Columns::dup, "duplicates"},
+                                                                    {&Columns::sup, "superseded"},
+                                                                    {&Columns::rej, "rejected"},
+                                                                    {&Columns::rst, "restarts"},
+                                                                    {&Columns::late, "late"},
+                                                                    {&Columns::clate, "controller_late"},
+                                                                    {&Columns::sil, "silences"},
+                                                                    {&Columns::guard, "guard_trips"}};
+    for (const auto& n : named) c.*(n.first) = need(n.second);
+    if (col_.count("replied") != 0) c.replied = col_.at("replied");
+  }
+
+  double value(const std::vector<std::string_view>& cells, std::size_t i) const {
+    if (cells[i].empty()) return kNaN;
+    const auto v = parse_double(cells[i]);
+    if (!v) throw DataError(fmt::format("{}:{}: column '{}': {}", path_, line_no_, header_[i], not_a_number(cells[i])));
+    return *v;
+  }
+
+  std::uint64_t count(const std::vector<std::string_view>& cells, std::size_t i) const {
+    const double v = value(cells, i);
+    if (!(v >= 0.0) || v != std::floor(v)) {
+      throw DataError(fmt::format("{}:{}: column '{}': '{}' is not a count", path_, line_no_, header_[i], cells[i]));
+    }
+    return static_cast<std::uint64_t>(v);
+  }
+
+  // The feed, made at the first row: the bounds are in every row of a log written since they were
+  // added (older logs: not drawn).
+  void make_feed(const std::vector<std::string_view>& cells) {
+    if (col_.count("joint_bound_deg") != 0) setup_.joint_bound_deg = value(cells, col_.at("joint_bound_deg"));
+    if (col_.count("tcp_bound_mm") != 0) setup_.tcp_bound_mm = value(cells, col_.at("tcp_bound_mm"));
+    if (!std::isfinite(setup_.joint_bound_deg)) setup_.joint_bound_deg = 0.0;
+    if (!std::isfinite(setup_.tcp_bound_mm)) setup_.tcp_bound_mm = 0.0;
+    feed_ = std::make_shared<runtime::MonitorFeed>(setup_);
+  }
+
+  void row(const std::vector<std::string_view>& cells) {
+    if (cells.size() != header_.size()) {
+      throw DataError(fmt::format("{}:{}: {} cells where the header has {} (a truncated or damaged log)", path_,
+                                  line_no_, cells.size(), header_.size()));
+    }
+    if (!feed_) make_feed(cells);
+    const Columns& c = c_;
+    const auto v = [&](std::size_t i) { return value(cells, i); };
+    const auto n = [&](std::size_t i) { return count(cells, i); };
+    runtime::MonitorRow r;
+    r.t_s = v(c.t);
+    if (!std::isfinite(r.t_s)) {
+      throw DataError(fmt::format("{}:{}: column 't_s': a cycle without a time", path_, line_no_));
+    }
+    if (r.t_s < last_t_) {
+      throw DataError(
+          fmt::format("{}:{}: column 't_s': time goes back ({} s after {} s)", path_, line_no_, r.t_s, last_t_));
+    }
+    last_t_ = r.t_s;
+    r.program_t_s = v(c.pt);
+    r.sequence = n(c.seq);
+    r.status = static_cast<int>(v(c.st));
+    r.replied = c.replied == kNoColumn || v(c.replied) != 0.0;
+    for (int k = 0; k < 6; ++k) r.wrench[k] = v(c.w[k]);
+    for (int k = 0; k < 3; ++k) r.raw_force[k] = v(c.raw[k]);
+    for (int j = 0; j < setup_.joints; ++j) r.dtheta_deg[j] = v(c.d[j]);
+    for (int k = 0; k < 3; ++k) r.tcp_mm[k] = v(c.c[k]);
+    r.delay_ms = v(c.delay);
+    r.answer_ms = v(c.answer);
+    r.arrival_ms = v(c.arrival);
+    r.jitter_ms = v(c.jitter);
+    missed_ += n(c.missed_before);
+    r.missed = missed_;
+    r.duplicates = n(c.dup);
+    r.superseded = n(c.sup);
+    r.rejected = n(c.rej);
+    r.restarts = n(c.rst);
+    r.late = n(c.late);
+    r.controller_late = n(c.clate);
+    r.silences = n(c.sil);
+    r.guard_trips = n(c.guard);
+    feed_->add(r);
+  }
+
+  std::string path_;
+  runtime::MonitorSetup setup_;
+  std::string stop_reason_;
+  std::map<std::string, std::size_t> col_;
+  std::vector<std::string> header_;
+  Columns c_{};
+  std::shared_ptr<runtime::MonitorFeed> feed_;
+  int line_no_ = 0;
+  double last_t_ = -1e300;
+  std::uint64_t missed_ = 0;
+};
+
 }  // namespace
 
 std::shared_ptr<runtime::MonitorFeed> read_cycle_log_feed(const std::string& path) {
   const std::string text = read_input_file(path, InputKind::kCsvTable);
-  runtime::MonitorSetup setup;
-  setup.recorded = true;
-  setup.source = path;
-  setup.link = "recorded log";
-  std::map<std::string, std::size_t> col;
-  std::vector<std::string> header;
-  std::shared_ptr<runtime::MonitorFeed> feed;
+  LogReader reader(path);
   std::size_t pos = 0;
   int line_no = 0;
-  double last_t = -1e300;
-  std::uint64_t missed = 0;
-  auto need = [&](const std::string& name) {
-    const auto it = col.find(name);
-    if (it == col.end()) throw DataError(fmt::format("{}: not a deflex cycle log: no column '{}'", path, name));
-    return it->second;
-  };
-  struct Columns {
-    std::size_t t, pt, seq, st, w[6], raw[3], d[kMaxJoints], c[3], delay, answer, arrival, jitter, missed_before, dup,
-        sup, rej, rst, late, clate, sil, guard;
-  } c{};
   while (pos < text.size()) {
     auto end = text.find('\n', pos);
     if (end == std::string::npos) end = text.size();
@@ -54,106 +239,9 @@ std::shared_ptr<runtime::MonitorFeed> read_cycle_log_feed(const std::string& pat
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (trim_view(line).empty()) continue;
-    if (line[0] == '#') continue;
-    const auto cells = cells_of(line);
-    if (header.empty()) {
-      for (std::size_t i = 0; i < cells.size(); ++i) {
-        header.emplace_back(cells[i]);
-        col[header.back()] = i;
-      }
-      c.t = need("t_s");
-      c.pt = need("program_t_s");
-      c.seq = need("sequence");
-      c.st = need("status");
-      const char* wrench[6] = {"fx_N", "fy_N", "fz_N", "mx_Nm", "my_Nm", "mz_Nm"};
-      for (int k = 0; k < 6; ++k) c.w[k] = need(wrench[k]);
-      const char* raw[3] = {"meas_fx_N", "meas_fy_N", "meas_fz_N"};
-      for (int k = 0; k < 3; ++k) c.raw[k] = need(raw[k]);
-      int joints = 0;
-      while (joints < kMaxJoints && col.count(fmt::format("dtheta{}_deg", joints + 1)) != 0) {
-        c.d[joints] = col.at(fmt::format("dtheta{}_deg", joints + 1));
-        ++joints;
-      }
-      if (joints == 0) throw DataError(fmt::format("{}: not a deflex cycle log: no column 'dtheta1_deg'", path));
-      setup.joints = joints;
-      const char* corr[3] = {"corr_x_mm", "corr_y_mm", "corr_z_mm"};
-      for (int k = 0; k < 3; ++k) c.c[k] = need(corr[k]);
-      c.delay = need("delay_ms");
-      c.answer = need("answer_ms");
-      c.arrival = need("arrival_delay_ms");
-      c.jitter = need("jitter_ms");
-      c.missed_before = need("missed_before");
-      c.dup = need("duplicates");
-      c.sup = need("superseded");
-      c.rej = need("rejected");
-      c.rst = need("restarts");
-      c.late = need("late");
-      c.clate = need("controller_late");
-      c.sil = need("silences");
-      c.guard = need("guard_trips");
-      continue;
-    }
-    if (cells.size() != header.size()) {
-      throw DataError(fmt::format("{}:{}: {} cells where the header has {} (a truncated or damaged log)", path, line_no,
-                                  cells.size(), header.size()));
-    }
-    auto value = [&](std::size_t i) {
-      if (cells[i].empty()) return kNaN;
-      const auto v = parse_double(cells[i]);
-      if (!v) throw DataError(fmt::format("{}:{}: column '{}': {}", path, line_no, header[i], not_a_number(cells[i])));
-      return *v;
-    };
-    auto count = [&](std::size_t i) {
-      const double v = value(i);
-      if (!(v >= 0.0) || v != std::floor(v)) {
-        throw DataError(fmt::format("{}:{}: column '{}': '{}' is not a count", path, line_no, header[i], cells[i]));
-      }
-      return static_cast<std::uint64_t>(v);
-    };
-    if (!feed) {
-      // The bounds are in every row of a log written since they were added (older logs: not drawn).
-      if (col.count("joint_bound_deg") != 0) setup.joint_bound_deg = value(col.at("joint_bound_deg"));
-      if (col.count("tcp_bound_mm") != 0) setup.tcp_bound_mm = value(col.at("tcp_bound_mm"));
-      if (!std::isfinite(setup.joint_bound_deg)) setup.joint_bound_deg = 0.0;
-      if (!std::isfinite(setup.tcp_bound_mm)) setup.tcp_bound_mm = 0.0;
-      feed = std::make_shared<runtime::MonitorFeed>(setup);
-    }
-    runtime::MonitorRow r;
-    r.t_s = value(c.t);
-    if (!std::isfinite(r.t_s))
-      throw DataError(fmt::format("{}:{}: column 't_s': a cycle without a time", path, line_no));
-    if (r.t_s < last_t) {
-      throw DataError(
-          fmt::format("{}:{}: column 't_s': time goes back ({} s after {} s)", path, line_no, r.t_s, last_t));
-    }
-    last_t = r.t_s;
-    r.program_t_s = value(c.pt);
-    r.sequence = count(c.seq);
-    r.status = static_cast<int>(value(c.st));
-    for (int k = 0; k < 6; ++k) r.wrench[k] = value(c.w[k]);
-    for (int k = 0; k < 3; ++k) r.raw_force[k] = value(c.raw[k]);
-    for (int j = 0; j < setup.joints; ++j) r.dtheta_deg[j] = value(c.d[j]);
-    for (int k = 0; k < 3; ++k) r.tcp_mm[k] = value(c.c[k]);
-    r.delay_ms = value(c.delay);
-    r.answer_ms = value(c.answer);
-    r.arrival_ms = value(c.arrival);
-    r.jitter_ms = value(c.jitter);
-    missed += count(c.missed_before);
-    r.missed = missed;
-    r.duplicates = count(c.dup);
-    r.superseded = count(c.sup);
-    r.rejected = count(c.rej);
-    r.restarts = count(c.rst);
-    r.late = count(c.late);
-    r.controller_late = count(c.clate);
-    r.silences = count(c.sil);
-    r.guard_trips = count(c.guard);
-    feed->add(r);
+    reader.line(line, line_no);
   }
-  if (header.empty()) throw DataError(fmt::format("{}: no header row: not a deflex cycle log", path));
-  if (!feed || feed->rows_added() == 0) throw DataError(fmt::format("{}: no cycles (only the header)", path));
-  feed->set_state("recorded", "");
-  return feed;
+  return reader.finish();
 }
 
 }  // namespace deflex::monitor

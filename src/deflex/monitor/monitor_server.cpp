@@ -9,12 +9,16 @@
 #include <fmt/format.h>
 #include <httplib.h>
 
+#include "deflex/monitor/detail/bounded_http_server.hpp"
+
 #include "deflex/text/errors.hpp"
 #include "deflex/text/parse_number.hpp"
 
 namespace deflex {
 extern const char* const kMonitorPageHtml;
-}
+extern const char* const kDygraphsJs;
+extern const char* const kDygraphsCss;
+}  // namespace deflex
 
 namespace deflex::monitor {
 namespace {
@@ -55,15 +59,12 @@ MonitorAddress parse_monitor_address(const std::string& text, bool allow_remote,
   return a;
 }
 
-MonitorServer::MonitorServer(std::shared_ptr<const runtime::MonitorFeed> feed, const MonitorAddress& address)
-    : feed_(std::move(feed)), host_(address.host), server_(std::make_unique<httplib::Server>()) {
-  server_->set_read_timeout(2, 0);
-  server_->set_write_timeout(2, 0);
-  server_->set_keep_alive_timeout(2);
-  server_->set_payload_max_length(4096);  // a request carries nothing the server uses
-  const std::string page = monitor_page();
+MonitorServer::MonitorServer(std::shared_ptr<const runtime::MonitorFeed> feed, const MonitorAddress& address,
+                             const MonitorLimits& limits)
+    : feed_(std::move(feed)), host_(address.host), server_(std::make_unique<detail::BoundedHttpServer>(limits)) {
+  const auto page = std::make_shared<const std::string>(monitor_page());
   server_->Get("/", [page](const httplib::Request&, httplib::Response& res) {
-    res.set_content(page, "text/html; charset=utf-8");
+    res.set_content(*page, "text/html; charset=utf-8");
     res.set_header("Cache-Control", "no-store");
   });
   server_->Get("/data", [feed = feed_](const httplib::Request& req, httplib::Response& res) {
@@ -81,32 +82,44 @@ MonitorServer::MonitorServer(std::shared_ptr<const runtime::MonitorFeed> feed, c
     res.set_header("Cache-Control", "no-store");
   });
   const std::string host = address.host == "localhost" ? "127.0.0.1" : address.host;
-  if (address.port == 0) {
-    port_ = server_->bind_to_any_port(host);
-  } else {
-    port_ = server_->bind_to_port(host, address.port) ? address.port : -1;
-  }
+  port_ = server_->bind_exclusive(host, address.port);
   if (port_ <= 0) {
-    throw InputError(fmt::format("option --monitor: cannot listen on {}:{} (in use, or not an address of this host)",
-                                 host, address.port));
+    throw InputError(fmt::format(
+        "option --monitor: cannot listen on {}:{} (in use, by another session's monitor too, or not an address of "
+        "this host)",
+        host, address.port));
   }
-  thread_ = std::thread([this] { server_->listen_after_bind(); });
+  thread_ = std::thread([this] { server_->listen_lowered(); });
   // Until the server runs, stop() would not reach it (and the destructor's join would wait forever).
   for (int i = 0; i < 2000 && !server_->is_running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
 }
 
 MonitorServer::~MonitorServer() {
-  server_->stop();
+  server_->stop_all();
   if (thread_.joinable()) thread_.join();
 }
 
 std::string MonitorServer::url() const { return fmt::format("http://{}:{}/", host_, port_); }
 
-std::string monitor_page() { return kMonitorPageHtml; }
+std::uint64_t MonitorServer::refused() const { return server_->refused(); }
+
+std::string monitor_page() {
+  static const std::string page = [] {
+    std::string p = kMonitorPageHtml;
+    const auto put = [&p](const std::string& marker, const std::string& text) {
+      const auto at = p.find(marker);
+      if (at != std::string::npos) p.replace(at, marker.size(), text);
+    };
+    put("<!--DEFLEX_DYGRAPHS_CSS-->", std::string("<style>\n") + kDygraphsCss + "\n</style>");
+    put("<!--DEFLEX_DYGRAPHS_JS-->", std::string("<script>\n") + kDygraphsJs + "\n</script>");
+    return p;
+  }();
+  return page;
+}
 
 std::string monitor_report(const runtime::MonitorFeed& feed, const std::string& title) {
   std::string page = monitor_page();
-  std::string data = feed.json(0);
+  std::string data = feed.json(0, static_cast<std::size_t>(-1));
   // Inside a <script> element: "</" would end it.
   std::string safe;
   safe.reserve(data.size());

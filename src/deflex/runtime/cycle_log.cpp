@@ -9,6 +9,12 @@
 
 namespace deflex::runtime {
 
+std::string cycle_log_preamble(const CycleLogInfo& info) {
+  return fmt::format("{} link={} period_ms={:g} force_components={} force_fault_N={:g}\n", kCycleLogPreamble,
+                     info.link.empty() ? "unknown" : info.link, info.period_s * 1e3, info.force_components,
+                     info.force_fault_n);
+}
+
 std::string cycle_log_header(int joints) {
   std::string h = "t_s,program_t_s,sequence,status,replied,session_start,step_limited";
   for (const char* name : {"q_nominal", "q_blend", "q_feedback", "q_command", "dtheta"}) {
@@ -68,9 +74,9 @@ void append_cycle_row(std::string& out, const SessionEntry& e, int joints, const
   out += '\n';
 }
 
-CycleLogFile::CycleLogFile(const std::string& path, int joints, const CycleLogBounds& bounds)
+CycleLogFile::CycleLogFile(const std::string& path, int joints, const CycleLogBounds& bounds, const CycleLogInfo& info)
     : file_(path, "option --log"), joints_(joints), bounds_(bounds) {
-  file_.write(cycle_log_header(joints));
+  file_.write(cycle_log_preamble(info) + cycle_log_header(joints));
   row_.reserve(4096);
 }
 
@@ -82,9 +88,14 @@ void CycleLogFile::write(const SessionEntry& e) {
   ++rows_;
 }
 
-void CycleLogFile::close() {
+void CycleLogFile::close(const std::string& stop_reason) {
   if (closed_) return;
   closed_ = true;
+  if (!stop_reason.empty()) {
+    std::string line = kCycleLogStop;
+    for (char ch : stop_reason) line += (ch == '\n' || ch == '\r') ? ' ' : ch;  // one line whatever the text
+    file_.write(line + "\n");
+  }
   file_.commit();
 }
 

@@ -22,6 +22,23 @@ struct CycleLogBounds {
   double tcp_mm = 0.0;
 };
 
+/// What a log's first line says of its session, so a log read back on its own (`deflex monitor --log`)
+/// names its link, the cycle its answers are measured against and what the sensor measures:
+/// "# deflex cycle log: link=egm-joint period_ms=4 force_components=6 force_fault_N=5000". Its last
+/// line, written when
+/// the session ends, says why: "# stop: REASON". CSV readers that skip '#' lines (deflex's own,
+/// pandas with comment='#') read the columns alone.
+struct CycleLogInfo {
+  std::string link;
+  double period_s = 0.0;
+  int force_components = 0;
+  double force_fault_n = 0.0;  ///< |F| above this is a force fault (the sensor's threshold)
+};
+inline constexpr char kCycleLogPreamble[] = "# deflex cycle log:";
+inline constexpr char kCycleLogStop[] = "# stop: ";
+/// The first line (with its newline).
+[[nodiscard]] std::string cycle_log_preamble(const CycleLogInfo& info);
+
 /// The header line (with its newline) for a robot of `joints` joints.
 [[nodiscard]] std::string cycle_log_header(int joints);
 /// One row (with its newline).
@@ -34,12 +51,13 @@ void append_cycle_row(std::string& out, const SessionEntry& e, int joints, const
 class CycleLogFile {
  public:
   /// Prepares `path` now, so a path that cannot be an output is an error at the session's start, and
-  /// writes the header. Throws InputError naming the option and the path.
-  CycleLogFile(const std::string& path, int joints, const CycleLogBounds& bounds);
+  /// writes the first line and the header. Throws InputError naming the option and the path.
+  CycleLogFile(const std::string& path, int joints, const CycleLogBounds& bounds, const CycleLogInfo& info = {});
 
   void write(const SessionEntry& e);
-  /// Puts the log in place; throws OutputError naming the path when a write failed (a full disk).
-  void close();
+  /// Ends the log with "# stop: REASON" (when `stop_reason` is not empty) and puts it in place; throws
+  /// OutputError naming the path when a write failed (a full disk).
+  void close(const std::string& stop_reason = "");
   [[nodiscard]] const std::string& path() const { return file_.path(); }
   [[nodiscard]] std::uint64_t rows() const { return rows_; }
 

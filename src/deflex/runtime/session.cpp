@@ -78,6 +78,8 @@ Session::Session(const SessionConfig& config, const RobotModel& robot, const Sen
     setup.link_name = info.name;
     setup.joints = robot.dof();
     setup.period_s = config_.online.period_s;
+    setup.force_components = sensor.components;
+    setup.force_fault_n = sensor.fault_threshold_N;
     setup.limits = link_->limits();
     setup.streams_program = info.streams_program;
     if (program_) {
@@ -96,6 +98,9 @@ Session::Session(const SessionConfig& config, const RobotModel& robot, const Sen
       MonitorSetup ms;
       ms.link = info.name;
       ms.joints = robot.dof();
+      ms.force_components = sensor.components;
+      ms.period_s = config_.online.period_s;
+      ms.force_fault_n = sensor.fault_threshold_N;
       ms.joint_bound_deg = rad_to_deg(setup.limits.joint_bound_rad);
       ms.tcp_bound_mm = setup.limits.tcp_bound_m * 1e3;
       ms.program_duration_s = setup.program_duration_s;

@@ -32,7 +32,7 @@ double Histogram::quantile(double q) const {
 }
 
 SessionReporter::SessionReporter(ReportSetup setup) : setup_(std::move(setup)) {
-  if (!setup_.log_path.empty()) log_ = std::make_unique<CycleLogFile>(setup_.log_path, setup_.joints, bounds());
+  if (!setup_.log_path.empty()) log_ = std::make_unique<CycleLogFile>(setup_.log_path, setup_.joints, bounds(), info());
   // Checked now: a path that cannot be written must not end a run at its first fault.
   if (!setup_.dump_path.empty()) check_fault_dump_path(setup_.dump_path);
   SessionEntry blank;
@@ -192,7 +192,7 @@ void SessionReporter::begin_episode(const SessionEntry& e) {
 
 void SessionReporter::write_dump(const std::string& why) {
   if (setup_.dump_path.empty()) return;
-  std::string text = cycle_log_header(setup_.joints);
+  std::string text = cycle_log_preamble(info()) + cycle_log_header(setup_.joints);
   const std::size_t first = (ring_head_ + ring_.size() - ring_count_) % ring_.size();
   for (std::size_t k = 0; k < ring_count_; ++k)
     append_cycle_row(text, ring_[(first + k) % ring_.size()], setup_.joints, bounds());
@@ -222,7 +222,7 @@ void SessionReporter::end(double now_s, StopReason reason, const std::string& re
     write_dump("the session stopped (" + reason_text + ")");
   if (log_) {
     try {
-      log_->close();
+      log_->close(reason_text);
     } catch (const Error& e) {
       log_error_ = e.what();
       log(LogLevel::kError, log_error_);

@@ -47,6 +47,8 @@ struct ReportSetup {
   const char* link_name = "";
   int joints = 6;
   double period_s = 0.004;
+  int force_components = 6;    ///< what the sensor measures (the cycle log's first line says it)
+  double force_fault_n = 0.0;  ///< the sensor's fault threshold (the same)
   CommandLimits limits;
   bool streams_program = false;
   double program_start_s = 0.0, program_duration_s = 0.0;
@@ -100,6 +102,9 @@ class SessionReporter {
   void log(LogLevel level, const std::string& text) const;
   [[nodiscard]] CycleLogBounds bounds() const {
     return {rad_to_deg(setup_.limits.joint_bound_rad), setup_.limits.tcp_bound_m * 1e3};
+  }
+  [[nodiscard]] CycleLogInfo info() const {
+    return {setup_.link_name, setup_.period_s, setup_.force_components, setup_.force_fault_n};
   }
   void on_cycle(const SessionEntry& e);
   void begin_episode(const SessionEntry& e);
