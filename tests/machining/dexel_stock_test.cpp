@@ -13,7 +13,7 @@
 namespace deflex {
 namespace {
 
-Cutter end_mill(double corner_mm = 0.0) {
+Cutter dexel_end_mill(double corner_mm = 0.0) {
   Cutter c;
   c.diameter_m = 10e-3;
   c.flutes = 3;
@@ -23,7 +23,7 @@ Cutter end_mill(double corner_mm = 0.0) {
 }
 
 // A 100 x 60 x 20 mm block, 0.5 mm grid and layers.
-DexelStock block() { return DexelStock::box(Vector3(0, 0, 0), Vector3(0.1, 0.06, 0.02), 0.5e-3, 0.5e-3); }
+DexelStock dexel_block() { return DexelStock::box(Vector3(0, 0, 0), Vector3(0.1, 0.06, 0.02), 0.5e-3, 0.5e-3); }
 
 /// Moves in 1 mm steps from `from` to `to` (mm), querying each point before its move; returns the
 /// engagement at the step nearest the middle.
@@ -46,8 +46,8 @@ Engagement pass(DexelStock& stock, const Cutter& cutter, const Vector3& from_mm,
 }
 
 TEST(DexelStock, APocketsFirstSlotIsAFullSlot) {
-  DexelStock stock = block();
-  const Engagement e = pass(stock, end_mill(), {-10, 30, 15}, {110, 30, 15});
+  DexelStock stock = dexel_block();
+  const Engagement e = pass(stock, dexel_end_mill(), {-10, 30, 15}, {110, 30, 15});
   ASSERT_EQ(e.count, 1);
   EXPECT_NEAR(e.entry_rad, 0.0, 1e-12);
   EXPECT_NEAR(e.exit_rad, kPi, 1e-12);
@@ -59,16 +59,16 @@ TEST(DexelStock, SideCutsAreExactOnACoarseGrid) {
   for (double heading_deg : {0.0, 90.0, 30.0}) {
     for (double ae_mm : {3.0, 1.27, 6.4}) {
       for (bool forward : {true, false}) {
-        DexelStock stock = block();
+        DexelStock stock = dexel_block();
         const double h = deg_to_rad(heading_deg);
         const Vector3 u(std::cos(h), std::sin(h), 0.0), left(-std::sin(h), std::cos(h), 0.0);
         const Vector3 centre(50, 30, 15);
-        (void)pass(stock, end_mill(), centre - 80 * u, centre + 80 * u);
+        (void)pass(stock, dexel_end_mill(), centre - 80 * u, centre + 80 * u);
         // The next pass ae to the left of the first (seen along u): conventional when it runs along u
         // with M3 (the material on +n), climb when it runs back.
         const Vector3 next = centre + ae_mm * left;
-        const Engagement e = forward ? pass(stock, end_mill(), next - 80 * u, next + 80 * u)
-                                     : pass(stock, end_mill(), next + 80 * u, next - 80 * u);
+        const Engagement e = forward ? pass(stock, dexel_end_mill(), next - 80 * u, next + 80 * u)
+                                     : pass(stock, dexel_end_mill(), next + 80 * u, next - 80 * u);
         ASSERT_TRUE(e.engaged());
         const double sweep = std::acos(1.0 - 2.0 * ae_mm / 10.0);
         EXPECT_NEAR(e.ae_m, ae_mm * 1e-3, 1e-6)
@@ -81,9 +81,9 @@ TEST(DexelStock, SideCutsAreExactOnACoarseGrid) {
 }
 
 TEST(DexelStock, WallsAreWhereTheyWereCut) {
-  DexelStock stock = block();
-  (void)pass(stock, end_mill(), {-10, 25, 15}, {110, 25, 15});
-  (void)pass(stock, end_mill(), {-10, 28.3, 15}, {110, 28.3, 15});
+  DexelStock stock = dexel_block();
+  (void)pass(stock, dexel_end_mill(), {-10, 25, 15}, {110, 25, 15});
+  (void)pass(stock, dexel_end_mill(), {-10, 28.3, 15}, {110, 28.3, 15});
   // Along y at x = 50 mm, 2.25 mm above the floor: material below 20 and above 33.3 mm.
   const auto lines = stock.along_y(0.05, 0.01725);
   ASSERT_EQ(lines.size(), 2u);
@@ -94,10 +94,10 @@ TEST(DexelStock, WallsAreWhereTheyWereCut) {
   ASSERT_EQ(below.size(), 1u);
   EXPECT_NEAR(below[0].second - below[0].first, 0.06, 1e-8);
   // A slanted pass: along x at y = 40 mm its wall lies where the line meets the band 5 mm from it.
-  DexelStock slant = block();
+  DexelStock slant = dexel_block();
   const double h = deg_to_rad(20.0);
   const Vector3 u(std::cos(h), std::sin(h), 0.0);
-  (void)pass(slant, end_mill(), Vector3(50, 30, 15) - 80 * u, Vector3(50, 30, 15) + 80 * u);
+  (void)pass(slant, dexel_end_mill(), Vector3(50, 30, 15) - 80 * u, Vector3(50, 30, 15) + 80 * u);
   // The band |(p - c) x u| <= 5: on the row y = 40, x - 50 = (10 cos h -+ 5) / sin h.
   const auto row = slant.along_x(0.040, 0.01725);
   ASSERT_EQ(row.size(), 2u);
@@ -106,8 +106,8 @@ TEST(DexelStock, WallsAreWhereTheyWereCut) {
 }
 
 TEST(DexelStock, ABullNosesWallFollowsItsCorner) {
-  DexelStock stock = block();
-  (void)pass(stock, end_mill(2.0), {-10, 30, 15}, {110, 30, 15});
+  DexelStock stock = dexel_block();
+  (void)pass(stock, dexel_end_mill(2.0), {-10, 30, 15}, {110, 30, 15});
   // A layer h above the tip, within the 2 mm corner: the wall at R - rc + sqrt(rc^2 - (rc - h)^2).
   for (double z_mm : {15.25, 15.75, 16.25, 17.25}) {
     const double hz = z_mm - 15.0, u = std::max(0.0, 2.0 - hz);
@@ -120,8 +120,8 @@ TEST(DexelStock, ABullNosesWallFollowsItsCorner) {
 }
 
 TEST(DexelStock, ARampCutsEachLayerWhereTheTipPassedBelowIt) {
-  DexelStock stock = block();
-  ASSERT_EQ(stock.remove_swept(end_mill(), Vector3(0.0, 0.03, 0.020), Vector3(0.04, 0.03, 0.010), Vector3::UnitZ()),
+  DexelStock stock = dexel_block();
+  ASSERT_EQ(stock.remove_swept(dexel_end_mill(), Vector3(0.0, 0.03, 0.020), Vector3(0.04, 0.03, 0.010), Vector3::UnitZ()),
             StockStatus::kCut);
   // The layer at 15.25 mm: the tip is below it past x = 19 mm (z = 20 - x / 4); the cut reaches 5 mm
   // further each way: x from 14 mm to 45 mm on the ramp's own row.
@@ -132,27 +132,27 @@ TEST(DexelStock, ARampCutsEachLayerWhereTheTipPassedBelowIt) {
 }
 
 TEST(DexelStock, AirAndTiltedAxesAreSaid) {
-  DexelStock stock = block();
+  DexelStock stock = dexel_block();
   CutFrame frame;
   ASSERT_TRUE(make_cut_frame(Vector3::UnitZ(), Vector3::UnitX(), frame));
   Engagement e;
-  EXPECT_EQ(stock.engagement(end_mill(), frame, Vector3(0.05, 0.03, 0.021), SpindleTurn::kClockwise, e),
+  EXPECT_EQ(stock.engagement(dexel_end_mill(), frame, Vector3(0.05, 0.03, 0.021), SpindleTurn::kClockwise, e),
             StockStatus::kInAir);
-  EXPECT_EQ(stock.remove_swept(end_mill(), Vector3(0, 0.03, 0.021), Vector3(0.1, 0.03, 0.021), Vector3::UnitZ()),
+  EXPECT_EQ(stock.remove_swept(dexel_end_mill(), Vector3(0, 0.03, 0.021), Vector3(0.1, 0.03, 0.021), Vector3::UnitZ()),
             StockStatus::kInAir);
   const Vector3 tilted(0.1, 0.0, 1.0);
-  EXPECT_EQ(stock.remove_swept(end_mill(), Vector3(0, 0.03, 0.015), Vector3(0.1, 0.03, 0.015), tilted),
+  EXPECT_EQ(stock.remove_swept(dexel_end_mill(), Vector3(0, 0.03, 0.015), Vector3(0.1, 0.03, 0.015), tilted),
             StockStatus::kUnsupportedAxis);
   EXPECT_EQ(stock.along_x(0.03, 0.017).size(), 1u);  // nothing changed
   EXPECT_EQ(stock.removed_volume_m3(), 0.0);
 }
 
 TEST(DexelStock, ALineCutIntoTooManyPiecesKeepsMaterialNotLosesIt) {
-  DexelStock stock = block();
+  DexelStock stock = dexel_block();
   // Eight slots across the line y = 30: nine pieces of material on it, six kept.
   for (int s = 0; s < 8; ++s) {
     const double x = 0.008 + s * 0.012;
-    (void)stock.remove_swept(end_mill(), Vector3(x, -0.01, 0.015), Vector3(x, 0.07, 0.015), Vector3::UnitZ());
+    (void)stock.remove_swept(dexel_end_mill(), Vector3(x, -0.01, 0.015), Vector3(x, 0.07, 0.015), Vector3::UnitZ());
   }
   const auto row = stock.along_x(0.03, 0.017);
   EXPECT_EQ(row.size(), 6u);
@@ -163,14 +163,14 @@ TEST(DexelStock, ALineCutIntoTooManyPiecesKeepsMaterialNotLosesIt) {
 }
 
 TEST(DexelStock, QueriesAndMovesDoNotAllocate) {
-  DexelStock stock = block();
+  DexelStock stock = dexel_block();
   CutFrame frame;
   ASSERT_TRUE(make_cut_frame(Vector3::UnitZ(), Vector3::UnitX(), frame));
-  (void)stock.remove_swept(end_mill(), Vector3(-0.01, 0.03, 0.015), Vector3(0.05, 0.03, 0.015), Vector3::UnitZ());
+  (void)stock.remove_swept(dexel_end_mill(), Vector3(-0.01, 0.03, 0.015), Vector3(0.05, 0.03, 0.015), Vector3::UnitZ());
   Engagement e;
   test::AllocationGuard guard;
-  (void)stock.remove_swept(end_mill(), Vector3(-0.01, 0.033, 0.015), Vector3(0.05, 0.033, 0.015), Vector3::UnitZ());
-  (void)stock.engagement(end_mill(), frame, Vector3(0.051, 0.036, 0.015), SpindleTurn::kClockwise, e);
+  (void)stock.remove_swept(dexel_end_mill(), Vector3(-0.01, 0.033, 0.015), Vector3(0.05, 0.033, 0.015), Vector3::UnitZ());
+  (void)stock.engagement(dexel_end_mill(), frame, Vector3(0.051, 0.036, 0.015), SpindleTurn::kClockwise, e);
   EXPECT_EQ(guard.allocations(), 0u);
   EXPECT_TRUE(e.engaged());
 }

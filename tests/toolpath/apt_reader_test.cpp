@@ -10,7 +10,7 @@
 namespace deflex::test {
 namespace {
 
-constexpr double kExact = 1e-12;
+constexpr double kAptExact = 1e-12;
 
 TEST(AptReader, IsoRecordsGiveTheHandComputedPoints) {
   const std::string cl =
@@ -38,10 +38,10 @@ TEST(AptReader, IsoRecordsGiveTheHandComputedPoints) {
   EXPECT_EQ(p[0].motion, MotionKind::kRapid);
   EXPECT_EQ(p[0].feed_m_s, 0.0);
   EXPECT_EQ(p[0].line, 8u);
-  EXPECT_NEAR((p[0].position_m - mm(0, 0, 50)).norm(), 0.0, kExact);
+  EXPECT_NEAR((p[0].position_m - mm(0, 0, 50)).norm(), 0.0, kAptExact);
   EXPECT_EQ(p[1].motion, MotionKind::kLinear);  // RAPID was for one GOTO only
-  EXPECT_NEAR(p[1].feed_m_s, 0.01, kExact);     // 600 mm/min
-  EXPECT_NEAR((p[2].position_m - mm(20, 0, 0)).norm(), 0.0, kExact);
+  EXPECT_NEAR(p[1].feed_m_s, 0.01, kAptExact);     // 600 mm/min
+  EXPECT_NEAR((p[2].position_m - mm(20, 0, 0)).norm(), 0.0, kAptExact);
   for (std::size_t k = 3; k <= 20; ++k) {
     EXPECT_NEAR((p[k].position_m - mm(20, 10, 0)).norm(), 0.010, 1e-15) << k;
     EXPECT_EQ(p[k].motion, MotionKind::kArcCcw);
@@ -58,8 +58,8 @@ TEST(AptReader, IsoRecordsGiveTheHandComputedPoints) {
     EXPECT_EQ(q.spindle_rpm, 15000.0);
   }
   ASSERT_TRUE(s.cutter.has_value());
-  EXPECT_NEAR(s.cutter->diameter_m, 0.010, kExact);
-  EXPECT_NEAR(s.cutter->corner_radius_m, 0.0005, kExact);
+  EXPECT_NEAR(s.cutter->diameter_m, 0.010, kAptExact);
+  EXPECT_NEAR(s.cutter->corner_radius_m, 0.0005, kAptExact);
   ASSERT_EQ(s.tools.size(), 1u);
   ASSERT_TRUE(s.tools[0].cutter.has_value());
   EXPECT_EQ(s.tools[0].cutter->line, 4u);
@@ -100,7 +100,7 @@ TEST(AptReader, NxClsfFormReads) {
   EXPECT_EQ(p.back().motion, MotionKind::kLinear);
   EXPECT_EQ(p.back().tool, 4);
   ASSERT_TRUE(s.cutter.has_value());
-  EXPECT_NEAR(s.cutter->diameter_m, 0.012, kExact);
+  EXPECT_NEAR(s.cutter->diameter_m, 0.012, kAptExact);
   ASSERT_EQ(s.tools.size(), 1u);
   EXPECT_EQ(s.tools[0].number, 4);
   EXPECT_TRUE(s.tools[0].cutter.has_value());  // TLDATA after LOAD/TOOL belongs to tool 4
@@ -119,11 +119,11 @@ TEST(AptReader, BlanksContinuationsFeedUnitsAndInches) {
       "GOTO/3,2,3\n";
   const auto p = apt_points(cl);
   ASSERT_EQ(p.size(), 3u);
-  EXPECT_NEAR((p[0].position_m - mm(25.4, 50.8, 76.2)).norm(), 0.0, kExact);
+  EXPECT_NEAR((p[0].position_m - mm(25.4, 50.8, 76.2)).norm(), 0.0, kAptExact);
   EXPECT_EQ(p[0].line, 4u);
-  EXPECT_NEAR(p[0].feed_m_s, 254.0 / 60000.0, kExact);  // 10 in/min
-  EXPECT_NEAR(p[1].feed_m_s, 508.0 / 60000.0, kExact);  // 20 per minute in the file's inches
-  EXPECT_NEAR(p[2].feed_m_s, 0.01, kExact);             // 600 mm/min whatever the file's unit
+  EXPECT_NEAR(p[0].feed_m_s, 254.0 / 60000.0, kAptExact);  // 10 in/min
+  EXPECT_NEAR(p[1].feed_m_s, 508.0 / 60000.0, kAptExact);  // 20 per minute in the file's inches
+  EXPECT_NEAR(p[2].feed_m_s, 0.01, kAptExact);             // 600 mm/min whatever the file's unit
   EXPECT_EQ(p[0].spindle, SpindleTurn::kCounterClockwise);
   EXPECT_EQ(p[0].spindle_rpm, 2300.0);
 }
