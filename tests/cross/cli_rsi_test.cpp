@@ -253,7 +253,7 @@ TEST(CliRsi, BadOptionsAreRefusedNamingTheOption) {
   expect(base + "--link rsi --rsi-port 0 --rsi-correction-latency-ms -1", "--rsi-correction-latency-ms");
   expect(base + "--link rsi --rsi-port 0 --rsi-max-document-bytes 10", "--rsi-max-document-bytes");
   expect(base + "--link rsi --rsi-port 0 --log-level loud", "--log-level");
-  expect(base + "--link rsi --rsi-port 0 --log-file /nonexistent/dir/field.log", "/nonexistent/dir/field.log");
+  expect(base + "--link rsi --rsi-port 0 --log-file /dev/null/dir/field.log", "option --log-file");
   expect(base + "--link rsi --rsi-port 0 --fault-dump /dev/null/dir/dump.csv", "option --fault-dump");
   const std::string setup = "controller-setup -o " + ::testing::TempDir() + " ";
   expect(setup + "--link fanuc --sensor-ip 10.0.0.2", "--link");
