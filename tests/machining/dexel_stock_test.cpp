@@ -121,8 +121,9 @@ TEST(DexelStock, ABullNosesWallFollowsItsCorner) {
 
 TEST(DexelStock, ARampCutsEachLayerWhereTheTipPassedBelowIt) {
   DexelStock stock = dexel_block();
-  ASSERT_EQ(stock.remove_swept(dexel_end_mill(), Vector3(0.0, 0.03, 0.020), Vector3(0.04, 0.03, 0.010), Vector3::UnitZ()),
-            StockStatus::kCut);
+  ASSERT_EQ(
+      stock.remove_swept(dexel_end_mill(), Vector3(0.0, 0.03, 0.020), Vector3(0.04, 0.03, 0.010), Vector3::UnitZ()),
+      StockStatus::kCut);
   // The layer at 15.25 mm: the tip is below it past x = 19 mm (z = 20 - x / 4); the cut reaches 5 mm
   // further each way: x from 14 mm to 45 mm on the ramp's own row.
   const auto row = stock.along_x(0.03, 0.01525);
@@ -169,7 +170,8 @@ TEST(DexelStock, QueriesAndMovesDoNotAllocate) {
   (void)stock.remove_swept(dexel_end_mill(), Vector3(-0.01, 0.03, 0.015), Vector3(0.05, 0.03, 0.015), Vector3::UnitZ());
   Engagement e;
   test::AllocationGuard guard;
-  (void)stock.remove_swept(dexel_end_mill(), Vector3(-0.01, 0.033, 0.015), Vector3(0.05, 0.033, 0.015), Vector3::UnitZ());
+  (void)stock.remove_swept(dexel_end_mill(), Vector3(-0.01, 0.033, 0.015), Vector3(0.05, 0.033, 0.015),
+                           Vector3::UnitZ());
   (void)stock.engagement(dexel_end_mill(), frame, Vector3(0.051, 0.036, 0.015), SpindleTurn::kClockwise, e);
   EXPECT_EQ(guard.allocations(), 0u);
   EXPECT_TRUE(e.engaged());

@@ -40,7 +40,7 @@ TEST(AptReader, IsoRecordsGiveTheHandComputedPoints) {
   EXPECT_EQ(p[0].line, 8u);
   EXPECT_NEAR((p[0].position_m - mm(0, 0, 50)).norm(), 0.0, kAptExact);
   EXPECT_EQ(p[1].motion, MotionKind::kLinear);  // RAPID was for one GOTO only
-  EXPECT_NEAR(p[1].feed_m_s, 0.01, kAptExact);     // 600 mm/min
+  EXPECT_NEAR(p[1].feed_m_s, 0.01, kAptExact);  // 600 mm/min
   EXPECT_NEAR((p[2].position_m - mm(20, 0, 0)).norm(), 0.0, kAptExact);
   for (std::size_t k = 3; k <= 20; ++k) {
     EXPECT_NEAR((p[k].position_m - mm(20, 10, 0)).norm(), 0.010, 1e-15) << k;
