@@ -11,11 +11,12 @@
 namespace deflex {
 namespace {
 
-// The peak is sampled again when the engagement's entry or exit moves by more than this, its depth
-// or the feed per tooth by more than 1 %: a steady cut keeps its peak, and the peak (2 us a
-// point) stays off the per-point budget.
-constexpr double kPeakAngleTolRad = 0.25 * kPi / 180.0;
-constexpr double kPeakRelativeTol = 0.01;
+// The peak is that of the engagement's one-arc summary (first entry to last exit over the whole band
+// of heights: a patchwork engagement's peak costs a sampled integral over every patch, some 40 us),
+// sampled again only when its entry or exit moves by more than a degree, its band or the feed per
+// tooth by more than 2 %: a steady cut keeps its peak, and the peak stays off the per-point budget.
+constexpr double kPeakAngleTolRad = 1.0 * kPi / 180.0;
+constexpr double kPeakRelativeTol = 0.02;
 
 bool close_relative(double a, double b) {
   return std::abs(a - b) <= kPeakRelativeTol * std::max(std::abs(a), std::abs(b));
@@ -98,13 +99,21 @@ bool MillingProcess::engage(const MillingPointInput& in, Engagement& e) {
 }
 
 void MillingProcess::update_peak(const MillingCut& cut, const Engagement& e) {
-  const Engagement& p = peak_engagement_;
-  const bool same = peak_fz_m_ > 0.0 && p.count == e.count && std::abs(p.entry_rad - e.entry_rad) <= kPeakAngleTolRad &&
-                    std::abs(p.exit_rad - e.exit_rad) <= kPeakAngleTolRad && close_relative(p.ap_m, e.ap_m) &&
-                    close_relative(peak_fz_m_, cut.fz_m);
+  EngagementPatch band{e.entry_rad, e.exit_rad, HUGE_VAL, -HUGE_VAL};
+  for (int k = 0; k < e.count; ++k) {
+    band.z_lo_m = std::min(band.z_lo_m, e.patches[static_cast<std::size_t>(k)].z_lo_m);
+    band.z_hi_m = std::max(band.z_hi_m, e.patches[static_cast<std::size_t>(k)].z_hi_m);
+  }
+  const EngagementPatch& p = peak_band_;
+  const bool same = peak_fz_m_ > 0.0 && std::abs(p.entry_rad - band.entry_rad) <= kPeakAngleTolRad &&
+                    std::abs(p.exit_rad - band.exit_rad) <= kPeakAngleTolRad && close_relative(p.z_lo_m, band.z_lo_m) &&
+                    close_relative(p.z_hi_m, band.z_hi_m) && close_relative(peak_fz_m_, cut.fz_m);
   if (!same) {
-    peak_n_ = peak_milling_force(cut, e).peak_force_n;
-    peak_engagement_ = e;
+    Engagement one;
+    one.add(band);
+    one.summarise(cut.cutter.radius_m());
+    peak_n_ = peak_milling_force(cut, one).peak_force_n;
+    peak_band_ = band;
     peak_fz_m_ = cut.fz_m;
   }
   out_.peak_force_n = peak_n_;

@@ -71,11 +71,13 @@ struct MillingPointForce {
   /// On the tool (= on the robot), workpiece frame, N and Nm, moment about the tool tip (the TCP):
   /// averaged over a revolution.
   Wrench wrench = Wrench::Zero();
-  CutFrame frame;             ///< feed, normal, axis (workpiece frame); valid when kCut
-  double ae_m = 0.0;          ///< radial width (one-arc summary of the engagement)
-  double ap_m = 0.0;          ///< axial depth
-  double fz_m = 0.0;          ///< feed per tooth in the plane normal to the axis
-  double peak_force_n = 0.0;  ///< largest force magnitude over a revolution
+  CutFrame frame;     ///< feed, normal, axis (workpiece frame); valid when kCut
+  double ae_m = 0.0;  ///< radial width (one-arc summary of the engagement)
+  double ap_m = 0.0;  ///< axial depth
+  double fz_m = 0.0;  ///< feed per tooth in the plane normal to the axis
+  /// Largest force magnitude over a revolution, of the engagement's one-arc summary (first entry to
+  /// last exit over all its heights), within 1 degree and 2 % of the point's.
+  double peak_force_n = 0.0;
   double tooth_passing_hz = 0.0;
 };
 
@@ -122,8 +124,9 @@ class MillingProcess {
   std::optional<Vector3> previous_;
   std::optional<int> tool_;
   Engagement engagement_;
-  // The last peak and what it was computed for: recomputed when the engagement or the feed per tooth moves.
-  Engagement peak_engagement_;
+  // The last peak and the one-arc band it was computed for: recomputed when the band or the feed per
+  // tooth moves.
+  EngagementPatch peak_band_;
   double peak_fz_m_ = -1.0, peak_n_ = 0.0;
 };
 
