@@ -163,7 +163,10 @@ struct ToolSpinPlanner::Impl {
   std::deque<Held> points;     // not emitted yet
   std::size_t costed = 0;      // points at the front of `points` already costed into a stage
   std::deque<double> ready;
-  std::vector<double> d, d_next, s0, s1;
+  std::vector<double> d, d_next, s0, s1, norms;
+  std::vector<int> root;
+  Eigen::Matrix<double, Eigen::Dynamic, 6> stacked;  // every candidate's compliance, 3 rows each
+  Eigen::VectorXd deflections;
   std::array<std::size_t, static_cast<std::size_t>(Reason::kCount)> reasons{};
   std::optional<Held> last;
   double last_stage_s = 0.0;
@@ -185,7 +188,10 @@ struct ToolSpinPlanner::Impl {
     seed.assign(static_cast<std::size_t>(grid), JointVector::Zero(m.dof()));
     seeded.assign(static_cast<std::size_t>(grid), false);
     d.assign(static_cast<std::size_t>(grid), kInfinity);
-    d_next = s0 = s1 = d;
+    d_next = s0 = s1 = norms = d;
+    root.assign(index(grid), 0);
+    stacked.setZero(3 * grid, 6);
+    deflections.setZero(3 * grid);
   }
 
   void check_options() const {
@@ -203,6 +209,9 @@ struct ToolSpinPlanner::Impl {
   }
 
   [[nodiscard]] std::size_t index(int g) const { return static_cast<std::size_t>(g); }
+  /// A grid index one step past either end, back on the circle (no division: it runs a few thousand
+  /// times a stage).
+  [[nodiscard]] int wrap_state(int g) const { return g < 0 ? g + grid : g >= grid ? g - grid : g; }
   [[nodiscard]] Stage& stage(std::size_t k) { return stages[k - stage_base]; }
   [[nodiscard]] std::size_t newest() const { return stage_base + stages.size() - 1; }
 
@@ -374,20 +383,30 @@ struct ToolSpinPlanner::Impl {
 
   /// S0, S1 of the points between the last stage and `next`: sums of each candidate's deflection, and
   /// of it weighted by the point's place u (0..1) in the interval, for the interpolated angle.
+  /// The compliance is taken at the interval's middle (the mean of its two stages'): over one stage
+  /// spacing it changes by well under a percent, and one product a point serves every candidate.
   void cost_interval(const Stage& prev, const Stage& next) {
     std::fill(s0.begin(), s0.end(), 0.0);
     std::fill(s1.begin(), s1.end(), 0.0);
+    for (int g = 0; g < grid; ++g) {
+      const Candidate &c0 = prev.c[index(g)], &c1 = next.c[index(g)];
+      stacked.middleRows<3>(3 * g) =
+          c0.feasible && c1.feasible ? Compliance36(0.5 * (c0.a + c1.a)) : Compliance36::Zero();
+    }
     const double length = next.s - prev.s;
+    Wrench last = Wrench::Constant(std::numeric_limits<double>::quiet_NaN());
     for (; costed < points.size() && points[costed].s <= next.s; ++costed) {
       const Held& h = points[costed];
       if (!h.p.cutting) continue;
       const double u = length > 0.0 ? (h.s - prev.s) / length : 1.0;
+      if (h.p.wrench != last) {
+        last = h.p.wrench;
+        deflections.noalias() = stacked * last;
+        for (int g = 0; g < grid; ++g) norms[index(g)] = deflections.segment<3>(3 * g).norm();
+      }
       for (int g = 0; g < grid; ++g) {
-        const Candidate &c0 = prev.c[index(g)], &c1 = next.c[index(g)];
-        if (!c0.feasible || !c1.feasible) continue;
-        const double dev = (1.0 - u) * (c0.a * h.p.wrench).norm() + u * (c1.a * h.p.wrench).norm();
-        s0[index(g)] += dev;
-        s1[index(g)] += u * dev;
+        s0[index(g)] += norms[index(g)];
+        s1[index(g)] += u * norms[index(g)];
       }
     }
   }
@@ -400,7 +419,7 @@ struct ToolSpinPlanner::Impl {
       const bool b_ok = prev.c[index(b)].feasible && next.c[index(b)].feasible;
       for (const int offset : {0, -1, 1}) {
         if (!b_ok || (offset != 0 && (next.stay_only || grid < 3))) continue;
-        const int a = (b + offset + grid) % grid;
+        const int a = wrap_state(b + offset);
         if (!(d[index(a)] < kInfinity) || !prev.c[index(a)].feasible || !next.c[index(a)].feasible) continue;
         const double c =
             d[index(a)] + s0[index(a)] - s1[index(a)] + s1[index(b)] + (offset != 0 ? kChangePenalty : 0.0);
@@ -431,18 +450,22 @@ struct ToolSpinPlanner::Impl {
     return best;
   }
 
-  /// The state at stage k on the path that ends in state g at the newest stage.
-  int ancestor(int g, std::size_t k) {
-    for (std::size_t j = newest(); j > k; --j) g = (g + stage(j).back[index(g)] + grid) % grid;
-    return g;
+  /// The state at stage k of the path ending in each state of the newest stage (all traced at once).
+  void ancestors(std::size_t k) {
+    for (int g = 0; g < grid; ++g) root[index(g)] = g;
+    for (std::size_t j = newest(); j > k; --j) {
+      const std::vector<std::int8_t>& back = stage(j).back;
+      for (int& r : root) r = wrap_state(r + back[index(r)]);
+    }
   }
 
   /// Decides stage k (every stage before it is decided): the best path's state there; paths through
   /// other states are dropped, and the points up to it get their angles.
   void decide(std::size_t k) {
-    const int c = ancestor(best_state(), k);
+    ancestors(k);
+    const int c = root[index(best_state())];
     for (int g = 0; g < grid; ++g) {
-      if (d[index(g)] < kInfinity && ancestor(g, k) != c) d[index(g)] = kInfinity;
+      if (root[index(g)] != c) d[index(g)] = kInfinity;
     }
     Stage& st = stage(k);
     st.decided = c;
