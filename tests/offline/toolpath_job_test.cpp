@@ -388,6 +388,109 @@ TEST(ToolSpin, NeverLosesToTheBestFixedAngleByMoreThanTwoPercentOnTheExamples) {
   }
 }
 
+/// The numbers of a text in order (signs and decimals as written).
+std::vector<double> numbers_in(const std::string& text) {
+  std::vector<double> out;
+  const std::regex number(R"([-+]?[0-9]+\.?[0-9]*(E[+-]?[0-9]+)?)");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), number); it != std::sregex_iterator(); ++it) {
+    out.push_back(std::stod(it->str()));
+  }
+  return out;
+}
+
+/// The swarf pass compensated into a robot program of `kind`, its text, and the job's points.
+std::string robot_program(ToolpathOutputKind kind, const Pose& workpiece, std::vector<ToolpathJobPoint>& points) {
+  const RobotModel model = spindle_robot();
+  const MillingForceModel force(al7075(0.5, 20.0), end_mill());
+  const std::string path = ::testing::TempDir() + (kind == ToolpathOutputKind::kRapid ? "/swarf.mod" : "/swarf.src");
+  {
+    OutputFile file(path);
+    ToolpathProgramOptions p;
+    p.base_T_workpiece = workpiece;
+    ToolpathProgramWriter program(file, kind, p, model);
+    ToolpathJobOptions o;
+    o.base_T_workpiece = workpiece;
+    auto reader = open_toolpath(kSrc + "/examples/machining/swarf_wall.apt");
+    ToolpathSinks sinks;
+    sinks.program = &program;
+    sinks.keep = &points;
+    (void)run_toolpath_job(model, *reader, force, nullptr, o, sinks);
+    program.finish("the end");
+    file.commit();
+  }
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::filesystem::remove(path);
+  return text.str();
+}
+
+// The RAPID module moves through every compensated pose in the work object the workpiece placement
+// declares, at the program's feed: each robtarget is base_T_workpiece^-1 tcp_command.
+TEST(ToolpathProgram, RapidTargetsAreTheCompensatedPosesInTheWorkpieceFrame) {
+  Pose workpiece = workpiece_at(1950, -100, 780);
+  workpiece.linear() = Eigen::AngleAxisd(deg_to_rad(30.0), Vector3::UnitZ()).toRotationMatrix();
+  std::vector<ToolpathJobPoint> points;
+  const std::string text = robot_program(ToolpathOutputKind::kRapid, workpiece, points);
+  EXPECT_NE(text.find("PERS wobjdata wobjDeflex:=[FALSE,TRUE,\"\",[[1950.0000,-100.0000,780.0000],[0.96592583,"
+                      "0.00000000,0.00000000,0.25881905]]"),
+            std::string::npos);
+  std::vector<std::string> moves;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) {
+    if (l.rfind("    Move", 0) == 0) moves.push_back(l);
+  }
+  ASSERT_EQ(moves.size(), points.size());
+  EXPECT_EQ(moves.front().rfind("    MoveJ [[", 0), 0u);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const std::vector<double> n = numbers_in(moves[i].substr(moves[i].find('[')));
+    const Pose target = workpiece.inverse() * points[i].compensated.tcp_command;
+    EXPECT_LT((Vector3(n[0], n[1], n[2]) - target.translation() * 1e3).norm(), 1e-4) << moves[i];
+    const Eigen::Quaterniond q(target.linear());
+    EXPECT_NEAR(std::abs(q.w() * n[3] + q.x() * n[4] + q.y() * n[5] + q.z() * n[6]), 1.0, 1e-7) << moves[i];
+    const ToolpathPoint& s = points[i].source;
+    if (i > 0 && s.motion != MotionKind::kRapid) {
+      EXPECT_NE(moves[i].find(fmt::format("\\V:={:.4f},", s.feed_m_s * 1e3)), std::string::npos) << moves[i];
+    }
+    EXPECT_NE(moves[i].find(fmt::format("! line {}", s.line)), std::string::npos);
+  }
+  EXPECT_NE(text.find("  ! the end\nENDMODULE\n"), std::string::npos);
+}
+
+// The KRL program: $BASE is the placement (A about z: 30 deg), one PTP then a LIN a point, $VEL.CP
+// the feed in m/s where it changes, the poses the compensated ones as Z-Y-X Euler angles.
+TEST(ToolpathProgram, KrlMovesThroughTheCompensatedPosesInBase) {
+  Pose workpiece = workpiece_at(1950, -100, 780);
+  workpiece.linear() = Eigen::AngleAxisd(deg_to_rad(30.0), Vector3::UnitZ()).toRotationMatrix();
+  std::vector<ToolpathJobPoint> points;
+  const std::string text = robot_program(ToolpathOutputKind::kKrl, workpiece, points);
+  EXPECT_NE(text.find("$BASE = {X 1950.0000,Y -100.0000,Z 780.0000,A 30.0000,B 0.0000,C 0.0000}"), std::string::npos);
+  std::vector<std::string> moves;
+  std::istringstream in(text);
+  double vel = 0.25;
+  for (std::string l; std::getline(in, l);) {
+    if (l.rfind("  $VEL.CP = ", 0) == 0) vel = std::stod(l.substr(12));
+    if (l.rfind("  PTP {", 0) != 0 && l.rfind("  LIN {", 0) != 0) continue;
+    const std::size_t i = moves.size();
+    ASSERT_LT(i, points.size());
+    moves.push_back(l);
+    const std::vector<double> n = numbers_in(l.substr(l.find('{')));
+    const Pose target = workpiece.inverse() * points[i].compensated.tcp_command;
+    EXPECT_LT((Vector3(n[0], n[1], n[2]) - target.translation() * 1e3).norm(), 1e-4) << l;
+    const Matrix3 r =
+        (Eigen::AngleAxisd(deg_to_rad(n[3]), Vector3::UnitZ()) * Eigen::AngleAxisd(deg_to_rad(n[4]), Vector3::UnitY()) *
+         Eigen::AngleAxisd(deg_to_rad(n[5]), Vector3::UnitX()))
+            .toRotationMatrix();
+    EXPECT_LT((r - target.linear()).norm(), 1e-5) << l;
+    const ToolpathPoint& s = points[i].source;
+    const double expected = s.motion == MotionKind::kRapid ? 0.25 : s.feed_m_s;
+    if (i > 0) EXPECT_NEAR(vel, expected, 1e-5 * expected) << l;  // six significant digits (a KRL REAL)
+  }
+  EXPECT_EQ(moves.size(), points.size());
+  EXPECT_EQ(moves.front().rfind("  PTP {", 0), 0u);
+  EXPECT_NE(moves.front().find(",S 'B"), std::string::npos);
+}
+
 std::string error_of(const std::function<void()>& f) {
   try {
     f();
