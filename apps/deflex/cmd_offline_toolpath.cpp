@@ -1,6 +1,7 @@
 // `deflex offline --toolpath`: G-code or APT/CL data in, the milling force predicted along it from
 // the cutter, the coefficients and the stock, the spindle angle chosen for stiffness, and the
 // compensated program out (G-code over the source, RAPID or KRL), with the per-point CSV and a chart.
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -170,7 +171,9 @@ void run_offline_toolpath(const ToolpathRunOptions& o, const std::function<IkReq
   if (write_back) write_back->finish();
   if (program) program->finish(summary);
   if (csv) csv->finish();
-  if (out.plot != nullptr) out.plot->write(svg_toolpath_chart(r.chart, o.toolpath, gcode));
+  if (out.plot != nullptr) {
+    out.plot->write(svg_toolpath_chart(r.chart, std::filesystem::path(o.toolpath).filename().string(), gcode));
+  }
   out.transaction.commit();  // every file, or none
   if (o.json) {
     print_json(toolpath_json(model, o, r, *force, stock ? stock->describe() : "", job.spin, gcode));

@@ -27,12 +27,18 @@ void toolpath_panel(Canvas& c, const std::vector<double>& s_mm, const std::vecto
   const svg::Range range = svg::fitted_range(all, from_zero);
   const Scale y{range.lo, range.hi, bottom, top};
   svg::value_axis(c, y, x.p0, x.p1, axis_label, 1.0, 56.0);
+  // Steps: a point's value holds along the move into it (its force is that move's), so a long
+  // positioning move is drawn at its end's value, not as a ramp from the cut before it.
   for (const ToolpathSeries& one : series) {
     std::vector<double> xy;
     for (std::size_t i = 0; i < s_mm.size(); ++i) {
       if (!std::isfinite(one.values[i])) continue;
-      xy.push_back(x(s_mm[i]));
-      xy.push_back(y(std::clamp(one.values[i], range.lo, range.hi)));
+      const double v = y(std::clamp(one.values[i], range.lo, range.hi));
+      if (xy.size() >= 2 && std::abs(xy.back() - v) < 0.05) {
+        xy[xy.size() - 2] = x(s_mm[i]);  // the same level goes on: one segment, not one a sample
+        continue;
+      }
+      xy.insert(xy.end(), {x(s_mm[i == 0 ? 0 : i - 1]), v, x(s_mm[i]), v});
     }
     c.polyline(xy, one.colour, 1.4, one.extra);
   }
@@ -66,7 +72,7 @@ std::string svg_toolpath_chart(const std::vector<ToolpathChartSample>& samples, 
   const double left = 90.0, right = width - 30.0;
   const Scale x{s_mm.front(), std::max(s_mm.back(), s_mm.front() + 1e-9), left, right};
   toolpath_panel(c, s_mm,
-                 {{force, svg::colour(0), "average over a revolution (compensated)", ""},
+                 {{force, svg::colour(0), "average over a revolution (what the compensation follows)", ""},
                   {peak, svg::colour(1), "per-revolution peak", R"(stroke-dasharray="5,3")"}},
                  x, 90.0, 300.0, "cutting force (N)", true);
   std::vector<ToolpathSeries> d{{deflection, svg::kUcColour, "without compensation", ""},
