@@ -405,7 +405,7 @@ std::string toolpath_summary_text(const ToolpathJobResult& r, bool gcode) {
   if (gcode) {
     s += fmt::format(
         "G-code carries positions only: the orientation part of the correction (max {:.4f} mrad) and the spindle "
-        "angle are left to the controller; run so, the tip's residual is mean {:.4f} mm, max {:.4f} mm\n",
+        "angle are left to the controller; run so, the tip's residual is mean {:.2g} mm, max {:.2g} mm\n",
         r.max_orientation_correction_rad * 1e3, r.mean_gcode_residual_m * 1e3, r.max_gcode_residual_m * 1e3);
   }
   return s;
