@@ -175,7 +175,7 @@ BENCHMARK(BM_ToolpathJobOptimize)
     ->Unit(benchmark::kSecond)
     ->Iterations(1);
 BENCHMARK(BM_ToolpathJobFixed)->Args({500, 6})->Args({500, 66})->Unit(benchmark::kSecond)->Iterations(1);
-BENCHMARK(BM_ToolpathJobOptimizeOut)->Args({500, 66})->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(BM_ToolpathJobOptimizeOut)->Args({500, 6})->Args({500, 66})->Unit(benchmark::kSecond)->Iterations(1);
 
 }  // namespace
 

@@ -75,7 +75,7 @@ struct ToolpathJobResult {
   ArmConfiguration configuration;
   /// With a G-code output: the orientation part of the correction it cannot carry (the largest
   /// rotation between the desired and the commanded TCP, rad), and the tip's residual when the
-  /// compensated positions are run at the programmed orientation and spin (m).
+  /// compensated positions are run at the programmed orientation and spin (m; every tenth cutting point).
   double max_orientation_correction_rad = 0.0;
   double max_gcode_residual_m = 0.0, mean_gcode_residual_m = 0.0;
   std::vector<ToolpathChartSample> chart;  ///< options.chart_samples of them at most
