@@ -484,7 +484,9 @@ TEST(ToolpathProgram, KrlMovesThroughTheCompensatedPosesInBase) {
     EXPECT_LT((r - target.linear()).norm(), 1e-5) << l;
     const ToolpathPoint& s = points[i].source;
     const double expected = s.motion == MotionKind::kRapid ? 0.25 : s.feed_m_s;
-    if (i > 0) EXPECT_NEAR(vel, expected, 1e-5 * expected) << l;  // six significant digits (a KRL REAL)
+    if (i > 0) {
+      EXPECT_NEAR(vel, expected, 1e-5 * expected) << l;  // six significant digits (a KRL REAL)
+    }
   }
   EXPECT_EQ(moves.size(), points.size());
   EXPECT_EQ(moves.front().rfind("  PTP {", 0), 0u);
