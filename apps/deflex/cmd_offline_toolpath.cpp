@@ -37,8 +37,7 @@ std::unique_ptr<MillingForceModel> toolpath_force(const ToolpathRunOptions& o, c
         "engagement",
         o.forces.front()));
   }
-  models.front().release();
-  return std::unique_ptr<MillingForceModel>(milling);
+  return std::unique_ptr<MillingForceModel>(static_cast<MillingForceModel*>(models.front().release()));
 }
 
 /// The outputs, prepared before anything is read.

@@ -60,11 +60,10 @@ double wrap_angle(double a) { return std::remainder(a, 2.0 * kPi); }
 
 Matrix3 tcp_rotation(const Vector3& tool_axis, const Vector3& reference_x, double spin_rad) {
   const Vector3 z = -tool_axis;
-  const Vector3 x0 = reference_x;
-  const Vector3 y0 = z.cross(x0);
+  const Vector3 y0 = z.cross(reference_x);
   const double c = std::cos(spin_rad), s = std::sin(spin_rad);
   Matrix3 r;
-  r.col(0) = c * x0 + s * y0;
+  r.col(0) = c * reference_x + s * y0;
   r.col(1) = z.cross(Vector3(r.col(0)));
   r.col(2) = z;
   return r;
@@ -190,8 +189,8 @@ struct ToolSpinPlanner::Impl {
     d.assign(static_cast<std::size_t>(grid), kInfinity);
     d_next = s0 = s1 = norms = d;
     root.assign(index(grid), 0);
-    stacked.setZero(3 * grid, 6);
-    deflections.setZero(3 * grid);
+    stacked.setZero(rows_of(grid), 6);
+    deflections.setZero(rows_of(grid));
   }
 
   void check_options() const {
@@ -209,6 +208,8 @@ struct ToolSpinPlanner::Impl {
   }
 
   [[nodiscard]] std::size_t index(int g) const { return static_cast<std::size_t>(g); }
+  /// The first of candidate g's three rows in the stacked compliances.
+  [[nodiscard]] static Eigen::Index rows_of(int g) { return 3 * static_cast<Eigen::Index>(g); }
   /// A grid index one step past either end, back on the circle (no division: it runs a few thousand
   /// times a stage).
   [[nodiscard]] int wrap_state(int g) const { return g < 0 ? g + grid : g >= grid ? g - grid : g; }
@@ -390,7 +391,7 @@ struct ToolSpinPlanner::Impl {
     std::fill(s1.begin(), s1.end(), 0.0);
     for (int g = 0; g < grid; ++g) {
       const Candidate &c0 = prev.c[index(g)], &c1 = next.c[index(g)];
-      stacked.middleRows<3>(3 * g) =
+      stacked.middleRows<3>(rows_of(g)) =
           c0.feasible && c1.feasible ? Compliance36(0.5 * (c0.a + c1.a)) : Compliance36::Zero();
     }
     const double length = next.s - prev.s;
@@ -402,7 +403,7 @@ struct ToolSpinPlanner::Impl {
       if (h.p.wrench != last) {
         last = h.p.wrench;
         deflections.noalias() = stacked * last;
-        for (int g = 0; g < grid; ++g) norms[index(g)] = deflections.segment<3>(3 * g).norm();
+        for (int g = 0; g < grid; ++g) norms[index(g)] = deflections.segment<3>(rows_of(g)).norm();
       }
       for (int g = 0; g < grid; ++g) {
         s0[index(g)] += norms[index(g)];
