@@ -90,8 +90,8 @@ struct ToolpathProgramWriter::Impl {
         "  ! Robtargets in {} (the workpiece frame). The TCP of {} must be the robot model's, the tool tip with its z "
         "out of the spindle along the tool: [[{:.4f},{:.4f},{:.4f}],[{:.8f},{:.8f},{:.8f},{:.8f}]] (mm).\n",
         o.wobj, o.tool, zero_below(tcp.translation().x() * 1e3, 1e-4), zero_below(tcp.translation().y() * 1e3, 1e-4),
-        zero_below(tcp.translation().z() * 1e3, 1e-4), zero_below(tq.w(), 1e-8), zero_below(tq.x(), 1e-8), zero_below(tq.y(), 1e-8),
-        zero_below(tq.z(), 1e-8));
+        zero_below(tcp.translation().z() * 1e3, 1e-4), zero_below(tq.w(), 1e-8), zero_below(tq.x(), 1e-8),
+        zero_below(tq.y(), 1e-8), zero_below(tq.z(), 1e-8));
     s += "  ! Feed moves: MoveL at the program's feed (\\V, mm/s); positioning moves at vDeflexRapid.\n\n";
     const Pose& w = o.base_T_workpiece;
     const Eigen::Quaterniond q(w.linear());
@@ -99,8 +99,8 @@ struct ToolpathProgramWriter::Impl {
     s += fmt::format(
         "  PERS wobjdata {}:=[FALSE,TRUE,\"\",[[{:.4f},{:.4f},{:.4f}],[{:.8f},{:.8f},{:.8f},{:.8f}]],"
         "[[0,0,0],[1,0,0,0]]];\n",
-        o.wobj, zero_below(t.x(), 1e-4), zero_below(t.y(), 1e-4), zero_below(t.z(), 1e-4), zero_below(q.w(), 1e-8), zero_below(q.x(), 1e-8),
-        zero_below(q.y(), 1e-8), zero_below(q.z(), 1e-8));
+        o.wobj, zero_below(t.x(), 1e-4), zero_below(t.y(), 1e-4), zero_below(t.z(), 1e-4), zero_below(q.w(), 1e-8),
+        zero_below(q.x(), 1e-8), zero_below(q.y(), 1e-8), zero_below(q.z(), 1e-8));
     s += fmt::format("  CONST speeddata vDeflexRapid:=[{:g},500,5000,1000];\n\n", o.rapid_speed_mm_s);
     s += "  PROC main()\n    ! Stop rather than reach a target in another arm configuration.\n    ConfL\\On;\n";
   }
@@ -115,8 +115,8 @@ struct ToolpathProgramWriter::Impl {
       const Vector3 t = p.translation() * 1e3;
       const Vector3 abc = krl_abc(p.linear(), Vector3::Zero());
       return fmt::format("{{X {:.4f},Y {:.4f},Z {:.4f},A {:.4f},B {:.4f},C {:.4f}}}", zero_below(t.x(), 1e-4),
-                         zero_below(t.y(), 1e-4), zero_below(t.z(), 1e-4), zero_below(abc.x(), 1e-4), zero_below(abc.y(), 1e-4),
-                         zero_below(abc.z(), 1e-4));
+                         zero_below(t.y(), 1e-4), zero_below(t.z(), 1e-4), zero_below(abc.x(), 1e-4),
+                         zero_below(abc.y(), 1e-4), zero_below(abc.z(), 1e-4));
     };
     s += fmt::format("  $BASE = {}  ; the workpiece frame in the robot's base ($WORLD)\n", frame(o.base_T_workpiece));
     s += fmt::format("  $TOOL = {}  ; the robot model's TCP: the tool tip, z out of the spindle along the tool\n",
@@ -134,8 +134,8 @@ struct ToolpathProgramWriter::Impl {
         "[[{:.4f},{:.4f},{:.4f}],[{:.8f},{:.8f},{:.8f},{:.8f}],[{},{},{},{}],"
         "[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]]",
         zero_below(t.x(), 1e-4), zero_below(t.y(), 1e-4), zero_below(t.z(), 1e-4), zero_below(q_previous.w(), 1e-8),
-        zero_below(q_previous.x(), 1e-8), zero_below(q_previous.y(), 1e-8), zero_below(q_previous.z(), 1e-8), c.cf1, c.cf4, c.cf6,
-        c.cfx);
+        zero_below(q_previous.x(), 1e-8), zero_below(q_previous.y(), 1e-8), zero_below(q_previous.z(), 1e-8), c.cf1,
+        c.cf4, c.cf6, c.cfx);
     const std::string suffix = fmt::format("{}\\WObj:={};  ! line {}\n", o.tool, o.wobj, tp.line);
     if (points == 0) {
       buffer += fmt::format("    MoveJ {},vDeflexRapid,fine,{}", robtarget, suffix);
@@ -149,9 +149,10 @@ struct ToolpathProgramWriter::Impl {
   void add_krl(const ToolpathPoint& tp, const OfflinePoint& p, const Pose& target) {
     const Vector3 t = target.translation() * 1e3;
     abc_previous = krl_abc(target.linear(), abc_previous);
-    const std::string pos = fmt::format("X {:.4f},Y {:.4f},Z {:.4f},A {:.4f},B {:.4f},C {:.4f}", zero_below(t.x(), 1e-4),
-                                        zero_below(t.y(), 1e-4), zero_below(t.z(), 1e-4), zero_below(abc_previous.x(), 1e-4),
-                                        zero_below(abc_previous.y(), 1e-4), zero_below(abc_previous.z(), 1e-4));
+    const std::string pos =
+        fmt::format("X {:.4f},Y {:.4f},Z {:.4f},A {:.4f},B {:.4f},C {:.4f}", zero_below(t.x(), 1e-4),
+                    zero_below(t.y(), 1e-4), zero_below(t.z(), 1e-4), zero_below(abc_previous.x(), 1e-4),
+                    zero_below(abc_previous.y(), 1e-4), zero_below(abc_previous.z(), 1e-4));
     if (points == 0) {
       const KukaConfiguration k = kuka_configuration(model, ws, p.q_command);
       buffer +=
