@@ -25,30 +25,6 @@ constexpr double kChangePenalty = 1e-12;
 // The workpiece's x counts as along the tool axis when it lies within this of it (sin of ~8 deg).
 constexpr double kReferenceMinSine = 0.14;
 
-using Compliance36 = Eigen::Matrix<double, 3, 6>;
-
-/// Why a candidate angle is out at a stage.
-enum class Reason : int { kUnreachable, kConfiguration, kLimits, kSingular, kCount };
-
-struct Candidate {
-  Compliance36 a = Compliance36::Zero();  // translational deflection per wrench about the TCP: J_p K^-1 J^T T
-  bool feasible = false;
-};
-
-struct Stage {
-  double s = 0.0;  // effective path length, m
-  bool stay_only = false;
-  std::size_t line = 0;
-  std::vector<Candidate> c;
-  std::vector<std::int8_t> back;  // the best predecessor's grid offset (-1, 0, 1) of each state
-  int decided = -1;
-};
-
-struct Held {
-  SpinPoint p;
-  double s = 0.0;
-};
-
 Vector3 unit_normal_part(const Vector3& v, const Vector3& axis) {
   const Vector3 n = v - axis.dot(v) * axis;
   return n / n.norm();
@@ -140,6 +116,32 @@ std::string describe_tool_spin(const ToolSpinOptions& o) {
 }
 
 struct ToolSpinPlanner::Impl {
+  // The planner's own types: nested, since Impl (a member of a class in a header) may not hold types of
+  // the anonymous namespace.
+  using Compliance36 = Eigen::Matrix<double, 3, 6>;
+
+  /// Why a candidate angle is out at a stage.
+  enum class Reason : int { kUnreachable, kConfiguration, kLimits, kSingular, kCount };
+
+  struct Candidate {
+    Compliance36 a = Compliance36::Zero();  // translational deflection per wrench about the TCP: J_p K^-1 J^T T
+    bool feasible = false;
+  };
+
+  struct Stage {
+    double s = 0.0;  // effective path length, m
+    bool stay_only = false;
+    std::size_t line = 0;
+    std::vector<Candidate> c;
+    std::vector<std::int8_t> back;  // the best predecessor's grid offset (-1, 0, 1) of each state
+    int decided = -1;
+  };
+
+  struct Held {
+    SpinPoint p;
+    double s = 0.0;
+  };
+
   const RobotModel& model;
   ToolSpinOptions o;
   IkRequest first;
@@ -395,14 +397,14 @@ struct ToolSpinPlanner::Impl {
           c0.feasible && c1.feasible ? Compliance36(0.5 * (c0.a + c1.a)) : Compliance36::Zero();
     }
     const double length = next.s - prev.s;
-    Wrench last = Wrench::Constant(std::numeric_limits<double>::quiet_NaN());
+    Wrench wrench = Wrench::Constant(std::numeric_limits<double>::quiet_NaN());
     for (; costed < points.size() && points[costed].s <= next.s; ++costed) {
       const Held& h = points[costed];
       if (!h.p.cutting) continue;
       const double u = length > 0.0 ? (h.s - prev.s) / length : 1.0;
-      if (h.p.wrench != last) {
-        last = h.p.wrench;
-        deflections.noalias() = stacked * last;
+      if (h.p.wrench != wrench) {
+        wrench = h.p.wrench;
+        deflections.noalias() = stacked * wrench;
         for (int g = 0; g < grid; ++g) norms[index(g)] = deflections.segment<3>(rows_of(g)).norm();
       }
       for (int g = 0; g < grid; ++g) {
