@@ -23,6 +23,7 @@
 #include "deflex/paths/pose_source.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/output_file.hpp"
+#include "offline_toolpath.hpp"
 
 namespace deflex::cli {
 namespace {
@@ -37,6 +38,9 @@ struct OfflineOpts {
   std::string motion = "absj", zone = "fine", tool = "tool0", wobj = "wobj0", module = "DeflexOffline";
   double speed_mm_s = 10.0;
   bool circle_given = false, orientation_given = false, json = false;
+  // --toolpath
+  std::string toolpath, workpiece, cutter, stock, tool_spin = "optimize", toolpath_options, plot_out;
+  bool zone_given = false, wobj_given = false, module_given = false, speed_given = false, motion_given = false;
 };
 
 nlohmann::json program_json(const RobotModel& model, const ProgramCompensation& result) {
@@ -379,9 +383,53 @@ double write_whole_path_outputs(const OfflineOpts& o, const RobotModel& model, c
   return nominal_s;
 }
 
+/// --toolpath: the options of a path and of an existing program do not apply.
+void run_toolpath(const OfflineOpts& o, int& exit_code) {
+  if (o.circle_given || !o.line.empty() || !o.path_csv.empty() || !o.program_in.empty()) {
+    throw InputError("--toolpath is the path: give no --circle, --line, --path or --program-in");
+  }
+  if (!o.rapid_out.empty() || !o.trajectory_out.empty() || !o.nominal_trajectory_out.empty() || o.orientation_given ||
+      o.speed_given || o.motion_given || !o.tooldata.empty() || !o.wobjdata.empty()) {
+    throw InputError(
+        "with --toolpath the program's feed is the speed and the tool axis the orientation: the robot program is "
+        "--program-out part.mod (RAPID), part.src (KRL) or part.nc (G-code); --rapid, --joint-trajectory, "
+        "--nominal-trajectory, --orientation-wxyz, --speed-mm-s, --motion, --tooldata and --wobjdata do not apply");
+  }
+  ToolpathRunOptions t;
+  t.robot = o.robot;
+  t.stiffness = o.stiffness;
+  t.toolpath = o.toolpath;
+  t.workpiece = o.workpiece;
+  t.cutter = o.cutter;
+  t.stock = o.stock;
+  t.tool_spin = o.tool_spin;
+  t.reader_options = o.toolpath_options;
+  t.forces = o.forces;
+  t.csv_out = o.csv_out;
+  t.program_out = o.program_out;
+  t.plot_out = o.plot_out;
+  t.zone = o.zone_given ? o.zone : "";
+  t.tool = o.tool;
+  t.wobj = o.wobj_given ? o.wobj : "";
+  t.name = o.module_given ? o.module : "";
+  t.json = o.json;
+  run_offline_toolpath(
+      t, [&](const RobotModel& model) { return first_ik_request(o, model); }, exit_code);
+}
+
 void run(const OfflineOpts& o, int& exit_code) {
   if (o.forces.empty()) {
-    throw InputError("give a force model: --force ldbb:...|constant:...|tool:...|table:FILE.csv");
+    throw InputError("give a force model: --force ldbb:...|constant:...|tool:...|table:FILE.csv|milling:...");
+  }
+  if (!o.toolpath.empty()) {
+    run_toolpath(o, exit_code);
+    return;
+  }
+  for (const auto& [given, name] :
+       {std::pair{!o.workpiece.empty(), "--workpiece"}, std::pair{!o.cutter.empty(), "--cutter"},
+        std::pair{!o.stock.empty(), "--stock"}, std::pair{!o.plot_out.empty(), "--plot"},
+        std::pair{!o.toolpath_options.empty(), "--toolpath-options"}}) {
+    if (given) throw InputError(fmt::format("option {} goes with --toolpath", name));
   }
   if (!o.program_in.empty()) {
     if (o.circle_given || !o.line.empty() || !o.path_csv.empty()) {
@@ -441,7 +489,8 @@ void setup_offline(CLI::App& sub, int& exit_code) {
                  "\"ldbb:phi_deg=A,force_N=...\" (circle only: pivot on the circle's axis, bar inclined by A), "
                  "\"constant:fx_N=..,fy_N=..,fz_N=..,mx_Nm=..,my_Nm=..,mz_Nm=..\" (base frame), \"tool:fz_N=..,...\" "
                  "(the same keys in the TCP frame: a drilling or milling thrust that turns with the tool), "
-                 "\"table:FILE.csv\"")
+                 "\"table:FILE.csv\", \"milling:Ktc_N_mm2=..,...|file=COEFFS.yaml[,ae_mm=..,ap_mm=..]\" (with "
+                 "--toolpath)")
       ->required();
   sub.add_option("--speed-mm-s", o->speed_mm_s,
                  "TCP speed, mm/s (default 10): the RAPID speeddata and the timing of the joint trajectories");
@@ -467,7 +516,8 @@ void setup_offline(CLI::App& sub, int& exit_code) {
                  "An existing robot program to compensate target by target: ABB RAPID module (.mod, .modx, .prg, "
                  ".sys) or KUKA KRL program (.src, its .dat beside it); every other byte is kept");
   sub.add_option("--program-out", o->program_out,
-                 "Where the compensated program goes (KRL: the .src; its .dat is written beside it)");
+                 "Where the compensated program goes (KRL: the .src; its .dat is written beside it). With --toolpath: "
+                 ".nc/.gcode/.tap (G-code over the source), .mod/.modx/.prg (RAPID) or .src (KRL)");
   sub.add_option("--tooldata", o->tooldata,
                  "Tool declared outside the program, in its own syntax (repeatable): RAPID "
                  "\"tGun=[TRUE,[[x,y,z],[q1,q2,q3,q4]],[mass,[cx,cy,cz],[1,0,0,0],0,0,0]]\" (mm), KRL "
@@ -476,10 +526,36 @@ void setup_offline(CLI::App& sub, int& exit_code) {
                  "Work object or base declared outside the program (repeatable): RAPID "
                  "\"wobjTable=[FALSE,TRUE,\"\",[[x,y,z],[q1,q2,q3,q4]],[[0,0,0],[1,0,0,0]]]\", KRL "
                  "\"BASE_DATA[2]={X ..,Y ..,Z ..,A ..,B ..,C ..}\" or \"$BASE={...}\"");
+  sub.add_option("--toolpath", o->toolpath,
+                 "A CAM toolpath to compensate for its milling force: G-code (.nc, .gcode, .tap) or APT/CL data (.apt, "
+                 ".cls), points in the workpiece frame (docs/machining.md)");
+  sub.add_option(
+      "--workpiece", o->workpiece,
+      "--toolpath: the workpiece frame in the robot's base frame \"x_mm=..,y_mm=..,z_mm=..,qw=..,qx=..,qy=..,"
+      "qz=..\" (the quaternion optional)");
+  sub.add_option("--cutter", o->cutter,
+                 "--toolpath: the milling cutter \"diameter_mm=..,flutes=..,helix_deg=..[,corner_radius_mm=..]\"");
+  sub.add_option("--stock", o->stock,
+                 "--toolpath: the stock the program cuts, workpiece frame \"box:min_mm=X;Y;Z,max_mm=X;Y;Z,cell_mm=C"
+                 "[,model=zmap|dexel][,layer_mm=L]\" (z-map by default)");
+  sub.add_option("--tool-spin", o->tool_spin,
+                 "--toolpath: the spindle's free angle: optimize (default: chosen for stiffness; keys step_deg, "
+                 "rate_deg_per_mm, limit_margin_deg, singularity_floor, lag_stages after optimize:) or fixed:DEG");
+  sub.add_option("--toolpath-options", o->toolpath_options,
+                 "--toolpath: reading \"chord_mm=0.01,arc_tolerance_mm=0.01,step_mm=0,rotary=head-head|table-table,"
+                 "dialect=iso|siemens,apt_units=mm|inch\"");
+  sub.add_option("--plot", o->plot_out,
+                 "--toolpath: write an SVG chart of the force, the deflection with and without compensation and the "
+                 "spindle angle along the path");
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code, &sub] {
     o->circle_given = sub.count("--circle") > 0;
     o->orientation_given = sub.count("--orientation-wxyz") > 0;
+    o->zone_given = sub.count("--zone") > 0;
+    o->wobj_given = sub.count("--wobj") > 0;
+    o->module_given = sub.count("--module") > 0;
+    o->speed_given = sub.count("--speed-mm-s") > 0;
+    o->motion_given = sub.count("--motion") > 0;
     run(*o, exit_code);
   });
 }
@@ -487,8 +563,8 @@ void setup_offline(CLI::App& sub, int& exit_code) {
 }  // namespace
 
 DEFLEX_COMMAND("offline",
-               "Offline compensation: a path (circle, line or CSV) and a force model to compensated joints, CSV and an "
-               "ABB RAPID module",
+               "Offline compensation: a path (circle, line, CSV or a CAM toolpath) and a force model to compensated "
+               "joints, CSV and a robot program",
                setup_offline, 30);
 
 }  // namespace deflex::cli

@@ -1,5 +1,5 @@
 // The parts of the deflex Python module, one function a part of the library (model, identify,
-// offline, evaluate, online, study, runtime), each in its own file; module.cpp calls them in this order.
+// offline, machining, evaluate, online, study, runtime), each in its own file; module.cpp calls them in this order.
 #pragma once
 
 #include <memory>
@@ -39,6 +39,7 @@ void bind_errors(py::module_& m);
 void bind_model(py::module_& m);
 void bind_identify(py::module_& m);
 void bind_offline(py::module_& m);
+void bind_machining(py::module_& m);
 void bind_evaluate(py::module_& m);
 void bind_online(py::module_& m);
 void bind_study(py::module_& m);

@@ -9,6 +9,7 @@ PYBIND11_MODULE(_deflex, m) {
   deflex::python::bind_model(m);
   deflex::python::bind_identify(m);
   deflex::python::bind_offline(m);
+  deflex::python::bind_machining(m);
   deflex::python::bind_evaluate(m);
   deflex::python::bind_online(m);
   deflex::python::bind_study(m);

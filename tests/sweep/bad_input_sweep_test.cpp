@@ -492,7 +492,8 @@ std::vector<BadInput> option_cases() {
 
 std::vector<BadInput> all_cases() {
   std::vector<BadInput> cases = file_cases();
-  for (auto* more : {option_cases, output_cases, input_file_cases, program_cases, limit_cases, tracker_sensor_cases}) {
+  for (auto* more : {option_cases, output_cases, input_file_cases, program_cases, limit_cases, tracker_sensor_cases,
+                     toolpath_cases}) {
     for (auto& c : more()) cases.push_back(std::move(c));
   }
   return cases;

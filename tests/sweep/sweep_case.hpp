@@ -48,11 +48,12 @@ inline std::string source_file(const std::string& rel) { return slurp(std::strin
 /// nothing otherwise).
 std::string with(const std::string& text, const std::string& from, const std::string& to);
 
-// The generators, one per class of bad input (file_safety_cases.cpp, program_cases.cpp).
+// The generators, one per class of bad input (file_safety_cases.cpp, program_cases.cpp, toolpath_cases.cpp).
 std::vector<BadInput> output_cases();          ///< outputs that are inputs, links, devices, folders
 std::vector<BadInput> input_file_cases();      ///< FIFOs, devices, folders, oversize files as inputs
 std::vector<BadInput> program_cases();         ///< malformed RAPID modules and KRL programs
 std::vector<BadInput> limit_cases();           ///< URDF limits, YAML rules, value ranges, repeated keys
 std::vector<BadInput> tracker_sensor_cases();  ///< tracker files, registration, RDT calibration pages
+std::vector<BadInput> toolpath_cases();        ///< malformed toolpaths, milling options, stock, reach
 
 }  // namespace deflex::test

@@ -54,7 +54,7 @@ TEST(AptReader, IsoRecordsGiveTheHandComputedPoints) {
   EXPECT_NEAR((p[21].tool_axis - Vector3(0, 0.6, 0.8)).norm(), 0.0, 1e-15);
   for (const auto& q : p) {
     EXPECT_EQ(q.tool, 1);
-    EXPECT_EQ(q.spindle, SpindleTurn::kClockwise);
+    EXPECT_EQ(q.spindle, SpindleState::kClockwise);
     EXPECT_EQ(q.spindle_rpm, 15000.0);
   }
   ASSERT_TRUE(s.cutter.has_value());
@@ -124,7 +124,7 @@ TEST(AptReader, BlanksContinuationsFeedUnitsAndInches) {
   EXPECT_NEAR(p[0].feed_m_s, 254.0 / 60000.0, kAptExact);  // 10 in/min
   EXPECT_NEAR(p[1].feed_m_s, 508.0 / 60000.0, kAptExact);  // 20 per minute in the file's inches
   EXPECT_NEAR(p[2].feed_m_s, 0.01, kAptExact);             // 600 mm/min whatever the file's unit
-  EXPECT_EQ(p[0].spindle, SpindleTurn::kCounterClockwise);
+  EXPECT_EQ(p[0].spindle, SpindleState::kCounterClockwise);
   EXPECT_EQ(p[0].spindle_rpm, 2300.0);
 }
 

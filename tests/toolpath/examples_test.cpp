@@ -31,7 +31,7 @@ TEST(MachiningExamples, PocketStaysAtTheCuttersRadiusFromItsWalls) {
     contour = contour || q.x() < -60.0;
     if (p.motion != MotionKind::kRapid) {
       EXPECT_GT(p.feed_m_s, 0.0);
-      EXPECT_EQ(p.spindle, SpindleTurn::kClockwise);
+      EXPECT_EQ(p.spindle, SpindleState::kClockwise);
       EXPECT_EQ(p.spindle_rpm, 15000.0);
     }
     // Below the top, inside the pocket's outline (60 x 40, corners 8): the tool's centre keeps 5 mm

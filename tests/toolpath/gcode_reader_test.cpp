@@ -54,8 +54,8 @@ TEST(GcodeReader, ThreeAxisProgramWithModalWordsGivesTheHandComputedPoints) {
   EXPECT_NEAR(p[2].feed_m_s, 0.025, kExact);
   EXPECT_NEAR(p[3].feed_m_s, 0.025, kExact);
   EXPECT_EQ(p[4].feed_m_s, 0.0);
-  EXPECT_EQ(p[3].spindle, SpindleTurn::kClockwise);
-  EXPECT_EQ(p[4].spindle, SpindleTurn::kOff);  // M5 acts before the block's motion
+  EXPECT_EQ(p[3].spindle, SpindleState::kClockwise);
+  EXPECT_EQ(p[4].spindle, SpindleState::kOff);  // M5 acts before the block's motion
   EXPECT_EQ(summary.rapids_before_position_known, 1u);
   EXPECT_EQ(summary.points, 5u);
   EXPECT_EQ(summary.motion_blocks, 5u);
@@ -87,7 +87,7 @@ TEST(GcodeReader, InchesAndIncrementalMovesConvertToMetres) {
   EXPECT_NEAR(p[4].position_m.norm(), 0.0, kExact);
   EXPECT_NEAR(p[1].feed_m_s, 508.0 / 60000.0, kExact);
   EXPECT_NEAR(p[3].feed_m_s, 508.0 / 60000.0, kExact);
-  EXPECT_EQ(p[1].spindle, SpindleTurn::kCounterClockwise);
+  EXPECT_EQ(p[1].spindle, SpindleState::kCounterClockwise);
   EXPECT_EQ(summary.units, LengthUnit::kInch);
   EXPECT_TRUE(summary.units_changed);
 }

@@ -7,6 +7,7 @@
 
 #include "deflex/force/constant_wrench_model.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
+#include "deflex/force/milling_force_model.hpp"
 #include "deflex/force/tool_wrench_model.hpp"
 #include "deflex/force/wrench_table_model.hpp"
 #include "deflex/paths/key_value_spec.hpp"
@@ -115,8 +116,25 @@ std::vector<std::unique_ptr<ForceModel>> parse_force_specs(const std::string& sp
     models.push_back(std::make_unique<WrenchTableModel>(WrenchTableModel::read_file(file)));
     return models;
   }
+  if (kind == "milling") {
+    if (!context.cutter) {
+      throw InputError(
+          fmt::format("force spec '{}': the milling force needs the cutter: give --cutter "
+                      "\"diameter_mm=..,flutes=..,helix_deg=..\"",
+                      spec));
+    }
+    std::vector<std::unique_ptr<ForceModel>> models;
+    MillingSpec milling = parse_milling_spec(spec);
+    try {
+      models.push_back(std::make_unique<MillingForceModel>(std::move(milling), *context.cutter));
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("force spec '{}': {}", spec, e.what()));
+    }
+    return models;
+  }
   throw InputError(fmt::format(
-      "force spec '{}': unknown kind '{}' (use ldbb:..., constant:..., tool:... or table:FILE.csv)", spec, kind));
+      "force spec '{}': unknown kind '{}' (use ldbb:..., constant:..., tool:..., table:FILE.csv or milling:...)", spec,
+      kind));
 }
 
 std::unique_ptr<ForceModel> parse_force_spec(const std::string& spec, const ForceSpecContext& context) {

@@ -5,6 +5,8 @@
 //   constant:fx_N=..,fy_N=..,fz_N=..,mx_Nm=..,my_Nm=..,mz_Nm=..   (absent components are 0)
 //   tool:fx_N=..,fy_N=..,fz_N=..,mx_Nm=..,my_Nm=..,mz_Nm=..       (the same, in the TCP frame)
 //   table:FILE.csv                                          (see wrench_table_model.hpp)
+//   milling:Ktc_N_mm2=..,...[,ae_mm=..,ap_mm=..]           (a toolpath's cutting force, with a cutter;
+//   milling:file=COEFFS.yaml[,...]                           milling_force_model.hpp)
 //
 // Keys are separated by ',' and the components of one value by ';'. Every unit is in the key's
 // name; positions in mm, forces in N, moments in Nm (moment about the TCP), base frame (tool: the
@@ -23,6 +25,7 @@
 #include <vector>
 
 #include "deflex/force/force_model.hpp"
+#include "deflex/machining/cutter.hpp"
 #include "deflex/paths/circle_path.hpp"
 
 namespace deflex {
@@ -30,11 +33,13 @@ namespace deflex {
 /// What the path knows that a spec may refer to.
 struct ForceSpecContext {
   std::optional<CirclePath> circle;  ///< enables ldbb:phi_deg=...
+  std::optional<Cutter> cutter;      ///< the cutter a milling: spec needs (--cutter)
 };
 
 /// Every model the spec describes (more than one only for several force_N values). Throws
 /// InputError quoting the spec and the key at fault (unknown or repeated key, bad number, missing
-/// key, phi_deg without a circle); a table spec throws DataError from the CSV reader.
+/// key, phi_deg without a circle, milling without a cutter); a table spec throws DataError from the CSV
+/// reader, a milling spec's coefficient file ModelError.
 [[nodiscard]] std::vector<std::unique_ptr<ForceModel>> parse_force_specs(const std::string& spec,
                                                                          const ForceSpecContext& context = {});
 

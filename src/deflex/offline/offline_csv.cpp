@@ -44,17 +44,35 @@ std::vector<std::string> offline_csv_columns(int dof) {
   return c;
 }
 
-OfflineCsvWriter::OfflineCsvWriter(OutputFile& out, int dof, const std::string& robot_name,
-                                   const std::string& force_description, bool predicted)
-    : dof_(dof), out_(out, offline_csv_columns(dof)) {
-  out_.comment(
-      fmt::format("deflex offline: robot {}; force {}; wrench in the base frame, moment about the WAP; "
-                  "deflection = loaded minus unloaded TCP pose when commanded to the desired joints{}",
-                  robot_name, force_description, predicted ? "" : " (not predicted: columns are zero)"));
-  row_.reserve(offline_csv_columns(dof).size());
+namespace {
+
+std::vector<std::string> with_extra(int dof, const std::vector<std::string>& extra) {
+  std::vector<std::string> c = offline_csv_columns(dof);
+  c.insert(c.end(), extra.begin(), extra.end());
+  return c;
 }
 
-void OfflineCsvWriter::write(std::size_t index, const OfflinePoint& p) {
+}  // namespace
+
+OfflineCsvWriter::OfflineCsvWriter(OutputFile& out, int dof, const std::string& robot_name,
+                                   const std::string& force_description, bool predicted)
+    : OfflineCsvWriter(out, dof, robot_name, force_description, predicted, {}, "") {}
+
+OfflineCsvWriter::OfflineCsvWriter(OutputFile& out, int dof, const std::string& robot_name,
+                                   const std::string& force_description, bool predicted,
+                                   const std::vector<std::string>& extra_columns, const std::string& note)
+    : dof_(dof), extra_(extra_columns.size()), out_(out, with_extra(dof, extra_columns)) {
+  out_.comment(
+      fmt::format("deflex offline: robot {}; force {}; wrench in the base frame, moment about the WAP; "
+                  "deflection = loaded minus unloaded TCP pose when commanded to the desired joints{}{}",
+                  robot_name, force_description, predicted ? "" : " (not predicted: columns are zero)", note));
+  row_.reserve(offline_csv_columns(dof).size() + extra_);
+}
+
+void OfflineCsvWriter::write(std::size_t index, const OfflinePoint& p, std::span<const double> extra) {
+  if (extra.size() != extra_) {
+    throw InputError(fmt::format("path point {}: {} extra values for {} extra columns", index, extra.size(), extra_));
+  }
   if (p.q_desired.size() != dof_ || p.q_command.size() != dof_) {
     throw InputError(fmt::format("path point {}: {} desired and {} command joints for a {}-joint file", index,
                                  p.q_desired.size(), p.q_command.size(), dof_));
@@ -86,6 +104,7 @@ void OfflineCsvWriter::write(std::size_t index, const OfflinePoint& p) {
   row_.push_back(p.predicted_deflection.head<3>().norm() * 1e3);
   row_.push_back(p.predicted_residual.head<3>().norm() * 1e3);
   row_.push_back(p.predicted_residual.tail<3>().norm() * 1e3);
+  row_.insert(row_.end(), extra.begin(), extra.end());
   out_.row(row_);
 }
 

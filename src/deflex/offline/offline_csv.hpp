@@ -3,6 +3,7 @@
 // names its unit.
 #pragma once
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -26,12 +27,17 @@ class OfflineCsvWriter {
  public:
   OfflineCsvWriter(OutputFile& out, int dof, const std::string& robot_name, const std::string& force_description,
                    bool predicted);
-  void write(std::size_t index, const OfflinePoint& point);
+  /// With `extra_columns` after the standard ones (a toolpath's feed, spindle, engagement, spin, ...):
+  /// write() then takes one value for each. `note` goes at the end of the '#' line.
+  OfflineCsvWriter(OutputFile& out, int dof, const std::string& robot_name, const std::string& force_description,
+                   bool predicted, const std::vector<std::string>& extra_columns, const std::string& note);
+  void write(std::size_t index, const OfflinePoint& point, std::span<const double> extra = {});
   /// Flushes the rows to the output; throws OutputError when a write failed.
   void finish();
 
  private:
   int dof_;
+  std::size_t extra_;
   CsvWriter out_;
   std::vector<double> row_;
   Eigen::Quaterniond q_desired_ = Eigen::Quaterniond::Identity();  // sign continuity along the path

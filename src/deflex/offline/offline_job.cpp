@@ -100,7 +100,8 @@ std::vector<std::string> offline_load_labels(const std::vector<const ForceModel*
   for (std::size_t k = 0; k < forces.size(); ++k) {
     std::string label;
     for (const char c : forces[k]->label()) label += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-    if (std::find(labels.begin(), labels.end(), label) != labels.end()) label += "_" + std::to_string(k + 1);
+    // fmt rather than "_" + std::to_string(): GCC 12 warns falsely (-Wrestrict) on that inlined concatenation.
+    if (std::find(labels.begin(), labels.end(), label) != labels.end()) label += fmt::format("_{}", k + 1);
     labels.push_back(label);
   }
   return labels;

@@ -45,17 +45,6 @@ namespace {
 /// Below this threshold (a caller asking to hear of no singularity) the shortcut is not taken.
 constexpr double kArmMarginThreshold = 1e-6;
 
-/// The opw_solutions() arm mask of the arm whose branches have cfx `cfx` away from the singularities:
-/// cfx bit 2 is the back shoulder; bit 1 is set for the first elbow (sin gamma > 0) exactly when
-/// axis 2 turns against the canonical y axis (opw_ik.cpp, abb_cfx: the lower arm cross product has
-/// the sign of sin gamma).
-unsigned arm_of_configuration(const OpwGeometry& g, int cfx) {
-  const unsigned shoulder = (static_cast<unsigned>(cfx) >> 2U) & 1U;
-  const unsigned bit1 = (static_cast<unsigned>(cfx) >> 1U) & 1U;
-  const unsigned elbow = bit1 ^ (g.sign[1] < 0.0 ? 1U : 0U);
-  return 1U << (2U * shoulder + elbow);
-}
-
 double max_abs_diff(const Eigen::Matrix<double, 6, 1>& a, const JointVector& b) {
   double m = 0.0;
   for (int j = 0; j < 6; ++j) {
@@ -65,6 +54,16 @@ double max_abs_diff(const Eigen::Matrix<double, 6, 1>& a, const JointVector& b) 
 }
 
 }  // namespace
+
+unsigned opw_arm_of_configuration(const OpwGeometry& g, int cfx) {
+  // cfx bit 2 is the back shoulder; bit 1 is set for the first elbow (sin gamma > 0) exactly when
+  // axis 2 turns against the canonical y axis (opw_ik.cpp, abb_cfx: the lower arm cross product has
+  // the sign of sin gamma).
+  const unsigned shoulder = (static_cast<unsigned>(cfx) >> 2U) & 1U;
+  const unsigned bit1 = (static_cast<unsigned>(cfx) >> 1U) & 1U;
+  const unsigned elbow = bit1 ^ (g.sign[1] < 0.0 ? 1U : 0U);
+  return 1U << (2U * shoulder + elbow);
+}
 
 JointPath solve_path_ik(const RobotModel& model, const std::vector<Pose>& poses, const IkRequest& first) {
   return solve_path_ik(model, poses, first, PathIkOptions{});
@@ -130,7 +129,7 @@ const JointVector& PathIkSolver::next(const Pose& base_T_tcp) {
     request_.match_quadrants = false;
     if (const OpwGeometry* g = model_.opw();
         g != nullptr && !request_.kuka_configuration && request_.near_singular_threshold >= kArmMarginThreshold) {
-      arm_ = arm_of_configuration(*g, r.configuration.cfx);
+      arm_ = opw_arm_of_configuration(*g, r.configuration.cfx);
     }
   } else {
     for (int j = 0; j < model_.dof(); ++j) {

@@ -29,6 +29,10 @@ struct PathIkOptions {
   bool allow_near_singular = false;
 };
 
+/// The opw_solutions() arm mask (opw_ik.hpp) of the arm whose branches have configuration `cfx` away
+/// from the shoulder and elbow singularities: one shoulder and one elbow.
+[[nodiscard]] unsigned opw_arm_of_configuration(const OpwGeometry& g, int cfx);
+
 /// Solves every pose of `poses` (base_T_tcp). The first point uses `first` as given (its
 /// configuration and seed pick the solution); every later point keeps the first point's cfx and is
 /// the solution closest to the previous point. Throws InputError "path point I: REASON" (I 0-based)

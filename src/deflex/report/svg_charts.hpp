@@ -10,6 +10,7 @@
 
 #include "deflex/evaluate/lap_split.hpp"
 #include "deflex/model/tracker_trace.hpp"
+#include "deflex/offline/toolpath_job.hpp"
 #include "deflex/study/study_tables.hpp"
 
 namespace deflex {
@@ -72,6 +73,12 @@ std::string svg_lap_overlay(const PathPlot& plot);
 /// (still deflected the way the load pushes) and - over-compensated; per direction of travel the
 /// sector means against the angle (as in svg_lap_overlay), in mm.
 std::string svg_signed_error(const PathPlot& plot);
+
+/// A toolpath job along its path length (samples from ToolpathJobOptions::chart_samples): the cutting
+/// force averaged over a revolution and its per-revolution peak (N); the predicted deflection of the
+/// tip without compensation, with the compensated robot program and, when `gcode`, with the compensated
+/// G-code run at the programmed orientation (mm); the spindle angle (deg).
+std::string svg_toolpath_chart(const std::vector<ToolpathChartSample>& samples, const std::string& title, bool gcode);
 
 /// Polar deviation plot: around the circle (angle as in svg_lap_overlay), the distance from the
 /// reference drawn outward from a ring that stands for 0 mm, magnified, with rings labelled in mm;

@@ -197,20 +197,20 @@ void AptInterpreter::spindle_record() {
   need_args(1, 3);
   const auto& args = record_->args;
   if (args.size() == 1 && (args[0] == "OFF" || args[0] == "ON")) {
-    spindle_ = args[0] == "ON" ? spindle_direction_ : SpindleTurn::kOff;
+    spindle_ = args[0] == "ON" ? spindle_direction_ : SpindleState::kOff;
     spindle_off_line_ = args[0] == "OFF" ? record_->line : 0;
     return;
   }
   std::optional<double> rpm;
-  SpindleTurn direction = SpindleTurn::kClockwise;  // ISO 4343: CLW unless told
+  SpindleState direction = SpindleState::kClockwise;  // ISO 4343: CLW unless told
   for (std::size_t i = 0; i < args.size(); ++i) {
     if (is_number(i)) {
       if (rpm) fail_arg(i, "a second number");
       rpm = number(i);
     } else if (args[i] == "CLW") {
-      direction = SpindleTurn::kClockwise;
+      direction = SpindleState::kClockwise;
     } else if (args[i] == "CCLW") {
-      direction = SpindleTurn::kCounterClockwise;
+      direction = SpindleState::kCounterClockwise;
     } else if (args[i] == "SFM" || args[i] == "SMM") {
       fail_arg(i, "a surface speed is not read: export the spindle speed in RPM");
     } else if (args[i] != "RPM") {

@@ -40,7 +40,7 @@ void AptInterpreter::check_cutting() const {
              ? std::string("a cutting move (GOTO without RAPID) with no feed: no FEDRAT has set one")
              : fmt::format("a cutting move (GOTO without RAPID) at feed 0 (FEDRAT on line {})", feed_line_));
   }
-  if (spindle_ == SpindleTurn::kOff) {
+  if (spindle_ == SpindleState::kOff) {
     fail(spindle_off_line_ != 0
              ? fmt::format("a cutting move with the spindle stopped (SPINDL/OFF on line {})", spindle_off_line_)
              : std::string("a cutting move before any SPINDL has started the spindle"));

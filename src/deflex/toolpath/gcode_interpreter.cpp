@@ -284,7 +284,7 @@ void GcodeInterpreter::apply_spindle_and_tool(const Block& b) {
   }
   if (b.m_spindle != nullptr) {
     const int m = static_cast<int>(b.m_spindle->value);
-    spindle_ = m == 3 ? SpindleTurn::kClockwise : m == 4 ? SpindleTurn::kCounterClockwise : SpindleTurn::kOff;
+    spindle_ = m == 3 ? SpindleState::kClockwise : m == 4 ? SpindleState::kCounterClockwise : SpindleState::kOff;
     spindle_off_line_ = m == 5 ? line_.number : 0;
   }
 }

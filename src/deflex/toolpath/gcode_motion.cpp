@@ -224,7 +224,7 @@ void GcodeInterpreter::check_cutting(const Block& b, int motion) const {
               feed_line_ == 0 ? fmt::format("a cutting move ({}) with no feed: no F word has set one", g)
                               : fmt::format("a cutting move ({}) at feed 0 (F0 on line {})", g, feed_line_));
   }
-  if (spindle_ == SpindleTurn::kOff) {
+  if (spindle_ == SpindleState::kOff) {
     fail_word(b.m_spindle != nullptr   ? b.m_spindle->text(line_.text)
               : spindle_off_line_ != 0 ? "M5"
                                        : "M3",

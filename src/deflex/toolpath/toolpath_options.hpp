@@ -2,6 +2,8 @@
 // convention, the G-code dialect) and the fixed limits every point is held to. docs/machining.md.
 #pragma once
 
+#include <string>
+
 #include "deflex/toolpath/toolpath_point.hpp"
 
 namespace deflex {
@@ -45,6 +47,11 @@ struct ToolpathOptions {
 
 /// Throws InputError naming the field when an option is outside its range.
 void check_toolpath_options(const ToolpathOptions& options);
+
+/// The options from the command line's "chord_mm=0.01,arc_tolerance_mm=0.01,step_mm=1,
+/// rotary=head-head|table-table,dialect=iso|siemens,apt_units=mm|inch" (every key optional; step_mm=0
+/// keeps one point a linear block), checked. Throws InputError quoting the spec and naming the key.
+[[nodiscard]] ToolpathOptions parse_toolpath_options_spec(const std::string& spec);
 
 namespace toolpath_limits {
 /// A coordinate farther than this from the workpiece origin is refused (a typo or a unit slip): m.

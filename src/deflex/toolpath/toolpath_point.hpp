@@ -22,8 +22,9 @@ enum class MotionKind {
   kArcCcw,  ///< G3; an APT CIRCLE turning counter-clockwise seen from the spindle
 };
 
-/// The spindle's turning direction, seen from the spindle towards the tool tip.
-enum class SpindleTurn {
+/// Whether the spindle turns and which way, seen from the spindle towards the tool tip (the machining
+/// module's SpindleTurn is the direction alone, for a turning spindle).
+enum class SpindleState {
   kOff,               ///< M5, SPINDL/OFF, or never started
   kClockwise,         ///< M3, SPINDL/...,CLW
   kCounterClockwise,  ///< M4, SPINDL/...,CCLW
@@ -36,7 +37,7 @@ struct ToolpathPoint {
   Vector3 tool_axis = Vector3::UnitZ();  ///< unit vector from the tip into the spindle, workpiece frame
   double feed_m_s = 0.0;                 ///< programmed feed (F, at the tool tip), m/s; 0 for rapids
   double spindle_rpm = 0.0;              ///< programmed spindle speed (S), rev/min, >= 0
-  SpindleTurn spindle = SpindleTurn::kOff;
+  SpindleState spindle = SpindleState::kOff;
   int tool = 0;  ///< tool number in the spindle (T with M6, LOADTL); 0 when none
   MotionKind motion = MotionKind::kRapid;
   std::size_t line = 0;       ///< 1-based line of the source file the point comes from

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "deflex/paths/key_value_spec.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/parse_number.hpp"
 #include "deflex/toolpath/apt_reader.hpp"
@@ -29,6 +30,29 @@ void check_toolpath_options(const ToolpathOptions& o) {
     throw InputError(fmt::format("toolpath option max_linear_step_m: {} m is neither 0 nor inside 1e-5..1 m",
                                  number_text(o.max_linear_step_m)));
   }
+}
+
+ToolpathOptions parse_toolpath_options_spec(const std::string& spec) {
+  const KeyValueSpec keys(spec, spec, {"chord_mm", "arc_tolerance_mm", "step_mm", "rotary", "dialect", "apt_units"});
+  ToolpathOptions o;
+  o.chord_tolerance_m = keys.number("chord_mm", o.chord_tolerance_m * 1e3) * 1e-3;
+  o.arc_radius_tolerance_m = keys.number("arc_tolerance_mm", o.arc_radius_tolerance_m * 1e3) * 1e-3;
+  o.max_linear_step_m = keys.number("step_mm", 0.0) * 1e-3;
+  const auto choice = [&](const char* key, const char* a, const char* b) {
+    if (!keys.has(key)) return true;
+    const std::string& v = keys.text(key);
+    if (v != a && v != b) keys.fail(fmt::format("key '{}': '{}' is neither {} nor {}", key, v, a, b));
+    return v == a;
+  };
+  o.rotary = choice("rotary", "head-head", "table-table") ? RotaryConvention::kHeadHead : RotaryConvention::kTableTable;
+  o.dialect = choice("dialect", "iso", "siemens") ? GcodeDialect::kIso : GcodeDialect::kSiemens;
+  o.apt_default_units = choice("apt_units", "mm", "inch") ? LengthUnit::kMillimetre : LengthUnit::kInch;
+  try {
+    check_toolpath_options(o);
+  } catch (const InputError& e) {
+    keys.fail(e.what());
+  }
+  return o;
 }
 
 ToolpathFormat toolpath_format_for(const std::string& path) {

@@ -72,8 +72,8 @@ class AptInterpreter {
   double feed_m_s_ = 0.0;
   std::size_t feed_line_ = 0;
   double spindle_rpm_ = 0.0;
-  SpindleTurn spindle_ = SpindleTurn::kOff;
-  SpindleTurn spindle_direction_ = SpindleTurn::kClockwise;  // what SPINDL/ON restarts
+  SpindleState spindle_ = SpindleState::kOff;
+  SpindleState spindle_direction_ = SpindleState::kClockwise;  // what SPINDL/ON restarts
   std::size_t spindle_off_line_ = 0;
   int tool_ = 0;
   std::optional<CutterGeometry> pending_cutter_;  // stated before the tool it belongs to is loaded

@@ -16,7 +16,7 @@ namespace deflex::detail {
 struct PointContext {
   double feed_m_s = 0.0;
   double spindle_rpm = 0.0;
-  SpindleTurn spindle = SpindleTurn::kOff;
+  SpindleState spindle = SpindleState::kOff;
   int tool = 0;
   MotionKind motion = MotionKind::kRapid;
   std::size_t line = 0;

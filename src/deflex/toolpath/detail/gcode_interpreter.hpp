@@ -125,7 +125,7 @@ class GcodeInterpreter {
   std::size_t feed_line_ = 0;
   double spindle_rpm_ = 0.0;
   std::size_t spindle_rpm_line_ = 0;
-  SpindleTurn spindle_ = SpindleTurn::kOff;
+  SpindleState spindle_ = SpindleState::kOff;
   std::size_t spindle_off_line_ = 0;  // the M5 that stopped it; 0: never started
   int selected_tool_ = 0;
   int active_tool_ = 0;
