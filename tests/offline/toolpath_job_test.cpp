@@ -22,6 +22,7 @@
 #include "deflex/toolpath/gcode_reader.hpp"
 #include "machining/textbook_milling.hpp"
 #include "model/kdl_chain.hpp"
+#include "support/error_of.hpp"
 
 namespace deflex {
 namespace {
@@ -493,15 +494,6 @@ TEST(ToolpathProgram, KrlMovesThroughTheCompensatedPosesInBase) {
   EXPECT_NE(moves.front().find(",S 'B"), std::string::npos);
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(ToolpathJob, PointOutOfReachIsNamedByItsLine) {
   const RobotModel model = spindle_robot();
   const MillingForceModel force(al7075(3.0, 5.0), end_mill());
@@ -510,7 +502,7 @@ TEST(ToolpathJob, PointOutOfReachIsNamedByItsLine) {
   const std::string text = "G21 G90 G94\nS9000 M3\nG0 X0 Y0 Z5\nG1 Z-4 F900\nG1 X20 F2700\nG1 X3000\nG0 Z5\nM5\n";
   for (const char* spin : {"optimize", "fixed:0"}) {
     o.spin = parse_tool_spin_spec(spin);
-    const std::string e = error_of([&] { (void)run_text(model, text, force, nullptr, o); });
+    const std::string e = test::error_of([&] { (void)run_text(model, text, force, nullptr, o); });
     EXPECT_NE(e.find("t.nc: line 6"), std::string::npos) << spin << ": " << e;
     EXPECT_NE(e.find("any"), std::string::npos) << spin << ": " << e;
   }
@@ -522,7 +514,7 @@ TEST(ToolpathJob, StockTheToolNeverTouchesIsRefused) {
   const std::unique_ptr<Stock> stock = parse_stock_spec("box:min_mm=200;200;-20,max_mm=300;300;0,cell_mm=0.5");
   ToolpathJobOptions o;
   o.base_T_workpiece = workpiece_at(2000, 0, 800);
-  const std::string e = error_of([&] { (void)run_text(model, kSquareSlot, force, stock.get(), o); });
+  const std::string e = test::error_of([&] { (void)run_text(model, kSquareSlot, force, stock.get(), o); });
   EXPECT_NE(e.find("never touches the stock"), std::string::npos) << e;
   EXPECT_NE(e.find("t.nc"), std::string::npos) << e;
 }
@@ -535,7 +527,7 @@ TEST(ToolpathJob, TiltedToolAxisWithAStockIsRefusedNamingTheLine) {
   o.base_T_workpiece = workpiece_at(2000, 0, 800);
   const std::string text =
       "G21 G90 G94\nS9000 M3\nG43.5 H1\nG0 X-30 Y0 Z5 I0 J0 K1\nG1 Z-4 F900 I0 J0 K1\nG1 X0 F2700 I0 J0.2 K0.98\nM5\n";
-  const std::string e = error_of([&] { (void)run_text(model, text, force, stock.get(), o); });
+  const std::string e = test::error_of([&] { (void)run_text(model, text, force, stock.get(), o); });
   EXPECT_NE(e.find("t.nc: line 6"), std::string::npos) << e;
   EXPECT_NE(e.find("tilted"), std::string::npos) << e;
   EXPECT_NE(e.find("ae_mm="), std::string::npos) << e;
