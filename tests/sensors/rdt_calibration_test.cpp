@@ -203,8 +203,10 @@ TEST(RdtCalibration, MalformedPagesAndFilesAreNamed) {
   const std::string twice =
       error_of([] { (void)parse_netft_xml("<netft>\n<cfgcpf>1</cfgcpf>\n<cfgcpf>2</cfgcpf>\n</netft>", "t.xml"); });
   EXPECT_NE(twice.find("t.xml:3: field 'cfgcpf' given twice (also on line 2)"), std::string::npos) << twice;
-  const std::string file = error_of([] { (void)load_netft_xml("/nonexistent/netftapi2.xml"); });
-  EXPECT_NE(file.find("does not exist: there is no folder '/nonexistent'"), std::string::npos) << file;
+  // A folder of the test's own that it never makes (a path under / could exist on a shared machine).
+  const std::string missing = ::testing::TempDir() + "/rdt-calibration-no-such-folder";
+  const std::string file = error_of([&] { (void)load_netft_xml(missing + "/netftapi2.xml"); });
+  EXPECT_NE(file.find("does not exist: there is no folder '" + missing + "'"), std::string::npos) << file;
   const std::string rate = error_of([] { (void)parse_netft_xml(page_with({{"comrdtrate", "-7000"}}), "r.xml"); });
   EXPECT_NE(rate.find("field 'comrdtrate'"), std::string::npos) << rate;
   const std::string buffer = error_of([] { (void)parse_netft_xml(page_with({{"comrdtbsiz", "41"}}), "r.xml"); });
