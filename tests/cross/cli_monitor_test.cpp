@@ -34,6 +34,7 @@
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/transport/udp_transport.hpp"
+#include "support/sampled_speed.hpp"
 
 namespace deflex {
 namespace {
@@ -690,6 +691,96 @@ TEST(MonitorServer, OrdinaryRequestsAreAllAnsweredWithSlowlorisAndIdleClientsOn)
   for (auto& t : abusers) t.join();
   for (int fd : idle) ::close(fd);
   EXPECT_GT(dropped.load(), 0) << "the server never cut a slowloris connection off";
+}
+
+// The fault table's row for an abusive page: while ten slowloris clients, thirty idle event streams
+// and two clients asking for the data as fast as they can hold the monitor, the stream on the wire
+// keeps both invariants (every step between two targets the controller took within the per-cycle
+// limit this test computes from the program, every command within the bound of the nominal) and the
+// answers stay in time.
+TEST(CliMonitor, AnAbusivePageNeitherDelaysNorStepsTheStream) {
+  MonitorRun run("cli_monitor_abusive");
+  Child deflex;
+  spawn(deflex, run.args({"--monitor", "0", "--json"}), run.dir + "/stderr.txt", run.dir + "/stdout.json");
+  const int port = monitor_port_of(deflex);
+  ASSERT_GT(port, 0) << test::slurp(deflex.stderr_path);
+  const int egm_port = monitor_egm_port(deflex);
+  ASSERT_GT(egm_port, 0) << test::slurp(deflex.stderr_path);
+  std::atomic<bool> stop{false};
+  std::atomic<int> dropped{0};
+  std::atomic<long> floods{0};
+  std::vector<std::thread> abusers;
+  for (int k = 0; k < 10; ++k) abusers.emplace_back([&] { slowloris(port, stop, dropped); });
+  for (int k = 0; k < 2; ++k) {
+    abusers.emplace_back([&] {
+      while (!stop.load()) {
+        (void)http_request(port, "GET /data?since=0");
+        ++floods;
+      }
+    });
+  }
+  std::vector<int> idle;
+  for (int k = 0; k < 30; ++k) {
+    idle.push_back(connect_to(port));
+    const std::string req = "GET /events HTTP/1.1\r\nHost: x\r\nAccept: text/event-stream\r\n\r\n";
+    (void)!::send(idle.back(), req.data(), req.size(), MSG_NOSIGNAL);
+  }
+  // The controller in real time, every target it takes recorded (what went on the wire).
+  std::vector<JointVector> wire;
+  {
+    UdpTransport transport("127.0.0.1", 0);
+    cell::ControllerConfig cc;
+    cell::EgmPositionGuidanceController controller(
+        cc, run.program.points().front(), transport,
+        make_datagram_address("127.0.0.1", static_cast<std::uint16_t>(egm_port)));
+    const auto start = std::chrono::steady_clock::now();
+    auto next = start;
+    std::uint64_t taken = 0;
+    for (;;) {
+      const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (t > 3.0) break;
+      controller.tick(t);
+      if (controller.counters().targets != taken) {
+        taken = controller.counters().targets;
+        wire.push_back(controller.target());
+      }
+      next += std::chrono::milliseconds(4);
+      std::this_thread::sleep_until(next);
+    }
+    EXPECT_FALSE(controller.counters().timed_out);
+  }
+  stop = true;
+  for (auto& t : abusers) t.join();
+  for (int fd : idle) ::close(fd);
+  EXPECT_EQ(deflex.stop(), 0) << test::slurp(deflex.stderr_path);
+  EXPECT_GT(floods.load(), 10) << "the flood never got an answer";
+  ASSERT_GT(wire.size(), 200u);
+  // The per-cycle step limit from the program itself: its peak joint speed (sampled), the correction's
+  // rate bound (3 deg/s by default) and the ramp-in's blend (1 deg over 1 s at most, 1.5x for its shape).
+  const double period = 0.004, deg = kPi / 180.0;
+  const JointVector limit =
+      (period * (test::sampled_peak_speed(run.program) * 1.001 + JointVector::Constant(6, 3.0 * deg + 1.5 * deg)))
+          .array() +
+      1e-7;
+  double worst = 0.0;
+  for (std::size_t k = 1; k < wire.size(); ++k) {
+    worst = std::max(worst, ((wire[k] - wire[k - 1]).cwiseAbs().array() / limit.array()).maxCoeff());
+  }
+  EXPECT_LE(worst, 1.0) << "a step on the wire beyond the per-cycle limit with an abusive page on";
+  EXPECT_GT(worst, 0.05) << "the stream never moved: the check above saw nothing";
+  const CsvTable log = CsvTable::read_file(run.log);
+  double farthest = 0.0;
+  for (std::size_t r = 0; r < log.rows(); ++r) {
+    for (int j = 1; j <= 6; ++j) {
+      const std::string n = std::to_string(j) + "_deg";
+      farthest = std::max(farthest, std::abs(log.at(r, "q_command" + n) - log.at(r, "q_nominal" + n)));
+    }
+  }
+  EXPECT_LE(farthest, 0.5 + 1e-9) << "a command beyond the 0.5 deg bound of the nominal";
+  const auto doc = nlohmann::json::parse(test::slurp(run.dir + "/stdout.json"));
+  const double answers = doc["answers"].get<double>();
+  EXPECT_GT(answers, 200.0);
+  EXPECT_LT(doc["timing"]["late_answers"].get<double>(), 0.01 * answers) << doc["timing"].dump();
 }
 
 TEST(MonitorServer, ConnectionsBeyondItsCapAreRefusedAndItServesAgainAfter) {
