@@ -4,10 +4,11 @@
 # against its working direction (KUKA tools work along x), on the KR 210 R3100-2 from its
 # ROS-Industrial URDF. TOOL_DATA and BASE_DATA live in the controller's $config.dat, so they are
 # given on the command line in KRL syntax. Writes deburr_bracket.src and .dat.
-# Usage: 02_krl_program.sh [DEFLEX] [OUTDIR]
+# Usage: 02_krl_program.sh [DEFLEX] [OUTDIR] (example-out/ and the script's name when omitted)
 set -eu
 DEFLEX=${1:-deflex}
-OUT=${2:-.}
+OUT=${2:-example-out/02_krl_program}
+mkdir -p "$OUT"
 HERE=$(dirname "$0")
 "$DEFLEX" offline --robot "$HERE/../robots/kuka_kr210_r3100_2_flange.yaml" \
   --program-in "$HERE/deburr_bracket.src" --force "tool:fx_N=-150" \

@@ -1,7 +1,7 @@
 """deflex from Python, notebook style: identify a robot's joint stiffness from measured deflections,
 compensate a path for a process force with the identified model, and plot the deflection along it.
 
-Run (from the repository, after building): PYTHONPATH=build/python python3 examples/python/01_identify_compensate_plot.py [OUTDIR]
+Run (from the repository, after building): PYTHONPATH=build/python python3 examples/python/01_identify_compensate_plot.py [OUTDIR] (example-out/ and the script's name when omitted)
 Each block below is a notebook cell. Units: m, rad, N, Nm (mm only in printed figures, and said).
 """
 
@@ -13,7 +13,7 @@ import numpy as np
 
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
-out_dir = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".")
+out_dir = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "example-out/01_identify_compensate_plot")
 out_dir.mkdir(parents=True, exist_ok=True)
 
 # %% 1. The robot as its file describes it: kinematics and an assumed (nominal) joint stiffness.

@@ -8,7 +8,7 @@ wire's own codec, and measured here against the session's two stated limits:
   bound:  |command - nominal| per joint (joint links), |offset| at the TCP (egm-path)
   step:   |command(k) - command(k-1)| per joint or at the TCP, between consecutive commands
 
-Run (from the repository, after building): PYTHONPATH=build/python python3 examples/python/02_fault_table.py [OUTDIR]
+Run (from the repository, after building): PYTHONPATH=build/python python3 examples/python/02_fault_table.py [OUTDIR] (example-out/ and the script's name when omitted)
 It prints one row a fault and writes fault_table.csv (and fault_outage.png when matplotlib is there)
 into OUTDIR. Units: m, rad, N, s inside; mm, deg and ms in the printed figures, and said.
 """
@@ -20,7 +20,7 @@ import sys
 import deflex  # first: on an interpreter without NumPy its message says what to do
 import numpy as np
 
-out_dir = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".")
+out_dir = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "example-out/02_fault_table")
 out_dir.mkdir(parents=True, exist_ok=True)
 robot = deflex.Robot.builtin()
 FORCE_N = [300.0, 200.0, -1000.0]

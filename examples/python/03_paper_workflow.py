@@ -6,7 +6,7 @@ paper's figure of merit (mean distance of the loaded path from the unloaded one)
 differs from the model only in its stiffness, so compensation comes out near complete; the
 simulated cell of `deflex case-study` (run_case_study) is harder than the model, as a real cell is.
 
-Run (after building): PYTHONPATH=build/python python3 examples/python/03_paper_workflow.py [OUTDIR]
+Run (after building): PYTHONPATH=build/python python3 examples/python/03_paper_workflow.py [OUTDIR] (example-out/ and the script's name when omitted)
 or, with the module installed into an interpreter (scripts/python-module.sh), that interpreter alone.
 Each block is a notebook cell. Units: m, rad, N, Nm inside; mm only in printed figures, and said.
 """
@@ -17,7 +17,7 @@ import sys
 import deflex  # first: on an interpreter without NumPy its message says what to do
 import numpy as np
 
-out_dir = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".")
+out_dir = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "example-out/03_paper_workflow")
 out_dir.mkdir(parents=True, exist_ok=True)
 rng = np.random.default_rng(7)
 
