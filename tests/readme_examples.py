@@ -1,14 +1,15 @@
 #!/usr/bin/env python3
-"""Runs the README's examples as the README writes them, so they cannot drift from the program.
+"""Runs the README's and the docs' examples as they are written, so they cannot drift from the program.
 
-Every ```sh block of README.md must be preceded by a marker line:
+Every ```sh block of README.md and of each --doc file must be preceded by a marker line:
   <!-- readme-test: run -->            the block is run with bash -eu (deflex on the PATH is this
                                        build's program) and must exit 0
   <!-- readme-test: skip REASON -->    not run, for the reason given (needs a robot, takes minutes)
   <!-- test-command -->                the build-and-test command CI itself runs
 A ```console block whose lines start with "$ " is a transcript: each command is run and its output
 must match the lines that follow it (numbers to 1e-9 absolute or 1e-4 relative, text exactly).
-Commands run in a scratch directory holding links to the repository's examples/, data/ and docs/
+Each file's blocks run in order, in a fresh scratch directory of their own (a file's later blocks use
+what its earlier blocks wrote, as a reader pasting them in order would). Commands run in a scratch directory holding links to the repository's examples/, data/ and docs/
 and build/bin/ pointing at this build's programs, so README paths work unchanged.
 """
 import argparse
@@ -60,37 +61,35 @@ def run(cmd, work, env, timeout):
                           text=True, timeout=timeout)
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--readme", required=True)
-    ap.add_argument("--bin-dir", required=True)
-    ap.add_argument("--work", required=True)
-    args = ap.parse_args()
-    repo = os.path.dirname(os.path.abspath(args.readme))
-    work = os.path.abspath(args.work)
+def scratch(repo, work, bin_dir):
+    """A scratch directory with the repository's examples/, data/, docs/ and build/bin/ linked in."""
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(os.path.join(work, "build"))
     for d in ("examples", "data", "docs"):
         os.symlink(os.path.join(repo, d), os.path.join(work, d))
-    os.symlink(os.path.abspath(args.bin_dir), os.path.join(work, "build", "bin"))
+    os.symlink(os.path.abspath(bin_dir), os.path.join(work, "build", "bin"))
     env = dict(os.environ)
-    env["PATH"] = os.path.abspath(args.bin_dir) + os.pathsep + env.get("PATH", "")
+    env["PATH"] = os.path.abspath(bin_dir) + os.pathsep + env.get("PATH", "")
+    return env
 
-    with open(args.readme, encoding="utf-8") as f:
-        readme = f.read()
-    failures = []
-    ran = skipped = transcripts = 0
-    for lang, marker, line, text in blocks(readme):
-        where = f"README.md:{line}"
+
+def check_file(path, repo, work, bin_dir, failures, counts):
+    """Runs one Markdown file's blocks in order in its own scratch directory."""
+    env = scratch(repo, work, bin_dir)
+    with open(path, encoding="utf-8") as f:
+        text_of_file = f.read()
+    name = os.path.relpath(os.path.abspath(path), repo)
+    for lang, marker, line, text in blocks(text_of_file):
+        where = f"{name}:{line}"
         if lang == "sh":
             if marker == "<!-- test-command -->" or marker.startswith("<!-- readme-test: skip "):
-                skipped += 1
+                counts[2] += 1
                 continue
             if marker != "<!-- readme-test: run -->":
                 failures.append(f"{where}: a sh block without a readme-test marker (run, or skip with a reason)")
                 continue
             r = run(text, work, env, 240)
-            ran += 1
+            counts[0] += 1
             print(f"{where}: exit {r.returncode}")
             if r.returncode != 0:
                 failures.append(f"{where}: exit {r.returncode}\n{text}\n--- stdout\n{r.stdout}\n--- stderr\n{r.stderr}")
@@ -103,15 +102,31 @@ def main():
                 elif steps and l.strip():
                     steps[-1][1].append(l)
             for cmd, expected in steps:
-                transcripts += 1
+                counts[1] += 1
                 r = run(cmd, work, env, 120)
                 actual = [l for l in r.stdout.splitlines() if l.strip()]
                 ok = r.returncode == 0 and len(actual) == len(expected) and all(
                     same_line(e, a) for e, a in zip(expected, actual))
                 print(f"{where}: $ {cmd}: {'matches' if ok else 'DIFFERS'}")
                 if not ok:
-                    failures.append(f"{where}: $ {cmd}\nexit {r.returncode}\n--- README says\n" + "\n".join(expected) +
+                    failures.append(f"{where}: $ {cmd}\nexit {r.returncode}\n--- the file says\n" + "\n".join(expected) +
                                     "\n--- the program says\n" + r.stdout + "\n--- stderr\n" + r.stderr)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--readme", required=True)
+    ap.add_argument("--doc", action="append", default=[], help="a further Markdown file whose blocks run")
+    ap.add_argument("--bin-dir", required=True)
+    ap.add_argument("--work", required=True)
+    args = ap.parse_args()
+    repo = os.path.dirname(os.path.abspath(args.readme))
+    failures = []
+    counts = [0, 0, 0]  # sh blocks run, transcript commands checked, blocks skipped
+    for index, path in enumerate([args.readme] + args.doc):
+        work = os.path.join(os.path.abspath(args.work), str(index))
+        check_file(path, repo, work, args.bin_dir, failures, counts)
+    ran, transcripts, skipped = counts
     print(f"{ran} sh blocks run, {transcripts} transcript commands checked, {skipped} blocks skipped by their marker")
     if ran == 0 or transcripts == 0:
         failures.append("no runnable example found: the markers are missing")
