@@ -95,6 +95,7 @@ struct CalibrationRig {
   Workspace ws_nominal;
   cell::TrueRobotState state;
   bool have_state = false;
+  cell::CoupledTickCounters coupled;  // the loaded passes' coupled solves
   double dt;
   double hold_s;
   JointVector seed_q;
@@ -173,14 +174,13 @@ void run_calibration_pass(CalibrationRig& rig, CalibrationArc& arc, int loaded) 
   }
   CellArm arm{robot, ws, state, device, drift};
   Vector3 p_prev = arm.at_rest(q);
-  Vector3 v_prev = Vector3::Zero();
   const auto ticks = static_cast<long>(std::ceil(program.end_time_s() / dt));
   double next_sample = 1.0 / cc.sensor.rate_hz;
   for (long i = 1; i <= ticks; ++i) {
     const double t = static_cast<double>(i) * dt;
     program.sample(t, q);
     Wrench w;
-    const Vector3 p = arm.tick(q, loaded != 0, p_prev, v_prev, dt, w);
+    const Vector3 p = arm.tick(q, loaded != 0, dt, w);
     if (rig.force_from_sensor && loaded) {
       const Matrix3 base_R_flange = ws.base_T_flange.linear();
       forward_kinematics(rig.nominal, rig.ws_nominal, q);  // the orientation deflex knows (nominal, encoders)
@@ -197,9 +197,9 @@ void run_calibration_pass(CalibrationRig& rig, CalibrationArc& arc, int loaded) 
       }
     }
     tracker.observe(t - dt, p_prev, t, p, pass.trace);
-    v_prev = (p - p_prev) / dt;
     p_prev = p;
   }
+  rig.coupled.add(arm.counters());
 }
 
 // Adds an arc's measurements: at points along the arc, the mean of the tracker samples in a window,
@@ -264,6 +264,7 @@ CellCalibration identify_from_measurements(const CalibrationRig& rig, const std:
                       identify_stiffness(nominal, data, id_options),
                       static_cast<int>(data.size()),
                       force_sum / static_cast<double>(data.size()),
+                      {},
                       {}};
   std::vector<double> k(static_cast<std::size_t>(nominal.dof()));
   for (int j = 0; j < nominal.dof(); ++j) {
@@ -295,7 +296,8 @@ CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robo
                            {},
                            0,
                            0.0,
-                           {"exact stiffness given: model-consistent cell"}};
+                           {"exact stiffness given: model-consistent cell"},
+                           {}};
   }
   CalibrationRig rig(c, robot, seed);
   std::vector<StiffnessMeasurement> data;
@@ -308,7 +310,9 @@ CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robo
     }
     measure_calibration_arc(rig, arc, data);
   }
-  return identify_from_measurements(rig, data);
+  CellCalibration out = identify_from_measurements(rig, data);
+  out.coupled = rig.coupled;
+  return out;
 }
 
 }  // namespace deflex::study

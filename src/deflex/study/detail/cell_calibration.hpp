@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "deflex/cell/coupled_tick.hpp"
 #include "deflex/cell/true_robot.hpp"
 #include "deflex/identify/stiffness_identification.hpp"
 #include "deflex/study/case_config.hpp"
@@ -21,7 +22,8 @@ struct CellCalibration {
   /// Mean magnitude of the forces the identification was given (N): what the bar reported or the
   /// sensor read, never the force the cell applied.
   double mean_force_n = 0.0;
-  std::vector<std::string> notes;  ///< joints kept at the assumed value, warnings
+  std::vector<std::string> notes;     ///< joints kept at the assumed value, warnings
+  cell::CoupledTickCounters coupled;  ///< what the loaded passes' coupled solves of the arm and the bar did
 };
 
 /// Plans, measures and identifies. With config.exact_model the true diagonal stiffness is given
