@@ -140,8 +140,9 @@ Vector3 CoupledTickSolver::solve_with_process(CoupledArm arm, const JointVector&
   backup_ = arm.state;  // each solve starts from the last tick's state: a trial that misses is undone
   Vector3 arm_m, p_arm;
   Vector3 previous_arm_m = Vector3::Zero();
-  Wrench previous_w = Wrench::Zero(), previous_g = Wrench::Zero();
+  Wrench previous_w = Wrench::Zero();
   double miss = 0.0, previous_miss = 0.0;
+  bool cautious = false;
   int solves = 0;
   for (;;) {
     if (solves > 0) arm.state = backup_;
@@ -160,29 +161,30 @@ Vector3 CoupledTickSolver::solve_with_process(CoupledArm arm, const JointVector&
       break;
     }
     const Wrench solved_w = w;
-    if (solves > 1 && miss > 0.5 * previous_miss) {
+    if (solves > 1 && (cautious || miss > 0.5 * previous_miss)) {
       // Not contracting: a kink of the arm's response (a joint's lost motion taken up) or of the
-      // process's lies between the last two solves. The wrench where g, linear along the segment
-      // between them, is least: regula falsi when g changed sign.
-      const Wrench dg = g - previous_g;
-      const double s = dg.squaredNorm() > 0.0 ? std::clamp(-previous_g.dot(dg) / dg.squaredNorm(), -1.0, 2.0) : 0.5;
-      w = previous_w + s * (w - previous_w);
-    } else {
-      if (solves > 1) {
-        // Broyden's update: the arm's response as this tick's two solves show it along their wrenches'
-        // difference (what the tangent misses: the gears' hardening, the servo's yield ...).
-        const Vector3 dw = (w - previous_w).head<3>();
-        if (dw.squaredNorm() > 1e-4) {
-          c += (arm_m - previous_arm_m - c * dw) * dw.transpose() / dw.squaredNorm();
-          c_step_valid = false;
-        }
+      // process's lies between the last two solves, where Newton can overshoot. From here on, the arm
+      // taken for twice as compliant as its tangent: each step then falls short of the answer, by
+      // less than half the way for a process up to several times stiffer than the arm is soft, and
+      // never overshoots it.
+      if (!cautious) {
+        cautious = true;
+        c = 2.0 * tangent_;
+        c_step_valid = false;
       }
-      StepMatrix step{&c_step, &c_step_valid};
-      (void)settle_process(process, p_arm, solved_w, c, step, arm.ws.base_T_tcp.linear(), dt_s, w);
+    } else if (solves > 1) {
+      // Broyden's update: the arm's response as this tick's two solves show it along their wrenches'
+      // difference (what the tangent misses: the gears' hardening, the servo's yield ...).
+      const Vector3 dw = (w - previous_w).head<3>();
+      if (dw.squaredNorm() > 1e-4) {
+        c += (arm_m - previous_arm_m - c * dw) * dw.transpose() / dw.squaredNorm();
+        c_step_valid = false;
+      }
     }
+    StepMatrix step{&c_step, &c_step_valid};
+    (void)settle_process(process, p_arm, solved_w, c, step, arm.ws.base_T_tcp.linear(), dt_s, w);
     previous_arm_m = arm_m;
     previous_w = solved_w;
-    previous_g = g;
     previous_miss = miss;
   }
   // The arm's state and the workspace's kinematics are the last solve's.

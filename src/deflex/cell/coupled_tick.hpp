@@ -49,15 +49,16 @@ struct CoupledArm {
   ProcessForce* process;
 };
 
-/// Steps one run's arm tick by tick. Each tick with a process: a first guess from the last tick (the
-/// arm where the command puts it, deflected as then, the process settled against the arm's linear
-/// response), then
-/// Newton's method on p = A(F(p)): solve the arm under the process's wrench at the guess; if the
-/// process's wrench where the arm then stands differs from it by more than the tolerance, settle the
-/// process against the arm's linear response about that answer (a damped Newton on the process alone,
-/// cheap: the process's stiffness by finite differences) and solve the arm again. The arm's linear
+/// Steps one run's arm tick by tick. Each tick with a process: a first guess (the arm's TCP less its
+/// linear response to the force, extrapolated from the last three ticks; the process settled against
+/// that response), then Newton's method on p = A(F(p)): solve the arm under the process's wrench; if
+/// the process's wrench where the arm then stands differs from it by more than the tolerance, settle
+/// the process against the arm's linear response about that answer (a damped Newton on the process
+/// alone, cheap: its stiffness by finite differences) and solve the arm again. The arm's linear
 /// response is its tangent compliance (TrueRobot::tcp_force_compliance, refreshed as the arm moves)
-/// corrected by what the tick's own solves show of it (Broyden's update).
+/// corrected by what the tick's own solves show of it (Broyden's update); once a solve fails to halve
+/// the mismatch (a kink of the arm or the process between two solves), twice the tangent, whose steps
+/// fall short of the answer and never overshoot it.
 /// Thread safety: one thread at a time (its run's).
 class CoupledTickSolver {
  public:
