@@ -730,8 +730,11 @@ std::string describe_cell(const StudyContext& x, int f) {
       "beyond that model (the error budget lists its effects) is folded into them or left in the residual.",
       f == 1 ? "with" : "without", config.seed, k_true, cell.calibration.measurements, config.calibration.arcs, k_id,
       cell.calibration.estimate.residual_rms_m * 1e6);
+  // What the calibration did about joints it could not identify: measured again, or kept at the
+  // assumed stiffness (and why); the identification's own warnings stay in the calibration's notes.
   for (const auto& note : cell.calibration.notes) {
-    if (note.find("kept the assumed") != std::string::npos || note.find("poorly") != std::string::npos) {
+    if (note.find("kept the assumed") != std::string::npos || note.find("measured again") != std::string::npos ||
+        note.find("no load the bar") != std::string::npos) {
       text += " Calibration: " + note + ".";
     }
   }
