@@ -15,8 +15,11 @@ namespace deflex::cell {
 
 /// The true robot: what the compensators never see.
 struct TrueRobotConfig {
-  double stiffness_scale = 1.0;               ///< true K = built-in K * scale * seeded factor per joint
-  double stiffness_spread = 0.0;              ///< 1-sigma of the seeded log-factor per joint
+  double stiffness_scale = 1.0;   ///< true K = built-in K * scale * seeded factor per joint
+  double stiffness_spread = 0.0;  ///< 1-sigma of the seeded log-factor per joint
+  /// Per joint, the band its true stiffness is drawn in (Nm/rad; the factor is drawn again until the
+  /// joint lands inside): the identified stiffness of arms of this class. Empty: no band.
+  std::vector<double> stiffness_band_min_nm_per_rad, stiffness_band_max_nm_per_rad;
   double coupling_23 = 0.0;                   ///< off-diagonal K23/sqrt(K22 K33) (coupled joint stiffness)
   double forearm_ei_nm2 = 0.0;                ///< forearm bending stiffness EI (0: rigid link)
   double forearm_length_m = 1.2125;           ///< cantilever length, elbow to wrist centre

@@ -58,9 +58,22 @@ TrueRobot::TrueRobot(const CellConfig& config, bool sensor_mounted, std::uint64_
     set_dh_chain(desc, *desc.dh_convention, rows, lower, upper, speed);
   }
   std::vector<double> k_true(static_cast<std::size_t>(n));
+  const auto& band_lo = config.robot.stiffness_band_min_nm_per_rad;
+  const auto& band_hi = config.robot.stiffness_band_max_nm_per_rad;
   for (int i = 0; i < n; ++i) {
-    const double factor = std::exp(config.robot.stiffness_spread * normal(rng));
-    k_true[static_cast<std::size_t>(i)] = base.stiffness()[i] * config.robot.stiffness_scale * factor;
+    const auto iu = static_cast<std::size_t>(i);
+    const double mean = base.stiffness()[i] * config.robot.stiffness_scale;
+    double k = mean * std::exp(config.robot.stiffness_spread * normal(rng));
+    if (iu < band_lo.size() && iu < band_hi.size()) {
+      // A joint of this class of arm is inside the band its identifications report: the spread
+      // between arms is drawn within it (drawn again, a truncated log-normal; a scale that puts the
+      // joint's mean outside the band leaves it at the band's edge).
+      for (int tries = 0; (k < band_lo[iu] || k > band_hi[iu]) && tries < 100; ++tries) {
+        k = mean * std::exp(config.robot.stiffness_spread * normal(rng));
+      }
+      k = std::clamp(k, band_lo[iu], band_hi[iu]);
+    }
+    k_true[iu] = k;
   }
   desc.stiffness_nm_per_rad = k_true;
   desc.stiffness_note = "true stiffness of the simulated cell";
