@@ -20,8 +20,8 @@ namespace deflex::cell {
 struct CoupledTickOptions {
   /// Converged when the process's wrench at the arm's solved position differs from the wrench the arm
   /// was solved under by no more than these (every force component, N; every moment, Nm). At the
-  /// arm's 1-1.6 um/N, 10 mN is 10-16 nm of TCP position: 300 times below the tracker's noise and 200
-  /// times below what the bar's own noise moves the arm by from one tick to the next.
+  /// arm's 1-1.6 um/N, 50 mN is 50-80 nm of TCP position: some 60 times below the tracker's noise
+  /// (5 um) and 40 times below what the bar's own noise (0.3 % of 650 N) moves the arm by.
   double force_tolerance_n = 5e-2;
   double moment_tolerance_nm = 1e-3;
   /// Solves of the arm a tick at most; a tick that reaches it keeps its last iterate and is counted.
