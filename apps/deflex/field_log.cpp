@@ -73,7 +73,7 @@ void add_log_options(CLI::App& sub, LogOptions& options) {
                  "Append the time-stamped messages to this file as well as printing them on stderr");
 }
 
-void FieldLogHealth::on_failure(std::function<void(const std::string&)> f) {
+void FieldLogHealth::on_failure(const std::function<void(const std::string&)>& f) {
   std::string already;
   {
     const std::lock_guard<std::mutex> lock(mutex_);
@@ -101,7 +101,7 @@ void FieldLogHealth::failure(const std::string& what) {
 }
 
 std::shared_ptr<spdlog::logger> make_field_logger(const std::string& name, const LogOptions& options,
-                                                  std::shared_ptr<FieldLogHealth> health) {
+                                                  const std::shared_ptr<FieldLogHealth>& health) {
   static constexpr std::array<std::pair<const char*, spdlog::level::level_enum>, 7> kLevels = {{
       {"trace", spdlog::level::trace},
       {"debug", spdlog::level::debug},

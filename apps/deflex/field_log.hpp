@@ -29,7 +29,7 @@ class FieldLogHealth {
  public:
   /// Called once, with a sentence naming the file, when the first write fails (on the logging thread), or
   /// at once when one failed before.
-  void on_failure(std::function<void(const std::string&)> f);
+  void on_failure(const std::function<void(const std::string&)>& f);
   [[nodiscard]] bool failed() const { return failed_.load(); }
   [[nodiscard]] std::string error() const;
   void failure(const std::string& what);
@@ -46,6 +46,6 @@ class FieldLogHealth {
 /// for appending (checked now, not at the first line). A write to the file that fails later goes to
 /// `health` (when given) naming the file; the line still reaches stderr.
 std::shared_ptr<spdlog::logger> make_field_logger(const std::string& name, const LogOptions& options,
-                                                  std::shared_ptr<FieldLogHealth> health = nullptr);
+                                                  const std::shared_ptr<FieldLogHealth>& health = nullptr);
 
 }  // namespace deflex::cli
