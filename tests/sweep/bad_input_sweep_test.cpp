@@ -363,7 +363,7 @@ std::vector<BadInput> file_cases() {
          "true_robot.lost_motion_urad"},
         {"seal_friction_nan", "seal_friction_pct: 25 ", "seal_friction_pct: .nan ", "ldbb.seal_friction_pct"},
         {"clock_rate_huge", "clock_rate_ppm: 50 ", "clock_rate_ppm: 1e300 ", "tracker.clock_rate_ppm"},
-        {"moment_crosstalk_negative", "moment_crosstalk_pct: 1.5 ", "moment_crosstalk_pct: -1.5 ",
+        {"moment_crosstalk_negative", "moment_crosstalk_pct: 0.2 ", "moment_crosstalk_pct: -0.2 ",
          "sensor.moment_crosstalk_pct"},
         {"hardening_long", "hardening_softening: [0.5, 0.5, 0.5, 0.5, 0.5, 0.5]",
          "hardening_softening: [0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5]", "true_robot.hardening_softening"},
