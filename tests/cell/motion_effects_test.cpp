@@ -211,7 +211,11 @@ TEST(ForceSensorDaq, ZeroDriftGrowsLinearlyWithTheStatedSpreadPerTenMinutes) {
   EXPECT_NEAR(std::sqrt(sum2 / (3.0 * runs)), 0.4, 0.04 * 0.4);
 }
 
-TEST(LdbbDevice, StickSlipIsASawtoothOverTheTcpsTravel) {
+TEST(LdbbDevice, StickSlipIsASawtoothOverThePistonsTravel) {
+  // The bar along +z from the origin; the TCP moves 0.1 mm a tick along it, out then back: the piston
+  // travels 0.1 mm a tick either way, so a 1 mm tooth takes ten ticks: the force rises over nine and
+  // slips back over the tenth, whichever way the piston goes. The TCP moving across the bar does not
+  // slide the piston and leaves the sawtooth where it is.
   LdbbConfig c;
   c.bar_length_m = 0.15;
   c.time_constant_s = 0.3;
@@ -222,15 +226,23 @@ TEST(LdbbDevice, StickSlipIsASawtoothOverTheTcpsTravel) {
   c.stick_slip_travel_m = 0.001;
   LdbbDevice d(c, Vector3::Zero(), 500.0, 1);
   d.settle();
-  const Vector3 tcp(0.13, 0.0, 0.075);
-  const Vector3 v(0.0, 0.01, 0.0);  // 10 mm/s: 0.1 mm of travel per 10 ms tick
-  for (int i = 0; i < 25; ++i) {
-    d.advance(0.01);
-    const double travel = 1e-4 * i;  // travel before this tick
-    const double phase = travel / 0.001 - std::floor(travel / 0.001 + 1e-9);
-    const double expected = 500.0 * (1.0 + 0.1 * (phase - 0.5));
-    EXPECT_NEAR(d.wrench(tcp, v).head<3>().norm(), expected, 1e-6 * 500.0) << "tick " << i;
+  auto expected = [](double travel_m) {
+    const double x = travel_m / 0.001 - std::floor(travel_m / 0.001 + 1e-9);
+    const double shape = x < 0.9 ? x / 0.9 : (1.0 - x) / 0.1;
+    return 500.0 * (1.0 + 0.1 * (shape - 0.5));
+  };
+  EXPECT_NEAR(d.wrench(Vector3(0, 0, 0.15), Vector3::Zero())[2], expected(0.0), 1e-6);
+  for (int i = 1; i <= 25; ++i) {
+    const double out = i <= 15 ? i : 30 - i;  // out for 15 ticks, then back
+    EXPECT_NEAR(d.wrench(Vector3(0, 0, 0.15 + 1e-4 * out), Vector3(0, 0, 0.025))[2], expected(1e-4 * i), 1e-6)
+        << "tick " << i;
   }
+  // Swinging the bar about the pivot at its length: the force's size stays, its direction turns.
+  const double before = d.wrench(Vector3(0, 0, 0.151), Vector3::Zero()).head<3>().norm();
+  const double a = 0.03;
+  const Wrench swung = d.wrench(0.151 * Vector3(std::sin(a), 0, std::cos(a)), Vector3(0.151 * a / 0.004, 0, 0));
+  EXPECT_NEAR(swung.head<3>().norm(), before, 1e-9);
+  EXPECT_NEAR(swung[0] / swung[2], std::tan(a), 1e-12);
 }
 
 TEST(PathDrift, LoadedRunsWarmMoreWithTheSquareOfTheLoad) {

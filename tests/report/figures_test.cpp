@@ -36,6 +36,7 @@ std::vector<std::pair<std::string, std::string>> every_figure() {
           {"figure5 beyond", svg_figure5(r.study, SetupSelection::kBeyondPaper)},
           {"figure5 all", svg_figure5(r.study, SetupSelection::kAll)},
           {"compensation", svg_compensation(r.study)},
+          {"trends", svg_trends(r.study)},
           {"parity", svg_parity(r.study)},
           {"sweep", svg_speed_sweep(r.study)},
           {"path", svg_path_plot(r.path_plots.front())},
@@ -205,6 +206,59 @@ TEST(Compensation, OursPerLoadWithTheSeedsRangeAndThePapers) {
         << expected;
   }
   EXPECT_NE(svg.find(fmt::format("{:.0f}%", mean * 100.0)), std::string::npos) << "the value over its bar";
+}
+
+TEST(Trends, OursAndThePapersCOverUcAtTheirLoadsOnOneScale) {
+  const StudyResult s = test::synthetic_study();
+  const std::string svg = svg_trends(s);
+  EXPECT_EQ(test::xml_problem(svg), "");
+  struct Point {
+    double load, value, cx, cy;
+    bool paper;
+  };
+  std::vector<Point> points;
+  for (const auto& c : tags(svg, "circle")) {
+    const bool paper = !attribute(c, "data-paper").empty();
+    if (!paper && attribute(c, "data-value").empty()) continue;
+    points.push_back({std::stod(attribute(c, "data-load")),
+                      std::stod(attribute(c, paper ? "data-paper" : "data-value")), number(c, "cx"), number(c, "cy"),
+                      paper});
+  }
+  // The synthetic study compares offline with Table 1 and online with Table 2: 3 + 3 of ours, 3 + 3
+  // of the paper's.
+  ASSERT_EQ(points.size(), 12u);
+  // The paper's C/UC: 125 N offline 0.04 / 0.12; 650 N online mean(0.25, 0.19, 0.21) / 1.10.
+  for (const auto& [load, expected] : {std::pair{125.0, 0.04 / 0.12}, std::pair{650.0, 0.65 / 3.0 / 1.10}}) {
+    EXPECT_TRUE(std::any_of(points.begin(), points.end(), [&](const Point& p) {
+      return p.paper && p.load == load && std::abs(p.value - expected) < 1e-5;
+    })) << load;
+  }
+  // Ours at online 650 N: the printed C averaged over the speeds over the printed UC (as the tables).
+  const LoadResult& l = s.setups[1].loads[2];
+  auto round3 = [](double v) { return std::round(v * 1000.0) / 1000.0; };
+  double c_printed = 0.0, uc_mean = 0.0;
+  for (const int v : s.speeds_mm_s) {
+    c_printed += round3(l.c_mm.at(v)) / 3.0;
+    uc_mean += l.uc_mm.at(v) / 3.0;
+  }
+  EXPECT_TRUE(std::any_of(points.begin(), points.end(), [&](const Point& p) {
+    return !p.paper && p.load == 650.0 && std::abs(p.value - c_printed / round3(uc_mean)) < 1e-5;
+  }));
+  // Every point, ours and the paper's, on one vertical scale (the panels share it), and ours at the
+  // paper's x for the same load of the same panel.
+  const Point& a = points.front();
+  const auto b =
+      std::find_if(points.begin(), points.end(), [&](const Point& p) { return std::abs(p.value - a.value) > 0.05; });
+  ASSERT_NE(b, points.end());
+  const double px_per_unit = (b->cy - a.cy) / (b->value - a.value);
+  EXPECT_LT(px_per_unit, 0.0) << "C/UC grows upwards";
+  for (const auto& p : points) {
+    EXPECT_NEAR(p.cy, a.cy + (p.value - a.value) * px_per_unit, 0.2) << p.load << (p.paper ? " paper" : " ours");
+    if (p.paper) continue;
+    EXPECT_TRUE(std::any_of(points.begin(), points.end(), [&](const Point& q) {
+      return q.paper && q.load == p.load && std::abs(q.cx - p.cx) < 0.05;
+    })) << p.load;
+  }
 }
 
 // Log-axis position of a value from two labelled ticks (the test's own reading of the axis).
@@ -499,6 +553,7 @@ TEST(Figures, BadInputDrawsNoDataNeverNan) {
   for (const StudyResult& study : {s, StudyResult{}}) {
     clean(svg_figure5(study, SetupSelection::kAll), "figure5");
     clean(svg_compensation(study), "compensation");
+    clean(svg_trends(study), "trends");
     clean(svg_parity(study), "parity");
     clean(svg_speed_sweep(study), "sweep");
     ReportContent r;

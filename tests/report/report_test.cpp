@@ -189,14 +189,14 @@ TEST(HtmlReport, SelfContainedWellFormedAndComplete) {
   for (const char* needle :
        {"Table 1: offline compensation", "Table 2: online compensation", "Table 3: hybrid (beyond the paper)",
         "Figure 5", "ISO 9283", "Error budget", "Speed sweep", "Paths, laps and directions", "Notes",
-        "force sensor compliance &lt;unmodelled&gt;", "Compensation per load", "Parity with the paper",
-        "Time-synchronous error beside", "LDBB loads 125-650 N &amp; speeds", "<span class=\"paper\">(0.12)</span>",
-        "<span class=\"paper\">(1.10)</span>"}) {
+        "force sensor compliance &lt;unmodelled&gt;", "Compensation per load", "Trends against load",
+        "Parity with the paper", "Time-synchronous error beside", "LDBB loads 125-650 N &amp; speeds",
+        "<span class=\"paper\">(0.12)</span>", "<span class=\"paper\">(1.10)</span>"}) {
     EXPECT_NE(html.find(needle), std::string::npos) << needle;
   }
-  // Figure 5 (the paper's setups), its companion (hybrid), compensation, parity, for the one path
+  // Figure 5 (the paper's setups), its companion (hybrid), compensation, trends, parity, for the one path
   // plot its path, polar, per-lap and signed-error figures, the budget's chart and the sweep.
-  EXPECT_EQ(test::count_of(html, "<svg "), 10u);
+  EXPECT_EQ(test::count_of(html, "<svg "), 11u);
   // Budget sensitivities: (0.20 - 0.12) / 0.20 = 40%; 0.2004 prints as 0.200, so 0%, never "-0%".
   EXPECT_NE(html.find("<td>0.120</td><td>40%</td>"), std::string::npos);
   // Tables give the spread over the seeds: 625 N offline, C at 10 mm/s: mean m = 0.6125 * 1.02 *
@@ -220,9 +220,9 @@ TEST(HtmlReport, WritesTheReportAndFigures) {
       keep != nullptr ? std::filesystem::path(keep) : std::filesystem::temp_directory_path() / "deflex_report_test";
   const ReportContent content = test::synthetic_report();
   write_report(content, dir.string());
-  for (const char* f : {"report.html", "figure5.svg", "figure5_beyond.svg", "compensation.svg", "parity.svg",
-                        "speed_sweep.svg", "path_1.svg", "polar_1.svg", "laps_1.svg", "signed_1.svg", "budget_1.svg",
-                        "tables.md", "tables.csv", "error_budget.csv"}) {
+  for (const char* f : {"report.html", "figure5.svg", "figure5_beyond.svg", "compensation.svg", "trends.svg",
+                        "parity.svg", "speed_sweep.svg", "path_1.svg", "polar_1.svg", "laps_1.svg", "signed_1.svg",
+                        "budget_1.svg", "tables.md", "tables.csv", "error_budget.csv"}) {
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
   }
   std::ifstream in(dir / "report.html");

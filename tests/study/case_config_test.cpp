@@ -192,5 +192,24 @@ TEST(CaseConfig, OutOfRangeEffectSizesAndSeedsAreRefusedByName) {
   EXPECT_NE(old_budget.find("laps_each_way"), std::string::npos) << old_budget;
 }
 
+TEST(CaseConfig, TheStiffnessBandIsReadPerJointAndRefusedByNameWhenMalformed) {
+  const CaseConfig c = paper_case();
+  ASSERT_EQ(c.cell.robot.stiffness_band_min_nm_per_rad.size(), 6U);
+  EXPECT_DOUBLE_EQ(c.cell.robot.stiffness_band_min_nm_per_rad[0], 1.0e6);
+  EXPECT_DOUBLE_EQ(c.cell.robot.stiffness_band_max_nm_per_rad[5], 1.0e6);
+  const std::string min_line = "  stiffness_band_min_Nm_per_rad: [1.0e6, 1.0e6, 1.0e6, 2.0e5, 2.0e5, 2.0e5]\n";
+  const std::string alone = error_of(paper_with(min_line, ""));
+  EXPECT_NE(alone.find("true_robot.stiffness_band_max_Nm_per_rad"), std::string::npos) << alone;
+  EXPECT_NE(alone.find("both"), std::string::npos) << alone;
+  const std::string inverted =
+      error_of(paper_with(min_line, "  stiffness_band_min_Nm_per_rad: [1.0e6, 1.0e6, 1.0e6, 2.0e5, 2.0e5, 2.0e6]\n"));
+  EXPECT_NE(inverted.find("stiffness_band_max_Nm_per_rad"), std::string::npos) << inverted;
+  const std::string short_list = error_of(paper_with(min_line, "  stiffness_band_min_Nm_per_rad: [1.0e6, 1.0e6]\n"));
+  EXPECT_NE(short_list.find("stiffness_band_min_Nm_per_rad"), std::string::npos) << short_list;
+  const std::string negative =
+      error_of(paper_with(min_line, "  stiffness_band_min_Nm_per_rad: [1.0e6, 1.0e6, 1.0e6, 2.0e5, 2.0e5, -1]\n"));
+  EXPECT_NE(negative.find("stiffness_band_min_Nm_per_rad"), std::string::npos) << negative;
+}
+
 }  // namespace
 }  // namespace deflex::study

@@ -7,6 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <cmath>
 
 #include "deflex/cell/force_sensor.hpp"
@@ -337,6 +340,48 @@ TEST(CellCalibration, ItKnowsOnlyTheForceTheBarReports) {
     } else {
       EXPECT_NEAR(cell.calibration.mean_force_n, c.calibration.load_n, 1e-9);
       EXPECT_GT(worst, 0.05) << "the bar's friction did not reach the identified stiffness";
+    }
+  }
+}
+
+TEST(CellCalibration, AJointTheIdentificationCallsUnusableIsMeasuredAgainOrKeptAtItsPrior) {
+  // Two arcs instead of six: the identification flags some joints (a relative standard error over
+  // its limit, a compliance at the c >= 0 bound); joint 6, whose axis runs through the TCP ball, no
+  // force there ever turns. The calibration measures the flagged joints again at the planner's poses
+  // where those can turn them, and gives the compensators the assumed stiffness for every joint its
+  // final estimate still flags, never the flagged value.
+  CaseConfig c = paper_case();
+  c.calibration.arcs = 2;
+  for (const bool sensor : {false, true}) {
+    const SetupCell cell = build_setup_cell(c, sensor);
+    const CellCalibration& cal = cell.calibration;
+    const StiffnessEstimate& e = cal.estimate;
+    const auto& k = cal.identified.stiffness();
+    const auto& prior = cell.robot->nominal_model().stiffness();
+    ASSERT_FALSE(cal.remeasured_joints.empty()) << "sensor " << sensor;
+    EXPECT_GT(cal.measurements, 2 * c.calibration.points_per_arc) << "the planner's poses were measured";
+    EXPECT_EQ(std::count(cal.remeasured_joints.begin(), cal.remeasured_joints.end(), 6), 0);
+    EXPECT_EQ(std::count(cal.kept_joints.begin(), cal.kept_joints.end(), 6), 1);
+    for (int j = 0; j < 6; ++j) {
+      const auto ju = static_cast<std::size_t>(j);
+      const bool kept = std::count(cal.kept_joints.begin(), cal.kept_joints.end(), j + 1) > 0;
+      const bool flagged = std::count(e.unidentifiable_joints.begin(), e.unidentifiable_joints.end(), j + 1) > 0;
+      const double rel = e.std_error_nm_per_rad[ju] / e.stiffness_nm_per_rad[ju];
+      if (kept) {
+        EXPECT_EQ(k[j], prior[j]) << "joint " << j + 1;
+        EXPECT_TRUE(flagged || !std::isfinite(e.stiffness_nm_per_rad[ju])) << "joint " << j + 1;
+        const std::string mark = fmt::format("joint {}: ", j + 1);
+        EXPECT_EQ(std::count_if(cal.notes.begin(), cal.notes.end(),
+                                [&](const std::string& n) {
+                                  return n.rfind(mark, 0) == 0 && n.find("kept the assumed") != std::string::npos;
+                                }),
+                  1)
+            << "joint " << j + 1;
+      } else {
+        EXPECT_FALSE(flagged) << "joint " << j + 1;
+        EXPECT_LE(rel, IdentificationOptions{}.max_relative_std_error) << "joint " << j + 1;
+        EXPECT_EQ(k[j], e.stiffness_nm_per_rad[ju]) << "joint " << j + 1;
+      }
     }
   }
 }

@@ -15,8 +15,11 @@ namespace deflex::cell {
 
 /// The true robot: what the compensators never see.
 struct TrueRobotConfig {
-  double stiffness_scale = 1.0;               ///< true K = built-in K * scale * seeded factor per joint
-  double stiffness_spread = 0.0;              ///< 1-sigma of the seeded log-factor per joint
+  double stiffness_scale = 1.0;   ///< true K = built-in K * scale * seeded factor per joint
+  double stiffness_spread = 0.0;  ///< 1-sigma of the seeded log-factor per joint
+  /// Per joint, the band its true stiffness is drawn in (Nm/rad; the factor is drawn again until the
+  /// joint lands inside): the identified stiffness of arms of this class. Empty: no band.
+  std::vector<double> stiffness_band_min_nm_per_rad, stiffness_band_max_nm_per_rad;
   double coupling_23 = 0.0;                   ///< off-diagonal K23/sqrt(K22 K33) (coupled joint stiffness)
   double forearm_ei_nm2 = 0.0;                ///< forearm bending stiffness EI (0: rigid link)
   double forearm_length_m = 1.2125;           ///< cantilever length, elbow to wrist centre
@@ -116,7 +119,7 @@ struct LdbbConfig {
   double time_constant_s = 0.3;  ///< pneumatic first-order response
   double ripple = 0.0;           ///< relative amplitude
   double ripple_hz = 2.0;
-  double noise = 0.0;  ///< relative 1-sigma per servo cycle
+  double noise = 0.0;  ///< relative 1-sigma, correlated over time_constant_s (the chamber's response)
   /// The cylinder's seal friction (one physical model for the calibration and the tests): the seal
   /// carries up to seal_friction x the pneumatic force against the piston's last motion: less force
   /// reaches the TCP while the piston last moved with the load (as when the arm yields to it), more
@@ -128,7 +131,7 @@ struct LdbbConfig {
   double seal_friction_spread = 0.0;
   double seal_presliding_m = 0.0001;
   /// The cylinder's seal friction sticks and slips: a sawtooth of this relative amplitude, one tooth
-  /// per stick_slip_travel_m of the TCP's travel.
+  /// per stick_slip_travel_m of the piston's travel in the cylinder (either way).
   double stick_slip = 0.0;
   double stick_slip_travel_m = 0.0005;
   Vector3 pivot_error_m = Vector3::Zero();  ///< true pivot minus the force model's pivot

@@ -58,9 +58,22 @@ TrueRobot::TrueRobot(const CellConfig& config, bool sensor_mounted, std::uint64_
     set_dh_chain(desc, *desc.dh_convention, rows, lower, upper, speed);
   }
   std::vector<double> k_true(static_cast<std::size_t>(n));
+  const auto& band_lo = config.robot.stiffness_band_min_nm_per_rad;
+  const auto& band_hi = config.robot.stiffness_band_max_nm_per_rad;
   for (int i = 0; i < n; ++i) {
-    const double factor = std::exp(config.robot.stiffness_spread * normal(rng));
-    k_true[static_cast<std::size_t>(i)] = base.stiffness()[i] * config.robot.stiffness_scale * factor;
+    const auto iu = static_cast<std::size_t>(i);
+    const double mean = base.stiffness()[i] * config.robot.stiffness_scale;
+    double k = mean * std::exp(config.robot.stiffness_spread * normal(rng));
+    if (iu < band_lo.size() && iu < band_hi.size()) {
+      // A joint of this class of arm is inside the band its identifications report: the spread
+      // between arms is drawn within it (drawn again, a truncated log-normal; a scale that puts the
+      // joint's mean outside the band leaves it at the band's edge).
+      for (int tries = 0; (k < band_lo[iu] || k > band_hi[iu]) && tries < 100; ++tries) {
+        k = mean * std::exp(config.robot.stiffness_spread * normal(rng));
+      }
+      k = std::clamp(k, band_lo[iu], band_hi[iu]);
+    }
+    k_true[iu] = k;
   }
   desc.stiffness_nm_per_rad = k_true;
   desc.stiffness_note = "true stiffness of the simulated cell";
@@ -181,6 +194,37 @@ Vector3 TrueRobot::structural_displacement(const Workspace& ws, const Wrench& w)
   return d;
 }
 
+JointVector TrueRobot::motor_position(const JointVector& q_cmd, const TrueRobotState& state, double dt_s) const {
+  if (!(dt_s > 0.0)) return q_cmd;
+  return q_cmd - config_.robot.servo_following_s / dt_s * (q_cmd - state.q_cmd_last);
+}
+
+Matrix3 TrueRobot::tcp_force_compliance(Workspace& ws, const JointVector& q, const Wrench& wrench_base,
+                                        const TrueRobotState& state) const {
+  const int n = true_->dof();
+  Jacobian J(6, n);
+  jacobian(*true_, ws, q, EndPoint::kTcp, J);
+  const JointVector tau = J.transpose() * wrench_base;
+  // d(deflection)/d(tau): the gears' compliance at their torque along the hardening curve (its slope
+  // 1 + s exp(-|x|/tau_h)), and the servo's yield to a change faster than its integral action.
+  JointMatrix c = joint_compliance_;
+  for (int i = 0; i < n; ++i) {
+    const GearHardening& h = hardening_[static_cast<std::size_t>(i)];
+    if (h.softening > 0.0) {
+      c.col(i) *= 1.0 + h.softening * std::exp(-std::abs(state.gravity_torque_nm[i] + tau[i]) / h.torque_nm);
+    }
+    c(i, i) += config_.robot.servo_compliance_fraction * joint_compliance_(i, i);
+  }
+  const auto Jv = J.topRows<3>();
+  Matrix3 out = Jv * c * Jv.transpose();
+  for (int i = 0; i < 3; ++i) {
+    Wrench unit = Wrench::Zero();
+    unit[i] = 1.0;
+    out.col(i) += structural_displacement(ws, unit);  // linear in the wrench at a given configuration
+  }
+  return out;
+}
+
 Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd_in, const Wrench& wrench_base, TrueRobotState& state,
                          double dt_s) const {
   const RobotModel& m = *true_;
@@ -191,7 +235,7 @@ Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd_in, const Wrenc
   // makes the motor lag its command by servo_following_s of that speed.
   JointVector speed = JointVector::Zero(n);
   if (dt_s > 0.0) speed = (q_cmd_in - state.q_cmd_last) / dt_s;
-  const JointVector q_cmd = q_cmd_in - rc.servo_following_s * speed;
+  const JointVector q_cmd = motor_position(q_cmd_in, state, dt_s);
   // Start from the last deflection carried on by its last change: in steady motion the fixed point
   // then moves by far less than the tolerance, and one Jacobian does.
   JointVector q = q_cmd + state.deflection;
@@ -207,7 +251,7 @@ Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd_in, const Wrenc
   JointVector tau_eff(n);
   // The gears deflect along their hardening curves from the gravity preload (linear when off).
   const auto equivalent = [&](const JointVector& t) {
-    if (!hardening_on_) {
+    if (!hardening_on_ || !loaded) {  // unloaded: no process torque, nothing to harden
       tau_eff = t;
       return;
     }
@@ -221,7 +265,8 @@ Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd_in, const Wrenc
     lost[i] = state.lost_motion[static_cast<std::size_t>(i)].update(tau[i] + state.gravity_torque_nm[i]);
   }
   // The process deflection's scale per joint: stiffer when moving, and more yielding with the torque
-  // than against it.
+  // than against it. It scales the torque each gear yields to, so a coupled joint's share of another
+  // joint's deflection does not jump when its own torque changes sign.
   JointVector scale = JointVector::Ones(n);
   if (dt_s > 0.0 && (rc.speed_stiffening != 0.0 || rc.direction_asymmetry != 0.0)) {
     for (int i = 0; i < n; ++i) {
@@ -250,7 +295,7 @@ Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd_in, const Wrenc
   bool ws_current = false;
   for (int it = 0; it < 30; ++it) {
     equivalent(tau);
-    const JointVector q_new = q_cmd + scale.cwiseProduct(joint_compliance_ * tau_eff) + lost + servo;
+    const JointVector q_new = q_cmd + joint_compliance_ * scale.cwiseProduct(tau_eff) + lost + servo;
     const double step = (q_new - q).cwiseAbs().maxCoeff();
     q = q_new;
     if (!loaded) break;  // tau does not depend on q
@@ -268,6 +313,7 @@ Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd_in, const Wrenc
   state.q_actual = q;
   state.q_cmd_last = q_cmd_in;
   state.q_motor = q_cmd;
+  if (!loaded) return ws.base_T_tcp.translation();  // no process wrench: no structural displacement
   return ws.base_T_tcp.translation() + structural_displacement(ws, wrench_base);
 }
 

@@ -90,6 +90,19 @@ class TrueRobot {
   /// FK in `ws`: exposed for tests against the cantilever and sensor closed forms.
   [[nodiscard]] Vector3 structural_displacement(const Workspace& ws, const Wrench& wrench_base) const;
 
+  /// The motors' position for a solve to the command `q_cmd` a tick of `dt_s` after `state`'s: the
+  /// command less the servo's following error (rad).
+  [[nodiscard]] JointVector motor_position(const JointVector& q_cmd, const TrueRobotState& state, double dt_s) const;
+
+  /// The TCP's displacement per unit change of the force at the TCP (m/N, base frame) at the
+  /// configuration `q` under `wrench_base` (N, Nm at the TCP, base frame): the joints' compliance
+  /// (coupling included) at their gears' torque and with the servo's yield to a fast change, through the
+  /// TCP Jacobian, plus the links', the base's and the sensor's. The tangent of solve() without the
+  /// motion's scale and the lost motion: what a Newton step needs, not the arm's exact answer. Runs FK
+  /// at q in `ws`.
+  [[nodiscard]] Matrix3 tcp_force_compliance(Workspace& ws, const JointVector& q, const Wrench& wrench_base,
+                                             const TrueRobotState& state) const;
+
  private:
   CellConfig config_;
   bool sensor_mounted_;

@@ -30,6 +30,50 @@ std::string order_word(double a, double b) {
 // The paper's table name ("Table 2") from its caption.
 std::string table_name(const PaperTable& t) { return t.caption.substr(0, t.caption.find('.')); }
 
+// A signed percentage outside a target, with one decimal where whole percents would print the target
+// itself (-35.2 % outside 35 % must not read "-35%").
+std::string beside_target_text(double fraction, double target) {
+  return std::round(std::abs(fraction) * 100.0) == std::round(target * 100.0)
+             ? fmt::format("{:+.1f}%", fraction * 100.0)
+             : signed_percent_text(fraction);
+}
+
+// "falls", "rises" or "stays level" for C/UC from the first to the last load, as printed (two decimals).
+std::string trend_word(double first, double last) {
+  const double a = std::round(first * 100.0), b = std::round(last * 100.0);
+  return b < a - 2.0 ? "falls" : b > a + 2.0 ? "rises" : "stays level";
+}
+
+// One setup's compensation against the paper's at each load (whole percents as the tables print
+// them, the difference in points) and C/UC from its first load to its last, ours and the paper's.
+std::string compensation_rows_note(const SetupResult& s, const PaperTable& pt, const std::vector<int>& speeds) {
+  std::string rows;
+  double ours_first = kNaN, ours_last = kNaN, paper_first = kNaN, paper_last = kNaN, load_first = 0.0, load_last = 0.0;
+  for (const auto& l : s.loads) {
+    const PaperRow* pr = pt.row_for(l.load_N);
+    if (pr == nullptr) continue;
+    const double ours = printed_compensation_spread(l, speeds).mean, theirs = pr->mean_compensation();
+    if (!std::isfinite(ours) || !std::isfinite(theirs)) continue;
+    const double points = whole_percent(ours) - whole_percent(theirs);
+    rows += fmt::format("{}{:g} N {} against {} ({:+.0f} points)", rows.empty() ? "" : "; ", l.load_N,
+                        percent_text(ours), percent_text(theirs), points);
+    if (!std::isfinite(ours_first)) {
+      ours_first = 1.0 - ours;
+      paper_first = 1.0 - theirs;
+      load_first = l.load_N;
+    }
+    ours_last = 1.0 - ours;
+    paper_last = 1.0 - theirs;
+    load_last = l.load_N;
+  }
+  if (rows.empty()) return fmt::format("{}: no load of the paper's {} to compare.", s.setup, table_name(pt));
+  return fmt::format(
+      "{} against the paper's {}, compensation row by row (ours against the paper's): {}. C/UC from {:g} N to {:g} "
+      "N: ours {:.2f} to {:.2f} ({}), the paper's {:.2f} to {:.2f} ({}).",
+      s.setup, table_name(pt), rows, load_first, load_last, ours_first, ours_last, trend_word(ours_first, ours_last),
+      paper_first, paper_last, trend_word(paper_first, paper_last));
+}
+
 }  // namespace
 
 std::vector<std::string> tuned_values(const std::string& case_text) {
@@ -93,12 +137,12 @@ std::vector<std::string> honest_notes(const CaseConfig& /*config*/, const StudyR
       std::vector<std::string> outside;
       if (std::isfinite(uc) && std::abs(uc - 1.0) > kUcTarget) {
         outside.push_back(fmt::format("UC {:.3f} mm against the paper's {:.2f} mm, {} (target: within {})",
-                                      as_printed(l.uc_mean_spread().mean), pr->uc_mm, signed_percent_text(uc - 1.0),
-                                      percent_text(kUcTarget)));
+                                      as_printed(l.uc_mean_spread().mean), pr->uc_mm,
+                                      beside_target_text(uc - 1.0, kUcTarget), percent_text(kUcTarget)));
       }
       if (std::isfinite(c) && std::abs(c - 1.0) > kCTarget) {
         outside.push_back(fmt::format("C over the paper's speeds {} against the paper's (target: within {})",
-                                      signed_percent_text(c - 1.0), percent_text(kCTarget)));
+                                      beside_target_text(c - 1.0, kCTarget), percent_text(kCTarget)));
       }
       if (outside.empty()) continue;
       std::string text = fmt::format("{} {:g} N against the paper's {}: ", s.setup, l.load_N, table_name(*pt));
@@ -106,33 +150,11 @@ std::vector<std::string> honest_notes(const CaseConfig& /*config*/, const StudyR
       notes.push_back(text + ".");
     }
   }
-  // Compensation against the paper's, per setup: both from the printed figures, 1 - C / UC with UC
-  // the mean over the speeds, as the tables give them; the order of the two ranges said as it is.
+  // Compensation against the paper's, row by row (never pooled over the loads: a range of ours that
+  // overlaps the paper's can hide a gap at every row), then the trend of C/UC over the loads.
   for (const auto& s : study.setups) {
     const PaperTable* pt = paper_table_of(paper, s);
-    if (pt == nullptr) continue;
-    double lo = kNaN, hi = kNaN, plo = kNaN, phi = kNaN;
-    for (const auto& l : s.loads) {
-      const PaperRow* pr = pt->row_for(l.load_N);
-      if (pr == nullptr) continue;
-      for (const int v : speeds) {
-        const double ours = whole_percent(printed_compensation(l, v));
-        const double theirs = whole_percent(compensation_ratio(pr->uc_mm, value_at_speed(pr->c_mm, v)));
-        if (!std::isfinite(ours) || !std::isfinite(theirs)) continue;
-        lo = std::isfinite(lo) ? std::min(lo, ours) : ours;
-        hi = std::isfinite(hi) ? std::max(hi, ours) : ours;
-        plo = std::isfinite(plo) ? std::min(plo, theirs) : theirs;
-        phi = std::isfinite(phi) ? std::max(phi, theirs) : theirs;
-      }
-    }
-    if (!std::isfinite(lo)) continue;
-    const std::string relation = lo > phi   ? "above the paper's at every load and speed"
-                                 : hi < plo ? "below the paper's at every load and speed"
-                                            : "overlapping the paper's";
-    notes.push_back(
-        fmt::format("{}, compensation per load and speed: ours {:.0f}% to {:.0f}%, the paper's {:.0f}% to {:.0f}% "
-                    "({}): ours {}.",
-                    s.setup, lo, hi, plo, phi, table_name(*pt), relation));
+    if (pt != nullptr) notes.push_back(compensation_rows_note(s, *pt, speeds));
   }
   // The paper's headline, online ahead of offline at the highest load, checked on our figures and
   // on the paper's alike rather than asserted.

@@ -455,6 +455,13 @@ std::string figures_html(const StudyResult& study) {
   h += "<div class=\"fig\">\n" + svg_compensation(study) + "</div>\n";
   h += compensation_table(study);
   if (paper_setups) {
+    h += "<div class=\"fig\">\n" + svg_trends(study) + "</div>\n";
+    h += "<p class=\"caption\">The trends against load: C/UC per load (left axis; compensation 1 - C/UC on the "
+         "right), ours (solid) beside the paper's (dashed), one panel per table of the paper. The notes compare "
+         "them row by row. " +
+         whiskers_of("Ours") + "</p>\n";
+  }
+  if (paper_setups) {
     h += "<h2 id=\"parity\">Parity with the paper</h2>\n<div class=\"fig\">\n" + svg_parity(study) + "</div>\n";
     h += "<p class=\"caption\">Every figure of the paper's Tables 1 and 2 against ours: C per load and speed "
          "(dots) and UC per load (squares, the mean over the speeds). Log axes, so equal ratios are equal "
@@ -586,6 +593,7 @@ void write_report(const ReportContent& content, const std::string& out_dir, Outp
   }
   write_text("compensation.svg", svg_compensation(study));
   if (paper_setups) {
+    write_text("trends.svg", svg_trends(study));
     write_text("parity.svg", svg_parity(study));
   }
   if (!study.speed_sweep.empty()) {

@@ -33,6 +33,11 @@ std::string svg_figure5(const StudyResult& study, SetupSelection which = SetupSe
 /// 69-80%): ours, mean over the speeds, whiskers min to max over the seeds; the paper's outlined.
 std::string svg_compensation(const StudyResult& study);
 
+/// The trends against load, one panel per paper table: C/UC (left axis; compensation 1 - C/UC on the
+/// right) of every setup compared with that table, ours solid with whiskers over the seeds, the
+/// paper's dashed, so a slope the paper has and ours lacks shows at a glance.
+std::string svg_trends(const StudyResult& study);
+
 /// Parity plot: ours (y) against the paper's (x) for every figure of Tables 1 and 2 (C per load and
 /// speed, UC per load), every setup compared with a table (a setup on the paper's own kind of link
 /// against Table 2, marked with its paper_label), log axes, the line y = x, the band of C's fidelity

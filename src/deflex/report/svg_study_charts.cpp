@@ -312,6 +312,95 @@ std::string svg_compensation(const StudyResult& study) {
 
 namespace {
 
+// "Table 2" from the paper table's caption ("Table 2. Online compensation ...").
+std::string table_name(const PaperTable& t) { return t.caption.substr(0, t.caption.find('.')); }
+
+// One panel of the trends figure: C/UC against load for the setups compared with one paper table,
+// ours (solid, whiskers over the seeds) and the paper's (dashed, hollow), with compensation on the
+// right axis.
+void trend_panel(Canvas& c, const StudyResult& study, const PaperTable& table, double left, double right,
+                 const Scale& y) {
+  const PaperFigures paper = paper_reference();
+  const std::vector<int> speeds = study_speeds_mm_s(study);
+  const double lo = table.rows.front().load_N, hi = table.rows.back().load_N;
+  const double pad = hi > lo ? 0.08 * (hi - lo) : 50.0;
+  const Scale x{lo - pad, hi + pad, left, right};
+  svg::value_axis(c, y, left, right, "C/UC (C: mean over the speeds)", 1.0, 46.0);
+  for (const double t : svg::nice_ticks(y.d0, y.d1, 6)) {
+    c.text(right + 6.0, y(t) + 4.0, fmt::format("{:.0f}%", 100.0 * (1.0 - t)), kMinFont);
+  }
+  c.text(right + 4.0, y.p1 - 8.0, "compensation", kMinFont);
+  svg::position_axis(c, x, y.p0, "load |F| (N)");
+  c.text((left + right) / 2.0, y.p1 - 22.0, table_name(table) + ": " + table.setup, 13.0, "middle");
+  std::vector<double> theirs;
+  for (const auto& r : table.rows) theirs.insert(theirs.end(), {x(r.load_N), y(1.0 - r.mean_compensation())});
+  c.group_begin(table_name(table) + " of the paper: C/UC per load");
+  c.polyline(theirs, svg::kPaperColour, 1.8, R"(stroke-dasharray="6 4")");
+  for (std::size_t i = 0; i + 1 < theirs.size(); i += 2) {
+    const PaperRow& r = table.rows[i / 2];
+    c.circle(theirs[i], theirs[i + 1], 4.5, "white",
+             fmt::format(R"(stroke="{}" stroke-width="1.6" data-load="{:g}" data-paper="{:.6g}")", svg::kPaperColour,
+                         r.load_N, 1.0 - r.mean_compensation()));
+  }
+  c.group_end();
+  for (std::size_t k = 0; k < study.setups.size(); ++k) {
+    const SetupResult& s = study.setups[k];
+    if (paper_table_of(paper, s) == nullptr || paper_table_of(paper, s)->caption != table.caption) continue;
+    std::vector<double> ours;
+    c.group_begin(s.setup + ": C/UC per load, ours");
+    for (const auto& l : s.loads) {
+      const Spread sp = printed_compensation_spread(l, speeds);
+      if (!std::isfinite(sp.mean)) continue;
+      ours.insert(ours.end(), {x(l.load_N), y(1.0 - sp.mean)});
+      if (sp.n > 1) svg::whisker(c, x(l.load_N), y(1.0 - sp.max), y(1.0 - sp.min), svg::colour(k), 5.0);
+      c.circle(x(l.load_N), y(1.0 - sp.mean), 4.0, svg::colour(k),
+               fmt::format(R"(data-load="{:g}" data-value="{:.6g}")", l.load_N, 1.0 - sp.mean));
+    }
+    c.polyline(ours, svg::colour(k), 2.0);
+    c.group_end();
+  }
+}
+
+}  // namespace
+
+std::string svg_trends(const StudyResult& study) {
+  const PaperFigures paper = paper_reference();
+  const double width = svg::kMaxWidth, height = 425.0, top = 110.0, bottom = 370.0;
+  Canvas c(width, height);
+  c.title("Trends against load: C/UC and compensation, ours beside the paper's");
+  std::vector<const PaperTable*> tables;
+  double y_hi = 0.4;
+  for (const auto& s : study.setups) {
+    const PaperTable* pt = paper_table_of(paper, s);
+    if (pt == nullptr || pt->rows.empty()) continue;
+    if (std::find(tables.begin(), tables.end(), pt) == tables.end()) tables.push_back(pt);
+    for (const auto& l : s.loads) {
+      const Spread sp = printed_compensation_spread(l, study_speeds_mm_s(study));
+      if (std::isfinite(sp.min)) y_hi = std::max(y_hi, 1.0 - sp.min);
+    }
+  }
+  if (tables.empty()) {
+    c.text(width / 2.0, height / 2.0, "no setup the paper ran", 14.0, "middle");
+    return c.str();
+  }
+  const Scale y{0.0, svg::nice_ceiling(y_hi * 1.05), bottom, top};
+  double lx = 84.0;
+  for (std::size_t k = 0; k < study.setups.size(); ++k) {
+    if (paper_table_of(paper, study.setups[k]) == nullptr) continue;
+    lx = svg::legend_entry(c, lx, 52.0, "line", svg::colour(k), "ours: " + study.setups[k].setup);
+  }
+  lx = svg::legend_entry(c, lx, 52.0, "dash", svg::kPaperColour, "the paper's");
+  c.text(84.0, 72.0, whisker_note(study), 12.0, "start", R"(fill="#444")");
+  const double panel_w = (width - 20.0) / static_cast<double>(tables.size());
+  for (std::size_t i = 0; i < tables.size(); ++i) {
+    const double left = 10.0 + panel_w * static_cast<double>(i) + 64.0;
+    trend_panel(c, study, *tables[i], left, left + panel_w - 150.0, y);
+  }
+  return c.str();
+}
+
+namespace {
+
 /// One figure of the paper's tables beside ours, for the parity plot.
 struct ParityPoint {
   std::string setup;
@@ -323,9 +412,6 @@ struct ParityPoint {
   std::string label;  // the setup's paper_label: how it is compared with a table of another name
   std::string table;  // then the paper's table it is compared with ("Table 2")
 };
-
-// "Table 2" from the paper table's caption ("Table 2. Online compensation ...").
-std::string table_name(const PaperTable& t) { return t.caption.substr(0, t.caption.find('.')); }
 
 /// Every load of the study the paper's tables have: UC, then C at each of the paper's speeds.
 std::vector<ParityPoint> parity_points(const StudyResult& study, const PaperFigures& paper) {

@@ -242,19 +242,50 @@ void read_case_setups(const yaml::Field& root, const yaml::Field& proto, CaseCon
   }
 }
 
+// The true joints' band (optional, both lists or neither): per joint, 0 < min <= max.
+void read_stiffness_band(const yaml::Field& r, std::size_t per_joint, cell::TrueRobotConfig& t) {
+  const bool lo = r.has("stiffness_band_min_Nm_per_rad"), hi = r.has("stiffness_band_max_Nm_per_rad");
+  if (!lo && !hi) return;
+  if (lo != hi) {
+    r.at(lo ? "stiffness_band_min_Nm_per_rad" : "stiffness_band_max_Nm_per_rad")
+        .fail("the stiffness band needs both its minimum and its maximum");
+  }
+  t.stiffness_band_min_nm_per_rad = r.at("stiffness_band_min_Nm_per_rad").as_doubles(per_joint);
+  t.stiffness_band_max_nm_per_rad =
+      r.at("stiffness_band_max_Nm_per_rad").as_doubles(t.stiffness_band_min_nm_per_rad.size());
+  for (std::size_t i = 0; i < t.stiffness_band_min_nm_per_rad.size(); ++i) {
+    if (!(t.stiffness_band_min_nm_per_rad[i] > 0.0)) r.at("stiffness_band_min_Nm_per_rad").fail("must be positive");
+    if (!(t.stiffness_band_max_nm_per_rad[i] >= t.stiffness_band_min_nm_per_rad[i])) {
+      r.at("stiffness_band_max_Nm_per_rad").fail("must not be below the band's minimum");
+    }
+  }
+}
+
 // The case file's "true_robot": how the simulated arm differs from the model deflex is given.
 void read_case_true_robot(const yaml::Field& root, CaseConfig& c) {
   const auto r = root.at("true_robot");
-  r.only_keys({"stiffness_scale",       "stiffness_spread_pct",
-               "coupling_23",           "forearm_EI_Nm2",
-               "forearm_length_mm",     "lost_motion_urad",
-               "lost_motion_torque_Nm", "gravity_torque_Nm",
-               "dh_length_sigma_mm",    "dh_angle_sigma_deg",
-               "hardening_softening",   "hardening_torque_Nm",
-               "upper_arm_EI_Nm2",      "base_tilt_compliance_nrad_per_Nm",
-               "speed_stiffening_pct",  "direction_asymmetry_pct",
-               "speed_ref_mrad_s",      "servo_following_ms",
-               "servo_compliance_pct",  "servo_integral_s"});
+  r.only_keys({"stiffness_scale",
+               "stiffness_spread_pct",
+               "stiffness_band_min_Nm_per_rad",
+               "stiffness_band_max_Nm_per_rad",
+               "coupling_23",
+               "forearm_EI_Nm2",
+               "forearm_length_mm",
+               "lost_motion_urad",
+               "lost_motion_torque_Nm",
+               "gravity_torque_Nm",
+               "dh_length_sigma_mm",
+               "dh_angle_sigma_deg",
+               "hardening_softening",
+               "hardening_torque_Nm",
+               "upper_arm_EI_Nm2",
+               "base_tilt_compliance_nrad_per_Nm",
+               "speed_stiffening_pct",
+               "direction_asymmetry_pct",
+               "speed_ref_mrad_s",
+               "servo_following_ms",
+               "servo_compliance_pct",
+               "servo_integral_s"});
   auto& t = c.cell.robot;
   t.upper_arm_ei_nm2 = non_negative_or(r, "upper_arm_EI_Nm2", 0.0);
   t.base_tilt_compliance_rad_per_nm = non_negative_or(r, "base_tilt_compliance_nrad_per_Nm", 0.0) * 1e-9;
@@ -271,6 +302,7 @@ void read_case_true_robot(const yaml::Field& root, CaseConfig& c) {
   t.servo_integral_s = case_number(r, "servo_integral_s", non_negative, 0.1, unscaled, above(0.0, "must be positive"));
   t.stiffness_scale = positive(r.at("stiffness_scale"));
   t.stiffness_spread = non_negative(r.at("stiffness_spread_pct")) / 100.0;
+  read_stiffness_band(r, c.cell.robot_file.empty() ? 6 : 0, t);
   t.coupling_23 = case_number(r, "coupling_23", any_sign, kRequired, unscaled, inside(0.9, "must be within +-0.9"));
   t.forearm_ei_nm2 = non_negative(r.at("forearm_EI_Nm2"));
   t.forearm_length_m = positive(r.at("forearm_length_mm")) * kMm;

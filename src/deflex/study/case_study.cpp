@@ -176,6 +176,7 @@ struct LoadedJob {
   bool write_trace = false;
   std::uint64_t link_cycles = 0, rejected = 0, guard_trips = 0;
   double max_deviation_rad = 0.0, max_tcp_m = 0.0, delay_s = 0.0;
+  cell::CoupledTickCounters coupled{};  // the run's coupled solves of the arm and the bar
 };
 
 // A run of the error budget: a setup's compensated run on a cell built without one effect, or
@@ -184,6 +185,7 @@ struct BudgetJob {
   int setup;
   std::optional<Effect> off;
   double residual_mm = NAN;
+  cell::CoupledTickCounters coupled;  // its calibration's and run's coupled solves
 };
 
 std::string budget_label(const BudgetJob& bj) { return bj.off ? to_string(*bj.off) : "every effect off"; }
@@ -386,10 +388,10 @@ void plan_error_budget(StudyContext& x) {
           e == Effect::kSensorCompliance || e == Effect::kSensorDrift || e == Effect::kSensorMoment;
       if (sensor_only && !sc.sensor_mounted) continue;
       if ((e == Effect::kSensorErrors || e == Effect::kSensorCalibration || e == Effect::kLatency) && offline) continue;
-      x.budget_jobs.push_back(BudgetJob{static_cast<int>(i), e});
+      x.budget_jobs.push_back(BudgetJob{static_cast<int>(i), e, NAN, {}});
     }
     // And every effect off at once, so the reader sees what the one-at-a-time figures do not add up to.
-    x.budget_jobs.push_back(BudgetJob{static_cast<int>(i), std::nullopt});
+    x.budget_jobs.push_back(BudgetJob{static_cast<int>(i), std::nullopt, NAN, {}});
   }
 }
 
@@ -480,6 +482,7 @@ void run_loaded_job(StudyContext& x, LoadedJob& j) {
   j.max_deviation_rad = run.max_command_deviation_rad;
   j.max_tcp_m = run.max_tcp_correction_m;
   j.delay_s = run.measured_delay_s;
+  j.coupled = run.coupled;
   if (j.write_trace) {
     x.sink(fmt::format("{}_{}_{:.0f}N_{}mm_s", family_label(fam),
                        j.kind == RunKind::kUncompensated ? "uc" : to_string(j.strategy), j.load_n, mm_s(j.speed)),
@@ -517,7 +520,10 @@ void run_budget_job(StudyContext& x, BudgetJob& bj) {
   const double v = config.budget.speed_m_s;
   const Reference reference = make_reference(simulate_run(cfg, cell, x.unloaded_spec(0, fam, v)), false);
   const RunSpec c_spec = x.loaded_spec(0, fam, RunKind::kCompensated, sc.strategy, load, v);
-  bj.residual_mm = evaluate_run(simulate_run(cfg, cell, c_spec), reference).mean_mm;
+  const RunOutput run = simulate_run(cfg, cell, c_spec);
+  bj.residual_mm = evaluate_run(run, reference).mean_mm;
+  bj.coupled = cell.calibration.coupled;
+  bj.coupled.add(run.coupled);
   x.progress.add(x.cal_cost + 2.0 * run_cost(config, v, x.laps), fmt::format("budget: {}", budget_label(bj)));
 }
 
@@ -724,8 +730,11 @@ std::string describe_cell(const StudyContext& x, int f) {
       "beyond that model (the error budget lists its effects) is folded into them or left in the residual.",
       f == 1 ? "with" : "without", config.seed, k_true, cell.calibration.measurements, config.calibration.arcs, k_id,
       cell.calibration.estimate.residual_rms_m * 1e6);
+  // What the calibration did about joints it could not identify: measured again, or kept at the
+  // assumed stiffness (and why); the identification's own warnings stay in the calibration's notes.
   for (const auto& note : cell.calibration.notes) {
-    if (note.find("kept the assumed") != std::string::npos || note.find("poorly") != std::string::npos) {
+    if (note.find("kept the assumed") != std::string::npos || note.find("measured again") != std::string::npos ||
+        note.find("no load the bar") != std::string::npos) {
       text += " Calibration: " + note + ".";
     }
   }
@@ -777,6 +786,21 @@ std::string describe_protocol(const StudyContext& x) {
       config.seed, n_seeds == 1 ? std::string() : fmt::format(" to {}", x.cfg_of(n_seeds - 1).seed));
 }
 }  // namespace
+
+std::string describe_coupled_solves(const cell::CoupledTickCounters& c) {
+  const cell::CoupledTickOptions o;
+  std::string text = fmt::format(
+      "Every loaded servo tick of the cell solves the arm and the bar's force together (Newton's method: the force "
+      "the bar gives where the arm then stands within {:g} N of the force the arm was solved under, at most {} "
+      "solves of the arm a tick), so no force lags the arm by a tick: {} loaded ticks, {:.2f} solves of the arm a "
+      "tick, at most {} in one tick; ",
+      o.force_tolerance_n, o.max_arm_solves, c.ticks,
+      c.ticks > 0 ? static_cast<double>(c.arm_solves) / static_cast<double>(c.ticks) : 0.0, c.most_arm_solves);
+  text += c.unconverged == 0 ? std::string("every one converged.")
+                             : fmt::format("{} reached the cap without converging (the worst left {:.3f} N apart).",
+                                           c.unconverged, c.worst_mismatch_n);
+  return text;
+}
 
 void run_parallel(std::vector<std::function<void()>>& jobs, int threads) {
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -835,6 +859,14 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
   out.runs += x.n_seeds * static_cast<int>(x.families.size() * x.speeds.size());
   out.calibrations += static_cast<int>(x.budget_jobs.size());
   out.simulated_s = x.progress.total;
+  for (const auto& j : x.loaded) out.coupled.add(j.coupled);
+  for (const auto& bj : x.budget_jobs) out.coupled.add(bj.coupled);
+  for (const auto& seed_cells : x.cells) {
+    for (const auto& cell : seed_cells) {
+      if (cell) out.coupled.add(cell->calibration.coupled);
+    }
+  }
+  out.setup_paragraphs.push_back(describe_coupled_solves(out.coupled));
   study.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "deflex/cell/coupled_tick.hpp"
 #include "deflex/evaluate/lap_split.hpp"
 #include "deflex/model/tracker_trace.hpp"
 #include "deflex/study/case_config.hpp"
@@ -66,10 +67,17 @@ struct CaseStudyOutput {
   double simulated_s = 0.0;                   ///< total simulated robot time (runs and calibrations)
   int runs = 0;
   int calibrations = 0;
+  /// What the cell's coupled solves of the arm and the bar did, over every loaded tick of the study
+  /// (runs and calibrations): ticks, solves of the arm, ticks that reached the cap.
+  cell::CoupledTickCounters coupled;
 };
 
 /// Runs the whole study. Throws deflex::Error on a case the cell cannot run (unreachable circle ...).
 [[nodiscard]] CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions& options);
+
+/// The coupled solves of a study in words: the method, its tolerance and cap, how many ticks and
+/// solves, and every tick that reached the cap.
+[[nodiscard]] std::string describe_coupled_solves(const cell::CoupledTickCounters& counters);
 
 /// Runs `jobs` on `threads` threads (0: hardware), largest first as given; rethrows the first
 /// exception after every thread has stopped.

@@ -12,6 +12,7 @@
 #include "deflex/cell/laser_tracker.hpp"
 #include "deflex/cell/ldbb_device.hpp"
 #include "deflex/cell/path_drift.hpp"
+#include "deflex/identify/calibration_planner.hpp"
 #include "deflex/online/force_pipeline.hpp"
 #include "deflex/paths/circle_path.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
@@ -95,6 +96,7 @@ struct CalibrationRig {
   Workspace ws_nominal;
   cell::TrueRobotState state;
   bool have_state = false;
+  cell::CoupledTickCounters coupled;  // the loaded passes' coupled solves
   double dt;
   double hold_s;
   JointVector seed_q;
@@ -173,14 +175,13 @@ void run_calibration_pass(CalibrationRig& rig, CalibrationArc& arc, int loaded) 
   }
   CellArm arm{robot, ws, state, device, drift};
   Vector3 p_prev = arm.at_rest(q);
-  Vector3 v_prev = Vector3::Zero();
   const auto ticks = static_cast<long>(std::ceil(program.end_time_s() / dt));
   double next_sample = 1.0 / cc.sensor.rate_hz;
   for (long i = 1; i <= ticks; ++i) {
     const double t = static_cast<double>(i) * dt;
     program.sample(t, q);
     Wrench w;
-    const Vector3 p = arm.tick(q, loaded != 0, p_prev, v_prev, dt, w);
+    const Vector3 p = arm.tick(q, loaded != 0, dt, w);
     if (rig.force_from_sensor && loaded) {
       const Matrix3 base_R_flange = ws.base_T_flange.linear();
       forward_kinematics(rig.nominal, rig.ws_nominal, q);  // the orientation deflex knows (nominal, encoders)
@@ -197,9 +198,9 @@ void run_calibration_pass(CalibrationRig& rig, CalibrationArc& arc, int loaded) 
       }
     }
     tracker.observe(t - dt, p_prev, t, p, pass.trace);
-    v_prev = (p - p_prev) / dt;
     p_prev = p;
   }
+  rig.coupled.add(arm.counters());
 }
 
 // Adds an arc's measurements: at points along the arc, the mean of the tracker samples in a window,
@@ -247,10 +248,76 @@ void measure_calibration_arc(CalibrationRig& rig, const CalibrationArc& arc, std
   }
 }
 
-// Identifies the joint stiffness from the measurements; a joint it cannot identify keeps the
-// assumed value, with a note.
-CellCalibration identify_from_measurements(const CalibrationRig& rig, const std::vector<StiffnessMeasurement>& data) {
-  const RobotModel& nominal = rig.nominal;
+// The planner's poses and loads around the test circle for a second look, each force at the TCP
+// ball (the bar has no lever on the tool), in the region the arcs span.
+CalibrationPlan plan_second_look(const CalibrationRig& rig) {
+  const CaseConfig& c = rig.c;
+  CalibrationPlanOptions o;
+  const Vector3 reach(c.radius_m() + 0.05, c.radius_m() + 0.05, 0.06);
+  o.region_min_m = c.circle.center_m - reach;
+  o.region_max_m = c.circle.center_m + reach;
+  o.load_n = rig.cal.load_n;
+  o.poses = 8;
+  o.loads_per_pose = 2;
+  o.lever_m = 0.0;
+  o.orientation = Eigen::Quaterniond(c.circle.tcp_orientation.linear());
+  o.noise_m = std::max(rig.cc.tracker.noise_m, 1e-6);
+  return plan_calibration(rig.nominal, o);
+}
+
+// Measures one planned point: the arm stands at its configuration, the bar placed along the planned
+// force (its table a bar's length behind the TCP), unloaded then loaded, the tracker's mean over the
+// last window of each hold; the force as the calibration takes it (the bar's report or the sensor).
+bool measure_planned_point(CalibrationRig& rig, const CalibrationPoint& point, int index,
+                           std::vector<StiffnessMeasurement>& data) {
+  const Vector3 f = point.wrench_base.head<3>();
+  const Vector3 along = f.normalized();
+  CalibrationArc hold{1000 + index,
+                      Arc{0.0, 0.0, true, 0.0},
+                      point.base_T_tcp.translation() - rig.cc.ldbb.bar_length_m * along,
+                      JointTrajectory({0.0, rig.hold_s + rig.cal.window_s}, {point.q, point.q}, rig.nominal),
+                      {},
+                      std::nullopt};
+  for (int loaded = 0; loaded < 2; ++loaded) run_calibration_pass(rig, hold, loaded);
+  Vector3 mean[2] = {Vector3::Zero(), Vector3::Zero()};
+  for (int pass = 0; pass < 2; ++pass) {
+    if (hold.passes[pass].trace.empty()) return false;
+    for (const auto& sample : hold.passes[pass].trace) mean[pass] += sample.p_m;
+    mean[pass] /= static_cast<double>(hold.passes[pass].trace.size());
+  }
+  StiffnessMeasurement m;
+  m.q = point.q;
+  m.dp_m = mean[1] - mean[0];
+  m.wrench_base = Wrench::Zero();
+  if (rig.force_from_sensor) {
+    const auto& forces = hold.passes[1].force_base;
+    if (forces.empty()) return false;
+    Vector3 sum = Vector3::Zero();
+    for (const auto& fb : forces) sum += fb;
+    m.wrench_base.head<3>() = sum / static_cast<double>(forces.size());
+  } else {
+    m.wrench_base.head<3>() = rig.cal.load_n * along;  // the set-point along the bar as placed
+  }
+  data.push_back(m);
+  return true;
+}
+
+// The joints an estimate cannot give the compensators (0-based): not identified at all, or flagged by
+// the identification (a relative standard error over its limit, its compliance at the c >= 0 bound,
+// collinear with others): a value shown "but should not be used" is not used.
+std::vector<int> unusable_joints(const StiffnessEstimate& e) {
+  std::vector<int> out;
+  for (std::size_t j = 0; j < e.stiffness_nm_per_rad.size(); ++j) {
+    const double k = e.stiffness_nm_per_rad[j];
+    const int joint = static_cast<int>(j) + 1;
+    const bool flagged = std::find(e.unidentifiable_joints.begin(), e.unidentifiable_joints.end(), joint) !=
+                         e.unidentifiable_joints.end();
+    if (!(std::isfinite(k) && k > 0.0) || flagged) out.push_back(static_cast<int>(j));
+  }
+  return out;
+}
+
+StiffnessEstimate identify_cell(const CalibrationRig& rig, const std::vector<StiffnessMeasurement>& data) {
   if (data.size() < 6) {
     throw InputError("calibration: fewer than 6 measurements (check the calibration section of the case)");
   }
@@ -258,30 +325,101 @@ CellCalibration identify_from_measurements(const CalibrationRig& rig, const std:
   // outliers, and a robust re-weighting would throw good measurements away for it.
   IdentificationOptions id_options;
   id_options.robust = false;
+  return identify_stiffness(rig.nominal, data, id_options);
+}
+
+// "1, 4 and 6" of 0-based joints.
+std::string joints_text(const std::vector<int>& joints) {
+  std::string s;
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    s += fmt::format("{}{}", i == 0 ? "" : (i + 1 == joints.size() ? " and " : ", "), joints[i] + 1);
+  }
+  return s;
+}
+
+// The engineer's second look at the joints the arcs left unusable: those the planner's poses can turn
+// (its predicted relative standard error within the identification's limit) are measured again at
+// those poses and identified from every measurement; the rest are not measured again. Adds notes.
+StiffnessEstimate second_look(CalibrationRig& rig, const std::vector<int>& unusable,
+                              std::vector<StiffnessMeasurement>& data, StiffnessEstimate estimate,
+                              std::vector<std::string>& notes, int& added, std::vector<int>& remeasured) {
+  const CalibrationPlan plan = plan_second_look(rig);
+  const double limit = IdentificationOptions{}.max_relative_std_error;
+  std::vector<int> can, cannot;
+  for (int j : unusable) {
+    const double se = plan.predicted_relative_std_error[static_cast<std::size_t>(j)];
+    (std::isfinite(se) && se <= limit ? can : cannot).push_back(j);
+  }
+  if (!cannot.empty()) {
+    double worst = 0.0;
+    for (int j : cannot) worst = std::max(worst, plan.predicted_relative_std_error[static_cast<std::size_t>(j)]);
+    notes.push_back(
+        fmt::format("joint{} {}: no load the bar can put on the TCP ball turns {} enough to identify "
+                    "(the planner's best poses leave a relative standard error of {})",
+                    cannot.size() == 1 ? "" : "s", joints_text(cannot), cannot.size() == 1 ? "it" : "them",
+                    std::isfinite(worst) ? fmt::format("{:.0f} %", 100.0 * worst) : "no bound"));
+  }
+  if (can.empty()) return estimate;
+  for (int j : can) remeasured.push_back(j + 1);
+  for (std::size_t i = 0; i < plan.points.size(); ++i) {
+    if (measure_planned_point(rig, plan.points[i], static_cast<int>(i), data)) ++added;
+  }
+  notes.push_back(
+      fmt::format("joint{} {}: measured again at {} poses and loads the planner added (the bar placed "
+                  "along each planned force)",
+                  can.size() == 1 ? "" : "s", joints_text(can), added));
+  return identify_cell(rig, data);
+}
+
+// Why the final estimate gives the compensators no value for 0-based joint `j`.
+std::string unusable_reason(const StiffnessEstimate& e, int j) {
+  const auto ju = static_cast<std::size_t>(j);
+  const double k = e.stiffness_nm_per_rad[ju];
+  if (!(std::isfinite(k) && k > 0.0)) return "not identified";
+  const double rel = e.std_error_nm_per_rad[ju] / k;
+  return std::isfinite(rel) ? fmt::format(
+                                  "its estimate {:.3g} Nm/rad has a relative standard error of {:.0f} %, "
+                                  "over the identification's {:.0f} %",
+                                  k, 100.0 * rel, 100.0 * IdentificationOptions{}.max_relative_std_error)
+                            : fmt::format("its estimate {:.3g} Nm/rad is flagged by the identification", k);
+}
+
+// The compensators' model from the final estimate: a usable joint takes its identified stiffness,
+// any other keeps the assumed one, and the notes say which and why.
+CellCalibration calibration_from(const CalibrationRig& rig, const std::vector<StiffnessMeasurement>& data,
+                                 StiffnessEstimate estimate, std::vector<std::string> notes, int added) {
+  const RobotModel& nominal = rig.nominal;
+  const std::vector<int> unusable = unusable_joints(estimate);
+  std::vector<double> k(static_cast<std::size_t>(nominal.dof()));
+  std::vector<int> kept;
+  for (int j = 0; j < nominal.dof(); ++j) {
+    const bool use = std::find(unusable.begin(), unusable.end(), j) == unusable.end();
+    k[static_cast<std::size_t>(j)] =
+        use ? estimate.stiffness_nm_per_rad[static_cast<std::size_t>(j)] : nominal.stiffness()[j];
+    if (!use) {
+      kept.push_back(j + 1);
+      notes.push_back(
+          fmt::format("joint {}: {}: kept the assumed stiffness ({:.3g} Nm/rad), the compensators never "
+                      "see the estimate",
+                      j + 1, unusable_reason(estimate, j), nominal.stiffness()[j]));
+    }
+  }
+  for (const auto& w : estimate.warnings) notes.push_back(w);
   double force_sum = 0.0;
   for (const auto& m : data) force_sum += m.wrench_base.head<3>().norm();
   CellCalibration out{nominal,
-                      identify_stiffness(nominal, data, id_options),
+                      std::move(estimate),
                       static_cast<int>(data.size()),
                       force_sum / static_cast<double>(data.size()),
-                      {}};
-  std::vector<double> k(static_cast<std::size_t>(nominal.dof()));
-  for (int j = 0; j < nominal.dof(); ++j) {
-    const double kj = out.estimate.stiffness_nm_per_rad[static_cast<std::size_t>(j)];
-    if (std::isfinite(kj) && kj > 0.0) {
-      k[static_cast<std::size_t>(j)] = kj;
-    } else {
-      k[static_cast<std::size_t>(j)] = nominal.stiffness()[j];
-      out.notes.push_back(fmt::format("joint {} not identifiable: kept the assumed stiffness", j + 1));
-    }
-  }
-  for (const auto& w : out.estimate.warnings) {
-    out.notes.push_back(w);
-  }
+                      std::move(notes),
+                      rig.coupled,
+                      {},
+                      std::move(kept)};
   out.identified = nominal.with_stiffness(
-      k, fmt::format("identified on the simulated cell while moving ({} measurements on {} arcs, "
-                     "residual {:.1f} um RMS)",
-                     data.size(), rig.cal.arcs, out.estimate.residual_rms_m * 1e6));
+      k, fmt::format("identified on the simulated cell while moving ({} measurements on {} arcs{}, residual {:.1f} "
+                     "um RMS)",
+                     data.size(), rig.cal.arcs, added > 0 ? fmt::format(" and {} planned poses", added) : "",
+                     out.estimate.residual_rms_m * 1e6));
   return out;
 }
 
@@ -295,7 +433,10 @@ CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robo
                            {},
                            0,
                            0.0,
-                           {"exact stiffness given: model-consistent cell"}};
+                           {"exact stiffness given: model-consistent cell"},
+                           {},
+                           {},
+                           {}};
   }
   CalibrationRig rig(c, robot, seed);
   std::vector<StiffnessMeasurement> data;
@@ -308,7 +449,15 @@ CellCalibration calibrate_setup(const CaseConfig& c, const cell::TrueRobot& robo
     }
     measure_calibration_arc(rig, arc, data);
   }
-  return identify_from_measurements(rig, data);
+  StiffnessEstimate estimate = identify_cell(rig, data);
+  std::vector<std::string> notes;
+  int added = 0;
+  const std::vector<int> unusable = unusable_joints(estimate);
+  std::vector<int> remeasured;
+  if (!unusable.empty()) estimate = second_look(rig, unusable, data, std::move(estimate), notes, added, remeasured);
+  CellCalibration out = calibration_from(rig, data, std::move(estimate), std::move(notes), added);
+  out.remeasured_joints = std::move(remeasured);
+  return out;
 }
 
 }  // namespace deflex::study

@@ -451,7 +451,6 @@ RunOutput drive_simulated_run(SimulatedRun& run) {
   cell::TrueRobotState state = robot.initial_state(q_motor);
   CellArm arm{robot, ws, state, ldbb, drift};
   Vector3 p_prev = arm.at_rest(q_motor);
-  Vector3 v_prev = Vector3::Zero();
   const double daq_period = 1.0 / c.sensor.rate_hz;
   double next_daq = daq_period;
 
@@ -460,7 +459,7 @@ RunOutput drive_simulated_run(SimulatedRun& run) {
     clock.set(t);
     q_motor = controller.tick(t);
     Wrench w;
-    const Vector3 p = arm.tick(q_motor, loaded, p_prev, v_prev, dt, w);
+    const Vector3 p = arm.tick(q_motor, loaded, dt, w);
     controller.encoders(state.q_motor);
     if (linked) {
       // The DAQ streams this tick's samples; the EGM message sent this tick reaches deflex after the
@@ -473,9 +472,9 @@ RunOutput drive_simulated_run(SimulatedRun& run) {
       poll_deflex_session(*session, out.link_cycles);
     }
     tracker.observe(t - dt, p_prev, t, p, out.trace);
-    v_prev = (p - p_prev) / dt;
     p_prev = p;
   }
+  out.coupled = arm.counters();
   return out;
 }
 

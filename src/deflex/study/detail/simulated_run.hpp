@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "deflex/cell/coupled_tick.hpp"
 #include "deflex/cell/force_sensor.hpp"
 #include "deflex/cell/true_robot.hpp"
 #include "deflex/link/controller_link.hpp"
@@ -55,7 +56,8 @@ struct RunOutput {
   LinkCounters link_counters;
   double max_command_deviation_rad = 0.0;  ///< largest |command - nominal| of any joint, any cycle
   double max_tcp_correction_m = 0.0;
-  double measured_delay_s = 0.0;  ///< the mean of the link's delay measurements over the run
+  double measured_delay_s = 0.0;      ///< the mean of the link's delay measurements over the run
+  cell::CoupledTickCounters coupled;  ///< what the loaded ticks' coupled solves of the arm and the bar did
 };
 
 /// SplitMix64's finaliser: a well-mixed 64-bit value from any seed (the cell's seeds are derived by it).
