@@ -229,9 +229,10 @@ TEST(MillingCell, ACompliantArmLeavesTheWallWhereTheClosedFormPutsIt) {
   std::uint64_t steady_unconverged = 0;
   const CoupledTickCounters counters = rig.cut(process, &steady_unconverged);
   // Every tick of the stretch the walls are probed on settles. The entry and the exit, where the
-  // arc's ends cross the block's corner, leave a few ticks at the solver's cap (the dexels' inside
-  // test changes family there, and the force jumps by newtons between two trial positions a
-  // micrometre apart): counted, and bounded here so that a change that spreads them is seen.
+  // engagement changes fastest, leave a few ticks at the solver's cap: the stock's engagement query
+  // (its sampled arc ends, its patches' depths from the height map) steps the force by up to a few
+  // newtons between trial positions a fraction of a micrometre apart, so no position satisfies both.
+  // Counted, and bounded here so that a change that spreads them is seen.
   EXPECT_EQ(steady_unconverged, 0u);
   EXPECT_LT(counters.unconverged, counters.ticks / 40);
   EXPECT_EQ(process.tilted_ticks(), 0u);
