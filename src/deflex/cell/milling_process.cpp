@@ -58,12 +58,13 @@ void MillingProcess::advance(double dt_s) { dt_s_ = dt_s; }
 Vector3 MillingProcess::feed_velocity(const Vector3& tip, const TcpMotion& motion) const {
   // The chips of a revolution are what the tool's motion over that revolution leaves for its teeth,
   // so the feed (its direction, and the feed per tooth) is the tool's mean velocity over the last
-  // revolution: 5 ticks at 12 000 rpm and 1 kHz; one tick when a revolution is shorter. The tick's
-  // own velocity would turn the cut frame with each trial of the coupled solve and with each
-  // micrometre the tool yields, a force a revolution does not see.
-  const int ticks = dt_s_ > 0.0 ? static_cast<int>(std::lround(60.0 / (config_.spindle_rpm * dt_s_))) : 1;
-  const int back = std::clamp(ticks, 1, std::min(history_count_, kHistory));
-  if (history_count_ == 0 || dt_s_ <= 0.0) return stock_R_base_ * motion.velocity_m_s;
+  // revolution: 5 ticks at 12 000 rpm and 1 kHz; one tick when a revolution is shorter, 64 at most.
+  // The tick's own velocity would turn the cut frame with each trial of the coupled solve and with
+  // each micrometre the tool yields, a force a revolution does not see.
+  if (history_count_ == 0 || !(dt_s_ > 0.0)) return stock_R_base_ * motion.velocity_m_s;
+  const double revolution_ticks = 60.0 / (config_.spindle_rpm * dt_s_);
+  const int back = revolution_ticks >= history_count_ ? history_count_
+                                                      : std::max(1, static_cast<int>(std::lround(revolution_ticks)));
   const std::size_t i = static_cast<std::size_t>((history_next_ + kHistory - back) % kHistory);
   return (tip - history_[i]) / (back * dt_s_);
 }
