@@ -325,5 +325,24 @@ TEST(MillingCell, BadProcessSettingsAreRefused) {
   EXPECT_NE(draw_true_coefficients(al7075(), 0.15, 1).ktc_n_m2, draw_true_coefficients(al7075(), 0.15, 2).ktc_n_m2);
 }
 
+TEST(MillingCell, TheTrueCoefficientsSpreadAsStated) {
+  // Log-normal draws: log(k / k_published) has mean 0 and standard deviation sigma. Over 2000 seeds
+  // the sample's mean lies within 3 standard errors (sigma / sqrt(n)) of 0 and its standard deviation
+  // within 3 of sigma (sigma / sqrt(2 n): 1.6 %).
+  constexpr double kSigma = 0.15;
+  constexpr int kDraws = 2000;
+  const CuttingCoefficients k0 = al7075();
+  double sum = 0.0, sum2 = 0.0;
+  for (int seed = 0; seed < kDraws; ++seed) {
+    const double l =
+        std::log(draw_true_coefficients(k0, kSigma, static_cast<std::uint64_t>(seed)).kre_n_m / k0.kre_n_m);
+    sum += l;
+    sum2 += l * l;
+  }
+  const double mean = sum / kDraws, sd = std::sqrt((sum2 - kDraws * mean * mean) / (kDraws - 1));
+  EXPECT_NEAR(mean, 0.0, 3.0 * kSigma / std::sqrt(kDraws));
+  EXPECT_NEAR(sd, kSigma, 3.0 * kSigma / std::sqrt(2.0 * kDraws));
+}
+
 }  // namespace
 }  // namespace deflex::cell
