@@ -296,9 +296,13 @@ TEST(MillingCell, TheProbesNoiseIsWhatItSaysAndBadSpecsAreRefused) {
   bad.points_along = 0;
   EXPECT_THROW((void)exact.wall(stock, bad), InputError);
   EXPECT_THROW(PartProbe(-1e-6, 1), InputError);
+  bad.points_along = 100000;
+  EXPECT_THROW((void)exact.wall(stock, bad), InputError);
   FloorSpec f;
   f.nx = 1;
   f.ny = 1;
+  EXPECT_THROW((void)exact.floor(stock, f), InputError);
+  f.nx = f.ny = 1 << 20;  // the product would overflow an int
   EXPECT_THROW((void)exact.floor(stock, f), InputError);
 }
 

@@ -13,6 +13,9 @@
 namespace deflex::cell {
 namespace {
 
+// Points a side of a probed grid at most: a CMM's program probes tens to hundreds.
+constexpr int kMaxGrid = 10000;
+
 void check_range(double lo, double hi, const char* what) {
   if (!std::isfinite(lo) || !std::isfinite(hi) || hi < lo) {
     throw InputError(fmt::format("part probe: {}: {} .. {} m is not an increasing range", what, lo, hi));
@@ -65,9 +68,9 @@ PartProbe::PartProbe(double noise_m, std::uint64_t seed) : noise_m_(noise_m), rn
 WallProfile PartProbe::wall(const DexelStock& stock, const WallSpec& spec) {
   check_range(spec.along_lo_m, spec.along_hi_m, "wall: along");
   check_range(spec.z_lo_m, spec.z_hi_m, "wall: z");
-  if (spec.points_along < 1 || spec.points_up < 1) {
-    throw InputError(
-        fmt::format("part probe: wall: {} x {} points: a wall needs at least one", spec.points_along, spec.points_up));
+  if (spec.points_along < 1 || spec.points_up < 1 || spec.points_along > kMaxGrid || spec.points_up > kMaxGrid) {
+    throw InputError(fmt::format("part probe: wall: {} x {} points: each side needs 1..{}", spec.points_along,
+                                 spec.points_up, kMaxGrid));
   }
   if (!std::isfinite(spec.nominal_m) || !(spec.search_m > 0.0)) {
     throw InputError("part probe: wall: the nominal must be finite and the search distance positive");
@@ -100,11 +103,12 @@ WallProfile PartProbe::wall(const DexelStock& stock, const WallSpec& spec) {
 FloorFlatness PartProbe::floor(const DexelStock& stock, const FloorSpec& spec) {
   check_range(spec.x_lo_m, spec.x_hi_m, "floor: x");
   check_range(spec.y_lo_m, spec.y_hi_m, "floor: y");
-  if (spec.nx < 1 || spec.ny < 1 || spec.nx * spec.ny < 3) {
-    throw InputError(fmt::format("part probe: floor: {} x {} points: a plane needs at least 3", spec.nx, spec.ny));
+  if (spec.nx < 1 || spec.ny < 1 || spec.nx > kMaxGrid || spec.ny > kMaxGrid || spec.nx * spec.ny < 3) {
+    throw InputError(fmt::format("part probe: floor: {} x {} points: a plane needs at least 3, each side at most {}",
+                                 spec.nx, spec.ny, kMaxGrid));
   }
   std::vector<Vector3> pts;
-  pts.reserve(static_cast<std::size_t>(spec.nx * spec.ny));
+  pts.reserve(static_cast<std::size_t>(spec.nx) * static_cast<std::size_t>(spec.ny));
   for (int j = 0; j < spec.ny; ++j) {
     for (int i = 0; i < spec.nx; ++i) {
       const double x = grid_at(spec.x_lo_m, spec.x_hi_m, i, spec.nx), y = grid_at(spec.y_lo_m, spec.y_hi_m, j, spec.ny);

@@ -86,9 +86,10 @@ class PartProbe {
   /// Throws InputError for a noise that is negative or not finite.
   PartProbe(double noise_m, std::uint64_t seed);
 
-  /// Throws InputError for an empty grid, a range that is not increasing, or a search not positive.
+  /// Throws InputError for an empty grid or one over 10 000 points a side, a range that is not
+  /// increasing, or a search not positive.
   [[nodiscard]] WallProfile wall(const DexelStock& stock, const WallSpec& spec);
-  /// Throws InputError for an empty grid or a range that is not increasing.
+  /// Throws InputError for fewer than 3 points, over 10 000 a side, or a range that is not increasing.
   [[nodiscard]] FloorFlatness floor(const DexelStock& stock, const FloorSpec& spec);
   /// The width between walls `a` and `b` (measured), nominally their nominal planes apart.
   [[nodiscard]] static WidthMeasure width(const WallProfile& a, const WallSpec& a_spec, const WallProfile& b,
