@@ -273,7 +273,9 @@ void compliant_cut_against_closed_form(bool climb) {
     EXPECT_LT(wall.peak_to_valley_m, 0.1e-6);
     // Down milling pushes the tool off the wall with most of its force, so there the chip's feedback
     // matters: leaving it out misses by more than the tolerance.
-    if (climb) EXPECT_GT(std::abs(rig.side * no_feedback.y() - off), 2.0 * tolerance);
+    if (climb) {
+      EXPECT_GT(std::abs(rig.side * no_feedback.y() - off), 2.0 * tolerance);
+    }
   }
 }
 
