@@ -241,12 +241,11 @@ void compliant_cut_against_closed_form(bool climb) {
   std::uint64_t steady_unconverged = 0;
   const CoupledTickCounters counters = rig.cut(process, &steady_unconverged);
   // Down milling: every tick of the stretch the walls are probed on settles; the entry and the exit,
-  // where the engagement changes fastest, leave a few at the solver's cap. Up milling: the wall is on
-  // the side the teeth enter, where the chip starts from nothing, and the stock's engagement query
-  // (its arc ends located to a fraction of a micrometre on a curved boundary interpolated between
-  // lines 0.1 mm apart) steps the edge force by newtons between trial positions a fraction of a
-  // micrometre apart, so no position satisfies both, there as well: about one tick in six. Counted,
-  // and bounded here so that a change that spreads them is seen.
+  // where the engagement changes fastest, leave a few at the solver's cap (the force steps by newtons
+  // between trial positions a fraction of a micrometre apart there). Up milling leaves about one tick
+  // in six at the cap, along the probed walls too; what steps its force is not pinned down (clipping
+  // the arcs to a minimum chip thickness of 1-3 um, or taking the feed over 1 to 20 ticks, leaves as
+  // many). Counted, and bounded here so that a change that spreads them is seen.
   if (climb) {
     EXPECT_EQ(steady_unconverged, 0u);
     EXPECT_LT(counters.unconverged, counters.ticks / 40);
