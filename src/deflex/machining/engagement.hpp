@@ -12,15 +12,14 @@
 
 #include <array>
 
+#include "deflex/model/types.hpp"
+
 namespace deflex {
 
-/// The turning direction of the spindle, seen from the spindle towards the tip.
-enum class SpindleTurn {
-  kClockwise,         ///< M3
-  kCounterClockwise,  ///< M4
-};
-
-/// +1 for M3, -1 for M4: the sign of the normal axis in the immersion angle (milling_force.hpp).
+/// +1 for M3, -1 for M4: the sign of the normal axis in the immersion angle (milling_force.hpp). The
+/// spindle's direction is SpindleTurn (model/types.hpp, shared with the toolpath); a cut is given
+/// kClockwise or kCounterClockwise (kOff, a program's stopped spindle, cuts nothing and counts as M4
+/// here).
 [[nodiscard]] inline constexpr double turn_sign(SpindleTurn t) { return t == SpindleTurn::kClockwise ? 1.0 : -1.0; }
 
 /// One engaged region of the cutter: teeth cut between the immersion angles entry_rad..exit_rad

@@ -33,6 +33,14 @@ using Wrench = Vector6;
 /// Small twist-like displacement [dx dy dz drx dry drz] in m and rad, in the robot base frame.
 using Displacement = Vector6;
 
+/// A spindle's turning direction, seen from the spindle towards the tool tip: one type for the
+/// toolpath (a program's M3/M4/M5) and the cutting force (the immersion angle's sense).
+enum class SpindleTurn {
+  kOff,               ///< M5, SPINDL/OFF, or never started: no cutting direction
+  kClockwise,         ///< M3, SPINDL/...,CLW
+  kCounterClockwise,  ///< M4, SPINDL/...,CCLW
+};
+
 inline constexpr double kPi = 3.14159265358979323846;
 /// A quiet NaN: "no value" in a field that has none (a skipped row, an unmeasured figure).
 inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();

@@ -22,12 +22,7 @@ enum class MotionKind {
   kArcCcw,  ///< G3; an APT CIRCLE turning counter-clockwise seen from the spindle
 };
 
-/// The spindle's turning direction, seen from the spindle towards the tool tip.
-enum class SpindleTurn {
-  kOff,               ///< M5, SPINDL/OFF, or never started
-  kClockwise,         ///< M3, SPINDL/...,CLW
-  kCounterClockwise,  ///< M4, SPINDL/...,CCLW
-};
+// The spindle's turning direction is SpindleTurn (model/types.hpp), shared with the cutting force.
 
 /// One point of a toolpath. Every field is the program's value in effect at the point (modal words
 /// carried from earlier blocks).
