@@ -27,17 +27,17 @@ function(deflex_module name)
   add_library(${target} STATIC ${sources})
   add_library(deflex::${name} ALIAS ${target})
   set_target_properties(${target} PROPERTIES EXPORT_NAME ${name})
-  # src/compat: the deprecated forwarding headers of moved headers (installed beside the others).
   target_include_directories(
     ${target} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src> $<BUILD_INTERFACE:${PROJECT_BINARY_DIR}/generated>
-                     $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src/compat> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+                     $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   if(name IN_LIST DEFLEX_CXX17_MODULES)
     target_compile_features(${target} PUBLIC cxx_std_17)
     set_target_properties(${target} PROPERTIES CXX_STANDARD 20 CXX_STANDARD_REQUIRED ON)
   else()
     target_compile_features(${target} PUBLIC cxx_std_20)
   endif()
-  target_link_libraries(${target} PUBLIC Eigen3::Eigen fmt::fmt)
+  # deflex_compat: the deprecated forwarding headers of moved headers (CMakeLists.txt).
+  target_link_libraries(${target} PUBLIC Eigen3::Eigen fmt::fmt deflex_compat)
   target_compile_options(${target} PRIVATE ${DEFLEX_WARNING_FLAGS})
   if(DEFLEX_SANITIZE AND name IN_LIST DEFLEX_SANITIZE_EXCEPT)
     target_compile_options(${target} PRIVATE -fno-sanitize=all)
