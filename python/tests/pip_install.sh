@@ -30,10 +30,10 @@ assert deflex.__version__ == '$version', deflex.__version__; print('import defle
 }
 version=$(sed -n 's/^project(deflex VERSION \([0-9.]*\).*/\1/p' "$source_dir/CMakeLists.txt")
 
-# 1. pip install . (compiling the module for this venv).
+# 1. pip install . (compiling the module for this venv; -v shows the build's commands, checked below).
 "$python3" -m venv --system-site-packages "$work/venv"
 (cd "$work/src" && DEFLEX_FROM_BUILD="$build_dir" DEFLEX_REBUILD=1 DEFLEX_BUILD_TYPE=None \
-  "$work/venv/bin/python" -m pip install --no-build-isolation . >"$work/pip.log" 2>&1) ||
+  "$work/venv/bin/python" -m pip install -v --no-build-isolation . >"$work/pip.log" 2>&1) ||
   { cat "$work/pip.log" >&2; exit 1; }
 grep -q "cmake --build" "$work/pip.log" || { echo "FAIL: pip did not compile the module" >&2; exit 1; }
 check_installed "$work/venv/bin/python"
