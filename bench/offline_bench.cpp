@@ -64,7 +64,13 @@ struct AnchorPoint {
 class Anchor {
  public:
   explicit Anchor(const LongPath& p)
-      : p_(p), chain_(test::kdl_chain_from_dh(p.model)), fk_(chain_), jac_(chain_), q_(6), J_(6), points_(p.poses.size()) {
+      : p_(p),
+        chain_(test::kdl_chain_from_dh(p.model)),
+        fk_(chain_),
+        jac_(chain_),
+        q_(6),
+        J_(6),
+        points_(p.poses.size()) {
     for (int i = 0; i < 6; ++i) c_[i] = p.model.compliance()[i];
   }
   Anchor(const Anchor&) = delete;

@@ -54,8 +54,8 @@ struct TrackerPointsTag {
 /// Points of a registration: what read_tracker_file returns, or an array.
 using TrackerPointsArg = Arg<TrackerPointsTag>;
 struct TracesTag {
-  static constexpr auto name = py::detail::const_name(
-      "typing.Union[numpy.typing.ArrayLike, typing.Sequence[numpy.typing.ArrayLike]]");
+  static constexpr auto name =
+      py::detail::const_name("typing.Union[numpy.typing.ArrayLike, typing.Sequence[numpy.typing.ArrayLike]]");
 };
 /// One trace, or a list of traces.
 using TracesArg = Arg<TracesTag>;

@@ -65,7 +65,8 @@ TrackerFile registration_side(const py::handle& obj, const py::handle& names_arg
   for (py::ssize_t i = 0; i < n; ++i) {
     TrackerPoint p;
     p.p_m = Eigen::Map<const Vector3>(a.data() + i * cols + (cols - 3));
-    if (!p.p_m.allFinite()) throw InputError(fmt::format("argument {}: row {}: a position that is not finite", name, i));
+    if (!p.p_m.allFinite())
+      throw InputError(fmt::format("argument {}: row {}: a position that is not finite", name, i));
     if (f.has_names) p.name = labels[static_cast<std::size_t>(i)];
     p.line = static_cast<std::size_t>(i) < lines.size() ? lines[static_cast<std::size_t>(i)] : 0;
     f.points.push_back(p);
@@ -253,10 +254,9 @@ void bind_evaluate(py::module_& m) {
          const std::optional<std::vector<std::string>>& tracker_names,
          const std::optional<std::vector<std::string>>& base_names) {
         const py::object none = py::none();
-        const TrackerFile t = registration_side(tracker_points, tracker_names ? py::cast(*tracker_names) : none,
-                                                "tracker_points");
-        const TrackerFile b =
-            registration_side(base_points, base_names ? py::cast(*base_names) : none, "base_points");
+        const TrackerFile t =
+            registration_side(tracker_points, tracker_names ? py::cast(*tracker_names) : none, "tracker_points");
+        const TrackerFile b = registration_side(base_points, base_names ? py::cast(*base_names) : none, "base_points");
         RegistrationInput in = pair_tracker_points(t, b);
         in.max_rms_m = max_rms_m;
         const FrameRegistration r = register_frames(in);

@@ -288,7 +288,8 @@ Returns<IkSolutionsTag> ik(const RobotModel& r, const ArrayLike& target, const s
 }
 
 Returns<IkResultsTag> inverse_kinematics_of(const RobotModel& r, const ArrayLike& target,
-                                            const ConfigurationArg& configuration, const std::optional<ArrayLike>& seed) {
+                                            const ConfigurationArg& configuration,
+                                            const std::optional<ArrayLike>& seed) {
   const std::optional<ArmConfiguration> conf = arm_configuration_arg(configuration);
   if (!is_pose_batch(target)) {
     IkRequest req = Seeds(r, seed, 0).request(r.dof(), 0);

@@ -19,8 +19,8 @@ namespace {
 /// A sensor configuration as plain Python values (pickling), every field.
 py::tuple sensor_state(const SensorConfig& s) {
   return py::make_tuple(s.name, s.source, s.components, from_matrix(s.crosstalk), from_pose(s.flange_T_sensor),
-                        py::make_tuple(s.payload_mass_kg, from_vector(s.payload_cog_sensor_m), from_vector(s.bias_sensor),
-                                       from_vector(s.gravity_base_m_s2)),
+                        py::make_tuple(s.payload_mass_kg, from_vector(s.payload_cog_sensor_m),
+                                       from_vector(s.bias_sensor), from_vector(s.gravity_base_m_s2)),
                         py::make_tuple(s.lowpass_cutoff_hz, s.lowpass_order, s.sample_rate_hz, s.dead_band_N,
                                        s.dead_band_Nm, s.fault_threshold_N, s.fault_threshold_Nm));
 }
@@ -31,7 +31,8 @@ SensorConfig sensor_from_state(const py::tuple& t) {
   s.name = t[0].cast<std::string>();
   s.source = t[1].cast<std::string>();
   s.components = t[2].cast<int>();
-  s.crosstalk = Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(matrix_array(t[3], "crosstalk", 6, 6).data());
+  s.crosstalk =
+      Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(matrix_array(t[3], "crosstalk", 6, 6).data());
   s.flange_T_sensor = pose(t[4], "flange_T_sensor");
   const auto payload = t[5].cast<py::tuple>();
   s.payload_mass_kg = payload[0].cast<double>();
@@ -106,9 +107,10 @@ Vector6 sensor_wrench(const OnlineCompensator& c, const py::handle& obj, const c
     return w;
   }
   if (a.shape(0) == 3) {
-    throw InputError(fmt::format("argument {}: 3 values for a 6-axis sensor (SensorConfig.components 6): give "
-                                 "[Fx, Fy, Fz, Mx, My, Mz]",
-                                 name));
+    throw InputError(
+        fmt::format("argument {}: 3 values for a 6-axis sensor (SensorConfig.components 6): give "
+                    "[Fx, Fy, Fz, Mx, My, Mz]",
+                    name));
   }
   return vector6(obj, name);
 }
@@ -118,9 +120,10 @@ Array sensor_wrench_rows(const OnlineCompensator& c, const py::handle& obj, py::
   const Array a = to_array(obj, "wrench_sensor", 2);
   if (a.shape(1) != 3) return matrix_array(obj, "wrench_sensor", n, 6);
   if (c.pipeline().config().components != 3) {
-    throw InputError(fmt::format("argument wrench_sensor: ({}, 3) for a 6-axis sensor (SensorConfig.components 6): "
-                                 "give ({}, 6) [Fx, Fy, Fz, Mx, My, Mz]",
-                                 a.shape(0), n));
+    throw InputError(
+        fmt::format("argument wrench_sensor: ({}, 3) for a 6-axis sensor (SensorConfig.components 6): "
+                    "give ({}, 6) [Fx, Fy, Fz, Mx, My, Mz]",
+                    a.shape(0), n));
   }
   const Array forces = matrix_array(obj, "wrench_sensor", n, 3);
   Array out = new_array({n, 6});
@@ -162,7 +165,8 @@ void bind_online(py::module_& m) {
   pose_property(sensor_class, "flange_T_sensor", &SensorConfig::flange_T_sensor, "flange to sensor frame, m");
   vector_property(sensor_class, "payload_cog_sensor_m", &SensorConfig::payload_cog_sensor_m);
   vector_property(sensor_class, "bias_sensor", &SensorConfig::bias_sensor, "N, Nm");
-  vector_property(sensor_class, "gravity_base_m_s2", &SensorConfig::gravity_base_m_s2, "gravity in the base frame, m/s^2");
+  vector_property(sensor_class, "gravity_base_m_s2", &SensorConfig::gravity_base_m_s2,
+                  "gravity in the base frame, m/s^2");
   m.def(
       "load_sensor_config", [](const PathArg& p) { return load_sensor_config(path_text(p)); }, "path"_a,
       "A sensor configuration YAML (docs/online.md).");

@@ -18,15 +18,15 @@
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/online/online_compensator.hpp"
 #include "deflex/online/online_strategy.hpp"
-#include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/line_path.hpp"
+#include "deflex/paths/path_ik.hpp"
 #include "deflex/rsi/rsi_link.hpp"
 #include "deflex/runtime/session.hpp"
 #include "deflex/sensors/rdt_force_source.hpp"
 #include "deflex/simple_message/simple_message_link.hpp"
+#include "deflex/text/errors.hpp"
 #include "deflex/transport/clock.hpp"
 #include "deflex/transport/memory_network.hpp"
-#include "deflex/text/errors.hpp"
 #include "deflex/transport/memory_stream.hpp"
 
 namespace deflex {
@@ -39,21 +39,21 @@ static_assert(!std::is_constructible_v<PathIkSolver, RobotModel, const IkRequest
 static_assert(!std::is_constructible_v<StiffnessIdentifier, RobotModel>);
 static_assert(!std::is_constructible_v<StiffnessIdentifier, RobotModel, const IdentificationOptions&>);
 // A temporary clock (the links, the session, the in-memory transports, the RDT source keep it).
-static_assert(!std::is_constructible_v<runtime::Session, const runtime::SessionConfig&, const RobotModel&,
-                                       const SensorConfig&, std::shared_ptr<const JointTrajectory>, const ForceModel*,
-                                       ForceSource*, SteadyClock>);
-static_assert(!std::is_constructible_v<runtime::Session, const runtime::SessionConfig&, const RobotModel&,
-                                       const SensorConfig&, std::shared_ptr<const JointTrajectory>, const ForceModel*,
-                                       ForceSource*, ManualClock>);
+static_assert(
+    !std::is_constructible_v<runtime::Session, const runtime::SessionConfig&, const RobotModel&, const SensorConfig&,
+                             std::shared_ptr<const JointTrajectory>, const ForceModel*, ForceSource*, SteadyClock>);
+static_assert(
+    !std::is_constructible_v<runtime::Session, const runtime::SessionConfig&, const RobotModel&, const SensorConfig&,
+                             std::shared_ptr<const JointTrajectory>, const ForceModel*, ForceSource*, ManualClock>);
 static_assert(!std::is_constructible_v<MemoryNetwork, SteadyClock>);
 static_assert(!std::is_constructible_v<MemoryStreamPair, ManualClock, double>);
-static_assert(!std::is_constructible_v<EgmJointLink, OnlineCompensator&, OnlineStrategy&,
-                                       std::shared_ptr<const JointTrajectory>, DatagramTransport&, SteadyClock,
-                                       ForceSource*>);
+static_assert(
+    !std::is_constructible_v<EgmJointLink, OnlineCompensator&, OnlineStrategy&, std::shared_ptr<const JointTrajectory>,
+                             DatagramTransport&, SteadyClock, ForceSource*>);
 static_assert(!std::is_constructible_v<EgmPathLink, OnlineCompensator&, OnlineStrategy&, DatagramTransport&,
                                        SteadyClock, ForceSource*>);
-static_assert(!std::is_constructible_v<RsiLink, OnlineCompensator&, OnlineStrategy&, DatagramTransport&,
-                                       SteadyClock, ForceSource*>);
+static_assert(!std::is_constructible_v<RsiLink, OnlineCompensator&, OnlineStrategy&, DatagramTransport&, SteadyClock,
+                                       ForceSource*>);
 static_assert(!std::is_constructible_v<SimpleMessageLink, OnlineCompensator&, OnlineStrategy&,
                                        std::shared_ptr<const JointTrajectory>, StreamTransport&, StreamTransport&,
                                        SteadyClock, ForceSource*>);

@@ -251,7 +251,7 @@ TEST_F(Compensator, JointsBeyondTheLimitsAreAStatusNotACommand) {
     out = comp.step({t, far, far});
   }
   EXPECT_EQ(out.status, CycleStatus::kOutsideLimits);
-  EXPECT_LT(static_cast<int>(out.status), 0);  // not usable: q_command must not be sent
+  EXPECT_LT(static_cast<int>(out.status), 0);           // not usable: q_command must not be sent
   EXPECT_LT(out.q_command.cwiseAbs().maxCoeff(), 1.0);  // nothing near 10 rad comes out
   EXPECT_STREQ(to_string(out.status), "outside_limits");
   t += 0.004;

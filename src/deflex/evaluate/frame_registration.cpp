@@ -322,15 +322,15 @@ bool pair_by(const TrackerFile& t, const TrackerFile& b, std::string (*key_of)(c
   for (const auto& p : b.points) base.insert(target_of(p.name));
   for (const auto& p : t.points) {
     if (base.count(target_of(p.name)) == 0) {
-      throw DataError(fmt::format("{}: point '{}' is not in {} (pairs are made by name)", point_place(t, p), p.name,
-                                  b.source));
+      throw DataError(
+          fmt::format("{}: point '{}' is not in {} (pairs are made by name)", point_place(t, p), p.name, b.source));
     }
     base.erase(target_of(p.name));
   }
   for (const auto& p : b.points) {
     if (base.count(target_of(p.name)) != 0) {
-      throw DataError(fmt::format("{}: point '{}' is not in {} (pairs are made by name)", point_place(b, p), p.name,
-                                  t.source));
+      throw DataError(
+          fmt::format("{}: point '{}' is not in {} (pairs are made by name)", point_place(b, p), p.name, t.source));
     }
   }
   throw DataError(fmt::format("{} and {}: the point names do not pair", t.source, b.source));
@@ -353,8 +353,8 @@ RegistrationInput pair_tracker_points(const TrackerFile& t, const TrackerFile& b
   for (std::size_t i = 0; i < t.points.size(); ++i) {
     in.tracker_m.push_back(t.points[i].p_m);
     in.base_m.push_back(b.points[i].p_m);
-    const std::string where =
-        t.points[i].line > 0 ? fmt::format("point {} (line {})", i + 1, t.points[i].line) : fmt::format("point {}", i + 1);
+    const std::string where = t.points[i].line > 0 ? fmt::format("point {} (line {})", i + 1, t.points[i].line)
+                                                   : fmt::format("point {}", i + 1);
     in.names.push_back(t.has_names ? t.points[i].name : where);
   }
   return in;

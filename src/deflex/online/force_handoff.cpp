@@ -1,8 +1,8 @@
 // The force sensor driver's hand-off to the cycle (force_handoff.hpp).
 #include "deflex/online/force_handoff.hpp"
 
-#include <boost/lockfree/spsc_queue.hpp>
 #include <fmt/format.h>
+#include <boost/lockfree/spsc_queue.hpp>
 
 #include "deflex/text/errors.hpp"
 

@@ -17,8 +17,8 @@
 #include "deflex/study/case_report.hpp"
 
 int main() {
-  const deflex::InputError error("old paths");           // deflex/model/errors.hpp
-  const deflex::TrackerTrace trace;                       // deflex/evaluate/tracker_trace.hpp
-  const deflex::StudyResult study;  // deflex/evaluate/study_tables.hpp
+  const deflex::InputError error("old paths");  // deflex/model/errors.hpp
+  const deflex::TrackerTrace trace;             // deflex/evaluate/tracker_trace.hpp
+  const deflex::StudyResult study;              // deflex/evaluate/study_tables.hpp
   return trace.empty() && study.setups.empty() && error.what()[0] == 'o' ? 0 : 1;
 }

@@ -3,6 +3,7 @@
 // silence the warning meanwhile).
 #pragma once
 #ifndef DEFLEX_NO_DEPRECATED_HEADER_WARNINGS
-#pragma GCC warning "deflex/model/csv_table.hpp is deprecated: include deflex/text/csv_table.hpp (this header goes in deflex 0.3)"
+#pragma GCC warning \
+    "deflex/model/csv_table.hpp is deprecated: include deflex/text/csv_table.hpp (this header goes in deflex 0.3)"
 #endif
 #include "deflex/text/csv_table.hpp"

@@ -3,6 +3,7 @@
 // silence the warning meanwhile).
 #pragma once
 #ifndef DEFLEX_NO_DEPRECATED_HEADER_WARNINGS
-#pragma GCC warning "deflex/model/nearest_name.hpp is deprecated: include deflex/text/nearest_name.hpp (this header goes in deflex 0.3)"
+#pragma GCC warning \
+    "deflex/model/nearest_name.hpp is deprecated: include deflex/text/nearest_name.hpp (this header goes in deflex 0.3)"
 #endif
 #include "deflex/text/nearest_name.hpp"

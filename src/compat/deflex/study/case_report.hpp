@@ -3,6 +3,7 @@
 // silence the warning meanwhile).
 #pragma once
 #ifndef DEFLEX_NO_DEPRECATED_HEADER_WARNINGS
-#pragma GCC warning "deflex/study/case_report.hpp is deprecated: include deflex/report/case_report.hpp (this header goes in deflex 0.3)"
+#pragma GCC warning \
+    "deflex/study/case_report.hpp is deprecated: include deflex/report/case_report.hpp (this header goes in deflex 0.3)"
 #endif
 #include "deflex/report/case_report.hpp"
