@@ -3,8 +3,10 @@
 # sources yet), and tests/NAME/*_test.cpp into the test program deflex_NAME_tests. Adding a file
 # to a module needs no edit here: new files are found at configure time (CONFIGURE_DEPENDS).
 # Each module is also the target deflex::NAME, in the build tree (an alias) and in the installed
-# package (find_package(deflex COMPONENTS NAME), cmake/deflexConfig.cmake.in): it passes on C++20
-# and its include path, and records what a consumer's CMake must find for it (deflex_module_requires).
+# package (find_package(deflex COMPONENTS NAME), cmake/deflexConfig.cmake.in): it passes on its
+# include path and the C++ standard its public headers need (C++17 for the modules in
+# DEFLEX_CXX17_MODULES, C++20 for the others; each module itself compiles as C++20), and records what
+# a consumer's CMake must find for it (deflex_module_requires).
 set(DEFLEX_MODULE_TARGETS "" CACHE INTERNAL "")
 set(DEFLEX_MODULE_NAMES "" CACHE INTERNAL "")
 
@@ -28,8 +30,14 @@ function(deflex_module name)
   target_include_directories(
     ${target} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src> $<BUILD_INTERFACE:${PROJECT_BINARY_DIR}/generated>
                      $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
-  target_compile_features(${target} PUBLIC cxx_std_20)
-  target_link_libraries(${target} PUBLIC Eigen3::Eigen fmt::fmt)
+  if(name IN_LIST DEFLEX_CXX17_MODULES)
+    target_compile_features(${target} PUBLIC cxx_std_17)
+    set_target_properties(${target} PROPERTIES CXX_STANDARD 20 CXX_STANDARD_REQUIRED ON)
+  else()
+    target_compile_features(${target} PUBLIC cxx_std_20)
+  endif()
+  # deflex_compat: the deprecated forwarding headers of moved headers (CMakeLists.txt).
+  target_link_libraries(${target} PUBLIC Eigen3::Eigen fmt::fmt deflex_compat)
   target_compile_options(${target} PRIVATE ${DEFLEX_WARNING_FLAGS})
   if(DEFLEX_SANITIZE AND name IN_LIST DEFLEX_SANITIZE_EXCEPT)
     target_compile_options(${target} PRIVATE -fno-sanitize=all)

@@ -29,15 +29,17 @@ packages=(
   # dygraphs: the monitor page's charts, embedded in the program at build time (the page needs no network)
   libjs-dygraphs
   python3 python3-dev python3-numpy python3-pytest pybind11-dev
-  # mypy's stubgen: the Python module's .pyi stubs (typed signatures for editors and type checkers)
-  python3-mypy
+  # `pip install .` (pyproject.toml: setuptools' build_ext drives the CMake) into a venv that sees them
+  # (--system-site-packages): setuptools and wheel build it, venv makes the environment
+  python3-setuptools python3-wheel python3-venv
 )
 # chromium: the tests open the live monitor page in headless Chromium and read what it shows;
 # python3-yaml: the Python tests give the case study a case as a dict read from the case file;
-# python3-venv: the Python module is installed into and tested in a second interpreter (a venv);
+# python3-build: the wheel test builds one with `python3 -m build --no-isolation`; python3-mypy: the
+# README's and the examples' Python are type-checked against the module's stubs;
 # locales: a comma-decimal locale (de_DE.UTF-8, generated below) for the test that numbers parse the same
 # whatever the process locale (it skips, saying so, where the locale is missing)
-if [ "$tests" -eq 1 ]; then packages+=(chromium python3-yaml python3-venv locales); fi
+if [ "$tests" -eq 1 ]; then packages+=(chromium python3-yaml python3-build python3-mypy locales); fi
 if [ "$lint" -eq 1 ]; then packages+=(clang-format clang-tidy); fi
 missing=()
 for p in "${packages[@]}"; do

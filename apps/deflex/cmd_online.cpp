@@ -521,7 +521,7 @@ void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
     text = eol == std::string_view::npos ? std::string_view() : text.substr(eol + 1);
   }
   if (o.json) {
-    nlohmann::json doc = summary.json;
+    nlohmann::json doc = nlohmann::json::parse(summary.json_text);
     doc["protobuf_log_messages"] = egm_protobuf_log_messages();
     print_json(doc);
   }

@@ -1,8 +1,6 @@
 // `deflex register`: the tracker-to-base transform from points (and circles) measured in both frames.
 #include <iostream>
-#include <map>
 #include <memory>
-#include <set>
 
 #include <fmt/format.h>
 
@@ -24,73 +22,6 @@ struct RegisterOpts {
   bool json = false;
   TrackerReadOptions read;
 };
-
-// The target's own name: the last part of "Collection::Group::Target".
-std::string target_of(const std::string& name) {
-  const auto at = name.rfind("::");
-  return at == std::string::npos ? name : name.substr(at + 2);
-}
-
-// Pairs by the key `key_of` gives each point: every key once on each side, and the same keys on both.
-// Returns false (and pairs nothing) when the key sets differ; throws for a repeated key.
-bool pair_by(const TrackerFile& t, const TrackerFile& b, std::string (*key_of)(const std::string&),
-             RegistrationInput& in) {
-  std::map<std::string, const TrackerPoint*> base, tracker;
-  for (const auto* f : {&b, &t}) {
-    auto& into = f == &b ? base : tracker;
-    for (const auto& p : f->points) {
-      if (!into.emplace(key_of(p.name), &p).second) {
-        throw DataError(fmt::format("{}:{}: point '{}' named twice", f->source, p.line, key_of(p.name)));
-      }
-    }
-  }
-  for (const auto& [key, p] : tracker) {
-    if (base.count(key) == 0) return false;
-  }
-  if (base.size() != tracker.size()) return false;
-  for (const auto& p : t.points) {
-    in.tracker_m.push_back(p.p_m);
-    in.base_m.push_back(base.at(key_of(p.name))->p_m);
-    in.names.push_back(key_of(p.name));
-  }
-  return true;
-}
-
-std::string whole_name(const std::string& name) { return name; }
-
-// Pairs the points: by name when both files name them (the whole name, else the target's own name:
-// "Job::Reference::REF1" pairs with "REF1"), else by order (equal counts).
-void pair_points(const TrackerFile& t, const TrackerFile& b, RegistrationInput& in) {
-  if (t.has_names && b.has_names) {
-    if (pair_by(t, b, whole_name, in) || pair_by(t, b, target_of, in)) return;
-    std::set<std::string> base;
-    for (const auto& p : b.points) base.insert(target_of(p.name));
-    for (const auto& p : t.points) {
-      if (base.count(target_of(p.name)) == 0) {
-        throw DataError(
-            fmt::format("{}:{}: point '{}' is not in {} (pairs are made by name)", t.source, p.line, p.name, b.source));
-      }
-      base.erase(target_of(p.name));
-    }
-    for (const auto& p : b.points) {
-      if (base.count(target_of(p.name)) != 0) {
-        throw DataError(
-            fmt::format("{}:{}: point '{}' is not in {} (pairs are made by name)", b.source, p.line, p.name, t.source));
-      }
-    }
-  }
-  if (t.points.size() != b.points.size()) {
-    throw DataError(
-        fmt::format("{} has {} point(s) and {} has {}: without names on both sides they pair by order and "
-                    "must be as many",
-                    t.source, t.points.size(), b.source, b.points.size()));
-  }
-  for (std::size_t i = 0; i < t.points.size(); ++i) {
-    in.tracker_m.push_back(t.points[i].p_m);
-    in.base_m.push_back(b.points[i].p_m);
-    in.names.push_back(t.has_names ? t.points[i].name : fmt::format("point {} (line {})", i + 1, t.points[i].line));
-  }
-}
 
 CircleFit circle_of(const std::string& path, const TrackerReadOptions& read) {
   const TrackerFile f = read_tracker_file(path, read);
@@ -135,7 +66,10 @@ void setup_register(CLI::App& sub, int& exit_code) {
       const TrackerFile t = read_tracker_file(o->tracker, o->read);
       const TrackerFile b = read_tracker_file(o->base, base_read);
       tracker_frame = t.frame;
-      pair_points(t, b, in);
+      const RegistrationInput pairs = pair_tracker_points(t, b);
+      in.tracker_m = pairs.tracker_m;
+      in.base_m = pairs.base_m;
+      in.names = pairs.names;
     }
     for (std::size_t k = 0; k < o->tracker_circles.size(); ++k) {
       in.tracker_circles.push_back(circle_of(o->tracker_circles[k], o->read));

@@ -15,6 +15,7 @@
 #include "deflex/text/errors.hpp"
 #include "deflex/text/output_file.hpp"
 #include "deflex/text/run_files.hpp"
+#include "deflex/version.hpp"
 #include "option_ranges.hpp"
 
 namespace deflex::cli {
@@ -76,7 +77,7 @@ int run_program(int argc, char** argv) {
       "Units: SI inside (m, rad, N, Nm, s); options and CSV columns name their unit (mm, deg where users expect "
       "them)."};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "deflex 0.1.0");
+  app.set_version_flag("--version", std::string("deflex ") + kVersion);
   auto commands = command_registry();
   std::stable_sort(commands.begin(), commands.end(), [](const auto& a, const auto& b) { return a.order < b.order; });
   int exit_code = 0;

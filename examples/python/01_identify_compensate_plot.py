@@ -18,6 +18,7 @@ out_dir.mkdir(parents=True, exist_ok=True)
 
 # %% 1. The robot as its file describes it: kinematics and an assumed (nominal) joint stiffness.
 nominal = deflex.Robot.from_file(str(ROOT / "examples" / "robots" / "kuka_kr210_r2700.yaml"))
+assert nominal.stiffness is not None  # this file gives one (a bare URDF's is None)
 print(f"robot: {nominal.name}, nominal stiffness (Nm/rad): {np.array2string(nominal.stiffness, precision=3)}")
 
 # %% 2. Identify the stiffness from the shipped calibration measurements (examples/identify/: a
@@ -36,9 +37,7 @@ robot = nominal.with_stiffness(estimate.stiffness_nm_per_rad, f"identified from 
 
 # %% 3. Plan the task path inside the calibrated region (local calibration): a circle of 100 mm radius,
 #    tool pointing down, solved by IK with one arm configuration kept.
-circle = deflex.Circle()
-circle.centre_m = [1.6, 0.0, 0.8]
-circle.radius_m = 0.1
+circle = deflex.Circle(centre_m=[1.6, 0.0, 0.8], radius_m=0.1)
 q_path, configuration = deflex.solve_path_ik(robot, circle)
 print(f"path: {len(q_path)} points, arm configuration (cf1, cf4, cf6, cfx) = {configuration}")
 

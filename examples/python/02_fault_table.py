@@ -16,6 +16,7 @@ into OUTDIR. Units: m, rad, N, s inside; mm, deg and ms in the printed figures, 
 import csv
 import pathlib
 import sys
+from typing import Callable
 
 import deflex  # first: on an interpreter without NumPy its message says what to do
 import numpy as np
@@ -28,10 +29,7 @@ FORCE_N = [300.0, 200.0, -1000.0]
 # %% 1. The program: the paper's circle (radius 129.9 mm about (1800, 0, 900) mm, tool pointing down),
 #    at 50 mm/s after 0.5 s at rest, from the robot's IK. egm-joint and simple message stream it; for
 #    egm-path and rsi it is the controller's own program.
-circle = deflex.Circle()
-circle.centre_m = [1.8, 0.0, 0.9]
-circle.radius_m = 0.1299
-circle.points = 161
+circle = deflex.Circle(centre_m=[1.8, 0.0, 0.9], radius_m=0.1299, points=161)
 q_path, _ = deflex.solve_path_ik(robot, circle.poses((0.0, 0.0, 1.0, 0.0)))
 arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(robot.fk(q_path)[:, :3, 3], axis=0), axis=1))])
 t_prog = np.concatenate([[0.0], 0.5 + arc / 0.050])
@@ -131,9 +129,16 @@ def silence_then_restart(silence_s):
     return f
 
 
+def restart_behind_outage(outage_s):
+    def f(s):
+        s.restart(True)
+        s.outage(outage_s)
+    return f
+
+
 # %% 2. The faults, link by link.
 rows = []
-cases = [
+cases: list[tuple[str, str, Callable[[deflex.StandIn], object], dict[str, float]]] = [
     ("egm-joint", "outage 0.02 s", outage(0.02), {}),
     ("egm-joint", "outage 0.1 s", outage(0.1), {}),
     ("egm-joint", "outage 0.45 s", outage(0.45), {}),
@@ -150,7 +155,7 @@ cases = [
     ("egm-joint", "silent for good", outage(100.0), {"after_s": 4.0}),
     ("egm-joint", "force stale 1 s", sensor_gap(1.0), {}),
     ("egm-path", "outage 0.45 s", outage(0.45), {}),
-    ("egm-path", "restart behind a 1 s outage", lambda s: (s.restart(True), s.outage(1.0)), {}),
+    ("egm-path", "restart behind a 1 s outage", restart_behind_outage(1.0), {}),
     ("egm-path", "restart, no silence", lambda s: s.restart(True), {}),
     ("egm-path", "force stale 1 s", sensor_gap(1.0), {}),
     ("rsi", "outage 0.2 s", outage(0.2), {}),

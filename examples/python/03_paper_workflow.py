@@ -7,7 +7,7 @@ differs from the model only in its stiffness, so compensation comes out near com
 simulated cell of `deflex case-study` (run_case_study) is harder than the model, as a real cell is.
 
 Run (after building): PYTHONPATH=build/python python3 examples/python/03_paper_workflow.py [OUTDIR] (example-out/ and the script's name when omitted)
-or, with the module installed into an interpreter (scripts/python-module.sh), that interpreter alone.
+or, with the module installed into an interpreter (`pip install .`), that interpreter alone.
 Each block is a notebook cell. Units: m, rad, N, Nm inside; mm only in printed figures, and said.
 """
 
@@ -24,8 +24,12 @@ rng = np.random.default_rng(7)
 # %% 1. The model (the robot file's nominal stiffness) and the arm it stands for. The "true" arm is
 #    the same kinematics with each joint 10-25 % softer or stiffer: what a calibration is for.
 model = deflex.Robot.builtin()
-truth = model.with_stiffness(model.stiffness * np.array([0.85, 1.10, 0.80, 1.20, 0.90, 1.15]), "the synthetic truth")
-print(f"robot: {model.name}; nominal stiffness {np.array2string(model.stiffness / 1e6, precision=3)} MNm/rad")
+nominal_k = model.stiffness
+assert nominal_k is not None  # the built-in robot's file gives one (a bare URDF's is None)
+truth = model.with_stiffness(nominal_k * np.array([0.85, 1.10, 0.80, 1.20, 0.90, 1.15]), "the synthetic truth")
+truth_k = truth.stiffness
+assert truth_k is not None
+print(f"robot: {model.name}; nominal stiffness {np.array2string(nominal_k / 1e6, precision=3)} MNm/rad")
 
 # %% 2. Plan the calibration in a box around the work (m, base frame): poses and load directions that
 #    make every joint's compliance observable (the operator's sheet: plan.write_csv()).
@@ -55,7 +59,7 @@ drot += rng.normal(0.0, 20e-6, size=drot.shape)
 # %% 4. Identify the joint stiffness from those arrays (a measurement CSV's path works the same way).
 estimate = deflex.identify_stiffness(model, q=plan.q, wrench=plan.wrench, dp=dp, drot=drot)
 identified = model.with_stiffness(estimate.stiffness_nm_per_rad, "identified in 03_paper_workflow.py")
-error_pct = 100 * (estimate.stiffness_nm_per_rad / truth.stiffness - 1)
+error_pct = 100 * (estimate.stiffness_nm_per_rad / truth_k - 1)
 print(f"identified: residual RMS {estimate.residual_rms_m * 1e3:.4f} mm; stiffness error against the truth "
       f"{np.array2string(error_pct, precision=1)} %")
 

@@ -14,8 +14,9 @@ try:
 except ImportError as error:  # pragma: no cover - depends on the interpreter
     raise ImportError(
         f"deflex needs NumPy, which this interpreter ({sys.executable}) cannot import: install it there "
-        f"({sys.executable} -m pip install numpy; Debian's python3: apt-get install python3-numpy), or build deflex "
-        "for the python3 that has it (scripts/python-module.sh, docs/python.md)"
+        f"({sys.executable} -m pip install numpy; Debian's python3: apt-get install python3-numpy; a venv sees "
+        "Debian's when made with --system-site-packages), or install deflex into the python3 that has it "
+        "(docs/python.md)"
     ) from error
 
 try:
@@ -25,8 +26,8 @@ try:
 except ImportError as error:  # pragma: no cover - depends on the interpreter
     raise ImportError(
         f"deflex's extension module was built for another Python than this one ({sys.executable}, "
-        f"{sys.version.split()[0]}): {error}. Build it for this interpreter: scripts/python-module.sh "
-        f"--python {sys.executable} (docs/python.md)"
+        f"{sys.version.split()[0]}): {error}. Build it for this interpreter from deflex's checkout: "
+        f"{sys.executable} -m pip install --no-build-isolation . (docs/python.md)"
     ) from error
 
 

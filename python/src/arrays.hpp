@@ -47,6 +47,18 @@ struct ConfigurationTag {
 struct DataTag {
   static constexpr auto name = py::detail::const_name("typing.Union[str, os.PathLike, numpy.typing.ArrayLike]");
 };
+struct TrackerPointsTag {
+  static constexpr auto name =
+      py::detail::const_name("typing.Union[typing.Dict[str, typing.Any], numpy.typing.ArrayLike]");
+};
+/// Points of a registration: what read_tracker_file returns, or an array.
+using TrackerPointsArg = Arg<TrackerPointsTag>;
+struct TracesTag {
+  static constexpr auto name =
+      py::detail::const_name("typing.Union[numpy.typing.ArrayLike, typing.Sequence[numpy.typing.ArrayLike]]");
+};
+/// One trace, or a list of traces.
+using TracesArg = Arg<TracesTag>;
 struct CaseTag {
   static constexpr auto name = py::detail::const_name("typing.Union[str, os.PathLike, dict]");
 };
@@ -67,9 +79,28 @@ using ArrayLike = Arg<ArrayLikeTag>;
 using PathOrPoses = Arg<PathOrPosesTag>;
 /// A force: a spec string as `deflex offline --force` takes it, or wrenches.
 using ForceArg = Arg<ForceTag>;
-/// A file path: str or any os.PathLike (pathlib.Path), as the C++ library's string.
-using PathArg = std::filesystem::path;
+/// A file path: str or any os.PathLike (pathlib.Path), as the C++ library's string. Its own type (not
+/// std::filesystem::path, which the stubs would call os.PathLike alone) so the signatures say both.
+struct PathArg : std::filesystem::path {
+  using std::filesystem::path::path;
+  PathArg(std::filesystem::path p) : std::filesystem::path(std::move(p)) {}  // NOLINT: a path is one
+};
 [[nodiscard]] inline std::string path_text(const PathArg& p) { return p.string(); }
+
+/// A result whose Python type depends on the arguments (one pose or a batch), named in signatures
+/// and stubs by `Tag::name` rather than `object`.
+template <typename Tag>
+using Returns = Arg<Tag>;
+struct IkSolutionsTag {
+  static constexpr auto name =
+      py::detail::const_name("typing.Union[typing.List[IkResult], typing.List[typing.List[IkResult]]]");
+};
+struct IkResultsTag {
+  static constexpr auto name = py::detail::const_name("typing.Union[IkResult, typing.List[IkResult]]");
+};
+struct BoolOrArrayTag {
+  static constexpr auto name = py::detail::const_name("typing.Union[bool, numpy.ndarray]");
+};
 
 /// The array made read-only: what every array property returns, so that an edit in place
 /// (`circle.centre_m[2] = 0.9`) raises ValueError instead of changing a copy the object never sees.
@@ -189,6 +220,21 @@ void pose_property(py::class_<T>& c, const char* name, Pose T::*field, const cha
 
 namespace pybind11::detail {
 /// Takes any object (None too: the function decides what None means) and keeps it for the checks.
+/// PathArg: pybind11's own std::filesystem::path conversion (str, bytes, os.PathLike), named for both.
+template <>
+struct type_caster<deflex::python::PathArg> {
+  PYBIND11_TYPE_CASTER(deflex::python::PathArg, const_name("typing.Union[str, os.PathLike]"));
+  bool load(handle src, bool convert) {
+    make_caster<std::filesystem::path> inner;
+    if (!inner.load(src, convert)) return false;
+    value = deflex::python::PathArg(cast_op<std::filesystem::path&&>(std::move(inner)));
+    return true;
+  }
+  static handle cast(const deflex::python::PathArg& p, return_value_policy policy, handle parent) {
+    return make_caster<std::filesystem::path>::cast(p, policy, parent);
+  }
+};
+
 template <typename Tag>
 struct type_caster<deflex::python::Arg<Tag>> {
   PYBIND11_TYPE_CASTER(deflex::python::Arg<Tag>, Tag::name);

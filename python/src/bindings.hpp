@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <pybind11/pybind11.h>
 #include <nlohmann/json_fwd.hpp>
@@ -31,6 +32,11 @@ bool moment_about_tcp(const std::string& about);
 /// moment about the WAP at q, moved there from the TCP when `about_tcp` (FK at q into `ws`).
 Wrench wrench_at_wap(const RobotModel& model, Workspace& ws, const JointVector& q, const double* wrenches, bool per_row,
                      std::ptrdiff_t row, bool about_tcp);
+
+/// A library message as Python says it: the command line's option names replaced by the arguments the
+/// Python calls take (errors.cpp). Every exception's text goes through it, and so do warnings.
+std::string python_message(std::string text);
+std::vector<std::string> python_messages(std::vector<std::string> texts);
 
 /// A JSON document as the Python objects json.loads makes of it (dict, list, str, float, ...).
 py::object json_to_python(const nlohmann::json& doc);

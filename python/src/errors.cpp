@@ -4,6 +4,10 @@
 #include <Python.h>
 
 #include <new>
+#include <regex>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "bindings.hpp"
 #include "deflex/text/errors.hpp"
@@ -27,6 +31,49 @@ PyObject* new_exception(py::module_& m, const char* name, PyObject* bases, const
 
 }  // namespace
 
+std::string python_message(std::string text) {
+  // The library's messages name the command line's options where a setting is at fault; from Python
+  // the same setting is an argument, named as the call takes it (SI units: --lever-mm is lever_m).
+  static const std::vector<std::pair<std::string, std::string>> kNames = {
+      {"option --tracker-units", "argument length_unit"},
+      {"--tracker-units", "length_unit"},
+      {"option --tracker-angle-units", "argument angle_unit"},
+      {"--tracker-angle-units", "angle_unit"},
+      {"option --sa-columns", "argument columns"},
+      {"--sa-columns", "columns"},
+      {"(--lever-mm)", "(lever_m)"},
+      {"deflex register --max-rms-mm", "register_frames(max_rms_m=...)"},
+      {"give --force", "give force_model"},
+      {"option --tooldata", "argument tooldata"},
+      {"option --wobjdata", "argument wobjdata"},
+      {"--tooldata", "tooldata"},
+      {"--wobjdata", "wobjdata"},
+  };
+  for (const auto& [cli, python] : kNames) {
+    for (std::size_t at = text.find(cli); at != std::string::npos; at = text.find(cli, at + python.size())) {
+      text.replace(at, cli.size(), python);
+    }
+  }
+  // Settings named as the option with underscores (a Session's keyword arguments: --stop-ramp-s is
+  // stop_ramp_s).
+  static const std::regex kOption("option --([a-z0-9-]+)");
+  std::string out;
+  std::sregex_iterator it(text.begin(), text.end(), kOption), end;
+  std::size_t from = 0;
+  for (; it != end; ++it) {
+    std::string name = (*it)[1].str();
+    for (char& c : name) c = c == '-' ? '_' : c;
+    out.append(text, from, static_cast<std::size_t>(it->position()) - from).append("argument ").append(name);
+    from = static_cast<std::size_t>(it->position() + it->length());
+  }
+  return out.append(text, from, std::string::npos);
+}
+
+std::vector<std::string> python_messages(std::vector<std::string> texts) {
+  for (std::string& t : texts) t = python_message(std::move(t));
+  return texts;
+}
+
 void bind_errors(py::module_& m) {
   g_error = new_exception(m, "Error", PyExc_RuntimeError, "Base of every deflex error.");
   g_model_error = new_exception(m, "ModelError", g_error,
@@ -41,13 +88,13 @@ void bind_errors(py::module_& m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const InputError& e) {
-      PyErr_SetString(g_input_error, e.what());
+      PyErr_SetString(g_input_error, python_message(e.what()).c_str());
     } catch (const DataError& e) {
-      PyErr_SetString(g_data_error, e.what());
+      PyErr_SetString(g_data_error, python_message(e.what()).c_str());
     } catch (const ModelError& e) {
-      PyErr_SetString(g_model_error, e.what());
+      PyErr_SetString(g_model_error, python_message(e.what()).c_str());
     } catch (const Error& e) {
-      PyErr_SetString(g_error, e.what());
+      PyErr_SetString(g_error, python_message(e.what()).c_str());
     } catch (const py::builtin_exception&) {
       throw;  // pybind11's own (IndexError, StopIteration, TypeError, ...): its translator raises them
     } catch (const py::error_already_set&) {
@@ -57,7 +104,7 @@ void bind_errors(py::module_& m) {
     } catch (const std::exception& e) {
       // Anything else the library or the standard library throws (a file system error, an Eigen
       // size check) is still a deflex.Error, never a bare RuntimeError.
-      PyErr_SetString(g_error, e.what());
+      PyErr_SetString(g_error, python_message(e.what()).c_str());
     }
   });
 }

@@ -1,6 +1,8 @@
 // Path metrics: the paper's mean distance from the unloaded path and its companions, the
 // time-synchronous error, ISO 9283 path accuracy and repeatability. A trace is (N, 3) positions in m
 // or (N, 4) [t_s, x_m, y_m, z_m] (tracker CSV files: read_tracker_csv).
+#include <algorithm>
+
 #include <fmt/format.h>
 #include <pybind11/stl.h>
 
@@ -8,23 +10,17 @@
 #include "bindings.hpp"
 #include "deflex/evaluate/frame_registration.hpp"
 #include "deflex/evaluate/iso9283_path.hpp"
+#include "deflex/evaluate/lap_split.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
 #include "deflex/evaluate/time_alignment.hpp"
 #include "deflex/evaluate/tracker_files.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex::python {
 using namespace pybind11::literals;
 namespace {
 
 // (N, 3) points in m.
-std::vector<Vector3> points_of(const py::handle& obj, const char* name) {
-  const TrackerTrace t = tracker_trace(obj, name);
-  std::vector<Vector3> out;
-  out.reserve(t.size());
-  for (const auto& s : t) out.push_back(s.p_m);
-  return out;
-}
-
 std::vector<TrackerTrace> traces(const py::handle& list, const char* name) {
   std::vector<TrackerTrace> out;
   int i = 0;
@@ -33,6 +29,59 @@ std::vector<TrackerTrace> traces(const py::handle& list, const char* name) {
     out.push_back(tracker_trace(item, item_name.c_str()));
   }
   return out;
+}
+
+/// One side of a registration as the pairing reads it: the dict read_tracker_file returns (its points,
+/// names, file and lines), or an (N, 3) or (N, 4) array ([t_s,] x, y, z in m; t_s may be NaN) with
+/// optional names.
+TrackerFile registration_side(const py::handle& obj, const py::handle& names_arg, const char* name) {
+  TrackerFile f;
+  f.source = fmt::format("argument {}", name);
+  py::object points = py::reinterpret_borrow<py::object>(obj);
+  py::object names = py::reinterpret_borrow<py::object>(names_arg);
+  std::vector<int> lines;
+  if (py::isinstance<py::dict>(obj)) {
+    const auto d = py::reinterpret_borrow<py::dict>(obj);
+    if (!d.contains("points")) throw InputError(fmt::format("argument {}: a dict without 'points'", name));
+    points = d["points"];
+    if (names.is_none() && d.contains("names")) names = d["names"];
+    if (d.contains("source")) f.source = d["source"].cast<std::string>();
+    if (d.contains("lines")) lines = d["lines"].cast<std::vector<int>>();
+  }
+  const Array a = to_array(points, name, 2);
+  const py::ssize_t n = a.shape(0), cols = a.shape(1);
+  if (cols != 3 && cols != 4) {
+    throw InputError(fmt::format("argument {}: expected shape (N, 3) [x, y, z] or (N, 4) [t_s, x, y, z], got ({}, {})",
+                                 name, n, cols));
+  }
+  std::vector<std::string> labels;
+  if (!names.is_none()) {
+    labels = names.cast<std::vector<std::string>>();
+    if (static_cast<py::ssize_t>(labels.size()) != n) {
+      throw InputError(fmt::format("argument {}: {} names for {} points", name, labels.size(), n));
+    }
+  }
+  f.has_names = !labels.empty() && std::none_of(labels.begin(), labels.end(), [](const auto& s) { return s.empty(); });
+  for (py::ssize_t i = 0; i < n; ++i) {
+    TrackerPoint p;
+    p.p_m = Eigen::Map<const Vector3>(a.data() + i * cols + (cols - 3));
+    if (!p.p_m.allFinite())
+      throw InputError(fmt::format("argument {}: row {}: a position that is not finite", name, i));
+    if (f.has_names) p.name = labels[static_cast<std::size_t>(i)];
+    p.line = static_cast<std::size_t>(i) < lines.size() ? lines[static_cast<std::size_t>(i)] : 0;
+    f.points.push_back(p);
+  }
+  return f;
+}
+
+/// One trace ((N, 3) or (N, 4) numbers), rather than a list of traces.
+bool is_one_trace(const py::handle& obj) {
+  try {
+    const py::object a = py::module_::import("numpy").attr("asarray")(obj, "dtype"_a = "float64");
+    return a.attr("ndim").cast<int>() == 2;
+  } catch (const py::error_already_set&) {
+    return false;  // ragged: traces of different lengths
+  }
 }
 
 }  // namespace
@@ -63,6 +112,51 @@ void bind_evaluate(py::module_& m) {
   m.def(
       "read_tracker_csv", [](const PathArg& path) { return from_trace(read_tracker_csv(path_text(path))); }, "path"_a,
       "A tracker CSV (t_s,x_mm,y_mm,z_mm) as an (N, 4) array [t_s, x_m, y_m, z_m].");
+  m.def(
+      "split_laps",
+      [](const ArrayLike& trace, double min_turn_rad, double reversal_rad) {
+        const TrackerTrace t = tracker_trace(trace, "trace");
+        LapSplit s;
+        {
+          py::gil_scoped_release release;
+          s = split_laps(t, min_turn_rad, reversal_rad);
+        }
+        py::list laps;
+        for (const TrackerTrace& lap : s.laps) laps.append(from_trace(lap));
+        return laps;
+      },
+      "trace"_a, "min_turn_rad"_a = 0.9 * 2.0 * kPi, "reversal_rad"_a = deg_to_rad(5.0),
+      "The laps of a trace that goes round a closed path ((N, 4) [t_s, x_m, y_m, z_m] or (N, 3)), as `deflex "
+      "evaluate --split-laps` and the case study find them: by the angle turned about the centroid in the plane of "
+      "best fit, a lap ending after a full turn or where the direction reverses (by more than reversal_rad); pieces "
+      "that turn less than min_turn_rad (the approach, a partial lap) are dropped. A list of (M, 4) arrays.");
+  m.def(
+      "mean_reference",
+      [](const TracesArg& given, int bins) {
+        TrackerTrace all;
+        if (is_one_trace(given)) {
+          all = tracker_trace(given, "traces");
+        } else {
+          for (const TrackerTrace& t : traces(given, "traces")) all.insert(all.end(), t.begin(), t.end());
+        }
+        TrackerTrace mean;
+        {
+          py::gil_scoped_release release;
+          mean = mean_closed_path(all, bins);
+        }
+        Array out = new_array({static_cast<py::ssize_t>(mean.size()), 3});
+        for (std::size_t i = 0; i < mean.size(); ++i) {
+          for (int k = 0; k < 3; ++k) out.mutable_data()[3 * i + static_cast<std::size_t>(k)] = mean[i].p_m[k];
+        }
+        return out;
+      },
+      "traces"_a, "bins"_a = 3600,
+      "The mean of a closed path's laps as one closed polyline (M, 3) in m, the reference the case study measures "
+      "its loaded runs against (a nearest-point distance to a dense, noisy reference is biased low by the "
+      "reference's noise; to the laps' mean it is not): the samples of one trace, or of a list of traces (laps or "
+      "runs), binned by their angle about the centroid in the plane of best fit (bins equal sectors; `deflex "
+      "evaluate --mean-reference` takes about two samples a lap a bin, 36..3600), each bin's positions averaged. "
+      "Refuses fewer than 90 % of the bins holding a sample.");
   m.def(
       "mean_distance_to_path_m",
       [](const ArrayLike& loaded, const ArrayLike& reference) {
@@ -134,6 +228,10 @@ void bind_evaluate(py::module_& m) {
         d["length_unit"] = f.length_unit;
         d["has_time"] = f.has_time;
         d["encoding"] = f.encoding;
+        d["source"] = f.source;
+        std::vector<int> lines;
+        for (const auto& p : f.points) lines.push_back(p.line);
+        d["lines"] = lines;
         return d;
       },
       "path"_a, "length_unit"_a = "", "angle_unit"_a = "", "columns"_a = "", "expect_frame"_a = "",
@@ -152,25 +250,39 @@ void bind_evaluate(py::module_& m) {
       "Writes an (N, 4) trace [t_s, x_m, y_m, z_m] as a Spatial Analyzer ASCII export (mm, named working frame).");
   m.def(
       "register_frames",
-      [](const ArrayLike& tracker_points, const ArrayLike& base_points, double max_rms_m) {
-        RegistrationInput in;
-        in.tracker_m = points_of(tracker_points, "tracker_points");
-        in.base_m = points_of(base_points, "base_points");
+      [](const TrackerPointsArg& tracker_points, const TrackerPointsArg& base_points, double max_rms_m,
+         const std::optional<std::vector<std::string>>& tracker_names,
+         const std::optional<std::vector<std::string>>& base_names) {
+        const py::object none = py::none();
+        const TrackerFile t =
+            registration_side(tracker_points, tracker_names ? py::cast(*tracker_names) : none, "tracker_points");
+        const TrackerFile b = registration_side(base_points, base_names ? py::cast(*base_names) : none, "base_points");
+        RegistrationInput in = pair_tracker_points(t, b);
         in.max_rms_m = max_rms_m;
         const FrameRegistration r = register_frames(in);
         std::vector<double> res;
-        for (const auto& e : r.residuals) res.push_back(e.distance_m);
+        py::list names;
+        for (const auto& e : r.residuals) {
+          res.push_back(e.distance_m);
+          names.append(e.name);
+        }
         py::dict d;
         d["base_T_tracker"] = from_pose(r.base_T_tracker);
         d["rms_m"] = r.rms_m;
         d["max_m"] = r.max_m;
         d["residuals_m"] = from_vector(res);
+        d["names"] = names;
         return d;
       },
-      "tracker_points"_a, "base_points"_a, "max_rms_m"_a = kDefaultMaxRegistrationRmsM,
-      "The tracker-to-base transform (4x4, p_base = T p_tracker) from paired (N, 3) points in m, by Horn's closed "
-      "form, with the residual of each point; refuses fewer than 3 points, points on a line, a mirror image (no "
-      "rotation fits it) and an RMS above max_rms_m (default 1 mm: pairs that do not belong together).");
+      "tracker_points"_a, "base_points"_a, "max_rms_m"_a = kDefaultMaxRegistrationRmsM, "tracker_names"_a = py::none(),
+      "base_names"_a = py::none(),
+      "The tracker-to-base transform (4x4, p_base = T p_tracker) by Horn's closed form, with the residual of each "
+      "point (residuals_m, in the order of names). Each side is what read_tracker_file returns, or (N, 3) [x, y, z] "
+      "or (N, 4) [t_s, x, y, z] points in m with optional names (tracker_names, base_names). Points pair as `deflex "
+      "register` pairs them: by name when both sides name theirs (the whole name, else the target's own: "
+      "'Job::Reference::REF1' with 'REF1'), else by order. Refuses a name without a partner, fewer than 3 points, "
+      "points on a line, a mirror image (no rotation fits it) and an RMS above max_rms_m (default 1 mm: pairs that "
+      "do not belong together).");
   m.def(
       "align_time",
       [](const ArrayLike& measured, const ArrayLike& commanded, bool fit_drift, double search_s, double centre_s) {

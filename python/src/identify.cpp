@@ -68,6 +68,43 @@ py::dict measurements_to_dict(const std::vector<StiffnessMeasurement>& data) {
   return out;
 }
 
+int plan_dof(const CalibrationPlan& p) { return p.points.empty() ? 0 : static_cast<int>(p.points.front().q.size()); }
+
+/// A plan as plain Python values (pickling): its rows, then the figures.
+py::tuple plan_state(const CalibrationPlan& p) {
+  py::list rows;
+  for (const CalibrationPoint& c : p.points) {
+    rows.append(py::make_tuple(c.pose, from_vector(c.q), from_pose(c.base_T_tcp), from_vector(c.wrench_base),
+                               from_vector(c.load_point_base), from_vector(c.expected_dp_m)));
+  }
+  return py::make_tuple(rows, p.min_singular_value_m, p.condition_number, p.predicted_relative_std_error,
+                        p.candidate_poses, p.reachable_poses, p.warnings);
+}
+
+CalibrationPlan plan_from_state(const py::tuple& t) {
+  if (t.size() != 7) throw InputError("deflex.CalibrationPlan: not a pickled CalibrationPlan");
+  CalibrationPlan p;
+  for (const py::handle row : t[0].cast<py::list>()) {
+    const auto r = row.cast<py::tuple>();
+    CalibrationPoint c;
+    c.pose = r[0].cast<int>();
+    const Array q = to_array(r[1], "q", 1);
+    c.q = Eigen::Map<const Eigen::VectorXd>(q.data(), q.shape(0));
+    c.base_T_tcp = pose(r[2], "base_T_tcp");
+    c.wrench_base = vector6(r[3], "wrench");
+    c.load_point_base = vector3(r[4], "load_point");
+    c.expected_dp_m = vector3(r[5], "expected_dp");
+    p.points.push_back(c);
+  }
+  p.min_singular_value_m = t[1].cast<double>();
+  p.condition_number = t[2].cast<double>();
+  p.predicted_relative_std_error = t[3].cast<std::vector<double>>();
+  p.candidate_poses = t[4].cast<int>();
+  p.reachable_poses = t[5].cast<int>();
+  p.warnings = t[6].cast<std::vector<std::string>>();
+  return p;
+}
+
 }  // namespace
 
 void bind_identify(py::module_& m) {
@@ -89,7 +126,7 @@ void bind_identify(py::module_& m) {
       .def_readonly("condition_number", &StiffnessEstimate::condition_number)
       .def_readonly("unidentifiable_joints", &StiffnessEstimate::unidentifiable_joints, "1-based joint numbers")
       .def_readonly("fixed_joints", &StiffnessEstimate::fixed_joints, "1-based joint numbers")
-      .def_readonly("warnings", &StiffnessEstimate::warnings)
+      .def_property_readonly("warnings", [](const StiffnessEstimate& e) { return python_messages(e.warnings); })
       .def_property_readonly("robust_weights",
                              [](const StiffnessEstimate& e) { return frozen(from_vector(e.robust_weights)); })
       .def_readonly("rejected_measurements", &StiffnessEstimate::rejected_measurements, "0-based indices")
@@ -149,24 +186,31 @@ void bind_identify(py::module_& m) {
 
   m.def(
       "identify_stiffness",
-      [](const RobotModel& model, const DataArg& data, const std::optional<ArrayLike>& wrench_pos,
-         const std::optional<ArrayLike>& dp_pos, const std::optional<ArrayLike>& q_kw,
-         const std::optional<ArrayLike>& drot, const std::optional<ArrayLike>& weight, const OptionalFloats& fixed,
-         bool robust, double rotation_scale_m, double max_relative_std_error) {
+      [](const RobotModel& model, const DataArg& q_or_path, const std::optional<ArrayLike>& wrench_pos,
+         const std::optional<ArrayLike>& dp_pos, const std::optional<ArrayLike>& drot,
+         const std::optional<ArrayLike>& weight, const OptionalFloats& fixed, bool robust, double rotation_scale_m,
+         double max_relative_std_error, const DataArg& csv_path, const DataArg& data) {
         std::vector<StiffnessMeasurement> measurements;
         const auto given = [](const std::optional<ArrayLike>& a) { return a && !a->is_none(); };
-        const bool is_file = py::isinstance<py::str>(data.obj) || py::hasattr(data.obj, "__fspath__");
+        // The measurements: the second positional argument (q's place: arrays or a CSV path), csv_path=,
+        // or data= (either), one of them.
+        const int places = static_cast<int>(!q_or_path.is_none()) + static_cast<int>(!csv_path.is_none()) +
+                           static_cast<int>(!data.is_none());
+        if (places > 1) {
+          throw InputError("identify_stiffness: the measurements given twice (give q, csv_path or data, one of them)");
+        }
+        const py::object first = !q_or_path.is_none() ? q_or_path.obj : !csv_path.is_none() ? csv_path.obj : data.obj;
+        const bool is_file = py::isinstance<py::str>(first) || py::hasattr(first, "__fspath__");
         if (is_file) {
-          if (given(q_kw) || given(wrench_pos) || given(dp_pos)) {
-            throw InputError("identify_stiffness: give either data (a CSV path) or the arrays q, wrench, dp, not both");
+          if (given(wrench_pos) || given(dp_pos)) {
+            throw InputError(
+                "identify_stiffness: give either the measurement CSV's path or the arrays q, wrench, dp, not both");
           }
-          measurements = read_stiffness_measurements(data.obj.cast<PathArg>().string());
+          measurements = read_stiffness_measurements(first.cast<PathArg>().string());
         } else {
-          // Arrays: by keyword, or positionally as (robot, q, wrench, dp).
-          if (!data.is_none() && given(q_kw))
-            throw InputError("identify_stiffness: q given twice (positionally and as q=)");
+          if (!csv_path.is_none()) throw InputError("argument csv_path: a str or os.PathLike, not arrays");
           const py::object none = py::none();
-          const py::object q = !data.is_none() ? data.obj : given(q_kw) ? q_kw->obj : none;
+          const py::object& q = first;
           const py::object w = given(wrench_pos) ? wrench_pos->obj : none;
           const py::object dp = given(dp_pos) ? dp_pos->obj : none;
           if (q.is_none() || w.is_none() || dp.is_none()) {
@@ -191,13 +235,15 @@ void bind_identify(py::module_& m) {
         py::gil_scoped_release release;
         return identify_stiffness(model, measurements, options);
       },
-      "robot"_a, "data"_a = py::none(), "wrench"_a = py::none(), "dp"_a = py::none(), "q"_a = py::none(),
-      "drot"_a = py::none(), "weight"_a = py::none(), "fixed_stiffness_nm_per_rad"_a = py::none(), "robust"_a = true,
-      "rotation_scale_m"_a = 1.0, "max_relative_std_error"_a = 0.5,
-      "Joint stiffness from measured TCP deflections: data is the measurement CSV's path (str or os.PathLike), or "
-      "the arrays q (m, dof) rad, wrench (m, 6) N/Nm (base frame, moment about the WAP) and dp (m, 3) m, positionally "
-      "(robot, q, wrench, dp) or by keyword; optional drot (m, 3) rad and weight (m,). "
-      "fixed_stiffness_nm_per_rad: one entry a joint, a value to hold or None to estimate.");
+      "robot"_a, "q"_a = py::none(), "wrench"_a = py::none(), "dp"_a = py::none(), "drot"_a = py::none(),
+      "weight"_a = py::none(), "fixed_stiffness_nm_per_rad"_a = py::none(), "robust"_a = true,
+      "rotation_scale_m"_a = 1.0, "max_relative_std_error"_a = 0.5, py::kw_only(), "csv_path"_a = py::none(),
+      "data"_a = py::none(),
+      "Joint stiffness from measured TCP deflections: the measurement CSV's path (str or os.PathLike: "
+      "identify_stiffness(robot, csv_path) or csv_path=), or the arrays q (m, dof) rad, wrench (m, 6) N/Nm (base "
+      "frame, moment about the WAP) and dp (m, 3) m, positionally (robot, q, wrench, dp, drot, weight) or by keyword; "
+      "optional drot (m, 3) rad and weight (m,). fixed_stiffness_nm_per_rad: one entry a joint, a value to hold or "
+      "None to estimate. data= takes either form.");
 
   m.def(
       "identified_robot",
@@ -218,36 +264,37 @@ void bind_identify(py::module_& m) {
           },
           "1-based pose number of each row")
       .def_property_readonly(
-          "q",
-          [](const CalibrationPlan& p) {
-            return rows_of(p.points, &CalibrationPoint::q, p.points.empty() ? 0 : p.points.front().q.size());
-          },
+          "q", [](const CalibrationPlan& p) { return frozen(rows_of(p.points, &CalibrationPoint::q, plan_dof(p))); },
           "(rows, dof) rad")
       .def_property_readonly(
-          "base_T_tcp", [](const CalibrationPlan& p) { return poses_of(p.points, &CalibrationPoint::base_T_tcp); },
+          "base_T_tcp",
+          [](const CalibrationPlan& p) { return frozen(poses_of(p.points, &CalibrationPoint::base_T_tcp)); },
           "(rows, 4, 4), m")
       .def_property_readonly(
-          "wrench", [](const CalibrationPlan& p) { return rows_of(p.points, &CalibrationPoint::wrench_base, 6); },
+          "wrench",
+          [](const CalibrationPlan& p) { return frozen(rows_of(p.points, &CalibrationPoint::wrench_base, 6)); },
           "(rows, 6) N, Nm at the WAP, base frame")
       .def_property_readonly(
           "load_point",
-          [](const CalibrationPlan& p) { return rows_of(p.points, &CalibrationPoint::load_point_base, 3); },
+          [](const CalibrationPlan& p) { return frozen(rows_of(p.points, &CalibrationPoint::load_point_base, 3)); },
           "(rows, 3) m, where the force acts")
       .def_property_readonly(
           "expected_dp",
-          [](const CalibrationPlan& p) { return rows_of(p.points, &CalibrationPoint::expected_dp_m, 3); },
+          [](const CalibrationPlan& p) { return frozen(rows_of(p.points, &CalibrationPoint::expected_dp_m, 3)); },
           "(rows, 3) m, first-order deflection with the robot file's stiffness")
       .def_readonly("min_singular_value_m", &CalibrationPlan::min_singular_value_m)
       .def_readonly("condition_number", &CalibrationPlan::condition_number)
-      .def_property_readonly("predicted_relative_std_error",
-                             [](const CalibrationPlan& p) { return from_vector(p.predicted_relative_std_error); })
+      .def_property_readonly(
+          "predicted_relative_std_error",
+          [](const CalibrationPlan& p) { return frozen(from_vector(p.predicted_relative_std_error)); })
       .def_readonly("candidate_poses", &CalibrationPlan::candidate_poses)
       .def_readonly("reachable_poses", &CalibrationPlan::reachable_poses)
-      .def_readonly("warnings", &CalibrationPlan::warnings)
+      .def_property_readonly("warnings", [](const CalibrationPlan& p) { return python_messages(p.warnings); })
       .def(
           "write_csv",
           [](const CalibrationPlan& p, const PathArg& path) { write_calibration_plan(path_text(path), p); }, "path"_a,
-          "The plan as the operator's CSV (the same as deflex plan-calibration -o).");
+          "The plan as the operator's CSV (the same as deflex plan-calibration -o).")
+      .def(py::pickle(&plan_state, &plan_from_state));
 
   m.def(
       "plan_calibration",

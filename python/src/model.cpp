@@ -73,13 +73,15 @@ std::vector<py::ssize_t> result_shape(bool batch, py::ssize_t rows, std::vector<
   return rest;
 }
 
-/// Runs body(ws, i, q_i) for every row of q (rows of dof values), GIL released, spread over
-/// `threads` threads (0: every core), each with its own Workspace.
+/// Runs body(ws, i, q_i) for every row of q (rows of dof values), spread over `threads` threads (0:
+/// every core), each with its own Workspace; the GIL released for a batch (kGilRows rows or more: for
+/// fewer, releasing and taking it back costs more than the rows).
 template <typename Body>
 void for_each_row(const RobotModel& model, const double* qd, py::ssize_t rows, int threads, Body&& body) {
   const int dof = model.dof();
   const int n_threads = batch_threads(threads, rows);
-  py::gil_scoped_release release;
+  std::optional<py::gil_scoped_release> release;
+  if (rows >= kGilRows) release.emplace();
   parallel_rows(rows, n_threads, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
     Workspace ws(model);
     JointVector qi(dof);
@@ -223,14 +225,7 @@ std::vector<IkResult> ik_solutions(const RobotModel& r, Workspace& ws, const Pos
     IkResult one = inverse_kinematics(r, ws, p, req);
     return one.ok() ? std::vector<IkResult>{one} : std::vector<IkResult>{};
   }
-  std::vector<IkResult> all = all_ik_solutions(r, ws, p, req);
-  if (req.seed) {
-    const JointVector& seed = *req.seed;
-    std::stable_sort(all.begin(), all.end(), [&](const IkResult& a, const IkResult& b) {
-      return (a.q - seed).cwiseAbs().maxCoeff() < (b.q - seed).cwiseAbs().maxCoeff();
-    });
-  }
-  return all;
+  return all_ik_solutions(r, ws, p, req);  // nearest the seed first
 }
 
 /// The seeds of an IK call, read while the GIL is held: none, one (dof,) for every pose, or one a
@@ -274,10 +269,10 @@ bool is_pose_batch(const py::handle& obj) {
   return a && a.ndim() == 3;
 }
 
-py::object ik(const RobotModel& r, const ArrayLike& target, const std::optional<ArrayLike>& seed) {
+Returns<IkSolutionsTag> ik(const RobotModel& r, const ArrayLike& target, const std::optional<ArrayLike>& seed) {
   if (!is_pose_batch(target)) {
     Workspace ws(r);
-    return py::cast(ik_solutions(r, ws, pose(target, "pose"), Seeds(r, seed, 0).request(r.dof(), 0)));
+    return {py::cast(ik_solutions(r, ws, pose(target, "pose"), Seeds(r, seed, 0).request(r.dof(), 0)))};
   }
   const std::vector<Pose> p = poses(target, "pose");
   const Seeds seeds(r, seed, static_cast<py::ssize_t>(p.size()));
@@ -289,17 +284,18 @@ py::object ik(const RobotModel& r, const ArrayLike& target, const std::optional<
       out[i] = ik_solutions(r, ws, p[i], seeds.request(r.dof(), static_cast<py::ssize_t>(i)));
     }
   }
-  return py::cast(out);
+  return {py::cast(out)};
 }
 
-py::object inverse_kinematics_of(const RobotModel& r, const ArrayLike& target, const ConfigurationArg& configuration,
-                                 const std::optional<ArrayLike>& seed) {
+Returns<IkResultsTag> inverse_kinematics_of(const RobotModel& r, const ArrayLike& target,
+                                            const ConfigurationArg& configuration,
+                                            const std::optional<ArrayLike>& seed) {
   const std::optional<ArmConfiguration> conf = arm_configuration_arg(configuration);
   if (!is_pose_batch(target)) {
     IkRequest req = Seeds(r, seed, 0).request(r.dof(), 0);
     req.configuration = conf;
     Workspace ws(r);
-    return py::cast(inverse_kinematics(r, ws, pose(target, "pose"), req));
+    return {py::cast(inverse_kinematics(r, ws, pose(target, "pose"), req))};
   }
   const std::vector<Pose> p = poses(target, "pose");
   const Seeds seeds(r, seed, static_cast<py::ssize_t>(p.size()));
@@ -313,7 +309,7 @@ py::object inverse_kinematics_of(const RobotModel& r, const ArrayLike& target, c
       out[i] = inverse_kinematics(r, ws, p[i], req);
     }
   }
-  return py::cast(out);
+  return {py::cast(out)};
 }
 
 RobotHolder robot_from_state(const py::tuple& state) {
@@ -457,16 +453,16 @@ void bind_model(py::module_& m) {
           "stiffness_nm_per_rad"_a, "note"_a = "given from Python", "A copy with another joint stiffness (Nm/rad).")
       .def(
           "within_limits",
-          [](const RobotModel& r, const ArrayLike& q_obj, double tol) -> py::object {
+          [](const RobotModel& r, const ArrayLike& q_obj, double tol) -> Returns<BoolOrArrayTag> {
             bool batch = false;
             const Array q = joint_rows(q_obj, "q", r.dof(), batch);
-            if (!batch) return py::bool_(r.within_limits(Eigen::Map<const Eigen::VectorXd>(q.data(), r.dof()), tol));
+            if (!batch) return {py::bool_(r.within_limits(Eigen::Map<const Eigen::VectorXd>(q.data(), r.dof()), tol))};
             py::array_t<bool> out(q.shape(0));
             bool* o = out.mutable_data();
             for (py::ssize_t i = 0; i < q.shape(0); ++i) {
               o[i] = r.within_limits(Eigen::Map<const Eigen::VectorXd>(q.data() + i * r.dof(), r.dof()), tol);
             }
-            return out;
+            return {out};
           },
           "q"_a, "tolerance_rad"_a = 1e-9,
           "True when every joint is inside its limits; a bool array for a batch (N, dof).")

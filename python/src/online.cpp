@@ -14,6 +14,128 @@
 
 namespace deflex::python {
 using namespace pybind11::literals;
+namespace {
+
+/// A sensor configuration as plain Python values (pickling), every field.
+py::tuple sensor_state(const SensorConfig& s) {
+  return py::make_tuple(s.name, s.source, s.components, from_matrix(s.crosstalk), from_pose(s.flange_T_sensor),
+                        py::make_tuple(s.payload_mass_kg, from_vector(s.payload_cog_sensor_m),
+                                       from_vector(s.bias_sensor), from_vector(s.gravity_base_m_s2)),
+                        py::make_tuple(s.lowpass_cutoff_hz, s.lowpass_order, s.sample_rate_hz, s.dead_band_N,
+                                       s.dead_band_Nm, s.fault_threshold_N, s.fault_threshold_Nm));
+}
+
+SensorConfig sensor_from_state(const py::tuple& t) {
+  if (t.size() != 7) throw InputError("deflex.SensorConfig: not a pickled SensorConfig");
+  SensorConfig s;
+  s.name = t[0].cast<std::string>();
+  s.source = t[1].cast<std::string>();
+  s.components = t[2].cast<int>();
+  s.crosstalk =
+      Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(matrix_array(t[3], "crosstalk", 6, 6).data());
+  s.flange_T_sensor = pose(t[4], "flange_T_sensor");
+  const auto payload = t[5].cast<py::tuple>();
+  s.payload_mass_kg = payload[0].cast<double>();
+  s.payload_cog_sensor_m = vector3(payload[1], "payload_cog_sensor_m");
+  s.bias_sensor = vector6(payload[2], "bias_sensor");
+  s.gravity_base_m_s2 = vector3(payload[3], "gravity_base_m_s2");
+  const auto c = t[6].cast<py::tuple>();
+  s.lowpass_cutoff_hz = c[0].cast<double>();
+  s.lowpass_order = c[1].cast<int>();
+  s.sample_rate_hz = c[2].cast<double>();
+  s.dead_band_N = c[3].cast<double>();
+  s.dead_band_Nm = c[4].cast<double>();
+  s.fault_threshold_N = c[5].cast<double>();
+  s.fault_threshold_Nm = c[6].cast<double>();
+  return s;
+}
+
+py::tuple online_config_state(const OnlineConfig& c) {
+  return py::make_tuple(c.period_s, c.max_joint_correction_rad, c.max_tcp_correction_m, c.max_correction_rate_rad_s,
+                        c.max_tcp_rate_m_s, c.watchdog_s, c.fault_hold_s, c.jacobian_at == JacobianAt::kPlanned);
+}
+
+OnlineConfig online_config_from_state(const py::tuple& t) {
+  if (t.size() != 8) throw InputError("deflex.OnlineConfig: not a pickled OnlineConfig");
+  OnlineConfig c;
+  c.period_s = t[0].cast<double>();
+  c.max_joint_correction_rad = t[1].cast<double>();
+  c.max_tcp_correction_m = t[2].cast<double>();
+  c.max_correction_rate_rad_s = t[3].cast<double>();
+  c.max_tcp_rate_m_s = t[4].cast<double>();
+  c.watchdog_s = t[5].cast<double>();
+  c.fault_hold_s = t[6].cast<double>();
+  c.jacobian_at = t[7].cast<bool>() ? JacobianAt::kPlanned : JacobianAt::kFeedback;
+  return c;
+}
+
+py::tuple cycle_state(const CycleOutput& o) {
+  return py::make_tuple(from_vector(o.q_command), from_vector(o.dtheta), from_vector(o.wrench_base),
+                        from_vector(o.wrench_measured_base), static_cast<int>(o.status), o.size_limited, o.rate_limited,
+                        o.tcp_correction_m, from_vector(o.tcp_deflection_base_m), o.force_age_s, o.samples_used);
+}
+
+/// The vector of a pickled result: any length (a joint vector), values as they were (NaN included).
+Eigen::VectorXd state_vector(const py::handle& h) {
+  const Array a = to_array(h, "state", 1);
+  return Eigen::Map<const Eigen::VectorXd>(a.data(), a.shape(0));
+}
+
+CycleOutput cycle_from_state(const py::tuple& t) {
+  if (t.size() != 11) throw InputError("deflex.CycleOutput: not a pickled CycleOutput");
+  CycleOutput o;
+  o.q_command = state_vector(t[0]);
+  o.dtheta = state_vector(t[1]);
+  o.wrench_base = state_vector(t[2]);
+  o.wrench_measured_base = state_vector(t[3]);
+  o.status = static_cast<CycleStatus>(t[4].cast<int>());
+  o.size_limited = t[5].cast<bool>();
+  o.rate_limited = t[6].cast<bool>();
+  o.tcp_correction_m = t[7].cast<double>();
+  o.tcp_deflection_base_m = state_vector(t[8]);
+  o.force_age_s = t[9].cast<double>();
+  o.samples_used = t[10].cast<int>();
+  return o;
+}
+
+/// A raw sensor reading: (6,) [Fx Fy Fz Mx My Mz], or (3,) forces for a 3-axis sensor (no moments).
+Vector6 sensor_wrench(const OnlineCompensator& c, const py::handle& obj, const char* name) {
+  const Array a = to_array(obj, name, 1);
+  if (a.shape(0) == 3 && c.pipeline().config().components == 3) {
+    Vector6 w = Vector6::Zero();
+    w.head<3>() = vector3(obj, name);
+    return w;
+  }
+  if (a.shape(0) == 3) {
+    throw InputError(
+        fmt::format("argument {}: 3 values for a 6-axis sensor (SensorConfig.components 6): give "
+                    "[Fx, Fy, Fz, Mx, My, Mz]",
+                    name));
+  }
+  return vector6(obj, name);
+}
+
+/// Raw readings (n, 6), or (n, 3) forces for a 3-axis sensor (moments zero: its pipeline ignores them).
+Array sensor_wrench_rows(const OnlineCompensator& c, const py::handle& obj, py::ssize_t n) {
+  const Array a = to_array(obj, "wrench_sensor", 2);
+  if (a.shape(1) != 3) return matrix_array(obj, "wrench_sensor", n, 6);
+  if (c.pipeline().config().components != 3) {
+    throw InputError(
+        fmt::format("argument wrench_sensor: ({}, 3) for a 6-axis sensor (SensorConfig.components 6): "
+                    "give ({}, 6) [Fx, Fy, Fz, Mx, My, Mz]",
+                    a.shape(0), n));
+  }
+  const Array forces = matrix_array(obj, "wrench_sensor", n, 3);
+  Array out = new_array({n, 6});
+  double* d = out.mutable_data();
+  for (py::ssize_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 6; ++k) d[6 * i + k] = k < 3 ? forces.data()[3 * i + k] : 0.0;
+  }
+  return out;
+}
+
+}  // namespace
+
 void bind_online(py::module_& m) {
   py::class_<SensorConfig> sensor_class(m, "SensorConfig",
                                         "Force-sensor conditioning (docs/online.md): crosstalk, frame, payload, bias, "
@@ -36,11 +158,15 @@ void bind_online(py::module_& m) {
       .def_readwrite("dead_band_Nm", &SensorConfig::dead_band_Nm)
       .def_readwrite("fault_threshold_N", &SensorConfig::fault_threshold_N)
       .def_readwrite("fault_threshold_Nm", &SensorConfig::fault_threshold_Nm)
+      .def_readwrite("source", &SensorConfig::source, "the file it came from")
       .def("validate", &SensorConfig::validate)
-      .def("to_yaml", [](const SensorConfig& s) { return sensor_config_to_yaml(s); });
+      .def("to_yaml", [](const SensorConfig& s) { return sensor_config_to_yaml(s); })
+      .def(py::pickle(&sensor_state, &sensor_from_state));
   pose_property(sensor_class, "flange_T_sensor", &SensorConfig::flange_T_sensor, "flange to sensor frame, m");
   vector_property(sensor_class, "payload_cog_sensor_m", &SensorConfig::payload_cog_sensor_m);
   vector_property(sensor_class, "bias_sensor", &SensorConfig::bias_sensor, "N, Nm");
+  vector_property(sensor_class, "gravity_base_m_s2", &SensorConfig::gravity_base_m_s2,
+                  "gravity in the base frame, m/s^2");
   m.def(
       "load_sensor_config", [](const PathArg& p) { return load_sensor_config(path_text(p)); }, "path"_a,
       "A sensor configuration YAML (docs/online.md).");
@@ -51,6 +177,7 @@ void bind_online(py::module_& m) {
       .def_readwrite("max_joint_correction_rad", &OnlineConfig::max_joint_correction_rad)
       .def_readwrite("max_tcp_correction_m", &OnlineConfig::max_tcp_correction_m)
       .def_readwrite("max_correction_rate_rad_s", &OnlineConfig::max_correction_rate_rad_s)
+      .def_readwrite("max_tcp_rate_m_s", &OnlineConfig::max_tcp_rate_m_s)
       .def_readwrite("watchdog_s", &OnlineConfig::watchdog_s)
       .def_readwrite("fault_hold_s", &OnlineConfig::fault_hold_s)
       .def_property(
@@ -65,7 +192,8 @@ void bind_online(py::module_& m) {
             c.jacobian_at = v == "planned" ? JacobianAt::kPlanned : JacobianAt::kFeedback;
           },
           "'planned' (the exact compensation form) or 'feedback' (the paper's current pose)")
-      .def("validate", &OnlineConfig::validate);
+      .def("validate", &OnlineConfig::validate)
+      .def(py::pickle(&online_config_state, &online_config_from_state));
 
   py::class_<CycleOutput>(m, "CycleOutput", "One compensation cycle's result.")
       .def_property_readonly(
@@ -79,7 +207,7 @@ void bind_online(py::module_& m) {
                              [](const CycleOutput& o) { return frozen(from_vector(o.wrench_measured_base)); })
       .def_property_readonly(
           "status", [](const CycleOutput& o) { return std::string(to_string(o.status)); },
-          "ok, no_force_yet, stale_force, force_fault, held or invalid_input")
+          "ok, no_force_yet, stale_force, force_fault, held, invalid_input or outside_limits")
       .def_property_readonly(
           "usable", [](const CycleOutput& o) { return static_cast<int>(o.status) >= 0; },
           "False: q_command must not be sent")
@@ -89,7 +217,8 @@ void bind_online(py::module_& m) {
       .def_property_readonly("tcp_deflection_base_m",
                              [](const CycleOutput& o) { return frozen(from_vector(o.tcp_deflection_base_m)); })
       .def_readonly("force_age_s", &CycleOutput::force_age_s)
-      .def_readonly("samples_used", &CycleOutput::samples_used);
+      .def_readonly("samples_used", &CycleOutput::samples_used)
+      .def(py::pickle(&cycle_state, &cycle_from_state));
 
   py::class_<OnlineCompensator>(m, "OnlineCompensator",
                                 "The online compensation cycle (paper, Figure 3) for a loop of your own: push_force() "
@@ -114,12 +243,13 @@ void bind_online(py::module_& m) {
             }
             ForceSample s;
             s.t_s = t_s;
-            s.wrench_sensor = vector6(wrench_sensor, "wrench_sensor");
+            s.wrench_sensor = sensor_wrench(c, wrench_sensor, "wrench_sensor");
             s.valid = valid;
             c.push_force(s);
           },
           "t_s"_a, "wrench_sensor"_a, "valid"_a = true, "on_full"_a = "raise",
-          "Queues one raw sample: [Fx Fy Fz Mx My Mz] (N, Nm) in the sensor frame, at the sensor's time t_s (s). "
+          "Queues one raw sample: [Fx Fy Fz Mx My Mz] (N, Nm) in the sensor frame ([Fx Fy Fz] for a 3-axis sensor), at "
+          "the sensor's time t_s (s). "
           "The queue holds queue_capacity samples (two cycles at the sensor's rate, at least 64) until the next "
           "step(); a push into a full queue raises deflex.Error (on_full='drop': drops the oldest and counts it, as "
           "the C++ cycle does).")
@@ -164,7 +294,7 @@ void bind_online(py::module_& m) {
             const int dof = c.model().dof();
             const Array tf = to_array(t_force, "t_force_s", 1);
             require_finite(tf, "t_force_s");
-            const Array w = matrix_array(w_obj, "wrench_sensor", tf.shape(0), 6);
+            const Array w = sensor_wrench_rows(c, w_obj, tf.shape(0));
             const Array tc = to_array(t_cycle, "t_cycle_s", 1);
             require_finite(tc, "t_cycle_s");
             const py::ssize_t n = tc.shape(0), m_samples = tf.shape(0);
@@ -230,7 +360,8 @@ void bind_online(py::module_& m) {
                             "usable"_a = py::array(status).attr("__ge__")(0), "samples_used"_a = used);
           },
           "t_force_s"_a, "wrench_sensor"_a, "t_cycle_s"_a, "q_planned"_a, "valid"_a = py::none(),
-          "A recorded force log through the cycle: before each cycle time (s), every sample stamped at or before it is "
+          "A recorded force log (wrench_sensor (N, 6) N, Nm in the sensor frame; (N, 3) forces for a 3-axis sensor) "
+          "through the cycle: before each cycle time (s), every sample stamped at or before it is "
           "pushed, then one step(). Nothing is dropped: a cycle with more samples before it than queue_capacity raises "
           "deflex.Error. Returns arrays a cycle: q_command, dtheta (N, dof) rad, wrench_base (N, 6) N, Nm at the WAP, "
           "status (names), usable, samples_used.")

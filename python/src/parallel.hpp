@@ -17,6 +17,17 @@ namespace deflex::python {
 
 /// Rows a thread takes at least: below this a thread's start (about 20 us) costs more than it saves.
 inline constexpr std::ptrdiff_t kRowsPerThread = 256;
+/// Rows a per-configuration call holds the GIL for at most (about 0.1 us of C++ each): releasing and
+/// taking it back costs a few tenths of a microsecond, the whole of a single call's work.
+inline constexpr std::ptrdiff_t kGilRows = 16;
+
+/// The cores of this machine, counted once: std::thread::hardware_concurrency() reads
+/// /sys/devices/system/cpu/online on every call (glibc), 10-19 us on the build host, which a single
+/// fk() paid on every call (bench/python_call_bench.py).
+inline int machine_cores() {
+  static const int cores = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+  return cores;
+}
 
 /// The threads a batch of `rows` uses: `requested` (0: every core), at most one per kRowsPerThread
 /// rows, at least one. Negative or huge requests are an InputError.
@@ -24,9 +35,9 @@ inline int batch_threads(int requested, std::ptrdiff_t rows) {
   if (requested < 0 || requested > 1024) {
     throw InputError(fmt::format("argument threads: must be 0 (every core) to 1024, got {}", requested));
   }
-  const int cores = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
-  const int wanted = requested == 0 ? cores : requested;
   const auto by_rows = static_cast<int>(std::max<std::ptrdiff_t>(1, rows / kRowsPerThread));
+  if (by_rows == 1) return 1;  // a single configuration or a small batch: this thread alone
+  const int wanted = requested == 0 ? machine_cores() : requested;
   return std::max(1, std::min(wanted, by_rows));
 }
 

@@ -181,7 +181,7 @@ py::dict cycle_log(const std::vector<LinkCycleRecord>& records, int dof) {
 }
 
 py::dict summary_of(const runtime::SessionSummary& s) {
-  py::dict d = json_to_python(s.json);
+  py::dict d = py::module_::import("json").attr("loads")(s.json_text);
   d["text"] = s.text;
   return d;
 }

@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 #include <pybind11/stl.h>
+#include <yaml-cpp/yaml.h>
+#include <nlohmann/json.hpp>
 
 #include "arrays.hpp"
 #include "bindings.hpp"
@@ -41,6 +43,35 @@ struct CaseStudyRun {
   std::string case_text;
   std::vector<std::pair<std::string, TrackerTrace>> traces;  ///< sorted by name
 };
+
+/// `over`'s keys merged into `base`: a map into a map key by key (so {"protocol": {"laps_cw": 1}} keeps
+/// the other protocol keys), anything else (a number, a list such as setups) replacing what was there.
+void merge_into(YAML::Node base, const YAML::Node& over) {
+  for (const auto& kv : over) {
+    const std::string key = kv.first.as<std::string>();
+    if (kv.second.IsMap() && base[key].IsMap()) {
+      merge_into(base[key], kv.second);
+    } else {
+      base[key] = kv.second;
+    }
+  }
+}
+
+/// The paper's case file with a (partial) case dict's keys, as JSON text, merged over it.
+std::string case_over_paper(const std::string& json_text) {
+  YAML::Node over;
+  try {
+    over = YAML::Load(json_text);
+  } catch (const YAML::Exception& e) {
+    throw InputError(fmt::format("argument case: not a case dict ({})", e.what()));
+  }
+  if (!over.IsMap()) throw InputError("argument case: a dict of the case file's keys");
+  YAML::Node base = YAML::Load(study::paper_case_yaml());
+  merge_into(base, over);
+  YAML::Emitter out;
+  out << base;
+  return std::string(out.c_str()) + "\n";
+}
 
 }  // namespace
 
@@ -117,10 +148,11 @@ void bind_study(py::module_& m) {
           run.config = study::paper_case();
           run.case_text = study::paper_case_yaml();
         } else if (py::isinstance<py::dict>(case_arg)) {
-          // JSON is YAML: the dict's keys are the case file's, checked by the same reader.
+          // JSON is YAML: the dict's keys are the case file's, merged over the paper's case and checked by
+          // the same reader.
           const std::string text = py::module_::import("json").attr("dumps")(case_arg).cast<std::string>();
-          run.config = study::load_case_text(text, "<case dict>");
-          run.case_text = text;
+          run.case_text = case_over_paper(text);
+          run.config = study::load_case_text(run.case_text, "<case dict over the paper's case>");
         } else if (py::isinstance<py::str>(case_arg) || py::hasattr(case_arg, "__fspath__")) {
           run.config = study::load_case(case_arg.cast<PathArg>().string());
         } else {
@@ -155,7 +187,8 @@ void bind_study(py::module_& m) {
       "error_budget"_a = true, "threads"_a = 0, "traces"_a = false,
       "The case study (as `deflex case-study` with --case, --seeds, --seed, --quick, --no-sweep, --no-budget, "
       "--threads, --write-traces): case None for the paper's case, a case file's path, or a dict of its keys "
-      "(data/cases/paper.yaml's); seeds 0 for the case's own count, threads 0 for every core. Writes no files "
+      "(data/cases/paper.yaml's) merged over the paper's case (a nested dict key by key, a list such as setups "
+      "whole); seeds 0 for the case's own count, threads 0 for every core. Writes no files "
       "(write_report() and write_traces() do).");
 }
 

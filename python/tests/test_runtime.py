@@ -87,7 +87,7 @@ def test_settings_are_checked_and_named():
         deflex.StandIn(robot, "egm-joint", sweep(), egm_prot=1)
     with pytest.raises(deflex.InputError, match="setting period_s: 'fast' is not a number"):
         deflex.StandIn(robot, "egm-joint", sweep(), period_s="fast")
-    with pytest.raises(deflex.InputError, match="option --link: 'fanuc' is not one of"):
+    with pytest.raises(deflex.InputError, match="argument link: 'fanuc' is not one of"):
         deflex.StandIn(robot, "fanuc", sweep())
     with pytest.raises(deflex.InputError, match="rate bound allows"):
         deflex.StandIn(robot, "egm-joint", sweep(), max_correction_rate_rad_s=10.0)

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "support/poses.hpp"
 
@@ -276,8 +277,9 @@ TEST(Session, SensorFaultsAndStreamReRequestsAreNamedInTheLogAndTheSummary) {
             std::string::npos)
       << s.text;
   EXPECT_NE(s.text.find("2 stream re-requests"), std::string::npos) << s.text;
-  EXPECT_EQ(s.json["force_source"]["re_requests"], 2);
-  EXPECT_EQ(s.json["force_source"]["faulty"], 3);
+  const nlohmann::json j = nlohmann::json::parse(s.json_text);
+  EXPECT_EQ(j["force_source"]["re_requests"], 2);
+  EXPECT_EQ(j["force_source"]["faulty"], 3);
 }
 
 }  // namespace

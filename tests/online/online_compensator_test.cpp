@@ -231,6 +231,53 @@ TEST_F(Compensator, InvalidInputsNeverProduceACommand) {
                InputError);
 }
 
+// Joints beyond the robot file's limits (joint 1 of the IRB 6700: +-170 deg) are a status, never a
+// command: a planned q1 of 10 rad (a program in the wrong unit), feedback beyond a limit, and a
+// correction that would take a joint at its limit past it.
+TEST_F(Compensator, JointsBeyondTheLimitsAreAStatusNotACommand) {
+  OnlineCompensator comp(robot, flange_sensor(), cfg);
+  const ForceSample s = force_at_wap_sensor_frame(robot, q, Vector3(150, -300, 500));
+  CycleOutput out;
+  double t = 0.0;
+  for (int k = 0; k < 20; ++k, t += 0.004) {
+    comp.push_force(s);
+    out = comp.step({t, q, q});
+  }
+  ASSERT_EQ(out.status, CycleStatus::kOk);
+  JointVector far = q;
+  far[0] = 10.0;
+  {
+    test::AllocationGuard guard;
+    out = comp.step({t, far, far});
+  }
+  EXPECT_EQ(out.status, CycleStatus::kOutsideLimits);
+  EXPECT_LT(static_cast<int>(out.status), 0);           // not usable: q_command must not be sent
+  EXPECT_LT(out.q_command.cwiseAbs().maxCoeff(), 1.0);  // nothing near 10 rad comes out
+  EXPECT_STREQ(to_string(out.status), "outside_limits");
+  t += 0.004;
+  EXPECT_EQ(comp.step({t, q, far}).status, CycleStatus::kOutsideLimits);  // the feedback beyond
+  t += 0.004;
+  EXPECT_EQ(comp.step({t, q, q}).status, CycleStatus::kOk);  // back inside: corrections again
+  EXPECT_EQ(comp.counters().invalid_inputs, 2u);
+
+  // Joint 2 at the limit its correction points away from (the model's dtheta computed here by finite
+  // differences): q_command = q - dtheta would leave the limits.
+  Vector3 f(150, -300, 500);
+  JointVector edge = q;
+  edge[1] = robot.upper_limits()[1];
+  Wrench w = Wrench::Zero();
+  w.head<3>() = f;
+  if (model_dtheta(robot, edge, w)[1] > 0.0) {
+    edge[1] = robot.lower_limits()[1];
+    if (model_dtheta(robot, edge, w)[1] < 0.0) f = -f;
+  }
+  OnlineCompensator at_edge(robot, flange_sensor(), cfg);
+  at_edge.push_force(force_at_wap_sensor_frame(robot, edge, f));
+  out = at_edge.step({0.0, edge, edge});
+  EXPECT_EQ(out.status, CycleStatus::kOutsideLimits);
+  EXPECT_TRUE(out.q_command.isZero(0.0));
+}
+
 TEST_F(Compensator, RandomisedPropertiesHold) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "deflex/report/html_report.hpp"
 #include "svg_scan.hpp"

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "deflex/study/study_tables.hpp"
 #include "deflex/text/errors.hpp"

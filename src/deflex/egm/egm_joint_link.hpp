@@ -44,6 +44,10 @@ class EgmJointLink final : public ControllerLink {
   EgmJointLink(OnlineCompensator& compensator, OnlineStrategy& strategy, std::shared_ptr<const JointTrajectory> nominal,
                DatagramTransport& transport, const Clock& clock, ForceSource* force,
                const EgmJointLinkConfig& config = {});
+  /// A temporary clock would dangle: it does not compile (docs/architecture.md, "Ownership").
+  EgmJointLink(OnlineCompensator& compensator, OnlineStrategy& strategy, std::shared_ptr<const JointTrajectory> nominal,
+               DatagramTransport& transport, const Clock&& clock, ForceSource* force,
+               const EgmJointLinkConfig& config = {}) = delete;
 
   LinkPollResult poll(double timeout_s) noexcept override;
   [[nodiscard]] const char* name() const override { return "egm-joint"; }

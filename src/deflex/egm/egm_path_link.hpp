@@ -49,6 +49,9 @@ class EgmPathLink final : public ControllerLink {
   /// Every reference must outlive the link. `force` may be null. Throws InputError.
   EgmPathLink(OnlineCompensator& compensator, OnlineStrategy& strategy, DatagramTransport& transport,
               const Clock& clock, ForceSource* force, const EgmPathLinkConfig& config = {});
+  /// A temporary clock would dangle: it does not compile (docs/architecture.md, "Ownership").
+  EgmPathLink(OnlineCompensator& compensator, OnlineStrategy& strategy, DatagramTransport& transport,
+              const Clock&& clock, ForceSource* force, const EgmPathLinkConfig& config = {}) = delete;
 
   LinkPollResult poll(double timeout_s) noexcept override;
   [[nodiscard]] const char* name() const override { return "egm-path"; }

@@ -51,6 +51,9 @@ class EgmReceiver {
   /// `transport`, `clock` and `counters` must outlive the receiver. Throws InputError.
   EgmReceiver(DatagramTransport& transport, const Clock& clock, const RobotModel& model,
               const EgmReceiverConfig& config, LinkCounters& counters);
+  /// A temporary clock would dangle: it does not compile (docs/architecture.md, "Ownership").
+  EgmReceiver(DatagramTransport& transport, const Clock&& clock, const RobotModel& model,
+              const EgmReceiverConfig& config, LinkCounters& counters) = delete;
 
   enum class Result { kNothing, kNoneUsable, kMessage };
   /// Waits up to timeout_s, drains, and leaves the newest usable message in message(). `restarted`

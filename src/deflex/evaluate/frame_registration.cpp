@@ -3,12 +3,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <set>
 
 #include <fmt/format.h>
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <Eigen/SVD>
 
+#include "deflex/evaluate/tracker_files.hpp"
 #include "deflex/model/linear_algebra.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/yaml_fields.hpp"
@@ -270,6 +273,91 @@ TrackerFrame read_tracker_frame(const std::string& path) {
     }
   }
   return f;
+}
+
+namespace {
+
+// The target's own name: the last part of "Collection::Group::Target".
+std::string target_of(const std::string& name) {
+  const auto at = name.rfind("::");
+  return at == std::string::npos ? name : name.substr(at + 2);
+}
+
+std::string whole_name(const std::string& name) { return name; }
+
+// "FILE:LINE" of a point, or FILE alone for a point not read from a file.
+std::string point_place(const TrackerFile& f, const TrackerPoint& p) {
+  return p.line > 0 ? fmt::format("{}:{}", f.source, p.line) : f.source;
+}
+
+// Pairs by the key `key_of` gives each point: every key once on each side, and the same keys on both.
+// Returns false (and pairs nothing) when the key sets differ; throws for a repeated key.
+bool pair_by(const TrackerFile& t, const TrackerFile& b, std::string (*key_of)(const std::string&),
+             RegistrationInput& in) {
+  std::map<std::string, const TrackerPoint*> base, tracker;
+  for (const auto* f : {&b, &t}) {
+    auto& into = f == &b ? base : tracker;
+    for (const auto& p : f->points) {
+      if (!into.emplace(key_of(p.name), &p).second) {
+        throw DataError(fmt::format("{}: point '{}' named twice", point_place(*f, p), key_of(p.name)));
+      }
+    }
+  }
+  for (const auto& [key, p] : tracker) {
+    if (base.count(key) == 0) return false;
+  }
+  if (base.size() != tracker.size()) return false;
+  for (const auto& p : t.points) {
+    in.tracker_m.push_back(p.p_m);
+    in.base_m.push_back(base.at(key_of(p.name))->p_m);
+    in.names.push_back(key_of(p.name));
+  }
+  return true;
+}
+
+// Both files name their points but the names do not pair: the first point of either without a
+// partner, named with its file and line.
+[[noreturn]] void throw_unpaired(const TrackerFile& t, const TrackerFile& b) {
+  std::set<std::string> base;
+  for (const auto& p : b.points) base.insert(target_of(p.name));
+  for (const auto& p : t.points) {
+    if (base.count(target_of(p.name)) == 0) {
+      throw DataError(
+          fmt::format("{}: point '{}' is not in {} (pairs are made by name)", point_place(t, p), p.name, b.source));
+    }
+    base.erase(target_of(p.name));
+  }
+  for (const auto& p : b.points) {
+    if (base.count(target_of(p.name)) != 0) {
+      throw DataError(
+          fmt::format("{}: point '{}' is not in {} (pairs are made by name)", point_place(b, p), p.name, t.source));
+    }
+  }
+  throw DataError(fmt::format("{} and {}: the point names do not pair", t.source, b.source));
+}
+
+}  // namespace
+
+RegistrationInput pair_tracker_points(const TrackerFile& t, const TrackerFile& b) {
+  RegistrationInput in;
+  if (t.has_names && b.has_names) {
+    if (pair_by(t, b, whole_name, in) || pair_by(t, b, target_of, in)) return in;
+    throw_unpaired(t, b);
+  }
+  if (t.points.size() != b.points.size()) {
+    throw DataError(
+        fmt::format("{} has {} point(s) and {} has {}: without names on both sides they pair by order and "
+                    "must be as many",
+                    t.source, t.points.size(), b.source, b.points.size()));
+  }
+  for (std::size_t i = 0; i < t.points.size(); ++i) {
+    in.tracker_m.push_back(t.points[i].p_m);
+    in.base_m.push_back(b.points[i].p_m);
+    const std::string where = t.points[i].line > 0 ? fmt::format("point {} (line {})", i + 1, t.points[i].line)
+                                                   : fmt::format("point {}", i + 1);
+    in.names.push_back(t.has_names ? t.points[i].name : where);
+  }
+  return in;
 }
 
 }  // namespace deflex

@@ -63,6 +63,16 @@ struct FrameRegistration {
   std::size_t circles = 0;
 };
 
+struct TrackerFile;  // tracker_files.hpp
+
+/// Pairs the points of a tracker file with those of a base file (`deflex register`, Python's
+/// register_frames): by name when both name their points (the whole name, else the target's own name,
+/// so "Job::Reference::REF1" pairs with "REF1"), else by order (as many points on both sides); the
+/// tracker's order is kept. Throws DataError naming the file, the line and the point: a name repeated on
+/// one side, a name missing from the other, counts that differ without names. A point's `line` 0 (one
+/// not read from a file) is named by its file alone.
+[[nodiscard]] RegistrationInput pair_tracker_points(const TrackerFile& tracker, const TrackerFile& base);
+
 /// Least-squares rigid transform (rotation and translation, no scale) from the tracker frame to the
 /// base frame. A circle counts as its centre (a point) and its axis (a direction, weighted by the
 /// radius squared: as much as two points a radius apart along it). Throws InputError when the

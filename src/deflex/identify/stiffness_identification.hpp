@@ -99,6 +99,9 @@ class StiffnessIdentifier {
   /// that is not in [0, 1), NaN included; a scale or error bound that is not finite and > 0; a negative
   /// iteration count), in Release too.
   StiffnessIdentifier(const RobotModel& model, const IdentificationOptions& options = {});
+  /// The identifier keeps a reference to the model (docs/architecture.md, "Ownership"): a temporary
+  /// would dangle, so it does not compile.
+  StiffnessIdentifier(RobotModel&& model, const IdentificationOptions& options = {}) = delete;
   ~StiffnessIdentifier();
   StiffnessIdentifier(const StiffnessIdentifier&) = delete;
   StiffnessIdentifier& operator=(const StiffnessIdentifier&) = delete;

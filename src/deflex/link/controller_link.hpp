@@ -129,6 +129,8 @@ class ControllerLink {
   /// Every reference must outlive the link. Throws InputError on bad limits or rules.
   ControllerLink(OnlineCompensator& compensator, OnlineStrategy& strategy, ForceSource* force, const Clock& clock,
                  const CommandLimits& limits, const LinkStopRules& rules, std::size_t history_cycles);
+  ControllerLink(OnlineCompensator& compensator, OnlineStrategy& strategy, ForceSource* force, const Clock&& clock,
+                 const CommandLimits& limits, const LinkStopRules& rules, std::size_t history_cycles) = delete;
 
   /// Stops the link once (later calls keep the first reason): state kStopped, the cause and a
   /// printf-style sentence. Never allocates.

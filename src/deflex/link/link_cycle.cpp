@@ -239,7 +239,7 @@ LinkCycle::Verdict LinkCycle::run(const CycleRequest& rq) noexcept {
   r.wrench_base = out_.wrench_base;
   r.wrench_measured_base = out_.wrench_measured_base;
   r.status = out_.status;
-  if (out_.status == CycleStatus::kForceFault || out_.status == CycleStatus::kInvalidInput) fault_pending_ = true;
+  if (out_.status == CycleStatus::kForceFault || static_cast<int>(out_.status) < 0) fault_pending_ = true;
   if (static_cast<int>(out_.status) < 0) {
     ++counters_.invalid_cycles;
     r.q_command = r.q_nominal;

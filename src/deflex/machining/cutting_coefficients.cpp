@@ -16,6 +16,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <yaml-cpp/yaml.h>  // Field::node()
 
 #include "deflex/machining/cutter.hpp"
 #include "deflex/paths/key_value_spec.hpp"

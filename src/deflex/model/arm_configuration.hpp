@@ -21,7 +21,11 @@ struct ArmConfiguration {
   int cf4 = 0;
   int cf6 = 0;
   int cfx = 0;
-  bool operator==(const ArmConfiguration&) const = default;
+  // Written out (not `= default`): the model's headers compile as C++17 for a consumer that is.
+  bool operator==(const ArmConfiguration& o) const {
+    return cf1 == o.cf1 && cf4 == o.cf4 && cf6 == o.cf6 && cfx == o.cfx;
+  }
+  bool operator!=(const ArmConfiguration& o) const { return !(*this == o); }
 };
 
 /// KUKA's Status and Turn (KRL E6POS/POS components S and T), for a model whose joint values are
@@ -34,7 +38,8 @@ struct ArmConfiguration {
 struct KukaConfiguration {
   int status = 0;
   int turn = 0;
-  bool operator==(const KukaConfiguration&) const = default;
+  bool operator==(const KukaConfiguration& o) const { return status == o.status && turn == o.turn; }
+  bool operator!=(const KukaConfiguration& o) const { return !(*this == o); }
 };
 
 /// floor(q / 90 deg), the quadrant number confdata uses.

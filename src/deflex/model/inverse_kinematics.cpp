@@ -11,6 +11,7 @@
 #include <Eigen/SVD>
 
 #include "deflex/model/opw_ik.hpp"
+#include "deflex/text/errors.hpp"
 
 namespace deflex {
 namespace {
@@ -315,6 +316,10 @@ void fill_configuration(const RobotModel& model, IkResult& r) {
 std::vector<IkResult> all_ik_solutions(const RobotModel& model, Workspace& ws, const Pose& base_T_tcp,
                                        const IkRequest& request) {
   std::vector<IkResult> out;
+  if (request.seed && (request.seed->size() != model.dof() || !request.seed->allFinite())) {
+    throw InputError(fmt::format("all_ik_solutions: the seed has {} joint value(s), not {} finite ones for {}",
+                                 request.seed->size(), model.dof(), model.name()));
+  }
   OpwBranches branches;
   std::string message;
   if (!has_analytic_ik(model) || !branches_of(model, base_T_tcp, request, branches, message)) {
@@ -362,6 +367,14 @@ std::vector<IkResult> all_ik_solutions(const RobotModel& model, Workspace& ws, c
         break;
       }
     }
+  }
+  if (request.seed) {
+    // The nearest the seed first (the largest joint difference), as the seed picks one solution in
+    // inverse_kinematics(): [0] is each joint at the turn nearest the seed.
+    const JointVector& seed = *request.seed;
+    std::stable_sort(out.begin(), out.end(), [&](const IkResult& a, const IkResult& b) {
+      return (a.q - seed).cwiseAbs().maxCoeff() < (b.q - seed).cwiseAbs().maxCoeff();
+    });
   }
   return out;
 }

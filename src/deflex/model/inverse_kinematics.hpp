@@ -74,8 +74,10 @@ struct IkResult {
 [[nodiscard]] IkResult inverse_kinematics(const RobotModel& model, Workspace& ws, const Pose& base_T_tcp,
                                           const IkRequest& request = {});
 
-/// Every analytic solution inside the joint limits (all 2*pi turns of each joint), checked by FK.
-/// Empty for arms without an analytic solver. (Allocates; opw_solutions() is the hot-path form.)
+/// Every analytic solution inside the joint limits (all 2*pi turns of each joint), checked by FK; with
+/// a seed, the nearest it first (the largest joint difference), so [0] has each joint at the turn
+/// nearest the seed. Empty for arms without an analytic solver. Throws InputError for a seed that is
+/// not dof finite values. (Allocates; opw_solutions() is the hot-path form.)
 [[nodiscard]] std::vector<IkResult> all_ik_solutions(const RobotModel& model, Workspace& ws, const Pose& base_T_tcp,
                                                      const IkRequest& request = {});
 

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "deflex/text/errors.hpp"
+#include "deflex/text/input_ranges.hpp"
 
 namespace deflex {
 namespace {
@@ -118,9 +119,10 @@ RobotModel::RobotModel(RobotDescription desc) : desc_(std::move(desc)) {
     compliance_.resize(dof_);
     for (std::size_t i = 0; i < n; ++i) {
       const double k = d.stiffness_nm_per_rad[i];
-      if (!std::isfinite(k) || k <= 0.0) {
-        fail(d, fmt::format("joint_stiffness_Nm_per_rad[{}]", i + 1),
-             fmt::format("stiffness must be a positive finite number of Nm/rad, got {}", k));
+      // The robot file's range, whichever way the stiffness came (a file, with_stiffness, an
+      // identification): 1e-300 Nm/rad would deflect by 1e302 rad.
+      if (const auto why = range_violation(k, range::kJointStiffness)) {
+        fail(d, fmt::format("joint_stiffness_Nm_per_rad[{}]", i + 1), *why);
       }
       stiffness_[static_cast<int>(i)] = k;
       compliance_[static_cast<int>(i)] = 1.0 / k;
@@ -131,13 +133,15 @@ RobotModel::RobotModel(RobotDescription desc) : desc_(std::move(desc)) {
   opw_ = derive_opw_geometry(*this, opw_note_);
 }
 
+void RobotModel::throw_no_stiffness() const {
+  throw ModelError(
+      fmt::format("{}: field 'joint_stiffness_Nm_per_rad': the robot '{}' has no joint stiffness; "
+                  "add it to the robot file or identify it (deflex identify)",
+                  desc_.source, desc_.name));
+}
+
 const JointVector& RobotModel::stiffness() const {
-  if (!has_stiffness()) {
-    throw ModelError(
-        fmt::format("{}: field 'joint_stiffness_Nm_per_rad': the robot '{}' has no joint stiffness; "
-                    "add it to the robot file or identify it (deflex identify)",
-                    desc_.source, desc_.name));
-  }
+  if (!has_stiffness()) throw_no_stiffness();
   return stiffness_;
 }
 

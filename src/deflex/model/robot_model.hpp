@@ -91,8 +91,12 @@ class RobotModel {
   [[nodiscard]] bool has_stiffness() const { return !desc_.stiffness_nm_per_rad.empty(); }
   /// Joint stiffness, Nm/rad. Throws ModelError when the robot file gives none.
   [[nodiscard]] const JointVector& stiffness() const;
-  /// 1/k per joint, rad/Nm (zero stiffness is rejected at load, so this is finite).
-  [[nodiscard]] const JointVector& compliance() const { return compliance_; }
+  /// 1/k per joint, rad/Nm (the stiffness is held to its range at load, so this is finite). Throws
+  /// ModelError, as stiffness() does, when the robot file gives none.
+  [[nodiscard]] const JointVector& compliance() const {
+    if (!has_stiffness()) throw_no_stiffness();
+    return compliance_;
+  }
 
   [[nodiscard]] const JointVector& lower_limits() const { return lower_; }
   [[nodiscard]] const JointVector& upper_limits() const { return upper_; }
@@ -115,13 +119,16 @@ class RobotModel {
   /// Why the chain has no OPW geometry (empty when it has one).
   [[nodiscard]] const std::string& opw_note() const { return opw_note_; }
 
-  /// Returns a copy with a different stiffness (e.g. after identification). Validated again.
+  /// Returns a copy with a different stiffness (e.g. after identification). Validated again: a value
+  /// outside the robot file's range (input_ranges.hpp, kJointStiffness) is a ModelError.
   [[nodiscard]] RobotModel with_stiffness(const std::vector<double>& stiffness_nm_per_rad,
                                           const std::string& note) const;
   /// Returns a copy with a different tool (flange to TCP) and, optionally, WAP.
   [[nodiscard]] RobotModel with_tool(const Pose& flange_T_tcp, std::optional<Pose> flange_T_wap = std::nullopt) const;
 
  private:
+  [[noreturn]] void throw_no_stiffness() const;
+
   RobotDescription desc_;
   int dof_ = 0;
   JointVector stiffness_;

@@ -2,6 +2,7 @@
 #include "deflex/offline/compensate_path.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -13,11 +14,22 @@ namespace {
 
 constexpr double kDeflectionTolRad = 1e-13;  // fixed-point step at which a deflection counts as solved
 
+const ForceModel& shared_force(const std::shared_ptr<const ForceModel>& force) {
+  if (!force) throw InputError("offline compensation: no force model (a null pointer)");
+  return *force;
+}
+
 }  // namespace
 
 OfflineResult compensate_path(const RobotModel& model, const JointPath& path, const std::vector<Pose>& tcp_poses,
                               const ForceModel& force) {
   return compensate_path(model, path, tcp_poses, force, OfflineOptions{});
+}
+
+PathCompensator::PathCompensator(const RobotModel& model, std::shared_ptr<const ForceModel> force,
+                                 const OfflineOptions& options)
+    : PathCompensator(model, shared_force(force), options) {
+  force_owner_ = std::move(force);
 }
 
 PathCompensator::PathCompensator(const RobotModel& model, const ForceModel& force, const OfflineOptions& options)
@@ -138,6 +150,17 @@ OfflineResult PathCompensator::summary() const {
 
 OfflineResult compensate_path(const RobotModel& model, const JointPath& path, const std::vector<Pose>& tcp_poses,
                               const ForceModel& force, const OfflineOptions& options) {
+  OfflineResult result;
+  compensate_path(model, path, tcp_poses, force, options, result);
+  return result;
+}
+
+void compensate_path(const RobotModel& model, const JointPath& path, const std::vector<Pose>& tcp_poses,
+                     const ForceModel& force, const OfflineOptions& options, OfflineResult& out) {
+  std::vector<OfflinePoint> points = std::move(out.points);
+  points.clear();  // keeps its capacity
+  out = OfflineResult();
+  out.points = std::move(points);
   PathCompensator compensator(model, force, options);
   const std::size_t n = path.q.size();
   if (n == 0) {
@@ -151,14 +174,13 @@ OfflineResult compensate_path(const RobotModel& model, const JointPath& path, co
     throw InputError(fmt::format("offline compensation: the force model ({}) has {} points, the path {}",
                                  force.describe(), *force_points, n));
   }
-  std::vector<OfflinePoint> points;
-  points.reserve(n);
+  out.points.resize(n);  // within the capacity of a path as long before: no allocation
   for (std::size_t i = 0; i < n; ++i) {
-    points.push_back(compensator.compensate(i, path.q[i], tcp_poses[i]));
+    out.points[i] = compensator.compensate(i, path.q[i], tcp_poses[i]);
   }
-  OfflineResult result = compensator.summary();
-  result.points = std::move(points);
-  return result;
+  std::vector<OfflinePoint> filled = std::move(out.points);
+  out = compensator.summary();
+  out.points = std::move(filled);
 }
 
 }  // namespace deflex

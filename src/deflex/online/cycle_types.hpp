@@ -17,7 +17,13 @@ enum class CycleStatus : int {
   kForceFault = 3,     ///< a fault sample was seen within fault_hold_s: correction ramping to zero
   kHeld = 4,           ///< the caller asked to hold (hold_to_zero): correction ramping to zero
   kInvalidInput = -1,  ///< wrong joint count or non-finite joints/time: q_command must not be sent
+  /// A joint of q_planned, q_feedback or the compensated command outside the robot's limits (by more
+  /// than kCycleLimitToleranceRad): q_command must not be sent.
+  kOutsideLimits = -2,
 };
+
+/// How far beyond a joint limit a cycle's joints may be (rounding of a controller's feedback), rad.
+inline constexpr double kCycleLimitToleranceRad = 1e-6;
 
 [[nodiscard]] const char* to_string(CycleStatus s);
 

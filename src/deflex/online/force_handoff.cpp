@@ -2,6 +2,7 @@
 #include "deflex/online/force_handoff.hpp"
 
 #include <fmt/format.h>
+#include <boost/lockfree/spsc_queue.hpp>
 
 #include "deflex/text/errors.hpp"
 
@@ -17,16 +18,24 @@ std::size_t checked_capacity(std::size_t capacity) {
 
 }  // namespace
 
-ForceHandoff::ForceHandoff(std::size_t capacity) : capacity_(checked_capacity(capacity)), queue_(capacity) {}
+struct ForceHandoff::Ring {
+  explicit Ring(std::size_t capacity) : queue(capacity) {}
+  boost::lockfree::spsc_queue<ForceSample> queue;
+};
+
+ForceHandoff::ForceHandoff(std::size_t capacity)
+    : capacity_(checked_capacity(capacity)), ring_(std::make_unique<Ring>(capacity)) {}
+
+ForceHandoff::~ForceHandoff() = default;
 
 bool ForceHandoff::push(const ForceSample& sample) noexcept {
   pushed_.fetch_add(1, std::memory_order_relaxed);
-  if (queue_.push(sample)) return true;
+  if (ring_->queue.push(sample)) return true;
   refused_.fetch_add(1, std::memory_order_relaxed);
   return false;
 }
 
-bool ForceHandoff::latest(ForceSample& out) noexcept { return queue_.pop(out); }
+bool ForceHandoff::latest(ForceSample& out) noexcept { return ring_->queue.pop(out); }
 
 ForceSourceStats ForceHandoff::stats() const noexcept {
   ForceSourceStats s;

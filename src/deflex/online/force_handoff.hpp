@@ -9,8 +9,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
-
-#include <boost/lockfree/spsc_queue.hpp>
+#include <memory>
 
 #include "deflex/online/force_sample.hpp"
 
@@ -23,6 +22,9 @@ class ForceHandoff final : public ForceSource {
   /// Holds `capacity` samples (1 to 1 << 24; two cycles at the sensor's rate is the compensator's own
   /// queue). Throws InputError otherwise. Allocates here only.
   explicit ForceHandoff(std::size_t capacity);
+  ~ForceHandoff() override;
+  ForceHandoff(const ForceHandoff&) = delete;
+  ForceHandoff& operator=(const ForceHandoff&) = delete;
 
   /// The driver's thread: queues one sample; false (and counted) when the queue is full.
   bool push(const ForceSample& sample) noexcept;
@@ -34,8 +36,10 @@ class ForceHandoff final : public ForceSource {
   [[nodiscard]] std::size_t capacity() const { return capacity_; }
 
  private:
+  // Boost's ring behind a pointer made once here, so this header does not parse Boost.Lockfree's.
+  struct Ring;
   std::size_t capacity_;
-  boost::lockfree::spsc_queue<ForceSample> queue_;
+  std::unique_ptr<Ring> ring_;
   // Written by the producer, read by the consumer's stats(): relaxed counts, not synchronisation.
   alignas(64) std::atomic<std::uint64_t> pushed_{0};
   std::atomic<std::uint64_t> refused_{0};

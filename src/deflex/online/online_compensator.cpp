@@ -41,6 +41,8 @@ const char* to_string(CycleStatus s) {
       return "held";
     case CycleStatus::kInvalidInput:
       return "invalid_input";
+    case CycleStatus::kOutsideLimits:
+      return "outside_limits";
   }
   return "unknown";
 }
@@ -143,6 +145,16 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
       !in.wrench_offset_base.allFinite() || std::isnan(in.wrench_lead_s)) {
     ++counters_.invalid_inputs;
     out.status = CycleStatus::kInvalidInput;
+    out.q_command = JointVector::Zero(n);
+    out.dtheta = JointVector::Zero(n);
+    return out;
+  }
+  // Joints beyond the limits: a command for them is one no controller should be given (a program
+  // or feedback in the wrong unit, a wrong robot file); the status says so and nothing is commanded.
+  if (!model_.within_limits(in.q_planned, kCycleLimitToleranceRad) ||
+      !model_.within_limits(in.q_feedback, kCycleLimitToleranceRad)) {
+    ++counters_.invalid_inputs;
+    out.status = CycleStatus::kOutsideLimits;
     out.q_command = JointVector::Zero(n);
     out.dtheta = JointVector::Zero(n);
     return out;
@@ -257,6 +269,12 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
   out.q_command = in.q_planned - correction_;
   out.tcp_deflection_base_m = jac_.topRows<3>() * correction_;
   out.tcp_correction_m = out.tcp_deflection_base_m.norm();
+  if (!model_.within_limits(out.q_command, kCycleLimitToleranceRad)) {
+    // The correction takes a joint of a program at its limit beyond it.
+    ++counters_.invalid_inputs;
+    out.status = CycleStatus::kOutsideLimits;
+    out.q_command.setZero();
+  }
   return out;
 }
 

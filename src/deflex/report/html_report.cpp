@@ -8,6 +8,7 @@
 #include <map>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "deflex/evaluate/path_metrics.hpp"
 #include "deflex/study/paper_figures.hpp"

@@ -59,6 +59,9 @@ class RsiLink final : public ControllerLink {
   /// Every reference must outlive the link. `force` may be null. Throws InputError.
   RsiLink(OnlineCompensator& compensator, OnlineStrategy& strategy, DatagramTransport& transport, const Clock& clock,
           ForceSource* force, const RsiLinkConfig& config = {});
+  /// A temporary clock would dangle: it does not compile (docs/architecture.md, "Ownership").
+  RsiLink(OnlineCompensator& compensator, OnlineStrategy& strategy, DatagramTransport& transport, const Clock&& clock,
+          ForceSource* force, const RsiLinkConfig& config = {}) = delete;
 
   LinkPollResult poll(double timeout_s) noexcept override;
   [[nodiscard]] const char* name() const override { return "rsi"; }

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "deflex/online/online_strategy.hpp"
 #include "deflex/text/errors.hpp"
@@ -525,7 +526,8 @@ void Session::build_summary() {
     j["program"] = {
         {"time_s", s.program_time_s}, {"duration_s", program_->duration_s()}, {"behind_s", s.program_behind_s}};
   }
-  s.json = std::move(j);
+  // A path that is not UTF-8 (a log folder) is written with U+FFFD rather than refused.
+  s.json_text = j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace deflex::runtime

@@ -22,8 +22,6 @@
 #include <string>
 #include <thread>
 
-#include <nlohmann/json.hpp>
-
 #include "deflex/egm/egm_joint_link.hpp"
 #include "deflex/egm/egm_path_link.hpp"
 #include "deflex/online/online_strategy.hpp"
@@ -105,7 +103,7 @@ struct SessionSummary {
   double program_behind_s = 0.0;  ///< how far behind real time the program ran
   std::string output_error;       ///< the cycle log could not be written ("" when it was, or none was asked)
   std::string text;               ///< the summary as lines for a person
-  nlohmann::json json;            ///< the same for a program
+  std::string json_text;          ///< the same for a program: one JSON document (`deflex online --json`)
 };
 
 /// Thread safety: one thread drives it (poll(), service(), run(), finish() and the accessors; while
@@ -115,11 +113,15 @@ class Session {
  public:
   /// Builds everything and validates every option (InputError naming it): the link's options, the
   /// per-cycle step limit against the bound, a program for a streaming link, the log paths (Error
-  /// naming the path). `robot`, `clock`, `force` (may be null: push samples into compensator()),
-  /// `force_model` (hybrid and predictive) and the endpoints' transports must outlive the session.
+  /// naming the path). The robot is copied; `clock`, `force` (may be null: push samples into
+  /// compensator()), `force_model` (hybrid and predictive) and the endpoints' transports must outlive
+  /// the session, so a temporary clock does not compile (docs/architecture.md, "Ownership").
   Session(const SessionConfig& config, const RobotModel& robot, const SensorConfig& sensor,
           std::shared_ptr<const JointTrajectory> program, const ForceModel* force_model, ForceSource* force,
           const Clock& clock, const SessionEndpoints& endpoints = {}, LogSink sink = {});
+  Session(const SessionConfig& config, const RobotModel& robot, const SensorConfig& sensor,
+          std::shared_ptr<const JointTrajectory> program, const ForceModel* force_model, ForceSource* force,
+          const Clock&& clock, const SessionEndpoints& endpoints = {}, LogSink sink = {}) = delete;
   ~Session();
   Session(const Session&) = delete;
   Session& operator=(const Session&) = delete;

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "deflex/text/errors.hpp"
 
@@ -162,7 +163,7 @@ void SessionReporter::on_cycle(const SessionEntry& e) {
   // Fault episodes: a force fault, an invalid cycle, a guard trip or a message not answered.
   const bool guard = e.counters.guard_trips > last_guard_trips_;
   last_guard_trips_ = e.counters.guard_trips;
-  const bool fault = r.status == CycleStatus::kForceFault || r.status == CycleStatus::kInvalidInput || guard;
+  const bool fault = r.status == CycleStatus::kForceFault || static_cast<int>(r.status) < 0 || guard;
   if (in_episode_ && !fault && r.t_s - last_fault_s_ > setup_.fault_quiet_s) {
     in_episode_ = false;
     log(LogLevel::kInfo, fmt::format("fault episode {} ended: {} faulted cycles over {:.2f} s", episodes_, faulted_,

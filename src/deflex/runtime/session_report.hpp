@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>  // the declarations below; the caller includes <nlohmann/json.hpp> to use them
 
 #include "deflex/runtime/cycle_log.hpp"
 #include "deflex/runtime/monitor_feed.hpp"

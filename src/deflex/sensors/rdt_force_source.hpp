@@ -98,6 +98,9 @@ class RdtForceSource final : public ForceSource {
   /// without a calibration).
   RdtForceSource(DatagramTransport& transport, const Clock& clock, const DatagramAddress& sensor,
                  const RdtCalibration& calibration, const RdtStreamSettings& settings = {});
+  /// A temporary clock would dangle: it does not compile (docs/architecture.md, "Ownership").
+  RdtForceSource(DatagramTransport& transport, const Clock&& clock, const DatagramAddress& sensor,
+                 const RdtCalibration& calibration, const RdtStreamSettings& settings = {}) = delete;
 
   /// Requests the stream (OnRobot: sets the Compute Box's rate first). False when the transport
   /// could not send (counted).

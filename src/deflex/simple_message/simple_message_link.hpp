@@ -88,6 +88,10 @@ class SimpleMessageLink final : public ControllerLink {
   SimpleMessageLink(OnlineCompensator& compensator, OnlineStrategy& strategy,
                     std::shared_ptr<const JointTrajectory> nominal, StreamTransport& motion, StreamTransport& state,
                     const Clock& clock, ForceSource* force, const SimpleMessageLinkConfig& config = {});
+  /// A temporary clock would dangle: it does not compile (docs/architecture.md, "Ownership").
+  SimpleMessageLink(OnlineCompensator& compensator, OnlineStrategy& strategy,
+                    std::shared_ptr<const JointTrajectory> nominal, StreamTransport& motion, StreamTransport& state,
+                    const Clock&& clock, ForceSource* force, const SimpleMessageLinkConfig& config = {}) = delete;
 
   /// Waits up to timeout_s (no longer than until the next point is due) for either connection, reads
   /// what came, and sends the next point when it is due. kAnswered: a point was sent (one cycle);

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "deflex/evaluate/path_metrics.hpp"
 #include "deflex/text/csv_table.hpp"

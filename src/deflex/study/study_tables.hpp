@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>  // the declarations below; the caller includes <nlohmann/json.hpp> to use them
 
 #include "deflex/study/error_budget.hpp"
 #include "deflex/study/paper_figures.hpp"

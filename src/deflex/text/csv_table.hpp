@@ -9,6 +9,12 @@
 // '#' comment lines and blank lines skipped, cells trimmed of spaces and tabs.
 #pragma once
 
+// The text module's other headers compile as C++17 (the model's consumers may be); this one takes
+// and gives std::span.
+#if __cplusplus < 202002L
+#error "deflex/text/csv_table.hpp needs C++20 (std::span); the model's headers and text/errors.hpp need C++17"
+#endif
+
 #include <algorithm>
 #include <cstdio>
 #include <map>

@@ -28,7 +28,8 @@ class RunFilesScope {
 struct FileId {
   std::uint64_t device = 0;
   std::uint64_t inode = 0;
-  friend bool operator==(const FileId&, const FileId&) = default;
+  friend bool operator==(const FileId& a, const FileId& b) { return a.device == b.device && a.inode == b.inode; }
+  friend bool operator!=(const FileId& a, const FileId& b) { return !(a == b); }
 };
 
 /// Notes an input file; throws InputError naming both when this run writes it.

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
 
 #include "deflex/text/errors.hpp"
 #include "deflex/text/input_file.hpp"
@@ -18,7 +19,10 @@
 namespace deflex::yaml {
 
 Field::Field(const YAML::Node& node, std::string file, std::string path)
-    : node_(node), file_(std::move(file)), path_(std::move(path)) {}
+    : node_(std::make_shared<const YAML::Node>(node)), file_(std::move(file)), path_(std::move(path)) {}
+
+bool Field::is_sequence() const { return node().IsSequence(); }
+bool Field::is_map() const { return node().IsMap(); }
 
 namespace {
 
@@ -133,7 +137,7 @@ std::string scalar_text(const std::string& text) {
 }
 
 int Field::line() const {
-  const YAML::Mark m = node_.Mark();
+  const YAML::Mark m = node().Mark();
   return m.line >= 0 ? m.line + 1 : 0;
 }
 
@@ -144,15 +148,15 @@ void Field::fail(const std::string& message) const {
 }
 
 bool Field::has(const std::string& key) const {
-  return node_.IsMap() && node_[key].IsDefined() && !node_[key].IsNull();
+  return node().IsMap() && node()[key].IsDefined() && !node()[key].IsNull();
 }
 
 Field Field::at(const std::string& key) const {
   const std::string child = path_.empty() ? key : path_ + "." + key;
-  if (!node_.IsMap()) {
+  if (!node().IsMap()) {
     fail("expected a map with the key '" + key + "'");
   }
-  YAML::Node n = node_[key];
+  YAML::Node n = node()[key];
   if (!n.IsDefined() || n.IsNull()) {
     const int l = line();
     const std::string where = l > 0 ? fmt::format("{}:{}", file_, l) : file_;
@@ -162,19 +166,19 @@ Field Field::at(const std::string& key) const {
 }
 
 Field Field::at(std::size_t index) const {
-  if (!node_.IsSequence() || index >= node_.size()) {
+  if (!node().IsSequence() || index >= node().size()) {
     fail(fmt::format("expected a list with at least {} entries", index + 1));
   }
-  return Field(node_[index], file_, fmt::format("{}[{}]", path_, index + 1));
+  return Field(node()[index], file_, fmt::format("{}[{}]", path_, index + 1));
 }
 
-std::size_t Field::size() const { return node_.IsSequence() || node_.IsMap() ? node_.size() : 0; }
+std::size_t Field::size() const { return node().IsSequence() || node().IsMap() ? node().size() : 0; }
 
 double Field::as_double() const {
-  if (!node_.IsScalar()) {
+  if (!node().IsScalar()) {
     fail("expected a number");
   }
-  const std::string& s = node_.Scalar();
+  const std::string& s = node().Scalar();
   const std::optional<double> v = parse_double(trim_view(s));
   if (!v) {
     fail(not_a_number(s));
@@ -219,28 +223,28 @@ int Field::as_int() const {
 
 bool Field::as_bool() const {
   try {
-    return node_.as<bool>();
+    return node().as<bool>();
   } catch (const YAML::Exception&) {
     fail("expected true or false");
   }
 }
 
 std::string Field::as_string() const {
-  if (!node_.IsScalar()) {
+  if (!node().IsScalar()) {
     fail("expected a text value");
   }
-  return node_.Scalar();
+  return node().Scalar();
 }
 
 std::vector<double> Field::as_doubles(std::size_t expected_size) const {
-  if (!node_.IsSequence()) {
+  if (!node().IsSequence()) {
     fail("expected a list of numbers");
   }
-  if (expected_size != 0 && node_.size() != expected_size) {
-    fail(fmt::format("expected {} numbers, got {}", expected_size, node_.size()));
+  if (expected_size != 0 && node().size() != expected_size) {
+    fail(fmt::format("expected {} numbers, got {}", expected_size, node().size()));
   }
   std::vector<double> out;
-  for (std::size_t i = 0; i < node_.size(); ++i) {
+  for (std::size_t i = 0; i < node().size(); ++i) {
     out.push_back(at(i).as_double());
   }
   return out;
@@ -259,10 +263,10 @@ std::string Field::get(const std::string& key, const std::string& fallback) cons
 }
 
 void Field::only_keys(const std::vector<std::string>& allowed) const {
-  if (!node_.IsMap()) {
+  if (!node().IsMap()) {
     fail("expected a map");
   }
-  for (const auto& kv : node_) {
+  for (const auto& kv : node()) {
     const std::string key = kv.first.as<std::string>();
     if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
       Field(kv.first, file_, path_.empty() ? key : path_ + "." + key)

@@ -2,15 +2,21 @@
 // YAML reader (robot, sensor, case files) goes through these, so messages look the same everywhere.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
-#include <yaml-cpp/yaml.h>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
 #include "deflex/text/input_file.hpp"
 #include "deflex/text/input_ranges.hpp"
+
+// yaml-cpp's node, declared only: a file that includes this header does not parse yaml-cpp's (those
+// that call node() include <yaml-cpp/yaml.h> themselves).
+namespace YAML {
+class Node;
+}  // namespace YAML
 
 namespace deflex::yaml {
 
@@ -34,8 +40,8 @@ class Field {
   /// Child by index of a sequence.
   [[nodiscard]] Field at(std::size_t index) const;
   [[nodiscard]] std::size_t size() const;
-  [[nodiscard]] bool is_sequence() const { return node_.IsSequence(); }
-  [[nodiscard]] bool is_map() const { return node_.IsMap(); }
+  [[nodiscard]] bool is_sequence() const;
+  [[nodiscard]] bool is_map() const;
 
   [[nodiscard]] double as_double() const;  ///< finite number within +-1e12, else ModelError
   /// The number times `scale` (the file's unit to the range's unit), checked against `r`:
@@ -65,10 +71,10 @@ class Field {
   [[nodiscard]] const std::string& file() const { return file_; }
   [[nodiscard]] const std::string& path() const { return path_; }
   [[nodiscard]] int line() const;  ///< 1-based, 0 if unknown
-  [[nodiscard]] const YAML::Node& node() const { return node_; }
+  [[nodiscard]] const YAML::Node& node() const { return *node_; }
 
  private:
-  YAML::Node node_;
+  std::shared_ptr<const YAML::Node> node_;  // never null; copies of a Field share it as YAML::Node copies do
   std::string file_;
   std::string path_;
 };

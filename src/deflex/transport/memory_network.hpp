@@ -69,6 +69,9 @@ class MemoryTransport final : public DatagramTransport {
 class MemoryNetwork {
  public:
   explicit MemoryNetwork(const Clock& clock, std::size_t max_datagram_bytes = 2048, std::size_t queue_depth = 512);
+  /// A temporary clock would dangle: it does not compile (docs/architecture.md, "Ownership").
+  explicit MemoryNetwork(const Clock&& clock, std::size_t max_datagram_bytes = 2048,
+                         std::size_t queue_depth = 512) = delete;
   MemoryNetwork(const MemoryNetwork&) = delete;
   MemoryNetwork& operator=(const MemoryNetwork&) = delete;
 

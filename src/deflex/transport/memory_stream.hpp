@@ -44,6 +44,9 @@ class MemoryStreamPair {
   /// writes in flight per direction (writes at the same instant count once). Throws InputError.
   MemoryStreamPair(const Clock& clock, double latency_s, std::size_t window_bytes = 65536,
                    std::size_t max_writes = 4096);
+  /// A temporary clock would dangle: it does not compile (docs/architecture.md, "Ownership").
+  MemoryStreamPair(const Clock&& clock, double latency_s, std::size_t window_bytes = 65536,
+                   std::size_t max_writes = 4096) = delete;
   MemoryStreamPair(const MemoryStreamPair&) = delete;
   MemoryStreamPair& operator=(const MemoryStreamPair&) = delete;
 
