@@ -33,6 +33,7 @@
 #include <vector>
 
 #include <benchmark/benchmark.h>
+#include <nlohmann/json.hpp>
 
 #include "deflex/cell/rsi_controller.hpp"
 #include "deflex/model/robot_io.hpp"
@@ -336,7 +337,8 @@ void run_session(benchmark::State& state, bool abusive, bool realtime) {
       state.SkipWithError(refused_realtime.c_str());
       break;
     }
-    const auto& timing = summary.json["timing"];
+    const nlohmann::json document = nlohmann::json::parse(summary.json_text);
+    const auto& timing = document["timing"];
     const auto number = [](const nlohmann::json& v) { return v.is_number() ? v.get<double>() : 0.0; };
     state.counters["answers"] = static_cast<double>(summary.answers);
     state.counters["late"] = static_cast<double>(summary.late_answers);
