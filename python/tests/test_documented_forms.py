@@ -135,6 +135,9 @@ def sample(function, name, tmp_path):
         "measured": trace() + [0.04, 0, 0, 0], "commanded": trace(),
         "force_source": f"csv:{EXAMPLES / 'online' / 'force_replay.csv'}",
     }
+    machining = milling_sample(function, name, tmp_path)
+    if machining is not None:
+        return machining
     if function == "StandIn" and name == "link":
         return "egm-joint"
     if function == "StandIn" and name == "program":
@@ -142,6 +145,41 @@ def sample(function, name, tmp_path):
     if function == "write_joint_trajectory" and name == "q":
         return np.vstack([Q, Q + 0.01])
     return values[name]
+
+
+# The milling calls' arguments: the Al7075-T6 set written out with an engagement for the whole run, a
+# short straight slot as G-code, and full-slot mean forces from the textbook's closed forms.
+KC = {"Ktc_N_mm2": 767.0, "Krc_N_mm2": 168.8, "Kac_N_mm2": 222.0, "Kte_N_mm": 27.7, "Kre_N_mm": 26.6,
+      "Kae_N_mm": 0.7}
+MILLING = "milling:" + ",".join(f"{k}={v}" for k, v in KC.items()) + ",ae_mm=2,ap_mm=3"
+
+
+def slot_forces(fz_m, ap_m, flutes):
+    """Full-slot means on the tool (feed, normal, axis), N, from the closed forms (mm and N/mm units); a
+    clockwise (M3) tool is pushed back against its feed and along its axis away from the spindle."""
+    out = []
+    for fz, ap in zip(fz_m, ap_m):
+        fz_mm, ap_mm = fz * 1e3, ap * 1e3
+        out.append([-flutes * ap_mm * (fz_mm * KC["Krc_N_mm2"] / 4 + KC["Kre_N_mm"] / math.pi),
+                    flutes * ap_mm * (fz_mm * KC["Ktc_N_mm2"] / 4 + KC["Kte_N_mm"] / math.pi),
+                    -flutes * ap_mm * (fz_mm * KC["Kac_N_mm2"] / math.pi + KC["Kae_N_mm"] / 2)])
+    return np.array(out)
+
+
+def milling_sample(function, name, tmp_path):
+    """A value for the milling calls' arguments, or None for another call's."""
+    if function not in ("compensate_toolpath", "milling_force", "fit_cutting_coefficients"):
+        return None
+    fz = [3e-5, 6e-5, 9e-5, 1.2e-4]
+    if name == "toolpath":
+        path = tmp_path / "slot.nc"
+        path.write_text("G21 G90 G17\nS12000 M3\nG0 X-10 Y0 Z5\nG1 Z-3 F600\nG1 X20 F1500\nG0 Z5\nM5\n")
+        return path
+    return {"robot": deflex.Robot.from_file(EXAMPLES / "machining" / "irb6700_spindle.yaml"),
+            "workpiece": "x_mm=2000,y_mm=0,z_mm=800", "cutter": "diameter_mm=10,flutes=3,helix_deg=30",
+            "force": MILLING, "ae_m": 0.002, "ap_m": 0.003 if function == "milling_force" else [0.004] * 4,
+            "feed_mm_min": 1500.0, "spindle_rpm": 12000.0, "fz_m": fz,
+            "mean_force_n": slot_forces(fz, [0.004] * 4, 3), "flutes": 3}[name]
 
 
 def written_trajectory(tmp_path):
