@@ -105,7 +105,7 @@ Wrench LdbbDevice::wrench(const Vector3& tcp_m, const Vector3& tcp_velocity_m_s)
   TcpMotion motion;
   motion.position_m = tcp_m;
   motion.velocity_m_s = tcp_velocity_m_s;
-  const Wrench w = wrench_at(motion);
+  Wrench w = wrench_at(motion);
   commit(motion);
   return w;
 }
