@@ -75,15 +75,18 @@ inline int port_of(const Child& c, const std::string& key) {
   return -1;
 }
 
-/// Ticks a controller stand-in in real time every 4 ms for `seconds`.
-template <class Controller>
-void run_in_real_time(Controller& controller, double seconds) {
+/// Ticks a controller stand-in in real time every 4 ms for `seconds`, calling `after_tick()` after each
+/// tick (to record what the controller took).
+template <class Controller, class AfterTick = void (*)()>
+void run_in_real_time(
+    Controller& controller, double seconds, AfterTick after_tick = [] {}) {
   const auto start = std::chrono::steady_clock::now();
   auto next = start;
   for (;;) {
     const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (t > seconds) break;
     controller.tick(t);
+    after_tick();
     next += std::chrono::milliseconds(4);
     std::this_thread::sleep_until(next);
   }

@@ -34,7 +34,6 @@
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/transport/udp_transport.hpp"
-#include "support/sampled_speed.hpp"
 
 namespace deflex {
 namespace {
@@ -653,6 +652,17 @@ void slowloris(int port, const std::atomic<bool>& stop, std::atomic<int>& droppe
   if (fd >= 0) ::close(fd);
 }
 
+// `count` clients that ask for an event stream and then say nothing more (their sockets, to close).
+std::vector<int> idle_event_streams(int port, int count) {
+  std::vector<int> idle;
+  for (int k = 0; k < count; ++k) {
+    idle.push_back(connect_to(port));
+    const std::string req = "GET /events HTTP/1.1\r\nHost: x\r\nAccept: text/event-stream\r\n\r\n";
+    (void)!::send(idle.back(), req.data(), req.size(), MSG_NOSIGNAL);
+  }
+  return idle;
+}
+
 TEST(MonitorServer, OrdinaryRequestsAreAllAnsweredWithSlowlorisAndIdleClientsOn) {
   runtime::MonitorSetup setup;
   setup.link = "rsi";
@@ -669,12 +679,7 @@ TEST(MonitorServer, OrdinaryRequestsAreAllAnsweredWithSlowlorisAndIdleClientsOn)
   std::vector<std::thread> abusers;
   for (int k = 0; k < 10; ++k) abusers.emplace_back([&] { slowloris(server.port(), stop, dropped); });
   // Thirty clients that ask for an event stream and then say nothing more.
-  std::vector<int> idle;
-  for (int k = 0; k < 30; ++k) {
-    idle.push_back(connect_to(server.port()));
-    const std::string req = "GET /events HTTP/1.1\r\nHost: x\r\nAccept: text/event-stream\r\n\r\n";
-    (void)!::send(idle.back(), req.data(), req.size(), MSG_NOSIGNAL);
-  }
+  const std::vector<int> idle = idle_event_streams(server.port(), 30);
   std::this_thread::sleep_for(std::chrono::milliseconds(500));  // every slow connection open
   // Twenty ordinary requests at once: every one answered, with the data.
   std::vector<std::string> answers(20);
@@ -719,12 +724,7 @@ TEST(CliMonitor, AnAbusivePageNeitherDelaysNorStepsTheStream) {
       }
     });
   }
-  std::vector<int> idle;
-  for (int k = 0; k < 30; ++k) {
-    idle.push_back(connect_to(port));
-    const std::string req = "GET /events HTTP/1.1\r\nHost: x\r\nAccept: text/event-stream\r\n\r\n";
-    (void)!::send(idle.back(), req.data(), req.size(), MSG_NOSIGNAL);
-  }
+  const std::vector<int> idle = idle_event_streams(port, 30);
   // The controller in real time, every target it takes recorded (what went on the wire).
   std::vector<JointVector> wire;
   {
@@ -733,20 +733,12 @@ TEST(CliMonitor, AnAbusivePageNeitherDelaysNorStepsTheStream) {
     cell::EgmPositionGuidanceController controller(
         cc, run.program.points().front(), transport,
         make_datagram_address("127.0.0.1", static_cast<std::uint16_t>(egm_port)));
-    const auto start = std::chrono::steady_clock::now();
-    auto next = start;
     std::uint64_t taken = 0;
-    for (;;) {
-      const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (t > 3.0) break;
-      controller.tick(t);
-      if (controller.counters().targets != taken) {
-        taken = controller.counters().targets;
-        wire.push_back(controller.target());
-      }
-      next += std::chrono::milliseconds(4);
-      std::this_thread::sleep_until(next);
-    }
+    test::run_in_real_time(controller, 3.0, [&] {
+      if (controller.counters().targets == taken) return;
+      taken = controller.counters().targets;
+      wire.push_back(controller.target());
+    });
     EXPECT_FALSE(controller.counters().timed_out);
   }
   stop = true;
@@ -755,13 +747,9 @@ TEST(CliMonitor, AnAbusivePageNeitherDelaysNorStepsTheStream) {
   EXPECT_EQ(deflex.stop(), 0) << test::slurp(deflex.stderr_path);
   EXPECT_GT(floods.load(), 10) << "the flood never got an answer";
   ASSERT_GT(wire.size(), 200u);
-  // The per-cycle step limit from the program itself: its peak joint speed (sampled), the correction's
-  // rate bound (3 deg/s by default) and the ramp-in's blend (1 deg over 1 s at most, 1.5x for its shape).
-  const double period = 0.004, deg = kPi / 180.0;
-  const JointVector limit =
-      (period * (test::sampled_peak_speed(run.program) * 1.001 + JointVector::Constant(6, 3.0 * deg + 1.5 * deg)))
-          .array() +
-      1e-7;
+  // The per-cycle step limit the test computes from the program (test::cli_step_limit_deg), with the
+  // float32 rounding of the wire.
+  const JointVector limit = test::cli_step_limit_deg(run.program).array() * (kPi / 180.0) + 1e-7;
   double worst = 0.0;
   for (std::size_t k = 1; k < wire.size(); ++k) {
     worst = std::max(worst, ((wire[k] - wire[k - 1]).cwiseAbs().array() / limit.array()).maxCoeff());
