@@ -110,6 +110,9 @@ struct SensorConfig {
   double nominal_moment_nm = 50.0;
   double nominal_lateral_force_n = 1000.0;
   double moment_overload_growth = 0.0;
+  /// Draw the per-sample noise from the faster generator (noise_engine.hpp): the same distribution,
+  /// another stream. The sensor's own draws and the run's zero drift stay on the reference one.
+  bool fast_noise = false;
 };
 
 struct LdbbConfig {
@@ -148,6 +151,9 @@ struct TrackerConfig {
   /// per run). Its time stamps are its own clock's.
   double trigger_jitter_s = 0.0;
   double clock_rate_error = 0.0;
+  /// Draw the per-sample noise from the faster generator (noise_engine.hpp): the same distribution,
+  /// another stream. The clock's draws of a run stay on the reference one.
+  bool fast_noise = false;
 };
 
 /// The robot controller: its servo, and how it treats what an external sensor sends over EGM.
