@@ -170,7 +170,7 @@ void run(const CaseStudyOpts& o, int& exit_code) {
             l.setup, l.link, l.cycles, l.rejected, l.guard_trips, correction, l.measured_delay_s * 1e3);
       }
     }
-    std::cout << "\nThe cell: " << study::describe_coupled_solves(result.coupled) << "\n";
+    std::cout << "\nThe cell: " << study::describe_coupled_solves(result.coupled, result.coupled_options) << "\n";
     std::cout << fmt::format(
         "\n{} runs and {} calibrations, {:.0f} s of robot time simulated in {:.1f} s wall time; report in "
         "{}/report.html\n",

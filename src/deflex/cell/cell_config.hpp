@@ -50,6 +50,10 @@ struct TrueRobotConfig {
   double servo_following_s = 0.0;
   double servo_compliance_fraction = 0.0;
   double servo_integral_s = 0.1;
+  /// The deflected configuration's fixed point stops once a step moves no joint by more than this
+  /// (rad). The map contracts by about 1e-3 a step (compliance x force x reach), so the error left is
+  /// about a thousandth of it; the kinematics are those of the configuration a step before, within it.
+  double fixed_point_step_rad = 1e-10;
 };
 
 /// Run-to-run drift and path repeatability of the true robot: every run (the unloaded reference and

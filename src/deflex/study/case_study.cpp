@@ -320,6 +320,12 @@ std::string family_label(const Family& fam) {
 void use_fast_computation(CaseConfig& c) {
   c.cell.sensor.fast_noise = true;
   c.cell.tracker.fast_noise = true;
+  // The arm's deflected configuration to 1e-8 rad (error left ~1e-11 rad; its kinematics within
+  // 30 nm at the TCP), and a loaded tick's arm and bar agreeing to 0.25 N (0.25-0.4 um of TCP at the
+  // arm's 1-1.6 um/N: 20 times below the tracker's 5 um noise, and below the bar's own 2 N of noise).
+  c.cell.robot.fixed_point_step_rad = 1e-8;
+  c.coupled_tick.force_tolerance_n = 0.25;
+  c.coupled_tick.moment_tolerance_nm = 5e-3;
 }
 
 // The seeds' cases, the physical setups and families the setups need, and every speed an unloaded
@@ -826,8 +832,7 @@ std::string describe_protocol(const StudyContext& x) {
 }
 }  // namespace
 
-std::string describe_coupled_solves(const cell::CoupledTickCounters& c) {
-  const cell::CoupledTickOptions o;
+std::string describe_coupled_solves(const cell::CoupledTickCounters& c, const cell::CoupledTickOptions& o) {
   std::string text = fmt::format(
       "Every loaded servo tick of the cell solves the arm and the bar's force together (Newton's method: the force "
       "the bar gives where the arm then stands within {:g} N of the force the arm was solved under, at most {} "
@@ -906,7 +911,8 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
       if (cell) out.coupled.add(cell->calibration.coupled);
     }
   }
-  out.setup_paragraphs.push_back(describe_coupled_solves(out.coupled));
+  out.coupled_options = x.cfg_of(0).coupled_tick;
+  out.setup_paragraphs.push_back(describe_coupled_solves(out.coupled, out.coupled_options));
   x.charge(&StudyPhaseTimes::assembly_s, assembly_start);
   out.phases = x.phases;
   study.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

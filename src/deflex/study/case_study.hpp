@@ -85,7 +85,8 @@ struct CaseStudyOutput {
   /// What the cell's coupled solves of the arm and the bar did, over every loaded tick of the study
   /// (runs and calibrations): ticks, solves of the arm, ticks that reached the cap.
   cell::CoupledTickCounters coupled;
-  StudyPhaseTimes phases;  ///< where the CPU time went
+  cell::CoupledTickOptions coupled_options;  ///< the tolerance and cap those solves had
+  StudyPhaseTimes phases;                    ///< where the CPU time went
 };
 
 /// Runs the whole study. Throws deflex::Error on a case the cell cannot run (unreachable circle ...).
@@ -93,7 +94,8 @@ struct CaseStudyOutput {
 
 /// The coupled solves of a study in words: the method, its tolerance and cap, how many ticks and
 /// solves, and every tick that reached the cap.
-[[nodiscard]] std::string describe_coupled_solves(const cell::CoupledTickCounters& counters);
+[[nodiscard]] std::string describe_coupled_solves(const cell::CoupledTickCounters& counters,
+                                                  const cell::CoupledTickOptions& options = {});
 
 /// Runs `jobs` on `threads` threads (0: hardware), largest first as given; rethrows the first
 /// exception after every thread has stopped.
