@@ -1,8 +1,9 @@
 // The random bit generator behind the cell's per-sample noise (the tracker's and the force sensor's
 // 1 kHz draws): the reference Mersenne Twister (mt19937_64), or xoshiro256+ (Blackman and Vigna,
-// "Scrambled linear pseudorandom number generators", 2021), about four times cheaper a draw and
-// passing the same statistical batteries for the high bits a normal draw uses. Either feeds the same
-// normal distribution (Boost's ziggurat); the fast one gives another stream of the same noise.
+// "Scrambled linear pseudorandom number generators", 2021), which passes the same statistical
+// batteries for the high bits a normal draw uses. Either feeds the same normal distribution (Boost's
+// ziggurat); the fast one gives another stream of the same noise, a normal draw in about half the time
+// (measured on the build host through this class: 20 -> 10 ns, 64 random bits 9 -> 2 ns).
 #pragma once
 
 #include <cstdint>
