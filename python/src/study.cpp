@@ -141,7 +141,7 @@ void bind_study(py::module_& m) {
   m.def(
       "run_case_study",
       [](const CaseArg& case_in, int seeds, std::optional<long long> seed, bool quick, bool speed_sweep,
-         bool error_budget, int threads, bool traces) {
+         bool error_budget, int threads, bool traces, bool exact) {
         CaseStudyRun run;
         const py::object& case_arg = case_in.obj;
         if (case_arg.is_none() || (py::isinstance<py::str>(case_arg) && case_arg.cast<std::string>().empty())) {
@@ -169,6 +169,7 @@ void bind_study(py::module_& m) {
         options.speed_sweep = speed_sweep;
         options.error_budget = error_budget;
         options.threads = threads;
+        options.exact = exact;
         std::mutex trace_mutex;
         if (traces) {
           options.trace_sink = [&](const std::string& name, const TrackerTrace& trace) {
@@ -184,9 +185,9 @@ void bind_study(py::module_& m) {
         return run;
       },
       "case"_a = py::none(), "seeds"_a = 0, "seed"_a = py::none(), "quick"_a = false, "speed_sweep"_a = true,
-      "error_budget"_a = true, "threads"_a = 0, "traces"_a = false,
+      "error_budget"_a = true, "threads"_a = 0, "traces"_a = false, "exact"_a = false,
       "The case study (as `deflex case-study` with --case, --seeds, --seed, --quick, --no-sweep, --no-budget, "
-      "--threads, --write-traces): case None for the paper's case, a case file's path, or a dict of its keys "
+      "--threads, --write-traces, --exact): case None for the paper's case, a case file's path, or a dict of its keys "
       "(data/cases/paper.yaml's) merged over the paper's case (a nested dict key by key, a list such as setups "
       "whole); seeds 0 for the case's own count, threads 0 for every core. Writes no files "
       "(write_report() and write_traces() do).");

@@ -50,6 +50,10 @@ struct TrueRobotConfig {
   double servo_following_s = 0.0;
   double servo_compliance_fraction = 0.0;
   double servo_integral_s = 0.1;
+  /// The deflected configuration's fixed point stops once a step moves no joint by more than this
+  /// (rad). The map contracts by about 1e-3 a step (compliance x force x reach), so the error left is
+  /// about a thousandth of it; the kinematics are those of the configuration a step before, within it.
+  double fixed_point_step_rad = 1e-10;
 };
 
 /// Run-to-run drift and path repeatability of the true robot: every run (the unloaded reference and
@@ -110,6 +114,9 @@ struct SensorConfig {
   double nominal_moment_nm = 50.0;
   double nominal_lateral_force_n = 1000.0;
   double moment_overload_growth = 0.0;
+  /// Draw the per-sample noise from the faster generator (noise_engine.hpp): the same distribution,
+  /// another stream. The sensor's own draws and the run's zero drift stay on the reference one.
+  bool fast_noise = false;
 };
 
 struct LdbbConfig {
@@ -148,6 +155,9 @@ struct TrackerConfig {
   /// per run). Its time stamps are its own clock's.
   double trigger_jitter_s = 0.0;
   double clock_rate_error = 0.0;
+  /// Draw the per-sample noise from the faster generator (noise_engine.hpp): the same distribution,
+  /// another stream. The clock's draws of a run stay on the reference one.
+  bool fast_noise = false;
 };
 
 /// The robot controller: its servo, and how it treats what an external sensor sends over EGM.

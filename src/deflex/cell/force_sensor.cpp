@@ -38,9 +38,10 @@ ForceSensorDaq::ForceSensorDaq(const SensorConfig& sensor, const ToolConfig& too
   for (int i = 0; i < 3; ++i) cog_error[i] = normal_(rng_);
   calibration_.ee_cog_m = tool.ee_cog_m + sensor.sheet_cog_error_m * cog_error;
   calibration_.height_m = sensor.height_m + sensor.sheet_height_error_m * normal_(rng_);
-  rng_.seed(seed);  // noise and zero drift: this run's own
+  rng_.reseed(seed, false);  // noise and zero drift: this run's own
   normal_.reset();
   for (int i = 0; i < 3; ++i) zero_drift_n_per_s_[i] = sensor.zero_drift_n / 600.0 * normal_(rng_);
+  if (sensor.fast_noise) rng_.reseed(seed ^ kFastNoiseSalt, true);
   calibration_.ee_mass_kg = tool.ee_mass_kg * (1.0 + sensor.gravity_mass_error);
 }
 

@@ -11,6 +11,7 @@
 #include <boost/random/normal_distribution.hpp>
 
 #include "deflex/cell/cell_config.hpp"
+#include "deflex/cell/noise_engine.hpp"
 
 namespace deflex::cell {
 
@@ -56,7 +57,7 @@ class ForceSensorDaq {
   Matrix3 moment_crosstalk_ = Matrix3::Zero();  // N of each force channel per N m of each moment, at nominal
   Vector3 lever_m_ = Vector3::Zero();           // point of origin to the TCP, sensor frame
   SensorCalibration calibration_;
-  std::mt19937_64 rng_;
+  NoiseEngine rng_;
   boost::random::normal_distribution<double> normal_{0.0, 1.0};
 };
 

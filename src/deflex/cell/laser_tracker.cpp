@@ -13,6 +13,7 @@ LaserTracker::LaserTracker(const TrackerConfig& config, std::uint64_t seed, doub
       period_s_(1.0 / config.rate_hz) {
   trigger_s_ = config.trigger_jitter_s * normal_(rng_);
   rate_ = 1.0 + config.clock_rate_error * normal_(rng_);
+  if (config.fast_noise) rng_.reseed(seed ^ kFastNoiseSalt, true);
   period_s_ /= rate_;  // it samples at its own clock's rate
 }
 

@@ -11,6 +11,7 @@
 #include <boost/random/normal_distribution.hpp>
 
 #include "deflex/cell/cell_config.hpp"
+#include "deflex/cell/noise_engine.hpp"
 #include "deflex/model/tracker_trace.hpp"
 
 namespace deflex::cell {
@@ -28,7 +29,7 @@ class LaserTracker {
 
  private:
   TrackerConfig config_;
-  std::mt19937_64 rng_;
+  NoiseEngine rng_;
   boost::random::normal_distribution<double> normal_{0.0, 1.0};
   double next_s_, last_s_, origin_s_, period_s_;
   double trigger_s_ = 0.0;  // when its clock read zero, relative to the origin (simulation time)

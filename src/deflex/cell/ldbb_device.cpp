@@ -27,16 +27,20 @@ LdbbDevice::LdbbDevice(const LdbbConfig& config, const Vector3& nominal_pivot_m,
 }
 
 void LdbbDevice::advance(double dt_s) {
+  // A run steps by the same servo tick throughout: the chamber's factor for it is kept.
+  if (dt_s != step_dt_s_) {
+    step_dt_s_ = dt_s;
+    step_a_ = std::exp(-dt_s / config_.time_constant_s);
+  }
   const double target = setpoint_n_;
-  state_n_ += (target - state_n_) * (1.0 - std::exp(-dt_s / config_.time_constant_s));
+  state_n_ += (target - state_n_) * (1.0 - step_a_);
   t_ += dt_s;
   ripple_factor_ = 1.0 + config_.ripple * std::sin(2.0 * kPi * config_.ripple_hz * t_);
   if (config_.noise > 0.0) {
     // The regulator's noise reaches the force through the chamber's first-order response: an
     // Ornstein-Uhlenbeck process of the bar's time constant and a stationary 1-sigma of `noise` (exact
     // step), not a new draw every servo tick, which no air volume passes.
-    const double a = std::exp(-dt_s / config_.time_constant_s);
-    noise_draw_ = a * noise_draw_ + std::sqrt(1.0 - a * a) * normal_(rng_);
+    noise_draw_ = step_a_ * noise_draw_ + std::sqrt(1.0 - step_a_ * step_a_) * normal_(rng_);
   }
 }
 

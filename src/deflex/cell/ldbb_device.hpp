@@ -62,8 +62,9 @@ class LdbbDevice final : public ProcessForce {
   double noise_draw_ = 0.0;     // the pneumatic noise now, in units of its 1-sigma
   double ripple_factor_ = 1.0;  // this tick's 1 + ripple sin(2 pi f t)
   double t_ = 0.0;
-  double travel_m_ = 0.0;   // the piston's travel in the cylinder, either way, for the stick-slip
-  double per_tooth_ = 0.0;  // stick-slip teeth per metre of that travel
+  double step_dt_s_ = -1.0, step_a_ = 0.0;  // advance()'s chamber factor exp(-dt / tau) for its last step
+  double travel_m_ = 0.0;                   // the piston's travel in the cylinder, either way, for the stick-slip
+  double per_tooth_ = 0.0;                  // stick-slip teeth per metre of that travel
   double seal_friction_ = 0.0;
   double seal_n_ = 0.0;
   double last_length_m_ = -1.0;  // the bar's length at the last commit (negative: none yet)

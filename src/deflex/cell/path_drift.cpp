@@ -29,9 +29,13 @@ PathDrift::PathDrift(const DriftConfig& config, std::uint64_t seed, const PathDr
 
 void PathDrift::advance(double dt_s) {
   if (config_.wander_m <= 0.0) return;
-  const double a = std::exp(-dt_s / config_.wander_time_s);
-  const double s = config_.wander_m * std::sqrt(1.0 - a * a);
-  for (int i = 0; i < 3; ++i) wander_m_[i] = a * wander_m_[i] + s * normal_(rng_);
+  // A run steps by the same servo tick throughout: the step's factors are kept for it.
+  if (dt_s != step_dt_s_) {
+    step_dt_s_ = dt_s;
+    step_a_ = std::exp(-dt_s / config_.wander_time_s);
+    step_s_ = config_.wander_m * std::sqrt(1.0 - step_a_ * step_a_);
+  }
+  for (int i = 0; i < 3; ++i) wander_m_[i] = step_a_ * wander_m_[i] + step_s_ * normal_(rng_);
 }
 
 }  // namespace deflex::cell

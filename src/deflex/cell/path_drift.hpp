@@ -47,6 +47,7 @@ class PathDrift {
   Vector3 wander_m_ = Vector3::Zero();
   Vector3 load_offset_m_ = Vector3::Zero();
   bool active_ = false;
+  double step_dt_s_ = -1.0, step_a_ = 0.0, step_s_ = 0.0;  // advance()'s factors for its last step
 };
 
 }  // namespace deflex::cell

@@ -289,9 +289,10 @@ Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd_in, const Wrenc
     }
   }
   // Fixed point q = q_cmd + C tau(q). The map contracts by about |C dtau/dq| ~ C F L (1e-6 rad/Nm x
-  // 650 N x 2 m ~ 1e-3), so once a step moves no joint by more than 1e-10 rad the remaining error is
-  // about 1e-13 rad. The workspace then holds the kinematics of the last Jacobian's configuration,
-  // within that step of q (0.3 nm at 3 m), so it is not recomputed.
+  // 650 N x 2 m ~ 1e-3), so once a step moves no joint by more than fixed_point_step_rad (1e-10 rad by
+  // default) the remaining error is about a thousandth of it. The workspace then holds the kinematics
+  // of the last Jacobian's configuration, within that step of q (0.3 nm at 3 m for 1e-10), so it is
+  // not recomputed.
   bool ws_current = false;
   for (int it = 0; it < 30; ++it) {
     equivalent(tau);
@@ -299,7 +300,7 @@ Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd_in, const Wrenc
     const double step = (q_new - q).cwiseAbs().maxCoeff();
     q = q_new;
     if (!loaded) break;  // tau does not depend on q
-    if (step < 1e-10) {
+    if (step < rc.fixed_point_step_rad) {
       ws_current = true;  // the Jacobian before this step was taken at a q within the tolerance
       break;
     }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "deflex/cell/cell_config.hpp"
+#include "deflex/cell/coupled_tick.hpp"
 #include "deflex/model/types.hpp"
 
 namespace deflex::study {
@@ -111,6 +112,9 @@ struct CaseConfig {
   /// Give the compensators the true joint stiffness instead of an identified one (tests only:
   /// the model-consistent cell).
   bool exact_model = false;
+  /// How the cell's loaded ticks solve the arm and the bar together (the study's fast computation
+  /// loosens the tolerance; the exact one keeps these defaults).
+  cell::CoupledTickOptions coupled_tick;
 
   /// Circle radius, from the LDBB geometry: r = L cos(phi).
   [[nodiscard]] double radius_m() const;

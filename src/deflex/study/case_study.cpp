@@ -16,6 +16,8 @@
 #include <thread>
 #include <tuple>
 
+#include <time.h>
+
 #include "deflex/evaluate/iso9283_path.hpp"
 #include "deflex/evaluate/lap_split.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
@@ -27,6 +29,13 @@ namespace deflex::study {
 namespace {
 
 int mm_s(double speed_m_s) { return static_cast<int>(std::lround(speed_m_s * 1e3)); }
+
+// This thread's CPU time (s): the phases are timed per thread, so a busy machine does not count.
+double thread_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
 
 struct Figures {
   double mean_mm = 0, std_mm = 0, max_mm = 0, sync_mm = NAN, iso_accuracy_mm = NAN, iso_repeatability_mm = NAN;
@@ -219,6 +228,16 @@ struct StudyContext {
   double cal_cost = 0.0;                                    // simulated seconds of one calibration
   Progress progress;
   std::mutex sink_mutex;
+  std::mutex phase_mutex;
+  StudyPhaseTimes phases;
+
+  // Adds the thread's CPU time since `since_s` to a phase; returns the time now.
+  double charge(double StudyPhaseTimes::*phase, double since_s) {
+    const double now = thread_cpu_s();
+    std::lock_guard<std::mutex> lock(phase_mutex);
+    phases.*phase += now - since_s;
+    return now;
+  }
 
   // The case of seed `si`.
   const CaseConfig& cfg_of(int si) const { return seed_config[static_cast<std::size_t>(si)]; }
@@ -295,13 +314,29 @@ std::string family_label(const Family& fam) {
   return fmt::format("{}-{}", kFamilyName[fam.sensor ? 1 : 0], to_string(fam.link));
 }
 
+// The fast computation's changes to a seed's case: the tracker's and the sensor's 1 kHz noise from the
+// faster generator (the draws that set a run's course, its drift, clock and zero drift, stay the
+// reference's). The cell's sizes and what it shows the compensators stay as they are.
+void use_fast_computation(CaseConfig& c) {
+  c.cell.sensor.fast_noise = true;
+  c.cell.tracker.fast_noise = true;
+  // The arm's deflected configuration to 1e-8 rad (error left ~1e-11 rad; its kinematics within
+  // 30 nm at the TCP), and a loaded tick's arm and bar agreeing to 0.25 N (0.25-0.4 um of TCP at the
+  // arm's 1-1.6 um/N: 20 times below the tracker's 5 um noise, and below the bar's own 2 N of noise).
+  c.cell.robot.fixed_point_step_rad = 1e-8;
+  c.coupled_tick.force_tolerance_n = 0.25;
+  c.coupled_tick.moment_tolerance_nm = 5e-3;
+}
+
 // The seeds' cases, the physical setups and families the setups need, and every speed an unloaded
 // reference is run at.
 void plan_seeds_and_families(StudyContext& x) {
   const CaseConfig& config = x.config;
   x.seed_config.assign(static_cast<std::size_t>(x.n_seeds), config);
   for (int si = 0; si < x.n_seeds; ++si) {
-    x.seed_config[static_cast<std::size_t>(si)].seed = config.seed + static_cast<std::uint64_t>(si);
+    CaseConfig& c = x.seed_config[static_cast<std::size_t>(si)];
+    c.seed = config.seed + static_cast<std::uint64_t>(si);
+    if (!x.options.exact) use_fast_computation(c);
   }
   for (const auto& s : config.setups) {
     x.need_cell[s.sensor_mounted ? 1 : 0] = true;
@@ -421,8 +456,10 @@ int run_calibrations(StudyContext& x) {
     for (int f = 0; f < 2; ++f) {
       if (!x.need_cell[f]) continue;
       jobs.emplace_back([&x, si, f] {
+        const double start = thread_cpu_s();
         auto& slot = x.cells[static_cast<std::size_t>(si)][static_cast<std::size_t>(f)];
         slot.emplace(build_setup_cell(x.cfg_of(si), f == 1));
+        x.charge(&StudyPhaseTimes::calibration_s, start);
         x.progress.add(x.cal_cost, fmt::format("seed {}: calibration, {}", x.cfg_of(si).seed,
                                                f == 1 ? "sensor mounted" : "no sensor"));
       });
@@ -446,11 +483,14 @@ void run_unloaded_references(StudyContext& x, int si) {
     for (std::size_t f = 0; f < x.families.size(); ++f) {
       jobs.emplace_back([&x, si, f, v] {
         const Family& fam = x.families[f];
+        const double start = thread_cpu_s();
         RunOutput run = simulate_run(x.cfg_of(si), x.cell_of(si, fam.sensor), x.unloaded_spec(si, fam, v));
+        const double simulated = x.charge(&StudyPhaseTimes::unloaded_s, start);
         if (si == 0 && x.options.trace_sink && mm_s(v) == mm_s(x.config.budget.speed_m_s)) {
           x.sink(fmt::format("{}_unloaded_{}mm_s", family_label(fam), mm_s(v)), run.trace);
         }
         x.unloaded.at({si, static_cast<int>(f), mm_s(v)}) = make_reference(std::move(run), x.plotted(si, v));
+        x.charge(&StudyPhaseTimes::evaluation_s, simulated);
         x.progress.add(run_cost(x.config, v, x.laps),
                        fmt::format("seed {}: unloaded {} mm/s", x.cfg_of(si).seed, mm_s(v)));
       });
@@ -474,7 +514,9 @@ void release_references(StudyContext& x, int si) {
 void run_loaded_job(StudyContext& x, LoadedJob& j) {
   const Family& fam = x.families[static_cast<std::size_t>(j.family)];
   const RunSpec spec = x.loaded_spec(j.seed, fam, j.kind, j.strategy, j.load_n, j.speed);
+  const double start = thread_cpu_s();
   RunOutput run = simulate_run(x.cfg_of(j.seed), x.cell_of(j.seed, fam.sensor), spec);
+  const double simulated = x.charge(&StudyPhaseTimes::loaded_s, start);
   j.figures = evaluate_run(run, x.unloaded.at({j.seed, j.family, mm_s(j.speed)}));
   j.link_cycles = run.link_cycles;
   j.rejected = run.link_counters.rejected();
@@ -492,6 +534,7 @@ void run_loaded_job(StudyContext& x, LoadedJob& j) {
     j.plot_lap = thin_lap(run, kPlotPoints);
     j.plot_all_laps = plot_laps(run, kPlotLapPoints);
   }
+  x.charge(&StudyPhaseTimes::evaluation_s, simulated);
   x.progress.add(
       run_cost(x.config, j.speed, x.laps),
       fmt::format("seed {}: {} {} N {} mm/s", x.cfg_of(j.seed).seed,
@@ -511,6 +554,7 @@ CaseConfig budget_case(const StudyContext& x, const BudgetJob& bj) {
 // One run of the error budget: a cell built without the effect (its own calibration), its unloaded
 // reference and the setup's compensated run at the budget's load and speed.
 void run_budget_job(StudyContext& x, BudgetJob& bj) {
+  const double start = thread_cpu_s();
   const CaseConfig& config = x.config;
   const SetupConfig& sc = config.setups[static_cast<std::size_t>(bj.setup)];
   const Family& fam = x.families[static_cast<std::size_t>(x.family_of(sc))];
@@ -524,6 +568,7 @@ void run_budget_job(StudyContext& x, BudgetJob& bj) {
   bj.residual_mm = evaluate_run(run, reference).mean_mm;
   bj.coupled = cell.calibration.coupled;
   bj.coupled.add(run.coupled);
+  x.charge(&StudyPhaseTimes::budget_s, start);
   x.progress.add(x.cal_cost + 2.0 * run_cost(config, v, x.laps), fmt::format("budget: {}", budget_label(bj)));
 }
 
@@ -787,8 +832,7 @@ std::string describe_protocol(const StudyContext& x) {
 }
 }  // namespace
 
-std::string describe_coupled_solves(const cell::CoupledTickCounters& c) {
-  const cell::CoupledTickOptions o;
+std::string describe_coupled_solves(const cell::CoupledTickCounters& c, const cell::CoupledTickOptions& o) {
   std::string text = fmt::format(
       "Every loaded servo tick of the cell solves the arm and the bar's force together (Newton's method: the force "
       "the bar gives where the arm then stands within {:g} N of the force the arm was solved under, at most {} "
@@ -842,6 +886,7 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
   }
 
   // Assemble the study: per setup, load and speed the seeds' figures, their means and spread.
+  const double assembly_start = thread_cpu_s();
   StudyResult& study = out.study;
   study.case_name = config.name;
   study.seed = config.seed;
@@ -866,7 +911,10 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
       if (cell) out.coupled.add(cell->calibration.coupled);
     }
   }
-  out.setup_paragraphs.push_back(describe_coupled_solves(out.coupled));
+  out.coupled_options = x.cfg_of(0).coupled_tick;
+  out.setup_paragraphs.push_back(describe_coupled_solves(out.coupled, out.coupled_options));
+  x.charge(&StudyPhaseTimes::assembly_s, assembly_start);
+  out.phases = x.phases;
   study.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }

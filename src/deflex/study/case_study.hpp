@@ -24,6 +24,11 @@ struct CaseStudyOptions {
   bool speed_sweep = true;
   bool error_budget = true;
   int threads = 0;  ///< 0: one per hardware thread
+  /// The slow reference computation: the cell's noise from the reference generator and its solvers at
+  /// their tightest tolerances. Off (the default), the study computes the same runs and calibrations
+  /// faster, its printed means within a tenth of their spread over the seeds of the exact ones
+  /// (docs/case-study.md, "How long it takes"; tests/study/fast_mode_test.cpp checks it).
+  bool exact = false;
   /// Progress in [0, 1] with a short label; called from worker threads, one call at a time.
   std::function<void(double fraction, const std::string& label)> progress;
   /// Called with every run of the first seed at the error budget's speed and the highest load
@@ -59,6 +64,16 @@ struct LinkSummary {
   double measured_delay_s = 0.0;  ///< the link's measured delay (mean over the runs)
 };
 
+/// Where a study's CPU time went, summed over its threads (s of thread CPU time).
+struct StudyPhaseTimes {
+  double calibration_s = 0.0;  ///< the calibrations of the seeds' cells
+  double unloaded_s = 0.0;     ///< the unloaded reference runs (simulated)
+  double loaded_s = 0.0;       ///< the loaded runs of the tables and the sweep (simulated)
+  double evaluation_s = 0.0;   ///< the references' means and indexes, the runs' metrics and plotted laps
+  double budget_s = 0.0;       ///< the error budget's cells, calibrations and runs, all in
+  double assembly_s = 0.0;     ///< the tables, the plots and the setups' descriptions
+};
+
 struct CaseStudyOutput {
   StudyResult study;
   std::vector<LinkSummary> links;
@@ -70,6 +85,8 @@ struct CaseStudyOutput {
   /// What the cell's coupled solves of the arm and the bar did, over every loaded tick of the study
   /// (runs and calibrations): ticks, solves of the arm, ticks that reached the cap.
   cell::CoupledTickCounters coupled;
+  cell::CoupledTickOptions coupled_options;  ///< the tolerance and cap those solves had
+  StudyPhaseTimes phases;                    ///< where the CPU time went
 };
 
 /// Runs the whole study. Throws deflex::Error on a case the cell cannot run (unreachable circle ...).
@@ -77,7 +94,8 @@ struct CaseStudyOutput {
 
 /// The coupled solves of a study in words: the method, its tolerance and cap, how many ticks and
 /// solves, and every tick that reached the cap.
-[[nodiscard]] std::string describe_coupled_solves(const cell::CoupledTickCounters& counters);
+[[nodiscard]] std::string describe_coupled_solves(const cell::CoupledTickCounters& counters,
+                                                  const cell::CoupledTickOptions& options = {});
 
 /// Runs `jobs` on `threads` threads (0: hardware), largest first as given; rethrows the first
 /// exception after every thread has stopped.

@@ -173,7 +173,7 @@ void run_calibration_pass(CalibrationRig& rig, CalibrationArc& arc, int loaded) 
     state = fresh;
     state.lost_motion = lost_motion;
   }
-  CellArm arm{robot, ws, state, device, drift};
+  CellArm arm{robot, ws, state, device, drift, cell::CoupledTickSolver(rig.c.coupled_tick)};
   Vector3 p_prev = arm.at_rest(q);
   const auto ticks = static_cast<long>(std::ceil(program.end_time_s() / dt));
   double next_sample = 1.0 / cc.sensor.rate_hz;

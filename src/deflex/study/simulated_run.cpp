@@ -449,7 +449,7 @@ RunOutput drive_simulated_run(SimulatedRun& run) {
   Workspace ws(robot.true_model());
   JointVector q_motor = plan.program->points().front();
   cell::TrueRobotState state = robot.initial_state(q_motor);
-  CellArm arm{robot, ws, state, ldbb, drift};
+  CellArm arm{robot, ws, state, ldbb, drift, cell::CoupledTickSolver(plan.config.coupled_tick)};
   Vector3 p_prev = arm.at_rest(q_motor);
   const double daq_period = 1.0 / c.sensor.rate_hz;
   double next_daq = daq_period;

@@ -20,7 +20,7 @@ struct CellArm {
   cell::TrueRobotState& state;
   cell::LdbbDevice& bar;
   cell::PathDrift& drift;
-  cell::CoupledTickSolver solver{};
+  cell::CoupledTickSolver solver;
 
   /// The TCP (m, base frame, drifted) with the arm standing unloaded at the command `q` (rad): where
   /// a motion starts.
