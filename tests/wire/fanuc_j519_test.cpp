@@ -271,6 +271,47 @@ TEST(FanucJ519, NothingToSendFromANonFiniteOrUnrepresentableTarget) {
   EXPECT_EQ(j519::encode(3, c, out, sizeof out), 0u);
 }
 
+// The controller's check by hand: from rest at 8 ms, a step of d deg is a velocity d/T, an
+// acceleration d/T^2 and a jerk d/T^3; 0.001 deg is 1953.125 deg/s^3, over a CRX's 1240.
+TEST(FanucJ519, MotionCheckIsTheStreamsFiniteDifferences) {
+  std::array<j519::AxisLimits, j519::kAxes> limits{};
+  limits.fill({10.0, 1000.0, 1240.0});
+  j519::MotionCheck check(0.008, 6, limits);
+  check.reset({});
+  std::array<double, j519::kAxes> target{};
+  target[3] = 0.001;
+  std::size_t axis = 99;
+  double value = 0.0;
+  ASSERT_EQ(check.push(target, axis, value), j519::LimitExceeded::kJerk);
+  EXPECT_EQ(axis, 3u);
+  EXPECT_NEAR(value, 1953.125, 1e-9);
+  EXPECT_NEAR(check.peak().velocity, 0.125, 1e-12);
+  EXPECT_NEAR(check.peak().acceleration, 15.625, 1e-9);
+
+  // A ramp at constant velocity has no acceleration or jerk once going: 0.01 deg a cycle (1.25 deg/s)
+  // started with a jerk limit it may exceed only at the start.
+  limits.fill({10.0, 1000.0, 1e9});
+  j519::MotionCheck ramp(0.008, 6, limits);
+  ramp.reset({});
+  for (int k = 1; k <= 10; ++k) {
+    target.fill(0.01 * k);
+    ASSERT_EQ(ramp.push(target, axis, value), j519::LimitExceeded::kNone) << k;
+  }
+  EXPECT_NEAR(ramp.peak().velocity, 1.25, 1e-9);
+  // ... and a jump of 0.1 deg on axis 6 where the ramp would have stopped (12.5 deg/s) trips the
+  // velocity limit, reported as such.
+  target[5] += 0.1;
+  ASSERT_EQ(ramp.push(target, axis, value), j519::LimitExceeded::kVelocity);
+  EXPECT_EQ(axis, 5u);
+  EXPECT_NEAR(value, 12.5, 1e-9);
+  // Axes past the checked count are not the controller's (a six-axis arm's E1..E3).
+  j519::MotionCheck six(0.008, 6, limits);
+  six.reset({});
+  target.fill(0.0);
+  target[8] = 100.0;
+  EXPECT_EQ(six.push(target, axis, value), j519::LimitExceeded::kNone);
+}
+
 TEST(FanucJ519, EncodingAndDecodingDoNotAllocate) {
   unsigned char out[j519::kMaxDatagramBytes];
   const Bytes status = version_one_status();

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <utility>
 
 #include "deflex/wire/detail/byte_order.hpp"
 
@@ -321,6 +322,64 @@ DecodeStatus decode(const unsigned char* data, std::size_t size, Capability& out
   if (c.start_move > 9 || c.status_uses_tcp > 1) return DecodeStatus::kBadField;
   out = c;
   return DecodeStatus::kOk;
+}
+
+const char* to_string(LimitExceeded limit) noexcept {
+  switch (limit) {
+    case LimitExceeded::kNone:
+      return "none";
+    case LimitExceeded::kVelocity:
+      return "joint velocity";
+    case LimitExceeded::kAcceleration:
+      return "joint acceleration";
+    case LimitExceeded::kJerk:
+      return "joint jerk";
+  }
+  return "unknown";
+}
+
+MotionCheck::MotionCheck(double interval_s, std::size_t axes, const std::array<AxisLimits, kAxes>& limits) noexcept
+    : interval_s_(interval_s), axes_(std::min(axes, kAxes)), limits_(limits) {}
+
+void MotionCheck::reset(const std::array<double, kAxes>& position) noexcept {
+  history_.fill(position);
+  peak_ = AxisLimits{};
+}
+
+LimitExceeded MotionCheck::push(const std::array<double, kAxes>& target, std::size_t& axis, double& value) noexcept {
+  const double t = interval_s_;
+  LimitExceeded first = LimitExceeded::kNone;
+  for (std::size_t i = 0; i < axes_; ++i) {
+    const double p0 = target[i];
+    const double p1 = history_[0][i];
+    const double p2 = history_[1][i];
+    const double p3 = history_[2][i];
+    const double v = (p0 - p1) / t;
+    const double a = (p0 - 2.0 * p1 + p2) / (t * t);
+    const double j = (p0 - 3.0 * p1 + 3.0 * p2 - p3) / (t * t * t);
+    peak_.velocity = std::max(peak_.velocity, std::abs(v));
+    peak_.acceleration = std::max(peak_.acceleration, std::abs(a));
+    peak_.jerk = std::max(peak_.jerk, std::abs(j));
+    if (first != LimitExceeded::kNone) continue;
+    const AxisLimits& l = limits_[i];
+    const std::array<std::pair<LimitExceeded, double>, 3> checks{
+        {{LimitExceeded::kVelocity, std::abs(v) - l.velocity},
+         {LimitExceeded::kAcceleration, std::abs(a) - l.acceleration},
+         {LimitExceeded::kJerk, std::abs(j) - l.jerk}}};
+    const double values[] = {v, a, j};
+    for (std::size_t k = 0; k < checks.size(); ++k) {
+      if (checks[k].second > 0.0 || !std::isfinite(values[k])) {
+        first = checks[k].first;
+        axis = i;
+        value = values[k];
+        break;
+      }
+    }
+  }
+  history_[2] = history_[1];
+  history_[1] = history_[0];
+  history_[0] = target;
+  return first;
 }
 
 }  // namespace deflex::fanuc_j519

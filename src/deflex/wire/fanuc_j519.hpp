@@ -136,6 +136,39 @@ enum class DecodeStatus {
 };
 [[nodiscard]] const char* to_string(DecodeStatus status) noexcept;
 
+/// One axis's limits on the command stream, in the stream's units (deg/s, deg/s^2, deg/s^3 for joints).
+struct AxisLimits {
+  double velocity = 0.0;
+  double acceleration = 0.0;
+  double jerk = 0.0;
+};
+
+enum class LimitExceeded { kNone, kVelocity, kAcceleration, kJerk };
+[[nodiscard]] const char* to_string(LimitExceeded limit) noexcept;
+
+/// What the controller holds a command stream to: each axis's velocity, acceleration and jerk from
+/// the finite differences of successive targets at the communication interval (first, second and
+/// third differences over interval^1, ^2, ^3), against its limits; the stream stops at the first
+/// exceeded. The stand-in of the controller stops on it, and a link's tests check what it sent with it.
+class MotionCheck {
+ public:
+  /// Limits per axis for the first `axes` axes (the others are not checked). `interval_s` > 0.
+  MotionCheck(double interval_s, std::size_t axes, const std::array<AxisLimits, kAxes>& limits) noexcept;
+  /// The arm at rest at `position` (the stream's first target is measured from there).
+  void reset(const std::array<double, kAxes>& position) noexcept;
+  /// The next target: the first limit it exceeds, its axis (0-based) and the value it reached.
+  LimitExceeded push(const std::array<double, kAxes>& target, std::size_t& axis, double& value) noexcept;
+  /// The largest |velocity|, |acceleration| and |jerk| seen on any checked axis since reset().
+  [[nodiscard]] const AxisLimits& peak() const noexcept { return peak_; }
+
+ private:
+  double interval_s_;
+  std::size_t axes_;
+  std::array<AxisLimits, kAxes> limits_;
+  std::array<std::array<double, kAxes>, 3> history_{};  // the last three targets, newest first
+  AxisLimits peak_;
+};
+
 // Encoders: the datagram into `out`; return its size, or 0 when `capacity` is too small, the version
 // is unknown, or a target is not finite (never a half-written datagram to send).
 std::size_t encode_start(std::uint32_t version, unsigned char* out, std::size_t capacity) noexcept;
