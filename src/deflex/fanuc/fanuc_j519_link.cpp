@@ -195,6 +195,8 @@ bool FanucJ519Link::drain(double timeout_s, j519::Status& newest, bool& session_
     if (!gate_.take(from, status_.sequence, status_.time_stamp_ms, now, counters_, starts, arrival)) continue;
     if (got) ++counters_.superseded;
     newest = status_;
+    receipt_age_s_ = transport_.since_receipt_s();
+    taken_at_s_ = clock_.now_s();
     arrival_ = arrival;
     session_start = session_start || starts;
     got = true;
@@ -326,7 +328,7 @@ LinkPollResult FanucJ519Link::answer(std::uint32_t sequence, double now, bool se
       cycle_.not_sent(compute());
       return LinkPollResult::kNotAnswered;
     }
-    cycle_.sent(compute());
+    cycle_.sent(compute(), receipt_age_s_ + (clock_.now_s() - taken_at_s_));
     delay_.record_reference(now, cycle_.joint_command());
     stream_.consumed(period_s_);
     ++next_sequence_;

@@ -114,6 +114,8 @@ class FanucJ519Link final : public ControllerLink {
   fanuc_j519::Command command_;
   JointVector feedback_, program_, program_velocity_, blend_, blend_velocity_, nominal_;
   LinkArrival arrival_;
+  double receipt_age_s_ = 0.0;  // the newest status's age when it was read (the transport's time stamp)
+  double taken_at_s_ = 0.0;
 };
 
 }  // namespace deflex
