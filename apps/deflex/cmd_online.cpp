@@ -284,36 +284,13 @@ void check_link_options(const CLI::App& sub, LinkKind kind) {
   }
 }
 
-// "VEL,ACC,JERK" for every joint, or one triple a joint separated by ';'.
+// The FANUC link's settings from its options.
 void fanuc_settings(const OnlineOpts& o, FanucJ519LinkConfig& f) {
   f.version = o.fanuc_version < 0 ? 0U : static_cast<std::uint32_t>(o.fanuc_version);
   f.correction_share = o.fanuc_correction_share;
   f.max_catch_up = o.fanuc_catch_up;
   f.stream.ramp_in_s = o.ramp_in_s;
-  std::vector<std::string> joints;
-  std::string rest = o.fanuc_limits;
-  for (std::size_t at = rest.find(';'); at != std::string::npos; at = rest.find(';')) {
-    joints.push_back(rest.substr(0, at));
-    rest = rest.substr(at + 1);
-  }
-  joints.push_back(rest);
-  if (joints.size() > fanuc_j519::kAxes) {
-    throw InputError(fmt::format("option --fanuc-limits: {} triples, at most {}", joints.size(), fanuc_j519::kAxes));
-  }
-  for (std::size_t j = 0; j < joints.size(); ++j) {
-    double v[3] = {0.0, 0.0, 0.0};
-    char extra = 0;
-    if (std::sscanf(joints[j].c_str(), " %lf , %lf , %lf %c", &v[0], &v[1], &v[2], &extra) != 3) {
-      throw InputError(fmt::format(
-          "option --fanuc-limits: '{}' is not VEL,ACC,JERK (deg/s, deg/s^2, deg/s^3), e.g. 120,265,1240", joints[j]));
-    }
-    const fanuc_j519::AxisLimits l{v[0], v[1], v[2]};
-    if (joints.size() == 1) {
-      f.limits.fill(l);
-    } else {
-      f.limits[j] = l;
-    }
-  }
+  f.limits = parse_fanuc_limits(o.fanuc_limits, "--fanuc-limits");
   try {
     f.validate();
   } catch (const InputError& e) {

@@ -4,7 +4,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -88,6 +91,40 @@ void check_program(const JointTrajectory& program, double interval_s, const Fanu
 }
 
 }  // namespace
+
+std::array<j519::AxisLimits, j519::kAxes> parse_fanuc_limits(const std::string& text, const char* option) {
+  std::vector<std::string> joints;
+  std::string rest = text;
+  for (std::size_t at = rest.find(';'); at != std::string::npos; at = rest.find(';')) {
+    joints.push_back(rest.substr(0, at));
+    rest = rest.substr(at + 1);
+  }
+  joints.push_back(rest);
+  if (joints.size() > j519::kAxes) {
+    throw InputError(fmt::format("option {}: {} triples, at most {}", option, joints.size(), j519::kAxes));
+  }
+  std::array<j519::AxisLimits, j519::kAxes> limits = FanucJ519LinkConfig::default_limits();
+  for (std::size_t j = 0; j < joints.size(); ++j) {
+    double v[3] = {0.0, 0.0, 0.0};
+    char extra = 0;
+    if (std::sscanf(joints[j].c_str(), " %lf , %lf , %lf %c", &v[0], &v[1], &v[2], &extra) != 3) {
+      throw InputError(fmt::format("option {}: '{}' is not VEL,ACC,JERK (deg/s, deg/s^2, deg/s^3), e.g. 120,265,1240",
+                                   option, joints[j]));
+    }
+    for (const double x : v) {
+      if (!std::isfinite(x) || x <= 0.0) {
+        throw InputError(fmt::format("option {}: '{}': every limit must be positive", option, joints[j]));
+      }
+    }
+    const j519::AxisLimits l{v[0], v[1], v[2]};
+    if (joints.size() == 1) {
+      limits.fill(l);
+    } else {
+      limits[j] = l;
+    }
+  }
+  return limits;
+}
 
 void FanucJ519LinkConfig::validate() const {
   if (!j519::known_version(version)) {

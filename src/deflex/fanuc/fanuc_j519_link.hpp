@@ -61,6 +61,11 @@ struct FanucJ519LinkConfig {
   void validate() const;
 };
 
+/// "VEL,ACC,JERK" (deg/s, deg/s^2, deg/s^3) for every joint, or one triple a joint separated by ';' (as
+/// deflex online --fanuc-limits takes them). Throws InputError naming `option` and the triple.
+[[nodiscard]] std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> parse_fanuc_limits(const std::string& text,
+                                                                                       const char* option);
+
 /// Thread safety: one thread at a time (the loop's), as every ControllerLink.
 class FanucJ519Link final : public ControllerLink {
  public:
