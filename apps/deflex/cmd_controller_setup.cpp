@@ -12,6 +12,8 @@
 #include "cli_util.hpp"
 #include "command.hpp"
 #include "deflex/egm/egm_controller_setup.hpp"
+#include "deflex/fanuc/fanuc_controller_setup.hpp"
+#include "deflex/fanuc/fanuc_j519_link.hpp"
 #include "deflex/model/types.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/rsi/rsi_controller_setup.hpp"
@@ -37,12 +39,16 @@ struct ControllerSetupOpts {
          cond_time_s = 10.0, max_pos_deviation_deg = kNaN, max_speed_deviation_deg_s = kNaN, monitor_factor = 1.2,
          max_rate_deg_s = kShared.max_rate_deg_s,
          stop_silence_s = kNaN;  // default: the link kind's (runtime/link_table.cpp)
+  // FANUC Stream Motion.
+  std::string tp_program = "DEFLEXSM", fanuc_limits = "120,265,1240";
+  int fanuc_version = 1, robot_port = 60015, uframe = 0, utool = 1;
+  double fanuc_correction_share = 0.25, move_speed_pct = 10.0;
   bool json = false;
 };
 
 /// The options of `deflex controller-setup`, in the order --help lists them.
 void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
-  sub.add_option("--link", o.link, "egm-joint, egm-path or rsi (as deflex online --link)")->required();
+  sub.add_option("--link", o.link, "egm-joint, egm-path, rsi or fanuc-j519 (as deflex online --link)")->required();
   sub.add_option("--sensor-ip", o.sensor_ip,
                  "deflex's IPv4 address as the controller reaches it (the PC on the controller's network)")
       ->required();
@@ -96,6 +102,20 @@ void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
       ->capture_default_str();
   sub.add_option("--rsi-monitor-factor", o.monitor_factor,
                  "rsi: AXISCORRMON's MaxAi as a multiple of --max-joint-correction-deg")
+      ->capture_default_str();
+  sub.add_option("--tp-program", o.tp_program, "fanuc-j519: the TP program's name")->capture_default_str();
+  sub.add_option("--fanuc-version", o.fanuc_version, "fanuc-j519: deflex online --fanuc-version")
+      ->capture_default_str();
+  sub.add_option("--fanuc-limits", o.fanuc_limits, "fanuc-j519: deflex online --fanuc-limits (deg/s, deg/s^2, deg/s^3)")
+      ->capture_default_str();
+  sub.add_option("--fanuc-correction-share", o.fanuc_correction_share,
+                 "fanuc-j519: deflex online --fanuc-correction-share")
+      ->capture_default_str();
+  sub.add_option("--robot-port", o.robot_port, "fanuc-j519: deflex online --robot-port")->capture_default_str();
+  sub.add_option("--uframe", o.uframe, "fanuc-j519: the user frame the TP program sets")->capture_default_str();
+  sub.add_option("--utool", o.utool, "fanuc-j519: the tool frame the TP program sets")->capture_default_str();
+  sub.add_option("--move-speed-pct", o.move_speed_pct,
+                 "fanuc-j519: the TP program's joint move to --program's start, % of the joints' top speed")
       ->capture_default_str();
   sub.add_flag("--json", o.json, "Print one JSON document (the files written and where each goes) on stdout");
 }
@@ -165,6 +185,32 @@ std::vector<ControllerFile> rsi_setup_files(const ControllerSetupOpts& o) {
   return rsi_controller_setup(r);
 }
 
+/// The files of --link fanuc-j519: the TP program and the settings sheet.
+std::vector<ControllerFile> fanuc_setup_files(const ControllerSetupOpts& o) {
+  FanucSetupOptions f;
+  f.program_name = o.tp_program;
+  f.period_ms =
+      o.period_ms > 0.0 ? o.period_ms : runtime::link_kind(runtime::LinkKind::kFanucJ519).default_period_s * 1e3;
+  if (o.period_ms < 0.0) throw InputError("option --period-ms: must be > 0");
+  if (o.fanuc_version < 0) throw InputError("option --fanuc-version: 1, 3 or 4");
+  f.version = static_cast<std::uint32_t>(o.fanuc_version);
+  f.uframe = o.uframe;
+  f.utool = o.utool;
+  f.move_speed_pct = o.move_speed_pct;
+  f.limits = parse_fanuc_limits(o.fanuc_limits, "--fanuc-limits");
+  if (!(o.fanuc_correction_share > 0.0 && o.fanuc_correction_share < 1.0)) {
+    throw InputError("option --fanuc-correction-share: must be in (0, 1)");
+  }
+  f.correction_share = o.fanuc_correction_share;
+  f.robot_port = controller_setup_port(o.robot_port, "--robot-port");
+  f.pc_address = o.sensor_ip;
+  if (!o.program.empty()) {
+    const RobotModel model = load_cli_robot("controller-setup", o.robot);
+    f.start_rad = JointTrajectory::read_csv(o.program, model).points().front();
+  }
+  return fanuc_controller_setup(f);
+}
+
 /// Writes the files into --output-dir and lists them with where each goes (JSON with --json).
 void write_controller_setup_files(const ControllerSetupOpts& o, const std::vector<ControllerFile>& files) {
   OutputFolder folder(o.output_dir, "option --output-dir");  // made when missing, as every output's folder
@@ -191,8 +237,10 @@ void run_controller_setup(const ControllerSetupOpts& o, int& exit_code) {
     files = egm_setup_files(o);
   } else if (o.link == "rsi") {
     files = rsi_setup_files(o);
+  } else if (o.link == "fanuc-j519") {
+    files = fanuc_setup_files(o);
   } else {
-    throw InputError(fmt::format("option --link: '{}' is not egm-joint, egm-path or rsi", o.link));
+    throw InputError(fmt::format("option --link: '{}' is not egm-joint, egm-path, rsi or fanuc-j519", o.link));
   }
   write_controller_setup_files(o, files);
   exit_code = 0;
@@ -208,8 +256,9 @@ void setup_controller_setup(CLI::App& sub, int& exit_code) {
 }  // namespace
 
 DEFLEX_COMMAND("controller-setup",
-               "Write the robot controller's side of a link (--link egm-joint|egm-path|rsi): RAPID and UdpUc for ABB "
-               "EGM, the Ethernet config, RSI context and KRL for KUKA RSI, agreeing with deflex online's options",
+               "Write the robot controller's side of a link (--link egm-joint|egm-path|rsi|fanuc-j519): RAPID and "
+               "UdpUc for ABB EGM, the Ethernet config, RSI context and KRL for KUKA RSI, the TP program and "
+               "settings for FANUC Stream Motion, agreeing with deflex online's options",
                setup_controller_setup, 42);
 
 }  // namespace deflex::cli

@@ -77,6 +77,10 @@ struct OnlineOpts {
   std::string byte_order = "little";
   int buffer_depth = 2, max_failures = 3, max_frame_bytes = 1024;
   double reply_timeout_s = 1.0, state_timeout_s = 1.0, max_behind_s = 2.0;
+  // FANUC Stream Motion.
+  int robot_port = -1, fanuc_version = 1, fanuc_catch_up = 8;
+  std::string fanuc_limits = "120,265,1240";
+  double fanuc_correction_share = 0.25;
   LogOptions log_options;
 };
 
@@ -89,7 +93,7 @@ struct LinkOption {
 const std::vector<LinkOption>& link_options() {
   static const std::vector<LinkOption> options{
       {"--egm-port", {LinkKind::kEgmJoint, LinkKind::kEgmPath}},
-      {"--ramp-in-s", {LinkKind::kEgmJoint, LinkKind::kSimpleMessage}},
+      {"--ramp-in-s", {LinkKind::kEgmJoint, LinkKind::kSimpleMessage, LinkKind::kFanucJ519}},
       {"--no-speed-reference", {LinkKind::kEgmJoint}},
       {"--path-corr-frame", {LinkKind::kEgmPath}},
       {"--correction-latency-ms", {LinkKind::kEgmPath}},
@@ -99,7 +103,12 @@ const std::vector<LinkOption>& link_options() {
       {"--rsi-correction-latency-ms", {LinkKind::kRsi}},
       {"--rsi-max-document-bytes", {LinkKind::kRsi}},
       {"--rsi-timeout", {LinkKind::kRsi}},
-      {"--robot-host", {LinkKind::kSimpleMessage}},
+      {"--robot-host", {LinkKind::kSimpleMessage, LinkKind::kFanucJ519}},
+      {"--robot-port", {LinkKind::kFanucJ519}},
+      {"--fanuc-version", {LinkKind::kFanucJ519}},
+      {"--fanuc-limits", {LinkKind::kFanucJ519}},
+      {"--fanuc-correction-share", {LinkKind::kFanucJ519}},
+      {"--fanuc-catch-up", {LinkKind::kFanucJ519}},
       {"--motion-port", {LinkKind::kSimpleMessage}},
       {"--state-port", {LinkKind::kSimpleMessage}},
       {"--byte-order", {LinkKind::kSimpleMessage}},
@@ -111,7 +120,7 @@ const std::vector<LinkOption>& link_options() {
       {"--max-frame-bytes", {LinkKind::kSimpleMessage}},
       {"--max-behind-s", {LinkKind::kSimpleMessage}},
       {"--end-on-silence", {LinkKind::kEgmPath, LinkKind::kRsi}},
-      {"--end-silence-s", {LinkKind::kEgmJoint, LinkKind::kSimpleMessage}},
+      {"--end-silence-s", {LinkKind::kEgmJoint, LinkKind::kSimpleMessage, LinkKind::kFanucJ519}},
   };
   return options;
 }
@@ -145,7 +154,8 @@ void add_link_options(CLI::App& sub, OnlineOpts& o) {
   sub.add_option("--egm-port", o.egm_port,
                  "EGM: UDP port the controller's EGM messages arrive on (ABB examples: 6510)");
   sub.add_option("--ramp-in-s", o.ramp_in_s,
-                 "egm-joint, simple-message: blend from where the controller is to the program over this time, s")
+                 "egm-joint, simple-message, fanuc-j519: blend from where the controller is to the program over this "
+                 "time, s")
       ->capture_default_str();
   sub.add_flag("--no-speed-reference", o.no_speed_ref, "egm-joint: do not send the target's joint speeds");
   sub.add_option("--path-corr-frame", o.path_frame,
@@ -175,7 +185,26 @@ void add_link_options(CLI::App& sub, OnlineOpts& o) {
                  "controller-setup writes the same): with the <Delay> it reports, an RSI stopped by it is recognised")
       ->capture_default_str();
   sub.add_option("--robot-host", o.robot_host,
-                 "simple-message: the controller's address (its motion and state servers listen there)");
+                 "simple-message: the controller's address (its motion and state servers listen there); "
+                 "fanuc-j519: its IPv4 address");
+  sub.add_option("--robot-port", o.robot_port, "fanuc-j519: the controller's Stream Motion UDP port (default 60015)");
+  sub.add_option("--fanuc-version", o.fanuc_version,
+                 "fanuc-j519: the Stream Motion protocol version the controller speaks: 1 (float32 targets), 3 or 4 "
+                 "(float64; R-30iB Plus V9.40P and later)")
+      ->capture_default_str();
+  sub.add_option("--fanuc-limits", o.fanuc_limits,
+                 "fanuc-j519: the controller's limits on the stream, VEL,ACC,JERK in deg/s, deg/s^2, deg/s^3, for "
+                 "every joint, or one triple a joint separated by ';' (its threshold tables' strictest values or the "
+                 "pendant's $STMO_GRP limits; default a CRX-10iA/L's strictest)")
+      ->capture_default_str();
+  sub.add_option("--fanuc-correction-share", o.fanuc_correction_share,
+                 "fanuc-j519: the share of the acceleration and jerk limits the correction may take (0..1; the "
+                 "program keeps the rest); the correction is smoothed to stay within it (its delay is reported)")
+      ->capture_default_str();
+  sub.add_option("--fanuc-catch-up", o.fanuc_catch_up,
+                 "fanuc-j519: statuses lost or late in a row that deflex answers with one command each, in order, "
+                 "as FANUC's driver does (more: the session stops, too slow); at most the controller's queue")
+      ->capture_default_str();
   sub.add_option("--motion-port", o.motion_port, "simple-message: TCP port of the motion server (JOINT_TRAJ_PT)")
       ->capture_default_str();
   sub.add_option("--state-port", o.state_port, "simple-message: TCP port of the state server (JOINT_POSITION)")
@@ -255,6 +284,20 @@ void check_link_options(const CLI::App& sub, LinkKind kind) {
   }
 }
 
+// The FANUC link's settings from its options.
+void fanuc_settings(const OnlineOpts& o, FanucJ519LinkConfig& f) {
+  f.version = o.fanuc_version < 0 ? 0U : static_cast<std::uint32_t>(o.fanuc_version);
+  f.correction_share = o.fanuc_correction_share;
+  f.max_catch_up = o.fanuc_catch_up;
+  f.stream.ramp_in_s = o.ramp_in_s;
+  f.limits = parse_fanuc_limits(o.fanuc_limits, "--fanuc-limits");
+  try {
+    f.validate();
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("options --fanuc-*: {}", e.what()));
+  }
+}
+
 runtime::SessionConfig session_config(const OnlineOpts& o, const CLI::App& sub) {
   runtime::SessionConfig c;
   c.link = runtime::parse_link_kind(o.link);
@@ -323,6 +366,7 @@ runtime::SessionConfig session_config(const OnlineOpts& o, const CLI::App& sub) 
   c.network.egm_port = o.egm_port;
   c.network.rsi_port = o.rsi_port;
   c.network.robot_host = o.robot_host;
+  c.network.robot_port = o.robot_port;
   c.network.motion_port = o.motion_port;
   c.network.state_port = o.state_port;
   c.network.connect_timeout_s = o.connect_timeout_s;
@@ -377,6 +421,7 @@ runtime::SessionConfig session_config(const OnlineOpts& o, const CLI::App& sub) 
   s.simple_message.max_frame_bytes = static_cast<std::size_t>(o.max_frame_bytes);
   s.simple_message.max_behind_s = o.max_behind_s;
   s.simple_message.stream.ramp_in_s = o.ramp_in_s;
+  fanuc_settings(o, c.fanuc_j519);
   return c;
 }
 
@@ -621,7 +666,8 @@ void setup_online(CLI::App& sub, int& exit_code) {
 }  // namespace
 
 DEFLEX_COMMAND("online",
-               "Online compensation on a controller link (--link egm-joint|egm-path|rsi|simple-message): condition "
+               "Online compensation on a controller link (--link egm-joint|egm-path|rsi|simple-message|fanuc-j519): "
+               "condition "
                "force samples and answer the controller, never beyond the bound of the nominal",
                setup_online, 40);
 

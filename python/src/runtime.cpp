@@ -77,8 +77,22 @@ const std::map<std::string, Setter>& settings() {
     integer("state_port", [](C& c) -> int& { return c.network.state_port; });
     real("connect_timeout_s", [](C& c) -> double& { return c.network.connect_timeout_s; });
     t["ramp_in_s"] = [](C& c, const py::handle& v) {
-      c.egm_joint.stream.ramp_in_s = c.simple_message.stream.ramp_in_s = as<double>(v, "ramp_in_s");
+      c.egm_joint.stream.ramp_in_s = c.simple_message.stream.ramp_in_s = c.fanuc_j519.stream.ramp_in_s =
+          as<double>(v, "ramp_in_s");
     };
+    integer("robot_port", [](C& c) -> int& { return c.network.robot_port; });
+    t["fanuc_version"] = [](C& c, const py::handle& v) {
+      const int version = as<int>(v, "fanuc_version");
+      if (!fanuc_j519::known_version(version < 0 ? 0U : static_cast<std::uint32_t>(version))) {
+        throw InputError(fmt::format("setting fanuc_version: {} is not 1, 3 or 4", version));
+      }
+      c.fanuc_j519.version = static_cast<std::uint32_t>(version);
+    };
+    t["fanuc_limits"] = [](C& c, const py::handle& v) {
+      c.fanuc_j519.limits = parse_fanuc_limits(as<std::string>(v, "fanuc_limits"), "fanuc_limits");
+    };
+    real("fanuc_correction_share", [](C& c) -> double& { return c.fanuc_j519.correction_share; });
+    integer("fanuc_catch_up", [](C& c) -> int& { return c.fanuc_j519.max_catch_up; });
     flag("send_speed_reference", [](C& c) -> bool& { return c.egm_joint.send_speed_reference; });
     t["path_corr_frame"] = [](C& c, const py::handle& v) {
       c.egm_path.frame = parse_path_corr_frame(as<std::string>(v, "path_corr_frame"));

@@ -81,6 +81,30 @@ def test_rsi_restart_starts_the_correction_from_zero():
     assert s.finish()["counters"]["restarts"] == 1
 
 
+def test_fanuc_streams_within_its_controllers_jerk_limit_and_ends_with_last_data():
+    robot = deflex.Robot.builtin()
+    t, q = sweep(6.0)
+    s = deflex.StandIn(robot, "fanuc-j519", (t, q), force_base_N=[0.0, 0.0, -650.0],
+                       fanuc_limits="120,265,1240")
+    s.run_for(2.0)
+    s.set_force([0.0, 300.0, -650.0])  # a step in the force while the arm moves
+    s.run_for(8.0)
+    summary = s.finish()
+    assert summary["stop_reason"] == "program-end" and summary["exit_code"] == 0, summary["reason"]
+    assert "last-data" in summary["reason"]
+    # The controller's check, done here on what it received: finite differences at its 8 ms interval.
+    wire = np.degrees(s.wire["joints_rad"])
+    assert wire.shape[0] > 700
+    period = 0.008
+    velocity = np.abs(np.diff(wire, 1, axis=0)) / period
+    acceleration = np.abs(np.diff(wire, 2, axis=0)) / period**2
+    jerk = np.abs(np.diff(wire, 3, axis=0)) / period**3
+    assert velocity.max() <= 120.0
+    assert acceleration.max() <= 265.0
+    assert jerk.max() <= 1240.0, jerk.max()
+    assert jerk.max() > 1.0  # the correction moved the stream
+
+
 def test_settings_are_checked_and_named():
     robot = deflex.Robot.builtin()
     with pytest.raises(deflex.InputError, match="setting 'egm_prot' is not one of"):
@@ -89,6 +113,10 @@ def test_settings_are_checked_and_named():
         deflex.StandIn(robot, "egm-joint", sweep(), period_s="fast")
     with pytest.raises(deflex.InputError, match="argument link: 'fanuc' is not one of"):
         deflex.StandIn(robot, "fanuc", sweep())
+    with pytest.raises(deflex.InputError, match="setting fanuc_version: 2 is not 1, 3 or 4"):
+        deflex.StandIn(robot, "fanuc-j519", sweep(), fanuc_version=2)
+    with pytest.raises(deflex.InputError, match="is not VEL,ACC,JERK"):
+        deflex.StandIn(robot, "fanuc-j519", sweep(), fanuc_limits="120;265")
     with pytest.raises(deflex.InputError, match="rate bound allows"):
         deflex.StandIn(robot, "egm-joint", sweep(), max_correction_rate_rad_s=10.0)
 

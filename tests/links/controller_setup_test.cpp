@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/egm/egm_controller_setup.hpp"
+#include "deflex/fanuc/fanuc_controller_setup.hpp"
 #include "deflex/rsi/rsi_controller_setup.hpp"
 #include "deflex/text/errors.hpp"
 #include "wire/libxml2_reader.hpp"
@@ -404,6 +405,71 @@ TEST(ControllerSetup, EgmSupervisionIsDerivedTightFromDeflexsOwnLimits) {
   const EgmSupervision loose = egm_supervision(o);
   EXPECT_GT(loose.max_speed_deviation_deg_s, 235.0);
   EXPECT_NE(file(egm_controller_setup(o), ".mod").text.find("the robot's joint speed limits"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace deflex
+
+namespace deflex {
+namespace {
+
+// FANUC: the TP program waits in IBGN after moving to the program's start (its joints, in degrees,
+// as the .LS position section writes them), and the sheet sets the interval deflex runs at.
+TEST(ControllerSetup, FanucTpProgramWaitsInIbgnAtTheProgramsStart) {
+  FanucSetupOptions o;
+  o.period_ms = 4.0;
+  o.version = 3;
+  o.start_rad = JointVector(6);
+  o.start_rad << deg_to_rad(10.0), deg_to_rad(-20.5), deg_to_rad(30.25), 0.0, deg_to_rad(90.0), deg_to_rad(-179.0);
+  o.limits.fill({120.0, 265.0, 1240.0});
+  const std::vector<ControllerFile> files = fanuc_controller_setup(o);
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(files[0].name, "DEFLEXSM.LS");
+  const std::string& tp = files[0].text;
+  EXPECT_EQ(tp.rfind("/PROG  DEFLEXSM\n", 0), 0u) << tp;
+  // The lines in order, numbered: frames, the move to the start, IBGN start then end.
+  const std::size_t move = tp.find("   3:  J P[1] 10% FINE ;");
+  const std::size_t start = tp.find("   5:  IBGN start[1] ;");
+  const std::size_t end = tp.find("   6:  IBGN end[1] ;");
+  ASSERT_NE(move, std::string::npos) << tp;
+  ASSERT_NE(start, std::string::npos) << tp;
+  ASSERT_NE(end, std::string::npos) << tp;
+  EXPECT_LT(move, start);
+  EXPECT_LT(start, end);
+  for (const char* joint : {"J1=    10.000 deg", "J2=   -20.500 deg", "J3=    30.250 deg", "J6=  -179.000 deg"}) {
+    EXPECT_NE(tp.find(joint), std::string::npos) << joint << "\n" << tp;
+  }
+  EXPECT_NE(tp.find("/END\n"), std::string::npos);
+  const std::string& sheet = files[1].text;
+  EXPECT_NE(sheet.find("$STMO.$COM_INT        = 4 "), std::string::npos) << sheet;
+  EXPECT_NE(sheet.find("--fanuc-version 3"), std::string::npos) << sheet;
+  EXPECT_NE(sheet.find("jerk 1240 deg/s^3"), std::string::npos) << sheet;
+  EXPECT_EQ(sheet.find("S647"), std::string::npos) << "the 1 ms option only for a 1 ms interval";
+  o.period_ms = 1.0;
+  EXPECT_NE(fanuc_controller_setup(o)[1].text.find("S647"), std::string::npos);
+}
+
+TEST(ControllerSetup, FanucOptionsThatCannotWorkAreRefused) {
+  const auto refused = [](const FanucSetupOptions& o, const char* words) {
+    try {
+      (void)fanuc_controller_setup(o);
+      ADD_FAILURE() << "expected an InputError naming " << words;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  FanucSetupOptions o;
+  o.program_name = "deflex";
+  refused(o, "--tp-program");
+  o = FanucSetupOptions{};
+  o.program_name = "TOOLONGNAME";
+  refused(o, "--tp-program");
+  o = FanucSetupOptions{};
+  o.period_ms = 2.0;
+  refused(o, "8, 4 or 1 ms");
+  o = FanucSetupOptions{};
+  o.version = 2;
+  refused(o, "--fanuc-version");
 }
 
 }  // namespace

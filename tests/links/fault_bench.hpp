@@ -1,6 +1,7 @@
 // A bench for the fault table (docs/online.md, "Faults and exit codes"): deflex's runtime session
 // against the simulated cell's stand-in of the real controller, in memory (standin/standin_session.hpp:
-// EGM position guidance or path correction, KUKA RSI, the RAPID simple message server), with the
+// EGM position guidance or path correction, KUKA RSI, the RAPID simple message server, FANUC Stream
+// Motion), with the
 // faults a cell has injected by the test. What deflex sent is read off the wire on the controller's
 // side, and the two invariants are checked there, against limits the test computes itself from the
 // program it made (its peak speed by sampling, not the library's figure) and the settings it gave.
@@ -21,7 +22,10 @@ namespace deflex::test {
 inline runtime::SessionConfig bench_session(runtime::LinkKind kind) {
   runtime::SessionConfig c;
   const bool sm = kind == runtime::LinkKind::kSimpleMessage;
-  const double period = kind == runtime::LinkKind::kEgmPath ? 0.048 : sm ? 0.1 : 0.004;
+  const double period = kind == runtime::LinkKind::kEgmPath     ? 0.048
+                        : sm                                    ? 0.1
+                        : kind == runtime::LinkKind::kFanucJ519 ? 0.008
+                                                                : 0.004;
   c.link = kind;
   c.online = bench_online(period);
   c.online.watchdog_s = std::max(0.05, 2.5 * period);
@@ -59,9 +63,10 @@ struct FaultBench {
   /// blend's (1.5 x the start tolerance over the ramp) and the correction's rate, over one period.
   [[nodiscard]] JointVector joint_step_limit() const {
     const double period = config.online.period_s;
-    const JointStreamConfig& s =
-        kind == runtime::LinkKind::kSimpleMessage ? config.simple_message.stream : config.egm_joint.stream;
-    const bool streams = kind == runtime::LinkKind::kEgmJoint || kind == runtime::LinkKind::kSimpleMessage;
+    const JointStreamConfig& s = kind == runtime::LinkKind::kSimpleMessage ? config.simple_message.stream
+                                 : kind == runtime::LinkKind::kFanucJ519   ? config.fanuc_j519.stream
+                                                                           : config.egm_joint.stream;
+    const bool streams = runtime::link_kind(kind).streams_program;
     JointVector limit = JointVector::Constant(6, period * config.online.max_correction_rate_rad_s);
     if (streams) {
       limit += period * (sampled_peak_speed(*program) * 1.001 +

@@ -41,6 +41,8 @@ void expect_wire_is_what_was_sent(FaultBench& b) {
       const LinkCycleRecord& r = *sent[at];
       if (b.kind == LinkKind::kEgmJoint) {
         found = (r.q_command - c.joints).cwiseAbs().maxCoeff() < 1e-12;
+      } else if (b.kind == LinkKind::kFanucJ519) {
+        found = (r.q_command - c.joints).cwiseAbs().maxCoeff() < 1e-9;  // float32 degrees on the wire
       } else if (b.kind == LinkKind::kRsi) {
         found = ((r.q_command - r.q_nominal) - c.joints).cwiseAbs().maxCoeff() < 1e-9;
       } else {
@@ -560,6 +562,100 @@ TEST(FaultTable, SimpleMessageAStaleForceRampsAtTheRateBound) {
   b.run_for(2.0);
   ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
   expect_invariants(b, "simple message stale");
+}
+
+// ---- fanuc-j519: a controller that stops itself at the first fault ----------------------------------
+// FANUC's controller keeps a short queue of commands and stops the stream (MOTN-603) when it runs dry,
+// and checks every target's velocity, acceleration and jerk (MOTN-609..611): an outage or a stall of
+// more than an interval ends the session on the controller's side, and deflex names it. What it sent
+// until then holds both invariants, and no alarm ever comes from its own stream.
+
+void expect_no_motion_alarm(FaultBench& b, const char* what) {
+  EXPECT_EQ(b.standin->fanuc()->alarm().find("MOTN-61"), std::string::npos)
+      << what << ": " << b.standin->fanuc()->alarm();
+}
+
+TEST(FaultTable, FanucJ519RunsTheProgramToItsEndWithLastDataAndNoAlarm) {
+  FaultBench b(LinkKind::kFanucJ519, sweep(6.0));
+  b.run_for(10.0);
+  ASSERT_TRUE(b.session->ended());
+  const runtime::SessionSummary& s = b.session->finish();
+  EXPECT_EQ(s.reason, StopReason::kProgramEnd) << s.reason_text;
+  EXPECT_EQ(s.exit_code, 0);
+  for (int k = 0; k < 10; ++k) b.standin->tick();
+  EXPECT_TRUE(b.standin->fanuc()->ended());
+  EXPECT_EQ(b.standin->fanuc()->alarm(), "");
+  expect_invariants(b, "fanuc to the end");
+}
+
+TEST(FaultTable, FanucJ519OutagesAndStallsStopTheControllerAndDeflexNamesIt) {
+  for (const double fault : {0.02, 0.1, 0.5}) {
+    for (const bool stall : {false, true}) {
+      SCOPED_TRACE(testing::Message() << (stall ? "stall " : "outage ") << fault << " s");
+      FaultBench b(LinkKind::kFanucJ519, sweep());
+      b.run_for(2.0);
+      if (stall) {
+        b.standin->stall(true);
+        b.run_for(fault);
+        b.standin->stall(false);
+      } else {
+        b.standin->outage(fault);
+      }
+      b.run_for(3.0);
+      ASSERT_TRUE(b.session->ended());
+      const runtime::SessionSummary& s = b.session->finish();
+      EXPECT_EQ(s.reason, StopReason::kControllerStopped) << s.reason_text;
+      EXPECT_EQ(s.exit_code, 6);
+      EXPECT_NE(s.reason_text.find("ready bit"), std::string::npos) << s.reason_text;
+      EXPECT_NE(b.standin->fanuc()->alarm().find("MOTN-603"), std::string::npos) << b.standin->fanuc()->alarm();
+      expect_no_motion_alarm(b, "fault");
+      expect_invariants(b, "fanuc fault");
+    }
+  }
+}
+
+TEST(FaultTable, FanucJ519AStopRequestBringsTheProgramToRestAndEndsWithLastData) {
+  FaultBench b(LinkKind::kFanucJ519, sweep());
+  b.run_for(3.0);
+  b.session->request_stop();
+  b.run_for(3.0);
+  ASSERT_TRUE(b.session->ended());
+  const runtime::SessionSummary& s = b.session->finish();
+  EXPECT_EQ(s.reason, StopReason::kUserStop) << s.reason_text;
+  for (int k = 0; k < 10; ++k) b.standin->tick();
+  EXPECT_TRUE(b.standin->fanuc()->ended());
+  EXPECT_EQ(b.standin->fanuc()->alarm(), "");
+  expect_invariants(b, "fanuc stop request");
+}
+
+TEST(FaultTable, FanucJ519AnEStopOrARestartEndsTheSession) {
+  for (const bool estop : {true, false}) {
+    FaultBench b(LinkKind::kFanucJ519, sweep());
+    b.run_for(2.0);
+    const std::size_t sent = b.wire().size();
+    if (estop) {
+      b.standin->motors_off();
+    } else {
+      b.standin->restart();
+    }
+    b.run_for(2.0);
+    ASSERT_TRUE(b.session->ended());
+    EXPECT_EQ(b.session->finish().reason, StopReason::kControllerStopped) << b.session->finish().reason_text;
+    EXPECT_LE(b.wire().size(), sent + 2) << "deflex went on sending after the controller stopped";
+    expect_invariants(b, estop ? "fanuc e-stop" : "fanuc restart");
+  }
+}
+
+TEST(FaultTable, FanucJ519AStaleForceRampsTheCorrectionOutWithoutAnAlarm) {
+  FaultBench b(LinkKind::kFanucJ519, sweep());
+  b.run_for(3.0);
+  ASSERT_GT(b.session->link().last_cycle().dtheta.cwiseAbs().maxCoeff(), 1e-5);
+  b.standin->sensor_silent(true);
+  b.run_for(3.0);
+  ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
+  EXPECT_LT(b.session->link().last_cycle().dtheta.cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_EQ(b.standin->fanuc()->alarm(), "");
+  expect_invariants(b, "fanuc stale force");
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "deflex/link/correction_smoother.hpp"
 #include "deflex/online/online_strategy.hpp"
 #include "deflex/text/errors.hpp"
 
@@ -35,6 +36,9 @@ double CommandLimits::resolution_rad(double v) const noexcept {
       return std::max(std::abs(v), 1.0) * static_cast<double>(std::numeric_limits<float>::epsilon());
     case WireRounding::kDecimalsDeg:
       return deg_to_rad(0.5 * std::pow(10.0, -decimals)) * (1.0 + 1e-9);
+    case WireRounding::kFloat32Deg:
+      return deg_to_rad(std::max(std::abs(rad_to_deg(v)), 1.0)) *
+             static_cast<double>(std::numeric_limits<float>::epsilon());
   }
   return 0.0;
 }
@@ -49,6 +53,8 @@ double CommandLimits::round(double v) const noexcept {
       const double scale = std::pow(10.0, decimals);
       return deg_to_rad(std::round(rad_to_deg(v) * scale) / scale);
     }
+    case WireRounding::kFloat32Deg:
+      return deg_to_rad(static_cast<double>(static_cast<float>(rad_to_deg(v))));
   }
   return v;
 }
@@ -162,6 +168,7 @@ void LinkCycle::anchor_tcp(const Vector3& offset_m, bool after_silence) noexcept
 void LinkCycle::restart_from_zero(bool after_silence) noexcept {
   comp_.reset();
   last_dtheta_.setZero();
+  if (smoother_ != nullptr) smoother_->reset(last_dtheta_);
   previous_command_.setZero();
   previous_offset_m_.setZero();
   have_previous_ = true;
@@ -235,6 +242,7 @@ LinkCycle::Verdict LinkCycle::run(const CycleRequest& rq) noexcept {
   const StrategyStatus ss = strategy_.prepare(input_, *rq.feedback, *rq.target, rq.lead_s, comp_.filter_delay_s());
   input_.hold_to_zero = input_.hold_to_zero || rq.hold || ss != StrategyStatus::kOk;
   out_ = force_ != nullptr ? comp_.step(input_, *force_) : comp_.step(input_);
+  if (smoother_ != nullptr && static_cast<int>(out_.status) >= 0) out_.dtheta = smoother_->step(out_.dtheta);
   r.dtheta = out_.dtheta;
   r.wrench_base = out_.wrench_base;
   r.wrench_measured_base = out_.wrench_measured_base;

@@ -37,6 +37,7 @@ namespace deflex {
 // The cycle drives these by reference; their headers are the .cpp files' business.
 class OnlineCompensator;
 class OnlineStrategy;
+class CorrectionSmoother;
 
 /// What a link sends the controller, and so what its command is measured against.
 enum class CommandForm : int {
@@ -51,6 +52,7 @@ enum class WireRounding : int {
   kExact = 0,        ///< doubles (EGM's protobuf)
   kFloat32 = 1,      ///< float32 radians (simple message)
   kDecimalsDeg = 2,  ///< degrees as text with `decimals` decimals (RSI)
+  kFloat32Deg = 3,   ///< float32 degrees (FANUC Stream Motion version 1)
 };
 
 /// The two invariants on what goes on the wire, stated once at the session's start.
@@ -166,6 +168,11 @@ class LinkCycle {
   [[nodiscard]] double reanchor_gap(const JointVector& q) const noexcept;
   [[nodiscard]] double reanchor_gap(const Vector3& offset_m) const noexcept;
 
+  /// The correction passes through `smoother` before the command is formed (controllers that check
+  /// the stream's acceleration and jerk: FANUC's Stream Motion); null: none. It must outlive the
+  /// cycle; a restart from zero resets it. The joint forms only.
+  void shape_with(CorrectionSmoother* smoother) noexcept { smoother_ = smoother; }
+
   /// The TCP rotation the model predicts and the link cannot correct this cycle (recorded; rad).
   void note_uncorrected_rotation(double rad) noexcept { record_.rotation_uncorrected_rad = rad; }
   [[nodiscard]] const char* guard_message() const { return guard_message_.data(); }
@@ -195,6 +202,7 @@ class LinkCycle {
   OnlineCompensator& comp_;
   OnlineStrategy& strategy_;
   ForceSource* force_;
+  CorrectionSmoother* smoother_ = nullptr;
   CommandLimits limits_;
   LinkCounters& counters_;
   LinkHistory history_;

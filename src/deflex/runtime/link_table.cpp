@@ -7,11 +7,11 @@
 
 namespace deflex::runtime {
 
-const std::array<LinkKindInfo, 4>& link_kinds() {
+const std::array<LinkKindInfo, 5>& link_kinds() {
   // Stop silences: EGM rides through outages up to 3 s (its controller holds the last target; the
   // generated RAPID's CommTimeout matches); RSI's controller stops itself long before (its Timeout of
   // late answers), so 1 s of silence means it stopped; simple message has its own state timeout.
-  static const std::array<LinkKindInfo, 4> kinds{{
+  static const std::array<LinkKindInfo, 5> kinds{{
       {LinkKind::kEgmJoint, "egm-joint",
        "ABB EGM position guidance (EGMActJoint/EGMRunJoint): deflex streams --program", true, CommandForm::kJointTarget,
        0.004, 3.0},
@@ -27,6 +27,12 @@ const std::array<LinkKindInfo, 4>& link_kinds() {
        "ROS-Industrial simple message over TCP to a robot program (ABB RAPID, Fanuc KAREL servers): deflex streams "
        "--program one point a cycle",
        true, CommandForm::kJointTarget, 0.1, 1.0},
+      // FANUC's controller stops the stream itself two intervals after a missed command (MOTN-603):
+      // a second's silence means it has stopped.
+      {LinkKind::kFanucJ519, "fanuc-j519",
+       "FANUC Stream Motion (J519) over UDP: deflex streams --program, one command a status, within the "
+       "controller's velocity, acceleration and jerk limits",
+       true, CommandForm::kJointTarget, 0.008, 1.0},
   }};
   return kinds;
 }

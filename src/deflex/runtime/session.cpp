@@ -122,6 +122,35 @@ Session::~Session() {
   }
 }
 
+// FANUC Stream Motion: deflex is the client; its datagrams go to the controller's address and port.
+void Session::open_fanuc_j519(const SessionEndpoints& endpoints, ForceSource* force,
+                              std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules) {
+  FanucJ519LinkConfig c = config_.fanuc_j519;
+  c.stop = rules;
+  c.history_cycles = config_.history_cycles;
+  const NetworkConfig& net = config_.network;
+  const double period_ms = config_.online.period_s * 1e3;
+  if (std::abs(period_ms - 8.0) > 1e-9 && std::abs(period_ms - 4.0) > 1e-9 && std::abs(period_ms - 1.0) > 1e-9) {
+    throw InputError(fmt::format(
+        "option --period-ms: FANUC's communication interval ($STMO.$COM_INT) is 8, 4 or 1 ms (got {:g})", period_ms));
+  }
+  DatagramTransport* t = endpoints.datagram;
+  if (!net.robot_host.empty() || t == nullptr) {
+    if (net.robot_host.empty()) {
+      throw InputError("option --robot-host: the fanuc-j519 link needs the controller's IPv4 address");
+    }
+    const std::uint16_t port = port_option(net.robot_port == -1 ? 60015 : net.robot_port, "--robot-port", "", 1);
+    c.controller = make_datagram_address(net.robot_host, port);
+  }
+  if (t == nullptr) {
+    own_datagram_ = std::make_unique<UdpTransport>(net.bind_address, 0);
+    t = own_datagram_.get();
+  }
+  link_ = std::make_unique<FanucJ519Link>(*compensator_, *strategy_, std::move(program), *t, clock_, force, c);
+  where_ = fmt::format("FANUC Stream Motion to {} (protocol {}), from {}", to_string(c.controller), c.version,
+                       to_string(t->local_address()));
+}
+
 void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
                         std::shared_ptr<const JointTrajectory> program) {
   const LinkKindInfo& info = link_kind(config_.link);
@@ -197,6 +226,9 @@ void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
                                                   clock_, force, c);
       break;
     }
+    case LinkKind::kFanucJ519:
+      open_fanuc_j519(endpoints, force, std::move(program), rules);
+      break;
   }
 }
 
@@ -354,9 +386,10 @@ const SessionSummary& Session::finish() {
     case StopReason::kStartRefused: {
       std::string joints;
       const JointVector& d = link_->start_distance();
-      const double tolerance = link_kind(config_.link).kind == LinkKind::kSimpleMessage
+      const double tolerance = config_.link == LinkKind::kSimpleMessage
                                    ? config_.simple_message.stream.start_tolerance_rad
-                                   : config_.egm_joint.stream.start_tolerance_rad;
+                               : config_.link == LinkKind::kFanucJ519 ? config_.fanuc_j519.stream.start_tolerance_rad
+                                                                      : config_.egm_joint.stream.start_tolerance_rad;
       for (int j = 0; j < d.size(); ++j) {
         if (d[j] > tolerance) {
           joints += fmt::format("{}joint {} is {:.3f} deg away", joints.empty() ? "" : ", ", j + 1, rad_to_deg(d[j]));

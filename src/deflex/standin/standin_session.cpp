@@ -1,10 +1,12 @@
 // deflex's runtime against an in-memory stand-in of the controller (see standin_session.hpp).
 #include "deflex/standin/standin_session.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "deflex/text/errors.hpp"
 #include "deflex/wire/egm_codec.hpp"
+#include "deflex/wire/fanuc_j519.hpp"
 #include "deflex/wire/rsi_xml.hpp"
 
 namespace deflex::standin {
@@ -81,7 +83,11 @@ StandInSession::StandInSession(const runtime::SessionConfig& config, const Robot
   if (!program_) throw InputError("stand-in: a program is needed (the nominal deflex streams, or the controller's)");
   if (robot.dof() != 6) throw InputError("stand-in: the controller stand-ins drive 6-axis arms");
   tap_ = std::make_unique<Tap>(controller_port_, *this);
-  const bool streams = kind_ == runtime::LinkKind::kEgmJoint || kind_ == runtime::LinkKind::kSimpleMessage;
+  if (kind_ == runtime::LinkKind::kFanucJ519) {
+    config_.fanuc_j519.controller = kController;
+    config_.network.robot_host.clear();
+  }
+  const bool streams = runtime::link_kind(kind_).streams_program;
   runtime::SessionEndpoints ends{&deflex_port_, &motion_.client(), &state_.client()};
   session_ = std::make_unique<runtime::Session>(config_, robot, sensor, streams ? program_ : nullptr, force_model,
                                                 &sensor_, clock_, ends);
@@ -127,6 +133,15 @@ StandInSession::StandInSession(const runtime::SessionConfig& config, const Robot
       controller_ = std::move(c);
       break;
     }
+    case runtime::LinkKind::kFanucJ519: {
+      cell::FanucJ519ControllerConfig fc = standin.fanuc;
+      fc.interval_s = config_.online.period_s;
+      fc.version = config_.fanuc_j519.version;
+      auto c = std::make_unique<cell::FanucJ519Controller>(fc, program_->points().front(), *tap_);
+      fanuc_ = c.get();
+      controller_ = std::move(c);
+      break;
+    }
   }
   arm_ = program_->points().front();
 }
@@ -148,6 +163,12 @@ void StandInSession::decode(const unsigned char* data, std::size_t size) {
     RsiSensorMessage m;
     if (decode_rsi_sensor(data, size, config_.rsi.sentype, 6, m) != RsiDecodeStatus::kOk) return;
     c.joints = m.correction_deg * (kPi / 180.0);
+  } else if (kind_ == runtime::LinkKind::kFanucJ519) {
+    fanuc_j519::Command m;
+    std::uint32_t version = 0;
+    if (fanuc_j519::decode(data, size, m, version) != fanuc_j519::DecodeStatus::kOk) return;
+    c.joints = JointVector(6);
+    for (int i = 0; i < 6; ++i) c.joints[i] = deg_to_rad(m.target[static_cast<std::size_t>(i)]);
   } else {
     return;
   }
@@ -155,7 +176,9 @@ void StandInSession::decode(const unsigned char* data, std::size_t size) {
 }
 
 void StandInSession::tick() {
-  const double tick_s = standin_.controller.servo_period_s;
+  // FANUC's 1 ms interval needs a tick of 1 ms.
+  const double tick_s = fanuc_ != nullptr ? std::min(standin_.controller.servo_period_s, config_.online.period_s)
+                                          : standin_.controller.servo_period_s;
   t_s_ += tick_s;
   clock_.set(t_s_);
   arm_ = controller_->tick(t_s_);
@@ -200,6 +223,7 @@ void StandInSession::restart(bool reset_reference, double off_s) {
     }
     rsi_->restart();
   }
+  if (fanuc_ != nullptr) fanuc_->restart(t_s_);
   if (server_ != nullptr) throw InputError("stand-in: the simple message server has no session to restart");
 }
 
@@ -213,6 +237,8 @@ void StandInSession::motors_off() {
     egm_->motors_off();
   } else if (server_ != nullptr) {
     server_->emergency_stop(t_s_);
+  } else if (fanuc_ != nullptr) {
+    fanuc_->raise_alarm("SRVO-001 Operator panel E-stop");
   } else {
     throw InputError("stand-in: this controller reports no motor state");
   }

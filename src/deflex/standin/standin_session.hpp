@@ -15,6 +15,7 @@
 
 #include "deflex/cell/egm_path_controller.hpp"
 #include "deflex/cell/egm_position_controller.hpp"
+#include "deflex/cell/fanuc_j519_controller.hpp"
 #include "deflex/cell/rsi_controller.hpp"
 #include "deflex/cell/simple_message_server.hpp"
 #include "deflex/runtime/session.hpp"
@@ -36,6 +37,9 @@ struct StandInConfig {
   cell::SimpleMessageServerConfig server;  ///< the RAPID server's buffer, state period, read period
   /// The RSI controller; its AXISCORR limits and AXISCORRMON follow the session's bound when NaN.
   cell::RsiControllerConfig rsi;
+  /// FANUC Stream Motion: its queue, dead time, lag and limits (the interval and the protocol version
+  /// follow the session's).
+  cell::FanucJ519ControllerConfig fanuc;
   double network_latency_s = 0.0002;       ///< one way
   Vector3 force_base_n = Vector3::Zero();  ///< the process force at the TCP, base frame (N)
   double sensor_rate_hz = 250.0;           ///< samples a second the stand-in sensor gives (one a tick at 250 Hz)
@@ -93,7 +97,8 @@ class StandInSession {
   void restart(bool reset_reference = true, double off_s = 0.0);
   /// The controller ends its session now: EGM with mciState `mci_state` (2 STOPPED, 1 ERROR).
   void end_session(int mci_state = 2);
-  /// The motors go off (EGM: an emergency stop); simple message: the server's emergency stop.
+  /// The motors go off (EGM: an emergency stop); simple message: the server's emergency stop; FANUC: an
+  /// e-stop alarm.
   void motors_off();
   /// The force sensor stops (true) or comes back.
   void sensor_silent(bool silent) { sensor_.on = !silent; }
@@ -112,6 +117,7 @@ class StandInSession {
   [[nodiscard]] cell::EgmPathCorrectionController* path() { return path_; }
   [[nodiscard]] cell::RsiController* rsi() { return rsi_; }
   [[nodiscard]] cell::SimpleMessageServer* server() { return server_; }
+  [[nodiscard]] cell::FanucJ519Controller* fanuc() { return fanuc_; }
   [[nodiscard]] MemoryNetwork& network() { return network_; }
   [[nodiscard]] ManualClock& clock() { return clock_; }
 
@@ -137,6 +143,7 @@ class StandInSession {
   cell::EgmPathCorrectionController* path_ = nullptr;
   cell::RsiController* rsi_ = nullptr;
   cell::SimpleMessageServer* server_ = nullptr;
+  cell::FanucJ519Controller* fanuc_ = nullptr;
   std::vector<WireCommand> wire_;
   double t_s_ = 0.0;
   double next_sample_s_ = 0.0;

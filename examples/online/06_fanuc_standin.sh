@@ -1,0 +1,34 @@
+#!/bin/sh
+# deflex online --link fanuc-j519 against the Python stand-in of a FANUC controller (Stream Motion,
+# protocol 1, 8 ms: statuses numbered in turn, a command queue that must never run dry, every target's
+# velocity, acceleration and jerk checked), over loopback UDP. Passes when the session ended on its
+# time limit with the last-data command and the stand-in never alarmed.
+#   sh examples/online/06_fanuc_standin.sh build/bin/deflex /tmp/fanuc-example
+set -eu
+DEFLEX=$1
+OUT=$2
+HERE=$(cd "$(dirname "$0")" && pwd)
+mkdir -p "$OUT"
+# The paper's circle as a nominal program, held 10 s at its start.
+"$DEFLEX" offline --circle "centre_mm=1800;0;900,radius_mm=129.9,points=81" --force "ldbb:phi_deg=30,force_N=400" \
+    --speed-mm-s 30 --hold-start-s 10 --nominal-trajectory "$OUT/nominal.csv" > /dev/null
+# A free UDP port for the controller.
+PORT=$(python3 -c 'import socket; s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+python3 "$HERE/fanuc_j519_standin.py" --port "$PORT" --program "$OUT/nominal.csv" --seconds 7 > "$OUT/standin.txt" &
+STANDIN=$!
+sleep 0.3
+"$DEFLEX" online --link fanuc-j519 --robot-host 127.0.0.1 --robot-port "$PORT" --program "$OUT/nominal.csv" \
+    --force-source "csv:$HERE/force_replay.csv" --loop --duration-s 4 --log "$OUT/cycles.csv" \
+    --log-file "$OUT/online.log" --json > "$OUT/summary.json"
+STATUS=0
+wait "$STANDIN" || STATUS=$?
+cat "$OUT/standin.txt"
+python3 - "$OUT/summary.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["link"] == "fanuc-j519", s
+assert s["counters"]["replies"] > 300, s["counters"]
+assert s["counters"]["guard_trips"] == 0, s["counters"]
+print("deflex: %d commands, exit %d (%s)" % (s["counters"]["replies"], s["exit_code"], s["stop_reason"]))
+PY
+exit "$STATUS"

@@ -1,0 +1,421 @@
+// FANUC Stream Motion, deflex as the motion source (see fanuc_j519_link.hpp).
+#include "deflex/fanuc/fanuc_j519_link.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "deflex/online/online_strategy.hpp"
+#include "deflex/text/errors.hpp"
+
+namespace deflex {
+namespace {
+
+namespace j519 = fanuc_j519;
+
+CommandLimits fanuc_limits(const OnlineCompensator& c, const JointTrajectory* program, const FanucJ519LinkConfig& f) {
+  f.validate();
+  if (program == nullptr) throw InputError("FANUC J519 link: no program to stream");
+  if (program->dof() != c.model().dof()) {
+    throw InputError(
+        fmt::format("FANUC J519 link: the program has {} joints, the robot {}", program->dof(), c.model().dof()));
+  }
+  if (c.model().dof() > static_cast<int>(j519::kAxes)) {
+    throw InputError(fmt::format("FANUC J519 link: the robot has {} joints, the protocol carries at most {}",
+                                 c.model().dof(), j519::kAxes));
+  }
+  CommandLimits l = command_limits(CommandForm::kJointTarget, c.config(), c.model().dof(), program, &f.stream);
+  l.rounding = f.version == 1 ? WireRounding::kFloat32Deg : WireRounding::kExact;
+  return l;
+}
+
+// The smoother's limits: the correction's share of the strictest joint's acceleration and jerk (rad),
+// its step the compensator's rate bound over one interval.
+SmootherLimits smoother_limits(const OnlineCompensator& c, const FanucJ519LinkConfig& f) {
+  SmootherLimits s;
+  s.cycle_s = c.config().period_s;
+  s.step_rad = c.config().max_correction_rate_rad_s * s.cycle_s;
+  double acc = std::numeric_limits<double>::infinity();
+  double jerk = acc;
+  for (int j = 0; j < c.model().dof(); ++j) {
+    acc = std::min(acc, f.limits[static_cast<std::size_t>(j)].acceleration);
+    jerk = std::min(jerk, f.limits[static_cast<std::size_t>(j)].jerk);
+  }
+  s.acceleration = deg_to_rad(acc) * f.correction_share;
+  s.jerk = deg_to_rad(jerk) * f.correction_share;
+  return s;
+}
+
+// The program alone, sampled at the interval as the controller will see it, within the share of the
+// limits the correction leaves it; throws InputError naming the first joint and time that is not.
+void check_program(const JointTrajectory& program, double interval_s, const FanucJ519LinkConfig& f) {
+  std::array<j519::AxisLimits, j519::kAxes> rest = f.limits;
+  for (j519::AxisLimits& l : rest) {
+    l.acceleration *= 1.0 - f.correction_share;
+    l.jerk *= 1.0 - f.correction_share;
+  }
+  j519::MotionCheck check(interval_s, static_cast<std::size_t>(program.dof()), rest);
+  JointVector q(program.dof());
+  std::array<double, j519::kAxes> deg{};
+  const auto to_deg = [&] {
+    for (int j = 0; j < q.size(); ++j) deg[static_cast<std::size_t>(j)] = rad_to_deg(q[j]);
+  };
+  program.sample(program.start_time_s(), q);
+  to_deg();
+  check.reset(deg);
+  const auto steps = static_cast<long>(std::ceil(program.duration_s() / interval_s));
+  for (long k = 1; k <= steps + 3; ++k) {
+    program.sample(std::min(program.start_time_s() + static_cast<double>(k) * interval_s, program.end_time_s()), q);
+    to_deg();
+    std::size_t axis = 0;
+    double value = 0.0;
+    const j519::LimitExceeded hit = check.push(deg, axis, value);
+    if (hit == j519::LimitExceeded::kNone) continue;
+    const j519::AxisLimits& l = rest[axis];
+    const double limit = hit == j519::LimitExceeded::kVelocity       ? l.velocity
+                         : hit == j519::LimitExceeded::kAcceleration ? l.acceleration
+                                                                     : l.jerk;
+    throw InputError(fmt::format(
+        "FANUC J519 link: the program alone reaches a {} of {:.6g} on joint {} at {:.3f} s, over the {:.6g} the "
+        "controller allows less the correction's share ({:.0f} %) at a {:.0f} ms interval: the controller would "
+        "stop the stream; slow the program down or give the controller's own limits",
+        j519::to_string(hit), std::abs(value), axis + 1, static_cast<double>(k) * interval_s, limit,
+        100.0 * f.correction_share, interval_s * 1e3));
+  }
+}
+
+}  // namespace
+
+std::array<j519::AxisLimits, j519::kAxes> parse_fanuc_limits(const std::string& text, const char* option) {
+  std::vector<std::string> joints;
+  std::string rest = text;
+  for (std::size_t at = rest.find(';'); at != std::string::npos; at = rest.find(';')) {
+    joints.push_back(rest.substr(0, at));
+    rest = rest.substr(at + 1);
+  }
+  joints.push_back(rest);
+  if (joints.size() > j519::kAxes) {
+    throw InputError(fmt::format("option {}: {} triples, at most {}", option, joints.size(), j519::kAxes));
+  }
+  std::array<j519::AxisLimits, j519::kAxes> limits = FanucJ519LinkConfig::default_limits();
+  for (std::size_t j = 0; j < joints.size(); ++j) {
+    double v[3] = {0.0, 0.0, 0.0};
+    char extra = 0;
+    if (std::sscanf(joints[j].c_str(), " %lf , %lf , %lf %c", &v[0], &v[1], &v[2], &extra) != 3) {
+      throw InputError(fmt::format("option {}: '{}' is not VEL,ACC,JERK (deg/s, deg/s^2, deg/s^3), e.g. 120,265,1240",
+                                   option, joints[j]));
+    }
+    for (const double x : v) {
+      if (!std::isfinite(x) || x <= 0.0) {
+        throw InputError(fmt::format("option {}: '{}': every limit must be positive", option, joints[j]));
+      }
+    }
+    const j519::AxisLimits l{v[0], v[1], v[2]};
+    if (joints.size() == 1) {
+      limits.fill(l);
+    } else {
+      limits[j] = l;
+    }
+  }
+  return limits;
+}
+
+void FanucJ519LinkConfig::validate() const {
+  if (!j519::known_version(version)) {
+    throw InputError(fmt::format("FANUC J519 link: protocol version {} is not 1, 3 or 4", version));
+  }
+  if (!(correction_share > 0.0 && correction_share < 1.0)) {
+    throw InputError(fmt::format("FANUC J519 link: the correction's share of the limits must be in (0, 1), got {}",
+                                 correction_share));
+  }
+  for (std::size_t i = 0; i < limits.size(); ++i) {
+    const j519::AxisLimits& l = limits[i];
+    for (const double v : {l.velocity, l.acceleration, l.jerk}) {
+      if (!std::isfinite(v) || v <= 0.0) {
+        throw InputError(
+            fmt::format("FANUC J519 link: joint {}'s limits must be positive (velocity {} deg/s, "
+                        "acceleration {} deg/s^2, jerk {} deg/s^3)",
+                        i + 1, l.velocity, l.acceleration, l.jerk));
+      }
+    }
+  }
+  if (!(start_resend_s > 0.0) || max_catch_up < 0 || max_catch_up > 9) {
+    throw InputError("FANUC J519 link: start_resend_s must be > 0 and max_catch_up in 0..9");
+  }
+}
+
+FanucJ519Link::FanucJ519Link(OnlineCompensator& compensator, OnlineStrategy& strategy,
+                             std::shared_ptr<const JointTrajectory> nominal, DatagramTransport& transport,
+                             const Clock& clock, ForceSource* force, const FanucJ519LinkConfig& config)
+    : ControllerLink(compensator, strategy, force, clock, fanuc_limits(compensator, nominal.get(), config), config.stop,
+                     config.history_cycles),
+      config_(config),
+      transport_(transport),
+      gate_([&] {
+        ControllerGateConfig g;
+        g.period_s = compensator.config().period_s;
+        return g;
+      }()),
+      stream_(std::move(nominal), config.stream),
+      smoother_(smoother_limits(compensator, config), compensator.model().dof()),
+      delay_(config.initial_delay_s),
+      period_s_(compensator.config().period_s) {
+  check_program(stream_.trajectory(), period_s_, config_);
+  const int n = compensator.model().dof();
+  for (JointVector* q : {&feedback_, &program_, &program_velocity_, &blend_, &blend_velocity_, &nominal_}) {
+    *q = JointVector::Zero(n);
+  }
+  rx_.assign(config_.max_packet_bytes + 1, 0);
+  tx_.assign(j519::kMaxDatagramBytes, 0);
+  cycle_.shape_with(&smoother_);
+}
+
+bool FanucJ519Link::send_command(std::uint32_t sequence, const JointVector& target_rad, bool last) noexcept {
+  command_.sequence = sequence;
+  command_.last = last;
+  command_.joint_style = true;
+  command_.target.fill(0.0);
+  for (int i = 0; i < target_rad.size(); ++i) command_.target[static_cast<std::size_t>(i)] = rad_to_deg(target_rad[i]);
+  const std::size_t n = j519::encode(config_.version, command_, tx_.data(), tx_.size());
+  if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) {
+    ++counters_.send_errors;
+    return false;
+  }
+  ++counters_.replies;
+  return true;
+}
+
+bool FanucJ519Link::drain(double timeout_s, j519::Status& newest, bool& session_start) noexcept {
+  bool got = false;
+  DatagramAddress from;
+  if (!transport_.wait_readable(timeout_s)) return false;
+  for (int i = 0; i < 1024; ++i) {  // a flood cannot hold the cycle
+    const long n = transport_.receive(rx_.data(), rx_.size(), from);
+    if (n < 0) break;
+    ++counters_.datagrams;
+    const double now = clock_.now_s();
+    if (!(from == config_.controller)) {
+      ++counters_.foreign_sender;
+      continue;
+    }
+    gate_.heard(from, now);
+    if (static_cast<std::size_t>(n) > config_.max_packet_bytes) {
+      ++counters_.oversized;
+      continue;
+    }
+    const j519::DecodeStatus d = j519::decode(rx_.data(), static_cast<std::size_t>(n), status_);
+    if (d != j519::DecodeStatus::kOk) {
+      if (d == j519::DecodeStatus::kNonFinite) {
+        ++counters_.non_finite;
+      } else if (d == j519::DecodeStatus::kWrongSize) {
+        ++counters_.truncated;
+      } else {
+        ++counters_.malformed;
+      }
+      continue;
+    }
+    if (status_.version != config_.version) {
+      stop_link(LinkStopCause::kProtocol,
+                "the controller streams protocol version %u, deflex was set to version %u (FANUC's MOTN-607): give "
+                "--fanuc-version %u",
+                status_.version, config_.version, status_.version);
+      return false;
+    }
+    bool starts = false;
+    LinkArrival arrival;
+    if (!gate_.take(from, status_.sequence, status_.time_stamp_ms, now, counters_, starts, arrival)) continue;
+    if (got) ++counters_.superseded;
+    newest = status_;
+    receipt_age_s_ = transport_.since_receipt_s();
+    taken_at_s_ = clock_.now_s();
+    arrival_ = arrival;
+    session_start = session_start || starts;
+    got = true;
+  }
+  return got;
+}
+
+bool FanucJ519Link::controller_state(const j519::Status& s) noexcept {
+  const double program_s = stream_.program_time_s() - stream_.trajectory().start_time_s();
+  if (s.version >= 3 && s.in_error()) {
+    stop_link(LinkStopCause::kController,
+              "the controller reports an error (robot status 0x%02x: in error or e-stopped) at program time %.3f s",
+              static_cast<unsigned>(s.robot_status), program_s);
+    return false;
+  }
+  if (!s.ready()) {
+    if (!ready_seen_) {
+      ++counters_.not_running;  // the TP program is not waiting in IBGN yet: nothing is consumed
+      return false;
+    }
+    const auto unanswered = static_cast<std::int32_t>(s.sequence - next_sequence_);
+    if (unanswered > 1) {
+      stop_link(LinkStopCause::kController,
+                "the controller cleared its ready bit at program time %.3f s, after %d of its statuses deflex did not "
+                "answer in time (the PC stalled or the network lost them): its command queue ran dry (MOTN-603)",
+                program_s, unanswered);
+    } else {
+      stop_link(LinkStopCause::kController,
+                "the controller cleared its ready bit at program time %.3f s: it stopped the stream (an alarm such "
+                "as MOTN-603 receiving interval over or a joint limit MOTN-609..611, or the TP program left IBGN)",
+                program_s);
+    }
+    return false;
+  }
+  return true;
+}
+
+// The first ready status of a session: its joints are where the arm is, the anchor of the stream.
+bool FanucJ519Link::start_session(const j519::Status& s) noexcept {
+  for (int i = 0; i < feedback_.size(); ++i) feedback_[i] = deg_to_rad(s.joints_deg[static_cast<std::size_t>(i)]);
+  const double gap = cycle_.reanchor_gap(feedback_);
+  if (stop_if_anchor_unreachable(gap, "the controller (FANUC J519)")) return false;
+  nominal_ = cycle_.has_sent() && gap <= 2.0 ? cycle_.last_command() : feedback_;
+  if (!stream_.begin(nominal_, cycle_.correction())) {
+    if (state_ == LinkState::kWaiting) {
+      refuse_start(stream_.distance());
+    } else {
+      Eigen::Index j = 0;
+      const double d = stream_.distance().maxCoeff(&j);
+      stop_link(LinkStopCause::kController,
+                "the controller restarted with joint %d %.3f deg from deflex's command (tolerance %.3f deg): not "
+                "resumed",
+                static_cast<int>(j) + 1, rad_to_deg(d), rad_to_deg(config_.stream.start_tolerance_rad));
+    }
+    return false;
+  }
+  cycle_.anchor_joints(nominal_, after_silence());
+  next_sequence_ = s.sequence;
+  ready_seen_ = true;
+  state_ = LinkState::kRunning;
+  return true;
+}
+
+LinkPollResult FanucJ519Link::poll(double timeout_s) noexcept {
+  if (state_ == LinkState::kStopped || state_ == LinkState::kRefused) {
+    j519::Status ignored;
+    bool starts = false;
+    if (drain(0.0, ignored, starts) && state_ == LinkState::kRefused) ++counters_.refused;
+    return announce_terminal();
+  }
+  double now = clock_.now_s();
+  if (!ready_seen_ && now - last_start_s_ >= config_.start_resend_s) {
+    const std::size_t n = j519::encode_start(config_.version, tx_.data(), tx_.size());
+    if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) ++counters_.send_errors;
+    last_start_s_ = now;
+  }
+  j519::Status s;
+  bool session_start = false;
+  const std::uint64_t before = counters_.datagrams;
+  if (!drain(timeout_s, s, session_start)) {
+    if (state_ == LinkState::kStopped) return announce_terminal();
+    now = clock_.now_s();
+    if (apply_silence_rules(now)) return announce_terminal();
+    return counters_.datagrams > before ? LinkPollResult::kRejected : LinkPollResult::kIdle;
+  }
+  now = clock_.now_s();
+  heard(now);
+  for (int i = 0; i < feedback_.size(); ++i) feedback_[i] = deg_to_rad(s.joints_deg[static_cast<std::size_t>(i)]);
+  if (state_ == LinkState::kFinished) return finish(s, now);
+  if (!controller_state(s)) return state_ == LinkState::kStopped ? announce_terminal() : LinkPollResult::kNotAnswered;
+  if (session_start || !ready_seen_) {
+    if (!start_session(s)) return announce_terminal();
+    session_start = true;
+  }
+  return answer(s.sequence, now, session_start);
+}
+
+LinkPollResult FanucJ519Link::answer(std::uint32_t sequence, double now, bool session_start) noexcept {
+  const auto t_read = std::chrono::steady_clock::now();
+  const auto missing = static_cast<std::int32_t>(sequence - next_sequence_);
+  if (missing < 0) return LinkPollResult::kRejected;  // answered already (the gate refuses most of these)
+  if (missing > config_.max_catch_up) {
+    stop_link(LinkStopCause::kTooSlow,
+              "%d controller statuses went unanswered in a row (%.0f ms), more than the %d deflex catches up: the "
+              "controller's command buffer will have run dry (MOTN-603)",
+              missing, missing * period_s_ * 1e3, config_.max_catch_up);
+    return announce_terminal();
+  }
+  delay_.observe_feedback(now, feedback_);
+  const auto compute = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_read).count(); };
+  for (std::int32_t k = 0; k <= missing; ++k) {
+    if (ramping_down_) stream_.begin_stop(ramp_down_s_);
+    stream_.sample(program_, program_velocity_, blend_, blend_velocity_);
+    nominal_ = program_ + blend_;
+    CycleRequest rq;
+    rq.t_s = now;
+    rq.sequence = next_sequence_;
+    rq.program_time_s = stream_.program_time_s();
+    rq.nominal = &program_;
+    rq.blend = &blend_;
+    rq.feedback = &feedback_;
+    rq.target = &nominal_;
+    rq.delay_s = rq.lead_s = delay_.delay_s() + smoother_.delay_s();
+    rq.session_start = session_start && k == 0;
+    rq.arrival = arrival_;
+    const LinkCycle::Verdict verdict = cycle_.run(rq);
+    if (verdict != LinkCycle::Verdict::kSend) return cycle_not_passed(verdict, compute());
+    if (!send_command(next_sequence_, cycle_.joint_command(), false)) {
+      cycle_.not_sent(compute());
+      return LinkPollResult::kNotAnswered;
+    }
+    cycle_.sent(compute(), receipt_age_s_ + (clock_.now_s() - taken_at_s_));
+    delay_.record_reference(now, cycle_.joint_command());
+    stream_.consumed(period_s_);
+    ++next_sequence_;
+    if (k > 0) ++caught_up_;
+  }
+  if ((ramping_down_ && stream_.at_standstill()) || stream_.finished()) state_ = LinkState::kFinished;
+  return LinkPollResult::kAnswered;
+}
+
+// The program has ended (or a planned stop came to rest): the next status gets the last target again,
+// flagged last-data; once the controller reports the session over (the ready or in-motion bit clear, as
+// the TP program leaves IBGN), or after a second, the stop packet ends its status output.
+LinkPollResult FanucJ519Link::finish(const j519::Status& s, double now) noexcept {
+  if (!last_data_sent_) {
+    if (!send_command(s.sequence, cycle_.last_command(), true)) return LinkPollResult::kNotAnswered;
+    last_data_sent_ = true;
+    last_data_s_ = now;
+    return LinkPollResult::kAnswered;
+  }
+  if (s.ready() && s.in_motion() && now - last_data_s_ < 1.0) return LinkPollResult::kNotAnswered;
+  const std::size_t n = j519::encode_stop(config_.version, tx_.data(), tx_.size());
+  if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) ++counters_.send_errors;
+  if (ramping_down_) {
+    stop_link(LinkStopCause::kRequested,
+              "stopped on request: the program was brought to rest on its path over %.2f s; the last command went "
+              "out flagged last-data, then the stop packet",
+              ramp_down_s_);
+  } else {
+    stop_link(LinkStopCause::kEnded,
+              "the program ended: the last command went out flagged last-data, then the stop packet");
+  }
+  return announce_terminal();
+}
+
+void FanucJ519Link::stop() noexcept {
+  if (state_ != LinkState::kStopped && cycle_.has_sent()) {
+    // Without the last-data flag the controller stops the stream itself (MOTN-603, a controlled stop);
+    // the stop packet ends its status output.
+    const std::size_t n = j519::encode_stop(config_.version, tx_.data(), tx_.size());
+    if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) ++counters_.send_errors;
+  }
+  stop_link(LinkStopCause::kRequested, "stop requested: the stop packet went out");
+}
+
+std::string FanucJ519Link::protocol_summary() const {
+  return fmt::format(
+      "FANUC J519 (protocol {}): {} commands sent, {} to catch up lost statuses; the correction smoothed over {} "
+      "intervals ({:.0f} ms) to stay within {:.0f} % of the acceleration and jerk limits",
+      config_.version, counters_.replies, caught_up_, smoother_.taps(), smoother_.delay_s() * 1e3,
+      100.0 * config_.correction_share);
+}
+
+}  // namespace deflex

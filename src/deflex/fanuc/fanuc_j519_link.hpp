@@ -1,0 +1,126 @@
+// FANUC Stream Motion (option J519), deflex as the motion source. deflex sends the start packet to
+// the controller (UDP 60015); the controller then sends a status every communication interval (8, 4
+// or 1 ms) and takes, in answer to each, one command: the absolute joint target (degrees) carrying the
+// status's sequence number,
+//     target = program(p) + blend - dtheta_smoothed,   |target_i - (program_i(p) + blend_i)| <= bound.
+// The controller checks every joint's velocity, acceleration and jerk from successive commands and
+// stops the stream at the first over its limits (MOTN-609..611 / 720..722), so the correction passes
+// through a smoother with closed-form bounds (link/correction_smoother.hpp) sized from the limits the
+// user gives for the controller and the share of them the correction may take, and the program is
+// checked against the rest of them before the session starts.
+//
+// The program's clock is the controller's: it moves on one interval per command, and a status whose
+// number skips some (a status lost on the way) is answered with one command for each number missed,
+// in order (as FANUC's own driver catches up), so no interval of the program is dropped and no velocity
+// dip enters the stream; more than `max_catch_up` missed is a PC too slow for the controller's buffer
+// (kTooSlow). A session starts at the first status with the ready bit set: its joints are the anchor
+// (the first command is where the arm is; the offset to the program is blended out). The ready bit
+// cleared after that (an alarm, the TP program leaving IBGN) or, in protocol 3 and 4, the in-error or
+// e-stop bits, stop the link (kController). The session ends with a command flagged last-data
+// (holding the last target) and the stop packet: at the program's end (kEnded), after a planned stop
+// has brought the program to rest on its path (kRequested), or at stop().
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+
+#include "deflex/link/controller_gate.hpp"
+#include "deflex/link/controller_link.hpp"
+#include "deflex/link/correction_smoother.hpp"
+#include "deflex/link/joint_stream.hpp"
+#include "deflex/online/delay_estimator.hpp"
+#include "deflex/transport/datagram_transport.hpp"
+#include "deflex/wire/fanuc_j519.hpp"
+
+namespace deflex {
+
+struct FanucJ519LinkConfig {
+  DatagramAddress controller;  ///< where the controller listens (port 60015 by default)
+  std::uint32_t version = 1;   ///< the protocol version (1: float32 targets; 3, 4: float64)
+  /// The controller's limits on the stream per joint (deg/s, deg/s^2, deg/s^3): the threshold tables'
+  /// strictest values, or the $STMO_GRP limits read on the pendant. Default: a CRX-10iA/L's
+  /// strictest (120 deg/s, 265 deg/s^2, 1240 deg/s^3).
+  std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> limits = default_limits();
+  /// The share of the acceleration and jerk limits the correction may use; the program keeps the rest.
+  double correction_share = 0.25;
+  JointStreamConfig stream;
+  LinkStopRules stop;
+  std::size_t history_cycles = 1000;
+  double initial_delay_s = 0.04;
+  double start_resend_s = 0.5;  ///< the start packet again while no status comes
+  int max_catch_up = 3;         ///< statuses missed in a row that are caught up; more: kTooSlow
+  std::size_t max_packet_bytes = 1400;
+
+  static std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> default_limits() {
+    std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> l{};
+    l.fill({120.0, 265.0, 1240.0});
+    return l;
+  }
+  /// Throws InputError naming the setting.
+  void validate() const;
+};
+
+/// "VEL,ACC,JERK" (deg/s, deg/s^2, deg/s^3) for every joint, or one triple a joint separated by ';' (as
+/// deflex online --fanuc-limits takes them). Throws InputError naming `option` and the triple.
+[[nodiscard]] std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> parse_fanuc_limits(const std::string& text,
+                                                                                       const char* option);
+
+/// Thread safety: one thread at a time (the loop's), as every ControllerLink.
+class FanucJ519Link final : public ControllerLink {
+ public:
+  /// Every reference must outlive the link. The controller's interval is the compensator's period_s.
+  /// Throws InputError on a configuration that cannot work: a bad setting, a program for another
+  /// number of joints or one that alone exceeds the controller's limits (naming the joint, the time
+  /// and the limit), limits the smoother cannot meet.
+  FanucJ519Link(OnlineCompensator& compensator, OnlineStrategy& strategy,
+                std::shared_ptr<const JointTrajectory> nominal, DatagramTransport& transport, const Clock& clock,
+                ForceSource* force, const FanucJ519LinkConfig& config);
+  FanucJ519Link(OnlineCompensator& compensator, OnlineStrategy& strategy,
+                std::shared_ptr<const JointTrajectory> nominal, DatagramTransport& transport, const Clock&& clock,
+                ForceSource* force, const FanucJ519LinkConfig& config) = delete;
+
+  LinkPollResult poll(double timeout_s) noexcept override;
+  void stop() noexcept override;
+  [[nodiscard]] const char* name() const override { return "fanuc-j519"; }
+  [[nodiscard]] const DelayEstimator* delay_estimator() const override { return &delay_; }
+  [[nodiscard]] std::string protocol_summary() const override;
+
+  [[nodiscard]] const JointStream& stream() const { return stream_; }
+  [[nodiscard]] const CorrectionSmoother& smoother() const { return smoother_; }
+  /// Commands sent as catch-up for statuses that never arrived.
+  [[nodiscard]] std::uint64_t caught_up() const { return caught_up_; }
+
+ private:
+  bool drain(double timeout_s, fanuc_j519::Status& newest, bool& session_start) noexcept;
+  bool controller_state(const fanuc_j519::Status& s) noexcept;
+  bool start_session(const fanuc_j519::Status& s) noexcept;
+  LinkPollResult answer(std::uint32_t sequence, double now, bool session_start) noexcept;
+  LinkPollResult finish(const fanuc_j519::Status& s, double now) noexcept;
+  bool send_command(std::uint32_t sequence, const JointVector& target_rad, bool last) noexcept;
+
+  FanucJ519LinkConfig config_;
+  DatagramTransport& transport_;
+  ControllerGate gate_;
+  JointStream stream_;
+  CorrectionSmoother smoother_;
+  DelayEstimator delay_;
+  double period_s_;
+  double last_start_s_ = -1e300;
+  bool ready_seen_ = false;          // a status with the ready bit set arrived this session
+  std::uint32_t next_sequence_ = 0;  // the sequence number the next command carries
+  std::uint64_t caught_up_ = 0;
+  bool last_data_sent_ = false;
+  double last_data_s_ = 0.0;
+
+  // Preallocated per-cycle buffers.
+  std::vector<unsigned char> rx_, tx_;
+  fanuc_j519::Status status_;
+  fanuc_j519::Command command_;
+  JointVector feedback_, program_, program_velocity_, blend_, blend_velocity_, nominal_;
+  LinkArrival arrival_;
+  double receipt_age_s_ = 0.0;  // the newest status's age when it was read (the transport's time stamp)
+  double taken_at_s_ = 0.0;
+};
+
+}  // namespace deflex

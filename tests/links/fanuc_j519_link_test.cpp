@@ -1,0 +1,292 @@
+// deflex's FANUC Stream Motion link against a stand-in of the controller with its semantics
+// (cell/fanuc_j519_controller.hpp: lock-step sequence numbers, a command queue that must never run
+// dry, the velocity / acceleration / jerk check of every target, alarms that stop the stream, dead
+// time and servo lag): the command converges to the model's correction (computed here with a
+// finite-difference Jacobian) without the controller ever alarming, and every fault a cell has ends
+// with the link stopped for a named reason and nothing beyond the bound or the step limit sent.
+#include <gtest/gtest.h>
+
+#include "deflex/cell/fanuc_j519_controller.hpp"
+#include "deflex/fanuc/fanuc_j519_link.hpp"
+#include "deflex/text/errors.hpp"
+#include "links/link_harness.hpp"
+#include "support/allocation_guard.hpp"
+#include "support/poses.hpp"
+
+namespace deflex {
+namespace {
+
+using test::pose_deg;
+
+OnlineConfig fanuc_online() {
+  OnlineConfig c = test::bench_online(0.008);
+  c.max_correction_rate_rad_s = deg_to_rad(3.0);  // deflex online's default --max-rate-deg-s
+  return c;
+}
+
+struct FanucBench {
+  RobotModel robot = test::bench_robot();
+  ManualClock clock;
+  MemoryNetwork network{clock};
+  MemoryTransport& pc_port = network.add_endpoint(test::kSensorAddress, 0.0002);
+  MemoryTransport& controller_port = network.add_endpoint(test::kControllerAddress, 0.0002);
+  OnlineCompensator compensator;
+  OnlineStrategy strategy;
+  test::ConstantForce force;
+  std::shared_ptr<const JointTrajectory> program;
+  FanucJ519Link link;
+  cell::FanucJ519Controller controller;
+  double t_s = 0.0;
+  bool stalled = false;
+  // The wire invariants, checked on what the controller took.
+  double worst_deviation_rad = 0.0;
+
+  static FanucJ519LinkConfig link_config(std::uint32_t version) {
+    FanucJ519LinkConfig c;
+    c.controller = test::kControllerAddress;
+    c.version = version;
+    return c;
+  }
+  static cell::FanucJ519ControllerConfig controller_config(std::uint32_t version) {
+    cell::FanucJ519ControllerConfig c;
+    c.version = version;
+    return c;
+  }
+
+  FanucBench(std::shared_ptr<const JointTrajectory> p, const JointVector& arm, std::uint32_t version = 1,
+             std::uint32_t controller_version = 0)
+      : compensator(robot, test::bench_sensor(), fanuc_online()),
+        strategy(robot, StrategyKind::kOnline, nullptr),
+        program(std::move(p)),
+        link(compensator, strategy, program, pc_port, clock, &force, link_config(version)),
+        controller(controller_config(controller_version == 0 ? version : controller_version), arm, controller_port) {}
+
+  /// One 4 ms servo tick of the controller, then deflex answers what reached it (unless stalled).
+  LinkPollResult tick() {
+    t_s += 0.004;
+    clock.set(t_s);
+    controller.tick(t_s);
+    clock.set(t_s + 0.0002);
+    LinkPollResult last = LinkPollResult::kIdle;
+    while (!stalled) {
+      const LinkPollResult r = link.poll(0.0);
+      if (r == LinkPollResult::kIdle) break;
+      last = r;
+    }
+    return last;
+  }
+  void run(double seconds) {
+    const double end = t_s + seconds;
+    while (t_s < end - 1e-9) tick();
+  }
+};
+
+// What the controller took never left the program by more than the bound, and never moved by more
+// than the link's per-cycle step limit.
+void expect_wire_invariants(const FanucBench& b) {
+  const CommandLimits& l = b.link.limits();
+  const std::vector<JointVector>& taken = b.controller.taken();
+  for (std::size_t k = 1; k < taken.size(); ++k) {
+    const JointVector step = (taken[k] - taken[k - 1]).cwiseAbs();
+    for (int j = 0; j < step.size(); ++j) {
+      ASSERT_LE(step[j], l.joint_step_rad[j] * (1 + 1e-9) + 1e-9) << "target " << k << " joint " << j + 1;
+    }
+  }
+  EXPECT_LE(b.link.cycle_stats().max_program_deviation_rad, l.joint_bound_rad + 1e-9);
+}
+
+TEST(FanucJ519Link, ConstantForceHoldsTheModelsCorrectionAndTheControllerNeverAlarms) {
+  const JointVector q0 = pose_deg(5, 25, -5, 20, 35, -15);
+  FanucBench bench(test::hold_program(test::bench_robot(), q0, 60.0), q0);
+  const Vector3 f_base(150.0, -250.0, -300.0);
+  const JointVector expected = test::model_correction(bench.robot, q0, f_base);
+  ASSERT_LT(expected.cwiseAbs().maxCoeff(), bench.compensator.config().max_joint_correction_rad);
+  for (int k = 0; k < 5000; ++k) {  // 20 s
+    bench.force.reading = test::reading_at(bench.robot, bench.controller.position(), f_base);
+    bench.tick();
+    ASSERT_EQ(bench.controller.alarm(), "") << "at " << bench.t_s << " s";
+  }
+  ASSERT_EQ(bench.link.state(), LinkState::kRunning);
+  const JointVector sent = q0 - bench.controller.taken().back();
+  EXPECT_LT((sent - expected).cwiseAbs().maxCoeff(), 0.01 * expected.cwiseAbs().maxCoeff())
+      << "sent " << sent.transpose() << "\nmodel " << expected.transpose();
+  // The stream stayed within what the controller allows, and the smoother's bounds were the binding ones.
+  const fanuc_j519::AxisLimits& peak = bench.controller.check().peak();
+  EXPECT_LE(peak.jerk, 0.25 * 1240.0 + 1e-6);
+  EXPECT_LE(peak.acceleration, 0.25 * 265.0 + 1e-6);
+  EXPECT_GT(peak.jerk, 1.0);  // the correction did move the stream
+  EXPECT_EQ(bench.link.counters().guard_trips, 0u);
+  expect_wire_invariants(bench);
+}
+
+TEST(FanucJ519Link, AProgramUnderAForceStepEndsWithLastDataAndNoAlarm) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  const auto program = test::sweep_program(test::bench_robot(), q0, pose_deg(12, -6, 9, 15, -12, 25), 6.0);
+  FanucBench bench(program, q0);
+  for (int k = 0; k < 2500 && bench.link.state() != LinkState::kStopped; ++k) {
+    // 650 N switched on at 2 s: the step the compensator's rate limit alone would pass as a ramp whose
+    // start is some 47,000 deg/s^3 of jerk at 8 ms.
+    const Vector3 f = bench.t_s > 2.0 ? Vector3(0.0, 0.0, -650.0) : Vector3::Zero();
+    bench.force.reading = test::reading_at(bench.robot, bench.controller.position(), f);
+    bench.tick();
+    ASSERT_EQ(bench.controller.alarm(), "") << "at " << bench.t_s << " s";
+  }
+  EXPECT_EQ(bench.link.state(), LinkState::kStopped);
+  EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kEnded) << bench.link.stop_reason();
+  bench.run(0.05);  // the controller takes the last-data command at its next interval
+  EXPECT_TRUE(bench.controller.ended());
+  EXPECT_EQ(bench.controller.alarm(), "");
+  EXPECT_GT(bench.link.cycle_stats().max_program_deviation_rad, 1e-5);
+  expect_wire_invariants(bench);
+}
+
+TEST(FanucJ519Link, OneLostStatusIsCaughtUpAndTheStreamGoesOn) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  FanucBench bench(test::sweep_program(test::bench_robot(), q0, pose_deg(5, 5, 5, 5, 5, 5), 8.0), q0);
+  bench.run(1.0);
+  // One status lost on its way to deflex (the controller's packets to the PC during 4 ms).
+  // An 8 ms window holds exactly one of the controller's status times (and no answer, since none came).
+  bench.network.add_outage(bench.t_s + 0.0005, bench.t_s + 0.0085, test::kSensorAddress);
+  bench.run(2.0);
+  EXPECT_EQ(bench.controller.alarm(), "");
+  EXPECT_EQ(bench.link.state(), LinkState::kRunning);
+  EXPECT_GE(bench.link.caught_up(), 1u);
+  expect_wire_invariants(bench);
+}
+
+TEST(FanucJ519Link, FaultsStopTheLinkWithANamedReasonAndNothingUnsafeOnTheWire) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  const auto program = test::sweep_program(test::bench_robot(), q0, pose_deg(8, -4, 6, 10, -8, 12), 20.0);
+  struct Case {
+    const char* name;
+    LinkStopCause cause;
+    const char* words;
+  };
+  const Case cases[] = {
+      {"outage", LinkStopCause::kController, "ready bit"},  // the queue ran dry: MOTN-603
+      {"stall", LinkStopCause::kController, "did not answer in time"},
+      {"estop", LinkStopCause::kController, "ready bit"},
+      {"planned", LinkStopCause::kRequested, "last-data"},
+      {"silence", LinkStopCause::kSilent, ""},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    FanucBench bench(program, q0);
+    bench.force.reading = test::reading_at(bench.robot, q0, Vector3(0, 0, -400));
+    bench.run(2.0);
+    ASSERT_EQ(bench.link.state(), LinkState::kRunning);
+    const std::string what = c.name;
+    if (what == "outage") bench.network.add_outage(bench.t_s, bench.t_s + 0.1);
+    if (what == "stall") bench.stalled = true;
+    if (what == "estop") bench.controller.raise_alarm("SRVO-001 Operator panel E-stop");
+    if (what == "planned") bench.link.request_planned_stop(0.5);
+    if (what == "silence") bench.network.add_outage(bench.t_s, bench.t_s + 60.0, test::kSensorAddress);
+    bench.run(0.1);
+    bench.stalled = false;
+    bench.run(5.0);
+    EXPECT_EQ(bench.link.state(), LinkState::kStopped);
+    EXPECT_EQ(bench.link.stop_cause(), c.cause) << bench.link.stop_reason();
+    EXPECT_NE(std::string(bench.link.stop_reason()).find(c.words), std::string::npos) << bench.link.stop_reason();
+    if (what == "planned") {
+      EXPECT_EQ(bench.controller.alarm(), "");
+      EXPECT_TRUE(bench.controller.ended());
+    }
+    // The controller's own check never tripped on what deflex sent (its alarms came from the fault).
+    EXPECT_EQ(bench.controller.alarm().find("MOTN-61"), std::string::npos) << bench.controller.alarm();
+    expect_wire_invariants(bench);
+  }
+}
+
+// A restart of the TP program (after an alarm was reset, say) starts with the ready bit clear: to
+// deflex the stream it ran has stopped, and a new session needs a new `deflex online`.
+TEST(FanucJ519Link, AControllerRestartEndsTheSessionItRan) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  FanucBench bench(test::hold_program(test::bench_robot(), q0, 30.0), q0);
+  bench.force.reading = test::reading_at(bench.robot, q0, Vector3(0, 0, -400));
+  bench.run(2.0);
+  bench.controller.restart(bench.t_s);
+  const std::uint64_t taken = bench.controller.counters().taken;
+  bench.run(2.0);
+  EXPECT_EQ(bench.link.state(), LinkState::kStopped);
+  EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kController) << bench.link.stop_reason();
+  EXPECT_EQ(bench.controller.counters().taken, taken) << "nothing moved the arm after the restart";
+  expect_wire_invariants(bench);
+}
+
+TEST(FanucJ519Link, GarbageIsCountedAndNeverAnswered) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  FanucBench bench(test::hold_program(test::bench_robot(), q0, 30.0), q0);
+  bench.run(1.0);
+  const std::uint64_t replies = bench.link.counters().replies;
+  MemoryTransport& stranger = bench.network.add_endpoint(test::kStrangerAddress, 0.0002);
+  std::vector<unsigned char> junk(132, 0xAB);
+  // Garbage from the controller's own address (truncated, wrong type) and a stranger's valid-looking status.
+  for (int k = 0; k < 50; ++k) {
+    bench.controller_port.send_to(junk.data(), 60 + static_cast<std::size_t>(k), test::kSensorAddress);
+    stranger.send_to(junk.data(), junk.size(), test::kSensorAddress);
+  }
+  bench.clock.set(bench.t_s + 0.001);  // delivered, and no status of the controller's among them
+  while (bench.link.poll(0.0) != LinkPollResult::kIdle) {
+  }
+  EXPECT_EQ(bench.link.counters().replies, replies);
+  EXPECT_GE(bench.link.counters().foreign_sender, 50u);
+  EXPECT_GE(bench.link.counters().malformed + bench.link.counters().truncated, 50u);
+  bench.run(1.0);
+  EXPECT_EQ(bench.controller.alarm(), "");
+  EXPECT_EQ(bench.link.state(), LinkState::kRunning);
+}
+
+TEST(FanucJ519Link, AVersionMismatchStopsTheLinkNamingBoth) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  FanucBench bench(test::hold_program(test::bench_robot(), q0, 30.0), q0, 1, 3);
+  bench.run(1.0);
+  EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kProtocol);
+  EXPECT_NE(std::string(bench.link.stop_reason()).find("version 3"), std::string::npos) << bench.link.stop_reason();
+  EXPECT_EQ(bench.controller.counters().taken, 0u);
+}
+
+TEST(FanucJ519Link, ProtocolThreeCarriesDoublesAndRunsTheSame) {
+  const JointVector q0 = pose_deg(5, 25, -5, 20, 35, -15);
+  FanucBench bench(test::hold_program(test::bench_robot(), q0, 60.0), q0, 3);
+  const Vector3 f_base(0.0, 200.0, -300.0);
+  const JointVector expected = test::model_correction(bench.robot, q0, f_base);
+  for (int k = 0; k < 4000; ++k) {
+    bench.force.reading = test::reading_at(bench.robot, bench.controller.position(), f_base);
+    bench.tick();
+  }
+  EXPECT_EQ(bench.controller.alarm(), "");
+  EXPECT_LT(((q0 - bench.controller.taken().back()) - expected).cwiseAbs().maxCoeff(),
+            0.01 * expected.cwiseAbs().maxCoeff());
+}
+
+TEST(FanucJ519Link, AProgramTooFastForTheControllerIsRefusedBeforeAnythingIsSent) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  // 30 deg on joint 1 in 0.5 s: a peak acceleration of 30 (pi/0.5)^2 / 2 = 592 deg/s^2, over 265.
+  const auto fast = test::sweep_program(test::bench_robot(), q0, pose_deg(30, 0, 0, 0, 0, 0), 0.5);
+  try {
+    FanucBench bench(fast, q0);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("joint 1"), std::string::npos) << e.what();
+  }
+}
+
+TEST(FanucJ519Link, PollDoesNotAllocate) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  FanucBench bench(test::sweep_program(test::bench_robot(), q0, pose_deg(5, 5, 5, 5, 5, 5), 8.0), q0);
+  bench.force.reading = test::reading_at(bench.robot, q0, Vector3(0, 0, -400));
+  bench.run(1.0);
+  for (int k = 0; k < 200; ++k) {
+    bench.t_s += 0.004;
+    bench.clock.set(bench.t_s);
+    bench.controller.tick(bench.t_s);
+    bench.clock.set(bench.t_s + 0.0002);
+    test::AllocationGuard guard;
+    bench.link.poll(0.0);
+    ASSERT_EQ(guard.allocations(), 0u) << k;
+  }
+  EXPECT_EQ(bench.link.state(), LinkState::kRunning);
+}
+
+}  // namespace
+}  // namespace deflex
