@@ -76,7 +76,7 @@ class Controller:
         if kind != 1 or version != 1:
             self.alarm = "MOTN-607 ST: Protocol version mismatch"
             return
-        in_turn = (1 <= seq <= self.status_seq) if self.expected == 0 else seq == self.expected
+        in_turn = (1 <= seq <= self.status_seq) if self.expected == 0 else seq == self.expected <= self.status_seq
         if not in_turn:
             self.alarm = "MOTN-601 ST: Sequence No. error"
             return

@@ -132,7 +132,7 @@ TEST(CorrectionSmoother, RefusesLimitsItCannotMeetAndSaysWhy) {
     (void)CorrectionSmoother::taps_for(l);
     FAIL() << "expected an InputError";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("lower the step limit"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("lower the correction's rate bound"), std::string::npos) << e.what();
   }
   EXPECT_THROW(CorrectionSmoother(crx_share(), 0), InputError);
 }

@@ -12,6 +12,7 @@
 #include "links/link_harness.hpp"
 #include "support/allocation_guard.hpp"
 #include "support/poses.hpp"
+#include "support/sampled_speed.hpp"
 
 namespace deflex {
 namespace {
@@ -47,19 +48,21 @@ struct FanucBench {
     c.version = version;
     return c;
   }
-  static cell::FanucJ519ControllerConfig controller_config(std::uint32_t version) {
+  static cell::FanucJ519ControllerConfig controller_config(std::uint32_t version, double interval_s) {
     cell::FanucJ519ControllerConfig c;
     c.version = version;
+    c.interval_s = interval_s;
     return c;
   }
 
   FanucBench(std::shared_ptr<const JointTrajectory> p, const JointVector& arm, std::uint32_t version = 1,
-             std::uint32_t controller_version = 0)
+             std::uint32_t controller_version = 0, double controller_interval_s = 0.008)
       : compensator(robot, test::bench_sensor(), fanuc_online()),
         strategy(robot, StrategyKind::kOnline, nullptr),
         program(std::move(p)),
         link(compensator, strategy, program, pc_port, clock, &force, link_config(version)),
-        controller(controller_config(controller_version == 0 ? version : controller_version), arm, controller_port) {}
+        controller(controller_config(controller_version == 0 ? version : controller_version, controller_interval_s),
+                   arm, controller_port) {}
 
   /// One 4 ms servo tick of the controller, then deflex answers what reached it (unless stalled).
   LinkPollResult tick() {
@@ -81,18 +84,29 @@ struct FanucBench {
   }
 };
 
-// What the controller took never left the program by more than the bound, and never moved by more
-// than the link's per-cycle step limit.
+// What the controller took never moved by more than the per-cycle step limit computed here (the
+// program's peak speed sampled every 0.5 ms, the blend's 1.5 x 0.2 deg over the 1 s ramp-in, the 3 deg/s
+// rate bound, over 8 ms), and never left the program (sampled here at the program time the link
+// recorded) plus its blend by more than the bound it was configured with.
 void expect_wire_invariants(const FanucBench& b) {
-  const CommandLimits& l = b.link.limits();
+  const JointVector limit = 0.008 * (test::sampled_peak_speed(*b.program) * 1.001).array() +
+                            0.008 * (1.5 * deg_to_rad(0.2) / 1.0 + deg_to_rad(3.0)) + 1e-6;
   const std::vector<JointVector>& taken = b.controller.taken();
   for (std::size_t k = 1; k < taken.size(); ++k) {
     const JointVector step = (taken[k] - taken[k - 1]).cwiseAbs();
     for (int j = 0; j < step.size(); ++j) {
-      ASSERT_LE(step[j], l.joint_step_rad[j] * (1 + 1e-9) + 1e-9) << "target " << k << " joint " << j + 1;
+      ASSERT_LE(step[j], limit[j]) << "target " << k << " joint " << j + 1;
     }
   }
-  EXPECT_LE(b.link.cycle_stats().max_program_deviation_rad, l.joint_bound_rad + 1e-9);
+  const double bound = b.compensator.config().max_joint_correction_rad + 1e-6;
+  JointVector q(6);
+  const LinkHistory& h = b.link.history();  // the last 1000 cycles
+  for (std::size_t k = 0; k < h.size(); ++k) {
+    const LinkCycleRecord& r = h.at(k);
+    if (!r.replied) continue;
+    b.program->sample(r.program_time_s, q);
+    ASSERT_LE((r.q_command - (q + r.q_blend)).cwiseAbs().maxCoeff(), bound) << "at " << r.t_s << " s";
+  }
 }
 
 TEST(FanucJ519Link, ConstantForceHoldsTheModelsCorrectionAndTheControllerNeverAlarms) {
@@ -269,6 +283,65 @@ TEST(FanucJ519Link, AProgramTooFastForTheControllerIsRefusedBeforeAnythingIsSent
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("joint 1"), std::string::npos) << e.what();
   }
+}
+
+// A planned stop while the program moves at 12 deg/s: its speed falls along a smoothstep, so the
+// controller's jerk check holds (a linear ramp over 0.5 s would add 12 / (0.5 x 0.008) = 3000 deg/s^3).
+TEST(FanucJ519Link, APlannedStopOfAFastProgramStaysWithinTheJerkLimit) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  FanucBench bench(test::sweep_program(test::bench_robot(), q0, pose_deg(30, 0, 0, 30, 0, 0), 4.0, 161), q0);
+  bench.force.reading = test::reading_at(bench.robot, q0, Vector3(0, 0, -400));
+  bench.run(2.0);  // the peak speed: 30 pi / 8 = 11.8 deg/s
+  bench.link.request_planned_stop(0.5);
+  bench.run(2.0);
+  EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kRequested) << bench.link.stop_reason();
+  EXPECT_EQ(bench.controller.alarm(), "");
+  EXPECT_TRUE(bench.controller.ended());
+  EXPECT_GT(bench.controller.check().peak().velocity, 10.0);
+  EXPECT_LE(bench.controller.check().peak().jerk, 1240.0);
+}
+
+// A force that jumps as the program ends: the correction settles before the last-data command.
+TEST(FanucJ519Link, TheLastDataCommandFreezesAStreamAtRest) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  FanucBench bench(test::sweep_program(test::bench_robot(), q0, pose_deg(5, 5, 5, 5, 5, 5), 3.0), q0);
+  for (int k = 0; k < 2000 && bench.link.state() != LinkState::kStopped; ++k) {
+    const Vector3 f = bench.t_s > 3.9 ? Vector3(0.0, 300.0, -650.0) : Vector3::Zero();
+    bench.force.reading = test::reading_at(bench.robot, bench.controller.position(), f);
+    bench.tick();
+  }
+  bench.run(0.1);
+  EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kEnded) << bench.link.stop_reason();
+  EXPECT_EQ(bench.controller.alarm(), "");
+  EXPECT_TRUE(bench.controller.ended());
+  // The last targets taken are equal: the stream was at rest when it was frozen.
+  const auto& taken = bench.controller.taken();
+  ASSERT_GT(taken.size(), 3u);
+  EXPECT_EQ(taken[taken.size() - 1], taken[taken.size() - 3]);
+}
+
+// The controller begins a new session with the ready bit set at once: not resumed.
+TEST(FanucJ519Link, ANewSessionWhileTheStreamRunsIsNotResumed) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  FanucBench bench(test::hold_program(test::bench_robot(), q0, 30.0), q0);
+  bench.run(2.0);
+  bench.controller.restart(bench.t_s - 1.0);  // statuses from 1 again, ready already
+  const std::uint64_t taken = bench.controller.counters().taken;
+  bench.run(1.0);
+  // Stopped, whichever the link saw first: the new numbering, or the controller's alarm at a command
+  // of the old one still on its way (MOTN-601); nothing moved the arm after the restart.
+  EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kController) << bench.link.stop_reason();
+  EXPECT_EQ(bench.controller.counters().taken, taken);
+}
+
+// deflex runs 8 ms, the controller 4 ms: its time stamps say so before anything is sent.
+TEST(FanucJ519Link, AControllerAtAnotherIntervalIsRefusedBeforeAnyCommand) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  FanucBench bench(test::hold_program(test::bench_robot(), q0, 30.0), q0, 1, 0, 0.004);
+  bench.run(1.0);
+  EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kProtocol) << bench.link.stop_reason();
+  EXPECT_NE(std::string(bench.link.stop_reason()).find("every 4.0 ms"), std::string::npos) << bench.link.stop_reason();
+  EXPECT_EQ(bench.controller.counters().commands, 0u);
 }
 
 TEST(FanucJ519Link, PollDoesNotAllocate) {

@@ -54,7 +54,7 @@ TEST(FanucJ519, VersionOneCommandIsTheManualsSixtyFourBytes) {
 TEST(FanucJ519, VersionThreeCommandCarriesDoublesAndAZeroIoBlock) {
   Bytes expected =
       hex("000000C9 00000003 01020304"  // type 201, version 3, sequence
-          "01 01 0000"                  // last, motion control, unused
+          "01 01 FFFF"                  // last, motion control, unused (0xFFFF as FANUC's driver writes)
           "4024000000000000 0000000000000000 C056A00000000000");
   expected = test::zeros_after(expected, 6 * 8 + j519::kIoBytes);
   ASSERT_EQ(expected.size(), j519::kCommandV3Bytes);

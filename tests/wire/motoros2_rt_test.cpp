@@ -20,7 +20,7 @@ namespace rt = motoros2_rt;
 using test::Bytes;
 using test::hex;
 
-rt::Command sample_command() {
+rt::Command rt_command() {
   rt::Command c;
   c.sequence = 0x01020304;
   c.delta[0][0] = 0.001;  // S, 1 mrad this cycle
@@ -29,7 +29,7 @@ rt::Command sample_command() {
   return c;
 }
 
-Bytes sample_command_bytes() {
+Bytes rt_command_bytes() {
   Bytes b =
       hex("01000000 00000000 04030201"  // version 1, joint increments, sequence
           "FCA9F1D24D62503F");          // delta[0][0] = 0.001 rad
@@ -43,10 +43,10 @@ Bytes sample_command_bytes() {
 }
 
 TEST(MotoRos2Rt, CommandIsTheSixHundredTwentyBytePackedStruct) {
-  const Bytes expected = sample_command_bytes();
+  const Bytes expected = rt_command_bytes();
   ASSERT_EQ(expected.size(), rt::kCommandBytes);
   unsigned char out[rt::kCommandBytes];
-  ASSERT_EQ(rt::encode(sample_command(), out, sizeof out), rt::kCommandBytes);
+  ASSERT_EQ(rt::encode(rt_command(), out, sizeof out), rt::kCommandBytes);
   EXPECT_EQ(Bytes(out, out + sizeof out), expected);
 
   rt::Command back;
@@ -101,7 +101,7 @@ TEST(MotoRos2Rt, RobotStateIsSixBooleansAndAnErrorCode) {
 }
 
 TEST(MotoRos2Rt, GarbageIsRefusedWithItsReason) {
-  const Bytes good = sample_command_bytes();
+  const Bytes good = rt_command_bytes();
   rt::Command c;
   EXPECT_EQ(rt::decode(good.data(), good.size() - 1, c), rt::DecodeStatus::kWrongSize);
   Bytes v2 = good;
@@ -120,13 +120,13 @@ TEST(MotoRos2Rt, GarbageIsRefusedWithItsReason) {
   EXPECT_EQ(c.sequence, 0u) << "a refused datagram leaves the output untouched";
 
   unsigned char out[rt::kReplyBytes];
-  rt::Command bad = sample_command();
+  rt::Command bad = rt_command();
   bad.delta[3][7] = std::numeric_limits<double>::infinity();
   EXPECT_EQ(rt::encode(bad, out, sizeof out), 0u);
-  bad = sample_command();
+  bad = rt_command();
   bad.tool[7] = -1;
   EXPECT_EQ(rt::encode(bad, out, sizeof out), 0u);
-  EXPECT_EQ(rt::encode(sample_command(), out, rt::kCommandBytes - 1), 0u);
+  EXPECT_EQ(rt::encode(rt_command(), out, rt::kCommandBytes - 1), 0u);
 }
 
 TEST(MotoRos2Rt, SequenceDistanceIsWrapSafe) {
@@ -143,7 +143,7 @@ TEST(MotoRos2Rt, EncodingAndDecodingDoNotAllocate) {
   rt::Reply r;
   test::AllocationGuard guard;
   for (int i = 0; i < 50; ++i) {
-    const std::size_t n = rt::encode(sample_command(), out, sizeof out);
+    const std::size_t n = rt::encode(rt_command(), out, sizeof out);
     ASSERT_EQ(rt::decode(out, n, c), rt::DecodeStatus::kOk);
     const std::size_t m = rt::encode(r, out, sizeof out);
     ASSERT_EQ(rt::decode(out, m, r), rt::DecodeStatus::kOk);

@@ -15,7 +15,7 @@
 //     lag), the ready bit clears (and, in protocol 3 and 4, the in-error bit sets); statuses go on
 //     until a stop packet (unconfirmed in FANUC's text: the strict reading keeps reporting);
 //   - a command flagged last-data ends the session as planned once it is taken (the TP program leaves
-//     IBGN: the ready bit clears, no alarm);
+//     IBGN: the ready bit clears, no alarm; FANUC's text does not say when the bit clears);
 //   - the arm follows the targets taken after a dead time, through a first-order servo lag.
 // Faults on request (tests): an alarm now (an e-stop), a restart of the TP program (a new session,
 // numbered from 1 again). A network outage is the network's. It knows nothing of deflex.

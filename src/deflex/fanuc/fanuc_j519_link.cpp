@@ -52,13 +52,53 @@ SmootherLimits smoother_limits(const OnlineCompensator& c, const FanucJ519LinkCo
   return s;
 }
 
-// The program alone, sampled at the interval as the controller will see it, within the share of the
-// limits the correction leaves it; throws InputError naming the first joint and time that is not.
-void check_program(const JointTrajectory& program, double interval_s, const FanucJ519LinkConfig& f) {
+// What the rest of the stream takes of each limit, per the closed forms (deg/s, deg/s^2, deg/s^3):
+//   the correction: its rate bound's velocity and its share of the acceleration and jerk;
+//   the ramp-in blend (a smoothstep of at most the start tolerance d over R): velocity 1.5 d/R,
+//     acceleration 6 d/R^2, jerk 6 d/(R^2 T) where its acceleration starts (a finite difference) plus
+//     12 d/R^3;
+//   protocol 1's float32 degrees: rounding errors of half an ulp u at the largest joint value give up to
+//     u/T, 2u/T^2 and 4u/T^3.
+// The program may use what is left; nothing left is an InputError naming the culprit.
+struct Budget {
+  double velocity, acceleration, jerk;
+};
+
+Budget program_budget(const j519::AxisLimits& l, const OnlineCompensator& c, const FanucJ519LinkConfig& f,
+                      double largest_deg) {
+  const double t = c.config().period_s;
+  const double d = rad_to_deg(f.stream.start_tolerance_rad);
+  const double r = f.stream.ramp_in_s;
+  const double u = f.version == 1
+                       ? std::nextafter(static_cast<float>(largest_deg), HUGE_VALF) - static_cast<float>(largest_deg)
+                       : 0.0;
+  Budget b;
+  b.velocity = l.velocity - rad_to_deg(c.config().max_correction_rate_rad_s) - (r > 0 ? 1.5 * d / r : 0.0) - u / t;
+  b.acceleration = l.acceleration * (1.0 - f.correction_share) - (r > 0 ? 6.0 * d / (r * r) : 0.0) - 2.0 * u / (t * t);
+  b.jerk = l.jerk * (1.0 - f.correction_share) - (r > 0 ? 6.0 * d / (r * r * t) + 12.0 * d / (r * r * r) : 0.0) -
+           4.0 * u / (t * t * t);
+  if (b.velocity <= 0.0 || b.acceleration <= 0.0 || b.jerk <= 0.0) {
+    throw InputError(fmt::format(
+        "FANUC J519 link: at a {:g} ms interval the correction (--max-rate-deg-s, --fanuc-correction-share), the "
+        "ramp-in blend (--ramp-in-s {:g} from up to {:g} deg away){} leave the program nothing of the limits "
+        "{:g} deg/s, {:g} deg/s^2, {:g} deg/s^3: lengthen --ramp-in-s{}, lower --max-rate-deg-s",
+        t * 1e3, r, d, f.version == 1 ? " and protocol 1's float32 rounding" : "", l.velocity, l.acceleration, l.jerk,
+        f.version == 1 ? ", use --fanuc-version 3" : ""));
+  }
+  return b;
+}
+
+// The program alone, sampled at the interval as the controller will see it, within what the budget
+// leaves it; throws InputError naming the first joint and time that is not.
+void check_program(const JointTrajectory& program, const OnlineCompensator& c, const FanucJ519LinkConfig& f) {
+  const double interval_s = c.config().period_s;
+  double largest = 0.0;
+  for (const JointVector& q : program.points()) largest = std::max(largest, rad_to_deg(q.cwiseAbs().maxCoeff()));
+  largest += rad_to_deg(c.config().max_joint_correction_rad) + rad_to_deg(f.stream.start_tolerance_rad);
   std::array<j519::AxisLimits, j519::kAxes> rest = f.limits;
-  for (j519::AxisLimits& l : rest) {
-    l.acceleration *= 1.0 - f.correction_share;
-    l.jerk *= 1.0 - f.correction_share;
+  for (std::size_t j = 0; j < static_cast<std::size_t>(program.dof()); ++j) {
+    const Budget b = program_budget(f.limits[j], c, f, largest);
+    rest[j] = {b.velocity, b.acceleration, b.jerk};
   }
   j519::MotionCheck check(interval_s, static_cast<std::size_t>(program.dof()), rest);
   JointVector q(program.dof());
@@ -83,8 +123,9 @@ void check_program(const JointTrajectory& program, double interval_s, const Fanu
                                                                      : l.jerk;
     throw InputError(fmt::format(
         "FANUC J519 link: the program alone reaches a {} of {:.6g} on joint {} at {:.3f} s, over the {:.6g} the "
-        "controller allows less the correction's share ({:.0f} %) at a {:.0f} ms interval: the controller would "
-        "stop the stream; slow the program down or give the controller's own limits",
+        "controller's limit leaves it beside the correction ({:.0f} % of acceleration and jerk), the ramp-in blend "
+        "and the wire's rounding at a {:.0f} ms interval: the controller would stop the stream; slow the program "
+        "down (or give it more points where it turns) or give the controller's own limits",
         j519::to_string(hit), std::abs(value), axis + 1, static_cast<double>(k) * interval_s, limit,
         100.0 * f.correction_share, interval_s * 1e3));
   }
@@ -146,7 +187,7 @@ void FanucJ519LinkConfig::validate() const {
     }
   }
   if (!(start_resend_s > 0.0) || max_catch_up < 0 || max_catch_up > 9) {
-    throw InputError("FANUC J519 link: start_resend_s must be > 0 and max_catch_up in 0..9");
+    throw InputError("FANUC J519 link: start_resend_s must be > 0 and max_catch_up (--fanuc-catch-up) in 0..9");
   }
 }
 
@@ -166,7 +207,7 @@ FanucJ519Link::FanucJ519Link(OnlineCompensator& compensator, OnlineStrategy& str
       smoother_(smoother_limits(compensator, config), compensator.model().dof()),
       delay_(config.initial_delay_s),
       period_s_(compensator.config().period_s) {
-  check_program(stream_.trajectory(), period_s_, config_);
+  check_program(stream_.trajectory(), compensator, config_);
   const int n = compensator.model().dof();
   for (JointVector* q : {&feedback_, &program_, &program_velocity_, &blend_, &blend_velocity_, &nominal_}) {
     *q = JointVector::Zero(n);
@@ -180,7 +221,7 @@ bool FanucJ519Link::send_command(std::uint32_t sequence, const JointVector& targ
   command_.sequence = sequence;
   command_.last = last;
   command_.joint_style = true;
-  command_.target.fill(0.0);
+  command_.target = aux_deg_;  // axes beyond the arm's (E1..E3) stay where the controller had them
   for (int i = 0; i < target_rad.size(); ++i) command_.target[static_cast<std::size_t>(i)] = rad_to_deg(target_rad[i]);
   const std::size_t n = j519::encode(config_.version, command_, tx_.data(), tx_.size());
   if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) {
@@ -291,6 +332,7 @@ bool FanucJ519Link::start_session(const j519::Status& s) noexcept {
     return false;
   }
   cycle_.anchor_joints(nominal_, after_silence());
+  for (std::size_t i = 0; i < j519::kAxes; ++i) aux_deg_[i] = s.joints_deg[i];
   next_sequence_ = s.sequence;
   ready_seen_ = true;
   state_ = LinkState::kRunning;
@@ -298,6 +340,40 @@ bool FanucJ519Link::start_session(const j519::Status& s) noexcept {
 }
 
 LinkPollResult FanucJ519Link::poll(double timeout_s) noexcept {
+  const LinkPollResult r = poll_once(timeout_s);
+  // However the link stopped, the controller's status output ends with the stop packet.
+  if ((state_ == LinkState::kStopped || state_ == LinkState::kRefused) && start_sent_ && !stop_sent_) {
+    send_stop_packet();
+  }
+  return r;
+}
+
+void FanucJ519Link::send_stop_packet() noexcept {
+  stop_sent_ = true;
+  const std::size_t n = j519::encode_stop(config_.version, tx_.data(), tx_.size());
+  if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) ++counters_.send_errors;
+}
+
+// FANUC's time stamps (2 ms resolution) tell the interval the controller runs: a session does not
+// start on a controller whose interval is not deflex's period (its program would run at another speed
+// and its jerk budget be off by the cube of the ratio).
+bool FanucJ519Link::interval_agrees(const j519::Status& s) noexcept {
+  if (!have_previous_status_) return false;
+  const auto cycles = static_cast<std::int32_t>(s.sequence - previous_sequence_);
+  if (cycles < 1 || cycles > 16) return false;
+  const double interval_ms = static_cast<double>(static_cast<std::int32_t>(s.time_stamp_ms - previous_stamp_ms_)) /
+                             static_cast<double>(cycles);
+  if (std::abs(interval_ms - period_s_ * 1e3) > 2.0 / static_cast<double>(cycles) + 1e-9) {
+    stop_link(LinkStopCause::kProtocol,
+              "the controller's statuses come every %.1f ms by their time stamps, deflex runs at %.0f ms "
+              "(--period-ms): set it to the controller's $STMO.$COM_INT",
+              interval_ms, period_s_ * 1e3);
+    return false;
+  }
+  return true;
+}
+
+LinkPollResult FanucJ519Link::poll_once(double timeout_s) noexcept {
   if (state_ == LinkState::kStopped || state_ == LinkState::kRefused) {
     j519::Status ignored;
     bool starts = false;
@@ -309,6 +385,7 @@ LinkPollResult FanucJ519Link::poll(double timeout_s) noexcept {
     const std::size_t n = j519::encode_start(config_.version, tx_.data(), tx_.size());
     if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) ++counters_.send_errors;
     last_start_s_ = now;
+    start_sent_ = true;
   }
   j519::Status s;
   bool session_start = false;
@@ -323,8 +400,28 @@ LinkPollResult FanucJ519Link::poll(double timeout_s) noexcept {
   heard(now);
   for (int i = 0; i < feedback_.size(); ++i) feedback_[i] = deg_to_rad(s.joints_deg[static_cast<std::size_t>(i)]);
   if (state_ == LinkState::kFinished) return finish(s, now);
+  if (!ready_seen_) {
+    // Every status before the session times the controller's interval.
+    const bool agrees = interval_agrees(s);
+    previous_sequence_ = s.sequence;
+    previous_stamp_ms_ = s.time_stamp_ms;
+    have_previous_status_ = true;
+    if (state_ == LinkState::kStopped) return announce_terminal();
+    if (!agrees) {
+      ++counters_.not_running;
+      return LinkPollResult::kNotAnswered;
+    }
+  }
   if (!controller_state(s)) return state_ == LinkState::kStopped ? announce_terminal() : LinkPollResult::kNotAnswered;
-  if (session_start || !ready_seen_) {
+  if (ready_seen_ && session_start) {
+    // A stream cannot be resumed: the controller's new session starts from rest while deflex's program
+    // and smoother are moving.
+    stop_link(LinkStopCause::kController,
+              "the controller began a new session (its statuses numbered afresh, or after a silence) while the "
+              "stream ran: a FANUC stream is not resumed; start deflex online again");
+    return announce_terminal();
+  }
+  if (!ready_seen_) {
     if (!start_session(s)) return announce_terminal();
     session_start = true;
   }
@@ -349,7 +446,9 @@ LinkPollResult FanucJ519Link::answer(std::uint32_t sequence, double now, bool se
     stream_.sample(program_, program_velocity_, blend_, blend_velocity_);
     nominal_ = program_ + blend_;
     CycleRequest rq;
-    rq.t_s = now;
+    // A caught-up command stands for an interval already past.
+    const double t_k = now - static_cast<double>(missing - k) * period_s_;
+    rq.t_s = t_k;
     rq.sequence = next_sequence_;
     rq.program_time_s = stream_.program_time_s();
     rq.nominal = &program_;
@@ -366,12 +465,17 @@ LinkPollResult FanucJ519Link::answer(std::uint32_t sequence, double now, bool se
       return LinkPollResult::kNotAnswered;
     }
     cycle_.sent(compute(), receipt_age_s_ + (clock_.now_s() - taken_at_s_));
-    delay_.record_reference(now, cycle_.joint_command());
+    delay_.record_reference(t_k, cycle_.joint_command());
     stream_.consumed(period_s_);
     ++next_sequence_;
     if (k > 0) ++caught_up_;
   }
-  if ((ramping_down_ && stream_.at_standstill()) || stream_.finished()) state_ = LinkState::kFinished;
+  // At the program's end (or a planned stop at rest) the correction is held and the smoother settles:
+  // the last-data command freezes a stream already at rest, adding no acceleration or jerk.
+  if ((ramping_down_ && stream_.at_standstill()) || stream_.finished()) {
+    smoother_.hold();
+    if (smoother_.settled()) state_ = LinkState::kFinished;
+  }
   return LinkPollResult::kAnswered;
 }
 
@@ -385,9 +489,10 @@ LinkPollResult FanucJ519Link::finish(const j519::Status& s, double now) noexcept
     last_data_s_ = now;
     return LinkPollResult::kAnswered;
   }
-  if (s.ready() && s.in_motion() && now - last_data_s_ < 1.0) return LinkPollResult::kNotAnswered;
-  const std::size_t n = j519::encode_stop(config_.version, tx_.data(), tx_.size());
-  if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) ++counters_.send_errors;
+  // The stop packet once the TP program has left IBGN (the ready bit clear): the last-data command
+  // may wait in the controller's queue until then. At most a second.
+  if (s.ready() && now - last_data_s_ < 1.0) return LinkPollResult::kNotAnswered;
+  send_stop_packet();
   if (ramping_down_) {
     stop_link(LinkStopCause::kRequested,
               "stopped on request: the program was brought to rest on its path over %.2f s; the last command went "
@@ -401,12 +506,9 @@ LinkPollResult FanucJ519Link::finish(const j519::Status& s, double now) noexcept
 }
 
 void FanucJ519Link::stop() noexcept {
-  if (state_ != LinkState::kStopped && cycle_.has_sent()) {
-    // Without the last-data flag the controller stops the stream itself (MOTN-603, a controlled stop);
-    // the stop packet ends its status output.
-    const std::size_t n = j519::encode_stop(config_.version, tx_.data(), tx_.size());
-    if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) ++counters_.send_errors;
-  }
+  // Without the last-data flag the controller stops the stream itself (MOTN-603, a controlled stop);
+  // the stop packet ends its status output.
+  if (state_ != LinkState::kStopped && start_sent_ && !stop_sent_) send_stop_packet();
   stop_link(LinkStopCause::kRequested, "stop requested: the stop packet went out");
 }
 

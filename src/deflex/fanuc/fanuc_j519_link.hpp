@@ -18,7 +18,12 @@
 // cleared after that (an alarm, the TP program leaving IBGN) or, in protocol 3 and 4, the in-error or
 // e-stop bits, stop the link (kController). The session ends with a command flagged last-data
 // (holding the last target) and the stop packet: at the program's end (kEnded), after a planned stop
-// has brought the program to rest on its path (kRequested), or at stop().
+// has brought the program to rest on its path (kRequested); at either the correction is first held and
+// the smoother settled, so the last command adds no acceleration or jerk. A stop for any other reason,
+// or stop(), sends the stop packet alone (the controller then stops the stream itself, MOTN-603). A
+// controller that begins a new session while the stream runs (its statuses numbered afresh) stops the
+// link: a stream is not resumed. The first statuses time the controller's interval by their time
+// stamps; one that is not --period-ms stops the link before any command (kProtocol).
 #pragma once
 
 #include <array>
@@ -44,14 +49,21 @@ struct FanucJ519LinkConfig {
   std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> limits = default_limits();
   /// The share of the acceleration and jerk limits the correction may use; the program keeps the rest.
   double correction_share = 0.25;
-  JointStreamConfig stream;
+  /// The blend from where the arm is to the program: a start tolerance of 0.2 deg (the TP program
+  /// moves the arm to the program's start first), so the blend's jerk stays small at every interval.
+  JointStreamConfig stream = fanuc_stream();
   LinkStopRules stop;
   std::size_t history_cycles = 1000;
   double initial_delay_s = 0.04;
   double start_resend_s = 0.5;  ///< the start packet again while no status comes
-  int max_catch_up = 3;         ///< statuses missed in a row that are caught up; more: kTooSlow
+  int max_catch_up = 8;         ///< statuses missed in a row that are caught up (0..9); more: kTooSlow
   std::size_t max_packet_bytes = 1400;
 
+  static JointStreamConfig fanuc_stream() {
+    JointStreamConfig s;
+    s.start_tolerance_rad = 0.2 * kPi / 180.0;
+    return s;
+  }
   static std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> default_limits() {
     std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> l{};
     l.fill({120.0, 265.0, 1240.0});
@@ -92,6 +104,9 @@ class FanucJ519Link final : public ControllerLink {
   [[nodiscard]] std::uint64_t caught_up() const { return caught_up_; }
 
  private:
+  LinkPollResult poll_once(double timeout_s) noexcept;
+  void send_stop_packet() noexcept;
+  bool interval_agrees(const fanuc_j519::Status& s) noexcept;
   bool drain(double timeout_s, fanuc_j519::Status& newest, bool& session_start) noexcept;
   bool controller_state(const fanuc_j519::Status& s) noexcept;
   bool start_session(const fanuc_j519::Status& s) noexcept;
@@ -111,6 +126,9 @@ class FanucJ519Link final : public ControllerLink {
   std::uint32_t next_sequence_ = 0;  // the sequence number the next command carries
   std::uint64_t caught_up_ = 0;
   bool last_data_sent_ = false;
+  bool start_sent_ = false, stop_sent_ = false;
+  bool have_previous_status_ = false;  // the status before the first ready one answered (its interval)
+  std::uint32_t previous_sequence_ = 0, previous_stamp_ms_ = 0;
   double last_data_s_ = 0.0;
 
   // Preallocated per-cycle buffers.
@@ -119,6 +137,7 @@ class FanucJ519Link final : public ControllerLink {
   fanuc_j519::Command command_;
   JointVector feedback_, program_, program_velocity_, blend_, blend_velocity_, nominal_;
   LinkArrival arrival_;
+  std::array<double, fanuc_j519::kAxes> aux_deg_{};  // the anchor status's joints: the axes beyond the arm's
   double receipt_age_s_ = 0.0;  // the newest status's age when it was read (the transport's time stamp)
   double taken_at_s_ = 0.0;
 };

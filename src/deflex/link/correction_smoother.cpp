@@ -32,8 +32,8 @@ std::size_t CorrectionSmoother::taps_for(const SmootherLimits& limits) {
   if (needed > static_cast<double>(kMaxTaps)) {
     throw InputError(fmt::format(
         "correction smoother: a step of {:.6g} rad a cycle of {:.6g} s needs {:.0f} cycles of averaging to stay "
-        "within {:.6g} rad/s^2 and {:.6g} rad/s^3 (a delay of {:.3g} s), more than the {} it holds: lower the step "
-        "limit",
+        "within {:.6g} rad/s^2 and {:.6g} rad/s^3 (a delay of {:.3g} s), more than the {} it holds: lower the "
+        "correction's rate bound (--max-rate-deg-s) or give it a larger share of the limits",
         s, t, needed, limits.acceleration, limits.jerk, (needed - 1.0) * t, kMaxTaps));
   }
   return static_cast<std::size_t>(needed);
@@ -47,7 +47,15 @@ CorrectionSmoother::CorrectionSmoother(const SmootherLimits& limits, int joints)
   reset(JointVector::Zero(joints));
 }
 
+void CorrectionSmoother::hold() noexcept {
+  if (holding_) return;
+  holding_ = true;
+  held_steps_ = 0;
+}
+
 void CorrectionSmoother::reset(const JointVector& correction) noexcept {
+  holding_ = false;
+  held_steps_ = 0;
   limited_ = correction;
   first_ = correction;
   out_ = correction;
@@ -69,9 +77,13 @@ const JointVector& CorrectionSmoother::average(Stage& stage, const JointVector& 
 
 const JointVector& CorrectionSmoother::step(const JointVector& wanted) noexcept {
   const double s = limits_.step_rad;
-  for (int j = 0; j < joints_; ++j) {
-    const double change = wanted[j] - limited_[j];
-    limited_[j] += std::clamp(change, -s, s);
+  if (holding_) {
+    ++held_steps_;  // the rate-limited value stays: the averages converge on it
+  } else {
+    for (int j = 0; j < joints_; ++j) {
+      const double change = wanted[j] - limited_[j];
+      limited_[j] += std::clamp(change, -s, s);
+    }
   }
   const JointVector& first = average(a_, limited_);
   return average(b_, first);

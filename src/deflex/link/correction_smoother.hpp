@@ -43,8 +43,14 @@ class CorrectionSmoother {
 
   /// Starts from `correction` held (rest: no velocity, no acceleration).
   void reset(const JointVector& correction) noexcept;
-  /// The next cycle's smoothed correction towards `wanted` (same size as at construction).
+  /// The next cycle's smoothed correction towards `wanted` (same size as at construction); while held,
+  /// towards what it was held at (`wanted` is not read).
   const JointVector& step(const JointVector& wanted) noexcept;
+  /// From now on the correction settles where it is (a stream's end): after 2N + 1 more steps its
+  /// output is constant, with no velocity, acceleration or jerk (settled()). reset() releases it.
+  void hold() noexcept;
+  [[nodiscard]] bool holding() const noexcept { return holding_; }
+  [[nodiscard]] bool settled() const noexcept { return holding_ && held_steps_ >= 2 * taps_ + 1; }
 
   [[nodiscard]] std::size_t taps() const noexcept { return taps_; }
   /// The moving averages' delay, (N - 1) cycles, s.
@@ -65,6 +71,8 @@ class CorrectionSmoother {
 
   SmootherLimits limits_;
   std::size_t taps_;
+  bool holding_ = false;
+  std::size_t held_steps_ = 0;
   int joints_;
   JointVector limited_;
   JointVector first_;

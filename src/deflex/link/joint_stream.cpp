@@ -71,12 +71,13 @@ void JointStream::consumed(double period_s) noexcept {
   ++blend_cycles_;
   blend_t_s_ = static_cast<double>(blend_cycles_) * period_s;
   if (stopping()) {
-    // The program moves by the integral of the speed factor 1 - t/T over this cycle.
-    const double t0 = std::min(stop_elapsed_s_, stop_ramp_s_);
-    const double t1 = std::min(stop_elapsed_s_ + period_s, stop_ramp_s_);
+    // The program moves by the integral of the speed factor 1 - (3u^2 - 2u^3), u = t/T, over this
+    // cycle: (t1 - t0) - T (F(u1) - F(u0)) with F(u) = u^3 - u^4/2.
+    const double u0 = std::min(stop_elapsed_s_, stop_ramp_s_) / stop_ramp_s_;
+    const double u1 = std::min(stop_elapsed_s_ + period_s, stop_ramp_s_) / stop_ramp_s_;
     stop_elapsed_s_ += period_s;
-    program_t_s_ =
-        std::min(program_t_s_ + (t1 - t0) - (t1 * t1 - t0 * t0) / (2.0 * stop_ramp_s_), trajectory_->end_time_s());
+    const auto f = [](double u) { return u * u * u - 0.5 * u * u * u * u; };
+    program_t_s_ = std::min(program_t_s_ + stop_ramp_s_ * ((u1 - u0) - (f(u1) - f(u0))), trajectory_->end_time_s());
     return;
   }
   if (program_t_s_ < trajectory_->end_time_s()) ++cycles_;
@@ -92,7 +93,11 @@ void JointStream::begin_stop(double ramp_s) noexcept {
 
 double JointStream::speed_factor() const {
   if (!stopping()) return 1.0;
-  return std::max(0.0, 1.0 - stop_elapsed_s_ / stop_ramp_s_);
+  // A smoothstep down from 1 to 0: no step in the deceleration at either end, so the stop adds a
+  // bounded jerk (6 v / T^2 at most) to the stream, which a controller that checks the jerk of what it
+  // is sent (FANUC's Stream Motion) accepts where a linear ramp's v / (T x cycle) would stop it.
+  const double u = std::clamp(stop_elapsed_s_ / stop_ramp_s_, 0.0, 1.0);
+  return 1.0 - u * u * (3.0 - 2.0 * u);
 }
 
 }  // namespace deflex

@@ -14,8 +14,10 @@
 //   - The blend has its own clock (it goes on after the program's end); the end's last point is held.
 //   - A planned stop while the program moves (begin_stop(): SIGINT, SIGTERM, a time limit) brings it to
 //     a standstill on its own path: the program's clock slows from one period a cycle to none over the
-//     ramp (speed factor 1 - t/ramp), so every joint's speed only falls (within its limits and the
-//     per-cycle step limit) and it decelerates at most its peak program speed over the ramp.
+//     ramp (speed factor 1 - smoothstep(t/ramp)), so every joint's speed only falls (within its limits
+//     and the per-cycle step limit), its deceleration starts and ends at zero (no jerk spike for a
+//     controller that checks it), at most 1.5 x its peak program speed over the ramp, and it stops
+//     after half the ramp's length of program time, as a linear ramp would.
 #pragma once
 
 #include <cstdint>

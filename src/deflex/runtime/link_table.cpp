@@ -27,8 +27,8 @@ const std::array<LinkKindInfo, 5>& link_kinds() {
        "ROS-Industrial simple message over TCP to a robot program (ABB RAPID, Fanuc KAREL servers): deflex streams "
        "--program one point a cycle",
        true, CommandForm::kJointTarget, 0.1, 1.0},
-      // FANUC's controller stops the stream itself two intervals after a missed command (MOTN-603):
-      // a second's silence means it has stopped.
+      // FANUC's controller stops the stream itself once its queue of commands runs dry (MOTN-603): a
+      // second's silence means it has stopped.
       {LinkKind::kFanucJ519, "fanuc-j519",
        "FANUC Stream Motion (J519) over UDP: deflex streams --program, one command a status, within the "
        "controller's velocity, acceleration and jerk limits",

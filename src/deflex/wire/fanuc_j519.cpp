@@ -140,7 +140,8 @@ std::size_t encode(std::uint32_t version, const Command& command, unsigned char*
   put_header(kTypeCommandV3, version, out);
   wire_bytes::store_u32(kBe, command.sequence, out + 8);
   out[12] = command.last ? 1 : 0;
-  out[13] = 1;  // motion, not I/O only
+  out[13] = 1;               // motion, not I/O only
+  out[14] = out[15] = 0xFF;  // unused: FANUC's own driver writes 0xFFFF
   for (std::size_t i = 0; i < kAxes; ++i) wire_bytes::store_f64(kBe, command.target[i], out + 16 + 8 * i);
   return kCommandV3Bytes;
 }
