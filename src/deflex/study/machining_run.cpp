@@ -295,9 +295,8 @@ bool PathWrenchModel::wrench_at_pose(const Pose& base_T_tcp, Wrench& out) const 
   return true;
 }
 
-std::vector<PassProgram> plan_passes(const MillCell& mc, const std::vector<MillPass>& passes, const Vector3& stock_min,
-                                     const Vector3& stock_max, MachiningStrategy strategy, double feed_mm_min,
-                                     const CuttingCoefficients* k) {
+std::vector<PassProgram> plan_passes(const MillCell& mc, const std::vector<MillPass>& passes, const StockBox& stock,
+                                     MachiningStrategy strategy, double feed_mm_min, const CuttingCoefficients* k) {
   const RobotModel& model = mc.setup.calibration.identified;
   const bool offline_model = strategy == MachiningStrategy::kOffline || strategy == MachiningStrategy::kHybrid;
   if (offline_model && k == nullptr) throw InputError("machining plan: the offline strategies need coefficients");
@@ -309,7 +308,7 @@ std::vector<PassProgram> plan_passes(const MillCell& mc, const std::vector<MillP
     MillingSpec spec;
     spec.coefficients.k = *k;
     force = std::make_unique<MillingForceModel>(spec, study_cutter());
-    nominal_stock = std::make_unique<DexelStock>(DexelStock::box(stock_min, stock_max, 0.1e-3, 0.5e-3));
+    nominal_stock = std::make_unique<DexelStock>(make_stock(stock));
     predictor = std::make_unique<MillingProcess>(*force, nominal_stock.get());
   }
   std::vector<PassProgram> out;
@@ -339,7 +338,7 @@ std::vector<PassProgram> plan_passes(const MillCell& mc, const std::vector<MillP
     if (&pass != &passes.front()) {
       const Vector3 from = passes[static_cast<std::size_t>(&pass - passes.data()) - 1].corners.back();
       const Vector3 to = pass.corners.front();
-      const double clear = stock_max.z() + 5e-3;
+      const double clear = stock.max_m.z() + 5e-3;
       for (const Vector3& v : {Vector3(from.x(), from.y(), clear), Vector3(to.x(), to.y(), clear)}) {
         MillingPointInput in;
         in.tip_m = v;
@@ -401,7 +400,7 @@ MillRunResult run_mill_passes(const MillCell& mc, const std::vector<MillPass>& p
 std::vector<SlotCut> run_slot_cuts(const MillCell& mc, const SlotCutPlan& plan, const MillRunSpec& spec,
                                    const std::string& log_dir) {
   const Cutter cutter = study_cutter();
-  DexelStock stock = DexelStock::box(plan.stock_min_m, plan.stock_max_m, 0.1e-3, 0.5e-3);
+  DexelStock stock = make_stock(plan.stock);
   std::vector<SlotCut> cuts;
   // The mounting's nominal axes: which of the sensor's axes lies along the feed (the workpiece's x)
   // and which along the tool axis (its z), from the nominal kinematics at the first point.
@@ -409,8 +408,8 @@ std::vector<SlotCut> run_slot_cuts(const MillCell& mc, const SlotCutPlan& plan, 
   for (std::size_t i = 0; i < plan.passes.size(); ++i) {
     const std::vector<MillPass> one{plan.passes[i]};
     const double feed_mm_min = plan.fz_m[i] * kStudySpindleRpm * cutter.flutes * 1e3;
-    const std::vector<PassProgram> programs = plan_passes(mc, one, plan.stock_min_m, plan.stock_max_m,
-                                                          MachiningStrategy::kUncompensated, feed_mm_min, nullptr);
+    const std::vector<PassProgram> programs =
+        plan_passes(mc, one, plan.stock, MachiningStrategy::kUncompensated, feed_mm_min, nullptr);
     MillRunSpec s = spec;
     s.strategy = MachiningStrategy::kUncompensated;
     s.feed_mm_min = feed_mm_min;

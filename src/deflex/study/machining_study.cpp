@@ -158,14 +158,14 @@ void prepare_seed(SeedCell& sc, int index, const SlotCutPlan& plan) {
   sc.fit.seed_index = index;
   sc.fit.fit = fit_cutting_coefficients(cuts);
   sc.fit.truth = sc.truth;
+  sc.fit.truth_runout_m = sc.runout_m;
   sc.fit.slot_fz_m = plan.fz_m;
 }
 
 MachiningRun run_part(const SeedCell& sc, const MillPart& part, MachiningStrategy strategy, double feed, int index) {
   const CuttingCoefficients* k = &sc.fit.fit.k;  // never the truth
-  const std::vector<PassProgram> programs =
-      plan_passes(*sc.cell, part.passes, part.stock_min_m, part.stock_max_m, strategy, feed, k);
-  DexelStock stock = DexelStock::box(part.stock_min_m, part.stock_max_m, 0.1e-3, 0.5e-3);
+  const std::vector<PassProgram> programs = plan_passes(*sc.cell, part.passes, part.stock, strategy, feed, k);
+  DexelStock stock = make_stock(part.stock);
   MillRunSpec spec;
   spec.strategy = strategy;
   spec.feed_mm_min = feed;
@@ -255,7 +255,7 @@ MachiningStudyOutput run_machining_study(const MachiningStudyOptions& options) {
       "roughed by a slot and finished 2 mm a side (one wall in climb, one in conventional milling); an outside "
       "contour 2 mm into the block's side, round a corner. Tool: 10 mm three-flute carbide end mill, 30 deg "
       "helix, 12 000 rpm, M3; feeds {:g} and {:g} mm/min. Probe: 1 um per point (a CMM).",
-      (part.stock_max_m.x() - part.stock_min_m.x()) * 1e3, out.feeds_mm_min[0], out.feeds_mm_min[1]));
+      (part.stock.max_m.x() - part.stock.min_m.x()) * 1e3, out.feeds_mm_min[0], out.feeds_mm_min[1]));
   out.setup_paragraphs.push_back(fmt::format(
       "Cell per seed: the LDBB case's IRB 6700 with its own draws and calibration; true coefficients drawn "
       "log-normally about the published Al7075-T6 set ({:g} % 1-sigma), runout {:g}-{:g} um. The offline model "

@@ -79,6 +79,7 @@ struct MachiningFit {
   int seed_index = 0;
   CoefficientFit fit;
   CuttingCoefficients truth;
+  double truth_runout_m = 0.0;
   std::vector<double> slot_fz_m;  ///< the slot cuts' feeds per tooth
 };
 

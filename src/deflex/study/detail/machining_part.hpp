@@ -9,9 +9,18 @@
 #include "deflex/cell/part_probe.hpp"
 #include "deflex/machining/cutter.hpp"
 #include "deflex/machining/cutting_coefficients.hpp"
+#include "deflex/machining/dexel_stock.hpp"
 #include "deflex/model/types.hpp"
 
 namespace deflex::study {
+
+/// A block of stock (stock frame, m) and the dexel model's resolution: lines every cell_m in x and
+/// y, layers at most layer_m apart in z.
+struct StockBox {
+  Vector3 min_m = Vector3::Zero(), max_m = Vector3::Zero();
+  double cell_m = 0.1e-3, layer_m = 0.5e-3;
+};
+[[nodiscard]] DexelStock make_stock(const StockBox& box);
 
 /// One pass of the tool: a polyline of tip points (stock frame, m) at the pass's feed.
 struct MillPass {
@@ -21,7 +30,7 @@ struct MillPass {
 
 /// The part: its stock block, the passes in the order they run, and what is probed.
 struct MillPart {
-  Vector3 stock_min_m = Vector3::Zero(), stock_max_m = Vector3::Zero();
+  StockBox stock;
   std::vector<MillPass> passes;
   cell::WallSpec climb_wall, conventional_wall, contour_wall, slot_wall_a, slot_wall_b;
   cell::FloorSpec pocket_floor, slot_floor;
@@ -38,7 +47,7 @@ inline constexpr double kStudySpindleRpm = 12000.0;
 
 /// The slot cuts a user runs to fit coefficients: one slot each, side by side in their own block.
 struct SlotCutPlan {
-  Vector3 stock_min_m = Vector3::Zero(), stock_max_m = Vector3::Zero();
+  StockBox stock;
   std::vector<MillPass> passes;
   std::vector<double> fz_m;
   double ap_m = 0.0;

@@ -77,9 +77,8 @@ struct MillRunResult {
 /// for offline and hybrid the compensated joints from the force the user's model predicts with `k`
 /// along the passes on the nominal stock.
 [[nodiscard]] std::vector<PassProgram> plan_passes(const MillCell& cell, const std::vector<MillPass>& passes,
-                                                   const Vector3& stock_min, const Vector3& stock_max,
-                                                   MachiningStrategy strategy, double feed_mm_min,
-                                                   const CuttingCoefficients* k);
+                                                   const StockBox& stock, MachiningStrategy strategy,
+                                                   double feed_mm_min, const CuttingCoefficients* k);
 
 /// Cuts the passes in order into `stock` (the true workpiece, stock frame) on the cell. Throws Error
 /// when the cell cannot run them (a refused session, a controller that timed out).
