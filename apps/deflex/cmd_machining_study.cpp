@@ -76,6 +76,13 @@ void run(const MachiningStudyOpts& o, int& exit_code) {
   out_folder.keep();
   for (const std::string& p : result.setup_paragraphs) std::cout << p << "\n";
   std::cout << "\n" << study::machining_table_text(result) << "\n" << study::machining_fit_text(result);
+  const cell::CoupledTickCounters& c = result.coupled;
+  std::cout << fmt::format(
+      "\nThe cell: {} cutting ticks of the parts, each the arm and the cut solved together ({:.2f} solves of the arm "
+      "a tick, at most {}); {} reached the cap of 8 without converging (the worst left {:.1f} N between the arm and "
+      "the cut)\n",
+      c.ticks, c.ticks > 0 ? static_cast<double>(c.arm_solves) / static_cast<double>(c.ticks) : 0.0, c.most_arm_solves,
+      c.unconverged, c.worst_mismatch_n);
   std::cout << fmt::format("\nTable as CSV in {}, the whole result as JSON in {}{}\n", csv_path, json_path,
                            o.report.empty() ? "" : ", report in " + o.report);
   exit_code = 0;

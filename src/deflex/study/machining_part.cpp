@@ -8,10 +8,10 @@
 namespace deflex::study {
 namespace {
 
-constexpr double kMm = 1e-3;
+constexpr double kMillMm = 1e-3;
 // The tool's tip starts and ends this far beyond the stock's ends (its radius and a millimetre):
 // every pass enters the material from the air.
-constexpr double kRunIn = 6.0 * kMm;
+constexpr double kRunIn = 6.0 * kMillMm;
 // The dexel stock's line spacing: 0.05 and 0.2 mm move the walls by under 3 um and take longer
 // (the force's ripple at 0.2 mm takes the coupled solve more trials).
 constexpr double kStockCellM = 0.1e-3;
@@ -25,8 +25,8 @@ cell::WallSpec part_wall(cell::WallSpec::Normal normal, double nominal, bool mat
   s.along_lo_m = lo;
   s.along_hi_m = hi;
   // Half a millimetre clear of the floor's corner and of the top edge's burr.
-  s.z_lo_m = -depth + 0.5 * kMm;
-  s.z_hi_m = -0.5 * kMm;
+  s.z_lo_m = -depth + 0.5 * kMillMm;
+  s.z_hi_m = -0.5 * kMillMm;
   s.points_along = points;
   s.points_up = 3;
   return s;
@@ -54,7 +54,7 @@ DexelStock make_stock(const StockBox& box) { return DexelStock::box(box.min_m, b
 
 Cutter study_cutter() {
   Cutter c;
-  c.diameter_m = 10.0 * kMm;
+  c.diameter_m = 10.0 * kMillMm;
   c.flutes = 3;
   c.helix_rad = deg_to_rad(30.0);
   return c;
@@ -76,32 +76,33 @@ CuttingCoefficients al7075_published() {
 // tool's right, M3), its wall y = 12 in conventional milling; the outside contour 2 mm into the
 // block's face y = 20, round the corner at x = L - 2 and down that face in climb.
 MillPart make_mill_part(bool quick) {
-  const double length = (quick ? 12.0 : 20.0) * kMm;
+  const double length = (quick ? 12.0 : 20.0) * kMillMm;
   const int points = quick ? 10 : 20;
   MillPart p;
-  p.stock.min_m = Vector3(0.0, -20.0 * kMm, -8.0 * kMm);
-  p.stock.max_m = Vector3(length, 20.0 * kMm, 0.0);
+  p.stock.min_m = Vector3(0.0, -20.0 * kMillMm, -8.0 * kMillMm);
+  p.stock.max_m = Vector3(length, 20.0 * kMillMm, 0.0);
   p.stock.cell_m = kStockCellM;
-  p.passes.push_back(straight("slot", -13.0 * kMm, -3.0 * kMm, length));
-  p.passes.push_back(straight("pocket rough", 5.0 * kMm, -4.0 * kMm, length));
-  p.passes.push_back(straight("pocket climb finish", 3.0 * kMm, -4.0 * kMm, length));
-  p.passes.push_back(straight("pocket conventional finish", 7.0 * kMm, -4.0 * kMm, length));
-  const double corner_x = length - 2.0 * kMm + 5.0 * kMm;
-  p.passes.push_back(MillPass{"contour",
-                              {Vector3(-kRunIn, 23.0 * kMm, -4.0 * kMm), Vector3(corner_x, 23.0 * kMm, -4.0 * kMm),
-                               Vector3(corner_x, 14.0 * kMm, -4.0 * kMm)}});
-  const double lo = 1.0 * kMm, hi = length - 1.0 * kMm;
+  p.passes.push_back(straight("slot", -13.0 * kMillMm, -3.0 * kMillMm, length));
+  p.passes.push_back(straight("pocket rough", 5.0 * kMillMm, -4.0 * kMillMm, length));
+  p.passes.push_back(straight("pocket climb finish", 3.0 * kMillMm, -4.0 * kMillMm, length));
+  p.passes.push_back(straight("pocket conventional finish", 7.0 * kMillMm, -4.0 * kMillMm, length));
+  const double corner_x = length - 2.0 * kMillMm + 5.0 * kMillMm;
+  p.passes.push_back(
+      MillPass{"contour",
+               {Vector3(-kRunIn, 23.0 * kMillMm, -4.0 * kMillMm), Vector3(corner_x, 23.0 * kMillMm, -4.0 * kMillMm),
+                Vector3(corner_x, 14.0 * kMillMm, -4.0 * kMillMm)}});
+  const double lo = 1.0 * kMillMm, hi = length - 1.0 * kMillMm;
   using N = cell::WallSpec::Normal;
   // The contour's second leg takes the end of the rib between the pocket and the contour: the walls
   // there are probed to 3 mm short of the block's end, all three alike.
-  const double rib_hi = length - 3.0 * kMm;
-  p.climb_wall = part_wall(N::kY, -2.0 * kMm, true, lo, rib_hi, 4.0 * kMm, points);
-  p.conventional_wall = part_wall(N::kY, 12.0 * kMm, false, lo, rib_hi, 4.0 * kMm, points);
-  p.contour_wall = part_wall(N::kY, 18.0 * kMm, true, lo, rib_hi, 4.0 * kMm, points);
-  p.slot_wall_a = part_wall(N::kY, -18.0 * kMm, true, lo, hi, 3.0 * kMm, points);
-  p.slot_wall_b = part_wall(N::kY, -8.0 * kMm, false, lo, hi, 3.0 * kMm, points);
-  p.pocket_floor = part_floor(-4.0 * kMm, lo, hi, -1.0 * kMm, 11.0 * kMm);
-  p.slot_floor = part_floor(-3.0 * kMm, lo, hi, -17.0 * kMm, -9.0 * kMm);
+  const double rib_hi = length - 3.0 * kMillMm;
+  p.climb_wall = part_wall(N::kY, -2.0 * kMillMm, true, lo, rib_hi, 4.0 * kMillMm, points);
+  p.conventional_wall = part_wall(N::kY, 12.0 * kMillMm, false, lo, rib_hi, 4.0 * kMillMm, points);
+  p.contour_wall = part_wall(N::kY, 18.0 * kMillMm, true, lo, rib_hi, 4.0 * kMillMm, points);
+  p.slot_wall_a = part_wall(N::kY, -18.0 * kMillMm, true, lo, hi, 3.0 * kMillMm, points);
+  p.slot_wall_b = part_wall(N::kY, -8.0 * kMillMm, false, lo, hi, 3.0 * kMillMm, points);
+  p.pocket_floor = part_floor(-4.0 * kMillMm, lo, hi, -1.0 * kMillMm, 11.0 * kMillMm);
+  p.slot_floor = part_floor(-3.0 * kMillMm, lo, hi, -17.0 * kMillMm, -9.0 * kMillMm);
   return p;
 }
 
@@ -109,19 +110,19 @@ MillPart make_mill_part(bool quick) {
 // short of its far end; the force is averaged where the whole front half of the tool is in the cut.
 SlotCutPlan make_slot_cut_plan(bool quick) {
   SlotCutPlan s;
-  s.fz_m = quick ? std::vector<double>{0.02 * kMm, 0.04 * kMm, 0.06 * kMm}
-                 : std::vector<double>{0.02 * kMm, 0.035 * kMm, 0.05 * kMm, 0.065 * kMm};
-  s.ap_m = 3.0 * kMm;
-  const double length = 14.0 * kMm;
-  s.stock.min_m = Vector3(0.0, -6.0 * kMm, -6.0 * kMm);
+  s.fz_m = quick ? std::vector<double>{0.02 * kMillMm, 0.04 * kMillMm, 0.06 * kMillMm}
+                 : std::vector<double>{0.02 * kMillMm, 0.035 * kMillMm, 0.05 * kMillMm, 0.065 * kMillMm};
+  s.ap_m = 3.0 * kMillMm;
+  const double length = 14.0 * kMillMm;
+  s.stock.min_m = Vector3(0.0, -6.0 * kMillMm, -6.0 * kMillMm);
   s.stock.cell_m = kStockCellM;
-  s.stock.max_m = Vector3(length, (12.0 * static_cast<double>(s.fz_m.size()) - 6.0) * kMm, 0.0);
+  s.stock.max_m = Vector3(length, (12.0 * static_cast<double>(s.fz_m.size()) - 6.0) * kMillMm, 0.0);
   for (std::size_t i = 0; i < s.fz_m.size(); ++i) {
-    const double y = 12.0 * kMm * static_cast<double>(i);
-    s.passes.push_back(MillPass{"slot cut", {Vector3(-kRunIn, y, -s.ap_m), Vector3(10.0 * kMm, y, -s.ap_m)}});
+    const double y = 12.0 * kMillMm * static_cast<double>(i);
+    s.passes.push_back(MillPass{"slot cut", {Vector3(-kRunIn, y, -s.ap_m), Vector3(10.0 * kMillMm, y, -s.ap_m)}});
   }
-  s.window_from_x_m = 0.5 * kMm;
-  s.window_to_x_m = 9.0 * kMm;
+  s.window_from_x_m = 0.5 * kMillMm;
+  s.window_to_x_m = 9.0 * kMillMm;
   return s;
 }
 

@@ -89,7 +89,7 @@ PartErrors probe_part(const MillPart& part, const DexelStock& stock, std::uint64
   return e;
 }
 
-Spread spread_of(const std::vector<double>& v) {
+Spread seed_spread(const std::vector<double>& v) {
   Spread s;
   s.n = static_cast<int>(v.size());
   if (v.empty()) return s;
@@ -120,7 +120,7 @@ void assemble_rows(MachiningStudyOutput& out) {
       Spread* cells[9] = {&row.climb_mean,      &row.climb_pv,     &row.conventional_mean,
                           &row.conventional_pv, &row.contour_mean, &row.contour_pv,
                           &row.pocket_flatness, &row.pocket_width, &row.slot_width};
-      for (int i = 0; i < 9; ++i) *cells[i] = spread_of(v[i]);
+      for (int i = 0; i < 9; ++i) *cells[i] = seed_spread(v[i]);
       out.rows.push_back(row);
     }
   }
@@ -248,6 +248,7 @@ MachiningStudyOutput run_machining_study(const MachiningStudyOptions& options) {
     return std::tie(a.seed_index, a.feed_mm_min, a.strategy) < std::tie(b.seed_index, b.feed_mm_min, b.strategy);
   });
   out.runs = std::move(runs);
+  for (const MachiningRun& r : out.runs) out.coupled.add(r.coupled);
   for (const SeedCell& sc : cells) out.fits.push_back(sc.fit);
   assemble_rows(out);
   out.setup_paragraphs.push_back(fmt::format(

@@ -105,6 +105,8 @@ struct MachiningStudyOutput {
   int seeds = 0;
   double probe_noise_m = 0.0;
   double simulated_s = 0.0;
+  /// What the cell's coupled solves of the arm and the cut did over every part (not the slot cuts).
+  cell::CoupledTickCounters coupled;
   std::vector<std::string> setup_paragraphs;  ///< the part, the tool, the cell in words
 };
 

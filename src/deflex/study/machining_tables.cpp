@@ -8,7 +8,7 @@
 namespace deflex::study {
 namespace {
 
-std::string um(const Spread& s) { return fmt::format("{:+.1f} ± {:.1f}", s.mean * 1e6, s.sd * 1e6); }
+std::string um_text(const Spread& s) { return fmt::format("{:+.1f} ± {:.1f}", s.mean * 1e6, s.sd * 1e6); }
 
 struct Column {
   const char* header;
@@ -37,15 +37,15 @@ nlohmann::json coefficients_json(const CuttingCoefficients& k) {
 
 std::string machining_table_text(const MachiningStudyOutput& out) {
   std::string s = fmt::format(
-      "Part errors over {} seeds (mean ± standard deviation; walls: mean deviation > 0 where material was left, "
+      "Part errors over {} seed{} (mean ± standard deviation; walls: mean deviation > 0 where material was left, "
       "P-V the profile's peak to valley; widths: measured - nominal)\n",
-      out.seeds);
+      out.seeds, out.seeds == 1 ? "" : "s");
   s += fmt::format("{:<14} {:>8}", "strategy", "mm/min");
   for (const Column& c : kColumns) s += fmt::format(" {:>16}", c.header);
   s += "\n";
   for (const MachiningRow& r : out.rows) {
     s += fmt::format("{:<14} {:>8g}", to_string(r.strategy), r.feed_mm_min);
-    for (const Column& c : kColumns) s += fmt::format(" {:>16}", um(r.*c.cell));
+    for (const Column& c : kColumns) s += fmt::format(" {:>16}", um_text(r.*c.cell));
     s += "\n";
   }
   return s;
