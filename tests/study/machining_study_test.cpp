@@ -5,7 +5,10 @@
 // uncompensated ones. The test reads the cell's truth; the strategies never do.
 #include <gtest/gtest.h>
 
+#include <yaml-cpp/yaml.h>
+
 #include <cmath>
+#include <filesystem>
 #include <memory>
 
 #include "deflex/cell/true_robot.hpp"
@@ -163,6 +166,32 @@ TEST_F(MachiningStudyQuick, EveryStrategyReducesTheWallErrorsByAStatedMargin) {
       }
     }
   }
+}
+
+// Every size the study gives the cell and the cuts lies inside the range data/cases/effect-ranges.yaml
+// documents for it, with its source.
+TEST_F(MachiningStudyQuick, EverySizeIsInsideItsDocumentedRange) {
+  const YAML::Node ranges =
+      YAML::LoadFile((std::filesystem::path(DEFLEX_SOURCE_DIR) / "data/cases/effect-ranges.yaml").string());
+  const YAML::Node milling = ranges["milling"];
+  ASSERT_TRUE(milling);
+  const MachiningSizes& z = out_->sizes;
+  auto check = [&](const char* key, double value) {
+    const YAML::Node r = milling[key];
+    ASSERT_TRUE(r && r["range"] && r["source"]) << key;
+    EXPECT_FALSE(r["source"].as<std::string>().empty()) << key;
+    EXPECT_GE(value, r["range"][0].as<double>()) << key;
+    EXPECT_LE(value, r["range"][1].as<double>()) << key;
+  };
+  check("coefficient_spread_pct", z.coefficient_spread * 100.0);
+  check("runout_um", z.runout_lo_m * 1e6);
+  check("runout_um", z.runout_hi_m * 1e6);
+  check("stock_cell_mm", z.stock_cell_m * 1e3);
+  check("probe_noise_um", z.probe_noise_m * 1e6);
+  ASSERT_FALSE(z.fz_m.empty());
+  for (double fz : z.fz_m) check("feed_per_tooth_mm", fz * 1e3);
+  ASSERT_FALSE(z.ap_m.empty());
+  for (double ap : z.ap_m) check("axial_depth_mm", ap * 1e3);
 }
 
 TEST(MachiningStudy, BadOptionsAreRefused) {

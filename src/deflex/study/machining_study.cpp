@@ -186,6 +186,21 @@ MachiningRun run_part(const SeedCell& sc, const MillPart& part, MachiningStrateg
   return run;
 }
 
+MachiningSizes study_sizes(const MillPart& part, const SlotCutPlan& plan, const std::vector<double>& feeds) {
+  MachiningSizes z;
+  z.coefficient_spread = kCoefficientSpread;
+  z.runout_lo_m = kRunoutLoM;
+  z.runout_hi_m = kRunoutHiM;
+  z.stock_cell_m = part.stock.cell_m;
+  z.probe_noise_m = kProbeNoiseM;
+  const Cutter cutter = study_cutter();
+  for (double f : feeds) z.fz_m.push_back(f / 60.0 * 1e-3 * 60.0 / (kStudySpindleRpm * cutter.flutes));
+  z.fz_m.insert(z.fz_m.end(), plan.fz_m.begin(), plan.fz_m.end());
+  for (const MillPass& p : part.passes) z.ap_m.push_back(-p.corners.front().z());
+  z.ap_m.push_back(plan.ap_m);
+  return z;
+}
+
 }  // namespace
 
 const char* to_string(MachiningStrategy s) {
@@ -249,6 +264,7 @@ MachiningStudyOutput run_machining_study(const MachiningStudyOptions& options) {
   });
   out.runs = std::move(runs);
   for (const MachiningRun& r : out.runs) out.coupled.add(r.coupled);
+  out.sizes = study_sizes(part, plan, out.feeds_mm_min);
   for (const SeedCell& sc : cells) out.fits.push_back(sc.fit);
   assemble_rows(out);
   out.setup_paragraphs.push_back(fmt::format(

@@ -96,6 +96,16 @@ struct MachiningRow {
   Spread pocket_flatness, pocket_width, slot_width;
 };
 
+/// The study's sizes of the cell and the cuts (data/cases/effect-ranges.yaml, milling:), SI.
+struct MachiningSizes {
+  double coefficient_spread = 0.0;  ///< relative 1-sigma of the true coefficients
+  double runout_lo_m = 0.0, runout_hi_m = 0.0;
+  double stock_cell_m = 0.0;
+  double probe_noise_m = 0.0;
+  std::vector<double> fz_m;  ///< every feed per tooth cut (the parts' and the slot cuts')
+  std::vector<double> ap_m;  ///< every axial depth cut
+};
+
 struct MachiningStudyOutput {
   std::vector<MachiningRun> runs;
   std::vector<MachiningFit> fits;
@@ -104,6 +114,7 @@ struct MachiningStudyOutput {
   std::vector<double> feeds_mm_min;
   int seeds = 0;
   double probe_noise_m = 0.0;
+  MachiningSizes sizes;
   double simulated_s = 0.0;
   /// What the cell's coupled solves of the arm and the cut did over every part (not the slot cuts).
   cell::CoupledTickCounters coupled;
