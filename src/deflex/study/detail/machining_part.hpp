@@ -19,6 +19,7 @@ namespace deflex::study {
 struct StockBox {
   Vector3 min_m = Vector3::Zero(), max_m = Vector3::Zero();
   double cell_m = 0.1e-3, layer_m = 0.5e-3;
+  EngagementSampling sampling{64, 20, 10e-6, 1e-6};  ///< the dexel stock's own default
 };
 [[nodiscard]] DexelStock make_stock(const StockBox& box);
 
