@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <mutex>
@@ -28,7 +29,12 @@ constexpr double kProbeNoiseM = 1e-6;
 // The study's feeds (mm/min): fz 0.042 and 0.083 mm at 12 000 rpm, three flutes.
 constexpr double kFeedsMmMin[] = {1500.0, 3000.0};
 
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 struct SeedCell {
+  double calibration_s = 0.0, slot_cuts_s = 0.0;
   std::unique_ptr<MillCell> cell;
   CuttingCoefficients truth;
   double runout_m = 0.0;
@@ -137,7 +143,10 @@ std::string make_log_dir(std::uint64_t seed) {
 
 void prepare_seed(SeedCell& sc, int index, const SlotCutPlan& plan) {
   const auto seed = static_cast<std::uint64_t>(index + 1);
+  const auto t0 = std::chrono::steady_clock::now();
   sc.cell = std::make_unique<MillCell>(build_mill_cell(seed));
+  sc.calibration_s = seconds_since(t0);
+  const auto t1 = std::chrono::steady_clock::now();
   const std::uint64_t tool_seed = splitmix(seed ^ 0x70015eedULL);
   sc.truth = cell::draw_true_coefficients(al7075_published(), kCoefficientSpread, tool_seed);
   std::mt19937_64 rng(splitmix(tool_seed));
@@ -160,9 +169,11 @@ void prepare_seed(SeedCell& sc, int index, const SlotCutPlan& plan) {
   sc.fit.truth = sc.truth;
   sc.fit.truth_runout_m = sc.runout_m;
   sc.fit.slot_fz_m = plan.fz_m;
+  sc.slot_cuts_s = seconds_since(t1);
 }
 
 MachiningRun run_part(const SeedCell& sc, const MillPart& part, MachiningStrategy strategy, double feed, int index) {
+  const auto t0 = std::chrono::steady_clock::now();
   const CuttingCoefficients* k = &sc.fit.fit.k;  // never the truth
   const std::vector<PassProgram> programs = plan_passes(*sc.cell, part.passes, part.stock, strategy, feed, k);
   DexelStock stock = make_stock(part.stock);
@@ -183,6 +194,7 @@ MachiningRun run_part(const SeedCell& sc, const MillPart& part, MachiningStrateg
   run.link_cycles = r.link_cycles;
   run.passes = std::move(r.passes);
   run.errors = probe_part(part, stock, splitmix(spec.seed ^ 0x9b0beULL), index == 0 ? &run.walls : nullptr);
+  run.seconds = seconds_since(t0);
   return run;
 }
 
@@ -263,7 +275,14 @@ MachiningStudyOutput run_machining_study(const MachiningStudyOptions& options) {
     return std::tie(a.seed_index, a.feed_mm_min, a.strategy) < std::tie(b.seed_index, b.feed_mm_min, b.strategy);
   });
   out.runs = std::move(runs);
-  for (const MachiningRun& r : out.runs) out.coupled.add(r.coupled);
+  for (const MachiningRun& r : out.runs) {
+    out.coupled.add(r.coupled);
+    out.times.parts_s[static_cast<int>(r.strategy)] += r.seconds;
+  }
+  for (const SeedCell& sc : cells) {
+    out.times.calibration_s += sc.calibration_s;
+    out.times.slot_cuts_s += sc.slot_cuts_s;
+  }
   out.sizes = study_sizes(part, plan, out.feeds_mm_min);
   for (const SeedCell& sc : cells) out.fits.push_back(sc.fit);
   assemble_rows(out);

@@ -69,6 +69,7 @@ struct MachiningRun {
   PartErrors errors;
   cell::CoupledTickCounters coupled;
   std::uint64_t link_cycles = 0;  ///< EGM messages deflex answered (online, hybrid)
+  double seconds = 0.0;           ///< the part's thread time (planning, cutting, probing)
   std::vector<WallTrace> walls;   ///< first seed only
   std::vector<PassTrace> passes;  ///< first seed only
 };
@@ -106,6 +107,14 @@ struct MachiningSizes {
   std::vector<double> ap_m;  ///< every axial depth cut
 };
 
+/// Where the study's time went: each phase's thread time summed over the seeds (s, steady clock; with
+/// several threads the sum exceeds the wall time).
+struct MachiningTimes {
+  double calibration_s = 0.0;                ///< the seeds' cells and their compliance calibrations
+  double slot_cuts_s = 0.0;                  ///< the slot cuts, their logs and the fits
+  double parts_s[4] = {0.0, 0.0, 0.0, 0.0};  ///< the parts, by strategy (kMachiningStrategies' order)
+};
+
 struct MachiningStudyOutput {
   std::vector<MachiningRun> runs;
   std::vector<MachiningFit> fits;
@@ -115,6 +124,7 @@ struct MachiningStudyOutput {
   int seeds = 0;
   double probe_noise_m = 0.0;
   MachiningSizes sizes;
+  MachiningTimes times;
   double simulated_s = 0.0;
   /// What the cell's coupled solves of the arm and the cut did over every part (not the slot cuts).
   cell::CoupledTickCounters coupled;
