@@ -47,7 +47,7 @@ void draw_machining_progress(double fraction, const std::string& label) {
   std::fflush(stderr);
 }
 
-void run(const MachiningStudyOpts& o, int& exit_code) {
+void run_machining_study_command(const MachiningStudyOpts& o, int& exit_code) {
   if (o.seeds < 0 || o.seeds > 20) throw InputError(fmt::format("option --seeds: {} is outside 1..20", o.seeds));
   if (o.threads < 0 || o.threads > 256) {
     throw InputError(fmt::format("option --threads: {} is outside 0..256", o.threads));
@@ -88,7 +88,7 @@ void run(const MachiningStudyOpts& o, int& exit_code) {
   exit_code = 0;
 }
 
-void setup(CLI::App& sub, int& exit_code) {
+void setup_machining_study(CLI::App& sub, int& exit_code) {
   auto o = std::make_shared<MachiningStudyOpts>();
   sub.add_flag("--quick", o->quick, "A shorter part, 3 slot cuts for the fit, 2 seeds (default 3)");
   sub.add_option("--seeds", o->seeds, "Seeds to run, each its own cell, tool and calibration (1..20)");
@@ -97,13 +97,13 @@ void setup(CLI::App& sub, int& exit_code) {
   sub.add_option("--report", o->report, "Write the HTML report (wall profiles, force, deflection) to this file");
   sub.add_option("--threads", o->threads, "Worker threads, 0..256 (default 0: one per hardware thread)");
   sub.add_flag("--no-progress", o->no_progress, "No progress on stderr");
-  sub.callback([o, &exit_code] { run(*o, exit_code); });
+  sub.callback([o, &exit_code] { run_machining_study_command(*o, exit_code); });
 }
 
 }  // namespace
 
 DEFLEX_COMMAND("machining-study",
                "The simulated cell mills an aluminium part under each strategy; the part's probed errors, tabled",
-               setup, 61);
+               setup_machining_study, 61);
 
 }  // namespace deflex::cli

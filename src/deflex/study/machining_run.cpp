@@ -159,35 +159,53 @@ struct PassRun {
   bool log_sensor;
 };
 
-void run_one_pass(const PassRun& r, MillRunResult& out) {
-  const cell::CellConfig& c = r.mc.config.cell;
-  const cell::TrueRobot& robot = *r.mc.setup.robot;
-  const bool linked = strategy_linked(r.spec.strategy);
-  const double speed = r.spec.feed_mm_min / 60.0 * 1e-3;
-  auto program = std::make_shared<const JointTrajectory>(
-      trajectory_at_tcp_speed(r.program.poses, r.program.q, speed, r.mc.setup.calibration.identified, kHoldS));
-  MillNetwork net(c);
-  std::unique_ptr<cell::RobotController> controller;
-  if (linked) {
-    controller = std::make_unique<cell::EgmPositionGuidanceController>(c.controller, program->points().front(),
-                                                                       net.controller_port, kMillDeflexEgm);
-  } else {
-    controller = std::make_unique<cell::ProgramController>(program);
-  }
-  cell::DaqStream daq(net.daq_port, kMillDeflexForce);
-  MillDeflex side;
-  if (linked) side = start_mill_session(r.mc, r.spec.strategy, program, r.program.predicted.get(), net, r.sensor);
+// The controller the pass's strategy talks to: the program itself, or EGM position guidance.
+std::unique_ptr<cell::RobotController> make_pass_controller(const cell::CellConfig& c, bool linked,
+                                                            const std::shared_ptr<const JointTrajectory>& program,
+                                                            MillNetwork& net) {
+  if (!linked) return std::make_unique<cell::ProgramController>(program);
+  return std::make_unique<cell::EgmPositionGuidanceController>(c.controller, program->points().front(),
+                                                               net.controller_port, kMillDeflexEgm);
+}
 
+cell::MillingProcessConfig pass_process_config(const PassRun& r) {
   cell::MillingProcessConfig pc;
   pc.cutter = study_cutter();
   pc.k = r.spec.true_k;
   pc.spindle_rpm = kStudySpindleRpm;
   pc.runout_m = r.spec.runout_m;
   pc.base_T_stock = r.base_T_stock;
-  cell::MillingProcess process(pc, r.stock);
-  const Pose stock_T_base = r.base_T_stock.inverse();
-  const Matrix3 decoupling = r.sensor.calibration().decoupling;
+  return pc;
+}
 
+// A sample of the pass for the report: the true tip (base frame) and the wrench it was solved under.
+void record_pass_sample(const PassRun& r, const Vector3& p_base, const Wrench& w, PassTrace& trace) {
+  const Pose stock_T_base = r.base_T_stock.inverse();
+  const Vector3 tip = stock_T_base * p_base;
+  trace.x_m.push_back(tip.x());
+  trace.true_force_n.push_back((stock_T_base.linear() * w.head<3>()).head<2>().norm());
+  trace.deflection_m.push_back(distance_from_pass(r.pass, tip));
+  // The model's wrench where the program put this point: the true tip taken back to the nominal frame.
+  Wrench predicted = Wrench::Zero();
+  const Pose programmed(Eigen::Translation3d(r.mc.base_T_workpiece * tip));
+  if (r.program.predicted) (void)r.program.predicted->wrench_at_pose(programmed, predicted);
+  trace.predicted_force_n.push_back(
+      (r.mc.base_T_workpiece.linear().transpose() * predicted.head<3>()).head<2>().norm());
+}
+
+void run_one_pass(const PassRun& r, MillRunResult& out) {
+  const cell::CellConfig& c = r.mc.config.cell;
+  const cell::TrueRobot& robot = *r.mc.setup.robot;
+  const bool linked = strategy_linked(r.spec.strategy);
+  auto program = std::make_shared<const JointTrajectory>(trajectory_at_tcp_speed(
+      r.program.poses, r.program.q, r.spec.feed_mm_min / 60.0 * 1e-3, r.mc.setup.calibration.identified, kHoldS));
+  MillNetwork net(c);
+  const std::unique_ptr<cell::RobotController> controller = make_pass_controller(c, linked, program, net);
+  cell::DaqStream daq(net.daq_port, kMillDeflexForce);
+  MillDeflex side;
+  if (linked) side = start_mill_session(r.mc, r.spec.strategy, program, r.program.predicted.get(), net, r.sensor);
+  cell::MillingProcess process(pass_process_config(r), r.stock);
+  const Matrix3 decoupling = r.sensor.calibration().decoupling;
   Workspace ws(robot.true_model());
   JointVector q = program->points().front();
   cell::TrueRobotState state = robot.initial_state(q);
@@ -195,13 +213,12 @@ void run_one_pass(const PassRun& r, MillRunResult& out) {
   (void)solver.at_rest(cell::CoupledArm{robot, ws, state, r.drift, nullptr}, q);
   const double end_s = program->end_time_s() + (linked ? kLinkTailS : 0.0);
   const double dt = c.controller.servo_period_s;
-  const auto ticks = static_cast<long>(std::ceil(end_s / dt));
   const double daq_period = 1.0 / c.sensor.rate_hz;
   double next_daq = daq_period;
   PassTrace trace;
   trace.name = r.pass.name;
   std::vector<std::pair<double, Vector3>> log;
-  for (long k = 1; k <= ticks; ++k) {
+  for (long k = 1; k <= static_cast<long>(std::ceil(end_s / dt)); ++k) {
     const double t = static_cast<double>(k) * dt;
     net.clock.set(t);
     q = controller->tick(t);
@@ -210,9 +227,8 @@ void run_one_pass(const PassRun& r, MillRunResult& out) {
     Wrench w;
     const Vector3 p = solver.tick(cell::CoupledArm{robot, ws, state, r.drift, &process}, q, dt, w);
     controller->encoders(state.q_motor);
-    const Matrix3 base_R_flange = ws.base_T_flange.linear();
     for (; next_daq <= t + 1e-12; next_daq += daq_period) {
-      const Vector3 reading = r.sensor.sample(w.head<3>(), base_R_flange, next_daq);
+      const Vector3 reading = r.sensor.sample(w.head<3>(), ws.base_T_flange.linear(), next_daq);
       if (linked) daq.send(next_daq, reading);
       if (r.log_sensor) log.emplace_back(next_daq, decoupling * reading);
     }
@@ -220,19 +236,7 @@ void run_one_pass(const PassRun& r, MillRunResult& out) {
       net.clock.set(t + c.controller.network_latency_s);
       poll_mill_session(*side.session, out.link_cycles);
     }
-    if (r.spec.trace && k % 10 == 0) {
-      const Vector3 tip = stock_T_base * p;
-      const Vector3 f = stock_T_base.linear() * w.head<3>();
-      trace.x_m.push_back(tip.x());
-      trace.true_force_n.push_back(f.head<2>().norm());
-      trace.deflection_m.push_back(distance_from_pass(r.pass, tip));
-      Wrench predicted = Wrench::Zero();
-      // The model's wrench where the program put this point: the true tip taken back to the nominal frame.
-      const Pose programmed(Eigen::Translation3d(r.mc.base_T_workpiece * tip));
-      if (r.program.predicted) (void)r.program.predicted->wrench_at_pose(programmed, predicted);
-      trace.predicted_force_n.push_back(
-          (r.mc.base_T_workpiece.linear().transpose() * predicted.head<3>()).head<2>().norm());
-    }
+    if (r.spec.trace && k % 10 == 0) record_pass_sample(r, p, w, trace);
   }
   if (linked) {
     (void)side.session->finish();
@@ -295,6 +299,48 @@ bool PathWrenchModel::wrench_at_pose(const Pose& base_T_tcp, Wrench& out) const 
   return true;
 }
 
+namespace {
+
+// The user's prediction of one pass (base frame, at each program point) from the force model on the
+// nominal stock, which `predictor` carries from pass to pass. From the second pass on, the tool
+// leaves the part as a CAM program would: up clear of the stock, across and down outside it, all
+// rapid (else the model would cut the straight line between the passes).
+std::shared_ptr<const PathWrenchModel> predict_pass(const MillCell& mc, const MillPass* previous, const MillPass& pass,
+                                                    const PassProgram& pp, double clear_z, double feed_mm_min,
+                                                    MillingProcess& predictor) {
+  if (previous != nullptr) {
+    const Vector3 from = previous->corners.back(), to = pass.corners.front();
+    for (const Vector3& v : {Vector3(from.x(), from.y(), clear_z), Vector3(to.x(), to.y(), clear_z)}) {
+      MillingPointInput in;
+      in.tip_m = v;
+      in.rapid = true;
+      in.spindle_rpm = kStudySpindleRpm;
+      in.turn = SpindleTurn::kClockwise;
+      (void)predictor.next(in);
+    }
+  }
+  const Matrix3 base_R_wp = mc.base_T_workpiece.linear();
+  std::vector<Vector3> positions;
+  std::vector<Wrench> wrenches;
+  for (std::size_t i = 0; i < pp.tips_workpiece_m.size(); ++i) {
+    MillingPointInput in;
+    in.tip_m = pp.tips_workpiece_m[i];
+    in.feed_mm_min = feed_mm_min;
+    in.spindle_rpm = kStudySpindleRpm;
+    in.turn = SpindleTurn::kClockwise;
+    in.line = i + 1;
+    in.rapid = i == 0;
+    const Wrench w_wp = predictor.next(in).wrench;
+    Wrench w;
+    w << base_R_wp * w_wp.head<3>(), base_R_wp * w_wp.tail<3>();
+    positions.push_back(pp.poses[i].translation());
+    wrenches.push_back(w);
+  }
+  return std::make_shared<const PathWrenchModel>(std::move(positions), std::move(wrenches));
+}
+
+}  // namespace
+
 std::vector<PassProgram> plan_passes(const MillCell& mc, const std::vector<MillPass>& passes, const StockBox& stock,
                                      MachiningStrategy strategy, double feed_mm_min, const CuttingCoefficients* k) {
   const RobotModel& model = mc.setup.calibration.identified;
@@ -314,10 +360,9 @@ std::vector<PassProgram> plan_passes(const MillCell& mc, const std::vector<MillP
   std::vector<PassProgram> out;
   IkRequest first;
   first.seed = standing_pose(model);
-  const Matrix3 base_R_wp = mc.base_T_workpiece.linear();
-  for (const MillPass& pass : passes) {
+  for (std::size_t n = 0; n < passes.size(); ++n) {
     PassProgram pp;
-    pp.tips_workpiece_m = sample_pass(pass, kProgramStepM);
+    pp.tips_workpiece_m = sample_pass(passes[n], kProgramStepM);
     for (const Vector3& tip : pp.tips_workpiece_m) {
       Pose pose = Pose::Identity();
       pose.linear() = mc.tcp_orientation;
@@ -331,42 +376,11 @@ std::vector<PassProgram> plan_passes(const MillCell& mc, const std::vector<MillP
       out.push_back(std::move(pp));
       continue;
     }
-    std::vector<Vector3> positions;
-    std::vector<Wrench> wrenches;
-    // Between passes the tool leaves the part as a CAM program would: up clear of the stock, across,
-    // and down outside it, all rapid (else the model would cut the straight line between them).
-    if (&pass != &passes.front()) {
-      const Vector3 from = passes[static_cast<std::size_t>(&pass - passes.data()) - 1].corners.back();
-      const Vector3 to = pass.corners.front();
-      const double clear = stock.max_m.z() + 5e-3;
-      for (const Vector3& v : {Vector3(from.x(), from.y(), clear), Vector3(to.x(), to.y(), clear)}) {
-        MillingPointInput in;
-        in.tip_m = v;
-        in.rapid = true;
-        in.spindle_rpm = kStudySpindleRpm;
-        in.turn = SpindleTurn::kClockwise;
-        (void)predictor->next(in);
-      }
-    }
-    for (std::size_t i = 0; i < pp.tips_workpiece_m.size(); ++i) {
-      MillingPointInput in;
-      in.tip_m = pp.tips_workpiece_m[i];
-      in.feed_mm_min = feed_mm_min;
-      in.spindle_rpm = kStudySpindleRpm;
-      in.turn = SpindleTurn::kClockwise;
-      in.line = i + 1;
-      in.rapid = i == 0;
-      const Wrench w_wp = predictor->next(in).wrench;
-      Wrench w;
-      w << base_R_wp * w_wp.head<3>(), base_R_wp * w_wp.tail<3>();
-      positions.push_back(pp.poses[i].translation());
-      wrenches.push_back(w);
-    }
-    pp.predicted = std::make_shared<const PathWrenchModel>(std::move(positions), std::move(wrenches));
+    pp.predicted = predict_pass(mc, n > 0 ? &passes[n - 1] : nullptr, passes[n], pp, stock.max_m.z() + 5e-3,
+                                feed_mm_min, *predictor);
     OfflineOptions options;
     options.predict = false;
-    const OfflineResult compensated = compensate_path(model, path, pp.poses, *pp.predicted, options);
-    for (const auto& p : compensated.points) {
+    for (const auto& p : compensate_path(model, path, pp.poses, *pp.predicted, options).points) {
       pp.q.push_back(p.q_command);
     }
     out.push_back(std::move(pp));
