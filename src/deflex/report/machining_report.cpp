@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "deflex/report/detail/svg_canvas.hpp"
 
@@ -53,7 +54,7 @@ struct ChartSeries {
 std::string line_chart(const std::string& title, const std::string& x_label, const std::string& y_label,
                        const std::vector<ChartSeries>& series) {
   constexpr double kW = 1000.0, kH = 300.0, kLeft = 70.0, kRight = 200.0, kTop = 34.0, kBottom = 46.0;
-  double x0 = INFINITY, x1 = -INFINITY, y0 = 0.0, y1 = 0.0;
+  double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = 0.0, y1 = 0.0;
   for (const ChartSeries& s : series) {
     for (double v : s.x) x0 = std::min(x0, v), x1 = std::max(x1, v);
     for (double v : s.y) y0 = std::min(y0, v), y1 = std::max(y1, v);

@@ -142,7 +142,7 @@ std::string make_log_dir(std::uint64_t seed) {
 }
 
 void prepare_seed(SeedCell& sc, int index, const SlotCutPlan& plan) {
-  const auto seed = static_cast<std::uint64_t>(index + 1);
+  const std::uint64_t seed = static_cast<std::uint64_t>(index) + 1;
   const auto t0 = std::chrono::steady_clock::now();
   sc.cell = std::make_unique<MillCell>(build_mill_cell(seed));
   sc.calibration_s = seconds_since(t0);
@@ -182,7 +182,7 @@ MachiningRun run_part(const SeedCell& sc, const MillPart& part, MachiningStrateg
   spec.feed_mm_min = feed;
   spec.true_k = sc.truth;
   spec.runout_m = sc.runout_m;
-  spec.seed = splitmix(static_cast<std::uint64_t>(index + 1) ^ (static_cast<std::uint64_t>(feed) << 8) ^
+  spec.seed = splitmix((static_cast<std::uint64_t>(index) + 1) ^ (static_cast<std::uint64_t>(feed) << 8) ^
                        (static_cast<std::uint64_t>(strategy) << 24));
   spec.trace = index == 0;
   MillRunResult r = run_mill_passes(*sc.cell, part.passes, programs, stock, spec, false);
