@@ -49,6 +49,7 @@ void bind_machining(py::module_& m);
 void bind_evaluate(py::module_& m);
 void bind_online(py::module_& m);
 void bind_study(py::module_& m);
+void bind_machining_study(py::module_& m);
 void bind_runtime(py::module_& m);
 
 }  // namespace deflex::python

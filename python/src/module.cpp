@@ -13,5 +13,6 @@ PYBIND11_MODULE(_deflex, m) {
   deflex::python::bind_evaluate(m);
   deflex::python::bind_online(m);
   deflex::python::bind_study(m);
+  deflex::python::bind_machining_study(m);
   deflex::python::bind_runtime(m);
 }

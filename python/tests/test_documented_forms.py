@@ -189,13 +189,15 @@ def written_trajectory(tmp_path):
     return path
 
 
-# The documented defaults of run_case_study run the whole paper's study (45 s on two cores): the form is
+# The documented defaults of run_case_study run the whole paper's study (45 s on two cores), and those of
+# run_machining_study the whole machining study (40 s of CPU): the form is
 # called with its documented keywords, the quick ones of them given quick values.
 QUICK = {"run_case_study": {"case": {"protocol": {"speeds_mm_s": [50], "sweep_load_N": 625},
                                      "error_budget": {"load_index": 0},
                                      "setups": [{"name": "offline", "strategy": "offline", "link": "program",
                                                  "sensor": False, "loads_N": [625]}]},
                             "quick": True, "speed_sweep": False, "error_budget": False, "threads": 2},
+         "run_machining_study": {"quick": True, "seeds": 1, "threads": 2},
          # A session on a real address: a port of the system's choosing, not EGM's 6511.
          "Session": {"egm_port": 0}}
 

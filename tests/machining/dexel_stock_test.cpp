@@ -80,6 +80,20 @@ TEST(DexelStock, SideCutsAreExactOnACoarseGrid) {
   }
 }
 
+TEST(DexelStock, ACoarserSamplingFindsTheSameSideCut) {
+  // The machining study's sampling (33 angles, the arcs' ends bisected 12 times: pi / 32 / 2^12 =
+  // 2.4e-5 rad, 0.12 um along the edge) against the closed form of a 2 mm climb side cut's arc: its
+  // end to that step, the width to 50 nm (the step times the edge's slope across the feed there).
+  DexelStock stock = dexel_block();
+  stock.set_sampling(EngagementSampling{32, 12, 10e-6, 1e-6});
+  (void)pass(stock, dexel_end_mill(), {-10, 30, 15}, {110, 30, 15});
+  const Engagement e = pass(stock, dexel_end_mill(), {110, 32, 15}, {-10, 32, 15});  // climb, back along x
+  ASSERT_TRUE(e.engaged());
+  EXPECT_NEAR(e.ae_m, 2e-3, 50e-9);
+  EXPECT_NEAR(kPi - e.entry_rad, std::acos(1.0 - 2.0 * 2.0 / 10.0), 2.5e-5);
+  EXPECT_NEAR(e.exit_rad, kPi, 1e-12);
+}
+
 TEST(DexelStock, WallsAreWhereTheyWereCut) {
   DexelStock stock = dexel_block();
   (void)pass(stock, dexel_end_mill(), {-10, 25, 15}, {110, 25, 15});
