@@ -112,11 +112,11 @@ class Controller:
         if last:
             self.ended, self.moving = True, False
 
-    def status(self, now):
+    def status(self, now, scheduled):
         self.status_seq += 1
         ready = not self.alarm and not self.ended and now >= self.ready_at
         bits = (1 if ready else 0) | 4 | (8 if self.moving else 0)
-        stamp = int(round(now * 500.0)) * 2 & 0xFFFFFFFF
+        stamp = int(round(scheduled * 500.0)) * 2 & 0xFFFFFFFF  # the controller's own clock, 2 ms resolution
         return STATUS.pack(0, 1, self.status_seq, bits, 0, 0, 0, 0, stamp, *([0.0] * 9),
                            *(self.position + [0.0] * 3), *([0.0] * 9))
 
@@ -149,10 +149,11 @@ def main():
                 next_status = now
             continue
         if c.pc is not None and next_status is not None and now >= next_status:
+            scheduled = next_status
             next_status += c.interval
             if not c.alarm and not c.ended:
                 c.take()
-            sock.sendto(c.status(now), c.pc)
+            sock.sendto(c.status(now, scheduled), c.pc)
     print("stand-in: %d statuses, %d targets taken, peaks %.2f deg/s, %.2f deg/s^2, %.1f deg/s^3; %s"
           % (c.status_seq, c.taken, c.peak[0], c.peak[1], c.peak[2],
              ("alarm " + c.alarm) if c.alarm else ("ended on last-data" if c.ended else "still streaming")))

@@ -128,7 +128,7 @@ void FanucJ519Controller::take_command(double t_s) {
   }
 }
 
-void FanucJ519Controller::send_status(double t_s) {
+void FanucJ519Controller::send_status(double t_s, double stamp_s) {
   j519::Status s;
   s.version = config_.version;
   s.sequence = ++status_seq_;
@@ -137,7 +137,7 @@ void FanucJ519Controller::send_status(double t_s) {
                                             (moving_ ? j519::kStatusInMotion : 0) |
                                             (counters_.commands > 0 ? j519::kStatusCommandReceived : 0));
   if (!alarm_.empty()) s.robot_status = j519::kRobotInError;
-  s.time_stamp_ms = static_cast<std::uint32_t>(std::llround(t_s * 500.0)) * 2U;  // 2 ms resolution
+  s.time_stamp_ms = static_cast<std::uint32_t>(std::llround(stamp_s * 500.0)) * 2U;  // 2 ms resolution
   const JointVector& q = have_encoders_ ? encoders_ : position_;
   for (int i = 0; i < q.size(); ++i) s.joints_deg[static_cast<std::size_t>(i)] = static_cast<float>(rad_to_deg(q[i]));
   const std::size_t n = j519::encode(config_.version, s, buffer_.data(), buffer_.size());
@@ -149,9 +149,12 @@ const JointVector& FanucJ519Controller::tick(double t_s) {
   last_t_s_ = t_s;
   read_packets(t_s);
   if (streaming_ && t_s + 1e-12 >= next_status_s_) {
+    // The controller's clock is its interpolation clock: the status is stamped with the interval's own
+    // time, however late the simulation got to it.
+    const double stamp_s = next_status_s_;
     next_status_s_ += config_.interval_s;
     if (alarm_.empty() && !ended_) take_command(t_s);
-    send_status(t_s);
+    send_status(t_s, stamp_s);
   }
   // The drives follow the newest target taken at least the dead time ago; after an alarm, where the
   // arm is (it decelerates to rest through the servo's lag).

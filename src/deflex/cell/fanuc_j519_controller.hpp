@@ -95,7 +95,7 @@ class FanucJ519Controller final : public RobotController {
  private:
   void read_packets(double t_s);
   void take_command(double t_s);
-  void send_status(double t_s);
+  void send_status(double t_s, double stamp_s);
   void stop_stream(const std::string& alarm);
 
   FanucJ519ControllerConfig config_;
