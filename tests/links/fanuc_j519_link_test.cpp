@@ -344,6 +344,31 @@ TEST(FanucJ519Link, AControllerAtAnotherIntervalIsRefusedBeforeAnyCommand) {
   EXPECT_EQ(bench.controller.counters().commands, 0u);
 }
 
+// Every poll of a whole session: the start (timing the interval, the anchor), a caught-up status, the
+// settling at the end, last-data and the stop packet.
+TEST(FanucJ519Link, NoPollFromStartToEndAllocates) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  FanucBench bench(test::sweep_program(test::bench_robot(), q0, pose_deg(5, 5, 5, 5, 5, 5), 2.0), q0);
+  bench.force.reading = test::reading_at(bench.robot, q0, Vector3(0, 0, -400));
+  bench.network.add_outage(1.0005, 1.0085, test::kSensorAddress);  // one status lost: caught up
+  std::size_t allocations = 0;
+  for (int k = 0; k < 2000 && bench.link.state() != LinkState::kStopped; ++k) {
+    bench.t_s += 0.004;
+    bench.clock.set(bench.t_s);
+    bench.controller.tick(bench.t_s);
+    bench.clock.set(bench.t_s + 0.0002);
+    for (;;) {
+      test::AllocationGuard guard;
+      const LinkPollResult r = bench.link.poll(0.0);
+      allocations += guard.allocations();
+      if (r == LinkPollResult::kIdle || bench.link.state() == LinkState::kStopped) break;
+    }
+  }
+  EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kEnded) << bench.link.stop_reason();
+  EXPECT_GE(bench.link.caught_up(), 1u);
+  EXPECT_EQ(allocations, 0u);
+}
+
 TEST(FanucJ519Link, PollDoesNotAllocate) {
   const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
   FanucBench bench(test::sweep_program(test::bench_robot(), q0, pose_deg(5, 5, 5, 5, 5, 5), 8.0), q0);
