@@ -312,26 +312,14 @@ bool FanucJ519Link::controller_state(const j519::Status& s) noexcept {
   return true;
 }
 
-// The first ready status of a session: its joints are where the arm is, the anchor of the stream.
+// The first ready status: its joints (in feedback_) are where the arm is, the anchor of the stream. It
+// is the only session a link runs (a new one stops it, poll_once), so nothing was sent before.
 bool FanucJ519Link::start_session(const j519::Status& s) noexcept {
-  for (int i = 0; i < feedback_.size(); ++i) feedback_[i] = deg_to_rad(s.joints_deg[static_cast<std::size_t>(i)]);
-  const double gap = cycle_.reanchor_gap(feedback_);
-  if (stop_if_anchor_unreachable(gap, "the controller (FANUC J519)")) return false;
-  nominal_ = cycle_.has_sent() && gap <= 2.0 ? cycle_.last_command() : feedback_;
-  if (!stream_.begin(nominal_, cycle_.correction())) {
-    if (state_ == LinkState::kWaiting) {
-      refuse_start(stream_.distance());
-    } else {
-      Eigen::Index j = 0;
-      const double d = stream_.distance().maxCoeff(&j);
-      stop_link(LinkStopCause::kController,
-                "the controller restarted with joint %d %.3f deg from deflex's command (tolerance %.3f deg): not "
-                "resumed",
-                static_cast<int>(j) + 1, rad_to_deg(d), rad_to_deg(config_.stream.start_tolerance_rad));
-    }
+  if (!stream_.begin(feedback_, cycle_.correction())) {
+    refuse_start(stream_.distance());
     return false;
   }
-  cycle_.anchor_joints(nominal_, after_silence());
+  cycle_.anchor_joints(feedback_, true);
   for (std::size_t i = 0; i < j519::kAxes; ++i) aux_deg_[i] = s.joints_deg[i];
   next_sequence_ = s.sequence;
   ready_seen_ = true;

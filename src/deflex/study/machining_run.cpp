@@ -78,13 +78,7 @@ MillDeflex start_mill_session(const MillCell& mc, MachiningStrategy strategy,
   const cell::CellConfig& c = config.cell;
   runtime::SessionConfig sc;
   sc.link = runtime::LinkKind::kEgmJoint;
-  deflex::OnlineConfig& oc = sc.online;
-  oc.period_s = c.controller.egm_period_s;
-  oc.max_joint_correction_rad = config.online.max_joint_correction_rad;
-  oc.max_tcp_correction_m = config.online.max_tcp_correction_m;
-  oc.max_correction_rate_rad_s = config.online.max_rate_rad_s;
-  oc.max_tcp_rate_m_s = config.online.max_tcp_rate_m_s;
-  oc.watchdog_s = std::max(config.online.watchdog_s, 2.0 * oc.period_s);
+  sc.online = online_config_from_case(config, c.controller.egm_period_s);
   sc.strategy = strategy == MachiningStrategy::kHybrid ? StrategyKind::kHybrid : StrategyKind::kOnline;
   sc.egm_joint.stream.ramp_in_s = config.online.ramp_in_s;
   sc.history_cycles = 16;
@@ -99,19 +93,6 @@ MillDeflex start_mill_session(const MillCell& mc, MachiningStrategy strategy,
                                          program, strategy == MachiningStrategy::kHybrid ? predicted : nullptr,
                                          side.force_source.get(), net.clock, endpoints);
   return side;
-}
-
-void poll_mill_session(runtime::Session& session, std::uint64_t& cycles) {
-  while (!session.ended()) {
-    const LinkPollResult r = session.poll(0.0);
-    if (session.ended() && runtime::exit_code(session.stop_reason()) != 0) {
-      const runtime::SessionSummary& end = session.finish();
-      throw Error(fmt::format("machining run: deflex's {} session ended: {} ({})", end.link,
-                              runtime::to_string(end.reason), end.reason_text));
-    }
-    if (r == LinkPollResult::kIdle) break;
-    if (r == LinkPollResult::kAnswered) ++cycles;
-  }
 }
 
 // The distance of `p` (stock frame) from the polyline's nearest segment, in the plane of the cut.
@@ -234,7 +215,7 @@ void run_one_pass(const PassRun& r, MillRunResult& out) {
     }
     if (linked) {
       net.clock.set(t + c.controller.network_latency_s);
-      poll_mill_session(*side.session, out.link_cycles);
+      poll_deflex_session(*side.session, out.link_cycles, "machining run");
     }
     if (r.spec.trace && k % 10 == 0) record_pass_sample(r, p, w, trace);
   }

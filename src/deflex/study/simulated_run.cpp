@@ -332,15 +332,9 @@ DeflexSide start_deflex_session(const RunPlan& plan, RunNetwork& net, cell::Forc
   sc.link = spec.link == LinkKind::kEgmPath         ? runtime::LinkKind::kEgmPath
             : spec.link == LinkKind::kSimpleMessage ? runtime::LinkKind::kSimpleMessage
                                                     : runtime::LinkKind::kEgmJoint;
-  deflex::OnlineConfig& oc = sc.online;
-  oc.period_s = spec.link == LinkKind::kEgmPath         ? c.controller.path_corr_period_s
-                : spec.link == LinkKind::kSimpleMessage ? config.online.stream_period_s
-                                                        : c.controller.egm_period_s;
-  oc.max_joint_correction_rad = config.online.max_joint_correction_rad;
-  oc.max_tcp_correction_m = config.online.max_tcp_correction_m;
-  oc.max_correction_rate_rad_s = config.online.max_rate_rad_s;
-  oc.max_tcp_rate_m_s = config.online.max_tcp_rate_m_s;
-  oc.watchdog_s = std::max(config.online.watchdog_s, 2.0 * oc.period_s);
+  sc.online = online_config_from_case(config, spec.link == LinkKind::kEgmPath         ? c.controller.path_corr_period_s
+                                              : spec.link == LinkKind::kSimpleMessage ? config.online.stream_period_s
+                                                                                      : c.controller.egm_period_s);
   StrategyKind kind = StrategyKind::kNone;  // the reference runs stream the program uncorrected
   if (plan.compensated) {
     kind = spec.strategy == Strategy::kHybrid       ? StrategyKind::kHybrid
@@ -408,21 +402,6 @@ struct SimulatedRun {
   RunInstruments instruments;
 };
 
-// Lets deflex answer whatever has reached it by now, counting the controller messages it answered;
-// throws when its session ended with an error.
-void poll_deflex_session(runtime::Session& session, std::uint64_t& link_cycles) {
-  while (!session.ended()) {
-    const LinkPollResult r = session.poll(0.0);
-    if (session.ended() && runtime::exit_code(session.stop_reason()) != 0) {
-      const runtime::SessionSummary& end = session.finish();
-      throw Error(fmt::format("run: deflex's {} session ended: {} ({})", end.link, runtime::to_string(end.reason),
-                              end.reason_text));
-    }
-    if (r == LinkPollResult::kIdle) break;
-    if (r == LinkPollResult::kAnswered) ++link_cycles;
-  }
-}
-
 // Drives the run tick by tick: the controller moves the arm, the bar loads it, drift displaces it,
 // the tracker records it and, on a link, the DAQ streams the force and deflex answers the controller.
 RunOutput drive_simulated_run(SimulatedRun& run) {
@@ -469,7 +448,7 @@ RunOutput drive_simulated_run(SimulatedRun& run) {
         daq.send(next_daq, sensor.sample(w.head<3>(), base_R_flange, next_daq));
       }
       clock.set(t + network_latency_s);
-      poll_deflex_session(*session, out.link_cycles);
+      poll_deflex_session(*session, out.link_cycles, "run");
     }
     tracker.observe(t - dt, p_prev, t, p, out.trace);
     p_prev = p;
@@ -493,6 +472,30 @@ void summarize_deflex_link(SimulatedRun& run, RunOutput& out) {
 }
 
 }  // namespace
+
+deflex::OnlineConfig online_config_from_case(const CaseConfig& config, double period_s) {
+  deflex::OnlineConfig oc;
+  oc.period_s = period_s;
+  oc.max_joint_correction_rad = config.online.max_joint_correction_rad;
+  oc.max_tcp_correction_m = config.online.max_tcp_correction_m;
+  oc.max_correction_rate_rad_s = config.online.max_rate_rad_s;
+  oc.max_tcp_rate_m_s = config.online.max_tcp_rate_m_s;
+  oc.watchdog_s = std::max(config.online.watchdog_s, 2.0 * period_s);
+  return oc;
+}
+
+void poll_deflex_session(runtime::Session& session, std::uint64_t& link_cycles, const char* what) {
+  while (!session.ended()) {
+    const LinkPollResult r = session.poll(0.0);
+    if (session.ended() && runtime::exit_code(session.stop_reason()) != 0) {
+      const runtime::SessionSummary& end = session.finish();
+      throw Error(fmt::format("{}: deflex's {} session ended: {} ({})", what, end.link, runtime::to_string(end.reason),
+                              end.reason_text));
+    }
+    if (r == LinkPollResult::kIdle) break;
+    if (r == LinkPollResult::kAnswered) ++link_cycles;
+  }
+}
 
 RunOutput simulate_run(const CaseConfig& config, const SetupCell& setup, const RunSpec& spec) {
   SimulatedRun run(config, setup, spec);

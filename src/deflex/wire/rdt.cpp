@@ -3,29 +3,17 @@
 
 #include <limits>
 
+#include "deflex/wire/detail/byte_order.hpp"
+
 namespace deflex {
 namespace {
 
-std::uint32_t read_be32(const unsigned char* p) noexcept {
-  return static_cast<std::uint32_t>(p[0]) << 24 | static_cast<std::uint32_t>(p[1]) << 16 |
-         static_cast<std::uint32_t>(p[2]) << 8 | static_cast<std::uint32_t>(p[3]);
-}
-
-std::uint16_t read_be16(const unsigned char* p) noexcept {
-  return static_cast<std::uint16_t>(static_cast<unsigned>(p[0]) << 8 | static_cast<unsigned>(p[1]));
-}
-
-void write_be32(std::uint32_t v, unsigned char* p) noexcept {
-  p[0] = static_cast<unsigned char>(v >> 24);
-  p[1] = static_cast<unsigned char>(v >> 16);
-  p[2] = static_cast<unsigned char>(v >> 8);
-  p[3] = static_cast<unsigned char>(v);
-}
-
-void write_be16(std::uint16_t v, unsigned char* p) noexcept {
-  p[0] = static_cast<unsigned char>(v >> 8);
-  p[1] = static_cast<unsigned char>(v);
-}
+// Big-endian fields through the wire module's byte helpers.
+constexpr wire_bytes::Order kBe = wire_bytes::Order::kBig;
+std::uint32_t read_be32(const unsigned char* p) noexcept { return wire_bytes::load_u32(kBe, p); }
+std::uint16_t read_be16(const unsigned char* p) noexcept { return wire_bytes::load_u16(kBe, p); }
+void write_be32(std::uint32_t v, unsigned char* p) noexcept { wire_bytes::store_u32(kBe, v, p); }
+void write_be16(std::uint16_t v, unsigned char* p) noexcept { wire_bytes::store_u16(kBe, v, p); }
 
 }  // namespace
 

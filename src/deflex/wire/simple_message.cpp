@@ -9,24 +9,19 @@
 #include <fmt/format.h>
 
 #include "deflex/text/errors.hpp"
+#include "deflex/wire/detail/byte_order.hpp"
 
 namespace deflex::simple_message {
 namespace {
 
-std::uint32_t read_u32(ByteOrder order, const unsigned char* p) noexcept {
-  if (order == ByteOrder::kLittle) {
-    return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 |
-           static_cast<std::uint32_t>(p[2]) << 16 | static_cast<std::uint32_t>(p[3]) << 24;
-  }
-  return static_cast<std::uint32_t>(p[3]) | static_cast<std::uint32_t>(p[2]) << 8 |
-         static_cast<std::uint32_t>(p[1]) << 16 | static_cast<std::uint32_t>(p[0]) << 24;
+wire_bytes::Order order_of(ByteOrder order) noexcept {
+  return order == ByteOrder::kLittle ? wire_bytes::Order::kLittle : wire_bytes::Order::kBig;
 }
-
+std::uint32_t read_u32(ByteOrder order, const unsigned char* p) noexcept {
+  return wire_bytes::load_u32(order_of(order), p);
+}
 void write_u32(ByteOrder order, std::uint32_t v, unsigned char* p) noexcept {
-  for (int i = 0; i < 4; ++i) {
-    const auto byte = static_cast<unsigned char>((v >> (8 * i)) & 0xffU);
-    p[order == ByteOrder::kLittle ? i : 3 - i] = byte;
-  }
+  wire_bytes::store_u32(order_of(order), v, p);
 }
 
 void write_header(ByteOrder order, const Header& h, std::size_t data_bytes, unsigned char* out) noexcept {

@@ -21,6 +21,10 @@
 #include "deflex/study/case_config.hpp"
 #include "deflex/study/detail/cell_calibration.hpp"
 
+namespace deflex::runtime {
+class Session;
+}
+
 namespace deflex::study {
 
 /// Everything one physical setup's runs share, built once (read-only while runs execute in parallel).
@@ -110,6 +114,14 @@ struct RunOutput {
 [[nodiscard]] deflex::SensorConfig tare_sensor(deflex::SensorConfig sheet_config, cell::ForceSensorDaq& sensor,
                                                const cell::TrueRobot& robot, const JointVector& q_tare,
                                                double max_std_n);
+
+/// deflex's online bounds and rates from the case, at the controller's cycle `period_s`: what a user
+/// would give `deflex online` (the force watchdog at least two cycles).
+[[nodiscard]] deflex::OnlineConfig online_config_from_case(const CaseConfig& config, double period_s);
+
+/// Lets deflex answer whatever has reached it by now, counting the controller messages it answered;
+/// throws Error, naming `what` ("run", "machining run"), when its session ended with an error.
+void poll_deflex_session(runtime::Session& session, std::uint64_t& link_cycles, const char* what);
 
 /// Runs one protocol run. Throws Error when the run cannot be done (an online strategy without the
 /// sensor, a refused start or a controller that timed out: a broken setup, never a result).
