@@ -21,25 +21,7 @@
 #include "deflex/rsi/rsi_link.hpp"
 #include "deflex/transport/udp_transport.hpp"
 
-// GCC sees the replacement operator new (malloc) and delete (free) of this file inlined into the same
-// translation unit and calls them mismatched; they are the standard replacement pair.
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<std::size_t> g_allocations{0};
-}  // namespace
-void* operator new(std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) {
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-  }
-  if (void* p = std::malloc(size == 0 ? 1 : size)) {
-    return p;
-  }
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#include "counting_new.hpp"
 
 namespace deflex {
 namespace {
