@@ -1,8 +1,11 @@
 // Command-line parsing helpers shared by the subcommands.
 #include "cli_util.hpp"
 
+#include <unistd.h>
+
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <sstream>
 
@@ -118,6 +121,30 @@ void print_json(const nlohmann::json& doc) {
   // A byte that is not UTF-8 (a file name, a program's text) becomes U+FFFD rather than an exception:
   // the readers refuse such text in the fields they take, names given by the shell may still carry it.
   std::cout << doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
+}
+
+void draw_study_progress(const char* command, double fraction, const std::string& label) {
+  static const bool terminal = ::isatty(STDERR_FILENO) != 0;
+  if (!terminal) {
+    static int tenths_shown = -1;
+    const int tenths = static_cast<int>(std::floor(fraction * 10.0 + 1e-9));
+    if (tenths > tenths_shown) {
+      tenths_shown = tenths;
+      std::fprintf(stderr, "deflex %s: %3d %% %s\n", command, tenths * 10, label.c_str());
+      std::fflush(stderr);
+    }
+    return;
+  }
+  constexpr int kWidth = 32;
+  const int filled = static_cast<int>(std::lround(fraction * kWidth));
+  std::string bar(static_cast<std::size_t>(filled), '#');
+  bar.resize(kWidth, '.');
+  std::fprintf(stderr, "\r[%s] %3.0f%% %-40.40s", bar.c_str(), fraction * 100.0, label.c_str());
+  std::fflush(stderr);
+}
+
+void end_study_progress() {
+  if (::isatty(STDERR_FILENO) != 0) std::cerr << "\n";
 }
 
 }  // namespace deflex::cli

@@ -48,4 +48,11 @@ nlohmann::json vector_to_json(const Eigen::Ref<const Eigen::VectorXd>& v);
 /// Prints a JSON document on stdout (only the document, so scripts can pipe it).
 void print_json(const nlohmann::json& doc);
 
+/// A long study's progress on stderr: on a terminal a bar redrawn in place; into a log or a pipe a
+/// plain line "deflex COMMAND:  40 % label" at each tenth of the way (a carriage-return bar would
+/// leave one line of some 50 kB there). Called under the study's progress lock.
+void draw_study_progress(const char* command, double fraction, const std::string& label);
+/// Ends the bar's line on a terminal (after a study drawn with draw_study_progress).
+void end_study_progress();
+
 }  // namespace deflex::cli

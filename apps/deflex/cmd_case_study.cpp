@@ -3,15 +3,11 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <mutex>
 #include <optional>
-
-#include <unistd.h>
 
 #include "cli_util.hpp"
 #include "command.hpp"
@@ -46,29 +42,6 @@ std::string first_matching(std::vector<std::string> paths, const std::string& pa
   return paths.empty() ? std::string() : paths.front();
 }
 
-// Progress on stderr: on a terminal a bar redrawn in place; into a log or a pipe a plain line at each
-// tenth of the way (a carriage-return bar would leave one line of some 50 kB there). Called under the
-// study's progress lock.
-void draw_progress(double fraction, const std::string& label) {
-  static const bool terminal = ::isatty(STDERR_FILENO) != 0;
-  if (!terminal) {
-    static int tenths_shown = -1;
-    const int tenths = static_cast<int>(std::floor(fraction * 10.0 + 1e-9));
-    if (tenths > tenths_shown) {
-      tenths_shown = tenths;
-      std::fprintf(stderr, "deflex case-study: %3d %% %s\n", tenths * 10, label.c_str());
-      std::fflush(stderr);
-    }
-    return;
-  }
-  constexpr int kWidth = 32;
-  const int filled = static_cast<int>(std::lround(fraction * kWidth));
-  std::string bar(static_cast<std::size_t>(filled), '#');
-  bar.resize(kWidth, '.');
-  std::fprintf(stderr, "\r[%s] %3.0f%% %-40.40s", bar.c_str(), fraction * 100.0, label.c_str());
-  std::fflush(stderr);
-}
-
 void run(const CaseStudyOpts& o, int& exit_code) {
   study::CaseConfig config = o.case_file.empty() ? study::paper_case() : study::load_case(o.case_file);
   // The report's folder before the study runs, so a path that cannot be one fails at once; made as
@@ -85,7 +58,8 @@ void run(const CaseStudyOpts& o, int& exit_code) {
   options.error_budget = !o.no_budget;
   options.threads = o.threads;
   options.seeds = o.seeds;
-  if (!o.no_progress) options.progress = draw_progress;
+  if (!o.no_progress)
+    options.progress = [](double f, const std::string& l) { draw_study_progress("case-study", f, l); };
   std::vector<std::string> traces_written;
   std::mutex trace_mutex;
   if (!o.traces_dir.empty()) {
@@ -108,7 +82,7 @@ void run(const CaseStudyOpts& o, int& exit_code) {
   std::cerr << fmt::format("deflex case-study: {} ({} seed{} from {}{})\n", config.name, seeds, seeds == 1 ? "" : "s",
                            config.seed, o.quick ? ", quick" : "");
   const study::CaseStudyOutput result = study::run_case_study(config, options);
-  if (!o.no_progress && ::isatty(STDERR_FILENO) != 0) std::cerr << "\n";
+  if (!o.no_progress) end_study_progress();
 
   // The case file's text goes into the report as it is, and its notes read what it marks as tuned.
   const ReportContent report = study::case_report(

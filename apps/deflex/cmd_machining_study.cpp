@@ -2,14 +2,11 @@
 // strategy, the part is probed, and the part errors are tabled with their spread over seeds.
 #include <fmt/format.h>
 
-#include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 
-#include <unistd.h>
-
+#include "cli_util.hpp"
 #include "command.hpp"
 #include "deflex/report/machining_report.hpp"
 #include "deflex/study/machining_study.hpp"
@@ -25,27 +22,6 @@ struct MachiningStudyOpts {
   int threads = 0;
   bool quick = false, no_progress = false;
 };
-
-// Progress on stderr: a bar redrawn in place on a terminal, a line a tenth of the way otherwise.
-void draw_machining_progress(double fraction, const std::string& label) {
-  static const bool terminal = ::isatty(STDERR_FILENO) != 0;
-  if (!terminal) {
-    static int tenths_shown = -1;
-    const int tenths = static_cast<int>(std::floor(fraction * 10.0 + 1e-9));
-    if (tenths > tenths_shown) {
-      tenths_shown = tenths;
-      std::fprintf(stderr, "deflex machining-study: %3d %% %s\n", tenths * 10, label.c_str());
-      std::fflush(stderr);
-    }
-    return;
-  }
-  constexpr int kWidth = 32;
-  const int filled = static_cast<int>(std::lround(fraction * kWidth));
-  std::string bar(static_cast<std::size_t>(filled), '#');
-  bar.resize(kWidth, '.');
-  std::fprintf(stderr, "\r[%s] %3.0f%% %-40.40s", bar.c_str(), fraction * 100.0, label.c_str());
-  std::fflush(stderr);
-}
 
 void run_machining_study_command(const MachiningStudyOpts& o, int& exit_code) {
   if (o.seeds < 0 || o.seeds > 20) throw InputError(fmt::format("option --seeds: {} is outside 1..20", o.seeds));
@@ -64,11 +40,12 @@ void run_machining_study_command(const MachiningStudyOpts& o, int& exit_code) {
   options.quick = o.quick;
   options.seeds = o.seeds;
   options.threads = o.threads;
-  if (!o.no_progress) options.progress = draw_machining_progress;
+  if (!o.no_progress)
+    options.progress = [](double f, const std::string& l) { draw_study_progress("machining-study", f, l); };
   std::cerr << fmt::format("deflex machining-study: {} seeds{}\n", o.seeds > 0 ? o.seeds : (o.quick ? 2 : 3),
                            o.quick ? ", quick" : "");
   const study::MachiningStudyOutput result = study::run_machining_study(options);
-  if (!o.no_progress && ::isatty(STDERR_FILENO) != 0) std::cerr << "\n";
+  if (!o.no_progress) end_study_progress();
   csv.write(study::machining_table_csv(result));
   json.write(study::machining_json(result));
   if (html != nullptr) html->write(machining_report_html(result));
