@@ -20,25 +20,17 @@
 namespace deflex::study {
 namespace {
 
-class MachiningStudyQuick : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    MachiningStudyOptions o;
-    o.quick = true;
-    out_ = std::make_unique<MachiningStudyOutput>(run_machining_study(o));
+// The quick study takes 17 s of CPU, and ctest runs every test in a process of its own: the checks
+// below share one run, in the one test at the end of the file, each under its own name.
+std::unique_ptr<MachiningStudyOutput> out_;
+const MachiningRun& run(MachiningStrategy s, double feed, int seed) {
+  for (const MachiningRun& r : out_->runs) {
+    if (r.strategy == s && r.feed_mm_min == feed && r.seed_index == seed) return r;
   }
-  static void TearDownTestSuite() { out_.reset(); }
-  static const MachiningRun& run(MachiningStrategy s, double feed, int seed) {
-    for (const MachiningRun& r : out_->runs) {
-      if (r.strategy == s && r.feed_mm_min == feed && r.seed_index == seed) return r;
-    }
-    throw Error("no such run");
-  }
-  static std::unique_ptr<MachiningStudyOutput> out_;
-};
-std::unique_ptr<MachiningStudyOutput> MachiningStudyQuick::out_;
+  throw Error("no such run");
+}
 
-TEST_F(MachiningStudyQuick, TheTableHasEveryStrategyFeedAndSeed) {
+void the_table_has_every_strategy_feed_and_seed() {
   ASSERT_EQ(out_->seeds, 2);
   EXPECT_EQ(out_->runs.size(), 2u * 2u * 4u);
   EXPECT_EQ(out_->rows.size(), 2u * 4u);
@@ -57,7 +49,7 @@ TEST_F(MachiningStudyQuick, TheTableHasEveryStrategyFeedAndSeed) {
 // as much in it), comes out 9-17 % high on every seed: within 20 %. Most of that is the sensor's
 // calibration errors the user never learns (its turn about the tool axis, its sensitivities): with them
 // switched off the same cuts fit Krc 3 % high, against 12 % with them.
-TEST_F(MachiningStudyQuick, TheFittedCoefficientsFollowTheCellsDrawnTruth) {
+void the_fitted_coefficients_follow_the_cells_drawn_truth() {
   ASSERT_EQ(out_->fits.size(), 2u);
   for (const MachiningFit& f : out_->fits) {
     const CuttingCoefficients& k = f.fit.k;
@@ -101,7 +93,7 @@ Vector6 textbook_side_cut(const CuttingCoefficients& k, double ae, double ap, do
 // outermost tooth cuts it). The deflection: the true arm's static solve (all its elastic effects) at
 // the program's joints under the per-tooth sum's force at the width and depth the deflection itself
 // leaves (a fixed point).
-TEST_F(MachiningStudyQuick, TheUncompensatedContourWallIsWhereTheClosedFormPutsIt) {
+void the_uncompensated_contour_wall_is_where_the_closed_form_puts_it() {
   const MillCell mc = build_mill_cell(1);  // seed index 0's cell, rebuilt: the same draws
   const MillPart part = make_mill_part(true);
   const MillPass& contour = part.passes.back();
@@ -152,7 +144,7 @@ TEST_F(MachiningStudyQuick, TheUncompensatedContourWallIsWhereTheClosedFormPutsI
 
 // Each strategy leaves the down-milled walls (the pocket's and the contour's) and the pocket's width
 // within 35 % of the uncompensated error, at both feeds, on every seed.
-TEST_F(MachiningStudyQuick, EveryStrategyReducesTheWallErrorsByAStatedMargin) {
+void every_strategy_reduces_the_wall_errors_by_a_stated_margin() {
   for (int seed = 0; seed < out_->seeds; ++seed) {
     for (double feed : out_->feeds_mm_min) {
       const PartErrors& uc = run(MachiningStrategy::kUncompensated, feed, seed).errors;
@@ -172,7 +164,7 @@ TEST_F(MachiningStudyQuick, EveryStrategyReducesTheWallErrorsByAStatedMargin) {
 
 // Every size the study gives the cell and the cuts lies inside the range data/cases/effect-ranges.yaml
 // documents for it, with its source.
-TEST_F(MachiningStudyQuick, EverySizeIsInsideItsDocumentedRange) {
+void every_size_is_inside_its_documented_range() {
   const YAML::Node ranges =
       YAML::LoadFile((std::filesystem::path(DEFLEX_SOURCE_DIR) / "data/cases/effect-ranges.yaml").string());
   const YAML::Node milling = ranges["milling"];
@@ -194,6 +186,33 @@ TEST_F(MachiningStudyQuick, EverySizeIsInsideItsDocumentedRange) {
   for (double fz : z.fz_m) check("feed_per_tooth_mm", fz * 1e3);
   ASSERT_FALSE(z.ap_m.empty());
   for (double ap : z.ap_m) check("axial_depth_mm", ap * 1e3);
+}
+
+TEST(MachiningStudyQuick, TheQuickStudyChecks) {
+  MachiningStudyOptions o;
+  o.quick = true;
+  out_ = std::make_unique<MachiningStudyOutput>(run_machining_study(o));
+  {
+    SCOPED_TRACE("TheTableHasEveryStrategyFeedAndSeed");
+    the_table_has_every_strategy_feed_and_seed();
+  }
+  {
+    SCOPED_TRACE("TheFittedCoefficientsFollowTheCellsDrawnTruth");
+    the_fitted_coefficients_follow_the_cells_drawn_truth();
+  }
+  {
+    SCOPED_TRACE("TheUncompensatedContourWallIsWhereTheClosedFormPutsIt");
+    the_uncompensated_contour_wall_is_where_the_closed_form_puts_it();
+  }
+  {
+    SCOPED_TRACE("EveryStrategyReducesTheWallErrorsByAStatedMargin");
+    every_strategy_reduces_the_wall_errors_by_a_stated_margin();
+  }
+  {
+    SCOPED_TRACE("EverySizeIsInsideItsDocumentedRange");
+    every_size_is_inside_its_documented_range();
+  }
+  out_.reset();
 }
 
 TEST(MachiningStudy, BadOptionsAreRefused) {
