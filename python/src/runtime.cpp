@@ -2,12 +2,12 @@
 // (the same session object: runtime/session.hpp), against a real controller's address; deflex.StandIn
 // runs one against an in-memory stand-in of the controller (standin/standin_session.hpp) with the
 // faults of a cell on request. Both hand back the cycle log as NumPy arrays and the summary as a dict.
-// Settings are keyword arguments with the C++ field names and SI units; an unknown one is an
+// Settings are keyword arguments: the keys of the library's settings table (runtime/session_settings.hpp),
+// in SI units, checked by the library as the command line's options are; an unknown one is an
 // InputError naming it.
 #include <cmath>
-#include <functional>
-#include <map>
 #include <memory>
+#include <vector>
 
 #include <fmt/format.h>
 #include <pybind11/stl.h>
@@ -16,7 +16,8 @@
 #include "bindings.hpp"
 #include "deflex/force/force_spec.hpp"
 #include "deflex/runtime/session.hpp"
-#include "deflex/sensors/force_source_spec.hpp"
+#include "deflex/runtime/session_force.hpp"
+#include "deflex/runtime/session_settings.hpp"
 #include "deflex/standin/standin_session.hpp"
 #include "deflex/text/errors.hpp"
 
@@ -24,119 +25,50 @@ namespace deflex::python {
 using namespace pybind11::literals;
 namespace {
 
-// One setting: its name, and how a Python value sets it in the session's configuration.
-using Setter = std::function<void(runtime::SessionConfig&, const py::handle&)>;
-
-template <typename T>
-T as(const py::handle& v, const std::string& name) {
-  try {
-    return v.cast<T>();
-  } catch (const py::cast_error&) {
-    throw InputError(fmt::format("setting {}: {} is not a {}", name, py::str(py::repr(v)).cast<std::string>(),
-                                 std::is_same_v<T, bool>          ? "bool"
-                                 : std::is_same_v<T, std::string> ? "str"
-                                                                  : "number"));
+// A keyword's value as the settings table takes it; a value of the wrong kind is passed on as it is,
+// so that the library refuses it with the words the command line gets.
+runtime::SettingValue setting_value(const runtime::SessionSetting& s, const py::handle& v) {
+  const bool is_bool = py::isinstance<py::bool_>(v);
+  switch (s.type) {
+    case runtime::SettingType::kReal:
+    case runtime::SettingType::kInteger:
+      if (!is_bool && (py::isinstance<py::int_>(v) || py::isinstance<py::float_>(v))) return v.cast<double>();
+      return std::string();  // the wrong kind: "expects a number"
+    case runtime::SettingType::kFlag:
+      if (is_bool) return v.cast<bool>();
+      break;
+    case runtime::SettingType::kText:
+      if (py::isinstance<py::str>(v)) return v.cast<std::string>();
+      break;
   }
+  return 0.0;  // the wrong kind: "expects True or False", "expects words"
 }
 
-const std::map<std::string, Setter>& settings() {
-  using C = runtime::SessionConfig;
-  static const std::map<std::string, Setter> table = [] {
-    std::map<std::string, Setter> t;
-    const auto real = [&t](const char* name, std::function<double&(C&)> field) {
-      t[name] = [field, name](C& c, const py::handle& v) { field(c) = as<double>(v, name); };
-    };
-    const auto integer = [&t](const char* name, std::function<int&(C&)> field) {
-      t[name] = [field, name](C& c, const py::handle& v) { field(c) = as<int>(v, name); };
-    };
-    const auto flag = [&t](const char* name, std::function<bool&(C&)> field) {
-      t[name] = [field, name](C& c, const py::handle& v) { field(c) = as<bool>(v, name); };
-    };
-    const auto text = [&t](const char* name, std::function<std::string&(C&)> field) {
-      t[name] = [field, name](C& c, const py::handle& v) { field(c) = as<std::string>(v, name); };
-    };
-    real("period_s", [](C& c) -> double& { return c.online.period_s; });
-    real("max_joint_correction_rad", [](C& c) -> double& { return c.online.max_joint_correction_rad; });
-    real("max_tcp_correction_m", [](C& c) -> double& { return c.online.max_tcp_correction_m; });
-    real("max_correction_rate_rad_s", [](C& c) -> double& { return c.online.max_correction_rate_rad_s; });
-    real("max_tcp_rate_m_s", [](C& c) -> double& { return c.online.max_tcp_rate_m_s; });
-    real("watchdog_s", [](C& c) -> double& { return c.online.watchdog_s; });
-    t["stop_silence_s"] = [](C& c, const py::handle& v) { c.stop_silence_s = as<double>(v, "stop_silence_s"); };
-    real("end_silence_s", [](C& c) -> double& { return c.end_silence_s; });
-    flag("end_on_silence", [](C& c) -> bool& { return c.end_on_silence; });
-    real("duration_s", [](C& c) -> double& { return c.duration_s; });
-    real("stop_ramp_s", [](C& c) -> double& { return c.stop_ramp_s; });
-    real("status_interval_s", [](C& c) -> double& { return c.status_interval_s; });
-    text("log_path", [](C& c) -> std::string& { return c.log_path; });
-    text("fault_dump_path", [](C& c) -> std::string& { return c.fault_dump_path; });
-    text("bind_address", [](C& c) -> std::string& { return c.network.bind_address; });
-    integer("egm_port", [](C& c) -> int& { return c.network.egm_port; });
-    integer("rsi_port", [](C& c) -> int& { return c.network.rsi_port; });
-    text("robot_host", [](C& c) -> std::string& { return c.network.robot_host; });
-    integer("motion_port", [](C& c) -> int& { return c.network.motion_port; });
-    integer("state_port", [](C& c) -> int& { return c.network.state_port; });
-    real("connect_timeout_s", [](C& c) -> double& { return c.network.connect_timeout_s; });
-    t["ramp_in_s"] = [](C& c, const py::handle& v) {
-      c.egm_joint.stream.ramp_in_s = c.simple_message.stream.ramp_in_s = c.fanuc_j519.stream.ramp_in_s =
-          as<double>(v, "ramp_in_s");
-    };
-    integer("robot_port", [](C& c) -> int& { return c.network.robot_port; });
-    t["fanuc_version"] = [](C& c, const py::handle& v) {
-      const int version = as<int>(v, "fanuc_version");
-      if (!fanuc_j519::known_version(version < 0 ? 0U : static_cast<std::uint32_t>(version))) {
-        throw InputError(fmt::format("setting fanuc_version: {} is not 1, 3 or 4", version));
-      }
-      c.fanuc_j519.version = static_cast<std::uint32_t>(version);
-    };
-    t["fanuc_limits"] = [](C& c, const py::handle& v) {
-      c.fanuc_j519.limits = parse_fanuc_limits(as<std::string>(v, "fanuc_limits"), "fanuc_limits");
-    };
-    real("fanuc_correction_share", [](C& c) -> double& { return c.fanuc_j519.correction_share; });
-    integer("fanuc_catch_up", [](C& c) -> int& { return c.fanuc_j519.max_catch_up; });
-    flag("send_speed_reference", [](C& c) -> bool& { return c.egm_joint.send_speed_reference; });
-    t["path_corr_frame"] = [](C& c, const py::handle& v) {
-      c.egm_path.frame = parse_path_corr_frame(as<std::string>(v, "path_corr_frame"));
-    };
-    text("rsi_sentype", [](C& c) -> std::string& { return c.rsi.sentype; });
-    integer("rsi_timeout", [](C& c) -> int& { return c.rsi.controller_timeout; });
-    integer("buffer_depth", [](C& c) -> int& { return c.simple_message.buffer_depth; });
-    real("max_behind_s", [](C& c) -> double& { return c.simple_message.max_behind_s; });
-    t["byte_order"] = [](C& c, const py::handle& v) {
-      c.simple_message.byte_order = simple_message::parse_byte_order(as<std::string>(v, "byte_order"));
-    };
-    t["jacobian_at"] = [](C& c, const py::handle& v) {
-      const std::string s = as<std::string>(v, "jacobian_at");
-      if (s != "planned" && s != "feedback") throw InputError("setting jacobian_at: 'planned' or 'feedback'");
-      c.online.jacobian_at = s == "planned" ? JacobianAt::kPlanned : JacobianAt::kFeedback;
-    };
-    flag("realtime", [](C& c) -> bool& { return c.realtime.enabled; });
-    integer("rt_priority", [](C& c) -> int& { return c.realtime.priority; });
-    integer("rt_cpu", [](C& c) -> int& { return c.realtime.cpu; });
-    return t;
-  }();
-  return table;
+std::string setting_keys() {
+  std::string keys;
+  for (const runtime::SessionSetting& s : runtime::session_settings())
+    keys += fmt::format("{}{}", keys.empty() ? "" : ", ", s.key);
+  return keys;
 }
 
-std::string setting_names() {
-  std::string names;
-  for (const auto& [name, setter] : settings()) names += (names.empty() ? "" : ", ") + name;
-  return names;
-}
-
-runtime::SessionConfig config_from(const std::string& link, const std::string& strategy, const py::kwargs& kwargs) {
-  runtime::SessionConfig c;
-  c.link = runtime::parse_link_kind(link);
-  c.strategy = parse_strategy(strategy);
-  c.online.period_s = runtime::link_kind(c.link).default_period_s;
-  c.status_interval_s = 0.0;  // a Python caller reads the summary; no status lines unless asked
+// The session's configuration from the keyword settings (runtime/session_settings.hpp: the command
+// line's options under their SI keys), checked by the library. `extra` are settings given as named
+// arguments (the force source).
+runtime::SessionConfig config_from(const std::string& link, const std::string& strategy, const py::kwargs& kwargs,
+                                   std::vector<runtime::GivenSetting> given = {}) {
+  bool status_given = false;
   for (const auto& [key, value] : kwargs) {
     const std::string name = key.cast<std::string>();
-    const auto it = settings().find(name);
-    if (it == settings().end()) {
-      throw InputError(fmt::format("setting '{}' is not one of {}", name, setting_names()));
+    const runtime::SessionSetting* s = runtime::find_session_setting(name);
+    if (s == nullptr || s->key != name) {
+      throw InputError(fmt::format("setting '{}' is not one of {}", name, setting_keys()));
     }
-    it->second(c, value);
+    status_given = status_given || s->key == "status_interval_s";
+    given.push_back({s, setting_value(*s, value)});
   }
+  // A Python caller reads the summary: no status lines unless asked.
+  if (!status_given) given.push_back({runtime::find_session_setting("status_interval_s"), 0.0});
+  runtime::SessionConfig c = runtime::make_session_config(link, strategy, given);
   c.collect_cycles = true;
   return c;
 }
@@ -248,17 +180,19 @@ void bind_runtime(py::module_& m) {
                        const py::kwargs& kwargs) {
              auto s = std::make_unique<PySession>();
              s->robot = robot;
-             const runtime::SessionConfig config = config_from(link, strategy, kwargs);
+             std::vector<runtime::GivenSetting> force;
+             force.push_back({runtime::find_session_setting("force_source"), force_source});
+             if (loop) force.push_back({runtime::find_session_setting("loop"), true});
+             if (!rdt_calibration.empty()) {
+               force.push_back({runtime::find_session_setting("rdt_calibration"), rdt_calibration});
+             }
+             const runtime::SessionConfig config = config_from(link, strategy, kwargs, std::move(force));
              SensorConfig sc = sensor.is_none() ? SensorConfig{} : sensor.cast<SensorConfig>();
              if (!force_model.empty()) s->force_model = parse_force_spec(force_model);
-             ForceSourceOptions fo;
-             fo.loop = loop;
-             fo.bind_address = config.network.bind_address;
-             fo.rdt_calibration.spec = rdt_calibration;
-             s->force = open_force_source(force_source, fo);
-             if (s->force.sample_rate_hz > 0.0) sc.sample_rate_hz = s->force.sample_rate_hz;
-             s->session = std::make_unique<runtime::Session>(config, *robot, sc, program_of(program, *robot),
-                                                             s->force_model.get(), s->force.source.get(), s->clock);
+             const std::shared_ptr<const JointTrajectory> nominal = program_of(program, *robot);
+             s->force = runtime::open_session_force(config, *robot, sc, nominal.get());
+             s->session = std::make_unique<runtime::Session>(config, *robot, sc, nominal, s->force_model.get(),
+                                                             s->force.source.get(), s->clock);
              return s;
            }),
            "robot"_a, "link"_a, "force_source"_a, py::kw_only(), "program"_a = py::none(), "sensor"_a = py::none(),

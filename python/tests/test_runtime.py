@@ -109,16 +109,16 @@ def test_settings_are_checked_and_named():
     robot = deflex.Robot.builtin()
     with pytest.raises(deflex.InputError, match="setting 'egm_prot' is not one of"):
         deflex.StandIn(robot, "egm-joint", sweep(), egm_prot=1)
-    with pytest.raises(deflex.InputError, match="setting period_s: 'fast' is not a number"):
+    with pytest.raises(deflex.InputError, match=r"setting period_s \(--period-ms\): expects a number"):
         deflex.StandIn(robot, "egm-joint", sweep(), period_s="fast")
     with pytest.raises(deflex.InputError, match="argument link: 'fanuc' is not one of"):
         deflex.StandIn(robot, "fanuc", sweep())
-    with pytest.raises(deflex.InputError, match="setting fanuc_version: 2 is not 1, 3 or 4"):
+    with pytest.raises(deflex.InputError, match="protocol version 2 is not 1, 3 or 4"):
         deflex.StandIn(robot, "fanuc-j519", sweep(), fanuc_version=2)
     with pytest.raises(deflex.InputError, match="is not VEL,ACC,JERK"):
         deflex.StandIn(robot, "fanuc-j519", sweep(), fanuc_limits="120;265")
     with pytest.raises(deflex.InputError, match="rate bound allows"):
-        deflex.StandIn(robot, "egm-joint", sweep(), max_correction_rate_rad_s=10.0)
+        deflex.StandIn(robot, "egm-joint", sweep(), max_correction_rate_rad_s=0.5, period_s=0.1)
 
 
 def test_a_session_on_udp_against_the_python_egm_standin(tmp_path):
@@ -150,3 +150,33 @@ def test_a_session_on_udp_against_the_python_egm_standin(tmp_path):
     nominal = np.array([[np.interp(p, t, q[:, j]) for j in range(6)] for p in log["program_t_s"][sent]])
     assert np.abs(nominal - log["q_nominal_rad"][sent]).max() < np.radians(0.05)  # the CSV's cubic vs linear
     assert "answers taken" in out
+
+
+def test_the_command_line_and_python_refuse_the_same_settings_with_the_same_words(tmp_path):
+    """Both front ends hand their settings to the library's table (runtime/session_settings.hpp): the same
+    bad value, once as `deflex online`'s option in its unit and once as Python's keyword in SI, is
+    refused with the same sentence."""
+    from conftest import run_cli
+
+    robot = deflex.Robot.builtin()
+    force = f"csv:{SOURCE_DIR / 'examples/online/force_replay.csv'}"
+    cases = [  # (link, Python keywords, the command line's options)
+        ("egm-joint", {"max_joint_correction_rad": 1.0}, ["--max-joint-correction-deg", "57.29577951308232"]),
+        ("egm-joint", {"period_s": 2.0}, ["--period-ms", "2000"]),
+        ("rsi", {"buffer_depth": 2}, ["--buffer-depth", "2"]),
+        ("simple-message", {"period_s": 0.004}, ["--period-ms", "4"]),
+        ("egm-joint", {"jacobian_at": "sideways"}, ["--jacobian-at", "sideways"]),
+        ("egm-joint", {"rt_cpu": 1}, ["--rt-cpu", "1"]),
+        ("egm-joint", {"tare_window_s": 0.5}, ["--tare-window-s", "0.5"]),
+        ("fanuc-j519", {"fanuc_correction_share": 1.5}, ["--fanuc-correction-share", "1.5"]),
+        ("egm-path", {"stop_ramp_s": 20.0}, ["--stop-ramp-s", "20"]),
+        ("rsi", {"rsi_sentype": "9lives"}, ["--rsi-sentype", "9lives"]),
+    ]
+    for link, keywords, options in cases:
+        with pytest.raises(deflex.InputError) as python_error:
+            deflex.Session(robot, link, force, **keywords)
+        cli = run_cli("online", "--link", link, "--force-source", force, *options, check=False)
+        assert cli.returncode == 2, cli.stderr
+        words = str(python_error.value)
+        assert words.startswith("setting "), words
+        assert f"deflex online: error: {words}\n" in cli.stderr, (words, cli.stderr)

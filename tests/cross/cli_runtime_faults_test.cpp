@@ -258,7 +258,7 @@ TEST(CliRuntimeFaults, RealTimeTheSystemRefusesIsExitTwoNamingThePermission) {
   const auto o = test::run_cli("online --link egm-joint --egm-port 0 --force-source csv:" + test::kForceReplay +
                                " --program " + program_path + " --rt-cpu 1");
   EXPECT_EQ(o.exit_code, 2);
-  EXPECT_NE(o.err.find("apply with --realtime"), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find("setting rt_cpu (--rt-cpu): applies with realtime (--realtime)"), std::string::npos) << o.err;
 }
 
 }  // namespace

@@ -266,14 +266,15 @@ TEST(CliSimpleMessage, BadOptionsAreRefusedBeforeAnythingConnects) {
     EXPECT_NE(r.err.find(fragment), std::string::npos) << args << "\n" << r.err;
   };
   expect(base + " --period-ms 100", "--robot-host");
-  expect(base + " --robot-host 127.0.0.1 --period-ms 4", "option --period-ms: simple-message sends one point a cycle");
+  expect(base + " --robot-host 127.0.0.1 --period-ms 4",
+         "setting period_s (--period-ms): simple-message sends one point a cycle");
   expect(base + " --robot-host 127.0.0.1 --period-ms 100 --egm-port 6510",
-         "option --egm-port: applies to --link egm-joint or egm-path, not simple-message");
+         "setting egm_port (--egm-port): applies to --link egm-joint or egm-path, not simple-message");
   expect(base + " --robot-host 127.0.0.1 --period-ms 100 --byte-order middle",
-         "option --byte-order: byte order 'middle'");
-  expect(base + " --robot-host 127.0.0.1 --period-ms 100 --buffer-depth 0", "option --buffer-depth");
-  expect(base + " --robot-host 127.0.0.1 --period-ms 100 --motion-port 70000", "option --motion-port");
-  expect(base + " --robot-host 127.0.0.1 --period-ms 100 --reply-timeout-s 0", "option --reply-timeout-s");
+         "setting byte_order (--byte-order): byte order 'middle'");
+  expect(base + " --robot-host 127.0.0.1 --period-ms 100 --buffer-depth 0", "(--buffer-depth)");
+  expect(base + " --robot-host 127.0.0.1 --period-ms 100 --motion-port 70000", "(--motion-port)");
+  expect(base + " --robot-host 127.0.0.1 --period-ms 100 --reply-timeout-s 0", "(--reply-timeout-s)");
   expect("online --link simple-message --force-source csv:" + test::kForceReplay +
              " --robot-host 127.0.0.1 --period-ms 100",
          "--program");

@@ -277,8 +277,8 @@ void add_message_cases(std::vector<BadInput>& cases) {
       {"record_max_std_zero", record + "--max-std-N 0", {"option --max-std-N"}},
       {"record_max_std_nm_negative", record + "--max-std-Nm -0.1", {"option --max-std-Nm"}},
       {"record_window_zero", record + "--window-s 0", {"option --window-s"}},
-      {"tare_window_zero", tare + "--tare-window-s 0", {"option --tare-window-s"}},
-      {"tare_max_std_negative", tare + "--tare-max-std-N -1", {"option --tare-max-std-N"}},
+      {"tare_window_zero", tare + "--tare-window-s 0", {"(--tare-window-s)"}},
+      {"tare_max_std_negative", tare + "--tare-max-std-N -1", {"(--tare-max-std-N)"}},
   };
   for (const auto& [tag, args, says] : options) {
     cases.push_back({"message_" + tag, args, {}, says});
