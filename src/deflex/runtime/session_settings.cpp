@@ -623,7 +623,7 @@ std::string links_text(LinkMask links) {
 
 // A value in the key's unit, and in the option's where that differs: "1 rad (57.3 deg)".
 std::string value_text(const SessionSetting& s, double v) {
-  const std::string key = fmt::format("{:.6g}{}{}", v, s.unit.empty() ? "" : " ", s.unit);
+  std::string key = fmt::format("{:.6g}{}{}", v, s.unit.empty() ? "" : " ", s.unit);
   if (s.option_unit.empty() || s.option_unit == s.unit) return key;
   return fmt::format("{} ({:.6g} {})", key, v * s.option_per_unit, s.option_unit);
 }
