@@ -39,12 +39,13 @@ Vector3 tcp_of(const RobotModel& m, const JointVector& q) {
 
 TEST(OnlineStrategy, HybridSubtractsTheModelForceAtTheFeedbackPose) {
   const RobotModel robot = tool_robot();
+  FrameCache frames(robot);
   const Vector3 pivot(1.6, 0.1, 0.6);
   const LdbbForceModel ldbb(pivot, 400.0, true);
   OnlineStrategy s(robot, StrategyKind::kHybrid, &ldbb);
   const JointVector fb = pose_deg(3, 28, 8, 5, 52, -4), target = pose_deg(5, 27, 9, 5, 51, -3);
   CycleInput in;
-  ASSERT_EQ(s.prepare(in, fb, target, 0.05, 0.009), StrategyStatus::kOk);
+  ASSERT_EQ(s.prepare(in, fb, target, 0.05, 0.009, frames), StrategyStatus::kOk);
   const Vector3 bar = tcp_of(robot, fb) - pivot;
   EXPECT_LT((in.wrench_offset_base.head<3>() + 400.0 * bar.normalized()).norm(), 1e-9);
   EXPECT_LT(in.wrench_offset_base.tail<3>().norm(), 1e-9);  // WAP = TCP: no moment
@@ -54,27 +55,29 @@ TEST(OnlineStrategy, HybridSubtractsTheModelForceAtTheFeedbackPose) {
 
 TEST(OnlineStrategy, PredictiveAddsTheModelsChangeOrLeadsAlongTheSlope) {
   const RobotModel robot = tool_robot();
+  FrameCache frames(robot);
   const Vector3 pivot(1.6, 0.1, 0.6);
   const LdbbForceModel ldbb(pivot, 650.0, false);
   const JointVector fb = pose_deg(3, 28, 8, 5, 52, -4), target = pose_deg(6, 27, 9, 5, 51, -3);
   CycleInput in;
   OnlineStrategy with_model(robot, StrategyKind::kPredictive, &ldbb);
-  ASSERT_EQ(with_model.prepare(in, fb, target, 0.06, 0.009), StrategyStatus::kOk);
+  ASSERT_EQ(with_model.prepare(in, fb, target, 0.06, 0.009, frames), StrategyStatus::kOk);
   const Vector3 at_fb = -650.0 * (tcp_of(robot, fb) - pivot).normalized();
   const Vector3 at_target = -650.0 * (tcp_of(robot, target) - pivot).normalized();
   EXPECT_LT((in.wrench_offset_base.head<3>() - (at_target - at_fb)).norm(), 1e-9);
   EXPECT_DOUBLE_EQ(in.wrench_lead_s, 0.009);  // only the filter's lag along the slope
   OnlineStrategy without(robot, StrategyKind::kPredictive, nullptr);
-  ASSERT_EQ(without.prepare(in, fb, target, 0.06, 0.009), StrategyStatus::kOk);
+  ASSERT_EQ(without.prepare(in, fb, target, 0.06, 0.009, frames), StrategyStatus::kOk);
   EXPECT_TRUE(in.wrench_offset_base.isZero());
   EXPECT_DOUBLE_EQ(in.wrench_lead_s, 0.069);  // the link delay and the filter's lag
 }
 
 TEST(OnlineStrategy, NoneHoldsAndBadConfigurationsAreRefused) {
   const RobotModel robot = tool_robot();
+  FrameCache frames(robot);
   OnlineStrategy none(robot, StrategyKind::kNone, nullptr);
   CycleInput in;
-  ASSERT_EQ(none.prepare(in, pose_deg(0, 20, 10, 0, 60, 0), pose_deg(0, 20, 10, 0, 60, 0), 0.05, 0.009),
+  ASSERT_EQ(none.prepare(in, pose_deg(0, 20, 10, 0, 60, 0), pose_deg(0, 20, 10, 0, 60, 0), 0.05, 0.009, frames),
             StrategyStatus::kOk);
   EXPECT_TRUE(in.hold_to_zero);
   EXPECT_THROW(OnlineStrategy(robot, StrategyKind::kHybrid, nullptr), InputError);
@@ -86,19 +89,20 @@ TEST(OnlineStrategy, NoneHoldsAndBadConfigurationsAreRefused) {
   const Vector3 tcp = tcp_of(robot, pose_deg(0, 20, 10, 0, 60, 0));
   const LdbbForceModel at_pivot(tcp, 100.0, true);
   OnlineStrategy hybrid(robot, StrategyKind::kHybrid, &at_pivot);
-  EXPECT_EQ(hybrid.prepare(in, pose_deg(0, 20, 10, 0, 60, 0), pose_deg(0, 20, 10, 0, 60, 0), 0.05, 0.009),
+  EXPECT_EQ(hybrid.prepare(in, pose_deg(0, 20, 10, 0, 60, 0), pose_deg(0, 20, 10, 0, 60, 0), 0.05, 0.009, frames),
             StrategyStatus::kModelForceUnavailable);
 }
 
 TEST(OnlineStrategy, PrepareDoesNotAllocate) {
   const RobotModel robot = tool_robot();
+  FrameCache frames(robot);
   const LdbbForceModel ldbb(Vector3(1.6, 0.1, 0.6), 400.0, true);
   OnlineStrategy s(robot, StrategyKind::kPredictive, &ldbb);
   CycleInput in;
   const JointVector fb = pose_deg(3, 28, 8, 5, 52, -4), target = pose_deg(5, 27, 9, 5, 51, -3);
-  (void)s.prepare(in, fb, target, 0.05, 0.009);
+  (void)s.prepare(in, fb, target, 0.05, 0.009, frames);
   test::AllocationGuard guard;
-  for (int i = 0; i < 100; ++i) (void)s.prepare(in, fb, target, 0.05, 0.009);
+  for (int i = 0; i < 100; ++i) (void)s.prepare(in, fb, target, 0.05, 0.009, frames);
   EXPECT_EQ(guard.allocations(), 0u);
 }
 

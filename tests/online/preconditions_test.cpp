@@ -30,6 +30,7 @@ JointVector joints_deg(double a, double b, double c, double d, double e, double 
 
 TEST(OnlinePreconditions, AStrategyRefusesJointVectorsOfTheWrongCountOrNotFiniteWithAStatus) {
   const RobotModel robot = builtin_irb6700();
+  FrameCache frames(robot);
   const LdbbForceModel ldbb(Vector3(1.6, 0.1, 0.6), 400.0, true);
   Wrench down = Wrench::Zero();
   down[2] = -300.0;
@@ -45,10 +46,10 @@ TEST(OnlinePreconditions, AStrategyRefusesJointVectorsOfTheWrongCountOrNotFinite
       StrategyStatus feedback_short, target_short, feedback_nan, target_nan;
       {
         test::AllocationGuard guard;
-        feedback_short = s.prepare(in, five, good, 0.05, 0.009);
-        target_short = s.prepare(in, good, five, 0.05, 0.009);
-        feedback_nan = s.prepare(in, not_finite, good, 0.05, 0.009);
-        target_nan = s.prepare(in, good, not_finite, 0.05, 0.009);
+        feedback_short = s.prepare(in, five, good, 0.05, 0.009, frames);
+        target_short = s.prepare(in, good, five, 0.05, 0.009, frames);
+        feedback_nan = s.prepare(in, not_finite, good, 0.05, 0.009, frames);
+        target_nan = s.prepare(in, good, not_finite, 0.05, 0.009, frames);
         EXPECT_EQ(guard.allocations(), 0u);
       }
       EXPECT_EQ(feedback_short, StrategyStatus::kInvalidInput) << to_string(kind);
@@ -58,7 +59,7 @@ TEST(OnlinePreconditions, AStrategyRefusesJointVectorsOfTheWrongCountOrNotFinite
         EXPECT_EQ(target_nan, StrategyStatus::kInvalidInput);
       }
       EXPECT_TRUE(in.wrench_offset_base.allFinite());
-      EXPECT_EQ(s.prepare(in, good, good, 0.05, 0.009), StrategyStatus::kOk) << to_string(kind);
+      EXPECT_EQ(s.prepare(in, good, good, 0.05, 0.009, frames), StrategyStatus::kOk) << to_string(kind);
     }
   }
 }

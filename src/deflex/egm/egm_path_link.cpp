@@ -58,29 +58,28 @@ EgmPathLink::EgmPathLink(OnlineCompensator& compensator, OnlineStrategy& strateg
       receiver_(transport, clock, compensator.model(), with_period(config.receiver, compensator.config().period_s),
                 counters_),
       delay_(config.initial_delay_s),
-      ws_(compensator.model()),
       jac_(6, compensator.model().dof()) {
   const int n = compensator.model().dof();
-  for (JointVector* q :
-       {&feedback_, &planned_, &previous_feedback_, &velocity_, &target_, &sent_offset_joints_, &reference_}) {
+  for (JointVector* q : {&feedback_, &planned_, &previous_feedback_, &velocity_, &target_, &sent_offset_joints_,
+                         &reference_, &previous_path_q_}) {
     *q = JointVector::Zero(n);
   }
   tx_.assign(512, 0);
 }
 
 bool EgmPathLink::correction_frame(const JointVector& q_feedback, Matrix3& base_R_frame) noexcept {
-  forward_kinematics(cycle_.compensator().model(), ws_, q_feedback);
+  const Workspace& ws = cycle_.compensator().frames().at(q_feedback);  // the cycle's, computed once
   switch (config_.frame) {
     case PathCorrFrame::kTool:
-      base_R_frame = ws_.base_T_tcp.linear();
+      base_R_frame = ws.base_T_tcp.linear();
       return true;
     case PathCorrFrame::kFlange:
-      base_R_frame = ws_.base_T_flange.linear();
+      base_R_frame = ws.base_T_flange.linear();
       return true;
     case PathCorrFrame::kPath: {
       if (!have_direction_) return false;
       const Vector3 x = travel_direction_;
-      Vector3 y = ws_.base_T_tcp.linear().col(2).cross(x);
+      Vector3 y = ws.base_T_tcp.linear().col(2).cross(x);
       if (!(y.norm() > 1e-6)) return false;  // travelling along the tool axis: no path frame
       y.normalize();
       base_R_frame.col(0) = x;
@@ -154,19 +153,24 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
 
   // Where the arm goes: its joint velocity and the controller's period from the feedback; the
   // direction of travel (path coordinates) from the controller's planned path, which the correction
-  // does not move (from the feedback it would chase its own correction), else from the feedback.
+  // does not move (from the feedback it would chase its own correction), else from the feedback: the
+  // TCP's step as the Jacobian at the feedback (the cycle's frames, no kinematics of its own) maps the
+  // joints' step, exact to first order in a 4-48 ms step.
   const RobotModel& model = cycle_.compensator().model();
-  forward_kinematics(model, ws_, m.has_planned ? planned_ : feedback_);
-  const Vector3 tcp = ws_.base_T_tcp.translation();
+  const JointVector& path_q = m.has_planned ? planned_ : feedback_;
   if (have_previous_) {
     const double dt = now - previous_t_s_;
     if (dt > 0.0) {
       velocity_ += 0.5 * ((feedback_ - previous_feedback_) / dt - velocity_);
       period_s_ = period_s_ > 0.0 ? period_s_ + 0.1 * (dt - period_s_) : dt;
-      const Vector3 step = tcp - previous_tcp_m_;
-      if (step.norm() > 1e-6) {
-        travel_direction_ = step.normalized();
-        have_direction_ = true;
+      if (config_.frame == PathCorrFrame::kPath) {
+        const Workspace& ws = cycle_.compensator().frames().at(feedback_);
+        point_jacobian(ws, ws.base_T_tcp.translation(), jac_);
+        const Vector3 step = jac_.topRows<3>() * (path_q - previous_path_q_);
+        if (step.norm() > 1e-6) {
+          travel_direction_ = step.normalized();
+          have_direction_ = true;
+        }
       }
     }
   } else {
@@ -174,7 +178,7 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
   }
   previous_feedback_ = feedback_;
   previous_t_s_ = now;
-  previous_tcp_m_ = tcp;
+  previous_path_q_ = path_q;
   have_previous_ = true;
 
   if (m.has_planned) {
@@ -209,7 +213,8 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
   const auto compute = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_read).count(); };
   if (verdict != LinkCycle::Verdict::kSend) return cycle_not_passed(verdict, compute());
   // The rotation the model predicts, which this mode cannot correct.
-  jacobian(model, ws_, target_, EndPoint::kTcp, jac_);
+  const Workspace& at_target = cycle_.compensator().frames().at(target_);  // the compensator's, computed
+  point_jacobian(at_target, at_target.base_T_tcp.translation(), jac_);
   const double rotation = (jac_.bottomRows<3>() * cycle_.output().dtheta).norm();
   cycle_.note_uncorrected_rotation(rotation);
   max_rotation_rad_ = std::max(max_rotation_rad_, rotation);

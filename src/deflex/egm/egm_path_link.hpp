@@ -84,7 +84,7 @@ class EgmPathLink final : public ControllerLink {
   double previous_t_s_ = 0.0;
   bool have_previous_ = false;
   double period_s_ = 0.0;
-  Vector3 previous_tcp_m_ = Vector3::Zero();
+  JointVector previous_path_q_;  // the joints the direction of travel was last taken from
   Vector3 travel_direction_ = Vector3::Zero();
   bool have_direction_ = false;
   Matrix3 last_frame_ = Matrix3::Identity();  // the correction frame last known (kept when it cannot be formed)
@@ -94,7 +94,6 @@ class EgmPathLink final : public ControllerLink {
   EgmPathCorrMessage reply_;
   std::vector<unsigned char> tx_;
   std::uint32_t reply_seq_ = 0;
-  Workspace ws_;
   Jacobian jac_;
 };
 

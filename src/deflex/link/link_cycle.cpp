@@ -239,7 +239,8 @@ LinkCycle::Verdict LinkCycle::run(const CycleRequest& rq) noexcept {
   input_.t_s = rq.t_s;
   input_.q_planned = *rq.target;
   input_.q_feedback = *rq.feedback;
-  const StrategyStatus ss = strategy_.prepare(input_, *rq.feedback, *rq.target, rq.lead_s, comp_.filter_delay_s());
+  const StrategyStatus ss =
+      strategy_.prepare(input_, *rq.feedback, *rq.target, rq.lead_s, comp_.filter_delay_s(), comp_.frames());
   input_.hold_to_zero = input_.hold_to_zero || rq.hold || ss != StrategyStatus::kOk;
   out_ = force_ != nullptr ? comp_.step(input_, *force_) : comp_.step(input_);
   if (smoother_ != nullptr && static_cast<int>(out_.status) >= 0) out_.dtheta = smoother_->step(out_.dtheta);

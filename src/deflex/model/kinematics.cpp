@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "deflex/model/detail/joint_sincos.hpp"
+#include "deflex/model/detail/kinematics_count.hpp"
 #include "deflex/text/errors.hpp"
 
 namespace deflex {
@@ -91,6 +92,8 @@ void forward_kinematics(const RobotModel& model, Workspace& ws, const JointVecto
   if (q.size() != model.dof() || ws.dof != model.dof()) [[unlikely]] {
     wrong_size(model, ws, q);
   }
+  if (&model == detail::kinematics_count.model) [[unlikely]]
+    ++detail::kinematics_count.calls;
   const FoldedChain& chain = model.folded_chain();
   const int n = chain.dof;
   ws.q = q;

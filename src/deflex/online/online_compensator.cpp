@@ -58,7 +58,7 @@ OnlineCompensator::OnlineCompensator(const RobotModel& model, const SensorConfig
       config_(config),
       flange_T_sensor_(sensor.flange_T_sensor),
       pipeline_(sensor, sensor_T_wap_of(model, sensor)),
-      ws_(model_),
+      frames_(model_),
       jac_(6, model.dof()) {
   config_.validate();
   (void)model_.stiffness();  // throws ModelError when the robot file gives no stiffness
@@ -170,8 +170,8 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
   have_cycle_ = true;
 
   // Sensor orientation from the configuration the arm has now.
-  forward_kinematics(model_, ws_, in.q_feedback);
-  const Matrix3 base_R_sensor = ws_.base_T_flange.linear() * flange_T_sensor_.linear();
+  const Workspace* ws = &frames_.at(in.q_feedback);
+  const Matrix3 base_R_sensor = ws->base_T_flange.linear() * flange_T_sensor_.linear();
 
   // Condition every queued sample with this cycle's orientation.
   while (queue_count_ > 0) {
@@ -215,12 +215,10 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
     out.status = CycleStatus::kHeld;
   } else {
     out.status = CycleStatus::kOk;
-    // dtheta = K^-1 J_wap(q)^T W. FK is already at q_feedback; a second FK only when the Jacobian is
-    // wanted at a different planned configuration.
-    if (config_.jacobian_at == JacobianAt::kPlanned && in.q_planned != in.q_feedback) {
-      forward_kinematics(model_, ws_, in.q_planned);
-    }
-    point_jacobian(ws_, ws_.base_T_wap.translation(), jac_);
+    // dtheta = K^-1 J_wap(q)^T W, at the feedback or at the configuration the command is for (the
+    // frames there computed once a cycle, whoever asked first).
+    if (config_.jacobian_at == JacobianAt::kPlanned) ws = &frames_.at(in.q_planned);
+    point_jacobian(*ws, ws->base_T_wap.translation(), jac_);
     target = model_.compliance().cwiseProduct(jac_.transpose() * used);
     if (!target.allFinite()) {
       target.setZero();
@@ -233,7 +231,7 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
       target[i] = clamped;
     }
     if (!model_.wap_is_tcp()) {
-      point_jacobian(ws_, ws_.base_T_tcp.translation(), jac_);
+      point_jacobian(*ws, ws->base_T_tcp.translation(), jac_);
     }
     const double tcp_m = (jac_.topRows<3>() * target).norm();
     if (tcp_m > config_.max_tcp_correction_m) {
@@ -243,9 +241,9 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
   }
   out.wrench_base = out.status == CycleStatus::kOk && used.allFinite() ? used : wrench_base_;
   if (out.status != CycleStatus::kOk) {
-    point_jacobian(ws_, ws_.base_T_tcp.translation(), jac_);  // FK is at q_feedback here
+    point_jacobian(*ws, ws->base_T_tcp.translation(), jac_);  // at the feedback here
   }
-  // jac_ is now the TCP Jacobian at the configuration FK holds.
+  // jac_ is now the TCP Jacobian at the configuration `ws` holds.
 
   // Rate bounds, joint and TCP; also the ramp to zero when the target dropped to zero. The change is
   // scaled as a whole, not clamped joint by joint: the new correction then lies on the segment from

@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "deflex/model/kinematics.hpp"
+#include "deflex/model/frame_cache.hpp"
 #include "deflex/online/cycle_types.hpp"
 #include "deflex/online/force_pipeline.hpp"
 
@@ -22,6 +22,9 @@ class OnlineCompensator {
  public:
   /// Throws ModelError when the model has no stiffness, InputError on a bad configuration.
   OnlineCompensator(const RobotModel& model, const SensorConfig& sensor, const OnlineConfig& config);
+  // Not copied: its frames refer to its own copy of the model.
+  OnlineCompensator(const OnlineCompensator&) = delete;
+  OnlineCompensator& operator=(const OnlineCompensator&) = delete;
 
   /// Queues one raw sample (conditioned at the next step() with that cycle's orientation). The queue
   /// holds two cycles of samples at the sensor's rate (at least 64), sized at construction; a full
@@ -48,6 +51,9 @@ class OnlineCompensator {
   [[nodiscard]] int queue_capacity() const { return queue_capacity_; }
   [[nodiscard]] int queued() const { return queue_count_; }
   [[nodiscard]] const RobotModel& model() const { return model_; }
+  /// The frames of this cycle's configurations (the feedback, the target), computed once each: the
+  /// strategy and the link ask here too, so the cycle runs forward kinematics at most twice.
+  [[nodiscard]] FrameCache& frames() { return frames_; }
   [[nodiscard]] const OnlineConfig& config() const { return config_; }
   [[nodiscard]] const ForcePipeline& pipeline() const { return pipeline_; }
 
@@ -56,7 +62,7 @@ class OnlineCompensator {
   OnlineConfig config_;
   Pose flange_T_sensor_;
   ForcePipeline pipeline_;
-  Workspace ws_;
+  FrameCache frames_;  // the cycle's frames, shared with the strategy and the link (one FK a configuration)
   Jacobian jac_;
 
   // Sized once from the sample rate and the cycle period: at the paper's 100 ms cycle a 1 kHz DAQ

@@ -30,7 +30,7 @@ StrategyKind parse_strategy(const std::string& name) {
 }
 
 OnlineStrategy::OnlineStrategy(const RobotModel& model, StrategyKind kind, const ForceModel* force_model)
-    : model_(model), kind_(kind), force_(force_model), ws_(model_) {
+    : dof_(model.dof()), kind_(kind), force_(force_model) {
   if (kind_ == StrategyKind::kHybrid && force_ == nullptr) {
     throw InputError("the hybrid strategy needs a force model (the offline program's): give --force");
   }
@@ -51,22 +51,22 @@ OnlineStrategy::OnlineStrategy(const RobotModel& model, StrategyKind kind, const
 bool OnlineStrategy::joints_usable(const JointVector& q) const noexcept {
   // forward_kinematics throws on the wrong count, which would end the program from this noexcept
   // path; the cycle's joints come from the wire each cycle, so nothing at set-up can vouch for them.
-  return q.size() == model_.dof() && q.allFinite();
+  return q.size() == dof_ && q.allFinite();
 }
 
-bool OnlineStrategy::model_wrench_at(const JointVector& q, Wrench& out) noexcept {
-  forward_kinematics(model_, ws_, q);
+bool OnlineStrategy::model_wrench_at(FrameCache& frames, const JointVector& q, Wrench& out) noexcept {
+  const Workspace& ws = frames.at(q);  // q was checked (joints_usable): the kinematics do not throw
   Wrench at_tcp;
-  if (!force_->wrench_at_pose(ws_.base_T_tcp, at_tcp) || !at_tcp.allFinite()) {
+  if (!force_->wrench_at_pose(ws.base_T_tcp, at_tcp) || !at_tcp.allFinite()) {
     return false;
   }
   // Force models give the moment about the TCP; the compensator works at the WAP.
-  out = moment_moved(at_tcp, ws_.base_T_tcp.translation(), ws_.base_T_wap.translation());
+  out = moment_moved(at_tcp, ws.base_T_tcp.translation(), ws.base_T_wap.translation());
   return true;
 }
 
 StrategyStatus OnlineStrategy::prepare(CycleInput& in, const JointVector& q_feedback, const JointVector& q_target,
-                                       double delay_s, double filter_lag_s) noexcept {
+                                       double delay_s, double filter_lag_s, FrameCache& frames) noexcept {
   in.wrench_offset_base.setZero();
   in.wrench_lead_s = 0.0;
   in.hold_to_zero = false;
@@ -79,7 +79,7 @@ StrategyStatus OnlineStrategy::prepare(CycleInput& in, const JointVector& q_feed
     case StrategyKind::kHybrid:
       if (!joints_usable(q_feedback)) return StrategyStatus::kInvalidInput;
       // The offline program already holds the model's part; correct only what the model missed.
-      if (!model_wrench_at(q_feedback, model_wrench_fb_)) return StrategyStatus::kModelForceUnavailable;
+      if (!model_wrench_at(frames, q_feedback, model_wrench_fb_)) return StrategyStatus::kModelForceUnavailable;
       in.wrench_offset_base = -model_wrench_fb_;
       return StrategyStatus::kOk;
     case StrategyKind::kPredictive: {
@@ -92,7 +92,7 @@ StrategyStatus OnlineStrategy::prepare(CycleInput& in, const JointVector& q_feed
       // for; the filter's lag (time, not pose) along the measured slope.
       if (!joints_usable(q_feedback) || !joints_usable(q_target)) return StrategyStatus::kInvalidInput;
       Wrench at_target;
-      if (!model_wrench_at(q_feedback, model_wrench_fb_) || !model_wrench_at(q_target, at_target)) {
+      if (!model_wrench_at(frames, q_feedback, model_wrench_fb_) || !model_wrench_at(frames, q_target, at_target)) {
         return StrategyStatus::kModelForceUnavailable;
       }
       in.wrench_offset_base = at_target - model_wrench_fb_;

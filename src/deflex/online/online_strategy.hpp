@@ -15,7 +15,7 @@
 #include <string>
 
 #include "deflex/force/force_model.hpp"
-#include "deflex/model/kinematics.hpp"
+#include "deflex/model/frame_cache.hpp"
 #include "deflex/online/online_compensator.hpp"
 
 namespace deflex {
@@ -34,10 +34,11 @@ enum class StrategyStatus : int {
   kInvalidInput = -2,
 };
 
-/// Thread safety: one thread at a time (its own Workspace); the force model it reads may be shared.
+/// Thread safety: one thread at a time (the cycle's frames it is handed); the force model it reads may
+/// be shared.
 class OnlineStrategy {
  public:
-  /// The strategy keeps a copy of `model`, so a temporary is fine. `force_model` (not owned, may be
+  /// `model` gives the joint count (the frames come from the cycle: prepare()). `force_model` (not owned, may be
   /// null; must outlive the strategy): required by hybrid, used by predictive when given. Throws
   /// InputError when hybrid has none, or when the model cannot give a wrench from a pose alone (a
   /// path-indexed table).
@@ -48,9 +49,10 @@ class OnlineStrategy {
   /// `delay_s`: how long after it is sent a command shows in the feedback (measured by the link);
   /// `filter_lag_s`: the force low-pass's own lag. Never allocates or throws: a q_feedback (hybrid,
   /// predictive with a model) or q_target (predictive with a model) that does not hold one finite value
-  /// a joint gives kInvalidInput, in Release too.
+  /// a joint gives kInvalidInput, in Release too. `frames`: the cycle's (the compensator's), so the
+  /// kinematics at the feedback and the target run once a cycle for the strategy and the compensator.
   StrategyStatus prepare(CycleInput& in, const JointVector& q_feedback, const JointVector& q_target, double delay_s,
-                         double filter_lag_s) noexcept;
+                         double filter_lag_s, FrameCache& frames) noexcept;
 
   [[nodiscard]] StrategyKind kind() const { return kind_; }
   [[nodiscard]] const ForceModel* force_model() const { return force_; }
@@ -59,12 +61,11 @@ class OnlineStrategy {
 
  private:
   [[nodiscard]] bool joints_usable(const JointVector& q) const noexcept;
-  bool model_wrench_at(const JointVector& q, Wrench& out) noexcept;
+  bool model_wrench_at(FrameCache& frames, const JointVector& q, Wrench& out) noexcept;
 
-  RobotModel model_;
+  int dof_;
   StrategyKind kind_;
   const ForceModel* force_;
-  Workspace ws_;
   Wrench model_wrench_fb_ = Wrench::Zero();
 };
 
