@@ -265,6 +265,9 @@ LinkPollResult Motoros2RtLink::answer(double now) noexcept {
   // Not answered: the command outstanding is sent again after resend_after_s and the controller's
   // answer to it (no motion) gives the next try.
   if (verdict != LinkCycle::Verdict::kSend) return cycle_not_passed(verdict, compute());
+  // The program's end (or a planned stop at rest) sampled: the reply to this last increment ends the
+  // session.
+  const bool last = (ramping_down_ && stream_.at_standstill()) || stream_.finished();
   const JointVector& command = cycle_.joint_command();
   increment_ = command - reported_;
   if (!send(outstanding_ + 1U, increment_)) {
@@ -276,8 +279,7 @@ LinkPollResult Motoros2RtLink::answer(double now) noexcept {
   cycle_.sent(compute(), receipt_age_s_ + (clock_.now_s() - taken_at_s_));
   delay_.record_reference(now, command);
   stream_.consumed(period_s_);
-  // The program's end (or a planned stop at rest): the reply to this last increment ends the session.
-  if ((ramping_down_ && stream_.at_standstill()) || stream_.finished()) state_ = LinkState::kFinished;
+  if (last) state_ = LinkState::kFinished;
   return LinkPollResult::kAnswered;
 }
 
