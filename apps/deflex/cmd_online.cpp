@@ -81,6 +81,9 @@ struct OnlineOpts {
   int robot_port = -1, fanuc_version = 1, fanuc_catch_up = 8;
   std::string fanuc_limits = "120,265,1240";
   double fanuc_correction_share = 0.25;
+  // MotoROS2 real-time.
+  int motoros2_group = 0, motoros2_tool = 0, motoros2_max_truncations = 25;
+  double motoros2_resend_ms = 12.0;
   LogOptions log_options;
 };
 
@@ -93,7 +96,7 @@ struct LinkOption {
 const std::vector<LinkOption>& link_options() {
   static const std::vector<LinkOption> options{
       {"--egm-port", {LinkKind::kEgmJoint, LinkKind::kEgmPath}},
-      {"--ramp-in-s", {LinkKind::kEgmJoint, LinkKind::kSimpleMessage, LinkKind::kFanucJ519}},
+      {"--ramp-in-s", {LinkKind::kEgmJoint, LinkKind::kSimpleMessage, LinkKind::kFanucJ519, LinkKind::kMotoros2Rt}},
       {"--no-speed-reference", {LinkKind::kEgmJoint}},
       {"--path-corr-frame", {LinkKind::kEgmPath}},
       {"--correction-latency-ms", {LinkKind::kEgmPath}},
@@ -103,8 +106,12 @@ const std::vector<LinkOption>& link_options() {
       {"--rsi-correction-latency-ms", {LinkKind::kRsi}},
       {"--rsi-max-document-bytes", {LinkKind::kRsi}},
       {"--rsi-timeout", {LinkKind::kRsi}},
-      {"--robot-host", {LinkKind::kSimpleMessage, LinkKind::kFanucJ519}},
-      {"--robot-port", {LinkKind::kFanucJ519}},
+      {"--robot-host", {LinkKind::kSimpleMessage, LinkKind::kFanucJ519, LinkKind::kMotoros2Rt}},
+      {"--robot-port", {LinkKind::kFanucJ519, LinkKind::kMotoros2Rt}},
+      {"--motoros2-group", {LinkKind::kMotoros2Rt}},
+      {"--motoros2-tool", {LinkKind::kMotoros2Rt}},
+      {"--motoros2-resend-ms", {LinkKind::kMotoros2Rt}},
+      {"--motoros2-max-truncations", {LinkKind::kMotoros2Rt}},
       {"--fanuc-version", {LinkKind::kFanucJ519}},
       {"--fanuc-limits", {LinkKind::kFanucJ519}},
       {"--fanuc-correction-share", {LinkKind::kFanucJ519}},
@@ -130,7 +137,7 @@ const std::vector<LinkOption>& link_options() {
 void add_bound_options(CLI::App& sub, OnlineOpts& o) {
   sub.add_option("--period-ms", o.period_ms,
                  "The controller's cycle in ms (default: egm-joint and rsi 4; egm-path 48, the EGMActMove SampleRate; "
-                 "simple-message 100, the paper's)");
+                 "simple-message 100, the paper's; motoros2-rt 4, the period start_rt_mode returns)");
   sub.add_option("--max-joint-correction-deg", o.max_joint_deg,
                  "Bound on each joint's correction, degrees: no command leaves the nominal by more")
       ->capture_default_str();
@@ -186,8 +193,22 @@ void add_link_options(CLI::App& sub, OnlineOpts& o) {
       ->capture_default_str();
   sub.add_option("--robot-host", o.robot_host,
                  "simple-message: the controller's address (its motion and state servers listen there); "
-                 "fanuc-j519: its IPv4 address");
-  sub.add_option("--robot-port", o.robot_port, "fanuc-j519: the controller's Stream Motion UDP port (default 60015)");
+                 "fanuc-j519, motoros2-rt: its IPv4 address");
+  sub.add_option("--robot-port", o.robot_port,
+                 "fanuc-j519: the controller's Stream Motion UDP port (default 60015); motoros2-rt: its "
+                 "rt_listener_udp_port_number (default 22000)");
+  sub.add_option("--motoros2-group", o.motoros2_group, "motoros2-rt: the control group deflex streams (0..7)")
+      ->capture_default_str();
+  sub.add_option("--motoros2-tool", o.motoros2_tool, "motoros2-rt: the tool number sent with every command (0..63)")
+      ->capture_default_str();
+  sub.add_option("--motoros2-resend-ms", o.motoros2_resend_ms,
+                 "motoros2-rt: a command whose reply has not come this long is sent again with the same number (the "
+                 "controller applies it at most once)")
+      ->capture_default_str();
+  sub.add_option("--motoros2-max-truncations", o.motoros2_max_truncations,
+                 "motoros2-rt: replies in a row flagging an increment the controller's Functional Safety Unit "
+                 "truncated before the session stops (the program is faster than its speed limit)")
+      ->capture_default_str();
   sub.add_option("--fanuc-version", o.fanuc_version,
                  "fanuc-j519: the Stream Motion protocol version the controller speaks: 1 (float32 targets), 3 or 4 "
                  "(float64; R-30iB Plus V9.40P and later)")
@@ -422,6 +443,12 @@ runtime::SessionConfig session_config(const OnlineOpts& o, const CLI::App& sub) 
   s.simple_message.max_behind_s = o.max_behind_s;
   s.simple_message.stream.ramp_in_s = o.ramp_in_s;
   fanuc_settings(o, c.fanuc_j519);
+  c.motoros2_rt.group = o.motoros2_group;
+  c.motoros2_rt.tool = o.motoros2_tool;
+  c.motoros2_rt.resend_after_s = o.motoros2_resend_ms * 1e-3;
+  c.motoros2_rt.max_truncation_run = o.motoros2_max_truncations;
+  c.motoros2_rt.stream.ramp_in_s = o.ramp_in_s;
+  c.motoros2_rt.validate();
   return c;
 }
 
@@ -665,10 +692,11 @@ void setup_online(CLI::App& sub, int& exit_code) {
 
 }  // namespace
 
-DEFLEX_COMMAND("online",
-               "Online compensation on a controller link (--link egm-joint|egm-path|rsi|simple-message|fanuc-j519): "
-               "condition "
-               "force samples and answer the controller, never beyond the bound of the nominal",
-               setup_online, 40);
+DEFLEX_COMMAND(
+    "online",
+    "Online compensation on a controller link (--link egm-joint|egm-path|rsi|simple-message|fanuc-j519|motoros2-rt): "
+    "condition "
+    "force samples and answer the controller, never beyond the bound of the nominal",
+    setup_online, 40);
 
 }  // namespace deflex::cli

@@ -78,7 +78,7 @@ const std::map<std::string, Setter>& settings() {
     real("connect_timeout_s", [](C& c) -> double& { return c.network.connect_timeout_s; });
     t["ramp_in_s"] = [](C& c, const py::handle& v) {
       c.egm_joint.stream.ramp_in_s = c.simple_message.stream.ramp_in_s = c.fanuc_j519.stream.ramp_in_s =
-          as<double>(v, "ramp_in_s");
+          c.motoros2_rt.stream.ramp_in_s = as<double>(v, "ramp_in_s");
     };
     integer("robot_port", [](C& c) -> int& { return c.network.robot_port; });
     t["fanuc_version"] = [](C& c, const py::handle& v) {
@@ -93,6 +93,10 @@ const std::map<std::string, Setter>& settings() {
     };
     real("fanuc_correction_share", [](C& c) -> double& { return c.fanuc_j519.correction_share; });
     integer("fanuc_catch_up", [](C& c) -> int& { return c.fanuc_j519.max_catch_up; });
+    integer("motoros2_group", [](C& c) -> int& { return c.motoros2_rt.group; });
+    integer("motoros2_tool", [](C& c) -> int& { return c.motoros2_rt.tool; });
+    real("motoros2_resend_s", [](C& c) -> double& { return c.motoros2_rt.resend_after_s; });
+    integer("motoros2_max_truncations", [](C& c) -> int& { return c.motoros2_rt.max_truncation_run; });
     flag("send_speed_reference", [](C& c) -> bool& { return c.egm_joint.send_speed_reference; });
     t["path_corr_frame"] = [](C& c, const py::handle& v) {
       c.egm_path.frame = parse_path_corr_frame(as<std::string>(v, "path_corr_frame"));
