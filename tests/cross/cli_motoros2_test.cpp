@@ -54,8 +54,8 @@ TEST(CliMotoros2, StreamsTheProgramWithTheModelsCorrectionWithinTheStepLimit) {
   Child deflex;
   spawn(deflex,
         {test::kDeflex, "online", "--link", "motoros2-rt", "--program", program_path, "--robot-host", "127.0.0.1",
-         "--robot-port", std::to_string(transport.local_address().port), "--force-source",
-         "csv:" + constant_force(dir), "--loop", "--log", log, "--duration-s", "4", "--status-interval-s", "1"},
+         "--robot-port", std::to_string(transport.local_address().port), "--force-source", "csv:" + constant_force(dir),
+         "--loop", "--log", log, "--duration-s", "4", "--status-interval-s", "1"},
         dir + "/stderr.txt");
   run_in_real_time(controller, 6.0);
   const int exit_code = deflex.wait();
@@ -114,8 +114,8 @@ TEST(CliMotoros2, BadMotoros2OptionsAreRefusedNamingThem) {
     EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.err;
     EXPECT_NE(r.err.find(c.words), std::string::npos) << c.args << "\n" << r.err;
   }
-  const auto no_host =
-      test::run_cli("online --link motoros2-rt --program " + program_path + " --force-source csv:" + test::kForceReplay);
+  const auto no_host = test::run_cli("online --link motoros2-rt --program " + program_path +
+                                     " --force-source csv:" + test::kForceReplay);
   EXPECT_EQ(no_host.exit_code, 2);
   EXPECT_NE(no_host.err.find("--robot-host"), std::string::npos) << no_host.err;
 }
