@@ -82,7 +82,7 @@ struct OnlineOpts {
   std::string fanuc_limits = "120,265,1240";
   double fanuc_correction_share = 0.25;
   // MotoROS2 real-time.
-  int motoros2_group = 0, motoros2_tool = 0, motoros2_max_truncations = 25;
+  int motoros2_group = 0, motoros2_tool = 0, motoros2_max_truncations = 25, motoros2_status_port = -1;
   double motoros2_resend_ms = 12.0;
   LogOptions log_options;
 };
@@ -112,6 +112,7 @@ const std::vector<LinkOption>& link_options() {
       {"--motoros2-tool", {LinkKind::kMotoros2Rt}},
       {"--motoros2-resend-ms", {LinkKind::kMotoros2Rt}},
       {"--motoros2-max-truncations", {LinkKind::kMotoros2Rt}},
+      {"--motoros2-status-port", {LinkKind::kMotoros2Rt}},
       {"--fanuc-version", {LinkKind::kFanucJ519}},
       {"--fanuc-limits", {LinkKind::kFanucJ519}},
       {"--fanuc-correction-share", {LinkKind::kFanucJ519}},
@@ -209,6 +210,10 @@ void add_link_options(CLI::App& sub, OnlineOpts& o) {
                  "motoros2-rt: replies in a row flagging an increment the controller's Functional Safety Unit "
                  "truncated before the session stops (the program is faster than its speed limit)")
       ->capture_default_str();
+  sub.add_option("--motoros2-status-port", o.motoros2_status_port,
+                 "motoros2-rt: read the controller's RobotState on this UDP port (its rt_status_udp_port_number, "
+                 "22001): an e-stop, an error, the drives off end the session at once; without it they show as "
+                 "the controller's silence");
   sub.add_option("--fanuc-version", o.fanuc_version,
                  "fanuc-j519: the Stream Motion protocol version the controller speaks: 1 (float32 targets), 3 or 4 "
                  "(float64; R-30iB Plus V9.40P and later)")
@@ -447,6 +452,7 @@ runtime::SessionConfig session_config(const OnlineOpts& o, const CLI::App& sub) 
   c.motoros2_rt.tool = o.motoros2_tool;
   c.motoros2_rt.resend_after_s = o.motoros2_resend_ms * 1e-3;
   c.motoros2_rt.max_truncation_run = o.motoros2_max_truncations;
+  c.motoros2_rt.status_port = o.motoros2_status_port;
   c.motoros2_rt.stream.ramp_in_s = o.ramp_in_s;
   c.motoros2_rt.validate();
   return c;

@@ -97,6 +97,7 @@ const std::map<std::string, Setter>& settings() {
     integer("motoros2_tool", [](C& c) -> int& { return c.motoros2_rt.tool; });
     real("motoros2_resend_s", [](C& c) -> double& { return c.motoros2_rt.resend_after_s; });
     integer("motoros2_max_truncations", [](C& c) -> int& { return c.motoros2_rt.max_truncation_run; });
+    integer("motoros2_status_port", [](C& c) -> int& { return c.motoros2_rt.status_port; });
     flag("send_speed_reference", [](C& c) -> bool& { return c.egm_joint.send_speed_reference; });
     t["path_corr_frame"] = [](C& c, const py::handle& v) {
       c.egm_path.frame = parse_path_corr_frame(as<std::string>(v, "path_corr_frame"));

@@ -766,6 +766,22 @@ TEST(FaultTable, Motoros2RtAStoppedOrRestartedControllerEndsTheSession) {
   }
 }
 
+TEST(FaultTable, Motoros2RtAnEStopOnTheStatusChannelEndsTheSessionAtOnce) {
+  FaultBench b(LinkKind::kMotoros2Rt, sweep(),
+               [](runtime::SessionConfig& c, standin::StandInConfig&) { c.motoros2_rt.status_port = 22001; });
+  b.run_for(2.0);
+  const std::size_t sent = b.wire().size();
+  b.standin->motors_off();
+  b.run_for(0.05);
+  ASSERT_TRUE(b.session->ended());
+  const runtime::SessionSummary& s = b.session->finish();
+  EXPECT_EQ(s.reason, StopReason::kControllerStopped) << s.reason_text;
+  EXPECT_EQ(s.exit_code, 6);
+  EXPECT_NE(s.reason_text.find("emergency stop"), std::string::npos) << s.reason_text;
+  EXPECT_EQ(b.wire().size(), sent);
+  expect_invariants(b, "motoros2 e-stop on the status channel");
+}
+
 TEST(FaultTable, Motoros2RtAStaleForceRampsTheCorrectionOut) {
   FaultBench b(LinkKind::kMotoros2Rt, sweep());
   b.run_for(3.0);

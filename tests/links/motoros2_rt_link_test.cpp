@@ -5,6 +5,8 @@
 // model's correction (computed here with a finite-difference Jacobian), the increments it took sum to
 // it, and every fault ends with the link stopped for a named reason or ridden through, with no
 // increment beyond the per-cycle step limit and no absolute beyond the bound of the nominal.
+#include <array>
+
 #include <gtest/gtest.h>
 
 #include "deflex/cell/motoros2_rt_controller.hpp"
@@ -29,6 +31,8 @@ struct MotoBench {
   MemoryNetwork network{clock, 8192};
   MemoryTransport& pc_port = network.add_endpoint(test::kSensorAddress, 0.0002);
   MemoryTransport& controller_port = network.add_endpoint(test::kControllerAddress, 0.0002);
+  // The PC's port for the controller's RobotState (rt_status_udp_port_number).
+  MemoryTransport& status_port = network.add_endpoint({test::kSensorAddress.ipv4, 22001}, 0.0002);
   OnlineCompensator compensator;
   OnlineStrategy strategy;
   test::ConstantForce force;
@@ -39,21 +43,24 @@ struct MotoBench {
   double t_s = 0.0;
   bool stalled = false;
 
-  static Motoros2RtLinkConfig link_config(int max_run) {
+  static Motoros2RtLinkConfig link_config(int max_run, bool status) {
     Motoros2RtLinkConfig c;
     c.controller = test::kControllerAddress;
     c.stop.stop_silence_s = 0.5;
     c.max_truncation_run = max_run;
+    c.status_port = status ? 22001 : -1;
     return c;
   }
 
+  /// With `cc.status_port` set, the link reads the controller's RobotState.
   MotoBench(std::shared_ptr<const JointTrajectory> p, const JointVector& arm,
             const cell::Motoros2RtControllerConfig& cc = {}, int max_run = 25)
       : compensator(robot, test::bench_sensor(), test::bench_online(kPeriod)),
         strategy(robot, StrategyKind::kOnline, nullptr),
         program(std::move(p)),
         start(arm),
-        link(compensator, strategy, program, pc_port, clock, &force, link_config(max_run)),
+        link(compensator, strategy, program, pc_port, clock, &force, link_config(max_run, cc.status_port >= 0),
+             cc.status_port >= 0 ? &status_port : nullptr),
         controller(cc, arm, controller_port) {}
 
   /// One 4 ms interpolation clock of the controller, then deflex answers what reached it.
@@ -297,6 +304,35 @@ TEST(Motoros2RtLink, AStoppedOrRestartedControllerEndsTheSessionAndNothingMovesT
   }
 }
 
+// With the status side channel an e-stop ends the session at once, named, instead of after the stop
+// silence; a status from another address, or one that does not decode, is counted and changes nothing.
+TEST(Motoros2RtLink, AnEStopTheStatusReportsStopsTheLinkAtOnce) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  cell::Motoros2RtControllerConfig cc;
+  cc.status_port = 22001;
+  MotoBench bench(test::sweep_program(test::bench_robot(), q0, pose_deg(8, -4, 6, 10, -8, 12), 20.0), q0, cc);
+  bench.run(1.0);
+  EXPECT_GT(bench.link.statuses(), 80u);  // one every 10 ms
+  MemoryTransport& stranger = bench.network.add_endpoint(test::kStrangerAddress, 0.0002);
+  rt::RobotState bad;
+  bad.e_stopped = true;
+  std::array<unsigned char, rt::kRobotStateBytes> b{};
+  ASSERT_EQ(rt::encode(bad, b.data(), b.size()), rt::kRobotStateBytes);
+  stranger.send_to(b.data(), b.size(), {test::kSensorAddress.ipv4, 22001});  // not the controller's
+  b[0] = 2;                                                                  // a boolean that is not 0 or 1
+  bench.controller_port.send_to(b.data(), b.size(), {test::kSensorAddress.ipv4, 22001});
+  bench.controller_port.send_to(b.data(), 20, {test::kSensorAddress.ipv4, 22001});
+  bench.run(0.2);
+  EXPECT_EQ(bench.link.state(), LinkState::kRunning);
+  EXPECT_EQ(bench.link.statuses_refused(), 3u);
+  bench.controller.stop("e-stop");
+  bench.run(0.03);  // three status periods
+  EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kController) << bench.link.stop_reason();
+  EXPECT_NE(std::string(bench.link.stop_reason()).find("an emergency stop"), std::string::npos)
+      << bench.link.stop_reason();
+  expect_wire_invariants(bench);
+}
+
 // A stalled PC: the controller applies nothing meanwhile (lock-step) and the stream resumes; a stall
 // beyond the controller's timeout ends its session, and deflex names the silence.
 TEST(Motoros2RtLink, AStalledPcIsRiddenThroughUntilTheControllersTimeout) {
@@ -398,11 +434,13 @@ TEST(Motoros2RtController, DropsTheSessionOnASequenceJumpBeyondItsMaximumOrASeco
   EXPECT_EQ(controller.counters().replies, replies) << "a dropped session answers nothing";
 }
 
-// Every poll of a whole session: the start, resends after lost commands, truncations, the end.
+// Every poll of a whole session: the start, resends after lost commands, truncations, the statuses,
+// the end.
 TEST(Motoros2RtLink, NoPollFromStartToEndAllocates) {
   const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
   const auto program = test::sweep_program(test::bench_robot(), q0, pose_deg(5, 5, 5, 5, 5, 5), 2.0);
   cell::Motoros2RtControllerConfig cc;
+  cc.status_port = 22001;
   cc.fsu_speed_rad_s = 0.95 * test::sampled_peak_speed(*program).maxCoeff();
   MotoBench bench(program, q0, cc, 10000);
   bench.force.reading = test::reading_at(bench.robot, q0, Vector3(0, 0, -400));
@@ -423,6 +461,7 @@ TEST(Motoros2RtLink, NoPollFromStartToEndAllocates) {
   EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kEnded) << bench.link.stop_reason();
   EXPECT_GE(bench.link.resent(), 1u);
   EXPECT_GE(bench.link.truncations(), 1u);
+  EXPECT_GT(bench.link.statuses(), 100u);
   EXPECT_EQ(allocations, 0u);
 }
 

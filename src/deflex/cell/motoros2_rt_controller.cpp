@@ -2,6 +2,7 @@
 #include "deflex/cell/motoros2_rt_controller.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -26,10 +27,30 @@ void Motoros2RtController::drop(const std::string& why) {
   if (dropped_.empty()) dropped_ = why;
 }
 
-void Motoros2RtController::stop(const std::string& why) { drop(why); }
+void Motoros2RtController::stop(const std::string& why) {
+  drop(why);
+  estop_ = true;
+}
+
+void Motoros2RtController::send_status(double t_s) {
+  if (config_.status_port < 0 || !have_pc_ || t_s + 1e-12 < next_status_s_) return;
+  next_status_s_ = t_s + config_.status_period_s;
+  rt::RobotState s;
+  s.drives_powered = !estop_;
+  s.e_stopped = estop_;
+  s.play_mode = true;
+  s.motion_possible = !estop_;
+  s.error = estop_;
+  s.error_code = estop_ ? 1 : 0;  // the stand-in's own code, not a Yaskawa alarm number
+  std::array<unsigned char, rt::kRobotStateBytes> b{};
+  const std::size_t n = rt::encode(s, b.data(), b.size());
+  const DatagramAddress to{pc_.ipv4, static_cast<std::uint16_t>(config_.status_port)};
+  if (n > 0 && transport_.send_to(b.data(), n, to)) ++counters_.statuses;
+}
 
 void Motoros2RtController::restart(double t_s) {
   dropped_.clear();
+  estop_ = false;
   have_pc_ = have_last_ = false;
   last_reply_size_ = 0;
   last_command_s_ = t_s;
@@ -147,6 +168,7 @@ const JointVector& Motoros2RtController::tick(double t_s) {
   const bool clock = std::floor(t_s / config_.period_s + 1e-9) > std::floor(last_t_s_ / config_.period_s + 1e-9);
   last_t_s_ = t_s;
   if (clock) read_commands(t_s);
+  send_status(t_s);
   if (dropped_.empty() && config_.timeout_s >= 0.0 && t_s - last_command_s_ > config_.timeout_s) {
     drop("no command for timeout_for_rt_msg");
   }

@@ -16,7 +16,10 @@
 //     command still reports the command position as if the whole increment were taken (strict: the
 //     sources do not say when the truncation shows), the next one reports the truncated position and
 //     sets the truncation flag;
-//   - the arm follows the command position after a dead time, through a first-order servo lag.
+//   - the arm follows the command position after a dead time, through a first-order servo lag;
+//   - with a status port, a RobotState every `status_period_s` to the first commander's IP at that port,
+//     healthy while the session runs and after it was dropped (strict: the sources do not say a
+//     dropped session shows there), reporting the e-stop after stop().
 // Faults on request (tests): stop() (an e-stop, an alarm, stop_traj_mode: it stops answering, the arm
 // comes to rest where it is), restart() (a new session: stop_traj_mode, start_rt_mode). It knows
 // nothing of deflex.
@@ -48,6 +51,8 @@ struct Motoros2RtControllerConfig {
   double max_speed_rad_s = 3.0;
   /// The FSU's speed limit per axis (rad/s): larger increments are truncated to it. Infinite: none set.
   double fsu_speed_rad_s = std::numeric_limits<double>::infinity();
+  int status_port = -1;           ///< rt_status_udp_port_number (22001); -1: no status sent
+  double status_period_s = 0.01;  ///< rt_status_sleep_period
 };
 
 struct Motoros2RtControllerCounters {
@@ -57,6 +62,7 @@ struct Motoros2RtControllerCounters {
   std::uint64_t skipped = 0;     ///< numbers never received within an accepted gap (their increments lost)
   std::uint64_t purged = 0;      ///< datagrams discarded after a command was taken
   std::uint64_t truncated = 0;   ///< increments the FSU truncated
+  std::uint64_t statuses = 0;    ///< RobotState datagrams sent
 };
 
 /// Thread safety: one thread at a time (the simulation's), with its transport.
@@ -81,7 +87,7 @@ class Motoros2RtController final : public RobotController {
   /// Every increment applied as received (before the FSU), in order.
   [[nodiscard]] const std::vector<JointVector>& increments() const { return increments_; }
 
-  /// The controller stops answering (an e-stop, an alarm, stop_traj_mode): the arm comes to rest.
+  /// An e-stop: the controller stops answering, the arm comes to rest, the status (if sent) reports it.
   void stop(const std::string& why);
   /// A new session (stop_traj_mode, start_rt_mode) at t_s: from the command position where the arm is,
   /// waiting for a first command numbered 0 from any sender.
@@ -92,6 +98,7 @@ class Motoros2RtController final : public RobotController {
   bool handle(const unsigned char* data, std::size_t size, const DatagramAddress& from, double t_s);
   void apply(const motoros2_rt::Command& c, const DatagramAddress& from, double t_s);
   void drop(const std::string& why);
+  void send_status(double t_s);
 
   Motoros2RtControllerConfig config_;
   DatagramTransport& transport_;
@@ -104,7 +111,8 @@ class Motoros2RtController final : public RobotController {
   double last_t_s_ = 0.0;
   std::string dropped_;
   JointVector command_, shortfall_, position_, encoders_, following_;
-  bool have_encoders_ = false, truncated_last_ = false;
+  bool have_encoders_ = false, truncated_last_ = false, estop_ = false;
+  double next_status_s_ = 0.0;
   std::deque<std::pair<double, JointVector>> delay_;
   std::vector<JointVector> taken_, increments_;
   Motoros2RtControllerCounters counters_;

@@ -58,6 +58,10 @@ void Motoros2RtLinkConfig::validate() const {
         fmt::format("setting motoros2 truncation run (--motoros2-max-truncations): must be 0..100000 (got {})",
                     max_truncation_run));
   }
+  if (status_port < -1 || status_port > 65535) {
+    throw InputError(fmt::format(
+        "setting motoros2 status port (--motoros2-status-port): 1..65535, or -1 for none (got {})", status_port));
+  }
   if (max_packet_bytes < rt::kReplyBytes) {
     throw InputError(fmt::format("setting motoros2 max_packet_bytes: must be at least the reply's {} bytes (got {})",
                                  rt::kReplyBytes, max_packet_bytes));
@@ -66,11 +70,13 @@ void Motoros2RtLinkConfig::validate() const {
 
 Motoros2RtLink::Motoros2RtLink(OnlineCompensator& compensator, OnlineStrategy& strategy,
                                std::shared_ptr<const JointTrajectory> nominal, DatagramTransport& transport,
-                               const Clock& clock, ForceSource* force, const Motoros2RtLinkConfig& config)
+                               const Clock& clock, ForceSource* force, const Motoros2RtLinkConfig& config,
+                               DatagramTransport* status)
     : ControllerLink(compensator, strategy, force, clock, motoros2_limits(compensator, nominal.get(), config),
                      config.stop, config.history_cycles),
       config_(config),
       transport_(transport),
+      status_(status),
       stream_(std::move(nominal), config.stream),
       delay_(config.initial_delay_s),
       period_s_(compensator.config().period_s) {
@@ -199,6 +205,37 @@ bool Motoros2RtLink::read_reply() noexcept {
   return true;
 }
 
+// The status side channel, drained: false when a status stopped the link. The controller sends it from
+// another port than its replies': its address is taken by IP alone.
+bool Motoros2RtLink::read_status() noexcept {
+  if (status_ == nullptr) return true;
+  DatagramAddress from;
+  for (int i = 0; i < 64; ++i) {
+    const long n = status_->receive(rx_.data(), rx_.size(), from);
+    if (n < 0) break;
+    rt::RobotState s;
+    if (from.ipv4 != config_.controller.ipv4 ||
+        rt::decode(rx_.data(), static_cast<std::size_t>(n), s) != rt::DecodeStatus::kOk) {
+      ++statuses_refused_;
+      continue;
+    }
+    ++statuses_;
+    const char* what = s.e_stopped          ? "an emergency stop"
+                       : s.error            ? "an error"
+                       : !s.drives_powered  ? "its drives off"
+                       : !s.motion_possible ? "motion not possible"
+                                            : nullptr;
+    if (what != nullptr) {
+      stop_link(LinkStopCause::kController,
+                "the controller's status reports %s (error code %d) at program time %.3f s: it will not take the "
+                "stream; clear it (reset_error) and start the real-time mode again",
+                what, static_cast<int>(s.error_code), stream_.program_time_s() - stream_.trajectory().start_time_s());
+      return false;
+    }
+  }
+  return true;
+}
+
 LinkPollResult Motoros2RtLink::poll(double timeout_s) noexcept {
   if (state_ == LinkState::kStopped || state_ == LinkState::kRefused) {
     const std::uint64_t before = counters_.datagrams;
@@ -206,6 +243,7 @@ LinkPollResult Motoros2RtLink::poll(double timeout_s) noexcept {
     if (state_ == LinkState::kRefused && counters_.datagrams > before) ++counters_.refused;
     return announce_terminal();
   }
+  if (!read_status()) return announce_terminal();
   double now = clock_.now_s();
   if (!sent_any_) {
     // Command 0, no motion: its reply says where the controller's command position is.

@@ -26,6 +26,10 @@
 // (or at once on stop_traj_mode). stop() sends nothing more: the arm stops where its last increment took
 // it. A silence longer than the stop silence is a controller that dropped the session (a sequence jump,
 // a second sender, an increment beyond its per-cycle maximum, its own timeout) or stopped (kSilent).
+// Given the status side channel (the RobotState datagram the controller sends every 10 ms to the PC's
+// port 22001), a status from the controller's address reporting an e-stop, an error, the drives off or
+// motion not possible stops the link at once (kController), naming it; a status that does not decode
+// is counted and ignored.
 #pragma once
 
 #include <cstdint>
@@ -53,6 +57,9 @@ struct Motoros2RtLinkConfig {
   /// Replies in a row with the safety unit's truncation flag before the link stops (0: the first).
   int max_truncation_run = 25;
   std::size_t max_packet_bytes = 4096;
+  /// The PC's UDP port the controller's RobotState comes to (rt_status_udp_port_number, 22001); -1: not
+  /// read. The session opens it; a link built directly is given its transport.
+  int status_port = -1;
   /// Throws InputError naming the setting.
   void validate() const;
 };
@@ -61,13 +68,14 @@ struct Motoros2RtLinkConfig {
 class Motoros2RtLink final : public ControllerLink {
  public:
   /// Every reference must outlive the link. The controller's interpolation period is the compensator's
-  /// period_s. Throws InputError on a bad setting or a program for another number of joints.
+  /// period_s; `status` (may be null) receives the controller's RobotState. Throws InputError on a bad
+  /// setting or a program for another number of joints.
   Motoros2RtLink(OnlineCompensator& compensator, OnlineStrategy& strategy,
                  std::shared_ptr<const JointTrajectory> nominal, DatagramTransport& transport, const Clock& clock,
-                 ForceSource* force, const Motoros2RtLinkConfig& config);
+                 ForceSource* force, const Motoros2RtLinkConfig& config, DatagramTransport* status = nullptr);
   Motoros2RtLink(OnlineCompensator& compensator, OnlineStrategy& strategy,
                  std::shared_ptr<const JointTrajectory> nominal, DatagramTransport& transport, const Clock&& clock,
-                 ForceSource* force, const Motoros2RtLinkConfig& config) = delete;
+                 ForceSource* force, const Motoros2RtLinkConfig& config, DatagramTransport* status = nullptr) = delete;
 
   LinkPollResult poll(double timeout_s) noexcept override;
   void stop() noexcept override;
@@ -83,9 +91,14 @@ class Motoros2RtLink final : public ControllerLink {
   [[nodiscard]] std::uint64_t shortfalls() const { return shortfalls_; }
   /// Commands sent again because their reply did not come in time.
   [[nodiscard]] std::uint64_t resent() const { return resent_; }
+  /// RobotState datagrams taken from the status side channel, and those refused (another address, not
+  /// the struct's size, a boolean neither 0 nor 1).
+  [[nodiscard]] std::uint64_t statuses() const { return statuses_; }
+  [[nodiscard]] std::uint64_t statuses_refused() const { return statuses_refused_; }
 
  private:
   bool receive_reply(double timeout_s) noexcept;
+  bool read_status() noexcept;
   bool take(const unsigned char* data, long n, const DatagramAddress& from) noexcept;
   bool read_reply() noexcept;
   bool send(std::uint32_t sequence, const JointVector& increment) noexcept;
@@ -96,13 +109,14 @@ class Motoros2RtLink final : public ControllerLink {
 
   Motoros2RtLinkConfig config_;
   DatagramTransport& transport_;
+  DatagramTransport* status_;
   JointStream stream_;
   DelayEstimator delay_;
   double period_s_;
   std::uint32_t outstanding_ = 0;  // the number of the command whose reply deflex waits for
   bool sent_any_ = false;
   double last_send_s_ = -1e300;
-  std::uint64_t truncations_ = 0, shortfalls_ = 0, resent_ = 0;
+  std::uint64_t truncations_ = 0, shortfalls_ = 0, resent_ = 0, statuses_ = 0, statuses_refused_ = 0;
   int truncation_run_ = 0;
   std::size_t tx_size_ = 0;
 

@@ -172,9 +172,17 @@ void Session::open_motoros2_rt(const SessionEndpoints& endpoints, ForceSource* f
     own_datagram_ = std::make_unique<UdpTransport>(net.bind_address, 0);
     t = own_datagram_.get();
   }
-  link_ = std::make_unique<Motoros2RtLink>(*compensator_, *strategy_, std::move(program), *t, clock_, force, c);
-  where_ = fmt::format("MotoROS2 real-time to {} (group {}), from {}", to_string(c.controller), c.group,
-                       to_string(t->local_address()));
+  DatagramTransport* status = endpoints.status;
+  if (c.status_port >= 0 && status == nullptr) {
+    own_status_ =
+        std::make_unique<UdpTransport>(net.bind_address, port_option(c.status_port, "--motoros2-status-port", "", 1));
+    status = own_status_.get();
+  }
+  if (c.status_port < 0) status = nullptr;
+  link_ = std::make_unique<Motoros2RtLink>(*compensator_, *strategy_, std::move(program), *t, clock_, force, c, status);
+  where_ = fmt::format("MotoROS2 real-time to {} (group {}), from {}{}", to_string(c.controller), c.group,
+                       to_string(t->local_address()),
+                       status != nullptr ? fmt::format(", its status on {}", to_string(status->local_address())) : "");
 }
 
 void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,

@@ -82,9 +82,10 @@ struct SessionConfig {
 /// Transports the caller gives (a simulated cell's in-memory network, tests). Null: the session opens
 /// real sockets from NetworkConfig.
 struct SessionEndpoints {
-  DatagramTransport* datagram = nullptr;  ///< EGM, RSI
+  DatagramTransport* datagram = nullptr;  ///< EGM, RSI, fanuc-j519, motoros2-rt
   StreamTransport* motion = nullptr;      ///< simple message
   StreamTransport* state = nullptr;
+  DatagramTransport* status = nullptr;  ///< motoros2-rt: the controller's RobotState (with status_port >= 0)
 };
 
 /// How a session ended and what it did.
@@ -190,6 +191,7 @@ class Session {
   std::unique_ptr<OnlineCompensator> compensator_;
   std::unique_ptr<OnlineStrategy> strategy_;
   std::unique_ptr<DatagramTransport> own_datagram_;
+  std::unique_ptr<DatagramTransport> own_status_;  // motoros2-rt: the controller's RobotState, when read
   std::unique_ptr<StreamTransport> own_motion_, own_state_;
   std::unique_ptr<ControllerLink> link_;
   ForceSource* force_ = nullptr;

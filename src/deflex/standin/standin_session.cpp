@@ -94,6 +94,12 @@ StandInSession::StandInSession(const runtime::SessionConfig& config, const Robot
   }
   const bool streams = runtime::link_kind(kind_).streams_program;
   runtime::SessionEndpoints ends{&deflex_port_, &motion_.client(), &state_.client()};
+  if (kind_ == runtime::LinkKind::kMotoros2Rt && config_.motoros2_rt.status_port >= 0) {
+    // The controller's RobotState comes to the PC's address at the status port.
+    ends.status = &network_.add_endpoint(
+        DatagramAddress{kDeflex.ipv4, static_cast<std::uint16_t>(config_.motoros2_rt.status_port)},
+        standin.network_latency_s);
+  }
   session_ = std::make_unique<runtime::Session>(config_, robot, sensor, streams ? program_ : nullptr, force_model,
                                                 &sensor_, clock_, ends);
   cell::ControllerConfig cc = standin.controller;
@@ -151,6 +157,7 @@ StandInSession::StandInSession(const runtime::SessionConfig& config, const Robot
       cell::Motoros2RtControllerConfig mc = standin.motoros2;
       mc.period_s = config_.online.period_s;
       mc.group = config_.motoros2_rt.group;
+      mc.status_port = config_.motoros2_rt.status_port;
       auto c = std::make_unique<cell::Motoros2RtController>(mc, program_->points().front(), *tap_);
       motoros2_ = c.get();
       controller_ = std::move(c);
