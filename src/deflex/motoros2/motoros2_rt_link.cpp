@@ -251,9 +251,10 @@ LinkPollResult Motoros2RtLink::poll(double timeout_s) noexcept {
     if (!send(0, increment_)) return LinkPollResult::kNotAnswered;
     outstanding_ = 0;
   }
-  resend_if_due(now);
+  // The wait ends when the command outstanding is due again; a reply already queued is read first.
+  const double wait_s = std::clamp(last_send_s_ + config_.resend_after_s - now, 0.0, std::max(0.0, timeout_s));
   const std::uint64_t before = counters_.datagrams;
-  if (!receive_reply(timeout_s)) {
+  if (!receive_reply(wait_s)) {
     now = clock_.now_s();
     if (apply_silence_rules(now)) return announce_terminal();
     resend_if_due(now);
