@@ -1,6 +1,7 @@
-// `deflex controller-setup --link egm-joint|egm-path|rsi`: writes what the robot controller needs to talk
-// to `deflex online` over that link (a RAPID module and the UdpUc entry for ABB EGM; the Ethernet
-// config, the RSI context and the KRL lines for KUKA RSI), from the same options and defaults as
+// `deflex controller-setup --link egm-joint|egm-path|rsi|fanuc-j519|motoros2-rt`: writes what the robot
+// controller needs to talk to `deflex online` over that link (a RAPID module and the UdpUc entry for ABB
+// EGM; the Ethernet config, the RSI context and the KRL lines for KUKA RSI; FANUC's TP program and
+// settings; MotoROS2's configuration keys), from the same options and defaults as
 // `deflex online` (ports, period, bounds, SENTYPE), so the controller's side agrees with deflex's.
 #include <cmath>
 #include <filesystem>
@@ -14,7 +15,9 @@
 #include "deflex/egm/egm_controller_setup.hpp"
 #include "deflex/fanuc/fanuc_controller_setup.hpp"
 #include "deflex/fanuc/fanuc_j519_link.hpp"
+#include "deflex/link/link_cycle.hpp"
 #include "deflex/model/types.hpp"
+#include "deflex/motoros2/motoros2_controller_setup.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/rsi/rsi_controller_setup.hpp"
 #include "deflex/rsi/rsi_link.hpp"
@@ -41,14 +44,18 @@ struct ControllerSetupOpts {
          stop_silence_s = kNaN;  // default: the link kind's (runtime/link_table.cpp)
   // FANUC Stream Motion.
   std::string tp_program = "DEFLEXSM", fanuc_limits = "120,265,1240";
-  int fanuc_version = 1, robot_port = 60015, uframe = 0, utool = 1;
+  int fanuc_version = 1, robot_port = -1, uframe = 0, utool = 1;  // robot_port -1: the protocol's
   double fanuc_correction_share = 0.25, move_speed_pct = 10.0;
+  // MotoROS2 real-time.
+  int motoros2_group = 0, motoros2_max_truncations = 25;
+  double motoros2_resend_ms = 12.0;
   bool json = false;
 };
 
 /// The options of `deflex controller-setup`, in the order --help lists them.
 void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
-  sub.add_option("--link", o.link, "egm-joint, egm-path, rsi or fanuc-j519 (as deflex online --link)")->required();
+  sub.add_option("--link", o.link, "egm-joint, egm-path, rsi, fanuc-j519 or motoros2-rt (as deflex online --link)")
+      ->required();
   sub.add_option("--sensor-ip", o.sensor_ip,
                  "deflex's IPv4 address as the controller reaches it (the PC on the controller's network)")
       ->required();
@@ -111,7 +118,15 @@ void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
   sub.add_option("--fanuc-correction-share", o.fanuc_correction_share,
                  "fanuc-j519: deflex online --fanuc-correction-share")
       ->capture_default_str();
-  sub.add_option("--robot-port", o.robot_port, "fanuc-j519: deflex online --robot-port")->capture_default_str();
+  sub.add_option("--robot-port", o.robot_port,
+                 "fanuc-j519, motoros2-rt: deflex online --robot-port (default 60015, 22000)");
+  sub.add_option("--motoros2-group", o.motoros2_group, "motoros2-rt: deflex online --motoros2-group")
+      ->capture_default_str();
+  sub.add_option("--motoros2-resend-ms", o.motoros2_resend_ms, "motoros2-rt: deflex online --motoros2-resend-ms")
+      ->capture_default_str();
+  sub.add_option("--motoros2-max-truncations", o.motoros2_max_truncations,
+                 "motoros2-rt: deflex online --motoros2-max-truncations")
+      ->capture_default_str();
   sub.add_option("--uframe", o.uframe, "fanuc-j519: the user frame the TP program sets")->capture_default_str();
   sub.add_option("--utool", o.utool, "fanuc-j519: the tool frame the TP program sets")->capture_default_str();
   sub.add_option("--move-speed-pct", o.move_speed_pct,
@@ -202,13 +217,43 @@ std::vector<ControllerFile> fanuc_setup_files(const ControllerSetupOpts& o) {
     throw InputError("option --fanuc-correction-share: must be in (0, 1)");
   }
   f.correction_share = o.fanuc_correction_share;
-  f.robot_port = controller_setup_port(o.robot_port, "--robot-port");
+  f.robot_port = controller_setup_port(o.robot_port == -1 ? 60015 : o.robot_port, "--robot-port");
   f.pc_address = o.sensor_ip;
   if (!o.program.empty()) {
     const RobotModel model = load_cli_robot("controller-setup", o.robot);
     f.start_rad = JointTrajectory::read_csv(o.program, model).points().front();
   }
   return fanuc_controller_setup(f);
+}
+
+/// The files of --link motoros2-rt: the motoros2_config.yaml keys and the settings sheet. With --program,
+/// each joint's fastest stream (the link's per-cycle step limit over the period: the program's peak,
+/// the ramp-in blend's and the correction's rate) for the safety unit's speed limits.
+std::vector<ControllerFile> motoros2_setup_files(const ControllerSetupOpts& o) {
+  const runtime::LinkKindInfo& kind = runtime::link_kind(runtime::LinkKind::kMotoros2Rt);
+  Motoros2SetupOptions m;
+  if (o.period_ms < 0.0) throw InputError("option --period-ms: must be > 0");
+  m.period_ms = o.period_ms > 0.0 ? o.period_ms : kind.default_period_s * 1e3;
+  m.robot_port = o.robot_port == -1 ? 22000 : o.robot_port;
+  m.group = o.motoros2_group;
+  m.stop_silence_s = std::isnan(o.stop_silence_s) ? kind.default_stop_silence_s : o.stop_silence_s;
+  m.resend_ms = o.motoros2_resend_ms;
+  m.max_truncations = o.motoros2_max_truncations;
+  m.pc_address = o.sensor_ip;
+  if (!o.program.empty()) {
+    const RobotModel model = load_cli_robot("controller-setup", o.robot);
+    const auto program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o.program, model));
+    OnlineConfig online;
+    online.period_s = m.period_ms * 1e-3;
+    online.max_joint_correction_rad = deg_to_rad(o.max_joint_deg);
+    online.max_correction_rate_rad_s = deg_to_rad(o.max_rate_deg_s);
+    JointStreamConfig stream;
+    stream.ramp_in_s = o.ramp_in_s;
+    stream.validate();
+    const CommandLimits l = command_limits(CommandForm::kJointTarget, online, model.dof(), program.get(), &stream);
+    m.stream_speed_rad_s = l.joint_step_rad / online.period_s;
+  }
+  return motoros2_controller_setup(m);
 }
 
 /// Writes the files into --output-dir and lists them with where each goes (JSON with --json).
@@ -239,8 +284,11 @@ void run_controller_setup(const ControllerSetupOpts& o, int& exit_code) {
     files = rsi_setup_files(o);
   } else if (o.link == "fanuc-j519") {
     files = fanuc_setup_files(o);
+  } else if (o.link == "motoros2-rt") {
+    files = motoros2_setup_files(o);
   } else {
-    throw InputError(fmt::format("option --link: '{}' is not egm-joint, egm-path, rsi or fanuc-j519", o.link));
+    throw InputError(
+        fmt::format("option --link: '{}' is not egm-joint, egm-path, rsi, fanuc-j519 or motoros2-rt", o.link));
   }
   write_controller_setup_files(o, files);
   exit_code = 0;
@@ -256,9 +304,10 @@ void setup_controller_setup(CLI::App& sub, int& exit_code) {
 }  // namespace
 
 DEFLEX_COMMAND("controller-setup",
-               "Write the robot controller's side of a link (--link egm-joint|egm-path|rsi|fanuc-j519): RAPID and "
-               "UdpUc for ABB EGM, the Ethernet config, RSI context and KRL for KUKA RSI, the TP program and "
-               "settings for FANUC Stream Motion, agreeing with deflex online's options",
+               "Write the robot controller's side of a link (--link egm-joint|egm-path|rsi|fanuc-j519|motoros2-rt): "
+               "RAPID and UdpUc for ABB EGM, the Ethernet config, RSI context and KRL for KUKA RSI, the TP program "
+               "and settings for FANUC Stream Motion, the motoros2_config.yaml keys for MotoROS2's real-time mode, "
+               "agreeing with deflex online's options",
                setup_controller_setup, 42);
 
 }  // namespace deflex::cli

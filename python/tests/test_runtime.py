@@ -105,6 +105,24 @@ def test_fanuc_streams_within_its_controllers_jerk_limit_and_ends_with_last_data
     assert jerk.max() > 1.0  # the correction moved the stream
 
 
+def test_motoros2_streams_increments_within_the_step_limit_and_reaches_the_programs_end():
+    robot = deflex.Robot.builtin()
+    t, q = sweep(6.0)
+    rate = 0.05
+    s = deflex.StandIn(robot, "motoros2-rt", (t, q), force_base_N=[0.0, 0.0, -650.0],
+                       max_correction_rate_rad_s=rate)
+    s.run_for(8.0)
+    summary = s.finish()
+    assert summary["stop_reason"] == "program-end" and summary["exit_code"] == 0, summary["reason"]
+    # The command position each increment moved the controller to: the program's 1501 points at 4 ms.
+    wire = s.wire["joints_rad"]
+    assert wire.shape[0] == 1501
+    assert (np.abs(np.diff(wire, axis=0)) <= step_limit(t, q, 0.004, rate)).all()
+    # It ends at the program's last point less the correction, within the 0.01 rad bound.
+    correction = np.abs(wire[-1] - q[-1])
+    assert correction.max() <= 0.01 and correction.max() > 1e-5
+
+
 def test_settings_are_checked_and_named():
     robot = deflex.Robot.builtin()
     with pytest.raises(deflex.InputError, match="setting 'egm_prot' is not one of"):
@@ -117,6 +135,8 @@ def test_settings_are_checked_and_named():
         deflex.StandIn(robot, "fanuc-j519", sweep(), fanuc_version=2)
     with pytest.raises(deflex.InputError, match="is not VEL,ACC,JERK"):
         deflex.StandIn(robot, "fanuc-j519", sweep(), fanuc_limits="120;265")
+    with pytest.raises(deflex.InputError, match="motoros2-group"):
+        deflex.StandIn(robot, "motoros2-rt", sweep(), motoros2_group=8)
     with pytest.raises(deflex.InputError, match="rate bound allows"):
         deflex.StandIn(robot, "egm-joint", sweep(), max_correction_rate_rad_s=0.5, period_s=0.1)
 

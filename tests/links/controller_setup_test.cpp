@@ -15,9 +15,11 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include "deflex/egm/egm_controller_setup.hpp"
 #include "deflex/fanuc/fanuc_controller_setup.hpp"
+#include "deflex/motoros2/motoros2_controller_setup.hpp"
 #include "deflex/rsi/rsi_controller_setup.hpp"
 #include "deflex/text/errors.hpp"
 #include "wire/libxml2_reader.hpp"
@@ -470,6 +472,56 @@ TEST(ControllerSetup, FanucOptionsThatCannotWorkAreRefused) {
   o = FanucSetupOptions{};
   o.version = 2;
   refused(o, "--fanuc-version");
+}
+
+// MotoROS2: the configuration keys, read back with a YAML parser, carry deflex's port, its stop silence
+// as the controller's timeout and the gap deflex never exceeds; the sheet gives each joint's speed the
+// FSU limit must stay above (the figures given, in degrees) and the period deflex runs at.
+TEST(ControllerSetup, Motoros2ConfigKeysFollowDeflexsSettings) {
+  Motoros2SetupOptions o;
+  o.robot_port = 22010;
+  o.stop_silence_s = 0.75;
+  o.group = 1;
+  o.stream_speed_rad_s = JointVector(2);
+  o.stream_speed_rad_s << 0.1, 0.25;
+  const std::vector<ControllerFile> files = motoros2_controller_setup(o);
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(files[0].name, "deflex_motoros2_config.yaml");
+  const YAML::Node y = YAML::Load(files[0].text);
+  EXPECT_EQ(y["rt_listener_udp_port_number"].as<int>(), 22010);
+  EXPECT_EQ(y["rt_status_udp_port_number"].as<int>(), 22001);
+  EXPECT_EQ(y["rt_status_sleep_period"].as<int>(), 10);
+  EXPECT_EQ(y["timeout_for_rt_msg"].as<int>(), 750);
+  EXPECT_EQ(y["max_sequence_diff_for_rt_msg"].as<int>(), 1);
+  const std::string& sheet = files[1].text;
+  EXPECT_NE(sheet.find("joint 1: above 5.730 deg/s"), std::string::npos) << sheet;  // 0.1 rad/s
+  EXPECT_NE(sheet.find("joint 2: above 14.324 deg/s"), std::string::npos) << sheet;
+  EXPECT_NE(sheet.find("--period-ms must equal it (4 ms here"), std::string::npos) << sheet;
+  EXPECT_NE(sheet.find("--motoros2-group 1"), std::string::npos) << sheet;
+  EXPECT_NE(sheet.find("timeout_for_rt_msg (750 ms)"), std::string::npos) << sheet;
+}
+
+TEST(ControllerSetup, Motoros2OptionsThatCannotWorkAreRefused) {
+  const auto refused = [](const Motoros2SetupOptions& o, const char* words) {
+    try {
+      (void)motoros2_controller_setup(o);
+      ADD_FAILURE() << "expected an InputError naming " << words;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  Motoros2SetupOptions o;
+  o.period_ms = 4.5;
+  refused(o, "--period-ms");
+  o = Motoros2SetupOptions{};
+  o.robot_port = 70000;
+  refused(o, "--robot-port");
+  o = Motoros2SetupOptions{};
+  o.group = 8;
+  refused(o, "--motoros2-group");
+  o = Motoros2SetupOptions{};
+  o.stop_silence_s = 0.02;  // shorter than two 12 ms resends and a period
+  refused(o, "--stop-silence-s");
 }
 
 }  // namespace

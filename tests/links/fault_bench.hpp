@@ -1,7 +1,7 @@
 // A bench for the fault table (docs/online.md, "Faults and exit codes"): deflex's runtime session
 // against the simulated cell's stand-in of the real controller, in memory (standin/standin_session.hpp:
 // EGM position guidance or path correction, KUKA RSI, the RAPID simple message server, FANUC Stream
-// Motion), with the
+// Motion, MotoROS2 real-time), with the
 // faults a cell has injected by the test. What deflex sent is read off the wire on the controller's
 // side, and the two invariants are checked there, against limits the test computes itself from the
 // program it made (its peak speed by sampling, not the library's figure) and the settings it gave.
@@ -65,6 +65,7 @@ struct FaultBench {
     const double period = config.online.period_s;
     const JointStreamConfig& s = kind == runtime::LinkKind::kSimpleMessage ? config.simple_message.stream
                                  : kind == runtime::LinkKind::kFanucJ519   ? config.fanuc_j519.stream
+                                 : kind == runtime::LinkKind::kMotoros2Rt  ? config.motoros2_rt.stream
                                                                            : config.egm_joint.stream;
     const bool streams = runtime::link_kind(kind).streams_program;
     JointVector limit = JointVector::Constant(6, period * config.online.max_correction_rate_rad_s);

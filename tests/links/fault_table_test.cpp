@@ -41,6 +41,9 @@ void expect_wire_is_what_was_sent(FaultBench& b) {
       const LinkCycleRecord& r = *sent[at];
       if (b.kind == LinkKind::kEgmJoint) {
         found = (r.q_command - c.joints).cwiseAbs().maxCoeff() < 1e-12;
+      } else if (b.kind == LinkKind::kMotoros2Rt) {
+        // The command position the increment moved the controller to: reported + increment.
+        found = (r.q_command - c.joints).cwiseAbs().maxCoeff() < 1e-12;
       } else if (b.kind == LinkKind::kFanucJ519) {
         found = (r.q_command - c.joints).cwiseAbs().maxCoeff() < 1e-9;  // float32 degrees on the wire
       } else if (b.kind == LinkKind::kRsi) {
@@ -656,6 +659,160 @@ TEST(FaultTable, FanucJ519AStaleForceRampsTheCorrectionOutWithoutAnAlarm) {
   EXPECT_LT(b.session->link().last_cycle().dtheta.cwiseAbs().maxCoeff(), 1e-9);
   EXPECT_EQ(b.standin->fanuc()->alarm(), "");
   expect_invariants(b, "fanuc stale force");
+}
+
+// ---- motoros2-rt: lock-step increments; the controller drops its session, deflex resends -----------
+// MotoROS2 answers each command once, applies nothing while no command comes, answers a command it
+// took again without applying it, and drops its session on a sequence jump, a second sender or its
+// own timeout; its safety unit may truncate increments. What went on the wire is the command
+// position each increment moved the controller to (reported + increment): within the bound of the
+// nominal, and no increment beyond the per-cycle step limit.
+
+TEST(FaultTable, Motoros2RtRunsTheProgramToItsEnd) {
+  FaultBench b(LinkKind::kMotoros2Rt, sweep(6.0));
+  b.run_for(8.0);
+  ASSERT_TRUE(b.session->ended());
+  const runtime::SessionSummary& s = b.session->finish();
+  EXPECT_EQ(s.reason, StopReason::kProgramEnd) << s.reason_text;
+  EXPECT_EQ(s.exit_code, 0);
+  EXPECT_EQ(b.standin->motoros2()->dropped(), "");
+  EXPECT_GT(b.wire().size(), 1500u);
+  expect_invariants(b, "motoros2 to the end");
+}
+
+TEST(FaultTable, Motoros2RtOutagesAndStallsAreRiddenThroughAndNothingSteps) {
+  for (const double fault : {0.02, 0.1, 0.3}) {
+    for (const bool stall : {false, true}) {
+      SCOPED_TRACE(testing::Message() << (stall ? "stall " : "outage ") << fault << " s");
+      FaultBench b(LinkKind::kMotoros2Rt, sweep());
+      b.run_for(2.0);
+      if (stall) {
+        b.standin->stall(true);
+        b.run_for(fault);
+        b.standin->stall(false);
+      } else {
+        b.standin->outage(fault);
+      }
+      b.run_for(2.0);
+      ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
+      EXPECT_EQ(b.standin->motoros2()->dropped(), "");
+      EXPECT_EQ(b.standin->motoros2()->counters().skipped, 0u);
+      expect_invariants(b, "motoros2 outage or stall");
+    }
+  }
+}
+
+// Beyond the stop silence (an outage) or the controller's own timeout (a stalled PC: the controller
+// drops its session), the session ends, named.
+TEST(FaultTable, Motoros2RtALongOutageOrAStallBeyondTheControllersTimeoutEndsTheSession) {
+  for (const bool stall : {false, true}) {
+    SCOPED_TRACE(stall ? "stall" : "outage");
+    FaultBench b(LinkKind::kMotoros2Rt, sweep(),
+                 [](runtime::SessionConfig&, standin::StandInConfig& sc) { sc.motoros2.timeout_s = 1.0; });
+    b.run_for(2.0);
+    const std::size_t sent = b.wire().size();
+    if (stall) {
+      b.standin->stall(true);
+      b.run_for(1.5);
+      b.standin->stall(false);
+    } else {
+      b.standin->outage(3.0);
+    }
+    b.run_for(4.0);
+    ASSERT_TRUE(b.session->ended());
+    const runtime::SessionSummary& s = b.session->finish();
+    EXPECT_EQ(s.reason, StopReason::kControllerSilent) << s.reason_text;
+    EXPECT_EQ(s.exit_code, exit_code(StopReason::kControllerSilent));
+    if (stall) {
+      EXPECT_EQ(b.standin->motoros2()->dropped(), "no command for timeout_for_rt_msg");
+      // The increment in flight as deflex stalled, and none after.
+      EXPECT_EQ(b.wire().size(), sent + 1) << "the controller applied an increment after its session ended";
+    }
+    expect_invariants(b, "motoros2 long fault");
+  }
+}
+
+TEST(FaultTable, Motoros2RtAStopRequestBringsTheProgramToRest) {
+  FaultBench b(LinkKind::kMotoros2Rt, sweep());
+  b.run_for(3.0);
+  b.session->request_stop();
+  b.run_for(3.0);
+  ASSERT_TRUE(b.session->ended());
+  const runtime::SessionSummary& s = b.session->finish();
+  EXPECT_EQ(s.reason, StopReason::kUserStop) << s.reason_text;
+  EXPECT_EQ(b.standin->motoros2()->dropped(), "");
+  expect_invariants(b, "motoros2 stop request");
+}
+
+// A stopped controller (an e-stop, stop_traj_mode) answers nothing more; a restarted one (a new real-time
+// session) waits for a command numbered 0, drops deflex's next and answers nothing: both end the session
+// on the silence, and nothing moves the arm after.
+TEST(FaultTable, Motoros2RtAStoppedOrRestartedControllerEndsTheSession) {
+  for (const bool estop : {true, false}) {
+    SCOPED_TRACE(estop ? "stopped" : "restarted");
+    FaultBench b(LinkKind::kMotoros2Rt, sweep());
+    b.run_for(2.0);
+    const std::size_t sent = b.wire().size();
+    if (estop) {
+      b.standin->motors_off();
+    } else {
+      b.standin->restart();
+    }
+    b.run_for(2.0);
+    ASSERT_TRUE(b.session->ended());
+    EXPECT_EQ(b.session->finish().reason, StopReason::kControllerSilent) << b.session->finish().reason_text;
+    EXPECT_EQ(b.wire().size(), sent) << "the controller applied an increment after it stopped";
+    expect_invariants(b, estop ? "motoros2 stopped" : "motoros2 restarted");
+  }
+}
+
+TEST(FaultTable, Motoros2RtAnEStopOnTheStatusChannelEndsTheSessionAtOnce) {
+  FaultBench b(LinkKind::kMotoros2Rt, sweep(),
+               [](runtime::SessionConfig& c, standin::StandInConfig&) { c.motoros2_rt.status_port = 22001; });
+  b.run_for(2.0);
+  const std::size_t sent = b.wire().size();
+  b.standin->motors_off();
+  b.run_for(0.05);
+  ASSERT_TRUE(b.session->ended());
+  const runtime::SessionSummary& s = b.session->finish();
+  EXPECT_EQ(s.reason, StopReason::kControllerStopped) << s.reason_text;
+  EXPECT_EQ(s.exit_code, 6);
+  EXPECT_NE(s.reason_text.find("emergency stop"), std::string::npos) << s.reason_text;
+  EXPECT_EQ(b.wire().size(), sent);
+  expect_invariants(b, "motoros2 e-stop on the status channel");
+}
+
+TEST(FaultTable, Motoros2RtAStaleForceRampsTheCorrectionOut) {
+  FaultBench b(LinkKind::kMotoros2Rt, sweep());
+  b.run_for(3.0);
+  ASSERT_GT(b.session->link().last_cycle().dtheta.cwiseAbs().maxCoeff(), 1e-5);
+  b.standin->sensor_silent(true);
+  b.run_for(3.0);
+  ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
+  EXPECT_LT(b.session->link().last_cycle().dtheta.cwiseAbs().maxCoeff(), 1e-9);
+  expect_invariants(b, "motoros2 stale force");
+}
+
+// The safety unit's speed limit below the program's speed: its truncations run on beyond the link's
+// limit, and the session ends naming the safety unit. Every increment deflex sent was within the step
+// limit and every absolute within the bound (the truncated positions are the controller's, not sent).
+TEST(FaultTable, Motoros2RtASafetyUnitThatKeepsTruncatingEndsTheSession) {
+  const auto program = sweep(10.0);
+  const double fsu = 0.5 * test::sampled_peak_speed(*program).maxCoeff();
+  FaultBench b(LinkKind::kMotoros2Rt, program,
+               [&](runtime::SessionConfig&, standin::StandInConfig& sc) { sc.motoros2.fsu_speed_rad_s = fsu; });
+  b.run_for(12.0);
+  ASSERT_TRUE(b.session->ended());
+  const runtime::SessionSummary& s = b.session->finish();
+  EXPECT_EQ(s.reason, StopReason::kControllerStopped) << s.reason_text;
+  EXPECT_EQ(s.exit_code, 6);
+  EXPECT_NE(s.reason_text.find("Functional Safety Unit"), std::string::npos) << s.reason_text;
+  EXPECT_GT(b.standin->motoros2()->counters().truncated, 25u);
+  const JointVector limit = b.joint_step_limit();
+  for (const JointVector& inc : b.standin->motoros2()->increments()) {
+    ASSERT_LE((inc.array() / limit.array()).abs().maxCoeff(), 1.0);
+  }
+  EXPECT_LE(b.worst_bound_fraction(), 1.0);
 }
 
 }  // namespace

@@ -7,11 +7,11 @@
 
 namespace deflex::runtime {
 
-const std::array<LinkKindInfo, 5>& link_kinds() {
+const std::array<LinkKindInfo, 6>& link_kinds() {
   // Stop silences: EGM rides through outages up to 3 s (its controller holds the last target; the
   // generated RAPID's CommTimeout matches); RSI's controller stops itself long before (its Timeout of
   // late answers), so 1 s of silence means it stopped; simple message has its own state timeout.
-  static const std::array<LinkKindInfo, 5> kinds{{
+  static const std::array<LinkKindInfo, 6> kinds{{
       {LinkKind::kEgmJoint, "egm-joint",
        "ABB EGM position guidance (EGMActJoint/EGMRunJoint): deflex streams --program", true, CommandForm::kJointTarget,
        0.004, 3.0},
@@ -33,6 +33,12 @@ const std::array<LinkKindInfo, 5>& link_kinds() {
        "FANUC Stream Motion (J519) over UDP: deflex streams --program, one command a status, within the "
        "controller's velocity, acceleration and jerk limits",
        true, CommandForm::kJointTarget, 0.008, 1.0},
+      // MotoROS2 answers each command once, and deflex sends a late one again every few cycles: half a
+      // second without a reply is a controller that dropped its real-time session or stopped.
+      {LinkKind::kMotoros2Rt, "motoros2-rt",
+       "Yaskawa MotoROS2 real-time motion (joint increments) over UDP: deflex streams --program, one increment a "
+       "reply, measured from the command position the controller reports",
+       true, CommandForm::kJointTarget, 0.004, 0.5},
   }};
   return kinds;
 }

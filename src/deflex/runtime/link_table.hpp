@@ -10,7 +10,14 @@
 
 namespace deflex::runtime {
 
-enum class LinkKind : int { kEgmJoint = 0, kEgmPath = 1, kRsi = 2, kSimpleMessage = 3, kFanucJ519 = 4 };
+enum class LinkKind : int {
+  kEgmJoint = 0,
+  kEgmPath = 1,
+  kRsi = 2,
+  kSimpleMessage = 3,
+  kFanucJ519 = 4,
+  kMotoros2Rt = 5
+};
 
 struct LinkKindInfo {
   LinkKind kind;
@@ -38,7 +45,7 @@ struct SessionOptionDefaults {
 };
 inline constexpr SessionOptionDefaults kSessionOptionDefaults{};
 
-[[nodiscard]] const std::array<LinkKindInfo, 5>& link_kinds();
+[[nodiscard]] const std::array<LinkKindInfo, 6>& link_kinds();
 [[nodiscard]] const LinkKindInfo& link_kind(LinkKind kind);
 /// The kind named `name`; throws InputError naming it and listing the known names.
 [[nodiscard]] LinkKind parse_link_kind(const std::string& name);

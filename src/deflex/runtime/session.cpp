@@ -151,6 +151,40 @@ void Session::open_fanuc_j519(const SessionEndpoints& endpoints, ForceSource* fo
                        to_string(t->local_address()));
 }
 
+// MotoROS2 real-time: deflex is the client, as for FANUC; the controller answers to the command's source.
+void Session::open_motoros2_rt(const SessionEndpoints& endpoints, ForceSource* force,
+                               std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules) {
+  Motoros2RtLinkConfig c = config_.motoros2_rt;
+  c.stop = rules;
+  c.history_cycles = config_.history_cycles;
+  c.validate();
+  const NetworkConfig& net = config_.network;
+  DatagramTransport* t = endpoints.datagram;
+  if (!net.robot_host.empty() || t == nullptr) {
+    if (net.robot_host.empty()) {
+      throw InputError("option --robot-host: the motoros2-rt link needs the controller's IPv4 address");
+    }
+    const std::uint16_t port =
+        port_option(net.robot_port == -1 ? motoros2_rt::kDefaultPort : net.robot_port, "--robot-port", "", 1);
+    c.controller = make_datagram_address(net.robot_host, port);
+  }
+  if (t == nullptr) {
+    own_datagram_ = std::make_unique<UdpTransport>(net.bind_address, 0);
+    t = own_datagram_.get();
+  }
+  DatagramTransport* status = endpoints.status;
+  if (c.status_port >= 0 && status == nullptr) {
+    own_status_ =
+        std::make_unique<UdpTransport>(net.bind_address, port_option(c.status_port, "--motoros2-status-port", "", 1));
+    status = own_status_.get();
+  }
+  if (c.status_port < 0) status = nullptr;
+  link_ = std::make_unique<Motoros2RtLink>(*compensator_, *strategy_, std::move(program), *t, clock_, force, c, status);
+  where_ = fmt::format("MotoROS2 real-time to {} (group {}), from {}{}", to_string(c.controller), c.group,
+                       to_string(t->local_address()),
+                       status != nullptr ? fmt::format(", its status on {}", to_string(status->local_address())) : "");
+}
+
 void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
                         std::shared_ptr<const JointTrajectory> program) {
   const LinkKindInfo& info = link_kind(config_.link);
@@ -228,6 +262,9 @@ void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
     }
     case LinkKind::kFanucJ519:
       open_fanuc_j519(endpoints, force, std::move(program), rules);
+      break;
+    case LinkKind::kMotoros2Rt:
+      open_motoros2_rt(endpoints, force, std::move(program), rules);
       break;
   }
 }
@@ -388,8 +425,9 @@ const SessionSummary& Session::finish() {
       const JointVector& d = link_->start_distance();
       const double tolerance = config_.link == LinkKind::kSimpleMessage
                                    ? config_.simple_message.stream.start_tolerance_rad
-                               : config_.link == LinkKind::kFanucJ519 ? config_.fanuc_j519.stream.start_tolerance_rad
-                                                                      : config_.egm_joint.stream.start_tolerance_rad;
+                               : config_.link == LinkKind::kFanucJ519  ? config_.fanuc_j519.stream.start_tolerance_rad
+                               : config_.link == LinkKind::kMotoros2Rt ? config_.motoros2_rt.stream.start_tolerance_rad
+                                                                       : config_.egm_joint.stream.start_tolerance_rad;
       for (int j = 0; j < d.size(); ++j) {
         if (d[j] > tolerance) {
           joints += fmt::format("{}joint {} is {:.3f} deg away", joints.empty() ? "" : ", ", j + 1, rad_to_deg(d[j]));

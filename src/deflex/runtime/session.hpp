@@ -32,9 +32,10 @@ namespace deflex::runtime {
 /// Transports the caller gives (a simulated cell's in-memory network, tests). Null: the session opens
 /// real sockets from NetworkConfig.
 struct SessionEndpoints {
-  DatagramTransport* datagram = nullptr;  ///< EGM, RSI
+  DatagramTransport* datagram = nullptr;  ///< EGM, RSI, fanuc-j519, motoros2-rt
   StreamTransport* motion = nullptr;      ///< simple message
   StreamTransport* state = nullptr;
+  DatagramTransport* status = nullptr;  ///< motoros2-rt: the controller's RobotState (with status_port >= 0)
 };
 
 /// How a session ended and what it did.
@@ -126,6 +127,8 @@ class Session {
   void open_link(const SessionEndpoints& endpoints, ForceSource* force, std::shared_ptr<const JointTrajectory> program);
   void open_fanuc_j519(const SessionEndpoints& endpoints, ForceSource* force,
                        std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules);
+  void open_motoros2_rt(const SessionEndpoints& endpoints, ForceSource* force,
+                        std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules);
   void push(SessionEntry::Kind kind, double now) noexcept;
   void end(StopReason reason) noexcept;
   void reporter_loop();
@@ -138,6 +141,7 @@ class Session {
   std::unique_ptr<OnlineCompensator> compensator_;
   std::unique_ptr<OnlineStrategy> strategy_;
   std::unique_ptr<DatagramTransport> own_datagram_;
+  std::unique_ptr<DatagramTransport> own_status_;  // motoros2-rt: the controller's RobotState, when read
   std::unique_ptr<StreamTransport> own_motion_, own_state_;
   std::unique_ptr<ControllerLink> link_;
   ForceSource* force_ = nullptr;

@@ -9,6 +9,7 @@
 #include "deflex/egm/egm_joint_link.hpp"
 #include "deflex/egm/egm_path_link.hpp"
 #include "deflex/fanuc/fanuc_j519_link.hpp"
+#include "deflex/motoros2/motoros2_rt_link.hpp"
 #include "deflex/online/online_strategy.hpp"
 #include "deflex/rsi/rsi_link.hpp"
 #include "deflex/runtime/link_table.hpp"
@@ -22,8 +23,8 @@ struct NetworkConfig {
   std::string bind_address = "127.0.0.1";  ///< UDP links bind here (0.0.0.0 or the cell network's address on a cell)
   int egm_port = -1;                       ///< EGM links: the UDP port the controller sends to (required)
   int rsi_port = -1;                       ///< rsi: the UDP port the controller sends to (required)
-  std::string robot_host;                  ///< simple message, fanuc-j519: the controller's address (required)
-  int robot_port = -1;                     ///< fanuc-j519: its UDP port (-1: the protocol's, 60015)
+  std::string robot_host;                  ///< simple message, fanuc-j519, motoros2-rt: the controller's address
+  int robot_port = -1;  ///< fanuc-j519, motoros2-rt: its UDP port (-1: the protocol's, 60015 or 22000)
   int motion_port = 11000, state_port = 11002;
   double connect_timeout_s = 5.0;
 };
@@ -56,7 +57,8 @@ struct SessionConfig {
   EgmPathLinkConfig egm_path;
   RsiLinkConfig rsi;
   SimpleMessageLinkConfig simple_message;
-  FanucJ519LinkConfig fanuc_j519;  ///< its controller address comes from NetworkConfig (or is given with a transport)
+  FanucJ519LinkConfig fanuc_j519;    ///< its controller address comes from NetworkConfig (or is given with a transport)
+  Motoros2RtLinkConfig motoros2_rt;  ///< as fanuc_j519
   double duration_s = 0.0;         ///< > 0: the session ends (planned) after this long
   /// A planned stop (request_stop(), the time limit) while the arm moves: a streaming link brings the
   /// program to rest on its path over this long, a correcting link ramps its correction out at the rate

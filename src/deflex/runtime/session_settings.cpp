@@ -25,6 +25,7 @@ constexpr LinkMask kPath = link_bit(LinkKind::kEgmPath);
 constexpr LinkMask kRsi = link_bit(LinkKind::kRsi);
 constexpr LinkMask kSm = link_bit(LinkKind::kSimpleMessage);
 constexpr LinkMask kFanuc = link_bit(LinkKind::kFanucJ519);
+constexpr LinkMask kMoto = link_bit(LinkKind::kMotoros2Rt);
 
 // The getters and setters of a table row come from one accessor of the field (a lambda without
 // captures: C++20 constructs one where it is needed).
@@ -97,18 +98,20 @@ SessionSetting words(SessionSetting s, Field /*field*/) {
 
 // The controller's cycle and what every command is held to.
 void bound_settings(std::vector<SessionSetting>& t) {
-  t.push_back(real({.key = "period_s",
-                    .option = "--period-ms",
-                    .unit = "s",
-                    .option_unit = "ms",
-                    .option_per_unit = 1e3,
-                    .min = 5e-4,
-                    .max = 1.0,
-                    .help = "the controller's cycle",
-                    .why = "a controller's cycle is 0.5 ms to 1 s",
-                    .default_text = "the link's: egm-joint, rsi 4; egm-path 48 (EGMActMove's SampleRate); "
-                                    "simple-message 100 (the paper's); fanuc-j519 8"},
-                   [](C& c) -> double& { return c.online.period_s; }));
+  t.push_back(
+      real({.key = "period_s",
+            .option = "--period-ms",
+            .unit = "s",
+            .option_unit = "ms",
+            .option_per_unit = 1e3,
+            .min = 5e-4,
+            .max = 1.0,
+            .help = "the controller's cycle",
+            .why = "a controller's cycle is 0.5 ms to 1 s",
+            .default_text =
+                "the link's: egm-joint, rsi 4; egm-path 48 (EGMActMove's SampleRate); "
+                "simple-message 100 (the paper's); fanuc-j519 8; motoros2-rt 4 (the period start_rt_mode returns)"},
+           [](C& c) -> double& { return c.online.period_s; }));
   t.push_back(real({.key = "max_joint_correction_rad",
                     .option = "--max-joint-correction-deg",
                     .unit = "rad",
@@ -192,7 +195,7 @@ void stop_settings(std::vector<SessionSetting>& t) {
                .min_open = true,
                .help = "no usable controller message this long: the controller is gone and the session stops (exit "
                        "code 5); shorter silences are ridden through",
-               .default_text = "the link's: egm-joint, egm-path 3; rsi, simple-message, fanuc-j519 1",
+               .default_text = "the link's: egm-joint, egm-path 3; rsi, simple-message, fanuc-j519 1; motoros2-rt 0.5",
                .get_real = [](const C& c) { return c.stop_silence_s.value_or(0.0); },
                .set_real = [](C& c, double v) { c.stop_silence_s = v; }});
   t.push_back(real({.key = "end_silence_s",
@@ -298,17 +301,18 @@ void network_settings(std::vector<SessionSetting>& t) {
                     [](C& c) -> int& { return c.network.rsi_port; }));
   t.push_back(words({.key = "robot_host",
                      .option = "--robot-host",
-                     .links = kSm | kFanuc,
+                     .links = kSm | kFanuc | kMoto,
                      .help = "the controller's address (simple-message: its motion and state servers listen there; "
-                             "fanuc-j519: its IPv4 address)"},
+                             "fanuc-j519, motoros2-rt: its IPv4 address)"},
                     [](C& c) -> std::string& { return c.network.robot_host; }));
   t.push_back(count({.key = "robot_port",
                      .option = "--robot-port",
                      .min = 1,
                      .max = kPort,
-                     .links = kFanuc,
-                     .help = "the controller's Stream Motion UDP port",
-                     .default_text = "60015"},
+                     .links = kFanuc | kMoto,
+                     .help = "the controller's UDP port (fanuc-j519: Stream Motion's; motoros2-rt: its "
+                             "rt_listener_udp_port_number)",
+                     .default_text = "the protocol's: fanuc-j519 60015, motoros2-rt 22000"},
                     [](C& c) -> int& { return c.network.robot_port; }));
   t.push_back(count({.key = "motion_port",
                      .option = "--motion-port",
@@ -346,7 +350,7 @@ void egm_rsi_settings(std::vector<SessionSetting>& t) {
                     .set_real =
                         [](C& c, double v) {
                           c.egm_joint.stream.ramp_in_s = c.simple_message.stream.ramp_in_s = v;
-                          c.fanuc_j519.stream.ramp_in_s = v;
+                          c.fanuc_j519.stream.ramp_in_s = c.motoros2_rt.stream.ramp_in_s = v;
                         }},
                    [](C& c) -> double& { return c.egm_joint.stream.ramp_in_s; }));
   t.push_back(flag({.key = "send_speed_reference",
@@ -541,6 +545,53 @@ void fanuc_settings(std::vector<SessionSetting>& t) {
                     [](C& c) -> int& { return c.fanuc_j519.max_catch_up; }));
 }
 
+void motoros2_settings(std::vector<SessionSetting>& t) {
+  t.push_back(count({.key = "motoros2_group",
+                     .option = "--motoros2-group",
+                     .min = 0,
+                     .max = 7,
+                     .links = kMoto,
+                     .help = "the control group deflex streams (0: the first robot)"},
+                    [](C& c) -> int& { return c.motoros2_rt.group; }));
+  t.push_back(count({.key = "motoros2_tool",
+                     .option = "--motoros2-tool",
+                     .min = 0,
+                     .max = 63,
+                     .links = kMoto,
+                     .help = "the tool number sent with every command"},
+                    [](C& c) -> int& { return c.motoros2_rt.tool; }));
+  t.push_back(real({.key = "motoros2_resend_s",
+                    .option = "--motoros2-resend-ms",
+                    .unit = "s",
+                    .option_unit = "ms",
+                    .option_per_unit = 1e3,
+                    .min = 0.0,
+                    .max = 1.0,
+                    .min_open = true,
+                    .links = kMoto,
+                    .help = "a command whose reply has not come this long is sent again with the same number (the "
+                            "controller applies it at most once)"},
+                   [](C& c) -> double& { return c.motoros2_rt.resend_after_s; }));
+  t.push_back(count({.key = "motoros2_max_truncations",
+                     .option = "--motoros2-max-truncations",
+                     .min = 0,
+                     .max = 100000,
+                     .links = kMoto,
+                     .help = "replies in a row flagging an increment the controller's Functional Safety Unit "
+                             "truncated before the session stops (the program is faster than its speed limit)"},
+                    [](C& c) -> int& { return c.motoros2_rt.max_truncation_run; }));
+  t.push_back(count({.key = "motoros2_status_port",
+                     .option = "--motoros2-status-port",
+                     .min = 1,
+                     .max = 65535,
+                     .links = kMoto,
+                     .help = "read the controller's RobotState on this UDP port (its rt_status_udp_port_number, "
+                             "22001): an e-stop, an error, the drives off end the session at once; without it they "
+                             "show as the controller's silence",
+                     .default_text = "not read"},
+                    [](C& c) -> int& { return c.motoros2_rt.status_port; }));
+}
+
 // The force source and the tare (session_force.hpp opens it).
 void force_settings(std::vector<SessionSetting>& t) {
   t.push_back(words({.key = "force_source",
@@ -609,6 +660,7 @@ std::vector<SessionSetting> make_table() {
   egm_rsi_settings(t);
   simple_message_settings(t);
   fanuc_settings(t);
+  motoros2_settings(t);
   force_settings(t);
   return t;
 }
@@ -717,6 +769,7 @@ void check_together(const C& c, std::span<const GivenSetting> settings) {
   } catch (const InputError& e) {
     throw InputError(fmt::format("settings fanuc_* (--fanuc-*): {}", e.what()));
   }
+  c.motoros2_rt.validate();  // its messages name the setting
 }
 
 }  // namespace

@@ -74,7 +74,8 @@ StandInSession::StandInSession(const runtime::SessionConfig& config, const Robot
       standin_(standin),
       robot_(robot),
       program_(std::move(program)),
-      network_(clock_),
+      // MotoROS2's reply is 2053 bytes.
+      network_(clock_, config.link == runtime::LinkKind::kMotoros2Rt ? 4096 : 2048),
       deflex_port_(network_.add_endpoint(kDeflex, standin.network_latency_s)),
       controller_port_(network_.add_endpoint(kController, standin.network_latency_s)),
       motion_(clock_, standin.network_latency_s),
@@ -87,8 +88,18 @@ StandInSession::StandInSession(const runtime::SessionConfig& config, const Robot
     config_.fanuc_j519.controller = kController;
     config_.network.robot_host.clear();
   }
+  if (kind_ == runtime::LinkKind::kMotoros2Rt) {
+    config_.motoros2_rt.controller = kController;
+    config_.network.robot_host.clear();
+  }
   const bool streams = runtime::link_kind(kind_).streams_program;
   runtime::SessionEndpoints ends{&deflex_port_, &motion_.client(), &state_.client()};
+  if (kind_ == runtime::LinkKind::kMotoros2Rt && config_.motoros2_rt.status_port >= 0) {
+    // The controller's RobotState comes to the PC's address at the status port.
+    ends.status = &network_.add_endpoint(
+        DatagramAddress{kDeflex.ipv4, static_cast<std::uint16_t>(config_.motoros2_rt.status_port)},
+        standin.network_latency_s);
+  }
   session_ = std::make_unique<runtime::Session>(config_, robot, sensor, streams ? program_ : nullptr, force_model,
                                                 &sensor_, clock_, ends);
   cell::ControllerConfig cc = standin.controller;
@@ -142,6 +153,16 @@ StandInSession::StandInSession(const runtime::SessionConfig& config, const Robot
       controller_ = std::move(c);
       break;
     }
+    case runtime::LinkKind::kMotoros2Rt: {
+      cell::Motoros2RtControllerConfig mc = standin.motoros2;
+      mc.period_s = config_.online.period_s;
+      mc.group = config_.motoros2_rt.group;
+      mc.status_port = config_.motoros2_rt.status_port;
+      auto c = std::make_unique<cell::Motoros2RtController>(mc, program_->points().front(), *tap_);
+      motoros2_ = c.get();
+      controller_ = std::move(c);
+      break;
+    }
   }
   arm_ = program_->points().front();
 }
@@ -182,6 +203,18 @@ void StandInSession::tick() {
   t_s_ += tick_s;
   clock_.set(t_s_);
   arm_ = controller_->tick(t_s_);
+  if (motoros2_ != nullptr) {
+    // Every increment the controller took, as the command position it moved to (the session's first
+    // command, with no increment, left out).
+    const auto& taken = motoros2_->taken();
+    for (std::size_t i = std::max<std::size_t>(motoros2_seen_, 1); i < taken.size(); ++i) {
+      WireCommand c;
+      c.t_s = t_s_;
+      c.joints = taken[i];
+      wire_.push_back(c);
+    }
+    motoros2_seen_ = taken.size();
+  }
   if (server_ != nullptr) {
     // Every point the server took, as the wire carried it (float32 radians).
     for (std::size_t i = wire_.size(); i < server_->accepted_points().size(); ++i) {
@@ -224,6 +257,7 @@ void StandInSession::restart(bool reset_reference, double off_s) {
     rsi_->restart();
   }
   if (fanuc_ != nullptr) fanuc_->restart(t_s_);
+  if (motoros2_ != nullptr) motoros2_->restart(t_s_);
   if (server_ != nullptr) throw InputError("stand-in: the simple message server has no session to restart");
 }
 
@@ -239,6 +273,8 @@ void StandInSession::motors_off() {
     server_->emergency_stop(t_s_);
   } else if (fanuc_ != nullptr) {
     fanuc_->raise_alarm("SRVO-001 Operator panel E-stop");
+  } else if (motoros2_ != nullptr) {
+    motoros2_->stop("e-stop");
   } else {
     throw InputError("stand-in: this controller reports no motor state");
   }

@@ -16,6 +16,7 @@
 #include "deflex/cell/egm_path_controller.hpp"
 #include "deflex/cell/egm_position_controller.hpp"
 #include "deflex/cell/fanuc_j519_controller.hpp"
+#include "deflex/cell/motoros2_rt_controller.hpp"
 #include "deflex/cell/rsi_controller.hpp"
 #include "deflex/cell/simple_message_server.hpp"
 #include "deflex/runtime/session.hpp"
@@ -27,8 +28,10 @@ namespace deflex::standin {
 /// What the controller received from deflex, in order, decoded with the wire's own codec (simple message:
 /// every point the server took, as the frame carried it).
 struct WireCommand {
-  double t_s = 0.0;                    ///< when the controller read it
-  JointVector joints;                  ///< absolute joints (egm-joint, simple message) or the joint offset (rsi), rad
+  double t_s = 0.0;  ///< when the controller read it
+  /// Absolute joints (egm-joint, simple message, fanuc-j519; motoros2-rt: the command position each increment
+  /// taken moved the controller to) or the joint offset (rsi), rad.
+  JointVector joints;
   Vector3 offset_m = Vector3::Zero();  ///< egm-path: the offset in the correction frame, m
 };
 
@@ -40,6 +43,9 @@ struct StandInConfig {
   /// FANUC Stream Motion: its queue, dead time, lag and limits (the interval and the protocol version
   /// follow the session's).
   cell::FanucJ519ControllerConfig fanuc;
+  /// MotoROS2 real-time: its dead time, lag, speed limits, sequence gap and timeout (the period follows
+  /// the session's).
+  cell::Motoros2RtControllerConfig motoros2;
   double network_latency_s = 0.0002;       ///< one way
   Vector3 force_base_n = Vector3::Zero();  ///< the process force at the TCP, base frame (N)
   double sensor_rate_hz = 250.0;           ///< samples a second the stand-in sensor gives (one a tick at 250 Hz)
@@ -98,7 +104,7 @@ class StandInSession {
   /// The controller ends its session now: EGM with mciState `mci_state` (2 STOPPED, 1 ERROR).
   void end_session(int mci_state = 2);
   /// The motors go off (EGM: an emergency stop); simple message: the server's emergency stop; FANUC: an
-  /// e-stop alarm.
+  /// e-stop alarm; MotoROS2: the controller stops answering.
   void motors_off();
   /// The force sensor stops (true) or comes back.
   void sensor_silent(bool silent) { sensor_.on = !silent; }
@@ -118,6 +124,7 @@ class StandInSession {
   [[nodiscard]] cell::RsiController* rsi() { return rsi_; }
   [[nodiscard]] cell::SimpleMessageServer* server() { return server_; }
   [[nodiscard]] cell::FanucJ519Controller* fanuc() { return fanuc_; }
+  [[nodiscard]] cell::Motoros2RtController* motoros2() { return motoros2_; }
   [[nodiscard]] MemoryNetwork& network() { return network_; }
   [[nodiscard]] ManualClock& clock() { return clock_; }
 
@@ -144,7 +151,9 @@ class StandInSession {
   cell::RsiController* rsi_ = nullptr;
   cell::SimpleMessageServer* server_ = nullptr;
   cell::FanucJ519Controller* fanuc_ = nullptr;
+  cell::Motoros2RtController* motoros2_ = nullptr;
   std::vector<WireCommand> wire_;
+  std::size_t motoros2_seen_ = 0;  // the MotoROS2 controller's increments already in wire_
   double t_s_ = 0.0;
   double next_sample_s_ = 0.0;
   bool stalled_ = false;
