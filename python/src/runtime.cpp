@@ -230,27 +230,34 @@ void bind_runtime(py::module_& m) {
       "at the TCP in the base frame; server_read_period_s: simple message, the robot program takes a point at most "
       "this "
       "often (a slow consumer); comm_timeout_s: EGM's \\CommTimeout, s. Settings as deflex.Session's.")
-      .def(py::init([](const RobotHolder& robot, const std::string& link, const py::object& program,
-                       const py::handle& force_base_n, const py::object& sensor, const std::string& strategy,
-                       double server_read_period_s, double comm_timeout_s, const py::kwargs& kwargs) {
-             const runtime::SessionConfig config = config_from(link, strategy, kwargs);
-             standin::StandInConfig sc;
-             sc.force_base_n = vector3(force_base_n, "force_base_N");
-             if (!(server_read_period_s >= 0.0 && server_read_period_s <= 10.0)) {
-               throw InputError(fmt::format("server_read_period_s: {} s is not in 0..10 s", server_read_period_s));
-             }
-             sc.server.read_period_s = server_read_period_s;
-             if (!(comm_timeout_s > 0.0 && comm_timeout_s <= 60.0)) {
-               throw InputError(fmt::format("comm_timeout_s: {} s is not in 0..60 s", comm_timeout_s));
-             }
-             sc.controller.egm_comm_timeout_s = comm_timeout_s;
-             const SensorConfig sensor_config = sensor.is_none() ? SensorConfig{} : sensor.cast<SensorConfig>();
-             return std::make_unique<standin::StandInSession>(config, *robot, sensor_config,
-                                                              program_of(program, *robot), nullptr, sc);
-           }),
-           "robot"_a, "link"_a, "program"_a, py::kw_only(), "force_base_N"_a = std::vector<double>{0.0, 0.0, 0.0},
-           "sensor"_a = py::none(), "strategy"_a = "online", "server_read_period_s"_a = 0.0, "comm_timeout_s"_a = 1.0,
-           py::keep_alive<1, 2>())
+      .def(
+          py::init([](const RobotHolder& robot, const std::string& link, const py::object& program,
+                      const py::handle& force_base_n, const py::object& sensor, const std::string& strategy,
+                      double server_read_period_s, double comm_timeout_s, const py::kwargs& kwargs) {
+            for (const char* key : {"force_source", "loop", "rdt_calibration", "rdt_rate_hz", "rdt_buffered", "tare"}) {
+              if (kwargs.contains(key)) {
+                throw InputError(fmt::format("{}: a stand-in has its own sensor (force_base_N, sensor_silent())",
+                                             runtime::setting_name(*runtime::find_session_setting(key))));
+              }
+            }
+            const runtime::SessionConfig config = config_from(link, strategy, kwargs);
+            standin::StandInConfig sc;
+            sc.force_base_n = vector3(force_base_n, "force_base_N");
+            if (!(server_read_period_s >= 0.0 && server_read_period_s <= 10.0)) {
+              throw InputError(fmt::format("server_read_period_s: {} s is not in 0..10 s", server_read_period_s));
+            }
+            sc.server.read_period_s = server_read_period_s;
+            if (!(comm_timeout_s > 0.0 && comm_timeout_s <= 60.0)) {
+              throw InputError(fmt::format("comm_timeout_s: {} s is not in 0..60 s", comm_timeout_s));
+            }
+            sc.controller.egm_comm_timeout_s = comm_timeout_s;
+            const SensorConfig sensor_config = sensor.is_none() ? SensorConfig{} : sensor.cast<SensorConfig>();
+            return std::make_unique<standin::StandInSession>(config, *robot, sensor_config, program_of(program, *robot),
+                                                             nullptr, sc);
+          }),
+          "robot"_a, "link"_a, "program"_a, py::kw_only(), "force_base_N"_a = std::vector<double>{0.0, 0.0, 0.0},
+          "sensor"_a = py::none(), "strategy"_a = "online", "server_read_period_s"_a = 0.0, "comm_timeout_s"_a = 1.0,
+          py::keep_alive<1, 2>())
       .def("run_for", &standin::StandInSession::run_for, "seconds"_a,
            "Ticks the stand-in for `seconds` of its own clock (or until the session ended).")
       .def("outage", &standin::StandInSession::outage, "seconds"_a, "Every datagram of the next `seconds` is lost.")

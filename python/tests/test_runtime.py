@@ -137,6 +137,8 @@ def test_settings_are_checked_and_named():
         deflex.StandIn(robot, "fanuc-j519", sweep(), fanuc_limits="120;265")
     with pytest.raises(deflex.InputError, match="motoros2-group"):
         deflex.StandIn(robot, "motoros2-rt", sweep(), motoros2_group=8)
+    with pytest.raises(deflex.InputError, match=r"setting tare \(--tare\): a stand-in has its own sensor"):
+        deflex.StandIn(robot, "egm-joint", sweep(), tare=True)
     with pytest.raises(deflex.InputError, match="rate bound allows"):
         deflex.StandIn(robot, "egm-joint", sweep(), max_correction_rate_rad_s=0.5, period_s=0.1)
 
