@@ -136,44 +136,69 @@ void OnlineCompensator::update_slope(double t_s) noexcept {
   if (stt > 0.0) slope_ = stw / stt;
 }
 
+// The cycle's stages, in order: the inputs refused or taken; the queued samples conditioned with the
+// arm's orientation now; the target correction the model gives for the wrench (or zero); the change
+// towards it held to the rate bounds; the command.
 CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
   CycleOutput out;
-  const int n = model_.dof();
   ++counters_.cycles;
-  if (in.q_planned.size() != n || in.q_feedback.size() != n || !in.q_planned.allFinite() ||
-      !in.q_feedback.allFinite() || !std::isfinite(in.t_s) || (have_cycle_ && in.t_s < last_cycle_t_s_) ||
-      !in.wrench_offset_base.allFinite() || std::isnan(in.wrench_lead_s)) {
-    ++counters_.invalid_inputs;
-    out.status = CycleStatus::kInvalidInput;
-    out.q_command = JointVector::Zero(n);
-    out.dtheta = JointVector::Zero(n);
-    return out;
-  }
-  // Joints beyond the limits: a command for them is one no controller should be given (a program
-  // or feedback in the wrong unit, a wrong robot file); the status says so and nothing is commanded.
-  if (!model_.within_limits(in.q_planned, kCycleLimitToleranceRad) ||
-      !model_.within_limits(in.q_feedback, kCycleLimitToleranceRad)) {
-    ++counters_.invalid_inputs;
-    out.status = CycleStatus::kOutsideLimits;
-    out.q_command = JointVector::Zero(n);
-    out.dtheta = JointVector::Zero(n);
-    return out;
-  }
+  if (refuse(in, out)) return out;
   // Time since the last cycle, at most one period: the rate bound holds per cycle, so after a gap
   // (a silence, a stalled PC, a late cycle) the correction moves by no more than one cycle's worth:
   // the controller takes one command a cycle, whatever the time between them.
   double dt = config_.period_s;
-  if (have_cycle_) {
-    dt = std::min(in.t_s - last_cycle_t_s_, config_.period_s);
-  }
+  if (have_cycle_) dt = std::min(in.t_s - last_cycle_t_s_, config_.period_s);
   last_cycle_t_s_ = in.t_s;
   have_cycle_ = true;
 
   // Sensor orientation from the configuration the arm has now.
   const Workspace* ws = &frames_.at(in.q_feedback);
-  const Matrix3 base_R_sensor = ws->base_T_flange.linear() * flange_T_sensor_.linear();
+  condition_queued(ws->base_T_flange.linear() * flange_T_sensor_.linear(), in.t_s, out);
+  if (have_force_) update_slope(in.t_s);
+  out.wrench_measured_base = wrench_base_;
+  Wrench used = wrench_base_ + in.wrench_offset_base;
+  if (in.wrench_lead_s > 0.0 && std::isfinite(in.wrench_lead_s)) used += in.wrench_lead_s * slope_;
 
-  // Condition every queued sample with this cycle's orientation.
+  const JointVector target = target_correction(in, used, ws, out);
+  out.wrench_base = out.status == CycleStatus::kOk && used.allFinite() ? used : wrench_base_;
+  if (out.status != CycleStatus::kOk) {
+    point_jacobian(*ws, ws->base_T_tcp.translation(), jac_);  // at the feedback here
+  }
+  // jac_ is now the TCP Jacobian at the configuration `ws` holds.
+  approach(target, dt, out);
+  out.dtheta = correction_;
+  out.q_command = in.q_planned - correction_;
+  out.tcp_deflection_base_m = jac_.topRows<3>() * correction_;
+  out.tcp_correction_m = out.tcp_deflection_base_m.norm();
+  if (!model_.within_limits(out.q_command, kCycleLimitToleranceRad)) {
+    // The correction takes a joint of a program at its limit beyond it.
+    ++counters_.invalid_inputs;
+    out.status = CycleStatus::kOutsideLimits;
+    out.q_command.setZero();
+  }
+  return out;
+}
+
+bool OnlineCompensator::refuse(const CycleInput& in, CycleOutput& out) noexcept {
+  const int n = model_.dof();
+  const bool invalid = in.q_planned.size() != n || in.q_feedback.size() != n || !in.q_planned.allFinite() ||
+                       !in.q_feedback.allFinite() || !std::isfinite(in.t_s) ||
+                       (have_cycle_ && in.t_s < last_cycle_t_s_) || !in.wrench_offset_base.allFinite() ||
+                       std::isnan(in.wrench_lead_s);
+  // Joints beyond the limits: a command for them is one no controller should be given (a program
+  // or feedback in the wrong unit, a wrong robot file); the status says so and nothing is commanded.
+  const bool outside = !invalid && (!model_.within_limits(in.q_planned, kCycleLimitToleranceRad) ||
+                                    !model_.within_limits(in.q_feedback, kCycleLimitToleranceRad));
+  if (!invalid && !outside) return false;
+  ++counters_.invalid_inputs;
+  out.status = invalid ? CycleStatus::kInvalidInput : CycleStatus::kOutsideLimits;
+  out.q_command = JointVector::Zero(n);
+  out.dtheta = JointVector::Zero(n);
+  return true;
+}
+
+void OnlineCompensator::condition_queued(const Matrix3& base_R_sensor, double t_s, CycleOutput& out) noexcept {
+  // Every queued sample with this cycle's orientation.
   while (queue_count_ > 0) {
     const ForceSample& s = queue_[static_cast<std::size_t>(queue_head_)];
     queue_head_ = (queue_head_ + 1) % queue_capacity_;
@@ -182,27 +207,22 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
     ++out.samples_used;
     if (c.status == PipelineStatus::kFault) {
       ++counters_.samples_fault;
-      last_fault_t_s_ = in.t_s;
+      last_fault_t_s_ = t_s;
     } else if (c.status == PipelineStatus::kInvalidSample) {
       ++counters_.samples_invalid;
     } else {
       ++counters_.samples_ok;
       wrench_base_ = c.wrench_base;
       have_force_ = true;
-      last_force_t_s_ = in.t_s;
+      last_force_t_s_ = t_s;
     }
   }
+}
 
-  if (have_force_) {
-    update_slope(in.t_s);
-  }
-  out.wrench_measured_base = wrench_base_;
-  Wrench used = wrench_base_ + in.wrench_offset_base;
-  if (in.wrench_lead_s > 0.0 && std::isfinite(in.wrench_lead_s)) {
-    used += in.wrench_lead_s * slope_;
-  }
-
-  // Target correction: the model's deflection, or zero when the force cannot be trusted.
+JointVector OnlineCompensator::target_correction(const CycleInput& in, const Wrench& used, const Workspace*& ws,
+                                                 CycleOutput& out) noexcept {
+  // The model's deflection, or zero when the force cannot be trusted.
+  const int n = model_.dof();
   JointVector target = JointVector::Zero(n);
   out.force_age_s = have_force_ ? in.t_s - last_force_t_s_ : 0.0;
   if (!have_force_) {
@@ -215,36 +235,31 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
     out.status = CycleStatus::kHeld;
   } else {
     out.status = CycleStatus::kOk;
-    // dtheta = K^-1 J_wap(q)^T W, at the feedback or at the configuration the command is for (the
-    // frames there computed once a cycle, whoever asked first).
-    if (config_.jacobian_at == JacobianAt::kPlanned) ws = &frames_.at(in.q_planned);
-    point_jacobian(*ws, ws->base_T_wap.translation(), jac_);
-    target = model_.compliance().cwiseProduct(jac_.transpose() * used);
-    if (!target.allFinite()) {
-      target.setZero();
-    }
-    // Size bounds: per joint, then the TCP translation it produces (scaled as a whole, so the
-    // direction of the correction is kept).
-    for (int i = 0; i < n; ++i) {
-      const double clamped = std::clamp(target[i], -config_.max_joint_correction_rad, config_.max_joint_correction_rad);
-      out.size_limited = out.size_limited || clamped != target[i];
-      target[i] = clamped;
-    }
-    if (!model_.wap_is_tcp()) {
-      point_jacobian(*ws, ws->base_T_tcp.translation(), jac_);
-    }
-    const double tcp_m = (jac_.topRows<3>() * target).norm();
-    if (tcp_m > config_.max_tcp_correction_m) {
-      target *= config_.max_tcp_correction_m / tcp_m;
-      out.size_limited = true;
-    }
   }
-  out.wrench_base = out.status == CycleStatus::kOk && used.allFinite() ? used : wrench_base_;
-  if (out.status != CycleStatus::kOk) {
-    point_jacobian(*ws, ws->base_T_tcp.translation(), jac_);  // at the feedback here
+  if (out.status != CycleStatus::kOk) return target;
+  // dtheta = K^-1 J_wap(q)^T W, at the feedback or at the configuration the command is for (the
+  // frames there computed once a cycle, whoever asked first).
+  if (config_.jacobian_at == JacobianAt::kPlanned) ws = &frames_.at(in.q_planned);
+  point_jacobian(*ws, ws->base_T_wap.translation(), jac_);
+  target = model_.compliance().cwiseProduct(jac_.transpose() * used);
+  if (!target.allFinite()) target.setZero();
+  // Size bounds: per joint, then the TCP translation it produces (scaled as a whole, so the
+  // direction of the correction is kept).
+  for (int i = 0; i < n; ++i) {
+    const double clamped = std::clamp(target[i], -config_.max_joint_correction_rad, config_.max_joint_correction_rad);
+    out.size_limited = out.size_limited || clamped != target[i];
+    target[i] = clamped;
   }
-  // jac_ is now the TCP Jacobian at the configuration `ws` holds.
+  if (!model_.wap_is_tcp()) point_jacobian(*ws, ws->base_T_tcp.translation(), jac_);
+  const double tcp_m = (jac_.topRows<3>() * target).norm();
+  if (tcp_m > config_.max_tcp_correction_m) {
+    target *= config_.max_tcp_correction_m / tcp_m;
+    out.size_limited = true;
+  }
+  return target;
+}
 
+void OnlineCompensator::approach(const JointVector& target, double dt, CycleOutput& out) noexcept {
   // Rate bounds, joint and TCP; also the ramp to zero when the target dropped to zero. The change is
   // scaled as a whole, not clamped joint by joint: the new correction then lies on the segment from
   // the old one to the target, and as both meet the size bounds (a box and a TCP ball, convex sets)
@@ -263,17 +278,6 @@ CycleOutput OnlineCompensator::step(const CycleInput& in) noexcept {
   } else {
     correction_ += change;
   }
-  out.dtheta = correction_;
-  out.q_command = in.q_planned - correction_;
-  out.tcp_deflection_base_m = jac_.topRows<3>() * correction_;
-  out.tcp_correction_m = out.tcp_deflection_base_m.norm();
-  if (!model_.within_limits(out.q_command, kCycleLimitToleranceRad)) {
-    // The correction takes a joint of a program at its limit beyond it.
-    ++counters_.invalid_inputs;
-    out.status = CycleStatus::kOutsideLimits;
-    out.q_command.setZero();
-  }
-  return out;
 }
 
 }  // namespace deflex

@@ -84,6 +84,12 @@ class OnlineCompensator {
   int slope_head_ = 0, slope_count_ = 0;
   Wrench slope_ = Wrench::Zero();
   void update_slope(double t_s) noexcept;
+  // The cycle's stages (step()).
+  bool refuse(const CycleInput& in, CycleOutput& out) noexcept;
+  void condition_queued(const Matrix3& base_R_sensor, double t_s, CycleOutput& out) noexcept;
+  JointVector target_correction(const CycleInput& in, const Wrench& used, const Workspace*& ws,
+                                CycleOutput& out) noexcept;
+  void approach(const JointVector& target, double dt, CycleOutput& out) noexcept;
   double last_force_t_s_ = 0.0;
   double last_fault_t_s_ = -1e300;
   double last_cycle_t_s_ = 0.0;
