@@ -151,13 +151,18 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
     state_ = LinkState::kRunning;
   }
 
-  // Where the arm goes: its joint velocity and the controller's period from the feedback; the
-  // direction of travel (path coordinates) from the controller's planned path, which the correction
+  track_motion(now, m.has_planned);
+  return answer(now, m.seqno, session_start, t_read);
+}
+
+// Where the arm goes: its joint velocity and the controller's period from the feedback; the
+// direction of travel (path coordinates); the delay between the reference and the feedback.
+void EgmPathLink::track_motion(double now, bool has_planned) noexcept {
+  // The direction of travel from the controller's planned path, which the correction
   // does not move (from the feedback it would chase its own correction), else from the feedback: the
   // TCP's step as the Jacobian at the feedback (the cycle's frames, no kinematics of its own) maps the
   // joints' step, exact to first order in a 4-48 ms step.
-  const RobotModel& model = cycle_.compensator().model();
-  const JointVector& path_q = m.has_planned ? planned_ : feedback_;
+  const JointVector& path_q = has_planned ? planned_ : feedback_;
   if (have_previous_) {
     const double dt = now - previous_t_s_;
     if (dt > 0.0) {
@@ -181,11 +186,16 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
   previous_path_q_ = path_q;
   have_previous_ = true;
 
-  if (m.has_planned) {
+  if (has_planned) {
     reference_ = planned_ + sent_offset_joints_;
     delay_.record_reference(now, reference_);
   }
   delay_.observe_feedback(now, feedback_);
+}
+
+// The cycle for this message, and the answer: the whole TCP offset in the correction frame.
+LinkPollResult EgmPathLink::answer(double now, std::uint32_t seqno, bool session_start,
+                                   std::chrono::steady_clock::time_point t_read) noexcept {
   // The correction sent now is applied after the servo delay, the channel's latency and on average
   // half a correction period: the predictive strategy evaluates it where the arm will be by then.
   const double lead = delay_.delay_s() + config_.correction_latency_s + 0.5 * period_s_;
@@ -198,7 +208,7 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
   }
   CycleRequest rq;
   rq.t_s = now;
-  rq.sequence = m.seqno;
+  rq.sequence = seqno;
   rq.nominal = &planned_;
   rq.feedback = &feedback_;
   rq.target = &target_;
@@ -232,20 +242,24 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
     return LinkPollResult::kNotAnswered;
   }
   cycle_.sent(compute(), receiver_.answer_time_s(clock_.now_s()));
-  // The joints' share of this offset, orientation held (6-axis arms; a fixed-size solve, no
-  // allocation). A singular Jacobian leaves the previous value: the delay measurement only.
-  if (model.dof() == 6) {
-    const Eigen::Matrix<double, 6, 6> j6 = jac_;
-    Eigen::Matrix<double, 6, 1> twist;
-    twist << correction, Vector3::Zero();
-    const Eigen::PartialPivLU<Eigen::Matrix<double, 6, 6>> lu(j6);
-    if (std::abs(lu.determinant()) > 1e-9) {
-      const Eigen::Matrix<double, 6, 1> dq = lu.solve(twist);
-      if (dq.allFinite()) sent_offset_joints_ = dq;
-    }
-  }
+  note_sent_offset(correction);
   stop_when_correction_gone();
   return LinkPollResult::kAnswered;
+}
+
+// The joints' share of the offset sent, orientation held (6-axis arms; a fixed-size solve, no
+// allocation), at the target's Jacobian (jac_). A singular Jacobian leaves the previous value: the
+// delay measurement only.
+void EgmPathLink::note_sent_offset(const Vector3& correction) noexcept {
+  if (cycle_.compensator().model().dof() != 6) return;
+  const Eigen::Matrix<double, 6, 6> j6 = jac_;
+  Eigen::Matrix<double, 6, 1> twist;
+  twist << correction, Vector3::Zero();
+  const Eigen::PartialPivLU<Eigen::Matrix<double, 6, 6>> lu(j6);
+  if (std::abs(lu.determinant()) > 1e-9) {
+    const Eigen::Matrix<double, 6, 1> dq = lu.solve(twist);
+    if (dq.allFinite()) sent_offset_joints_ = dq;
+  }
 }
 
 }  // namespace deflex

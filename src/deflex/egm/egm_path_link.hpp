@@ -12,6 +12,8 @@
 // running after it ran (EGMStop: the planned end; an error: a stop).
 #pragma once
 
+#include <chrono>
+
 #include "deflex/egm/egm_receiver.hpp"
 #include "deflex/link/controller_link.hpp"
 #include "deflex/model/kinematics.hpp"
@@ -69,6 +71,11 @@ class EgmPathLink final : public ControllerLink {
  private:
   bool correction_frame(const JointVector& q_feedback, Matrix3& base_R_frame) noexcept;
   bool controller_state(const EgmRobotMessage& m) noexcept;
+  // poll()'s stages after a message was taken.
+  void track_motion(double now, bool has_planned) noexcept;
+  LinkPollResult answer(double now, std::uint32_t seqno, bool session_start,
+                        std::chrono::steady_clock::time_point t_read) noexcept;
+  void note_sent_offset(const Vector3& correction) noexcept;
 
   EgmPathLinkConfig config_;
   EgmReceiver receiver_;
