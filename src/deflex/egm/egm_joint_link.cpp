@@ -88,6 +88,37 @@ bool EgmJointLink::controller_state(const EgmRobotMessage& m) noexcept {
   return true;
 }
 
+// A session (the first message, a restart) starts from the reference the controller holds. A
+// controller that kept following deflex's stream reports one of its last commands: the stream goes
+// on from the last one sent, as if nothing happened. One that reset its reference (a new EGMRunJoint)
+// reports where it now is: after a silence (its previous session ended) the stream goes on from there;
+// without one it may still be following the last command sent, and a reference more than two step
+// limits from it leaves no command that steps from both: the session is not resumed.
+// False: the session is not started (the link refused or stopped; poll() announces it).
+bool EgmJointLink::begin_session() noexcept {
+  const JointVector* anchor = &planned_;
+  const double gap = cycle_.reanchor_gap(planned_);
+  if (cycle_.has_sent() && gap <= 2.0) anchor = &cycle_.last_command();
+  if (stop_if_anchor_unreachable(gap, "the controller (EGM)")) return false;
+  nominal_ = *anchor;  // begin() and anchor_joints() must not see the cycle's own buffer change
+  if (!stream_.begin(nominal_, cycle_.correction())) {
+    if (state_ == LinkState::kWaiting) {
+      refuse_start(stream_.distance());
+    } else {
+      Eigen::Index j = 0;
+      const double d = stream_.distance().maxCoeff(&j);
+      stop_link(LinkStopCause::kController,
+                "the controller restarted holding joint %d %.3f deg from deflex's command (tolerance %.3f deg): not "
+                "resumed",
+                static_cast<int>(j) + 1, rad_to_deg(d), rad_to_deg(config_.stream.start_tolerance_rad));
+    }
+    return false;
+  }
+  cycle_.anchor_joints(nominal_, after_silence());
+  if (state_ == LinkState::kWaiting || state_ == LinkState::kRunning) state_ = LinkState::kRunning;
+  return true;
+}
+
 LinkPollResult EgmJointLink::poll(double timeout_s) noexcept {
   if (state_ == LinkState::kStopped || state_ == LinkState::kRefused) {
     bool ignored = false;
@@ -114,35 +145,8 @@ LinkPollResult EgmJointLink::poll(double timeout_s) noexcept {
     return state_ == LinkState::kStopped ? announce_terminal() : LinkPollResult::kNotAnswered;
   }
 
-  // A session (the first message, a restart) starts from the reference the controller holds. A
-  // controller that kept following deflex's stream reports one of its last commands: the stream goes
-  // on from the last one sent, as if nothing happened. One that reset its reference (a new EGMRunJoint)
-  // reports where it now is: after a silence (its previous session ended) the stream goes on from there;
-  // without one it may still be following the last command sent, and a reference more than two step
-  // limits from it leaves no command that steps from both: the session is not resumed.
   const bool session_start = restarted || state_ == LinkState::kWaiting;
-  if (session_start) {
-    const JointVector* anchor = &planned_;
-    const double gap = cycle_.reanchor_gap(planned_);
-    if (cycle_.has_sent() && gap <= 2.0) anchor = &cycle_.last_command();
-    if (stop_if_anchor_unreachable(gap, "the controller (EGM)")) return announce_terminal();
-    nominal_ = *anchor;  // begin() and anchor_joints() must not see the cycle's own buffer change
-    if (!stream_.begin(nominal_, cycle_.correction())) {
-      if (state_ == LinkState::kWaiting) {
-        refuse_start(stream_.distance());
-      } else {
-        Eigen::Index j = 0;
-        const double d = stream_.distance().maxCoeff(&j);
-        stop_link(LinkStopCause::kController,
-                  "the controller restarted holding joint %d %.3f deg from deflex's command (tolerance %.3f deg): not "
-                  "resumed",
-                  static_cast<int>(j) + 1, rad_to_deg(d), rad_to_deg(config_.stream.start_tolerance_rad));
-      }
-      return announce_terminal();
-    }
-    cycle_.anchor_joints(nominal_, after_silence());
-    if (state_ == LinkState::kWaiting || state_ == LinkState::kRunning) state_ = LinkState::kRunning;
-  }
+  if (session_start && !begin_session()) return announce_terminal();
   if (ramping_down_) stream_.begin_stop(ramp_down_s_);
   stream_.sample(program_, program_velocity_, blend_, blend_velocity_);
   nominal_ = program_ + blend_;
@@ -162,7 +166,15 @@ LinkPollResult EgmJointLink::poll(double timeout_s) noexcept {
   const LinkCycle::Verdict verdict = cycle_.run(rq);
   const auto compute = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_read).count(); };
   if (verdict != LinkCycle::Verdict::kSend) return cycle_not_passed(verdict, compute());
-  const JointVector& command = cycle_.joint_command();
+  return send(now, cycle_.joint_command(), t_read);
+}
+
+// The joint target (and its speed) to the controller; then the stream moves on.
+LinkPollResult EgmJointLink::send(double now, const JointVector& command,
+                                  std::chrono::steady_clock::time_point t_read) noexcept {
+  const auto compute_s = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_read).count();
+  };
   reply_.seqno = ++reply_seq_;
   reply_.tm_ms = egm_time_stamp_ms(now);
   for (int i = 0; i < command.size(); ++i) {
@@ -177,10 +189,10 @@ LinkPollResult EgmJointLink::poll(double timeout_s) noexcept {
   const std::size_t n = receiver_.codec().encode_sensor(reply_, tx_.data(), tx_.size());
   if (n == 0) ++counters_.send_errors;
   if (n == 0 || !receiver_.reply(tx_.data(), n)) {
-    cycle_.not_sent(compute());
+    cycle_.not_sent(compute_s());
     return LinkPollResult::kNotAnswered;
   }
-  cycle_.sent(compute(), receiver_.answer_time_s(clock_.now_s()));
+  cycle_.sent(compute_s(), receiver_.answer_time_s(clock_.now_s()));
   delay_.record_reference(now, command);
   stream_.consumed(period_s_);
   if (ramping_down_ && stream_.at_standstill()) {

@@ -16,6 +16,8 @@
 // the program had ended, a stop before.
 #pragma once
 
+#include <chrono>
+
 #include <memory>
 
 #include "deflex/egm/egm_receiver.hpp"
@@ -59,6 +61,9 @@ class EgmJointLink final : public ControllerLink {
 
  private:
   bool controller_state(const EgmRobotMessage& m) noexcept;
+  // poll()'s stages.
+  bool begin_session() noexcept;
+  LinkPollResult send(double now, const JointVector& command, std::chrono::steady_clock::time_point t_read) noexcept;
 
   EgmJointLinkConfig config_;
   EgmReceiver receiver_;
