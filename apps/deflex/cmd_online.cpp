@@ -25,7 +25,6 @@
 #include "deflex/sensors/force_source_spec.hpp"
 #include "deflex/sensors/wrench_tare.hpp"
 #include "deflex/text/errors.hpp"
-#include "deflex/wire/egm_codec.hpp"
 #include "field_log.hpp"
 
 namespace deflex::cli {
@@ -567,7 +566,6 @@ void run_online(const OnlineOpts& o, const CLI::App& sub, int& exit_code) {
   }
   if (o.json) {
     nlohmann::json doc = nlohmann::json::parse(summary.json_text);
-    doc["protobuf_log_messages"] = egm_protobuf_log_messages();
     print_json(doc);
   }
   exit_code = summary.exit_code;
