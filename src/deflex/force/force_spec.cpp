@@ -10,8 +10,8 @@
 #include "deflex/force/milling_force_model.hpp"
 #include "deflex/force/tool_wrench_model.hpp"
 #include "deflex/force/wrench_table_model.hpp"
-#include "deflex/paths/key_value_spec.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/text/key_value_spec.hpp"
 
 namespace deflex {
 namespace {
