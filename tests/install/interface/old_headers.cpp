@@ -14,6 +14,7 @@
 #include "deflex/model/parse_number.hpp"
 #include "deflex/model/run_files.hpp"
 #include "deflex/model/yaml_fields.hpp"
+#include "deflex/online/payload_identification.hpp"
 #include "deflex/paths/key_value_spec.hpp"
 #include "deflex/study/case_report.hpp"
 
