@@ -16,8 +16,8 @@
 #include "deflex/force/force_spec.hpp"
 #include "deflex/machining/milling_force_model.hpp"
 #include "deflex/machining/stock_spec.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/offline/toolpath_job.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 
 namespace {
 

@@ -8,7 +8,7 @@
 
 #include "deflex/identify/payload_identification.hpp"
 #include "deflex/model/kinematics.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 
 namespace deflex {

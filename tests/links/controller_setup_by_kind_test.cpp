@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/rsi/rsi_controller_setup.hpp"
 #include "deflex/runtime/controller_setup.hpp"
 #include "deflex/text/errors.hpp"
