@@ -6,7 +6,7 @@
 #include <random>
 #include <vector>
 
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 
 namespace deflex::bench {
 

@@ -17,8 +17,8 @@
 
 #include "deflex/egm/egm_joint_link.hpp"
 #include "deflex/egm/egm_path_link.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/transport/udp_transport.hpp"
 
 #include "counting_new.hpp"

@@ -16,7 +16,7 @@
 #include <Eigen/Cholesky>
 
 #include "deflex/identify/stiffness_identification.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 
 namespace {
 

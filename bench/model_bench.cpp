@@ -16,7 +16,7 @@
 #include "bench_robot.hpp"
 #include "deflex/model/compliance.hpp"
 #include "deflex/model/opw_geometry.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "model/kdl_chain.hpp"
 
 namespace {

@@ -36,8 +36,8 @@
 #include <nlohmann/json.hpp>
 
 #include "deflex/cell/rsi_controller.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/monitor/monitor_server.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/runtime/session.hpp"
 #include "deflex/transport/clock.hpp"
 #include "deflex/transport/udp_transport.hpp"

@@ -17,7 +17,7 @@
 
 #include <benchmark/benchmark.h>
 
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/motoros2/motoros2_rt_link.hpp"
 #include "deflex/online/online_strategy.hpp"
 #include "deflex/transport/udp_transport.hpp"

@@ -20,10 +20,10 @@
 #include <kdl/chainjnttojacsolver.hpp>
 
 #include "deflex/force/ldbb_force_model.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/path_spec.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "model/kdl_chain.hpp"
 #include "opw_anchor.hpp"
 

@@ -7,8 +7,8 @@
 
 #include <benchmark/benchmark.h>
 
-#include "deflex/model/robot_io.hpp"
 #include "deflex/online/online_compensator.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 
 // GCC sees the replacement operator new (malloc) and delete (free) of this file inlined into the same
 // translation unit and calls them mismatched; they are the standard replacement pair.

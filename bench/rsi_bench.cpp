@@ -16,8 +16,8 @@
 
 #include <benchmark/benchmark.h>
 
-#include "deflex/model/robot_io.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/rsi/rsi_link.hpp"
 #include "deflex/transport/udp_transport.hpp"
 

@@ -15,8 +15,8 @@
 #include <benchmark/benchmark.h>
 
 #include "deflex/cell/simple_message_server.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/simple_message/simple_message_link.hpp"
 #include "deflex/transport/memory_stream.hpp"
 #include "deflex/transport/tcp_stream.hpp"

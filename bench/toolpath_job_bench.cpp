@@ -14,10 +14,10 @@
 #include <fmt/format.h>
 
 #include "deflex/force/force_spec.hpp"
-#include "deflex/force/milling_force_model.hpp"
+#include "deflex/machining/milling_force_model.hpp"
 #include "deflex/machining/stock_spec.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/offline/toolpath_job.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 
 namespace {
 
@@ -58,7 +58,7 @@ void run_job(benchmark::State& state, const std::string& spin, bool outputs) {
   const RobotModel model = load_robot(std::string(DEFLEX_SOURCE_DIR) + "/examples/machining/irb6700_spindle.yaml");
   const std::string file = spiral_pocket(levels);
   ForceSpecContext context;
-  context.cutter = parse_cutter_spec("diameter_mm=10,flutes=3,helix_deg=30");
+  context.milling = milling_force_specs(parse_cutter_spec("diameter_mm=10,flutes=3,helix_deg=30"));
   const auto force =
       parse_force_spec("milling:file=" + std::string(DEFLEX_SOURCE_DIR) + "/data/machining/al7075-t6.yaml", context);
   ToolpathJobOptions o;
@@ -120,7 +120,7 @@ void BM_ToolpathForceOnly(benchmark::State& state) {
   const double cell_mm = static_cast<double>(state.range(0)) * 1e-3;
   const std::string file = spiral_pocket(static_cast<int>(state.range(1)));
   ForceSpecContext context;
-  context.cutter = parse_cutter_spec("diameter_mm=10,flutes=3,helix_deg=30");
+  context.milling = milling_force_specs(parse_cutter_spec("diameter_mm=10,flutes=3,helix_deg=30"));
   const auto force =
       parse_force_spec("milling:file=" + std::string(DEFLEX_SOURCE_DIR) + "/data/machining/al7075-t6.yaml", context);
   ToolpathOptions reading;

@@ -159,3 +159,29 @@ function(deflex_check_layering)
     message(FATAL_ERROR "includes across the layering (CMakeLists.txt's deflex_module DEPENDS):\n  ${text}")
   endif()
 endfunction()
+
+# deflex_check_front_door(): the program (apps/) does online work through runtime/ alone: a file of it
+# that includes a header of a controller link, a wire format or a transport fails the configure, naming
+# the file and the header. What the program needs of them the runtime offers (the link by kind, its
+# controller setup, the session's counters), so the program does not change with a link.
+function(deflex_check_front_door)
+  set(barred egm rsi simple_message fanuc motoros2 ur wire transport)
+  file(GLOB_RECURSE files CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/apps/*.cpp ${PROJECT_SOURCE_DIR}/apps/*.hpp)
+  set(violations "")
+  foreach(f IN LISTS files)
+    file(STRINGS ${f} lines REGEX "^[ \t]*#[ \t]*include[ \t]*[\"<]deflex/[a-z_0-9]+/")
+    foreach(line IN LISTS lines)
+      string(REGEX MATCH "deflex/([a-z_0-9]+)/[A-Za-z_0-9./]+" header "${line}")
+      if(CMAKE_MATCH_1 IN_LIST barred)
+        file(RELATIVE_PATH rel ${PROJECT_SOURCE_DIR} ${f})
+        list(APPEND violations "${rel} includes ${header}")
+      endif()
+    endforeach()
+  endforeach()
+  if(violations)
+    list(JOIN violations "\n  " text)
+    list(JOIN barred ", " names)
+    message(FATAL_ERROR "the program includes what only the runtime may (apps/ includes no header of ${names}; "
+                        "reach them through deflex/runtime/):\n  ${text}")
+  endif()
+endfunction()

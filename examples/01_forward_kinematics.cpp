@@ -3,7 +3,7 @@
 #include <cstdio>
 
 #include "deflex/model/kinematics.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 
 int main() {
   using namespace deflex;

@@ -5,7 +5,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "deflex/model/compliance.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 
 int main() {
   using namespace deflex;

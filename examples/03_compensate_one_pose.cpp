@@ -4,7 +4,7 @@
 #include <cstdio>
 
 #include "deflex/model/compliance.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 
 int main() {
   using namespace deflex;

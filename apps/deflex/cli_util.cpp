@@ -11,7 +11,7 @@
 
 #include <fmt/format.h>
 
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/input_ranges.hpp"
 #include "deflex/text/parse_number.hpp"

@@ -12,6 +12,7 @@
 #include "cli_util.hpp"
 #include "command.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
+#include "deflex/evaluate/tracker_csv.hpp"
 #include "deflex/evaluate/tracker_files.hpp"
 #include "deflex/model/tracker_trace.hpp"
 #include "deflex/report/case_report.hpp"

@@ -1,9 +1,8 @@
 // `deflex controller-setup --link egm-joint|egm-path|rsi|fanuc-j519|motoros2-rt`: writes what the robot
 // controller needs to talk to `deflex online` over that link (a RAPID module and the UdpUc entry for ABB
-// EGM; the Ethernet config, the RSI context and the KRL lines for KUKA RSI; FANUC's TP program and
-// settings; MotoROS2's configuration keys), from the same options and defaults as
-// `deflex online` (ports, period, bounds, SENTYPE), so the controller's side agrees with deflex's.
-#include <cmath>
+// EGM; the Ethernet config, the RSI context and the KRL lines for KUKA RSI; the TP program for FANUC;
+// MotoROS2's configuration keys), made by the
+// library by link kind (runtime/controller_setup.hpp) from the same defaults as `deflex online`.
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -12,50 +11,23 @@
 
 #include "cli_util.hpp"
 #include "command.hpp"
-#include "deflex/egm/egm_controller_setup.hpp"
-#include "deflex/fanuc/fanuc_controller_setup.hpp"
-#include "deflex/fanuc/fanuc_j519_link.hpp"
-#include "deflex/link/link_cycle.hpp"
-#include "deflex/model/types.hpp"
-#include "deflex/motoros2/motoros2_controller_setup.hpp"
-#include "deflex/paths/joint_trajectory.hpp"
-#include "deflex/rsi/rsi_controller_setup.hpp"
-#include "deflex/rsi/rsi_link.hpp"
-#include "deflex/runtime/link_table.hpp"
-#include "deflex/text/errors.hpp"
+#include "deflex/link/controller_file.hpp"
+#include "deflex/runtime/controller_setup.hpp"
 #include "deflex/text/output_file.hpp"
 
 namespace deflex::cli {
 namespace {
 
-struct ControllerSetupOpts {
-  // deflex online's defaults, held once (runtime/link_table.hpp): the files agree with a session
-  // started with the same options.
-  static constexpr runtime::SessionOptionDefaults kShared = runtime::kSessionOptionDefaults;
-  std::string link, sensor_ip, output_dir = ".", sentype = kShared.rsi_sentype, context = "deflex_rsi",
-                               device = "DEFLEX", egm_config = "default", module = "DeflexEgm",
-                               path_frame = kShared.path_frame, tool = "tool0", program, robot;
-  int egm_port = 6510, rsi_port = 49152,  // the ports ABB's and KUKA's examples use
-      rsi_timeout = kShared.rsi_timeout, rsi_precision = 4;
-  double period_ms = 0.0, max_joint_deg = kShared.max_joint_correction_deg, max_tcp_mm = kShared.max_tcp_correction_mm,
-         ramp_in_s = kShared.ramp_in_s, comm_timeout_s = kNaN, lowpass_hz = 20.0, convergence_deg = 0.1,
-         cond_time_s = 10.0, max_pos_deviation_deg = kNaN, max_speed_deviation_deg_s = kNaN, monitor_factor = 1.2,
-         max_rate_deg_s = kShared.max_rate_deg_s,
-         stop_silence_s = kNaN;  // default: the link kind's (runtime/link_table.cpp)
-  // FANUC Stream Motion.
-  std::string tp_program = "DEFLEXSM", fanuc_limits = "120,265,1240";
-  int fanuc_version = 1, robot_port = -1, uframe = 0, utool = 1;  // robot_port -1: the protocol's
-  double fanuc_correction_share = 0.25, move_speed_pct = 10.0;
-  // MotoROS2 real-time.
-  int motoros2_group = 0, motoros2_max_truncations = 25;
-  double motoros2_resend_ms = 12.0;
+// The settings and their defaults are the library's (runtime/controller_setup.hpp), which chooses the
+// files by link kind; the command adds where they go and how they are listed.
+struct ControllerSetupOpts : runtime::ControllerSetupSettings {
+  std::string output_dir = ".";
   bool json = false;
 };
 
 /// The options of `deflex controller-setup`, in the order --help lists them.
 void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
-  sub.add_option("--link", o.link, "egm-joint, egm-path, rsi, fanuc-j519 or motoros2-rt (as deflex online --link)")
-      ->required();
+  sub.add_option("--link", o.link, "egm-joint, egm-path, rsi, fanuc-j519 or motoros2-rt (as deflex online --link)")->required();
   sub.add_option("--sensor-ip", o.sensor_ip,
                  "deflex's IPv4 address as the controller reaches it (the PC on the controller's network)")
       ->required();
@@ -135,127 +107,6 @@ void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
   sub.add_flag("--json", o.json, "Print one JSON document (the files written and where each goes) on stdout");
 }
 
-/// A port option's value as a port; outside 1..65535 an error naming the option.
-std::uint16_t controller_setup_port(int p, const char* option) {
-  if (p < 1 || p > 65535) throw InputError(fmt::format("option {}: must be 1..65535 (got {})", option, p));
-  return static_cast<std::uint16_t>(p);
-}
-
-/// The files of --link egm-joint or egm-path: the RAPID module and the UdpUc entry.
-std::vector<ControllerFile> egm_setup_files(const ControllerSetupOpts& o) {
-  EgmSetupOptions e;
-  e.path_correction = o.link == "egm-path";
-  e.sensor_ip = o.sensor_ip;
-  e.port = controller_setup_port(o.egm_port, "--egm-port");
-  e.device = o.device;
-  e.egm_config = o.egm_config;
-  e.module = o.module;
-  const runtime::LinkKindInfo& kind = runtime::link_kind(runtime::parse_link_kind(o.link));
-  e.period_ms = o.period_ms > 0.0 ? o.period_ms : kind.default_period_s * 1e3;
-  if (o.period_ms < 0.0) throw InputError("option --period-ms: must be > 0");
-  e.max_joint_correction_deg = o.max_joint_deg;
-  e.max_tcp_correction_mm = o.max_tcp_mm;
-  e.comm_timeout_s = o.comm_timeout_s;
-  e.lowpass_hz = o.lowpass_hz;
-  e.ramp_in_s = o.ramp_in_s;
-  e.convergence_deg = o.convergence_deg;
-  e.cond_time_s = o.cond_time_s;
-  e.max_pos_deviation_deg = o.max_pos_deviation_deg;
-  e.max_speed_deviation_deg_s = o.max_speed_deviation_deg_s;
-  e.max_rate_deg_s = o.max_rate_deg_s;
-  e.stop_silence_s = std::isnan(o.stop_silence_s) ? kind.default_stop_silence_s : o.stop_silence_s;
-  const RobotModel model = load_cli_robot("controller-setup", o.robot);
-  if (model.has_max_speed()) {
-    for (int j = 0; j < model.dof(); ++j) e.robot_max_speed_deg_s.push_back(rad_to_deg(model.max_speed()[j]));
-  }
-  if (!o.program.empty()) {
-    if (e.path_correction) throw InputError("option --program: egm-path corrects the controller's own program");
-    const JointTrajectory program = JointTrajectory::read_csv(o.program, model);
-    for (int j = 0; j < program.dof(); ++j) e.program_peak_speed_deg_s.push_back(rad_to_deg(program.peak_speed()[j]));
-  }
-  e.path_frame = o.path_frame;
-  e.tool = o.tool;
-  return egm_controller_setup(e);
-}
-
-/// The files of --link rsi: the Ethernet config, the RSI context and the KRL program.
-std::vector<ControllerFile> rsi_setup_files(const ControllerSetupOpts& o) {
-  if (!o.program.empty() || !o.robot.empty()) {
-    throw InputError(
-        "options --program, --robot: apply to --link egm-joint and egm-path (the RSI limits come from "
-        "--max-joint-correction-deg)");
-  }
-  RsiSetupOptions r;
-  r.sensor_ip = o.sensor_ip;
-  r.port = controller_setup_port(o.rsi_port, "--rsi-port");
-  r.sentype = o.sentype;
-  r.context = o.context;
-  r.period_ms = o.period_ms > 0.0 ? o.period_ms : runtime::link_kind(runtime::LinkKind::kRsi).default_period_s * 1e3;
-  if (o.period_ms < 0.0) throw InputError("option --period-ms: must be > 0");
-  r.max_joint_correction_deg = o.max_joint_deg;
-  r.monitor_factor = o.monitor_factor;
-  r.timeout = o.rsi_timeout;
-  r.precision = o.rsi_precision;
-  r.restart_silence_s = RsiLinkConfig{}.restart_silence_s;
-  return rsi_controller_setup(r);
-}
-
-/// The files of --link fanuc-j519: the TP program and the settings sheet.
-std::vector<ControllerFile> fanuc_setup_files(const ControllerSetupOpts& o) {
-  FanucSetupOptions f;
-  f.program_name = o.tp_program;
-  f.period_ms =
-      o.period_ms > 0.0 ? o.period_ms : runtime::link_kind(runtime::LinkKind::kFanucJ519).default_period_s * 1e3;
-  if (o.period_ms < 0.0) throw InputError("option --period-ms: must be > 0");
-  if (o.fanuc_version < 0) throw InputError("option --fanuc-version: 1, 3 or 4");
-  f.version = static_cast<std::uint32_t>(o.fanuc_version);
-  f.uframe = o.uframe;
-  f.utool = o.utool;
-  f.move_speed_pct = o.move_speed_pct;
-  f.limits = parse_fanuc_limits(o.fanuc_limits, "--fanuc-limits");
-  if (!(o.fanuc_correction_share > 0.0 && o.fanuc_correction_share < 1.0)) {
-    throw InputError("option --fanuc-correction-share: must be in (0, 1)");
-  }
-  f.correction_share = o.fanuc_correction_share;
-  f.robot_port = controller_setup_port(o.robot_port == -1 ? 60015 : o.robot_port, "--robot-port");
-  f.pc_address = o.sensor_ip;
-  if (!o.program.empty()) {
-    const RobotModel model = load_cli_robot("controller-setup", o.robot);
-    f.start_rad = JointTrajectory::read_csv(o.program, model).points().front();
-  }
-  return fanuc_controller_setup(f);
-}
-
-/// The files of --link motoros2-rt: the motoros2_config.yaml keys and the settings sheet. With --program,
-/// each joint's fastest stream (the link's per-cycle step limit over the period: the program's peak,
-/// the ramp-in blend's and the correction's rate) for the safety unit's speed limits.
-std::vector<ControllerFile> motoros2_setup_files(const ControllerSetupOpts& o) {
-  const runtime::LinkKindInfo& kind = runtime::link_kind(runtime::LinkKind::kMotoros2Rt);
-  Motoros2SetupOptions m;
-  if (o.period_ms < 0.0) throw InputError("option --period-ms: must be > 0");
-  m.period_ms = o.period_ms > 0.0 ? o.period_ms : kind.default_period_s * 1e3;
-  m.robot_port = o.robot_port == -1 ? 22000 : o.robot_port;
-  m.group = o.motoros2_group;
-  m.stop_silence_s = std::isnan(o.stop_silence_s) ? kind.default_stop_silence_s : o.stop_silence_s;
-  m.resend_ms = o.motoros2_resend_ms;
-  m.max_truncations = o.motoros2_max_truncations;
-  m.pc_address = o.sensor_ip;
-  if (!o.program.empty()) {
-    const RobotModel model = load_cli_robot("controller-setup", o.robot);
-    const auto program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o.program, model));
-    OnlineConfig online;
-    online.period_s = m.period_ms * 1e-3;
-    online.max_joint_correction_rad = deg_to_rad(o.max_joint_deg);
-    online.max_correction_rate_rad_s = deg_to_rad(o.max_rate_deg_s);
-    JointStreamConfig stream;
-    stream.ramp_in_s = o.ramp_in_s;
-    stream.validate();
-    const CommandLimits l = command_limits(CommandForm::kJointTarget, online, model.dof(), program.get(), &stream);
-    m.stream_speed_rad_s = l.joint_step_rad / online.period_s;
-  }
-  return motoros2_controller_setup(m);
-}
-
 /// Writes the files into --output-dir and lists them with where each goes (JSON with --json).
 void write_controller_setup_files(const ControllerSetupOpts& o, const std::vector<ControllerFile>& files) {
   OutputFolder folder(o.output_dir, "option --output-dir");  // made when missing, as every output's folder
@@ -277,19 +128,8 @@ void write_controller_setup_files(const ControllerSetupOpts& o, const std::vecto
 
 /// Makes the link's files and writes them.
 void run_controller_setup(const ControllerSetupOpts& o, int& exit_code) {
-  std::vector<ControllerFile> files;
-  if (o.link == "egm-joint" || o.link == "egm-path") {
-    files = egm_setup_files(o);
-  } else if (o.link == "rsi") {
-    files = rsi_setup_files(o);
-  } else if (o.link == "fanuc-j519") {
-    files = fanuc_setup_files(o);
-  } else if (o.link == "motoros2-rt") {
-    files = motoros2_setup_files(o);
-  } else {
-    throw InputError(
-        fmt::format("option --link: '{}' is not egm-joint, egm-path, rsi, fanuc-j519 or motoros2-rt", o.link));
-  }
+  const std::vector<ControllerFile> files = runtime::controller_setup_files(
+      o, [](const std::string& path) { return load_cli_robot("controller-setup", path); });
   write_controller_setup_files(o, files);
   exit_code = 0;
 }

@@ -12,8 +12,8 @@
 #include "deflex/machining/coefficient_fit.hpp"
 #include "deflex/machining/cutter.hpp"
 #include "deflex/machining/milling_force.hpp"
-#include "deflex/paths/key_value_spec.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/text/key_value_spec.hpp"
 #include "deflex/text/output_file.hpp"
 
 namespace deflex::cli {

@@ -11,7 +11,7 @@
 #include "deflex/identify/calibration_planner.hpp"
 #include "deflex/identify/calibration_simulation.hpp"
 #include "deflex/identify/stiffness_identification.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/output_file.hpp"
 

@@ -11,9 +11,9 @@
 
 #include "cli_util.hpp"
 #include "command.hpp"
-#include "deflex/model/robot_io.hpp"
-#include "deflex/online/payload_identification.hpp"
+#include "deflex/identify/payload_identification.hpp"
 #include "deflex/online/sensor_config.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/sensors/force_source_spec.hpp"
 #include "deflex/sensors/wrench_tare.hpp"
 #include "deflex/text/errors.hpp"

@@ -10,7 +10,6 @@
 #include "cli_util.hpp"
 #include "command.hpp"
 #include "deflex/force/force_spec.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/offline/offline_csv.hpp"
 #include "deflex/offline/offline_job.hpp"
@@ -21,6 +20,7 @@
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/path_spec.hpp"
 #include "deflex/paths/pose_source.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/output_file.hpp"
 #include "offline_toolpath.hpp"
@@ -128,7 +128,8 @@ void run_program(const OfflineOpts& o, int& exit_code) {
 }
 
 /// The pose source of --circle, --line or --path, and its description for the outputs.
-std::unique_ptr<PoseSource> make_pose_source(const OfflineOpts& o, ForceSpecContext& context, std::string& path_text) {
+std::unique_ptr<PoseSource> make_pose_source(const OfflineOpts& o, const std::optional<CirclePath>& circle,
+                                             std::string& path_text) {
   if (!o.path_csv.empty()) {
     if (o.orientation_given) {
       std::cerr << "deflex offline: warning: --orientation-wxyz is ignored: the path file gives the orientation\n";
@@ -140,7 +141,7 @@ std::unique_ptr<PoseSource> make_pose_source(const OfflineOpts& o, ForceSpecCont
   const Eigen::Quaterniond orientation =
       checked_unit_quaternion(Eigen::Quaterniond(qv[0], qv[1], qv[2], qv[3]), "option --orientation-wxyz", 1e-3);
   if (o.circle_given) {
-    const CirclePath& c = *context.circle;
+    const CirclePath& c = *circle;
     path_text = fmt::format(
         "circle centre ({:.1f}, {:.1f}, {:.1f}) mm, radius {:.1f} mm, normal ({:g}, {:g}, {:g}), "
         "{}, {} points",
@@ -440,8 +441,10 @@ void run(const OfflineOpts& o, int& exit_code) {
   }
   check_path_options(o);
   ForceSpecContext context;
+  std::optional<CirclePath> circle;
   if (o.circle_given) {
-    context.circle = parse_circle_spec(o.circle == "default" ? "" : o.circle);
+    circle = parse_circle_spec(o.circle == "default" ? "" : o.circle);
+    context.circle = *circle;
   }
   std::vector<std::unique_ptr<ForceModel>> forces;
   std::vector<Run> runs = make_runs(o, context, forces);
@@ -453,7 +456,7 @@ void run(const OfflineOpts& o, int& exit_code) {
   const RobotModel model = load_cli_robot("offline", o.robot, o.stiffness);
   require_stiffness(model);  // before any path is solved
   std::string path_text;
-  const std::unique_ptr<PoseSource> source = make_pose_source(o, context, path_text);
+  const std::unique_ptr<PoseSource> source = make_pose_source(o, circle, path_text);
   const OfflineJobResult job = compensate_along(o, model, *source, runs);
   const ArmConfiguration& configuration = job.configuration;
   rapid.note = fmt::format("Path: {}; arm configuration [cf1,cf4,cf6,cfx] at the start [{},{},{},{}].", path_text,

@@ -9,7 +9,7 @@
 
 #include "cli_util.hpp"
 #include "deflex/force/force_spec.hpp"
-#include "deflex/force/milling_force_model.hpp"
+#include "deflex/machining/milling_force_model.hpp"
 #include "deflex/machining/stock_spec.hpp"
 #include "deflex/offline/toolpath_job.hpp"
 #include "deflex/report/svg_charts.hpp"
@@ -24,7 +24,7 @@ namespace {
 /// The one milling model of the --force options.
 std::unique_ptr<MillingForceModel> toolpath_force(const ToolpathRunOptions& o, const Cutter& cutter) {
   ForceSpecContext context;
-  context.cutter = cutter;
+  context.milling = milling_force_specs(cutter);
   if (o.forces.size() != 1) {
     throw InputError(fmt::format(
         "--toolpath compensates for one milling force: give one --force \"milling:...\" ({} given)", o.forces.size()));

@@ -19,14 +19,13 @@
 #include "cli_util.hpp"
 #include "command.hpp"
 #include "deflex/force/force_spec.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/monitor/cycle_log_reader.hpp"
 #include "deflex/monitor/monitor_server.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/runtime/session.hpp"
 #include "deflex/runtime/session_force.hpp"
 #include "deflex/runtime/session_settings.hpp"
 #include "deflex/text/errors.hpp"
-#include "deflex/wire/egm_codec.hpp"
 #include "field_log.hpp"
 
 namespace deflex::cli {
@@ -185,7 +184,6 @@ void run_online(const OnlineOpts& o, int& exit_code) {
   }
   if (o.json) {
     nlohmann::json doc = nlohmann::json::parse(summary.json_text);
-    doc["protobuf_log_messages"] = egm_protobuf_log_messages();
     print_json(doc);
   }
   exit_code = summary.exit_code;

@@ -20,7 +20,7 @@ fi
 cat > "$work/fk.cpp" <<'CPP'
 #include <cstdio>
 #include "deflex/model/kinematics.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 int main() {
   const deflex::RobotModel robot = deflex::builtin_irb6700();
   deflex::Workspace ws(robot);

@@ -13,6 +13,7 @@
 #include "deflex/evaluate/lap_split.hpp"
 #include "deflex/evaluate/path_metrics.hpp"
 #include "deflex/evaluate/time_alignment.hpp"
+#include "deflex/evaluate/tracker_csv.hpp"
 #include "deflex/evaluate/tracker_files.hpp"
 #include "deflex/text/errors.hpp"
 

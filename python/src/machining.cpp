@@ -8,6 +8,7 @@
 #include "bindings.hpp"
 #include "deflex/force/force_spec.hpp"
 #include "deflex/machining/coefficient_fit.hpp"
+#include "deflex/machining/milling_force_model.hpp"
 #include "deflex/machining/stock_spec.hpp"
 #include "deflex/offline/toolpath_job.hpp"
 #include "deflex/text/errors.hpp"
@@ -94,7 +95,7 @@ py::dict run_compensate_toolpath(const RobotModel& model, const PathArg& toolpat
                                  const std::string& reader_options, bool predict, const std::optional<PathArg>& csv,
                                  const std::optional<PathArg>& program_out) {
   ForceSpecContext context;
-  context.cutter = parse_cutter_spec(cutter_spec);
+  context.milling = milling_force_specs(parse_cutter_spec(cutter_spec));
   std::vector<std::unique_ptr<ForceModel>> models = parse_force_specs(force_spec, context);
   const auto* force = dynamic_cast<const MillingForceModel*>(models.front().get());
   if (force == nullptr) throw InputError("argument force: a toolpath takes the milling force (\"milling:...\")");

@@ -9,7 +9,7 @@
 #include "bindings.hpp"
 #include "deflex/model/compliance.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "parallel.hpp"
 

@@ -6,9 +6,9 @@
 
 #include "arrays.hpp"
 #include "bindings.hpp"
+#include "deflex/identify/payload_identification.hpp"
 #include "deflex/model/kinematics.hpp"
 #include "deflex/online/online_compensator.hpp"
-#include "deflex/online/payload_identification.hpp"
 #include "deflex/online/sensor_config.hpp"
 #include "deflex/text/errors.hpp"
 

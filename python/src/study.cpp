@@ -11,6 +11,7 @@
 
 #include "arrays.hpp"
 #include "bindings.hpp"
+#include "deflex/evaluate/tracker_csv.hpp"
 #include "deflex/evaluate/tracker_files.hpp"
 #include "deflex/report/case_report.hpp"
 #include "deflex/report/html_report.hpp"

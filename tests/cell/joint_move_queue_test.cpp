@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/cell/joint_move_queue.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 
 namespace deflex::cell {

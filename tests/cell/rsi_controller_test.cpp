@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/cell/rsi_controller.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/transport/memory_network.hpp"
 
 namespace deflex::cell {

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/cell/simple_message_server.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/transport/memory_stream.hpp"
 #include "support/simple_message_frames.hpp"
 

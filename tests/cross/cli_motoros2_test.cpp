@@ -18,7 +18,7 @@
 #include "cross/cli_child.hpp"
 #include "cross/cli_runner.hpp"
 #include "deflex/cell/motoros2_rt_controller.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/transport/udp_transport.hpp"

@@ -21,8 +21,8 @@
 #include "cross/cli_runner.hpp"
 #include "deflex/cell/egm_path_controller.hpp"
 #include "deflex/cell/egm_position_controller.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/transport/udp_transport.hpp"
 

@@ -20,9 +20,9 @@
 #include "cross/cli_child.hpp"
 #include "deflex/cell/egm_position_controller.hpp"
 #include "deflex/model/kinematics.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/model/types.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/transport/udp_transport.hpp"
 

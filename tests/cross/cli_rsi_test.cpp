@@ -20,7 +20,7 @@
 #include "cross/cli_child.hpp"
 #include "cross/cli_runner.hpp"
 #include "deflex/cell/rsi_controller.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/transport/udp_transport.hpp"
 #include "wire/protobuf_bytes.hpp"

@@ -18,8 +18,8 @@
 #include "cross/cli_child.hpp"
 #include "deflex/cell/egm_position_controller.hpp"
 #include "deflex/cell/rsi_controller.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/transport/udp_transport.hpp"
 

@@ -17,8 +17,8 @@
 
 #include "cross/cli_child.hpp"
 #include "deflex/cell/simple_message_server.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/transport/tcp_stream.hpp"
 #include "support/simple_message_frames.hpp"

@@ -11,10 +11,10 @@
 
 #include "cli_runner.hpp"
 #include "deflex/force/constant_wrench_model.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/paths/detail/pose_path_csv.hpp"
 #include "deflex/paths/path_ik.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/csv_table.hpp"
 
 namespace deflex {

@@ -16,7 +16,7 @@
 
 #include "cli_runner.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 
 namespace deflex {
 namespace {

@@ -3,6 +3,7 @@
 // round trip; and the round trip the issue asks for: the study's tracker data exported as SA files in a
 // tracker frame with noise, registered and evaluated, giving the base-frame figures within the noise.
 #include "deflex/evaluate/frame_registration.hpp"
+#include "deflex/evaluate/tracker_csv.hpp"
 
 #include <cmath>
 #include <filesystem>

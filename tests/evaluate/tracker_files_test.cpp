@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "deflex/evaluate/tracker_csv.hpp"
 #include "deflex/model/tracker_trace.hpp"
 #include "deflex/text/errors.hpp"
 

@@ -74,15 +74,16 @@ TEST(ForceSpec, LdbbWithPivotAndSeveralLoads) {
 }
 
 TEST(ForceSpec, LdbbPhiPlacesThePivotOnTheCircleAxis) {
+  const CirclePath circle = default_circle();  // centre (1.5, 0, 1.0) m, r = 0.1 m, normal +z
   ForceSpecContext ctx;
-  ctx.circle = default_circle();  // centre (1.5, 0, 1.0) m, r = 0.1 m, normal +z
+  ctx.circle = circle;
   const auto model = parse_force_spec("ldbb:phi_deg=45,force_N=625", ctx);
   const auto* ldbb = dynamic_cast<const LdbbForceModel*>(model.get());
   ASSERT_NE(ldbb, nullptr);
   EXPECT_TRUE(ldbb->push());
   // tan 45 = 1: the pivot is one radius below the centre, the bar sqrt(2) * 100 mm long.
   EXPECT_NEAR((ldbb->pivot_base_m() - Vector3(1.5, 0.0, 0.9)).norm(), 0.0, 1e-15);
-  for (const Pose& p : sample_circle(*ctx.circle, Eigen::Quaterniond(0, 0, 1, 0))) {
+  for (const Pose& p : sample_circle(circle, Eigen::Quaterniond(0, 0, 1, 0))) {
     EXPECT_NEAR(ldbb->inclination_rad(p), deg_to_rad(45.0), 1e-12);
     EXPECT_NEAR(ldbb->bar_length_m(p), 0.1 * std::sqrt(2.0), 1e-12);
   }

@@ -11,6 +11,7 @@
 #include "deflex/force/force_spec.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/force/tool_wrench_model.hpp"
+#include "deflex/paths/circle_path.hpp"
 #include "deflex/text/errors.hpp"
 #include "support/error_of.hpp"
 

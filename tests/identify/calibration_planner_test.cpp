@@ -16,7 +16,7 @@
 #include "deflex/model/compliance.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
 #include "deflex/model/linear_algebra.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
 

@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/identify/stiffness_identification.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "support/error_of.hpp"
 

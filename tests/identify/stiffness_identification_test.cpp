@@ -13,7 +13,7 @@
 #include "deflex/identify/stiffness_identification.hpp"
 #include "deflex/model/compliance.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "model/kdl_chain.hpp"
 #include "model/test_robots.hpp"

@@ -10,7 +10,7 @@
 
 #include "deflex/identify/stiffness_identification.hpp"
 #include "deflex/model/compliance.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 
 namespace deflex {

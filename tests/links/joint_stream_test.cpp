@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/link/joint_stream.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 
 namespace deflex {

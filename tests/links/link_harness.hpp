@@ -13,8 +13,8 @@
 #include "deflex/egm/egm_joint_link.hpp"
 #include "deflex/egm/egm_path_link.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/transport/memory_network.hpp"
 #include "online/fd_jacobian.hpp"
 

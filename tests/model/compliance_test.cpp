@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/model/compliance.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "online/fd_jacobian.hpp"
 #include "support/allocation_guard.hpp"
 #include "test_robots.hpp"

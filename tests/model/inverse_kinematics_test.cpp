@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "deflex/model/inverse_kinematics.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "test_robots.hpp"
 
 namespace deflex {

@@ -17,7 +17,7 @@
 #include "deflex/model/detail/joint_sincos.hpp"
 #include "deflex/model/folded_chain.hpp"
 #include "deflex/model/kinematics.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "online/fd_jacobian.hpp"
 #include "test_robots.hpp"
 

@@ -7,7 +7,7 @@
 #include <kdl/chainjnttojacsolver.hpp>
 
 #include "deflex/model/kinematics.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "kdl_chain.hpp"
 #include "test_robots.hpp"
 

@@ -14,7 +14,7 @@
 #include <kdl/chainjnttojacsolver.hpp>
 
 #include "deflex/model/opw_ik.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "kdl_chain.hpp"
 #include "kdl_reference_chain.hpp"
 #include "support/allocation_guard.hpp"

@@ -14,7 +14,7 @@
 #include "deflex/model/compliance.hpp"
 #include "deflex/model/inverse_kinematics.hpp"
 #include "deflex/model/kinematics.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "support/error_of.hpp"
 

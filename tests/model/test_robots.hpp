@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 
 namespace deflex::test {
 

@@ -8,9 +8,9 @@
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/force/wrench_table_model.hpp"
 #include "deflex/model/compliance.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/paths/path_spec.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
 

@@ -7,11 +7,11 @@
 #include <gtest/gtest.h>
 
 #include "deflex/force/ldbb_force_model.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/offline/offline_csv.hpp"
 #include "deflex/offline/offline_summary.hpp"
 #include "deflex/offline/rapid_module.hpp"
 #include "deflex/paths/path_spec.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
 #include "rapid_checker.hpp"

@@ -11,10 +11,10 @@
 
 #include "deflex/force/constant_wrench_model.hpp"
 #include "deflex/force/tool_wrench_model.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/offline/offline_csv.hpp"
 #include "deflex/paths/path_spec.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/output_file.hpp"
 #include "support/error_of.hpp"

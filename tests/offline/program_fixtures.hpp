@@ -8,9 +8,9 @@
 #include <gtest/gtest.h>
 
 #include "deflex/force/constant_wrench_model.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/offline/detail/krl_program.hpp"
 #include "deflex/offline/detail/rapid_program.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "support/error_of.hpp"
 
 namespace deflex::program_fixtures {

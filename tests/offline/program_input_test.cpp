@@ -8,11 +8,11 @@
 
 #include "deflex/force/constant_wrench_model.hpp"
 #include "deflex/force/wrench_table_model.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/offline/detail/krl_program.hpp"
 #include "deflex/offline/detail/program_text.hpp"
 #include "deflex/offline/detail/rapid_program.hpp"
 #include "deflex/offline/program_compensation.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
 #include "offline/program_fixtures.hpp"

@@ -15,9 +15,10 @@
 #include <kdl/chainjnttojacsolver.hpp>
 
 #include "deflex/force/force_spec.hpp"
+#include "deflex/machining/milling_force_model.hpp"
 #include "deflex/machining/stock_spec.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/offline/toolpath_job.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/toolpath/gcode_reader.hpp"
 #include "machining/textbook_milling.hpp"
@@ -341,7 +342,7 @@ struct SpinContest {
 SpinContest contest(const std::string& file, const std::string& force_spec, const std::string& stock_spec) {
   const RobotModel model = spindle_robot();
   ForceSpecContext context;
-  context.cutter = end_mill();
+  context.milling = milling_force_specs(end_mill());
   const auto models = parse_force_specs(force_spec, context);
   const auto& force = dynamic_cast<const MillingForceModel&>(*models.front());
   ToolpathJobOptions o;

@@ -3,8 +3,8 @@
 // correction and passed the bound on the way.
 #include <gtest/gtest.h>
 
-#include "deflex/model/robot_io.hpp"
 #include "deflex/online/online_compensator.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 
 namespace deflex {
 namespace {

@@ -3,8 +3,8 @@
 // allocation in the cycle.
 #include <gtest/gtest.h>
 
-#include "deflex/model/robot_io.hpp"
 #include "deflex/online/online_compensator.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "support/allocation_guard.hpp"
 
 namespace deflex {

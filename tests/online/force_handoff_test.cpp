@@ -5,9 +5,9 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/robot_io.hpp"
 #include "deflex/online/force_handoff.hpp"
 #include "deflex/online/online_compensator.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "support/allocation_guard.hpp"
 

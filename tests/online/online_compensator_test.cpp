@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/robot_io.hpp"
 #include "deflex/online/online_compensator.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "online/fd_jacobian.hpp"
 #include "support/allocation_guard.hpp"

@@ -12,9 +12,9 @@
 
 #include "deflex/force/constant_wrench_model.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/online/delay_estimator.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "support/allocation_guard.hpp"
 #include "support/error_of.hpp"

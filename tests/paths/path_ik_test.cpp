@@ -7,10 +7,10 @@
 #include <gtest/gtest.h>
 #include <kdl/chainfksolverpos_recursive.hpp>
 
-#include "deflex/model/robot_io.hpp"
 #include "deflex/paths/detail/pose_path_csv.hpp"
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/path_spec.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "model/kdl_chain.hpp"
 #include "support/allocation_guard.hpp"

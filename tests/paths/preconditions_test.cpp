@@ -9,11 +9,11 @@
 
 #include <gtest/gtest.h>
 
-#include "deflex/model/robot_io.hpp"
 #include "deflex/paths/circle_path.hpp"
 #include "deflex/paths/joint_trajectory.hpp"
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/paths/path_spec.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "support/error_of.hpp"
 

@@ -2,8 +2,8 @@
 // branch (KUKA Status) chosen at the first point is kept along the path.
 #include <gtest/gtest.h>
 
-#include "deflex/model/robot_io.hpp"
 #include "deflex/paths/path_ik.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 
 namespace deflex {
 namespace {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <random>
 
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 
 namespace deflex::cell {
 

@@ -7,11 +7,10 @@
 
 #include "deflex/force/constant_wrench_model.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
-#include "deflex/force/milling_force_model.hpp"
 #include "deflex/force/tool_wrench_model.hpp"
 #include "deflex/force/wrench_table_model.hpp"
-#include "deflex/paths/key_value_spec.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/text/key_value_spec.hpp"
 
 namespace deflex {
 namespace {
@@ -73,7 +72,7 @@ Wrench parse_wrench_keys(const std::string& spec, const std::string& body) {
 
 }  // namespace
 
-Vector3 ldbb_pivot_for_circle(const CirclePath& circle, double phi_rad) {
+Vector3 ldbb_pivot_for_circle(const CircleGeometry& circle, double phi_rad) {
   if (!std::isfinite(phi_rad) || std::abs(phi_rad) >= deg_to_rad(89.0)) {
     throw InputError(
         fmt::format("LDBB: inclination phi must be within +-89 deg (got {:.3f} deg)", rad_to_deg(phi_rad)));
@@ -117,20 +116,13 @@ std::vector<std::unique_ptr<ForceModel>> parse_force_specs(const std::string& sp
     return models;
   }
   if (kind == "milling") {
-    if (!context.cutter) {
+    if (!context.milling) {
       throw InputError(
           fmt::format("force spec '{}': the milling force needs the cutter: give --cutter "
                       "\"diameter_mm=..,flutes=..,helix_deg=..\"",
                       spec));
     }
-    std::vector<std::unique_ptr<ForceModel>> models;
-    MillingSpec milling = parse_milling_spec(spec);
-    try {
-      models.push_back(std::make_unique<MillingForceModel>(std::move(milling), *context.cutter));
-    } catch (const InputError& e) {
-      throw InputError(fmt::format("force spec '{}': {}", spec, e.what()));
-    }
-    return models;
+    return context.milling(spec);
   }
   throw InputError(fmt::format(
       "force spec '{}': unknown kind '{}' (use ldbb:..., constant:..., tool:..., table:FILE.csv or milling:...)", spec,

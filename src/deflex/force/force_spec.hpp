@@ -5,8 +5,8 @@
 //   constant:fx_N=..,fy_N=..,fz_N=..,mx_Nm=..,my_Nm=..,mz_Nm=..   (absent components are 0)
 //   tool:fx_N=..,fy_N=..,fz_N=..,mx_Nm=..,my_Nm=..,mz_Nm=..       (the same, in the TCP frame)
 //   table:FILE.csv                                          (see wrench_table_model.hpp)
-//   milling:Ktc_N_mm2=..,...[,ae_mm=..,ap_mm=..]           (a toolpath's cutting force, with a cutter;
-//   milling:file=COEFFS.yaml[,...]                           milling_force_model.hpp)
+//   milling:Ktc_N_mm2=..,...[,ae_mm=..,ap_mm=..]           (a toolpath's cutting force, with a cutter:
+//   milling:file=COEFFS.yaml[,...]                           machining/milling_force_model.hpp)
 //
 // Keys are separated by ',' and the components of one value by ';'. Every unit is in the key's
 // name; positions in mm, forces in N, moments in Nm (moment about the TCP), base frame (tool: the
@@ -19,21 +19,25 @@
 // demands (the ball runs on a sphere round the pivot).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "deflex/force/force_model.hpp"
-#include "deflex/machining/cutter.hpp"
-#include "deflex/paths/circle_path.hpp"
+#include "deflex/model/types.hpp"
 
 namespace deflex {
 
+/// The models of a spec of a process force the force module does not build itself (milling:, the
+/// machining module's milling_force_specs(cutter), which knows the cutter and the coefficients).
+using ProcessForceSpecs = std::function<std::vector<std::unique_ptr<ForceModel>>(const std::string& spec)>;
+
 /// What the path knows that a spec may refer to.
 struct ForceSpecContext {
-  std::optional<CirclePath> circle;  ///< enables ldbb:phi_deg=...
-  std::optional<Cutter> cutter;      ///< the cutter a milling: spec needs (--cutter)
+  std::optional<CircleGeometry> circle;  ///< enables ldbb:phi_deg=... (a CirclePath converts to it)
+  ProcessForceSpecs milling;             ///< builds milling: specs with the cutter (--cutter); empty: refused
 };
 
 /// Every model the spec describes (more than one only for several force_N values). Throws
@@ -49,6 +53,6 @@ struct ForceSpecContext {
 
 /// The LDBB pivot for a bar inclined by phi (rad) to the circle's plane (see the file comment), m.
 /// Throws InputError unless |phi| < 89 deg and the circle's normal, centre and radius (> 0) are finite.
-[[nodiscard]] Vector3 ldbb_pivot_for_circle(const CirclePath& circle, double phi_rad);
+[[nodiscard]] Vector3 ldbb_pivot_for_circle(const CircleGeometry& circle, double phi_rad);
 
 }  // namespace deflex

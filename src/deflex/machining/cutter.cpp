@@ -12,8 +12,8 @@
 #include <fmt/format.h>
 
 #include "deflex/model/types.hpp"
-#include "deflex/paths/key_value_spec.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/text/key_value_spec.hpp"
 
 namespace deflex {
 

@@ -19,9 +19,9 @@
 #include <yaml-cpp/yaml.h>  // Field::node()
 
 #include "deflex/machining/cutter.hpp"
-#include "deflex/paths/key_value_spec.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/input_ranges.hpp"
+#include "deflex/text/key_value_spec.hpp"
 #include "deflex/text/parse_number.hpp"
 #include "deflex/text/yaml_fields.hpp"
 

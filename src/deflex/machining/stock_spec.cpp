@@ -5,8 +5,8 @@
 
 #include "deflex/machining/dexel_stock.hpp"
 #include "deflex/machining/zmap_stock.hpp"
-#include "deflex/paths/key_value_spec.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/text/key_value_spec.hpp"
 
 namespace deflex {
 

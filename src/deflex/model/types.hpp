@@ -33,6 +33,14 @@ using Wrench = Vector6;
 /// Small twist-like displacement [dx dy dz drx dry drz] in m and rad, in the robot base frame.
 using Displacement = Vector6;
 
+/// A circle's geometry alone, in the robot base frame (m): what a force model placed on a circle needs
+/// of it (the sampled path, paths/circle_path.hpp, converts to it).
+struct CircleGeometry {
+  Vector3 centre_m = Vector3::Zero();
+  double radius_m = 0.1;
+  Vector3 normal = Vector3::UnitZ();  ///< need not be unit; must not be zero
+};
+
 inline constexpr double kPi = 3.14159265358979323846;
 /// A quiet NaN: "no value" in a field that has none (a skipped row, an unmeasured figure).
 inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();

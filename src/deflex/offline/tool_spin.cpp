@@ -11,9 +11,9 @@
 #include <fmt/format.h>
 
 #include "deflex/model/opw_ik.hpp"
-#include "deflex/paths/key_value_spec.hpp"
 #include "deflex/paths/path_ik.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/text/key_value_spec.hpp"
 
 namespace deflex {
 namespace {

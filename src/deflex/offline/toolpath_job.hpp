@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "deflex/force/milling_force_model.hpp"
+#include "deflex/machining/milling_force_model.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/offline/offline_csv.hpp"
 #include "deflex/offline/tool_spin.hpp"

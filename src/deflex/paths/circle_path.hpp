@@ -25,6 +25,9 @@ struct CirclePath {
   /// is 360 deg / (points - 1); the paper's 81 points give 4.5 deg steps.
   int points = 81;
   Vector3 start_reference = Vector3::UnitX();  ///< must not be parallel to `normal`
+
+  /// The circle's centre, radius and normal (what force specs place on it, force/force_spec.hpp).
+  operator CircleGeometry() const { return {centre_m, radius_m, normal}; }  // NOLINT(google-explicit-constructor)
 };
 
 /// The unit start direction u and the in-plane direction v = normal x u of a circle (base frame).

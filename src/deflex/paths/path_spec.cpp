@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 
 #include "deflex/paths/detail/pose_path_csv.hpp"
-#include "deflex/paths/key_value_spec.hpp"
+#include "deflex/text/key_value_spec.hpp"
 
 namespace deflex {
 namespace {

@@ -11,6 +11,7 @@
 #include "deflex/text/errors.hpp"
 #include "deflex/transport/tcp_stream.hpp"
 #include "deflex/transport/udp_transport.hpp"
+#include "deflex/wire/egm_codec.hpp"
 
 namespace deflex::runtime {
 
@@ -585,6 +586,7 @@ void Session::build_summary() {
                       {"log", config_.log_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(config_.log_path)},
                       {"log_dropped", s.log_dropped},
                       {"realtime", realtime_.text}};
+  j["protobuf_log_messages"] = egm_protobuf_log_messages();  // the EGM codec's messages kept off stderr
   if (reporter_) j["timing"] = reporter_->timing_json();
   if (force_ != nullptr) {
     const ForceSourceStats& f = s.force_source;

@@ -12,11 +12,11 @@
 #include <optional>
 #include <utility>
 
-#include "deflex/paths/key_value_spec.hpp"
 #include "deflex/sensors/detail/http_fetch.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/input_file.hpp"
 #include "deflex/text/input_ranges.hpp"
+#include "deflex/text/key_value_spec.hpp"
 #include "deflex/text/parse_number.hpp"
 
 namespace deflex {

@@ -14,7 +14,7 @@
 #include "deflex/cell/milling_process.hpp"
 #include "deflex/cell/path_drift.hpp"
 #include "deflex/cell/robot_controller.hpp"
-#include "deflex/force/milling_force_model.hpp"
+#include "deflex/machining/milling_force_model.hpp"
 #include "deflex/model/kinematics.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/online/online_strategy.hpp"

@@ -8,8 +8,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/paths/key_value_spec.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/text/key_value_spec.hpp"
 #include "deflex/text/parse_number.hpp"
 #include "deflex/toolpath/apt_reader.hpp"
 #include "deflex/toolpath/gcode_reader.hpp"

@@ -5,8 +5,8 @@
 
 #include <fmt/format.h>
 
-#include "deflex/paths/key_value_spec.hpp"
 #include "deflex/text/input_ranges.hpp"
+#include "deflex/text/key_value_spec.hpp"
 
 namespace deflex {
 

@@ -1,5 +1,5 @@
-// Every header of the model, and the text and version headers a model consumer includes, compiled
-// as C++17 with warnings as errors; a small FK to link and run.
+// Every header of the model and of the robot files, and the text and version headers a model consumer includes,
+// compiled as C++17 with warnings as errors; a small FK to link and run.
 #include "deflex/model/arm_configuration.hpp"
 #include "deflex/model/compliance.hpp"
 #include "deflex/model/folded_chain.hpp"
@@ -8,10 +8,10 @@
 #include "deflex/model/linear_algebra.hpp"
 #include "deflex/model/opw_geometry.hpp"
 #include "deflex/model/opw_ik.hpp"
-#include "deflex/model/robot_io.hpp"
 #include "deflex/model/robot_model.hpp"
 #include "deflex/model/tracker_trace.hpp"
 #include "deflex/model/types.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/version.hpp"
 

@@ -12,8 +12,11 @@
 #include "deflex/model/nearest_name.hpp"
 #include "deflex/model/output_file.hpp"
 #include "deflex/model/parse_number.hpp"
+#include "deflex/model/robot_io.hpp"
 #include "deflex/model/run_files.hpp"
 #include "deflex/model/yaml_fields.hpp"
+#include "deflex/online/payload_identification.hpp"
+#include "deflex/paths/key_value_spec.hpp"
 #include "deflex/study/case_report.hpp"
 
 int main() {

@@ -6,4 +6,5 @@
 #pragma GCC warning \
     "deflex/evaluate/tracker_trace.hpp is deprecated: include deflex/model/tracker_trace.hpp (this header goes in deflex 0.3)"
 #endif
+#include "deflex/evaluate/tracker_csv.hpp"
 #include "deflex/model/tracker_trace.hpp"

@@ -1,6 +1,6 @@
 // URDF tree structure with line numbers (TinyXML) and the choice of the serial chain, in time linear
 // in the number of links and joints.
-#include "deflex/model/detail/urdf_tree.hpp"
+#include "deflex/robotfile/detail/urdf_tree.hpp"
 
 #include <algorithm>
 #include <sstream>

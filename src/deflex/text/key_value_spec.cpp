@@ -1,5 +1,5 @@
 // key=value specification parser shared by the path and force specs.
-#include "deflex/paths/key_value_spec.hpp"
+#include "deflex/text/key_value_spec.hpp"
 
 #include <cmath>
 #include <sstream>

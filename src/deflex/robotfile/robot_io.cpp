@@ -1,5 +1,5 @@
 // Robot description files: deflex YAML, URDF chains, the built-in IRB6700.
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 
 #include <cmath>
 #include <filesystem>
@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 #include <urdf_parser/urdf_parser.h>
 
-#include "deflex/model/detail/urdf_tree.hpp"
+#include "deflex/robotfile/detail/urdf_tree.hpp"
 #include "deflex/text/csv_table.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/input_file.hpp"

@@ -7,8 +7,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "deflex/model/detail/urdf_tree.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/detail/urdf_tree.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 #include "support/error_of.hpp"
 

@@ -6,9 +6,9 @@
 #include <gtest/gtest.h>
 
 #include "deflex/model/kinematics.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
-#include "test_robots.hpp"
+#include "model/test_robots.hpp"
 
 namespace deflex {
 namespace {

@@ -6,9 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include "deflex/identify/payload_identification.hpp"
 #include "deflex/model/kinematics.hpp"
-#include "deflex/model/robot_io.hpp"
-#include "deflex/online/payload_identification.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
 
 namespace deflex {

@@ -1,5 +1,5 @@
 // Payload (mass, centre of gravity) and bias identification from static poses.
-#include "deflex/online/payload_identification.hpp"
+#include "deflex/identify/payload_identification.hpp"
 
 #include <cmath>
 

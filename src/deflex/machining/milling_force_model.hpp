@@ -14,6 +14,7 @@
 #include <string>
 
 #include "deflex/force/force_model.hpp"
+#include "deflex/force/force_spec.hpp"
 #include "deflex/machining/cutting_coefficients.hpp"
 #include "deflex/machining/milling_force.hpp"
 #include "deflex/machining/stock.hpp"
@@ -42,6 +43,11 @@ class MillingForceModel final : public ForceModel {
   MillingSpec spec_;
   Cutter cutter_;
 };
+
+/// The parser of milling: force specs (force_spec.hpp) with `cutter`, for ForceSpecContext::milling: one
+/// MillingForceModel a spec. It throws InputError quoting the spec (a bad key, a cutter out of range, an
+/// ae_mm override wider than the cutter) and ModelError for a coefficient file it cannot read.
+[[nodiscard]] ProcessForceSpecs milling_force_specs(const Cutter& cutter);
 
 /// One toolpath point as the force needs it, in the workpiece (stock) frame.
 struct MillingPointInput {

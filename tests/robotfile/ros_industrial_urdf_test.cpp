@@ -9,9 +9,9 @@
 #include <unistd.h>
 
 #include "deflex/model/kinematics.hpp"
-#include "deflex/model/robot_io.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/text/errors.hpp"
-#include "urdf_reference.hpp"
+#include "model/urdf_reference.hpp"
 
 namespace deflex {
 namespace {

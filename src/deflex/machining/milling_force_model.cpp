@@ -1,5 +1,5 @@
 // The milling force along a toolpath, point by point with the stock.
-#include "deflex/force/milling_force_model.hpp"
+#include "deflex/machining/milling_force_model.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -179,6 +179,19 @@ const MillingPointForce& MillingProcess::next(const MillingPointInput& in) {
   remove(in);
   previous_ = in.tip_m;
   return out_;
+}
+
+ProcessForceSpecs milling_force_specs(const Cutter& cutter) {
+  return [cutter](const std::string& spec) {
+    std::vector<std::unique_ptr<ForceModel>> models;
+    MillingSpec milling = parse_milling_spec(spec);
+    try {
+      models.push_back(std::make_unique<MillingForceModel>(std::move(milling), cutter));
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("force spec '{}': {}", spec, e.what()));
+    }
+    return models;
+  };
 }
 
 }  // namespace deflex
