@@ -17,9 +17,9 @@
 
 #include <benchmark/benchmark.h>
 
-#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/motoros2/motoros2_rt_link.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/transport/udp_transport.hpp"
 
 #include "counting_new.hpp"

@@ -27,7 +27,8 @@ struct ControllerSetupOpts : runtime::ControllerSetupSettings {
 
 /// The options of `deflex controller-setup`, in the order --help lists them.
 void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
-  sub.add_option("--link", o.link, "egm-joint, egm-path, rsi, fanuc-j519 or motoros2-rt (as deflex online --link)")->required();
+  sub.add_option("--link", o.link, "egm-joint, egm-path, rsi, fanuc-j519 or motoros2-rt (as deflex online --link)")
+      ->required();
   sub.add_option("--sensor-ip", o.sensor_ip,
                  "deflex's IPv4 address as the controller reaches it (the PC on the controller's network)")
       ->required();

@@ -67,9 +67,8 @@ CycleCount count_kinematics(const CycleCase& c) {
 }
 
 TEST(KinematicsPerCycle, AtMostOnceAtTheFeedbackAndOnceAtTheTarget) {
-  for (LinkKind link :
-       {LinkKind::kEgmJoint, LinkKind::kEgmPath, LinkKind::kRsi, LinkKind::kSimpleMessage, LinkKind::kFanucJ519,
-        LinkKind::kMotoros2Rt}) {
+  for (LinkKind link : {LinkKind::kEgmJoint, LinkKind::kEgmPath, LinkKind::kRsi, LinkKind::kSimpleMessage,
+                        LinkKind::kFanucJ519, LinkKind::kMotoros2Rt}) {
     for (const auto& [strategy, with_model] : {std::pair{StrategyKind::kOnline, false},
                                                {StrategyKind::kHybrid, true},
                                                {StrategyKind::kPredictive, false},

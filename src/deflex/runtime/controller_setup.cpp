@@ -154,8 +154,7 @@ std::vector<ControllerFile> controller_setup_files(const ControllerSetupSettings
   if (link == "rsi") return rsi_setup_files(settings);
   if (link == "fanuc-j519") return fanuc_setup_files(settings, load_robot);
   if (link == "motoros2-rt") return motoros2_setup_files(settings, load_robot);
-  throw InputError(
-      fmt::format("option --link: '{}' is not egm-joint, egm-path, rsi, fanuc-j519 or motoros2-rt", link));
+  throw InputError(fmt::format("option --link: '{}' is not egm-joint, egm-path, rsi, fanuc-j519 or motoros2-rt", link));
 }
 
 }  // namespace deflex::runtime

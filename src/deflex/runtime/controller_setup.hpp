@@ -1,7 +1,7 @@
 // The controller's side of a link, chosen by link kind: what `deflex controller-setup` writes (ABB EGM's
 // RAPID module and UdpUc entry; KUKA RSI's Ethernet config, context and KRL; FANUC Stream Motion's TP
-// program and settings sheet; MotoROS2's configuration keys and sheet), from the defaults a session uses (link_table.hpp), so the controller's
-// side agrees with deflex's.
+// program and settings sheet; MotoROS2's configuration keys and sheet), from the defaults a session uses
+// (link_table.hpp), so the controller's side agrees with deflex's.
 #pragma once
 
 #include <functional>

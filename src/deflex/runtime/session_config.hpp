@@ -59,7 +59,7 @@ struct SessionConfig {
   SimpleMessageLinkConfig simple_message;
   FanucJ519LinkConfig fanuc_j519;    ///< its controller address comes from NetworkConfig (or is given with a transport)
   Motoros2RtLinkConfig motoros2_rt;  ///< as fanuc_j519
-  double duration_s = 0.0;         ///< > 0: the session ends (planned) after this long
+  double duration_s = 0.0;           ///< > 0: the session ends (planned) after this long
   /// A planned stop (request_stop(), the time limit) while the arm moves: a streaming link brings the
   /// program to rest on its path over this long, a correcting link ramps its correction out at the rate
   /// bound; then the session ends. s, 0.05..10.
