@@ -1,7 +1,7 @@
-// `deflex controller-setup --link egm-joint|egm-path|rsi|fanuc-j519|motoros2-rt`: writes what the robot
+// `deflex controller-setup --link egm-joint|egm-path|rsi|fanuc-j519|motoros2-rt|ur-rtde`: writes what the robot
 // controller needs to talk to `deflex online` over that link (a RAPID module and the UdpUc entry for ABB
 // EGM; the Ethernet config, the RSI context and the KRL lines for KUKA RSI; FANUC's TP program and
-// settings; MotoROS2's configuration keys), from the same options and defaults as
+// settings; MotoROS2's configuration keys; the URScript servo program for UR), from the same options and defaults as
 // `deflex online` (ports, period, bounds, SENTYPE), so the controller's side agrees with deflex's.
 #include <cmath>
 #include <filesystem>
@@ -24,6 +24,7 @@
 #include "deflex/runtime/link_table.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/output_file.hpp"
+#include "deflex/ur/ur_controller_setup.hpp"
 
 namespace deflex::cli {
 namespace {
@@ -49,12 +50,16 @@ struct ControllerSetupOpts {
   // MotoROS2 real-time.
   int motoros2_group = 0, motoros2_max_truncations = 25;
   double motoros2_resend_ms = 12.0;
+  // Universal Robots RTDE.
+  double ur_lookahead_ms = 30.0, ur_gain = 2000.0;
+  int ur_register_offset = 24;
   bool json = false;
 };
 
 /// The options of `deflex controller-setup`, in the order --help lists them.
 void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
-  sub.add_option("--link", o.link, "egm-joint, egm-path, rsi, fanuc-j519 or motoros2-rt (as deflex online --link)")
+  sub.add_option("--link", o.link,
+                 "egm-joint, egm-path, rsi, fanuc-j519, motoros2-rt or ur-rtde (as deflex online --link)")
       ->required();
   sub.add_option("--sensor-ip", o.sensor_ip,
                  "deflex's IPv4 address as the controller reaches it (the PC on the controller's network)")
@@ -119,13 +124,18 @@ void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
                  "fanuc-j519: deflex online --fanuc-correction-share")
       ->capture_default_str();
   sub.add_option("--robot-port", o.robot_port,
-                 "fanuc-j519, motoros2-rt: deflex online --robot-port (default 60015, 22000)");
+                 "fanuc-j519, motoros2-rt, ur-rtde: deflex online --robot-port (default 60015, 22000, 30004)");
   sub.add_option("--motoros2-group", o.motoros2_group, "motoros2-rt: deflex online --motoros2-group")
       ->capture_default_str();
   sub.add_option("--motoros2-resend-ms", o.motoros2_resend_ms, "motoros2-rt: deflex online --motoros2-resend-ms")
       ->capture_default_str();
   sub.add_option("--motoros2-max-truncations", o.motoros2_max_truncations,
                  "motoros2-rt: deflex online --motoros2-max-truncations")
+      ->capture_default_str();
+  sub.add_option("--ur-lookahead-ms", o.ur_lookahead_ms, "ur-rtde: deflex online --ur-lookahead-ms")
+      ->capture_default_str();
+  sub.add_option("--ur-gain", o.ur_gain, "ur-rtde: deflex online --ur-gain")->capture_default_str();
+  sub.add_option("--ur-register-offset", o.ur_register_offset, "ur-rtde: deflex online --ur-register-offset")
       ->capture_default_str();
   sub.add_option("--uframe", o.uframe, "fanuc-j519: the user frame the TP program sets")->capture_default_str();
   sub.add_option("--utool", o.utool, "fanuc-j519: the tool frame the TP program sets")->capture_default_str();
@@ -256,6 +266,34 @@ std::vector<ControllerFile> motoros2_setup_files(const ControllerSetupOpts& o) {
   return motoros2_controller_setup(m);
 }
 
+/// The files of --link ur-rtde: the URScript servo program and the settings sheet. With --program, each
+/// joint's fastest stream (as for motoros2-rt): the script checks every step against it and the sheet
+/// gives the safety configuration's speed limits.
+std::vector<ControllerFile> ur_setup_files(const ControllerSetupOpts& o) {
+  const runtime::LinkKindInfo& kind = runtime::link_kind(runtime::LinkKind::kUrRtde);
+  UrSetupOptions u;
+  if (o.period_ms < 0.0) throw InputError("option --period-ms: must be > 0");
+  u.period_ms = o.period_ms > 0.0 ? o.period_ms : kind.default_period_s * 1e3;
+  u.robot_port = o.robot_port == -1 ? 30004 : o.robot_port;
+  u.lookahead_s = o.ur_lookahead_ms * 1e-3;
+  u.gain = o.ur_gain;
+  u.register_offset = o.ur_register_offset;
+  if (!o.program.empty()) {
+    const RobotModel model = load_cli_robot("controller-setup", o.robot);
+    const auto program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o.program, model));
+    OnlineConfig online;
+    online.period_s = u.period_ms * 1e-3;
+    online.max_joint_correction_rad = deg_to_rad(o.max_joint_deg);
+    online.max_correction_rate_rad_s = deg_to_rad(o.max_rate_deg_s);
+    JointStreamConfig stream;
+    stream.ramp_in_s = o.ramp_in_s;
+    stream.validate();
+    const CommandLimits l = command_limits(CommandForm::kJointTarget, online, model.dof(), program.get(), &stream);
+    u.stream_speed_rad_s = l.joint_step_rad / online.period_s;
+  }
+  return ur_controller_setup(u);
+}
+
 /// Writes the files into --output-dir and lists them with where each goes (JSON with --json).
 void write_controller_setup_files(const ControllerSetupOpts& o, const std::vector<ControllerFile>& files) {
   OutputFolder folder(o.output_dir, "option --output-dir");  // made when missing, as every output's folder
@@ -286,9 +324,11 @@ void run_controller_setup(const ControllerSetupOpts& o, int& exit_code) {
     files = fanuc_setup_files(o);
   } else if (o.link == "motoros2-rt") {
     files = motoros2_setup_files(o);
+  } else if (o.link == "ur-rtde") {
+    files = ur_setup_files(o);
   } else {
     throw InputError(
-        fmt::format("option --link: '{}' is not egm-joint, egm-path, rsi, fanuc-j519 or motoros2-rt", o.link));
+        fmt::format("option --link: '{}' is not egm-joint, egm-path, rsi, fanuc-j519, motoros2-rt or ur-rtde", o.link));
   }
   write_controller_setup_files(o, files);
   exit_code = 0;
@@ -303,11 +343,13 @@ void setup_controller_setup(CLI::App& sub, int& exit_code) {
 
 }  // namespace
 
-DEFLEX_COMMAND("controller-setup",
-               "Write the robot controller's side of a link (--link egm-joint|egm-path|rsi|fanuc-j519|motoros2-rt): "
-               "RAPID and UdpUc for ABB EGM, the Ethernet config, RSI context and KRL for KUKA RSI, the TP program "
-               "and settings for FANUC Stream Motion, the motoros2_config.yaml keys for MotoROS2's real-time mode, "
-               "agreeing with deflex online's options",
-               setup_controller_setup, 42);
+DEFLEX_COMMAND(
+    "controller-setup",
+    "Write the robot controller's side of a link (--link egm-joint|egm-path|rsi|fanuc-j519|motoros2-rt|ur-rtde): "
+    "RAPID and UdpUc for ABB EGM, the Ethernet config, RSI context and KRL for KUKA RSI, the TP program "
+    "and settings for FANUC Stream Motion, the motoros2_config.yaml keys for MotoROS2's real-time mode, the "
+    "URScript servo program for Universal Robots, "
+    "agreeing with deflex online's options",
+    setup_controller_setup, 42);
 
 }  // namespace deflex::cli

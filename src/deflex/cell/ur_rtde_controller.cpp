@@ -245,7 +245,7 @@ void UrRtdeController::servo_cycle(double t_s) {
   if (counter != counter_) {
     counter_ = counter;
     last_counter_change_s_ = t_s;
-  } else if (mode == 1 && t_s - last_counter_change_s_ > config_.watchdog_s + 1e-12) {
+  } else if (t_s - last_counter_change_s_ > config_.watchdog_s + 1e-12) {
     halt("the RTDE watchdog: input_int_register_" + std::to_string(o) + " did not change", 1);
     return;
   }
@@ -263,7 +263,7 @@ void UrRtdeController::servo_cycle(double t_s) {
   lookahead_s_ = la;
   gain_ = g;
   echo_ = counter;
-  if (mode == 2 && end_at_s_ < 0.0) end_at_s_ = t_s + 2.0 * la;
+  if (mode == 2 && end_at_s_ < 0.0) end_at_s_ = t_s + std::min(2.0 * la, 0.5 * config_.watchdog_s);
   targets_.push_back(q);
   ++counters_.servo_cycles;
   delay_.emplace_back(t_s + la, q);

@@ -8,12 +8,13 @@
 //     takes the newest input registers, and while the mode register says servo hands the six targets
 //     to servoj with the lookahead and gain the registers carry (0.03..0.2 s, 100..2000; outside them
 //     the program stops with an error, as servoj raises one); the end mode holds the last target and
-//     ends the program after twice the lookahead; it echoes the counter taken in its output register;
+//     ends the program after twice the lookahead (at most half the watchdog's period); it echoes the counter taken in
+//     its output register;
 //   - servoj's lookahead is a dead time of the lookahead and its gain a first-order lag of 1/gain s;
 //   - a servo target moving any joint faster than `max_speed_rad_s` (the safety configuration's joint
 //     speed limit) is a protective stop: the arm halts where it is, safety_mode 3, the program paused;
 //   - the watchdog (rtde_set_watchdog on the counter register, action stop): the counter unchanged for
-//     `watchdog_s` while servoing stops the program and the arm halts;
+//     `watchdog_s` once the first target came stops the program and the arm halts;
 //   - a connection closed by the client ends the RTDE session; the program's watchdog then stops it.
 // Faults on request (tests): protective_stop(), emergency_stop(), stop_program() (the pendant's stop),
 // error_message() (an error text message), stall_network() (TCP stalls both ways: nothing is read,
