@@ -32,7 +32,7 @@ using test::run_in_real_time;
 using test::spawn;
 
 // A constant reading of the sensor (its frame, N): 300 N along the tool's axis, 120 N across.
-std::string held_force_csv(const std::string& dir) {
+std::string ur_held_force_csv(const std::string& dir) {
   const std::string path = dir + "/force.csv";
   std::ofstream out(path);
   out << "t_s,fx_N,fy_N,fz_N\n";
@@ -64,7 +64,7 @@ TEST(CliUrRtde, StreamsTheProgramWithTheModelsCorrectionWithinTheStepLimit) {
          "--period-ms",
          "2",
          "--force-source",
-         "csv:" + held_force_csv(dir),
+         "csv:" + ur_held_force_csv(dir),
          "--loop",
          "--log",
          log,

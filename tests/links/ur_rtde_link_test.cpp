@@ -24,7 +24,7 @@ namespace {
 
 using test::pose_deg;
 
-constexpr double kPeriod = 0.002;
+constexpr double kUrPeriod = 0.002;
 
 struct UrBench {
   RobotModel robot = test::bench_robot();
@@ -48,7 +48,7 @@ struct UrBench {
   }
 
   UrBench(std::shared_ptr<const JointTrajectory> p, const JointVector& arm, const cell::UrRtdeControllerConfig& cc = {},
-          double lookahead_s = 0.03, double period_s = kPeriod)
+          double lookahead_s = 0.03, double period_s = kUrPeriod)
       : compensator(robot, test::bench_sensor(), test::bench_online(period_s)),
         strategy(robot, StrategyKind::kOnline, nullptr),
         program(std::move(p)),
@@ -57,7 +57,7 @@ struct UrBench {
         controller(cc, arm, pair.server()) {}
 
   /// One loop cycle of the controller, then deflex answers what reached it.
-  LinkPollResult tick(double period_s = kPeriod) {
+  LinkPollResult tick(double period_s = kUrPeriod) {
     t_s += period_s;
     clock.set(t_s);
     controller.tick(t_s);
@@ -70,7 +70,7 @@ struct UrBench {
     }
     return last;
   }
-  void run(double seconds, double period_s = kPeriod) {
+  void run(double seconds, double period_s = kUrPeriod) {
     const double end = t_s + seconds;
     while (t_s < end - 1e-9) tick(period_s);
   }
@@ -78,15 +78,15 @@ struct UrBench {
 
 // The per-cycle step limit computed here: the program's peak speed sampled every 0.5 ms, the blend's
 // 1.5 x 1 deg over the 1 s ramp-in, the rate bound, over one period.
-JointVector step_limit(const UrBench& b) {
-  return kPeriod * (test::sampled_peak_speed(*b.program) * 1.001).array() +
-         kPeriod * (1.5 * deg_to_rad(1.0) / 1.0 + b.compensator.config().max_correction_rate_rad_s) + 1e-9;
+JointVector ur_step_limit(const UrBench& b) {
+  return kUrPeriod * (test::sampled_peak_speed(*b.program) * 1.001).array() +
+         kUrPeriod * (1.5 * deg_to_rad(1.0) / 1.0 + b.compensator.config().max_correction_rate_rad_s) + 1e-9;
 }
 
 // Every target servoj took is within the step limit of the one before (the first: of the arm's start);
 // every absolute deflex sent within the bound of the program (sampled here) plus its blend.
-void expect_wire_invariants(const UrBench& b) {
-  const JointVector limit = step_limit(b);
+void expect_ur_wire_invariants(const UrBench& b) {
+  const JointVector limit = ur_step_limit(b);
   JointVector prev = b.start;
   for (std::size_t k = 0; k < b.controller.targets().size(); ++k) {
     const JointVector& q = b.controller.targets()[k];
@@ -104,7 +104,7 @@ void expect_wire_invariants(const UrBench& b) {
   }
 }
 
-bool says(const UrRtdeLink& link, const char* what) {
+bool ur_says(const UrRtdeLink& link, const char* what) {
   return std::string(link.stop_reason()).find(what) != std::string::npos;
 }
 
@@ -132,7 +132,7 @@ TEST(UrRtdeLink, ConstantForceHoldsTheModelsCorrection) {
   EXPECT_DOUBLE_EQ(bench.controller.gain(), 2000.0);
   EXPECT_EQ(bench.link.counters().guard_trips, 0u);
   EXPECT_EQ(bench.link.counters().rejected(), 0u);
-  expect_wire_invariants(bench);
+  expect_ur_wire_invariants(bench);
 }
 
 // The stand-in's dead time is the lookahead (0.1 s here), its lag 1/gain, plus up to a cycle: the
@@ -146,12 +146,12 @@ TEST(UrRtdeLink, ServojsLookaheadIsMeasuredAsTheLinksDelayAndIsTheStrategysLead)
   ASSERT_EQ(bench.link.state(), LinkState::kRunning) << bench.link.stop_reason();
   const DelayEstimator* d = bench.link.delay_estimator();
   ASSERT_TRUE(d->measured());
-  EXPECT_GE(d->delay_s(), 0.1 - 0.5 * kPeriod);
-  EXPECT_LE(d->delay_s(), 0.1 + 1.0 / 2000.0 + 3 * kPeriod);
+  EXPECT_GE(d->delay_s(), 0.1 - 0.5 * kUrPeriod);
+  EXPECT_LE(d->delay_s(), 0.1 + 1.0 / 2000.0 + 3 * kUrPeriod);
   // A measurement of its own, not the starting figure (0.1025 s) carried through.
-  EXPECT_GE(d->last_measurement_s(), 0.1 - 0.5 * kPeriod);
-  EXPECT_LE(d->last_measurement_s(), 0.1 + 1.0 / 2000.0 + 3 * kPeriod);
-  EXPECT_NE(d->last_measurement_s(), bench.link_config(0.1).servoj_delay_s(kPeriod));
+  EXPECT_GE(d->last_measurement_s(), 0.1 - 0.5 * kUrPeriod);
+  EXPECT_LE(d->last_measurement_s(), 0.1 + 1.0 / 2000.0 + 3 * kUrPeriod);
+  EXPECT_NE(d->last_measurement_s(), bench.link_config(0.1).servoj_delay_s(kUrPeriod));
   EXPECT_DOUBLE_EQ(bench.link.last_cycle().delay_s, d->delay_s());
 }
 
@@ -169,7 +169,7 @@ TEST(UrRtdeLink, AProgramRunsToItsEndAndTheScriptHoldsItsLastTarget) {
   const JointVector correction = (q0 + delta) - bench.controller.position();
   EXPECT_LE(correction.cwiseAbs().maxCoeff(), bench.compensator.config().max_joint_correction_rad);
   EXPECT_GT(correction.cwiseAbs().maxCoeff(), 1e-5);
-  expect_wire_invariants(bench);
+  expect_ur_wire_invariants(bench);
 }
 
 TEST(UrRtdeLink, ProtectiveAndEmergencyStopsAndAStoppedProgramEndTheSessionNamingThem) {
@@ -183,11 +183,11 @@ TEST(UrRtdeLink, ProtectiveAndEmergencyStopsAndAStoppedProgramEndTheSessionNamin
     if (fault == 2) bench.controller.stop_program();
     bench.run(0.05);
     EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kController) << fault;
-    EXPECT_TRUE(says(bench.link, fault == 0   ? "a protective stop (safety_mode 3)"
-                                 : fault == 1 ? "a robot emergency stop (safety_mode 7)"
-                                              : "stopped (runtime_state 1)"))
+    EXPECT_TRUE(ur_says(bench.link, fault == 0   ? "a protective stop (safety_mode 3)"
+                                    : fault == 1 ? "a robot emergency stop (safety_mode 7)"
+                                                 : "stopped (runtime_state 1)"))
         << bench.link.stop_reason();
-    expect_wire_invariants(bench);
+    expect_ur_wire_invariants(bench);
   }
 }
 
@@ -201,7 +201,7 @@ TEST(UrRtdeLink, ATargetBeyondTheControllersSpeedLimitIsAProtectiveStopTheLinkNa
   UrBench bench(program, q0, cc);
   bench.run(3.0);
   EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kController) << bench.link.stop_reason();
-  EXPECT_TRUE(says(bench.link, "protective stop")) << bench.link.stop_reason();
+  EXPECT_TRUE(ur_says(bench.link, "protective stop")) << bench.link.stop_reason();
   EXPECT_EQ(bench.controller.stopped(), "protective stop: a joint's speed limit was exceeded");
 }
 
@@ -220,9 +220,9 @@ TEST(UrRtdeLink, AStalledPcTripsTheScriptsWatchdogAndTheLinkStopsNamingIt) {
   bench.stalled = false;
   bench.run(0.05);
   EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kController);
-  EXPECT_TRUE(says(bench.link, "runtime_state 1")) << bench.link.stop_reason();
+  EXPECT_TRUE(ur_says(bench.link, "runtime_state 1")) << bench.link.stop_reason();
   EXPECT_LT((bench.controller.position() - where).cwiseAbs().maxCoeff(), 1e-12) << "the arm moved after the stop";
-  expect_wire_invariants(bench);
+  expect_ur_wire_invariants(bench);
 }
 
 TEST(UrRtdeLink, AnErrorTextMessageEndsTheSessionNamingIt) {
@@ -232,7 +232,7 @@ TEST(UrRtdeLink, AnErrorTextMessageEndsTheSessionNamingIt) {
   bench.controller.error_message("servoj: invalid setpoints");
   bench.run(0.01);
   EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kController);
-  EXPECT_TRUE(says(bench.link, "RTDE error message: servoj: invalid setpoints")) << bench.link.stop_reason();
+  EXPECT_TRUE(ur_says(bench.link, "RTDE error message: servoj: invalid setpoints")) << bench.link.stop_reason();
   EXPECT_EQ(bench.link.text_messages()[1], 1u);
 }
 
@@ -244,8 +244,8 @@ TEST(UrRtdeLink, ARefusedRecipeOrARateTheControllerCannotGiveStopsTheHandshake) 
     UrBench bench(test::hold_program(test::bench_robot(), q0, 10.0), q0, cc);
     bench.run(0.1);
     EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kController);
-    EXPECT_TRUE(says(bench.link, "input field 6")) << bench.link.stop_reason();
-    EXPECT_TRUE(says(bench.link, "IN_USE")) << bench.link.stop_reason();
+    EXPECT_TRUE(ur_says(bench.link, "input field 6")) << bench.link.stop_reason();
+    EXPECT_TRUE(ur_says(bench.link, "IN_USE")) << bench.link.stop_reason();
     EXPECT_EQ(bench.controller.counters().servo_cycles, 0u);
   }
   {
@@ -254,7 +254,7 @@ TEST(UrRtdeLink, ARefusedRecipeOrARateTheControllerCannotGiveStopsTheHandshake) 
     UrBench bench(test::hold_program(test::bench_robot(), q0, 10.0), q0, cc);
     bench.run(0.1, 0.008);
     EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kController);
-    EXPECT_TRUE(says(bench.link, "runs at most 125 Hz")) << bench.link.stop_reason();
+    EXPECT_TRUE(ur_says(bench.link, "runs at most 125 Hz")) << bench.link.stop_reason();
   }
   {  // CB3 at its own rate runs.
     cell::UrRtdeControllerConfig cc;
@@ -301,8 +301,8 @@ TEST(UrRtdeLink, GarbageOutOfOrderAndTruncatedPackagesAreCountedAndNeverAnswered
   ASSERT_EQ(bench.pair.server().write(short_header, 3), 3);
   bench.run(0.01);
   EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kProtocol);
-  EXPECT_TRUE(says(bench.link, "out of step")) << bench.link.stop_reason();
-  expect_wire_invariants(bench);
+  EXPECT_TRUE(ur_says(bench.link, "out of step")) << bench.link.stop_reason();
+  expect_ur_wire_invariants(bench);
 }
 
 TEST(UrRtdeLink, AClosedConnectionEndsTheSessionAndTheWatchdogStopsTheArm) {
@@ -323,7 +323,7 @@ TEST(UrRtdeLink, PollNeverAllocates) {
   ASSERT_TRUE(bench.link.handshake_done());
   std::size_t allocations = 0;
   for (int k = 0; k < 3000 && bench.link.state() != LinkState::kStopped; ++k) {
-    bench.t_s += kPeriod;
+    bench.t_s += kUrPeriod;
     bench.clock.set(bench.t_s);
     bench.controller.tick(bench.t_s);
     bench.clock.set(bench.t_s + 0.0003);
