@@ -315,6 +315,28 @@ TEST(UrRtdeLink, AClosedConnectionEndsTheSessionAndTheWatchdogStopsTheArm) {
   EXPECT_NE(bench.controller.stopped(), "");
 }
 
+// A server that never answers (another service on the port, a controller without RTDE): the link gives
+// up on the handshake after 2 s, naming what it waited for, and sent no target.
+TEST(UrRtdeLink, AControllerThatNeverAnswersTheHandshakeEndsTheSessionNamingIt) {
+  const RobotModel robot = test::bench_robot();
+  ManualClock clock;
+  MemoryStreamPair pair(clock, 0.0001);
+  OnlineCompensator compensator(robot, test::bench_sensor(), test::bench_online(kUrPeriod));
+  OnlineStrategy strategy(robot, StrategyKind::kOnline, nullptr);
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  UrRtdeLinkConfig config;
+  config.stop.stop_silence_s = 0.5;  // the session's default for ur-rtde: the handshake still gets 2 s
+  UrRtdeLink link(compensator, strategy, test::hold_program(robot, q0, 10.0), pair.client(), clock, nullptr, config);
+  for (int k = 0; k < 1100 && link.state() != LinkState::kStopped; ++k) {
+    clock.set(k * kUrPeriod);
+    (void)link.poll(0.0);
+  }
+  EXPECT_EQ(link.stop_cause(), LinkStopCause::kSilent);
+  EXPECT_TRUE(ur_says(link, "no answer to deflex's protocol version request")) << link.stop_reason();
+  EXPECT_GT(clock.now_s(), 2.0);
+  EXPECT_EQ(link.counters().replies, 0u);
+}
+
 TEST(UrRtdeLink, PollNeverAllocates) {
   const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
   UrBench bench(test::sweep_program(test::bench_robot(), q0, pose_deg(10, -5, 5, 0, 0, 0), 3.0), q0);

@@ -65,6 +65,16 @@ const char* runtime_state_name(std::uint32_t s) {
   }
 }
 
+const char* phase_name(int phase) {
+  constexpr const char* kNames[] = {"protocol version request",
+                                    "controller version request",
+                                    "output recipe",
+                                    "input recipe",
+                                    "start request",
+                                    "data"};
+  return phase >= 0 && phase < 6 ? kNames[phase] : "request";
+}
+
 CommandLimits ur_limits(const OnlineCompensator& c, const JointTrajectory* program, const UrRtdeLinkConfig& u) {
   u.validate();
   if (program == nullptr) throw InputError("UR RTDE link: no program to stream");
@@ -406,6 +416,18 @@ LinkPollResult UrRtdeLink::poll(double timeout_s) noexcept {
   if (!flush() || !send_request()) {
     stop_link(LinkStopCause::kConnection, "the RTDE connection is closed (a write failed)");
     return announce_terminal();
+  }
+  if (phase_ != Phase::kStreaming) {
+    const double now = clock_.now_s();
+    if (handshake_start_s_ < 0.0) handshake_start_s_ = now;
+    const double limit = std::max(2.0, rules_.stop_silence_s);
+    if (now - handshake_start_s_ > limit) {
+      stop_link(LinkStopCause::kSilent,
+                "the controller did not complete the RTDE handshake within %.1f s (no answer to deflex's %s): is "
+                "this port RTDE's (30004)?",
+                limit, phase_name(static_cast<int>(phase_)));
+      return announce_terminal();
+    }
   }
   if (!transport_.wait_readable(timeout_s) && rx_size_ == 0) {
     if (phase_ == Phase::kStreaming && apply_silence_rules(clock_.now_s())) return announce_terminal();

@@ -28,7 +28,8 @@
 // answered. The session ends on: a safety mode other than normal or reduced (a protective stop, an
 // e-stop, a violation, a fault), a robot mode other than running, the program not playing once it was
 // (stopped, paused, the script's watchdog), a text message of exception or error level, a closed
-// connection, a refused handshake (a field NOT_FOUND or IN_USE, a rate the controller cannot give).
+// connection, a refused handshake (a field NOT_FOUND or IN_USE, a rate the controller cannot give), a
+// handshake not completed within the stop silence (at least 2 s).
 #pragma once
 
 #include <array>
@@ -141,6 +142,7 @@ class UrRtdeLink final : public ControllerLink {
   std::int32_t robot_mode_ = 0, safety_mode_ = 0;
   std::uint32_t runtime_state_ = 0;
   double receipt_s_ = 0.0;
+  double handshake_start_s_ = -1.0;  // < 0: the first poll has not come
 };
 
 }  // namespace deflex
