@@ -7,6 +7,7 @@
 // here), and every fault ends with the link stopped for a named reason.
 #include <array>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -267,8 +268,8 @@ TEST(UrRtdeLink, ARefusedRecipeOrARateTheControllerCannotGiveStopsTheHandshake) 
 }
 
 // Packages the controller's stream should not hold, written into it by hand: each counted, none
-// answered; a header whose size is below the header's own stops the link (the stream cannot be
-// re-framed).
+// answered, an oversized one dropped by its size; a header whose size is below the header's own stops
+// the link (the stream cannot be re-framed).
 TEST(UrRtdeLink, GarbageOutOfOrderAndTruncatedPackagesAreCountedAndNeverAnswered) {
   const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
   UrBench bench(test::hold_program(test::bench_robot(), q0, 10.0), q0);
@@ -297,6 +298,18 @@ TEST(UrRtdeLink, GarbageOutOfOrderAndTruncatedPackagesAreCountedAndNeverAnswered
   EXPECT_EQ(bench.link.counters().out_of_order, 1u);
   bench.run(0.1);
   EXPECT_EQ(bench.link.state(), LinkState::kRunning);
+  // A package larger than the link takes (5000 bytes, over its 4096): dropped by its size, counted, and
+  // the stream framed again after it.
+  std::vector<unsigned char> big(5000, 0xAB);
+  big[0] = 5000 >> 8;
+  big[1] = 5000 & 0xFF;
+  big[2] = 'U';
+  ASSERT_EQ(bench.pair.server().write(big.data(), big.size()), static_cast<long>(big.size()));
+  const std::uint64_t before = bench.link.counters().replies;
+  bench.run(0.1);
+  EXPECT_EQ(bench.link.state(), LinkState::kRunning) << bench.link.stop_reason();
+  EXPECT_EQ(bench.link.counters().oversized, 1u);
+  EXPECT_GT(bench.link.counters().replies, before + 40);
   const unsigned char short_header[3] = {0, 2, 'U'};
   ASSERT_EQ(bench.pair.server().write(short_header, 3), 3);
   bench.run(0.01);

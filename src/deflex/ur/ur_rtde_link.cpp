@@ -343,14 +343,26 @@ bool UrRtdeLink::read_stream() noexcept {
     rx_size_ += static_cast<std::size_t>(n);
     std::size_t at = 0;
     for (;;) {
+      if (skip_ > 0) {  // the rest of an oversized package: its size framed it, its bytes are dropped
+        const std::size_t k = std::min(skip_, rx_size_ - at);
+        skip_ -= k;
+        at += k;
+        if (skip_ > 0) break;
+      }
       std::size_t bytes = 0;
       std::uint8_t type = 0;
       const rtde::FrameStatus f =
           rtde::peek_package(rx_.data() + at, rx_size_ - at, config_.max_package_bytes, bytes, type);
       if (f == rtde::FrameStatus::kIncomplete) break;
+      if (f == rtde::FrameStatus::kOversized) {
+        ++counters_.datagrams;
+        ++counters_.oversized;
+        skip_ = bytes;
+        continue;
+      }
       if (f != rtde::FrameStatus::kComplete) {
-        // Without a trustworthy size the stream cannot be re-framed: the connection is of no more use.
-        ++(f == rtde::FrameStatus::kOversized ? counters_.oversized : counters_.malformed);
+        // A size below the header's own: the stream cannot be re-framed, the connection is of no more use.
+        ++counters_.malformed;
         stop_link(LinkStopCause::kProtocol, "the controller's RTDE stream is out of step: a package header %s",
                   rtde::to_string(f));
         return false;

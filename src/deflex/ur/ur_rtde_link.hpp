@@ -25,11 +25,12 @@
 //
 // A package is taken only when it frames (a size within max_package_bytes, a known type), decodes
 // against its recipe, is finite and its timestamp moves on; anything else is counted and never
-// answered. The session ends on: a safety mode other than normal or reduced (a protective stop, an
-// e-stop, a violation, a fault), a robot mode other than running, the program not playing once it was
-// (stopped, paused, the script's watchdog), a text message of exception or error level, a closed
-// connection, a refused handshake (a field NOT_FOUND or IN_USE, a rate the controller cannot give), a
-// handshake not completed within the stop silence (at least 2 s).
+// answered (an oversized package's bytes are dropped by its size; a size below the header's own stops
+// the link: the stream cannot be re-framed). The session ends on: a safety mode other than normal or reduced (a
+// protective stop, an e-stop, a violation, a fault), a robot mode other than running, the program not playing once it
+// was (stopped, paused, the script's watchdog), a text message of exception or error level, a closed connection, a
+// refused handshake (a field NOT_FOUND or IN_USE, a rate the controller cannot give), a handshake not completed within
+// the stop silence (at least 2 s).
 #pragma once
 
 #include <array>
@@ -138,6 +139,7 @@ class UrRtdeLink final : public ControllerLink {
   // Preallocated buffers: the stream's bytes, the newest data package, what waits to be written.
   std::vector<unsigned char> rx_, data_, tx_;
   std::size_t rx_size_ = 0, data_size_ = 0, tx_begin_ = 0, tx_end_ = 0;
+  std::size_t skip_ = 0;  // bytes of an oversized package still to drop
   JointVector feedback_, program_, program_velocity_, blend_, blend_velocity_, nominal_, last_sent_;
   std::int32_t robot_mode_ = 0, safety_mode_ = 0;
   std::uint32_t runtime_state_ = 0;
