@@ -1,7 +1,7 @@
-// `deflex controller-setup --link egm-joint|egm-path|rsi|fanuc-j519|motoros2-rt`: writes what the robot
-// controller needs to talk to `deflex online` over that link (a RAPID module and the UdpUc entry for ABB
-// EGM; the Ethernet config, the RSI context and the KRL lines for KUKA RSI; the TP program for FANUC;
-// MotoROS2's configuration keys), made by the
+// `deflex controller-setup --link egm-joint|egm-path|rsi|fanuc-j519|motoros2-rt|ur-rtde`: writes what the
+// robot controller needs to talk to `deflex online` over that link (a RAPID module and the UdpUc entry
+// for ABB EGM; the Ethernet config, the RSI context and the KRL lines for KUKA RSI; the TP program for
+// FANUC; MotoROS2's configuration keys; UR's URScript servo program), made by the
 // library by link kind (runtime/controller_setup.hpp) from the same defaults as `deflex online`.
 #include <filesystem>
 #include <iostream>
@@ -27,7 +27,8 @@ struct ControllerSetupOpts : runtime::ControllerSetupSettings {
 
 /// The options of `deflex controller-setup`, in the order --help lists them.
 void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
-  sub.add_option("--link", o.link, "egm-joint, egm-path, rsi, fanuc-j519 or motoros2-rt (as deflex online --link)")
+  sub.add_option("--link", o.link,
+                 "egm-joint, egm-path, rsi, fanuc-j519, motoros2-rt or ur-rtde (as deflex online --link)")
       ->required();
   sub.add_option("--sensor-ip", o.sensor_ip,
                  "deflex's IPv4 address as the controller reaches it (the PC on the controller's network)")
@@ -92,13 +93,18 @@ void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
                  "fanuc-j519: deflex online --fanuc-correction-share")
       ->capture_default_str();
   sub.add_option("--robot-port", o.robot_port,
-                 "fanuc-j519, motoros2-rt: deflex online --robot-port (default 60015, 22000)");
+                 "fanuc-j519, motoros2-rt, ur-rtde: deflex online --robot-port (default 60015, 22000, 30004)");
   sub.add_option("--motoros2-group", o.motoros2_group, "motoros2-rt: deflex online --motoros2-group")
       ->capture_default_str();
   sub.add_option("--motoros2-resend-ms", o.motoros2_resend_ms, "motoros2-rt: deflex online --motoros2-resend-ms")
       ->capture_default_str();
   sub.add_option("--motoros2-max-truncations", o.motoros2_max_truncations,
                  "motoros2-rt: deflex online --motoros2-max-truncations")
+      ->capture_default_str();
+  sub.add_option("--ur-lookahead-ms", o.ur_lookahead_ms, "ur-rtde: deflex online --ur-lookahead-ms")
+      ->capture_default_str();
+  sub.add_option("--ur-gain", o.ur_gain, "ur-rtde: deflex online --ur-gain")->capture_default_str();
+  sub.add_option("--ur-register-offset", o.ur_register_offset, "ur-rtde: deflex online --ur-register-offset")
       ->capture_default_str();
   sub.add_option("--uframe", o.uframe, "fanuc-j519: the user frame the TP program sets")->capture_default_str();
   sub.add_option("--utool", o.utool, "fanuc-j519: the tool frame the TP program sets")->capture_default_str();
@@ -144,11 +150,12 @@ void setup_controller_setup(CLI::App& sub, int& exit_code) {
 
 }  // namespace
 
-DEFLEX_COMMAND("controller-setup",
-               "Write the robot controller's side of a link (--link egm-joint|egm-path|rsi|fanuc-j519|motoros2-rt): "
-               "RAPID and UdpUc for ABB EGM, the Ethernet config, RSI context and KRL for KUKA RSI, the TP program "
-               "and settings for FANUC Stream Motion, the motoros2_config.yaml keys for MotoROS2's real-time mode, "
-               "agreeing with deflex online's options",
-               setup_controller_setup, 42);
+DEFLEX_COMMAND(
+    "controller-setup",
+    "Write the robot controller's side of a link (--link egm-joint|egm-path|rsi|fanuc-j519|motoros2-rt|ur-rtde): "
+    "RAPID and UdpUc for ABB EGM, the Ethernet config, RSI context and KRL for KUKA RSI, the TP program "
+    "and settings for FANUC Stream Motion, the motoros2_config.yaml keys for MotoROS2's real-time mode, the "
+    "URScript servo program for Universal Robots, agreeing with deflex online's options",
+    setup_controller_setup, 42);
 
 }  // namespace deflex::cli

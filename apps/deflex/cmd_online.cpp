@@ -245,9 +245,10 @@ void setup_online(CLI::App& sub, int& exit_code) {
 
 }  // namespace
 
-DEFLEX_COMMAND("online",
-               "Online compensation on a controller link (--link egm-joint|egm-path|rsi|simple-message|fanuc-j519|"
-               "motoros2-rt): condition force samples and answer the controller, never beyond the bound of the nominal",
-               setup_online, 40);
+DEFLEX_COMMAND(
+    "online",
+    "Online compensation on a controller link (--link egm-joint|egm-path|rsi|simple-message|fanuc-j519|"
+    "motoros2-rt|ur-rtde): condition force samples and answer the controller, never beyond the bound of the nominal",
+    setup_online, 40);
 
 }  // namespace deflex::cli

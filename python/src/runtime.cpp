@@ -302,7 +302,8 @@ void bind_runtime(py::module_& m) {
             return d;
           },
           "What the controller received, decoded with the wire's own codec: t_s, joints_rad (absolute for egm-joint, "
-          "the offset for rsi, the command position each increment moved the controller to for motoros2-rt), "
+          "the offset for rsi, the command position each increment moved the controller to for motoros2-rt, each "
+          "target the servo program handed to servoj for ur-rtde), "
           "offset_m (egm-path, in its correction frame)");
 }
 

@@ -123,6 +123,26 @@ def test_motoros2_streams_increments_within_the_step_limit_and_reaches_the_progr
     assert correction.max() <= 0.01 and correction.max() > 1e-5
 
 
+def test_ur_rtde_servoes_targets_within_the_step_limit_and_reaches_the_programs_end():
+    robot = deflex.Robot.builtin()
+    t, q = sweep(6.0)
+    rate = 0.05
+    s = deflex.StandIn(robot, "ur-rtde", (t, q), force_base_N=[0.0, 0.0, -650.0],
+                       max_correction_rate_rad_s=rate, ur_lookahead_s=0.05)
+    s.run_for(8.0)
+    summary = s.finish()
+    assert summary["stop_reason"] == "program-end" and summary["exit_code"] == 0, summary["reason"]
+    # Each target the servo program handed to servoj, one a 2 ms cycle: the program's 3001 points, then
+    # the last one held while servoj reaches it.
+    wire = s.wire["joints_rad"]
+    assert wire.shape[0] >= 3001
+    assert (np.abs(np.diff(wire, axis=0)) <= step_limit(t, q, 0.002, rate)).all()
+    correction = np.abs(wire[-1] - q[-1])
+    assert correction.max() <= 0.01 and correction.max() > 1e-5
+    with pytest.raises(deflex.InputError, match="ur-lookahead-ms"):
+        deflex.StandIn(robot, "ur-rtde", sweep(), ur_lookahead_s=0.01)
+
+
 def test_settings_are_checked_and_named():
     robot = deflex.Robot.builtin()
     with pytest.raises(deflex.InputError, match="setting 'egm_prot' is not one of"):

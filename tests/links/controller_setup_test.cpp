@@ -14,6 +14,7 @@
 #include <type_traits>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -22,6 +23,8 @@
 #include "deflex/motoros2/motoros2_controller_setup.hpp"
 #include "deflex/rsi/rsi_controller_setup.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/ur/ur_controller_setup.hpp"
+#include "deflex/ur/ur_rtde_link.hpp"
 #include "wire/libxml2_reader.hpp"
 
 namespace deflex {
@@ -522,6 +525,100 @@ TEST(ControllerSetup, Motoros2OptionsThatCannotWorkAreRefused) {
   o = Motoros2SetupOptions{};
   o.stop_silence_s = 0.02;  // shorter than two 12 ms resends and a period
   refused(o, "--stop-silence-s");
+}
+
+// The registers a URScript text reads or writes through `function(N)`, as RTDE field names `prefix + N`,
+// comma separated in the order of first use.
+std::string registers_used(const std::string& text, const std::string& function, const std::string& prefix) {
+  std::vector<std::string> names;
+  for (std::size_t at = text.find(function + "("); at != std::string::npos; at = text.find(function + "(", at + 1)) {
+    const std::size_t open = at + function.size() + 1;
+    const std::string name = prefix + text.substr(open, text.find_first_of(",)", open) - open);
+    if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+  }
+  std::sort(names.begin(), names.end());
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ",") + n;
+  return s;
+}
+
+std::string sorted_csv(const std::string& csv) {
+  std::vector<std::string> names;
+  std::stringstream in(csv);
+  for (std::string n; std::getline(in, n, ',');) names.push_back(n);
+  std::sort(names.begin(), names.end());
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ",") + n;
+  return s;
+}
+
+// UR: the script reads exactly the input registers deflex's link sets up (its input recipe), writes the
+// output register the link reads, arms the watchdog on deflex's counter, calls servoj with the step
+// time of the rate, and checks each step against the stream's limit (0.1 rad/s over 2 ms, 1 % over);
+// its blocks close; the sheet gives the speed limits in degrees and servoj's delay.
+TEST(ControllerSetup, UrScriptUsesTheLinksRegistersAndDeflexsServojSettings) {
+  for (const int offset : {24, 0}) {
+    SCOPED_TRACE(offset);
+    UrSetupOptions o;
+    o.register_offset = offset;
+    o.lookahead_s = 0.05;
+    o.gain = 1000;
+    o.stream_speed_rad_s = JointVector::Constant(6, 0.1);
+    const std::vector<ControllerFile> files = ur_controller_setup(o);
+    ASSERT_EQ(files.size(), 2u);
+    EXPECT_EQ(files[0].name, "deflex_servo.script");
+    const std::string& script = files[0].text;
+    const std::string ints = registers_used(script, "read_input_integer_register", "input_int_register_");
+    const std::string doubles = registers_used(script, "read_input_float_register", "input_double_register_");
+    EXPECT_EQ(sorted_csv(ints + "," + doubles), sorted_csv(ur_rtde_input_names(offset)));
+    EXPECT_NE(ur_rtde_output_names(offset).find(
+                  registers_used(script, "write_output_integer_register", "output_int_register_")),
+              std::string::npos);
+    EXPECT_NE(script.find(fmt::format("rtde_set_watchdog(\"input_int_register_{}\", 10, \"stop\")", offset)),
+              std::string::npos)
+        << script;
+    EXPECT_NE(script.find("servoj(q, 0, 0, 0.002, lookahead, gain)"), std::string::npos) << script;
+    EXPECT_NE(script.find("step_max = [0.000202000, 0.000202000"), std::string::npos) << script;
+    // Every block (def, while, if) closes with an end.
+    std::size_t opened = 0, ends = 0;
+    std::stringstream lines(script);
+    for (std::string line; std::getline(lines, line);) {
+      const std::string t = line.substr(std::min(line.size(), line.find_first_not_of(' ')));
+      if (t.rfind("def ", 0) == 0 || t.rfind("while ", 0) == 0 || t.rfind("if ", 0) == 0) ++opened;
+      if (t == "end") ++ends;
+    }
+    EXPECT_EQ(opened, ends) << script;
+    const std::string& sheet = files[1].text;
+    EXPECT_NE(sheet.find("joint 6: above 5.730 deg/s"), std::string::npos) << sheet;
+    EXPECT_NE(sheet.find("about 53.0 ms"), std::string::npos) << sheet;  // 50 + 1 + 2
+  }
+  UrSetupOptions cb3;
+  cb3.period_ms = 8.0;
+  EXPECT_NE(ur_controller_setup(cb3)[0].text.find("servoj(q, 0, 0, 0.008, lookahead, gain)"), std::string::npos);
+  EXPECT_EQ(ur_controller_setup(cb3)[0].text.find("step_max"), std::string::npos);
+}
+
+TEST(ControllerSetup, UrOptionsThatCannotWorkAreRefused) {
+  const auto refused = [](const UrSetupOptions& o, const char* words) {
+    try {
+      (void)ur_controller_setup(o);
+      ADD_FAILURE() << "expected an InputError naming " << words;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  UrSetupOptions o;
+  o.period_ms = 4.0;
+  refused(o, "--period-ms");
+  o = UrSetupOptions{};
+  o.lookahead_s = 0.25;
+  refused(o, "--ur-lookahead-ms");
+  o = UrSetupOptions{};
+  o.gain = 50;
+  refused(o, "--ur-gain");
+  o = UrSetupOptions{};
+  o.register_offset = 3;
+  refused(o, "--ur-register-offset");
 }
 
 }  // namespace

@@ -25,6 +25,7 @@ inline runtime::SessionConfig bench_session(runtime::LinkKind kind) {
   const double period = kind == runtime::LinkKind::kEgmPath     ? 0.048
                         : sm                                    ? 0.1
                         : kind == runtime::LinkKind::kFanucJ519 ? 0.008
+                        : kind == runtime::LinkKind::kUrRtde    ? 0.002
                                                                 : 0.004;
   c.link = kind;
   c.online = bench_online(period);
@@ -66,6 +67,7 @@ struct FaultBench {
     const JointStreamConfig& s = kind == runtime::LinkKind::kSimpleMessage ? config.simple_message.stream
                                  : kind == runtime::LinkKind::kFanucJ519   ? config.fanuc_j519.stream
                                  : kind == runtime::LinkKind::kMotoros2Rt  ? config.motoros2_rt.stream
+                                 : kind == runtime::LinkKind::kUrRtde      ? config.ur_rtde.stream
                                                                            : config.egm_joint.stream;
     const bool streams = runtime::link_kind(kind).streams_program;
     JointVector limit = JointVector::Constant(6, period * config.online.max_correction_rate_rad_s);

@@ -44,6 +44,10 @@ void expect_wire_is_what_was_sent(FaultBench& b) {
       } else if (b.kind == LinkKind::kMotoros2Rt) {
         // The command position the increment moved the controller to: reported + increment.
         found = (r.q_command - c.joints).cwiseAbs().maxCoeff() < 1e-12;
+      } else if (b.kind == LinkKind::kUrRtde) {
+        // The script hands the newest registers to servoj every cycle: a target may repeat.
+        found = (r.q_command - c.joints).cwiseAbs().maxCoeff() < 1e-12;
+        if (found) --at;
       } else if (b.kind == LinkKind::kFanucJ519) {
         found = (r.q_command - c.joints).cwiseAbs().maxCoeff() < 1e-9;  // float32 degrees on the wire
       } else if (b.kind == LinkKind::kRsi) {
@@ -813,6 +817,120 @@ TEST(FaultTable, Motoros2RtASafetyUnitThatKeepsTruncatingEndsTheSession) {
     ASSERT_LE((inc.array() / limit.array()).abs().maxCoeff(), 1.0);
   }
   EXPECT_LE(b.worst_bound_fraction(), 1.0);
+}
+
+// ---- ur-rtde: one target an output package over TCP; the script's watchdog and the safety system ----
+// RTDE's TCP loses nothing: an outage is a stall of the connection both ways, the controller's packages
+// arriving together at its end (deflex answers the newest). The script servos to the newest registers
+// every 2 ms and stops the program when the counter does not change for its watchdog's 0.1 s; the
+// safety system's protective stop and e-stop show in safety_mode. What went on the wire is each target
+// the script handed to servoj.
+
+TEST(FaultTable, UrRtdeRunsTheProgramToItsEnd) {
+  FaultBench b(LinkKind::kUrRtde, sweep(6.0));
+  b.run_for(8.0);
+  ASSERT_TRUE(b.session->ended());
+  const runtime::SessionSummary& s = b.session->finish();
+  EXPECT_EQ(s.reason, StopReason::kProgramEnd) << s.reason_text;
+  EXPECT_EQ(s.exit_code, 0);
+  for (int k = 0; k < 250; ++k) b.standin->tick();  // the script holds the last target, then ends
+  EXPECT_EQ(b.standin->ur()->stopped(), "the program ended (the stream's end)");
+  EXPECT_GT(b.wire().size(), 2900u);
+  expect_invariants(b, "ur to the end");
+}
+
+TEST(FaultTable, UrRtdeStallsShorterThanTheWatchdogAreRiddenThroughAndNothingSteps) {
+  for (const double fault : {0.02, 0.06}) {
+    for (const bool stall : {false, true}) {
+      SCOPED_TRACE(testing::Message() << (stall ? "stalled PC " : "TCP stall ") << fault << " s");
+      FaultBench b(LinkKind::kUrRtde, sweep());
+      b.run_for(2.0);
+      if (stall) {
+        b.standin->stall(true);
+        b.run_for(fault);
+        b.standin->stall(false);
+      } else {
+        b.standin->outage(fault);
+      }
+      b.run_for(2.0);
+      ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
+      EXPECT_EQ(b.standin->ur()->stopped(), "");
+      expect_invariants(b, "ur short stall");
+    }
+  }
+}
+
+// Longer than the watchdog: the script stops the program and the arm halts; deflex, reading again,
+// ends the session naming the program's state.
+TEST(FaultTable, UrRtdeAStallBeyondTheWatchdogStopsTheProgramAndEndsTheSession) {
+  for (const bool stall : {false, true}) {
+    SCOPED_TRACE(stall ? "stalled PC" : "TCP stall");
+    FaultBench b(LinkKind::kUrRtde, sweep());
+    b.run_for(2.0);
+    if (stall) {
+      b.standin->stall(true);
+      b.run_for(0.3);
+      b.standin->stall(false);
+    } else {
+      b.standin->outage(0.3);
+    }
+    b.run_for(1.0);
+    ASSERT_TRUE(b.session->ended());
+    const runtime::SessionSummary& s = b.session->finish();
+    EXPECT_EQ(s.reason, StopReason::kControllerStopped) << s.reason_text;
+    EXPECT_EQ(s.exit_code, 6);
+    EXPECT_NE(s.reason_text.find("runtime_state 1"), std::string::npos) << s.reason_text;
+    EXPECT_NE(b.standin->ur()->stopped().find("watchdog"), std::string::npos) << b.standin->ur()->stopped();
+    expect_invariants(b, "ur long stall");
+  }
+}
+
+TEST(FaultTable, UrRtdeAStopRequestBringsTheProgramToRest) {
+  FaultBench b(LinkKind::kUrRtde, sweep());
+  b.run_for(3.0);
+  b.session->request_stop();
+  b.run_for(3.0);
+  ASSERT_TRUE(b.session->ended());
+  const runtime::SessionSummary& s = b.session->finish();
+  EXPECT_EQ(s.reason, StopReason::kUserStop) << s.reason_text;
+  for (int k = 0; k < 250; ++k) b.standin->tick();
+  EXPECT_EQ(b.standin->ur()->stopped(), "the program ended (the stream's end)");
+  expect_invariants(b, "ur stop request");
+}
+
+// An e-stop, a program stopped on the pendant, a protective stop from the safety system's joint
+// speed limit below the program's speed: each ends the session at once, named, exit 6.
+TEST(FaultTable, UrRtdeAnEStopAStoppedProgramOrALimitExceededEndsTheSessionNamingIt) {
+  const auto program = sweep(10.0);
+  const double limit = 0.5 * test::sampled_peak_speed(*program).maxCoeff();
+  for (int fault = 0; fault < 3; ++fault) {
+    SCOPED_TRACE(fault);
+    FaultBench b(LinkKind::kUrRtde, program, [&](runtime::SessionConfig&, standin::StandInConfig& sc) {
+      if (fault == 2) sc.ur.max_speed_rad_s = limit;
+    });
+    b.run_for(fault == 2 ? 0.0 : 2.0);
+    if (fault == 0) b.standin->motors_off();
+    if (fault == 1) b.standin->ur()->stop_program();
+    b.run_for(fault == 2 ? 10.0 : 0.05);
+    ASSERT_TRUE(b.session->ended());
+    const runtime::SessionSummary& s = b.session->finish();
+    EXPECT_EQ(s.reason, StopReason::kControllerStopped) << s.reason_text;
+    EXPECT_EQ(s.exit_code, 6);
+    const char* named = fault == 0 ? "emergency stop" : fault == 1 ? "runtime_state 1" : "protective stop";
+    EXPECT_NE(s.reason_text.find(named), std::string::npos) << s.reason_text;
+    expect_invariants(b, "ur stopped");
+  }
+}
+
+TEST(FaultTable, UrRtdeAStaleForceRampsTheCorrectionOut) {
+  FaultBench b(LinkKind::kUrRtde, sweep());
+  b.run_for(3.0);
+  ASSERT_GT(b.session->link().last_cycle().dtheta.cwiseAbs().maxCoeff(), 1e-5);
+  b.standin->sensor_silent(true);
+  b.run_for(3.0);
+  ASSERT_FALSE(b.session->ended()) << b.session->finish().reason_text;
+  EXPECT_LT(b.session->link().last_cycle().dtheta.cwiseAbs().maxCoeff(), 1e-9);
+  expect_invariants(b, "ur stale force");
 }
 
 }  // namespace

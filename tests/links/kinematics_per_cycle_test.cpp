@@ -8,6 +8,7 @@
 #include "deflex/force/constant_wrench_model.hpp"
 #include "deflex/model/frame_cache.hpp"
 #include "links/fault_bench.hpp"
+#include "support/poses.hpp"
 
 namespace deflex {
 namespace {
@@ -68,7 +69,7 @@ CycleCount count_kinematics(const CycleCase& c) {
 
 TEST(KinematicsPerCycle, AtMostOnceAtTheFeedbackAndOnceAtTheTarget) {
   for (LinkKind link : {LinkKind::kEgmJoint, LinkKind::kEgmPath, LinkKind::kRsi, LinkKind::kSimpleMessage,
-                        LinkKind::kFanucJ519, LinkKind::kMotoros2Rt}) {
+                        LinkKind::kFanucJ519, LinkKind::kMotoros2Rt, LinkKind::kUrRtde}) {
     for (const auto& [strategy, with_model] : {std::pair{StrategyKind::kOnline, false},
                                                {StrategyKind::kHybrid, true},
                                                {StrategyKind::kPredictive, false},

@@ -17,6 +17,7 @@
 #include "deflex/rsi/rsi_controller_setup.hpp"
 #include "deflex/rsi/rsi_link.hpp"
 #include "deflex/text/errors.hpp"
+#include "deflex/ur/ur_controller_setup.hpp"
 
 namespace deflex::runtime {
 namespace {
@@ -145,6 +146,34 @@ std::vector<ControllerFile> motoros2_setup_files(const ControllerSetupSettings& 
   return motoros2_controller_setup(m);
 }
 
+/// The files of ur-rtde: the URScript servo program and the settings sheet. With a program, each joint's
+/// fastest stream (as for motoros2-rt): the script checks every step against it and the sheet gives the
+/// safety configuration's speed limits.
+std::vector<ControllerFile> ur_setup_files(const ControllerSetupSettings& o, const RobotLoader& load_robot) {
+  const LinkKindInfo& kind = link_kind(LinkKind::kUrRtde);
+  UrSetupOptions u;
+  if (o.period_ms < 0.0) throw InputError("option --period-ms: must be > 0");
+  u.period_ms = o.period_ms > 0.0 ? o.period_ms : kind.default_period_s * 1e3;
+  u.robot_port = o.robot_port == -1 ? 30004 : o.robot_port;
+  u.lookahead_s = o.ur_lookahead_ms * 1e-3;
+  u.gain = o.ur_gain;
+  u.register_offset = o.ur_register_offset;
+  if (!o.program.empty()) {
+    const RobotModel model = read_robot(load_robot, o.robot);
+    const auto program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o.program, model));
+    OnlineConfig online;
+    online.period_s = u.period_ms * 1e-3;
+    online.max_joint_correction_rad = deg_to_rad(o.max_joint_deg);
+    online.max_correction_rate_rad_s = deg_to_rad(o.max_rate_deg_s);
+    JointStreamConfig stream;
+    stream.ramp_in_s = o.ramp_in_s;
+    stream.validate();
+    const CommandLimits l = command_limits(CommandForm::kJointTarget, online, model.dof(), program.get(), &stream);
+    u.stream_speed_rad_s = l.joint_step_rad / online.period_s;
+  }
+  return ur_controller_setup(u);
+}
+
 }  // namespace
 
 std::vector<ControllerFile> controller_setup_files(const ControllerSetupSettings& settings,
@@ -154,7 +183,9 @@ std::vector<ControllerFile> controller_setup_files(const ControllerSetupSettings
   if (link == "rsi") return rsi_setup_files(settings);
   if (link == "fanuc-j519") return fanuc_setup_files(settings, load_robot);
   if (link == "motoros2-rt") return motoros2_setup_files(settings, load_robot);
-  throw InputError(fmt::format("option --link: '{}' is not egm-joint, egm-path, rsi, fanuc-j519 or motoros2-rt", link));
+  if (link == "ur-rtde") return ur_setup_files(settings, load_robot);
+  throw InputError(
+      fmt::format("option --link: '{}' is not egm-joint, egm-path, rsi, fanuc-j519, motoros2-rt or ur-rtde", link));
 }
 
 }  // namespace deflex::runtime

@@ -1,7 +1,7 @@
 // The controller's side of a link, chosen by link kind: what `deflex controller-setup` writes (ABB EGM's
 // RAPID module and UdpUc entry; KUKA RSI's Ethernet config, context and KRL; FANUC Stream Motion's TP
-// program and settings sheet; MotoROS2's configuration keys and sheet), from the defaults a session uses
-// (link_table.hpp), so the controller's side agrees with deflex's.
+// program and settings sheet; MotoROS2's configuration keys and sheet; UR's URScript servo program), from the defaults
+// a session uses (link_table.hpp), so the controller's side agrees with deflex's.
 #pragma once
 
 #include <functional>
@@ -40,16 +40,19 @@ struct ControllerSetupSettings {
   // MotoROS2 real-time.
   int motoros2_group = 0, motoros2_max_truncations = 25;
   double motoros2_resend_ms = 12.0;
+  // Universal Robots RTDE.
+  double ur_lookahead_ms = 30.0, ur_gain = 2000.0;
+  int ur_register_offset = 24;
 };
 
 /// Reads the robot file `path` ("" or "builtin": the built-in IRB 6700), as the front end reads robots
 /// (the command line prints the file's notes).
 using RobotLoader = std::function<RobotModel(const std::string& path)>;
 
-/// The files for `settings.link` (egm-joint, egm-path, rsi, fanuc-j519 or motoros2-rt). The robot is read through
-/// `load_robot` only when the link needs it (egm: its joint speed limits; a program's joints); without
-/// a loader, load_robot_or_builtin. Throws InputError naming the option at fault (as `deflex
-/// controller-setup` spells it) for an unknown link or a setting that cannot work.
+/// The files for `settings.link` (egm-joint, egm-path, rsi, fanuc-j519, motoros2-rt or ur-rtde). The robot is read
+/// through `load_robot` only when the link needs it (egm: its joint speed limits; a program's joints); without a
+/// loader, load_robot_or_builtin. Throws InputError naming the option at fault (as `deflex controller-setup` spells it)
+/// for an unknown link or a setting that cannot work.
 [[nodiscard]] std::vector<ControllerFile> controller_setup_files(const ControllerSetupSettings& settings,
                                                                  const RobotLoader& load_robot = {});
 

@@ -7,11 +7,11 @@
 
 namespace deflex::runtime {
 
-const std::array<LinkKindInfo, 6>& link_kinds() {
+const std::array<LinkKindInfo, 7>& link_kinds() {
   // Stop silences: EGM rides through outages up to 3 s (its controller holds the last target; the
   // generated RAPID's CommTimeout matches); RSI's controller stops itself long before (its Timeout of
   // late answers), so 1 s of silence means it stopped; simple message has its own state timeout.
-  static const std::array<LinkKindInfo, 6> kinds{{
+  static const std::array<LinkKindInfo, 7> kinds{{
       {LinkKind::kEgmJoint, "egm-joint",
        "ABB EGM position guidance (EGMActJoint/EGMRunJoint): deflex streams --program", true, CommandForm::kJointTarget,
        0.004, 3.0},
@@ -39,6 +39,12 @@ const std::array<LinkKindInfo, 6>& link_kinds() {
        "Yaskawa MotoROS2 real-time motion (joint increments) over UDP: deflex streams --program, one increment a "
        "reply, measured from the command position the controller reports",
        true, CommandForm::kJointTarget, 0.004, 0.5},
+      // A UR controller sends its state every loop cycle over TCP, which loses nothing: half a second without a
+      // package is a controller (or a connection) that stopped.
+      {LinkKind::kUrRtde, "ur-rtde",
+       "Universal Robots RTDE (TCP 30004): deflex streams --program as joint targets into input registers, a "
+       "URScript program hands them to servoj every cycle (500 Hz e-Series, 125 Hz CB3)",
+       true, CommandForm::kJointTarget, 0.002, 0.5},
   }};
   return kinds;
 }

@@ -16,7 +16,8 @@ enum class LinkKind : int {
   kRsi = 2,
   kSimpleMessage = 3,
   kFanucJ519 = 4,
-  kMotoros2Rt = 5
+  kMotoros2Rt = 5,
+  kUrRtde = 6
 };
 
 struct LinkKindInfo {
@@ -45,7 +46,7 @@ struct SessionOptionDefaults {
 };
 inline constexpr SessionOptionDefaults kSessionOptionDefaults{};
 
-[[nodiscard]] const std::array<LinkKindInfo, 6>& link_kinds();
+[[nodiscard]] const std::array<LinkKindInfo, 7>& link_kinds();
 [[nodiscard]] const LinkKindInfo& link_kind(LinkKind kind);
 /// The kind named `name`; throws InputError naming it and listing the known names.
 [[nodiscard]] LinkKind parse_link_kind(const std::string& name);

@@ -186,6 +186,40 @@ void Session::open_motoros2_rt(const SessionEndpoints& endpoints, ForceSource* f
                        status != nullptr ? fmt::format(", its status on {}", to_string(status->local_address())) : "");
 }
 
+// Universal Robots RTDE: deflex is the client of the controller's RTDE server (one TCP connection).
+void Session::open_ur_rtde(const SessionEndpoints& endpoints, ForceSource* force,
+                           std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules) {
+  UrRtdeLinkConfig c = config_.ur_rtde;
+  c.stop = rules;
+  c.history_cycles = config_.history_cycles;
+  c.validate();  // before any connection is made
+  const NetworkConfig& net = config_.network;
+  const double period_ms = config_.online.period_s * 1e3;
+  if (std::abs(period_ms - 2.0) > 1e-9 && std::abs(period_ms - 8.0) > 1e-9) {
+    throw InputError(fmt::format(
+        "option --period-ms: a UR controller's loop is 2 ms (e-Series) or 8 ms (CB3) (got {:g})", period_ms));
+  }
+  StreamTransport* t = endpoints.motion;
+  if (t == nullptr) {
+    if (net.robot_host.empty()) {
+      throw InputError("option --robot-host: the ur-rtde link needs the controller's address");
+    }
+    if (!std::isfinite(net.connect_timeout_s) || !(net.connect_timeout_s > 0.0)) {
+      throw InputError(fmt::format("option --connect-timeout-s: must be > 0 (got {})", net.connect_timeout_s));
+    }
+    const std::uint16_t port =
+        port_option(net.robot_port == -1 ? rtde::kDefaultPort : net.robot_port, "--robot-port", "", 1);
+    own_motion_ = TcpStream::connect(net.robot_host, port, net.connect_timeout_s);
+    t = own_motion_.get();
+    where_ = fmt::format("UR RTDE to {}:{}", net.robot_host, port);
+  } else {
+    where_ = "UR RTDE";
+  }
+  link_ = std::make_unique<UrRtdeLink>(*compensator_, *strategy_, std::move(program), *t, clock_, force, c);
+  where_ += fmt::format(" (servoj lookahead {:g} ms, gain {:g}, registers from {})", c.lookahead_s * 1e3, c.gain,
+                        c.register_offset);
+}
+
 void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
                         std::shared_ptr<const JointTrajectory> program) {
   const LinkKindInfo& info = link_kind(config_.link);
@@ -266,6 +300,9 @@ void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
       break;
     case LinkKind::kMotoros2Rt:
       open_motoros2_rt(endpoints, force, std::move(program), rules);
+      break;
+    case LinkKind::kUrRtde:
+      open_ur_rtde(endpoints, force, std::move(program), rules);
       break;
   }
 }
@@ -428,6 +465,7 @@ const SessionSummary& Session::finish() {
                                    ? config_.simple_message.stream.start_tolerance_rad
                                : config_.link == LinkKind::kFanucJ519  ? config_.fanuc_j519.stream.start_tolerance_rad
                                : config_.link == LinkKind::kMotoros2Rt ? config_.motoros2_rt.stream.start_tolerance_rad
+                               : config_.link == LinkKind::kUrRtde     ? config_.ur_rtde.stream.start_tolerance_rad
                                                                        : config_.egm_joint.stream.start_tolerance_rad;
       for (int j = 0; j < d.size(); ++j) {
         if (d[j] > tolerance) {

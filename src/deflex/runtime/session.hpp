@@ -33,7 +33,7 @@ namespace deflex::runtime {
 /// real sockets from NetworkConfig.
 struct SessionEndpoints {
   DatagramTransport* datagram = nullptr;  ///< EGM, RSI, fanuc-j519, motoros2-rt
-  StreamTransport* motion = nullptr;      ///< simple message
+  StreamTransport* motion = nullptr;      ///< simple message; ur-rtde: its RTDE connection
   StreamTransport* state = nullptr;
   DatagramTransport* status = nullptr;  ///< motoros2-rt: the controller's RobotState (with status_port >= 0)
 };
@@ -129,6 +129,8 @@ class Session {
                        std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules);
   void open_motoros2_rt(const SessionEndpoints& endpoints, ForceSource* force,
                         std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules);
+  void open_ur_rtde(const SessionEndpoints& endpoints, ForceSource* force,
+                    std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules);
   void push(SessionEntry::Kind kind, double now) noexcept;
   void end(StopReason reason) noexcept;
   void reporter_loop();

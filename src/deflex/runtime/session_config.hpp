@@ -15,6 +15,7 @@
 #include "deflex/runtime/link_table.hpp"
 #include "deflex/runtime/realtime.hpp"
 #include "deflex/simple_message/simple_message_link.hpp"
+#include "deflex/ur/ur_rtde_link.hpp"
 
 namespace deflex::runtime {
 
@@ -23,8 +24,9 @@ struct NetworkConfig {
   std::string bind_address = "127.0.0.1";  ///< UDP links bind here (0.0.0.0 or the cell network's address on a cell)
   int egm_port = -1;                       ///< EGM links: the UDP port the controller sends to (required)
   int rsi_port = -1;                       ///< rsi: the UDP port the controller sends to (required)
-  std::string robot_host;                  ///< simple message, fanuc-j519, motoros2-rt: the controller's address
-  int robot_port = -1;  ///< fanuc-j519, motoros2-rt: its UDP port (-1: the protocol's, 60015 or 22000)
+  std::string robot_host;  ///< simple message, fanuc-j519, motoros2-rt, ur-rtde: the controller's address
+  /// fanuc-j519, motoros2-rt: its UDP port, ur-rtde: its RTDE TCP port (-1: the protocol's, 60015, 22000 or 30004)
+  int robot_port = -1;
   int motion_port = 11000, state_port = 11002;
   double connect_timeout_s = 5.0;
 };
@@ -59,6 +61,7 @@ struct SessionConfig {
   SimpleMessageLinkConfig simple_message;
   FanucJ519LinkConfig fanuc_j519;    ///< its controller address comes from NetworkConfig (or is given with a transport)
   Motoros2RtLinkConfig motoros2_rt;  ///< as fanuc_j519
+  UrRtdeLinkConfig ur_rtde;          ///< its controller address comes from NetworkConfig (or is given with a stream)
   double duration_s = 0.0;           ///< > 0: the session ends (planned) after this long
   /// A planned stop (request_stop(), the time limit) while the arm moves: a streaming link brings the
   /// program to rest on its path over this long, a correcting link ramps its correction out at the rate

@@ -18,14 +18,15 @@ namespace {
 using C = SessionConfig;
 constexpr double kDegPerRad = 180.0 / kPi;
 
-constexpr LinkMask kStreaming =
-    link_bit(LinkKind::kEgmJoint) | link_bit(LinkKind::kSimpleMessage) | link_bit(LinkKind::kFanucJ519);
+constexpr LinkMask kStreaming = link_bit(LinkKind::kEgmJoint) | link_bit(LinkKind::kSimpleMessage) |
+                                link_bit(LinkKind::kFanucJ519) | link_bit(LinkKind::kUrRtde);
 constexpr LinkMask kEgm = link_bit(LinkKind::kEgmJoint) | link_bit(LinkKind::kEgmPath);
 constexpr LinkMask kPath = link_bit(LinkKind::kEgmPath);
 constexpr LinkMask kRsi = link_bit(LinkKind::kRsi);
 constexpr LinkMask kSm = link_bit(LinkKind::kSimpleMessage);
 constexpr LinkMask kFanuc = link_bit(LinkKind::kFanucJ519);
 constexpr LinkMask kMoto = link_bit(LinkKind::kMotoros2Rt);
+constexpr LinkMask kUr = link_bit(LinkKind::kUrRtde);
 
 // The getters and setters of a table row come from one accessor of the field (a lambda without
 // captures: C++20 constructs one where it is needed).
@@ -110,7 +111,8 @@ void bound_settings(std::vector<SessionSetting>& t) {
             .why = "a controller's cycle is 0.5 ms to 1 s",
             .default_text =
                 "the link's: egm-joint, rsi 4; egm-path 48 (EGMActMove's SampleRate); "
-                "simple-message 100 (the paper's); fanuc-j519 8; motoros2-rt 4 (the period start_rt_mode returns)"},
+                "simple-message 100 (the paper's); fanuc-j519 8; motoros2-rt 4 (the period start_rt_mode returns); "
+                "ur-rtde 2 (e-Series; CB3: 8)"},
            [](C& c) -> double& { return c.online.period_s; }));
   t.push_back(real({.key = "max_joint_correction_rad",
                     .option = "--max-joint-correction-deg",
@@ -301,18 +303,18 @@ void network_settings(std::vector<SessionSetting>& t) {
                     [](C& c) -> int& { return c.network.rsi_port; }));
   t.push_back(words({.key = "robot_host",
                      .option = "--robot-host",
-                     .links = kSm | kFanuc | kMoto,
+                     .links = kSm | kFanuc | kMoto | kUr,
                      .help = "the controller's address (simple-message: its motion and state servers listen there; "
-                             "fanuc-j519, motoros2-rt: its IPv4 address)"},
+                             "fanuc-j519, motoros2-rt: its IPv4 address; ur-rtde: its RTDE server's)"},
                     [](C& c) -> std::string& { return c.network.robot_host; }));
   t.push_back(count({.key = "robot_port",
                      .option = "--robot-port",
                      .min = 1,
                      .max = kPort,
-                     .links = kFanuc | kMoto,
-                     .help = "the controller's UDP port (fanuc-j519: Stream Motion's; motoros2-rt: its "
-                             "rt_listener_udp_port_number)",
-                     .default_text = "the protocol's: fanuc-j519 60015, motoros2-rt 22000"},
+                     .links = kFanuc | kMoto | kUr,
+                     .help = "the controller's port (fanuc-j519: Stream Motion's UDP; motoros2-rt: its "
+                             "rt_listener_udp_port_number; ur-rtde: RTDE's TCP)",
+                     .default_text = "the protocol's: fanuc-j519 60015, motoros2-rt 22000, ur-rtde 30004"},
                     [](C& c) -> int& { return c.network.robot_port; }));
   t.push_back(count({.key = "motion_port",
                      .option = "--motion-port",
@@ -334,7 +336,7 @@ void network_settings(std::vector<SessionSetting>& t) {
                     .min = 0.0,
                     .max = 600.0,
                     .min_open = true,
-                    .links = kSm,
+                    .links = kSm | kUr,
                     .help = "the wait for each connection"},
                    [](C& c) -> double& { return c.network.connect_timeout_s; }));
 }
@@ -351,6 +353,7 @@ void egm_rsi_settings(std::vector<SessionSetting>& t) {
                         [](C& c, double v) {
                           c.egm_joint.stream.ramp_in_s = c.simple_message.stream.ramp_in_s = v;
                           c.fanuc_j519.stream.ramp_in_s = c.motoros2_rt.stream.ramp_in_s = v;
+                          c.ur_rtde.stream.ramp_in_s = v;
                         }},
                    [](C& c) -> double& { return c.egm_joint.stream.ramp_in_s; }));
   t.push_back(flag({.key = "send_speed_reference",
@@ -592,6 +595,36 @@ void motoros2_settings(std::vector<SessionSetting>& t) {
                     [](C& c) -> int& { return c.motoros2_rt.status_port; }));
 }
 
+// servoj's parameters go to the controller every cycle; the registers are the script's layout.
+void ur_settings(std::vector<SessionSetting>& t) {
+  t.push_back(real({.key = "ur_lookahead_s",
+                    .option = "--ur-lookahead-ms",
+                    .unit = "s",
+                    .option_unit = "ms",
+                    .option_per_unit = 1e3,
+                    .min = 0.03,
+                    .max = 0.2,
+                    .links = kUr,
+                    .help = "servoj's lookahead_time: it smooths the target by delaying it (command to motion takes "
+                            "about this plus 1/gain and a cycle; the predictive strategy leads by the measured delay)"},
+                   [](C& c) -> double& { return c.ur_rtde.lookahead_s; }));
+  t.push_back(real({.key = "ur_gain",
+                    .option = "--ur-gain",
+                    .min = 100.0,
+                    .max = 2000.0,
+                    .links = kUr,
+                    .help = "servoj's proportional gain (higher follows the target more closely)"},
+                   [](C& c) -> double& { return c.ur_rtde.gain; }));
+  t.push_back(count({.key = "ur_register_offset",
+                     .option = "--ur-register-offset",
+                     .min = 0,
+                     .max = 24,
+                     .links = kUr,
+                     .help = "the first RTDE input and output register of deflex's layout: 0, or 24 (the upper "
+                             "range, clear of fieldbus mappings); the script controller setup writes must agree"},
+                    [](C& c) -> int& { return c.ur_rtde.register_offset; }));
+}
+
 // The force source and the tare (session_force.hpp opens it).
 void force_settings(std::vector<SessionSetting>& t) {
   t.push_back(words({.key = "force_source",
@@ -661,6 +694,7 @@ std::vector<SessionSetting> make_table() {
   simple_message_settings(t);
   fanuc_settings(t);
   motoros2_settings(t);
+  ur_settings(t);
   force_settings(t);
   return t;
 }
@@ -770,6 +804,7 @@ void check_together(const C& c, std::span<const GivenSetting> settings) {
     throw InputError(fmt::format("settings fanuc_* (--fanuc-*): {}", e.what()));
   }
   c.motoros2_rt.validate();  // its messages name the setting
+  c.ur_rtde.validate();
 }
 
 }  // namespace

@@ -153,6 +153,15 @@ StandInSession::StandInSession(const runtime::SessionConfig& config, const Robot
       controller_ = std::move(c);
       break;
     }
+    case runtime::LinkKind::kUrRtde: {
+      cell::UrRtdeControllerConfig uc = standin.ur;
+      uc.e_series = config_.online.period_s < 0.005;
+      uc.register_offset = config_.ur_rtde.register_offset;
+      auto c = std::make_unique<cell::UrRtdeController>(uc, program_->points().front(), motion_.server());
+      ur_ = c.get();
+      controller_ = std::move(c);
+      break;
+    }
     case runtime::LinkKind::kMotoros2Rt: {
       cell::Motoros2RtControllerConfig mc = standin.motoros2;
       mc.period_s = config_.online.period_s;
@@ -197,9 +206,10 @@ void StandInSession::decode(const unsigned char* data, std::size_t size) {
 }
 
 void StandInSession::tick() {
-  // FANUC's 1 ms interval needs a tick of 1 ms.
-  const double tick_s = fanuc_ != nullptr ? std::min(standin_.controller.servo_period_s, config_.online.period_s)
-                                          : standin_.controller.servo_period_s;
+  // FANUC's 1 ms interval needs a tick of 1 ms, UR's 2 ms loop one of 2 ms.
+  const double tick_s = fanuc_ != nullptr || ur_ != nullptr
+                            ? std::min(standin_.controller.servo_period_s, config_.online.period_s)
+                            : standin_.controller.servo_period_s;
   t_s_ += tick_s;
   clock_.set(t_s_);
   arm_ = controller_->tick(t_s_);
@@ -214,6 +224,15 @@ void StandInSession::tick() {
       wire_.push_back(c);
     }
     motoros2_seen_ = taken.size();
+  }
+  if (ur_ != nullptr) {
+    for (std::size_t i = ur_seen_; i < ur_->targets().size(); ++i) {
+      WireCommand c;
+      c.t_s = t_s_;
+      c.joints = ur_->targets()[i];
+      wire_.push_back(c);
+    }
+    ur_seen_ = ur_->targets().size();
   }
   if (server_ != nullptr) {
     // Every point the server took, as the wire carried it (float32 radians).
@@ -241,7 +260,13 @@ void StandInSession::run_for(double seconds) {
   while (t_s_ < until - 1e-9 && !session_->ended()) tick();
 }
 
-void StandInSession::outage(double seconds) { network_.add_outage(t_s_, t_s_ + seconds); }
+void StandInSession::outage(double seconds) {
+  if (ur_ != nullptr) {
+    ur_->stall_network(t_s_ + seconds);  // TCP loses nothing: an outage is a stall both ways
+    return;
+  }
+  network_.add_outage(t_s_, t_s_ + seconds);
+}
 
 void StandInSession::reorder(int count) { network_.add_reordering(t_s_, count, kController); }
 
@@ -259,6 +284,7 @@ void StandInSession::restart(bool reset_reference, double off_s) {
   if (fanuc_ != nullptr) fanuc_->restart(t_s_);
   if (motoros2_ != nullptr) motoros2_->restart(t_s_);
   if (server_ != nullptr) throw InputError("stand-in: the simple message server has no session to restart");
+  if (ur_ != nullptr) throw InputError("stand-in: a UR program stopped and played again is a new session");
 }
 
 void StandInSession::end_session(int mci_state) {
@@ -275,6 +301,8 @@ void StandInSession::motors_off() {
     fanuc_->raise_alarm("SRVO-001 Operator panel E-stop");
   } else if (motoros2_ != nullptr) {
     motoros2_->stop("e-stop");
+  } else if (ur_ != nullptr) {
+    ur_->emergency_stop();
   } else {
     throw InputError("stand-in: this controller reports no motor state");
   }

@@ -19,6 +19,7 @@
 #include "deflex/cell/motoros2_rt_controller.hpp"
 #include "deflex/cell/rsi_controller.hpp"
 #include "deflex/cell/simple_message_server.hpp"
+#include "deflex/cell/ur_rtde_controller.hpp"
 #include "deflex/runtime/session.hpp"
 #include "deflex/transport/memory_network.hpp"
 #include "deflex/transport/memory_stream.hpp"
@@ -29,8 +30,8 @@ namespace deflex::standin {
 /// every point the server took, as the frame carried it).
 struct WireCommand {
   double t_s = 0.0;  ///< when the controller read it
-  /// Absolute joints (egm-joint, simple message, fanuc-j519; motoros2-rt: the command position each increment
-  /// taken moved the controller to) or the joint offset (rsi), rad.
+  /// Absolute joints (egm-joint, simple message, fanuc-j519; ur-rtde: each target the script handed to servoj;
+  /// motoros2-rt: the command position each increment taken moved the controller to) or the joint offset (rsi), rad.
   JointVector joints;
   Vector3 offset_m = Vector3::Zero();  ///< egm-path: the offset in the correction frame, m
 };
@@ -46,6 +47,9 @@ struct StandInConfig {
   /// MotoROS2 real-time: its dead time, lag, speed limits, sequence gap and timeout (the period follows
   /// the session's).
   cell::Motoros2RtControllerConfig motoros2;
+  /// Universal Robots over RTDE: its series, speed limit and watchdog (the register layout follows the
+  /// session's).
+  cell::UrRtdeControllerConfig ur;
   double network_latency_s = 0.0002;       ///< one way
   Vector3 force_base_n = Vector3::Zero();  ///< the process force at the TCP, base frame (N)
   double sensor_rate_hz = 250.0;           ///< samples a second the stand-in sensor gives (one a tick at 250 Hz)
@@ -92,7 +96,7 @@ class StandInSession {
   void run_for(double seconds);
 
   // The faults of a cell.
-  /// Every datagram in [now, now + seconds) is lost, both ways.
+  /// Every datagram in [now, now + seconds) is lost, both ways (ur-rtde: its TCP connection stalls that long).
   void outage(double seconds);
   /// The controller's next `count` messages are overtaken in the network by the one after them.
   void reorder(int count);
@@ -104,7 +108,7 @@ class StandInSession {
   /// The controller ends its session now: EGM with mciState `mci_state` (2 STOPPED, 1 ERROR).
   void end_session(int mci_state = 2);
   /// The motors go off (EGM: an emergency stop); simple message: the server's emergency stop; FANUC: an
-  /// e-stop alarm; MotoROS2: the controller stops answering.
+  /// e-stop alarm; MotoROS2: the controller stops answering; UR: a robot emergency stop.
   void motors_off();
   /// The force sensor stops (true) or comes back.
   void sensor_silent(bool silent) { sensor_.on = !silent; }
@@ -125,6 +129,7 @@ class StandInSession {
   [[nodiscard]] cell::SimpleMessageServer* server() { return server_; }
   [[nodiscard]] cell::FanucJ519Controller* fanuc() { return fanuc_; }
   [[nodiscard]] cell::Motoros2RtController* motoros2() { return motoros2_; }
+  [[nodiscard]] cell::UrRtdeController* ur() { return ur_; }
   [[nodiscard]] MemoryNetwork& network() { return network_; }
   [[nodiscard]] ManualClock& clock() { return clock_; }
 
@@ -152,6 +157,8 @@ class StandInSession {
   cell::SimpleMessageServer* server_ = nullptr;
   cell::FanucJ519Controller* fanuc_ = nullptr;
   cell::Motoros2RtController* motoros2_ = nullptr;
+  cell::UrRtdeController* ur_ = nullptr;
+  std::size_t ur_seen_ = 0;  // the UR script's servo targets already in wire_
   std::vector<WireCommand> wire_;
   std::size_t motoros2_seen_ = 0;  // the MotoROS2 controller's increments already in wire_
   double t_s_ = 0.0;
