@@ -16,8 +16,8 @@
 
 #include <benchmark/benchmark.h>
 
-#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/robotfile/robot_io.hpp"
 #include "deflex/transport/tcp_stream.hpp"
 #include "deflex/ur/ur_rtde_link.hpp"
 
