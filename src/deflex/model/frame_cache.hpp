@@ -39,6 +39,7 @@ class FrameCache {
 class KinematicsCallCounter {
  public:
   explicit KinematicsCallCounter(const RobotModel& model);
+  KinematicsCallCounter(const RobotModel&& model) = delete;  // it counts calls on that object: a named one
   ~KinematicsCallCounter();
   KinematicsCallCounter(const KinematicsCallCounter&) = delete;
   KinematicsCallCounter& operator=(const KinematicsCallCounter&) = delete;
