@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -116,6 +117,16 @@ inline std::string nominal_program(const std::string& dir, double speed_mm_s = 3
       "\"ldbb:phi_deg=30,force_N=400\" --speed-mm-s " +
       std::to_string(speed_mm_s) + " --hold-start-s " + std::to_string(hold_s) + " --nominal-trajectory " + path);
   EXPECT_EQ(r.exit_code, 0) << r.err;
+  return path;
+}
+
+/// A constant reading of the sensor (its frame, N) for 1 s, into DIR/force.csv (loop it for longer): 300
+/// N along the tool's axis, 120 N across; returns its path.
+inline std::string held_force_csv(const std::string& dir) {
+  const std::string path = dir + "/force.csv";
+  std::ofstream out(path);
+  out << "t_s,fx_N,fy_N,fz_N\n";
+  for (int k = 0; k <= 100; ++k) out << k * 0.01 << ",120.0,0.0,300.0\n";
   return path;
 }
 

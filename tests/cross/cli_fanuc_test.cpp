@@ -31,15 +31,6 @@ using test::Child;
 using test::run_in_real_time;
 using test::spawn;
 
-// A constant reading of the sensor (its frame, N): 300 N along the tool's axis, 120 N across.
-std::string constant_force(const std::string& dir) {
-  const std::string path = dir + "/force.csv";
-  std::ofstream out(path);
-  out << "t_s,fx_N,fy_N,fz_N\n";
-  for (int k = 0; k <= 100; ++k) out << k * 0.01 << ",120.0,0.0,300.0\n";
-  return path;
-}
-
 TEST(CliFanuc, StreamsTheProgramWithTheModelsCorrectionAndTheControllerNeverAlarms) {
   const std::string dir = ::testing::TempDir() + "/cli_fanuc";
   fs::create_directories(dir);
@@ -65,7 +56,7 @@ TEST(CliFanuc, StreamsTheProgramWithTheModelsCorrectionAndTheControllerNeverAlar
     spawn(deflex,
           {test::kDeflex, "online", "--link", "fanuc-j519", "--program", program_path, "--robot-host", "127.0.0.1",
            "--robot-port", std::to_string(transport->local_address().port), "--force-source",
-           "csv:" + constant_force(dir), "--loop", "--log", log, "--duration-s", "4", "--status-interval-s", "1"},
+           "csv:" + test::held_force_csv(dir), "--loop", "--log", log, "--duration-s", "4", "--status-interval-s", "1"},
           dir + "/stderr.txt");
     run_in_real_time(*held, 6.0);
     exit_code = deflex.wait();

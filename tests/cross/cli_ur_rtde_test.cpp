@@ -31,15 +31,6 @@ using test::Child;
 using test::run_in_real_time;
 using test::spawn;
 
-// A constant reading of the sensor (its frame, N): 300 N along the tool's axis, 120 N across.
-std::string ur_held_force_csv(const std::string& dir) {
-  const std::string path = dir + "/force.csv";
-  std::ofstream out(path);
-  out << "t_s,fx_N,fy_N,fz_N\n";
-  for (int k = 0; k <= 100; ++k) out << k * 0.01 << ",120.0,0.0,300.0\n";
-  return path;
-}
-
 TEST(CliUrRtde, StreamsTheProgramWithTheModelsCorrectionWithinTheStepLimit) {
   const std::string dir = ::testing::TempDir() + "/cli_ur_rtde";
   fs::create_directories(dir);
@@ -64,7 +55,7 @@ TEST(CliUrRtde, StreamsTheProgramWithTheModelsCorrectionWithinTheStepLimit) {
          "--period-ms",
          "2",
          "--force-source",
-         "csv:" + ur_held_force_csv(dir),
+         "csv:" + test::held_force_csv(dir),
          "--loop",
          "--log",
          log,
