@@ -22,6 +22,7 @@
 #include "deflex/transport/udp_transport.hpp"
 
 #include "counting_new.hpp"
+#include "link_round_trips.hpp"
 
 namespace deflex {
 namespace {
@@ -41,11 +42,6 @@ class ConstantForce final : public ForceSource {
 
  private:
   bool served_ = false;
-};
-
-struct RoundTrips {
-  std::vector<double> us;
-  std::size_t lost = 0;
 };
 
 // Sends `cycles` EgmRobot messages from a fresh socket to `to` and times each answer.
@@ -76,17 +72,6 @@ RoundTrips exchange(const DatagramAddress& to, std::size_t cycles, const JointVe
   for (std::size_t i = 0; i < cycles; ++i) one(r.us[i]);
   g_counting = false;
   return r;
-}
-
-void report(benchmark::State& state, RoundTrips& r) {
-  std::sort(r.us.begin(), r.us.end());
-  const auto pct = [&](double p) { return r.us[static_cast<std::size_t>(p * static_cast<double>(r.us.size() - 1))]; };
-  state.counters["cycles"] = static_cast<double>(r.us.size());
-  state.counters["p50_us"] = pct(0.50);
-  state.counters["p99_us"] = pct(0.99);
-  state.counters["max_us"] = r.us.back();
-  state.counters["lost"] = static_cast<double>(r.lost);
-  state.counters["allocations"] = static_cast<double>(g_allocations.load());
 }
 
 JointVector start_deg() {

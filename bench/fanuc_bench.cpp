@@ -22,40 +22,12 @@
 #include "deflex/transport/udp_transport.hpp"
 
 #include "counting_new.hpp"
+#include "link_round_trips.hpp"
 
 namespace deflex {
 namespace {
 
 namespace j519 = fanuc_j519;
-
-// A force source with a new sample every cycle.
-class ConstantForce final : public ForceSource {
- public:
-  bool latest(ForceSample& out) noexcept override {
-    served_ = !served_;
-    if (!served_) return false;
-    out.t_s += 0.001;
-    out.wrench_sensor << 50.0, -120.0, -400.0, 2.0, 1.0, -0.5;
-    return true;
-  }
-
- private:
-  bool served_ = false;
-};
-
-const JointVector& start_joints() {
-  static const JointVector q = [] {
-    JointVector v(6);
-    v << 0.0, 0.35, 0.17, 0.0, 1.05, 0.0;
-    return v;
-  }();
-  return q;
-}
-
-struct RoundTrips {
-  std::vector<double> us;
-  std::size_t lost = 0;
-};
 
 // The controller's side: waits for the start packet (when `wait_start`), then sends `cycles` statuses
 // to `to` (or to the start packet's sender) and times each answer.
@@ -93,17 +65,6 @@ RoundTrips exchange(UdpTransport& controller, DatagramAddress to, std::size_t cy
   return r;
 }
 
-void report(benchmark::State& state, RoundTrips& r) {
-  std::sort(r.us.begin(), r.us.end());
-  const auto pct = [&](double p) { return r.us[static_cast<std::size_t>(p * static_cast<double>(r.us.size() - 1))]; };
-  state.counters["cycles"] = static_cast<double>(r.us.size());
-  state.counters["p50_us"] = pct(0.50);
-  state.counters["p99_us"] = pct(0.99);
-  state.counters["max_us"] = r.us.back();
-  state.counters["lost"] = static_cast<double>(r.lost);
-  state.counters["allocations"] = static_cast<double>(g_allocations.load());
-}
-
 // The floor: the same statuses bounced by a plain UDP echo.
 void BM_FanucUdpLoopbackFloor(benchmark::State& state) {
   UdpTransport echo("127.0.0.1", 0);
@@ -135,7 +96,7 @@ void BM_FanucLinkRoundTrip(benchmark::State& state) {
   online.period_s = 0.008;
   OnlineCompensator comp(robot, sensor, online);
   OnlineStrategy strategy(robot, StrategyKind::kOnline, nullptr);
-  ConstantForce force;
+  FreshSampleForce force;
   UdpTransport transport("127.0.0.1", 0);
   UdpTransport controller("127.0.0.1", 0);
   SteadyClock clock;

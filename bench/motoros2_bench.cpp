@@ -23,40 +23,12 @@
 #include "deflex/transport/udp_transport.hpp"
 
 #include "counting_new.hpp"
+#include "link_round_trips.hpp"
 
 namespace deflex {
 namespace {
 
 namespace rt = motoros2_rt;
-
-// A force source with a new sample every cycle.
-class ConstantForce final : public ForceSource {
- public:
-  bool latest(ForceSample& out) noexcept override {
-    served_ = !served_;
-    if (!served_) return false;
-    out.t_s += 0.001;
-    out.wrench_sensor << 50.0, -120.0, -400.0, 2.0, 1.0, -0.5;
-    return true;
-  }
-
- private:
-  bool served_ = false;
-};
-
-const JointVector& start_joints() {
-  static const JointVector q = [] {
-    JointVector v(6);
-    v << 0.0, 0.35, 0.17, 0.0, 1.05, 0.0;
-    return v;
-  }();
-  return q;
-}
-
-struct RoundTrips {
-  std::vector<double> us;
-  std::size_t lost = 0;
-};
 
 // The controller's side: `link` true waits for the link's command 0 and answers every command with
 // its reply (the command position moved by its increments); false bounces replies off an echo at `to`.
@@ -100,17 +72,6 @@ RoundTrips exchange(UdpTransport& controller, DatagramAddress to, std::size_t cy
   return r;
 }
 
-void report(benchmark::State& state, RoundTrips& r) {
-  std::sort(r.us.begin(), r.us.end());
-  const auto pct = [&](double p) { return r.us[static_cast<std::size_t>(p * static_cast<double>(r.us.size() - 1))]; };
-  state.counters["cycles"] = static_cast<double>(r.us.size());
-  state.counters["p50_us"] = pct(0.50);
-  state.counters["p99_us"] = pct(0.99);
-  state.counters["max_us"] = r.us.back();
-  state.counters["lost"] = static_cast<double>(r.lost);
-  state.counters["allocations"] = static_cast<double>(g_allocations.load());
-}
-
 // The floor: the same replies bounced by a plain UDP echo.
 void BM_Motoros2UdpLoopbackFloor(benchmark::State& state) {
   UdpTransport echo("127.0.0.1", 0);
@@ -142,7 +103,7 @@ void BM_Motoros2LinkRoundTrip(benchmark::State& state) {
   online.period_s = 0.004;
   OnlineCompensator comp(robot, sensor, online);
   OnlineStrategy strategy(robot, StrategyKind::kOnline, nullptr);
-  ConstantForce force;
+  FreshSampleForce force;
   UdpTransport transport("127.0.0.1", 0);
   UdpTransport controller("127.0.0.1", 0);
   SteadyClock clock;

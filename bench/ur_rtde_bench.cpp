@@ -22,38 +22,10 @@
 #include "deflex/ur/ur_rtde_link.hpp"
 
 #include "counting_new.hpp"
+#include "link_round_trips.hpp"
 
 namespace deflex {
 namespace {
-
-// A force source with a new sample every cycle.
-class ConstantForce final : public ForceSource {
- public:
-  bool latest(ForceSample& out) noexcept override {
-    served_ = !served_;
-    if (!served_) return false;
-    out.t_s += 0.001;
-    out.wrench_sensor << 50.0, -120.0, -400.0, 2.0, 1.0, -0.5;
-    return true;
-  }
-
- private:
-  bool served_ = false;
-};
-
-const JointVector& start_joints() {
-  static const JointVector q = [] {
-    JointVector v(6);
-    v << 0.0, 0.35, 0.17, 0.0, 1.05, 0.0;
-    return v;
-  }();
-  return q;
-}
-
-struct RoundTrips {
-  std::vector<double> us;
-  std::size_t lost = 0;
-};
 
 // Reads one whole package into `in` (waiting up to `timeout_s` in all); its size, or 0.
 std::size_t read_package(StreamTransport& s, std::vector<unsigned char>& in, std::size_t& have, double timeout_s) {
@@ -162,17 +134,6 @@ RoundTrips exchange(StreamTransport& s, std::size_t cycles, bool link) {
   return r;
 }
 
-void report(benchmark::State& state, RoundTrips& r) {
-  std::sort(r.us.begin(), r.us.end());
-  const auto pct = [&](double p) { return r.us[static_cast<std::size_t>(p * static_cast<double>(r.us.size() - 1))]; };
-  state.counters["cycles"] = static_cast<double>(r.us.size());
-  state.counters["p50_us"] = pct(0.50);
-  state.counters["p99_us"] = pct(0.99);
-  state.counters["max_us"] = r.us.back();
-  state.counters["lost"] = static_cast<double>(r.lost);
-  state.counters["allocations"] = static_cast<double>(g_allocations.load());
-}
-
 // The floor: the same packages bounced by a plain TCP echo.
 void BM_UrRtdeTcpLoopbackFloor(benchmark::State& state) {
   TcpListener listener("127.0.0.1", 0);
@@ -205,7 +166,7 @@ void BM_UrRtdeLinkRoundTrip(benchmark::State& state) {
   online.period_s = 0.002;
   OnlineCompensator comp(robot, sensor, online);
   OnlineStrategy strategy(robot, StrategyKind::kOnline, nullptr);
-  ConstantForce force;
+  FreshSampleForce force;
   TcpListener listener("127.0.0.1", 0);
   std::unique_ptr<TcpStream> client = TcpStream::connect("127.0.0.1", listener.port(), 5.0);
   std::unique_ptr<TcpStream> controller = listener.accept(5.0);
