@@ -116,6 +116,23 @@ std::vector<ControllerFile> fanuc_setup_files(const ControllerSetupSettings& o, 
   return fanuc_controller_setup(f);
 }
 
+/// Each joint's fastest stream of the program (its own speed, the blend's and the correction's, as the
+/// link's step limit holds them), rad/s: for a controller's speed limits (MotoROS2's safety unit, UR's
+/// safety configuration).
+JointVector stream_speed_rad_s(const ControllerSetupSettings& o, double period_ms, const RobotLoader& load_robot) {
+  const RobotModel model = read_robot(load_robot, o.robot);
+  const auto program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o.program, model));
+  OnlineConfig online;
+  online.period_s = period_ms * 1e-3;
+  online.max_joint_correction_rad = deg_to_rad(o.max_joint_deg);
+  online.max_correction_rate_rad_s = deg_to_rad(o.max_rate_deg_s);
+  JointStreamConfig stream;
+  stream.ramp_in_s = o.ramp_in_s;
+  stream.validate();
+  const CommandLimits l = command_limits(CommandForm::kJointTarget, online, model.dof(), program.get(), &stream);
+  return l.joint_step_rad / online.period_s;
+}
+
 /// The files of motoros2-rt: the motoros2_config.yaml keys and the settings sheet. With a program, the
 /// sheet gives each joint's fastest stream (its speed and the correction's), for the safety unit's
 /// speed limits.
@@ -130,19 +147,7 @@ std::vector<ControllerFile> motoros2_setup_files(const ControllerSetupSettings& 
   m.resend_ms = o.motoros2_resend_ms;
   m.max_truncations = o.motoros2_max_truncations;
   m.pc_address = o.sensor_ip;
-  if (!o.program.empty()) {
-    const RobotModel model = read_robot(load_robot, o.robot);
-    const auto program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o.program, model));
-    OnlineConfig online;
-    online.period_s = m.period_ms * 1e-3;
-    online.max_joint_correction_rad = deg_to_rad(o.max_joint_deg);
-    online.max_correction_rate_rad_s = deg_to_rad(o.max_rate_deg_s);
-    JointStreamConfig stream;
-    stream.ramp_in_s = o.ramp_in_s;
-    stream.validate();
-    const CommandLimits l = command_limits(CommandForm::kJointTarget, online, model.dof(), program.get(), &stream);
-    m.stream_speed_rad_s = l.joint_step_rad / online.period_s;
-  }
+  if (!o.program.empty()) m.stream_speed_rad_s = stream_speed_rad_s(o, m.period_ms, load_robot);
   return motoros2_controller_setup(m);
 }
 
@@ -158,19 +163,7 @@ std::vector<ControllerFile> ur_setup_files(const ControllerSetupSettings& o, con
   u.lookahead_s = o.ur_lookahead_ms * 1e-3;
   u.gain = o.ur_gain;
   u.register_offset = o.ur_register_offset;
-  if (!o.program.empty()) {
-    const RobotModel model = read_robot(load_robot, o.robot);
-    const auto program = std::make_shared<const JointTrajectory>(JointTrajectory::read_csv(o.program, model));
-    OnlineConfig online;
-    online.period_s = u.period_ms * 1e-3;
-    online.max_joint_correction_rad = deg_to_rad(o.max_joint_deg);
-    online.max_correction_rate_rad_s = deg_to_rad(o.max_rate_deg_s);
-    JointStreamConfig stream;
-    stream.ramp_in_s = o.ramp_in_s;
-    stream.validate();
-    const CommandLimits l = command_limits(CommandForm::kJointTarget, online, model.dof(), program.get(), &stream);
-    u.stream_speed_rad_s = l.joint_step_rad / online.period_s;
-  }
+  if (!o.program.empty()) u.stream_speed_rad_s = stream_speed_rad_s(o, u.period_ms, load_robot);
   return ur_controller_setup(u);
 }
 
