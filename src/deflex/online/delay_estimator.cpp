@@ -42,94 +42,101 @@ void DelayEstimator::record_reference(double t_s, const JointVector& q_ref) noex
   count_ = std::min(count_ + 1, kRing);
 }
 
+// A feedback sample is measured in three stages: is the arm moving (else any reference matches), where
+// on the recent references it is (the match), and is the delay that match gives a measurement.
 void DelayEstimator::observe_feedback(double t_s, const JointVector& q_feedback) noexcept {
   if (!q_feedback.allFinite()) {
     return;
   }
-  // The arm must be moving: standing (before it starts, or stopped) it matches any reference that
-  // passed its place, at any delay.
-  constexpr double kMinStepRad = 1e-6;
-  const double feedback_step =
-      have_feedback_ && last_feedback_.size() == q_feedback.size() ? (q_feedback - last_feedback_).norm() : 0.0;
-  const double feedback_dt = t_s - last_feedback_t_;
-  const bool moving = have_feedback_ && feedback_step >= kMinStepRad && feedback_dt > 0.0;
-  last_feedback_ = q_feedback;
-  last_feedback_t_ = t_s;
-  have_feedback_ = true;
-  if (count_ < 3 || !moving) {
+  const FeedbackMotion motion = note_feedback(t_s, q_feedback);
+  if (count_ < 3 || !motion.moving) {
     return;
   }
-  const auto at = [&](int k) { return static_cast<std::size_t>((head_ - 1 - k + kRing) % kRing); };
   // The reference must be moving now (at rest, or after it stopped, every recent reference matches
   // the feedback equally), and the matched piece of it must be moving too.
-  if ((q_[at(0)] - q_[at(1)]).norm() < kMinStepRad) return;
-  double best2 = std::numeric_limits<double>::infinity();  // squared joint distance of the best match
-  double best_t = 0.0;
-  double best_step = 0.0;
-  double best_dt = 0.0;
-  int best_k = -1;
-  const int n = static_cast<int>(q_feedback.size());
-  const double* const f = q_feedback.data();
-  // Segments k in [k_from, k_to], k back from the newest. Plain loops over the joints on the segment
-  // kept when its reference was recorded: this runs for every feedback sample of a link.
-  const auto scan = [&](int k_from, int k_to) {
-    for (int k = std::max(1, k_from); k <= k_to && k < count_; ++k) {
-      const std::size_t i1 = at(k - 1), i0 = at(k);  // segment from the older i0 to the newer i1
-      if (t_s - t_[i0] > window_s_) break;
-      if (q_[i0].size() != n || q_[i1].size() != n) return;
-      const double* const a = q_[i0].data();
-      const double* const d = segment_[i1].data();
-      const double len2 = segment_len2_[i1];
-      double s = 0.0;
-      if (len2 > 0.0) {
-        double along = 0.0;
-        for (int j = 0; j < n; ++j) along += (f[j] - a[j]) * d[j];
-        s = std::clamp(along / len2, 0.0, 1.0);
-      }
-      double dist2 = 0.0;
-      for (int j = 0; j < n; ++j) {
-        const double e = a[j] + s * d[j] - f[j];
-        dist2 += e * e;
-      }
-      if (dist2 < best2) {
-        best2 = dist2;
-        best_t = t_[i0] + s * (t_[i1] - t_[i0]);
-        best_step = std::sqrt(len2);
-        best_dt = t_[i1] - t_[i0];
-        best_k = k;
-      }
-    }
-  };
-  // Where the last match was, give or take a few segments (the delay changes slowly); the whole
-  // window when that finds the best at its edge, and every 64th sample anyway.
-  constexpr int kNear = 6;
-  const bool full = last_k_ < 1 || ++since_full_ >= 64;
-  if (!full) {
-    scan(last_k_ - kNear, last_k_ + kNear);
-  }
-  if (full || best_k <= std::max(1, last_k_ - kNear) || best_k >= last_k_ + kNear) {
-    best2 = std::numeric_limits<double>::infinity();
-    best_k = -1;
-    scan(1, count_ - 1);
-    since_full_ = 0;
-  }
-  if (best_k < 0) return;
-  last_k_ = best_k;
+  if ((q_[ring_index(0)] - q_[ring_index(1)]).norm() < kMinStepRad) return;
+  const Match m = match_reference(t_s, q_feedback);
+  if (m.k < 0) return;
+  last_k_ = m.k;
   // How far the reference went from the match to now (cumulative path length).
-  const double travel = travel_[at(0)] - travel_[at(best_k)];
+  const double travel = travel_[ring_index(0)] - travel_[ring_index(m.k)];
   // Ambiguous: the feedback is not on the reference's recent path, or the reference has hardly moved
   // since the match (it rested there).
-  if (!(best_step > kMinStepRad) || !(std::sqrt(best2) < 0.1 * travel)) {
+  if (!(m.step > kMinStepRad) || !(std::sqrt(m.dist2) < 0.1 * travel)) {
     return;
   }
   // A delay line keeps the speed: the arm moves now as fast as the reference did where it matched.
   // An arm settling at the end of a motion creeps far slower than the reference it matches.
-  const double speed_ratio = best_dt > 0.0 ? (feedback_step / feedback_dt) / (best_step / best_dt) : 0.0;
+  const double speed_ratio = m.dt > 0.0 ? (motion.step / motion.dt) / (m.step / m.dt) : 0.0;
   if (!(speed_ratio > 0.5 && speed_ratio < 2.0)) {
     return;
   }
-  const double sample = t_s - best_t;
+  const double sample = t_s - m.t;
   if (!(sample >= 0.0) || !(sample < window_s_)) return;
+  take_measurement(sample);
+}
+
+DelayEstimator::FeedbackMotion DelayEstimator::note_feedback(double t_s, const JointVector& q_feedback) noexcept {
+  // The arm must be moving: standing (before it starts, or stopped) it matches any reference that
+  // passed its place, at any delay.
+  FeedbackMotion motion;
+  motion.step =
+      have_feedback_ && last_feedback_.size() == q_feedback.size() ? (q_feedback - last_feedback_).norm() : 0.0;
+  motion.dt = t_s - last_feedback_t_;
+  motion.moving = have_feedback_ && motion.step >= kMinStepRad && motion.dt > 0.0;
+  last_feedback_ = q_feedback;
+  last_feedback_t_ = t_s;
+  have_feedback_ = true;
+  return motion;
+}
+
+// Segments k in [k_from, k_to], k back from the newest. Plain loops over the joints on the segment
+// kept when its reference was recorded: this runs for every feedback sample of a link.
+void DelayEstimator::scan(double t_s, const JointVector& q_feedback, int k_from, int k_to, Match& best) const noexcept {
+  const int n = static_cast<int>(q_feedback.size());
+  const double* const f = q_feedback.data();
+  for (int k = std::max(1, k_from); k <= k_to && k < count_; ++k) {
+    const std::size_t i1 = ring_index(k - 1), i0 = ring_index(k);  // segment from the older i0 to the newer i1
+    if (t_s - t_[i0] > window_s_) break;
+    if (q_[i0].size() != n || q_[i1].size() != n) return;
+    const double* const a = q_[i0].data();
+    const double* const d = segment_[i1].data();
+    const double len2 = segment_len2_[i1];
+    double s = 0.0;
+    if (len2 > 0.0) {
+      double along = 0.0;
+      for (int j = 0; j < n; ++j) along += (f[j] - a[j]) * d[j];
+      s = std::clamp(along / len2, 0.0, 1.0);
+    }
+    double dist2 = 0.0;
+    for (int j = 0; j < n; ++j) {
+      const double e = a[j] + s * d[j] - f[j];
+      dist2 += e * e;
+    }
+    if (dist2 < best.dist2) {
+      best = Match{dist2, t_[i0] + s * (t_[i1] - t_[i0]), std::sqrt(len2), t_[i1] - t_[i0], k};
+    }
+  }
+}
+
+// Where the last match was, give or take a few segments (the delay changes slowly); the whole
+// window when that finds the best at its edge, and every 64th sample anyway.
+DelayEstimator::Match DelayEstimator::match_reference(double t_s, const JointVector& q_feedback) noexcept {
+  constexpr int kNear = 6;
+  Match best;
+  const bool full = last_k_ < 1 || ++since_full_ >= 64;
+  if (!full) {
+    scan(t_s, q_feedback, last_k_ - kNear, last_k_ + kNear, best);
+  }
+  if (full || best.k <= std::max(1, last_k_ - kNear) || best.k >= last_k_ + kNear) {
+    best = Match{};
+    scan(t_s, q_feedback, 1, count_ - 1, best);
+    since_full_ = 0;
+  }
+  return best;
+}
+
+void DelayEstimator::take_measurement(double sample) noexcept {
   // Once the estimate has settled, a measurement far from it is a mismatch (a reversal, the arm
   // coming to rest), not a change of the link: it is counted and left out.
   const auto far = [](double a, double b) { return std::abs(a - b) > std::max(0.02, 0.5 * b); };

@@ -11,7 +11,9 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "deflex/model/types.hpp"
 
@@ -44,6 +46,28 @@ class DelayEstimator {
 
  private:
   static constexpr int kRing = 256;
+  static constexpr double kMinStepRad = 1e-6;  // a step below this is standing still
+  struct FeedbackMotion {
+    double step = 0.0;  // since the previous sample, rad
+    double dt = 0.0;    // s
+    bool moving = false;
+  };
+  // The nearest point of the recent references to a feedback sample.
+  struct Match {
+    double dist2 = std::numeric_limits<double>::infinity();  // squared joint distance, rad^2
+    double t = 0.0;                                          // the reference's time there, s
+    double step = 0.0;                                       // the matched segment's length, rad
+    double dt = 0.0;                                         // and its duration, s
+    int k = -1;                                              // segments back from the newest
+  };
+  [[nodiscard]] std::size_t ring_index(int k) const noexcept {
+    return static_cast<std::size_t>((head_ - 1 - k + kRing) % kRing);
+  }
+  FeedbackMotion note_feedback(double t_s, const JointVector& q_feedback) noexcept;
+  Match match_reference(double t_s, const JointVector& q_feedback) noexcept;
+  void scan(double t_s, const JointVector& q_feedback, int k_from, int k_to, Match& best) const noexcept;
+  void take_measurement(double sample) noexcept;
+
   std::array<double, kRing> t_{};
   std::array<JointVector, kRing> q_{};
   std::array<double, kRing> travel_{};        // cumulative path length of the references, rad

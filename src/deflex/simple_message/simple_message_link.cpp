@@ -230,68 +230,73 @@ bool SimpleMessageLink::handle_state_frame(const sm::FrameView& f, double now) n
           sm::message_type_name(f.header.msg_type), f.header.msg_type, f.header.comm_type);
     return false;
   }
-  const auto count_bad = [this](sm::DecodeStatus s) {
-    if (s == sm::DecodeStatus::kTruncated) {
-      ++counters_.truncated;
-    } else if (s == sm::DecodeStatus::kNonFinite) {
-      ++counters_.non_finite;
-    } else {
-      ++counters_.malformed;
-    }
-  };
-  if (f.header.msg_type == sm::kJointPosition) {
-    const sm::DecodeStatus s = sm::decode(config_.byte_order, f.data, f.data_bytes, position_);
-    if (s != sm::DecodeStatus::kOk) {
-      count_bad(s);
-      fault(LinkStopCause::kProtocol, "state connection: JOINT_POSITION %s (%zu data bytes, %zu expected)",
-            sm::to_string(s), f.data_bytes, sm::kJointPositionBytes);
-      return false;
-    }
-    for (int j = 0; j < feedback_.size(); ++j) {
-      const double q = position_.joints_rad[static_cast<std::size_t>(j)];
-      if (q < lower_[j] || q > upper_[j]) {
-        ++counters_.out_of_limits;
-        fault(LinkStopCause::kProtocol,
-              "state connection: JOINT_POSITION joint %d at %.3f deg is beyond the robot's limits (check the byte "
-              "order, now %s)",
-              j + 1, rad_to_deg(q), sm::to_string(config_.byte_order));
-        return false;
-      }
-      feedback_[j] = q;
-    }
-    have_feedback_ = true;
-    last_state_s_ = now;
-    heard(now);
-    ++sm_.joint_positions;
-    delay_.observe_feedback(now, feedback_);
-    return true;
-  }
-  if (f.header.msg_type == sm::kRobotStatus) {
-    const sm::DecodeStatus s = sm::decode(config_.byte_order, f.data, f.data_bytes, status_);
-    if (s != sm::DecodeStatus::kOk) {
-      count_bad(s);
-      fault(LinkStopCause::kProtocol, "state connection: ROBOT_STATUS %s (%zu data bytes, %zu expected)",
-            sm::to_string(s), f.data_bytes, sm::kRobotStatusBytes);
-      return false;
-    }
-    ++sm_.robot_statuses;
-    if (status_.e_stopped == 1) {
-      fault(LinkStopCause::kController, "the controller reports an emergency stop (ROBOT_STATUS e_stopped)");
-      return false;
-    }
-    if (status_.in_error == 1) {
-      fault(LinkStopCause::kController, "the controller reports an error (ROBOT_STATUS in_error, error code %d)",
-            status_.error_code);
-      return false;
-    }
-    return true;
-  }
+  if (f.header.msg_type == sm::kJointPosition) return take_joint_position(f, now);
+  if (f.header.msg_type == sm::kRobotStatus) return take_robot_status(f);
   ++sm_.unknown_type;
   ++counters_.malformed;
   fault(LinkStopCause::kProtocol,
         "state connection: message type %d is not one the link speaks (JOINT_POSITION 10, ROBOT_STATUS 13)",
         f.header.msg_type);
   return false;
+}
+
+void SimpleMessageLink::count_bad_decode(sm::DecodeStatus s) noexcept {
+  if (s == sm::DecodeStatus::kTruncated) {
+    ++counters_.truncated;
+  } else if (s == sm::DecodeStatus::kNonFinite) {
+    ++counters_.non_finite;
+  } else {
+    ++counters_.malformed;
+  }
+}
+
+bool SimpleMessageLink::take_joint_position(const sm::FrameView& f, double now) noexcept {
+  const sm::DecodeStatus s = sm::decode(config_.byte_order, f.data, f.data_bytes, position_);
+  if (s != sm::DecodeStatus::kOk) {
+    count_bad_decode(s);
+    fault(LinkStopCause::kProtocol, "state connection: JOINT_POSITION %s (%zu data bytes, %zu expected)",
+          sm::to_string(s), f.data_bytes, sm::kJointPositionBytes);
+    return false;
+  }
+  for (int j = 0; j < feedback_.size(); ++j) {
+    const double q = position_.joints_rad[static_cast<std::size_t>(j)];
+    if (q < lower_[j] || q > upper_[j]) {
+      ++counters_.out_of_limits;
+      fault(LinkStopCause::kProtocol,
+            "state connection: JOINT_POSITION joint %d at %.3f deg is beyond the robot's limits (check the byte "
+            "order, now %s)",
+            j + 1, rad_to_deg(q), sm::to_string(config_.byte_order));
+      return false;
+    }
+    feedback_[j] = q;
+  }
+  have_feedback_ = true;
+  last_state_s_ = now;
+  heard(now);
+  ++sm_.joint_positions;
+  delay_.observe_feedback(now, feedback_);
+  return true;
+}
+
+bool SimpleMessageLink::take_robot_status(const sm::FrameView& f) noexcept {
+  const sm::DecodeStatus s = sm::decode(config_.byte_order, f.data, f.data_bytes, status_);
+  if (s != sm::DecodeStatus::kOk) {
+    count_bad_decode(s);
+    fault(LinkStopCause::kProtocol, "state connection: ROBOT_STATUS %s (%zu data bytes, %zu expected)",
+          sm::to_string(s), f.data_bytes, sm::kRobotStatusBytes);
+    return false;
+  }
+  ++sm_.robot_statuses;
+  if (status_.e_stopped == 1) {
+    fault(LinkStopCause::kController, "the controller reports an emergency stop (ROBOT_STATUS e_stopped)");
+    return false;
+  }
+  if (status_.in_error == 1) {
+    fault(LinkStopCause::kController, "the controller reports an error (ROBOT_STATUS in_error, error code %d)",
+          status_.error_code);
+    return false;
+  }
+  return true;
 }
 
 bool SimpleMessageLink::handle_motion_frame(const sm::FrameView& f, double now) noexcept {
@@ -326,6 +331,10 @@ bool SimpleMessageLink::handle_motion_frame(const sm::FrameView& f, double now) 
           sm::message_type_name(f.header.msg_type), f.data_bytes, full);
     return false;
   }
+  return reply_in_step(f) && take_reply(f.header.reply_code, now);
+}
+
+bool SimpleMessageLink::reply_in_step(const sm::FrameView& f) noexcept {
   const bool has_sequence = f.data_bytes >= 4;
   const std::int32_t sequence = has_sequence ? sm::read_int32(config_.byte_order, f.data) : 0;
   if (!waiting_reply_) {
@@ -342,7 +351,11 @@ bool SimpleMessageLink::handle_motion_frame(const sm::FrameView& f, double now) 
           waiting_sequence_);
     return false;
   }
-  if (f.header.reply_code == sm::kReplySuccess) {
+  return true;
+}
+
+bool SimpleMessageLink::take_reply(int reply_code, double now) noexcept {
+  if (reply_code == sm::kReplySuccess) {
     waiting_reply_ = false;
     ++accepted_;
     ++sm_.points_accepted;
@@ -356,7 +369,7 @@ bool SimpleMessageLink::handle_motion_frame(const sm::FrameView& f, double now) 
     }
     return true;
   }
-  if (f.header.reply_code == sm::kReplyFailure) {
+  if (reply_code == sm::kReplyFailure) {
     // Not taken: the controller's buffer was full, so it runs behind deflex's clock. Wait a cycle from
     // now and send the same point again (the schedule moves with it); a controller that keeps refusing
     // stops the link.
@@ -374,8 +387,7 @@ bool SimpleMessageLink::handle_motion_frame(const sm::FrameView& f, double now) 
     return true;
   }
   ++counters_.malformed;
-  fault(LinkStopCause::kProtocol, "motion connection: reply code %d, SUCCESS (1) or FAILURE (2) expected",
-        f.header.reply_code);
+  fault(LinkStopCause::kProtocol, "motion connection: reply code %d, SUCCESS (1) or FAILURE (2) expected", reply_code);
   return false;
 }
 
@@ -405,52 +417,13 @@ LinkPollResult SimpleMessageLink::poll(double timeout_s) noexcept {
   now = clock_.now_s();
   if (!read_port(Port::kState, now) || !read_port(Port::kMotion, now)) return announce_terminal();
 
-  if (state_ == LinkState::kRunning) {
-    // A stop ramp needs the controller to take points: one that fell silent meanwhile has nothing to ramp.
-    if (ramping_down_ && now - last_state_s_ > std::max(0.25, 2.5 * period_s_)) {
-      fault(LinkStopCause::kRequested,
-            "stopped on request: the controller fell silent for %.2f s during the stop ramp, so deflex stopped there",
-            now - last_state_s_);
-      return announce_terminal();
-    }
-    if (now - last_state_s_ > config_.state_timeout_s) {
-      fault(LinkStopCause::kSilent, "no JOINT_POSITION on the state connection for %.2f s (timeout %.2f s)",
-            now - last_state_s_, config_.state_timeout_s);
-      return announce_terminal();
-    }
-    if (waiting_reply_ && now - waiting_since_s_ > config_.reply_timeout_s) {
-      fault(LinkStopCause::kSilent, "no reply to point %d for %.2f s (timeout %.2f s)", waiting_sequence_,
-            now - waiting_since_s_, config_.reply_timeout_s);
-      return announce_terminal();
-    }
-  }
-  if (state_ == LinkState::kFinished && ramping_down_ && now - finished_at_s_ > config_.buffer_depth * period_s_) {
-    fault(LinkStopCause::kRequested,
-          "stopped on request: the program was brought to a standstill on its path over %.2f s and the controller "
-          "ran out its queue; STOP_TRAJECTORY sent",
-          ramp_down_s_);
-    return announce_terminal();
-  }
-  if (state_ == LinkState::kFinished && now - finished_at_s_ > rules_.end_silence_s) {
-    // The program's last point was taken: the session is over (the controller runs out its queue).
-    stop_link(LinkStopCause::kEnded, "the program's last point was taken %.2f s ago: the session is over",
-              now - finished_at_s_);
-    return announce_terminal();
-  }
+  if (!within_deadlines(now)) return announce_terminal();
   if (state_ == LinkState::kWaiting) {
     if (!have_feedback_) {
       flush();
       return LinkPollResult::kIdle;
     }
-    // The session starts with the arm where the controller says it is: it must be at the program's
-    // start, or nothing is ever sent.
-    if (!stream_.begin(feedback_, cycle_.correction())) {
-      refuse_start(stream_.distance());
-      return announce_terminal();
-    }
-    cycle_.anchor_joints(feedback_, true);  // the first session: nothing was sent before
-    state_ = LinkState::kRunning;
-    schedule_origin_s_ = first_origin_s_ = now;
+    if (!begin_session(now)) return announce_terminal();
   }
   if (state_ == LinkState::kRunning && !waiting_reply_ && now + 1e-9 >= next_due_s()) return send_point(now);
   if (!flush() && state_ == LinkState::kRunning) {
@@ -460,44 +433,66 @@ LinkPollResult SimpleMessageLink::poll(double timeout_s) noexcept {
   return LinkPollResult::kIdle;
 }
 
+// The session's clocks: the controller's silence, a reply that does not come, a stop ramp or the
+// program's end run out. False when one of them ended the link.
+bool SimpleMessageLink::within_deadlines(double now) noexcept {
+  if (state_ == LinkState::kRunning) {
+    // A stop ramp needs the controller to take points: one that fell silent meanwhile has nothing to ramp.
+    if (ramping_down_ && now - last_state_s_ > std::max(0.25, 2.5 * period_s_)) {
+      fault(LinkStopCause::kRequested,
+            "stopped on request: the controller fell silent for %.2f s during the stop ramp, so deflex stopped there",
+            now - last_state_s_);
+      return false;
+    }
+    if (now - last_state_s_ > config_.state_timeout_s) {
+      fault(LinkStopCause::kSilent, "no JOINT_POSITION on the state connection for %.2f s (timeout %.2f s)",
+            now - last_state_s_, config_.state_timeout_s);
+      return false;
+    }
+    if (waiting_reply_ && now - waiting_since_s_ > config_.reply_timeout_s) {
+      fault(LinkStopCause::kSilent, "no reply to point %d for %.2f s (timeout %.2f s)", waiting_sequence_,
+            now - waiting_since_s_, config_.reply_timeout_s);
+      return false;
+    }
+  }
+  if (state_ == LinkState::kFinished && ramping_down_ && now - finished_at_s_ > config_.buffer_depth * period_s_) {
+    fault(LinkStopCause::kRequested,
+          "stopped on request: the program was brought to a standstill on its path over %.2f s and the controller "
+          "ran out its queue; STOP_TRAJECTORY sent",
+          ramp_down_s_);
+    return false;
+  }
+  if (state_ == LinkState::kFinished && now - finished_at_s_ > rules_.end_silence_s) {
+    // The program's last point was taken: the session is over (the controller runs out its queue).
+    stop_link(LinkStopCause::kEnded, "the program's last point was taken %.2f s ago: the session is over",
+              now - finished_at_s_);
+    return false;
+  }
+  return true;
+}
+
+// The session starts with the arm where the controller says it is: it must be at the program's
+// start, or nothing is ever sent.
+bool SimpleMessageLink::begin_session(double now) noexcept {
+  if (!stream_.begin(feedback_, cycle_.correction())) {
+    refuse_start(stream_.distance());
+    return false;
+  }
+  cycle_.anchor_joints(feedback_, true);  // the first session: nothing was sent before
+  state_ = LinkState::kRunning;
+  schedule_origin_s_ = first_origin_s_ = now;
+  return true;
+}
+
 LinkPollResult SimpleMessageLink::send_point(double now) noexcept {
   const auto t_start = std::chrono::steady_clock::now();
   const auto compute = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   };
-  // How far behind its schedule the program runs: a controller that takes a point less often than once
-  // a cycle (FAILURE replies, slow replies) makes it late; past the limit the motion stops.
-  const double due = first_origin_s_ + (static_cast<double>(accepted_) + 1.0 - config_.buffer_depth) * period_s_;
-  sm_.behind_s = std::max(0.0, now - due);
-  sm_.max_behind_s = std::max(sm_.max_behind_s, sm_.behind_s);
-  if (sm_.behind_s > config_.max_behind_s) {
-    fault(LinkStopCause::kTooSlow,
-          "the controller has taken %llu points in %.2f s, %.2f s behind the program's %.0f ms a point (limit %.2f s): "
-          "it runs the program slower than planned",
-          static_cast<unsigned long long>(accepted_), now - first_origin_s_, sm_.behind_s, period_s_ * 1e3,
-          config_.max_behind_s);
-    return announce_terminal();
-  }
+  if (too_far_behind(now)) return announce_terminal();
   const double due_at_send = next_due_s();
-  if (ramping_down_) stream_.begin_stop(ramp_down_s_);
-  stream_.sample(program_, program_velocity_, blend_, blend_velocity_);
-  nominal_ = program_ + blend_;
-  // A planned stop: the point at rest after the ramp is the last, and what is queued is run out as at
-  // the program's end.
-  const bool last = stream_.finished() || (ramping_down_ && stream_.at_standstill());
-  // The point is executed buffer_depth cycles from now: the strategy is told the measured delay and
-  // the configuration the point is for.
-  CycleRequest rq;
-  rq.t_s = now;
-  rq.sequence = static_cast<std::uint32_t>(next_sequence_);
-  rq.program_time_s = stream_.program_time_s();
-  rq.nominal = &program_;
-  rq.blend = &blend_;
-  rq.feedback = &feedback_;
-  rq.target = &nominal_;
-  rq.delay_s = rq.lead_s = delay_.delay_s();
-  rq.session_start = !sent_any_;
-  const LinkCycle::Verdict verdict = cycle_.run(rq);
+  bool last = false;
+  const LinkCycle::Verdict verdict = plan_point(now, last);
   if (verdict == LinkCycle::Verdict::kInvalid) {
     cycle_.not_sent(compute());
     fault(LinkStopCause::kSafety, "the compensator refused point %d (%s): nothing sent", next_sequence_,
@@ -510,21 +505,7 @@ LinkPollResult SimpleMessageLink::send_point(double now) noexcept {
     return announce_terminal();
   }
   const JointVector& command = cycle_.joint_command();  // float32-rounded: what the wire carries
-  point_ = sm::JointTrajPt{};
-  for (int j = 0; j < command.size(); ++j)
-    point_.joints_rad[static_cast<std::size_t>(j)] = static_cast<float>(command[j]);
-  // The velocity field: the fastest joint's share of its top speed (ABB's and Fanuc's servers ignore it).
-  double velocity = 0.0;
-  const RobotModel& model = cycle_.compensator().model();
-  if (model.has_max_speed()) {
-    const JointVector& from = sent_any_ ? last_sent_ : feedback_;
-    for (int j = 0; j < command.size(); ++j) {
-      velocity = std::max(velocity, std::abs(command[j] - from[j]) / period_s_ / model.max_speed()[j]);
-    }
-  }
-  point_.sequence = next_sequence_;
-  point_.velocity = static_cast<float>(std::min(velocity, 1.0));
-  point_.duration_s = static_cast<float>(period_s_);
+  fill_point(command);
   // Room for this point and a STOP_TRAJECTORY behind it, always.
   unsigned char* at = outbox_.reserve(2 * kPointFrameBytes);
   if (at == nullptr) {
@@ -554,6 +535,64 @@ LinkPollResult SimpleMessageLink::send_point(double now) noexcept {
   // how late the point left against its schedule (its "answer time").
   cycle_.sent(compute(), std::max(0.0, now - due_at_send));
   return LinkPollResult::kAnswered;
+}
+
+// How far behind its schedule the program runs: a controller that takes a point less often than once
+// a cycle (FAILURE replies, slow replies) makes it late; past the limit the motion stops.
+bool SimpleMessageLink::too_far_behind(double now) noexcept {
+  const double due = first_origin_s_ + (static_cast<double>(accepted_) + 1.0 - config_.buffer_depth) * period_s_;
+  sm_.behind_s = std::max(0.0, now - due);
+  sm_.max_behind_s = std::max(sm_.max_behind_s, sm_.behind_s);
+  if (sm_.behind_s <= config_.max_behind_s) return false;
+  fault(LinkStopCause::kTooSlow,
+        "the controller has taken %llu points in %.2f s, %.2f s behind the program's %.0f ms a point (limit %.2f s): "
+        "it runs the program slower than planned",
+        static_cast<unsigned long long>(accepted_), now - first_origin_s_, sm_.behind_s, period_s_ * 1e3,
+        config_.max_behind_s);
+  return true;
+}
+
+// Where the program is at this point (the stop ramp's, when one runs) and the cycle's command for it;
+// `last` says the program ends with it.
+LinkCycle::Verdict SimpleMessageLink::plan_point(double now, bool& last) noexcept {
+  if (ramping_down_) stream_.begin_stop(ramp_down_s_);
+  stream_.sample(program_, program_velocity_, blend_, blend_velocity_);
+  nominal_ = program_ + blend_;
+  // A planned stop: the point at rest after the ramp is the last, and what is queued is run out as at
+  // the program's end.
+  last = stream_.finished() || (ramping_down_ && stream_.at_standstill());
+  // The point is executed buffer_depth cycles from now: the strategy is told the measured delay and
+  // the configuration the point is for.
+  CycleRequest rq;
+  rq.t_s = now;
+  rq.sequence = static_cast<std::uint32_t>(next_sequence_);
+  rq.program_time_s = stream_.program_time_s();
+  rq.nominal = &program_;
+  rq.blend = &blend_;
+  rq.feedback = &feedback_;
+  rq.target = &nominal_;
+  rq.delay_s = rq.lead_s = delay_.delay_s();
+  rq.session_start = !sent_any_;
+  return cycle_.run(rq);
+}
+
+// The JOINT_TRAJ_PT that carries the command.
+void SimpleMessageLink::fill_point(const JointVector& command) noexcept {
+  point_ = sm::JointTrajPt{};
+  for (int j = 0; j < command.size(); ++j)
+    point_.joints_rad[static_cast<std::size_t>(j)] = static_cast<float>(command[j]);
+  // The velocity field: the fastest joint's share of its top speed (ABB's and Fanuc's servers ignore it).
+  double velocity = 0.0;
+  const RobotModel& model = cycle_.compensator().model();
+  if (model.has_max_speed()) {
+    const JointVector& from = sent_any_ ? last_sent_ : feedback_;
+    for (int j = 0; j < command.size(); ++j) {
+      velocity = std::max(velocity, std::abs(command[j] - from[j]) / period_s_ / model.max_speed()[j]);
+    }
+  }
+  point_.sequence = next_sequence_;
+  point_.velocity = static_cast<float>(std::min(velocity, 1.0));
+  point_.duration_s = static_cast<float>(period_s_);
 }
 
 }  // namespace deflex

@@ -123,8 +123,18 @@ class SimpleMessageLink final : public ControllerLink {
   bool read_port(Port port, double now) noexcept;
   void discard_input() noexcept;
   bool handle_state_frame(const simple_message::FrameView& f, double now) noexcept;
+  void count_bad_decode(simple_message::DecodeStatus s) noexcept;
+  bool take_joint_position(const simple_message::FrameView& f, double now) noexcept;
+  bool take_robot_status(const simple_message::FrameView& f) noexcept;
   bool handle_motion_frame(const simple_message::FrameView& f, double now) noexcept;
+  bool reply_in_step(const simple_message::FrameView& f) noexcept;
+  bool take_reply(int reply_code, double now) noexcept;
+  bool within_deadlines(double now) noexcept;
+  bool begin_session(double now) noexcept;
   LinkPollResult send_point(double now) noexcept;
+  bool too_far_behind(double now) noexcept;
+  LinkCycle::Verdict plan_point(double now, bool& last) noexcept;
+  void fill_point(const JointVector& command) noexcept;
   bool flush() noexcept;
   void fault(LinkStopCause cause, const char* format, ...) noexcept __attribute__((format(printf, 3, 4)));
   void send_stop() noexcept;
