@@ -60,8 +60,7 @@ EgmPathLink::EgmPathLink(OnlineCompensator& compensator, OnlineStrategy& strateg
       delay_(config.initial_delay_s),
       jac_(6, compensator.model().dof()) {
   const int n = compensator.model().dof();
-  for (JointVector* q : {&feedback_, &planned_, &previous_feedback_, &velocity_, &target_, &sent_offset_joints_,
-                         &reference_, &previous_path_q_}) {
+  for (JointVector* q : {&feedback_, &planned_, &sent_offset_joints_, &reference_, &previous_path_q_}) {
     *q = JointVector::Zero(n);
   }
   tx_.assign(512, 0);
@@ -147,7 +146,7 @@ LinkPollResult EgmPathLink::poll(double timeout_s) noexcept {
       return announce_terminal();
     }
     cycle_.restart_from_zero(after_silence());
-    have_previous_ = false;  // the direction of travel is kept: the path is the same program
+    cycle_.motion().restart();  // the direction of travel is kept: the path is the same program
     state_ = LinkState::kRunning;
   }
 
@@ -163,28 +162,17 @@ void EgmPathLink::track_motion(double now, bool has_planned) noexcept {
   // TCP's step as the Jacobian at the feedback (the cycle's frames, no kinematics of its own) maps the
   // joints' step, exact to first order in a 4-48 ms step.
   const JointVector& path_q = has_planned ? planned_ : feedback_;
-  if (have_previous_) {
-    const double dt = now - previous_t_s_;
-    if (dt > 0.0) {
-      velocity_ += 0.5 * ((feedback_ - previous_feedback_) / dt - velocity_);
-      period_s_ = period_s_ > 0.0 ? period_s_ + 0.1 * (dt - period_s_) : dt;
-      if (config_.frame == PathCorrFrame::kPath) {
-        const Workspace& ws = cycle_.compensator().frames().at(feedback_);
-        point_jacobian(ws, ws.base_T_tcp.translation(), jac_);
-        const Vector3 step = jac_.topRows<3>() * (path_q - previous_path_q_);
-        if (step.norm() > 1e-6) {
-          travel_direction_ = step.normalized();
-          have_direction_ = true;
-        }
-      }
+  const double dt = cycle_.motion().observe(now, feedback_);
+  if (dt > 0.0 && config_.frame == PathCorrFrame::kPath) {
+    const Workspace& ws = cycle_.compensator().frames().at(feedback_);
+    point_jacobian(ws, ws.base_T_tcp.translation(), jac_);
+    const Vector3 step = jac_.topRows<3>() * (path_q - previous_path_q_);
+    if (step.norm() > 1e-6) {
+      travel_direction_ = step.normalized();
+      have_direction_ = true;
     }
-  } else {
-    velocity_.setZero();
   }
-  previous_feedback_ = feedback_;
-  previous_t_s_ = now;
   previous_path_q_ = path_q;
-  have_previous_ = true;
 
   if (has_planned) {
     reference_ = planned_ + sent_offset_joints_;
@@ -198,9 +186,7 @@ LinkPollResult EgmPathLink::answer(double now, std::uint32_t seqno, bool session
                                    std::chrono::steady_clock::time_point t_read) noexcept {
   // The correction sent now is applied after the servo delay, the channel's latency and on average
   // half a correction period: the predictive strategy evaluates it where the arm will be by then.
-  const double lead = delay_.delay_s() + config_.correction_latency_s + 0.5 * period_s_;
-  target_ = feedback_;
-  if (cycle_.strategy().kind() == StrategyKind::kPredictive) target_ += lead * velocity_;
+  const double lead = delay_.delay_s() + config_.correction_latency_s + 0.5 * cycle_.motion().period_s();
   Matrix3 base_R_frame = Matrix3::Identity();
   if (correction_frame(feedback_, base_R_frame)) {
     last_frame_ = base_R_frame;
@@ -211,7 +197,7 @@ LinkPollResult EgmPathLink::answer(double now, std::uint32_t seqno, bool session
   rq.sequence = seqno;
   rq.nominal = &planned_;
   rq.feedback = &feedback_;
-  rq.target = &target_;
+  rq.target = &cycle_.lead_target(feedback_, lead);
   rq.delay_s = delay_.delay_s();
   rq.lead_s = lead;
   // No frame yet (path coordinates before the arm moved): nothing can be expressed, the correction
@@ -223,7 +209,7 @@ LinkPollResult EgmPathLink::answer(double now, std::uint32_t seqno, bool session
   const auto compute = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_read).count(); };
   if (verdict != LinkCycle::Verdict::kSend) return cycle_not_passed(verdict, compute());
   // The rotation the model predicts, which this mode cannot correct.
-  const Workspace& at_target = cycle_.compensator().frames().at(target_);  // the compensator's, computed
+  const Workspace& at_target = cycle_.compensator().frames().at(*rq.target);  // the compensator's, computed
   point_jacobian(at_target, at_target.base_T_tcp.translation(), jac_);
   const double rotation = (jac_.bottomRows<3>() * cycle_.output().dtheta).norm();
   cycle_.note_uncorrected_rotation(rotation);

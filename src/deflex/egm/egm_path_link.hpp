@@ -65,7 +65,7 @@ class EgmPathLink final : public ControllerLink {
   [[nodiscard]] std::uint64_t rotation_warnings() const { return rotation_warnings_; }
   [[nodiscard]] double max_rotation_rad() const { return max_rotation_rad_; }
   /// The correction period the controller asks at (s, measured; 0 before two messages).
-  [[nodiscard]] double period_s() const { return period_s_; }
+  [[nodiscard]] double period_s() const { return cycle_.motion().period_s(); }
   [[nodiscard]] const EgmPathLinkConfig& config() const { return config_; }
 
  private:
@@ -82,15 +82,12 @@ class EgmPathLink final : public ControllerLink {
   DelayEstimator delay_;
   bool egm_ran_ = false;
 
-  JointVector feedback_, planned_, previous_feedback_, velocity_, target_;
+  JointVector feedback_, planned_;
   /// The joint motion the last offset sent asks of the controller (the arm's joints move by it,
   /// orientation held): the delay is measured between planned + this and the feedback, which carries
   /// the applied offset.
   JointVector sent_offset_joints_;
   JointVector reference_;
-  double previous_t_s_ = 0.0;
-  bool have_previous_ = false;
-  double period_s_ = 0.0;
   JointVector previous_path_q_;  // the joints the direction of travel was last taken from
   Vector3 travel_direction_ = Vector3::Zero();
   bool have_direction_ = false;

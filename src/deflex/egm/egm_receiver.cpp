@@ -71,6 +71,39 @@ bool EgmReceiver::plausible(const EgmRobotMessage& m) const noexcept {
   return true;
 }
 
+// Decodes the datagram in rx_ into msg_; a refused one is counted by its reason.
+bool EgmReceiver::decoded(std::size_t size) noexcept {
+  switch (codec_.decode_robot(rx_.data(), size, msg_)) {
+    case EgmDecodeStatus::kOk:
+      return true;
+    case EgmDecodeStatus::kMalformed:
+      ++counters_.malformed;
+      return false;
+    case EgmDecodeStatus::kTruncated:
+      ++counters_.truncated;
+      return false;
+    case EgmDecodeStatus::kMissingHeader:
+      ++counters_.missing_header;
+      return false;
+    case EgmDecodeStatus::kMissingJoints:
+      ++counters_.missing_joints;
+      return false;
+    case EgmDecodeStatus::kNonFinite:
+      ++counters_.non_finite;
+      return false;
+    case EgmDecodeStatus::kEmpty:
+      ++counters_.empty;
+      return false;
+    case EgmDecodeStatus::kSequenceOutOfRange:
+      ++counters_.sequence_out_of_range;
+      return false;
+    case EgmDecodeStatus::kMissingRequired:
+      ++counters_.missing_required;
+      return false;
+  }
+  return false;
+}
+
 EgmReceiver::Result EgmReceiver::drain(double timeout_s, bool& restarted) noexcept {
   restarted = false;
   if (!transport_.wait_readable(timeout_s)) {
@@ -91,34 +124,7 @@ EgmReceiver::Result EgmReceiver::drain(double timeout_s, bool& restarted) noexce
       ++counters_.oversized;
       continue;
     }
-    switch (codec_.decode_robot(rx_.data(), static_cast<std::size_t>(n), msg_)) {
-      case EgmDecodeStatus::kOk:
-        break;
-      case EgmDecodeStatus::kMalformed:
-        ++counters_.malformed;
-        continue;
-      case EgmDecodeStatus::kTruncated:
-        ++counters_.truncated;
-        continue;
-      case EgmDecodeStatus::kMissingHeader:
-        ++counters_.missing_header;
-        continue;
-      case EgmDecodeStatus::kMissingJoints:
-        ++counters_.missing_joints;
-        continue;
-      case EgmDecodeStatus::kNonFinite:
-        ++counters_.non_finite;
-        continue;
-      case EgmDecodeStatus::kEmpty:
-        ++counters_.empty;
-        continue;
-      case EgmDecodeStatus::kSequenceOutOfRange:
-        ++counters_.sequence_out_of_range;
-        continue;
-      case EgmDecodeStatus::kMissingRequired:
-        ++counters_.missing_required;
-        continue;
-    }
+    if (!decoded(static_cast<std::size_t>(n))) continue;
     // A packet whose joints no robot of this model can have (a corrupted or foreign sender) must not
     // be answered: its correction would be computed at a configuration that is not the arm's.
     if (!plausible(msg_)) {

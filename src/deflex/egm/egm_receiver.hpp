@@ -74,6 +74,7 @@ class EgmReceiver {
   [[nodiscard]] const LinkArrival& arrival() const { return arrival_; }
 
  private:
+  bool decoded(std::size_t size) noexcept;
   bool plausible(const EgmRobotMessage& m) const noexcept;
 
   DatagramTransport& transport_;

@@ -143,7 +143,8 @@ LinkCycle::LinkCycle(OnlineCompensator& compensator, OnlineStrategy& strategy, F
       force_(force),
       limits_(limits),
       counters_(counters),
-      history_(history_cycles, compensator.model().dof()) {
+      history_(history_cycles, compensator.model().dof()),
+      motion_(compensator.model().dof()) {
   const int n = compensator.model().dof();
   limits_.validate(n);
   for (JointVector* q : {&input_.q_planned, &input_.q_feedback, &command_, &previous_command_, &reference_,
@@ -151,6 +152,10 @@ LinkCycle::LinkCycle(OnlineCompensator& compensator, OnlineStrategy& strategy, F
     *q = JointVector::Zero(n);
   }
   record_ = history_.blank();
+}
+
+const JointVector& LinkCycle::lead_target(const JointVector& from, double lead_s) noexcept {
+  return motion_.lead(from, lead_s, strategy_.kind() == StrategyKind::kPredictive);
 }
 
 void LinkCycle::anchor_joints(const JointVector& q, bool after_silence) noexcept {
@@ -307,41 +312,48 @@ void LinkCycle::form_tcp_offset() noexcept {
   hold_near_last_sent();
 }
 
+// The final guard, in the form the wire carries: the bound against the nominal, the step from the
+// previous command (and from the last one sent, after a re-anchor without a silence).
 bool LinkCycle::guard(const JointVector* reference) noexcept {
+  return limits_.form == CommandForm::kTcpOffset ? guard_tcp_offset() : guard_joints(*reference);
+}
+
+bool LinkCycle::guard_tcp_offset() noexcept {
   LinkCycleRecord& r = record_;
-  constexpr double kRel = 1.0 + 1e-9;
-  if (limits_.form == CommandForm::kTcpOffset) {
-    r.deviation_m = offset_m_.norm();
-    r.step_m = have_previous_ ? (offset_m_ - previous_offset_m_).norm() : 0.0;
-    r.step_fraction = r.step_m / limits_.tcp_step_m;
-    if (!offset_m_.allFinite()) return refuse("the TCP offset is not finite: nothing sent");
-    if (r.deviation_m > limits_.tcp_bound_m * kRel + 1e-12) {
-      return refuse("the TCP offset %.6f mm is beyond the bound %.6f mm: nothing sent", r.deviation_m * 1e3,
-                    limits_.tcp_bound_m * 1e3);
-    }
-    if (r.step_m > limits_.tcp_step_m * kRel + 1e-12) {
-      return refuse("the TCP offset moved %.6f mm in one cycle, beyond the step limit %.6f mm: nothing sent",
-                    r.step_m * 1e3, limits_.tcp_step_m * 1e3);
-    }
-    if (hold_last_sent_) {
-      const double from_sent = (offset_m_ - last_sent_offset_m_).norm();
-      r.step_m = std::max(r.step_m, from_sent);
-      if (from_sent > limits_.tcp_step_m * kRel + 1e-12) {
-        return refuse(
-            "re-anchored without a silence, the TCP offset would move %.6f mm from the last offset sent, beyond the "
-            "step limit %.6f mm: nothing sent",
-            from_sent * 1e3, limits_.tcp_step_m * 1e3);
-      }
-    }
-    r.step_fraction = r.step_m / limits_.tcp_step_m;
-    return true;
+  r.deviation_m = offset_m_.norm();
+  r.step_m = have_previous_ ? (offset_m_ - previous_offset_m_).norm() : 0.0;
+  r.step_fraction = r.step_m / limits_.tcp_step_m;
+  if (!offset_m_.allFinite()) return refuse("the TCP offset is not finite: nothing sent");
+  if (r.deviation_m > limits_.tcp_bound_m * kRel + 1e-12) {
+    return refuse("the TCP offset %.6f mm is beyond the bound %.6f mm: nothing sent", r.deviation_m * 1e3,
+                  limits_.tcp_bound_m * 1e3);
   }
+  if (r.step_m > limits_.tcp_step_m * kRel + 1e-12) {
+    return refuse("the TCP offset moved %.6f mm in one cycle, beyond the step limit %.6f mm: nothing sent",
+                  r.step_m * 1e3, limits_.tcp_step_m * 1e3);
+  }
+  if (hold_last_sent_) {
+    const double from_sent = (offset_m_ - last_sent_offset_m_).norm();
+    r.step_m = std::max(r.step_m, from_sent);
+    if (from_sent > limits_.tcp_step_m * kRel + 1e-12) {
+      return refuse(
+          "re-anchored without a silence, the TCP offset would move %.6f mm from the last offset sent, beyond the "
+          "step limit %.6f mm: nothing sent",
+          from_sent * 1e3, limits_.tcp_step_m * 1e3);
+    }
+  }
+  r.step_fraction = r.step_m / limits_.tcp_step_m;
+  return true;
+}
+
+bool LinkCycle::guard_joints(const JointVector& reference) noexcept {
+  LinkCycleRecord& r = record_;
   double fraction = 0.0;
   for (int j = 0; j < command_.size(); ++j) {
     const double c = command_[j];
     if (!std::isfinite(c)) return refuse("joint %d of the command is not finite: nothing sent", j + 1);
     const double res = limits_.resolution_rad(c);
-    const double deviation = std::abs(c - (*reference)[j]);
+    const double deviation = std::abs(c - reference[j]);
     r.deviation_rad = std::max(r.deviation_rad, deviation);
     if (deviation > limits_.joint_bound_rad * kRel + res + 1e-12) {
       return refuse("joint %d of the command is %.6f deg from the nominal, beyond the bound %.6f deg: nothing sent",

@@ -26,6 +26,7 @@
 #include <limits>
 #include <string>
 
+#include "deflex/link/feedback_motion.hpp"
 #include "deflex/link/joint_stream.hpp"
 #include "deflex/link/link_history.hpp"
 #include "deflex/link/link_record.hpp"
@@ -183,6 +184,13 @@ class LinkCycle {
   [[nodiscard]] const OnlineCompensator& compensator() const { return comp_; }
   [[nodiscard]] OnlineCompensator& compensator() { return comp_; }
   [[nodiscard]] const OnlineStrategy& strategy() const { return strategy_; }
+  /// The arm's velocity from the feedback, for the links that correct a program the controller runs
+  /// (the predictive strategy's target there): the link observes each cycle's feedback into it.
+  [[nodiscard]] FeedbackMotion& motion() { return motion_; }
+  [[nodiscard]] const FeedbackMotion& motion() const { return motion_; }
+  /// The target of this cycle: `from` (the feedback or the planned joints), led by `lead_s` at the
+  /// feedback's velocity when the strategy is the predictive one.
+  [[nodiscard]] const JointVector& lead_target(const JointVector& from, double lead_s) noexcept;
   /// The last joint command sent (joint forms; valid once has_sent()).
   [[nodiscard]] const JointVector& last_command() const { return previous_command_; }
   [[nodiscard]] bool has_sent() const { return stats_.sent > 0; }
@@ -196,6 +204,9 @@ class LinkCycle {
   void form_tcp_offset() noexcept;
   void hold_near_last_sent() noexcept;
   bool guard(const JointVector* nominal_plus_blend) noexcept;
+  bool guard_tcp_offset() noexcept;
+  bool guard_joints(const JointVector& nominal_plus_blend) noexcept;
+  static constexpr double kRel = 1.0 + 1e-9;  // the guard's limits hold to rounding
   bool refuse(const char* format, ...) noexcept __attribute__((format(printf, 2, 3)));
   void finish(bool sent, double compute_s, double answer_s) noexcept;
 
@@ -206,6 +217,7 @@ class LinkCycle {
   CommandLimits limits_;
   LinkCounters& counters_;
   LinkHistory history_;
+  FeedbackMotion motion_;
   CycleInput input_;
   CycleOutput out_;
   JointVector command_, previous_command_, reference_, last_dtheta_;

@@ -90,7 +90,7 @@ RsiLink::RsiLink(OnlineCompensator& compensator, OnlineStrategy& strategy, Datag
   rx_.assign(config_.max_document_bytes + 1, 0);  // one byte more: an oversized datagram shows as such
   tx_.assign(kRsiMaxEncodedBytes, 0);
   for (RsiRobotMessage* m : {&msg_, &newest_}) m->actual_deg = m->setpoint_deg = JointVector::Zero(n);
-  for (JointVector* q : {&feedback_, &planned_, &previous_feedback_, &velocity_, &target_, &reply_.correction_deg}) {
+  for (JointVector* q : {&feedback_, &planned_, &reply_.correction_deg}) {
     *q = JointVector::Zero(n);
   }
 }
@@ -225,37 +225,23 @@ LinkPollResult RsiLink::poll(double timeout_s) noexcept {
       return announce_terminal();
     }
     cycle_.restart_from_zero(after_silence());
-    have_previous_ = false;
+    cycle_.motion().restart();
     state_ = LinkState::kRunning;
   }
 
   // The axes' velocity and the controller's period from the actual axes and the link's clock.
-  if (have_previous_) {
-    const double dt = now - previous_t_s_;
-    if (dt > 0.0) {
-      velocity_ += 0.5 * ((feedback_ - previous_feedback_) / dt - velocity_);
-      period_s_ = period_s_ > 0.0 ? period_s_ + 0.1 * (dt - period_s_) : dt;
-    }
-  } else {
-    velocity_.setZero();
-  }
-  previous_feedback_ = feedback_;
-  previous_t_s_ = now;
-  have_previous_ = true;
-
+  (void)cycle_.motion().observe(now, feedback_);
   if (m.has_setpoint) delay_.record_reference(now, planned_);
   delay_.observe_feedback(now, feedback_);
   // The correction sent now reaches the axes after the measured delay and AXISCORR's own latency:
   // the predictive strategy evaluates it where the program will be by then.
   const double lead = delay_.delay_s() + config_.correction_latency_s;
-  target_ = planned_;
-  if (cycle_.strategy().kind() == StrategyKind::kPredictive) target_ += lead * velocity_;
   CycleRequest rq;
   rq.t_s = now;
   rq.sequence = m.ipoc;
   rq.nominal = &planned_;
   rq.feedback = &feedback_;
-  rq.target = &target_;
+  rq.target = &cycle_.lead_target(planned_, lead);
   rq.delay_s = delay_.delay_s();
   rq.lead_s = lead;
   rq.session_start = session_start;

@@ -71,7 +71,7 @@ class RsiLink final : public ControllerLink {
   [[nodiscard]] std::string protocol_summary() const override;
   [[nodiscard]] const DatagramAddress& controller() const { return gate_.controller(); }
   /// The controller's cycle as its IPOCs show it (s; 0 before two documents).
-  [[nodiscard]] double period_s() const { return period_s_; }
+  [[nodiscard]] double period_s() const { return cycle_.motion().period_s(); }
   [[nodiscard]] const RsiLinkConfig& config() const { return config_; }
 
  protected:
@@ -97,9 +97,7 @@ class RsiLink final : public ControllerLink {
   JointVector lower_, upper_;
 
   // The cycle (preallocated).
-  JointVector feedback_, planned_, previous_feedback_, velocity_, target_;
-  double previous_t_s_ = 0.0, period_s_ = 0.0;
-  bool have_previous_ = false;
+  JointVector feedback_, planned_;
   RsiSensorMessage reply_;
 };
 

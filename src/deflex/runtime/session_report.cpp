@@ -84,10 +84,19 @@ void SessionReporter::on_force_source(const SessionEntry& e) {
   }
 }
 
+// Each cycle: written to the log and the ring, counted, checked for a silence or a restart worth a
+// line, and for the start or end of a fault episode.
 void SessionReporter::on_cycle(const SessionEntry& e) {
-  const LinkCycleRecord& r = e.record;
   ++cycles_;
   ++window_cycles_;
+  keep(e);
+  tally(e.record);
+  note_silence_and_restart(e);
+  track_faults(e);
+}
+
+void SessionReporter::keep(const SessionEntry& e) {
+  const LinkCycleRecord& r = e.record;
   if (log_) {
     try {
       log_->write(e);
@@ -103,7 +112,9 @@ void SessionReporter::on_cycle(const SessionEntry& e) {
   ring_[ring_head_] = e;
   ring_head_ = (ring_head_ + 1) % ring_.size();
   ring_count_ = std::min(ring_count_ + 1, ring_.size());
+}
 
+void SessionReporter::tally(const LinkCycleRecord& r) {
   compute_us_.add(r.compute_s * 1e6);
   arrival_ms_.add(r.arrival.arrival_delay_s * 1e3);
   window_compute_s_ = std::max(window_compute_s_, r.compute_s);
@@ -123,6 +134,19 @@ void SessionReporter::on_cycle(const SessionEntry& e) {
       window_program_dev_rad_ = std::max(window_program_dev_rad_, (r.q_command - r.q_nominal).cwiseAbs().maxCoeff());
     }
   }
+  // How far behind real time the program runs (streaming links, while it runs).
+  if (setup_.streams_program && r.replied) {
+    if (first_t_s_ < 0.0) {
+      first_t_s_ = r.t_s;
+      first_program_s_ = r.program_time_s;
+    } else if (r.program_time_s < setup_.program_start_s + setup_.program_duration_s) {
+      behind_s_ = std::max(0.0, (r.t_s - first_t_s_) - (r.program_time_s - first_program_s_));
+    }
+  }
+}
+
+void SessionReporter::note_silence_and_restart(const SessionEntry& e) {
+  const LinkCycleRecord& r = e.record;
   // A gap between cycles longer than a few controller cycles: a silence the link rode through.
   if (last_t_s_ >= 0.0) {
     const double gap = r.t_s - last_t_s_;
@@ -151,15 +175,10 @@ void SessionReporter::on_cycle(const SessionEntry& e) {
                           r.sequence));
     last_restarts_ = e.counters.restarts;
   }
-  // How far behind real time the program runs (streaming links, while it runs).
-  if (setup_.streams_program && r.replied) {
-    if (first_t_s_ < 0.0) {
-      first_t_s_ = r.t_s;
-      first_program_s_ = r.program_time_s;
-    } else if (r.program_time_s < setup_.program_start_s + setup_.program_duration_s) {
-      behind_s_ = std::max(0.0, (r.t_s - first_t_s_) - (r.program_time_s - first_program_s_));
-    }
-  }
+}
+
+void SessionReporter::track_faults(const SessionEntry& e) {
+  const LinkCycleRecord& r = e.record;
   // Fault episodes: a force fault, an invalid cycle, a guard trip or a message not answered.
   const bool guard = e.counters.guard_trips > last_guard_trips_;
   last_guard_trips_ = e.counters.guard_trips;

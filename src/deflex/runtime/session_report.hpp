@@ -107,6 +107,10 @@ class SessionReporter {
     return {setup_.link_name, setup_.period_s, setup_.force_components, setup_.force_fault_n};
   }
   void on_cycle(const SessionEntry& e);
+  void keep(const SessionEntry& e);
+  void tally(const LinkCycleRecord& r);
+  void note_silence_and_restart(const SessionEntry& e);
+  void track_faults(const SessionEntry& e);
   void begin_episode(const SessionEntry& e);
   void write_dump(const std::string& why);
   std::string status_line(double now_s);
