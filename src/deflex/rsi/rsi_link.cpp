@@ -233,6 +233,12 @@ LinkPollResult RsiLink::poll(double timeout_s) noexcept {
   (void)cycle_.motion().observe(now, feedback_);
   if (m.has_setpoint) delay_.record_reference(now, planned_);
   delay_.observe_feedback(now, feedback_);
+  return answer(m, now, session_start, t_read);
+}
+
+// The cycle for this message, and the answer: the whole AKorr offset, in degrees.
+LinkPollResult RsiLink::answer(const RsiRobotMessage& m, double now, bool session_start,
+                               std::chrono::steady_clock::time_point t_read) noexcept {
   // The correction sent now reaches the axes after the measured delay and AXISCORR's own latency:
   // the predictive strategy evaluates it where the program will be by then.
   const double lead = delay_.delay_s() + config_.correction_latency_s;

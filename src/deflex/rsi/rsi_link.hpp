@@ -17,6 +17,8 @@
 // the link too (or ends the session as planned, with end_on_silence, when the count was below it).
 #pragma once
 
+#include <chrono>
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -79,6 +81,8 @@ class RsiLink final : public ControllerLink {
   [[nodiscard]] bool silence_is_planned_end() const override;
 
  private:
+  LinkPollResult answer(const RsiRobotMessage& m, double now, bool session_start,
+                        std::chrono::steady_clock::time_point t_read) noexcept;
   enum class Drain { kNothing, kNoneUsable, kMessage };
   Drain drain(double timeout_s, bool& restarted) noexcept;
   [[nodiscard]] bool plausible(const RsiRobotMessage& m) const noexcept;

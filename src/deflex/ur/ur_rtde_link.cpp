@@ -414,33 +414,50 @@ bool UrRtdeLink::controller_ok(double now) noexcept {
   return true;
 }
 
-LinkPollResult UrRtdeLink::poll(double timeout_s) noexcept {
-  if (state_ == LinkState::kStopped || state_ == LinkState::kRefused) {
-    (void)flush();
-    if (!closed_) {
-      unsigned char sink[512];
-      for (long n = transport_.read(sink, sizeof(sink)); n > 0; n = transport_.read(sink, sizeof(sink))) {
-        if (state_ == LinkState::kRefused) ++counters_.refused;
-      }
+// A link that stopped reads what still comes (counted as refused when it refused to start) and says so.
+LinkPollResult UrRtdeLink::wind_down() noexcept {
+  (void)flush();
+  if (!closed_) {
+    unsigned char sink[512];
+    for (long n = transport_.read(sink, sizeof(sink)); n > 0; n = transport_.read(sink, sizeof(sink))) {
+      if (state_ == LinkState::kRefused) ++counters_.refused;
     }
-    return announce_terminal();
   }
+  return announce_terminal();
+}
+
+// A handshake the controller does not finish in time ends the link (a port that is not RTDE's).
+bool UrRtdeLink::handshake_overdue() noexcept {
+  if (phase_ == Phase::kStreaming) return false;
+  const double now = clock_.now_s();
+  if (handshake_start_s_ < 0.0) handshake_start_s_ = now;
+  const double limit = std::max(2.0, rules_.stop_silence_s);
+  if (now - handshake_start_s_ <= limit) return false;
+  stop_link(LinkStopCause::kSilent,
+            "the controller did not complete the RTDE handshake within %.1f s (no answer to deflex's %s): is this port "
+            "RTDE's (30004)?",
+            limit, phase_name(static_cast<int>(phase_)));
+  return true;
+}
+
+// The output package's fields the link reads: the actual joints and the controller's modes.
+void UrRtdeLink::take_state() noexcept {
+  rtde::DataView v;
+  (void)v.reset(out_recipe_, data_.data(), data_size_);
+  const std::array<double, 6> q = v.get_vector6d(kActualQ);
+  for (int j = 0; j < 6; ++j) feedback_[j] = q[static_cast<std::size_t>(j)];
+  robot_mode_ = v.get_int32(kRobotMode);
+  safety_mode_ = v.get_int32(kSafetyMode);
+  runtime_state_ = v.get_uint32(kRuntimeState);
+}
+
+LinkPollResult UrRtdeLink::poll(double timeout_s) noexcept {
+  if (state_ == LinkState::kStopped || state_ == LinkState::kRefused) return wind_down();
   if (!flush() || !send_request()) {
     stop_link(LinkStopCause::kConnection, "the RTDE connection is closed (a write failed)");
     return announce_terminal();
   }
-  if (phase_ != Phase::kStreaming) {
-    const double now = clock_.now_s();
-    if (handshake_start_s_ < 0.0) handshake_start_s_ = now;
-    const double limit = std::max(2.0, rules_.stop_silence_s);
-    if (now - handshake_start_s_ > limit) {
-      stop_link(LinkStopCause::kSilent,
-                "the controller did not complete the RTDE handshake within %.1f s (no answer to deflex's %s): is "
-                "this port RTDE's (30004)?",
-                limit, phase_name(static_cast<int>(phase_)));
-      return announce_terminal();
-    }
-  }
+  if (handshake_overdue()) return announce_terminal();
   if (!transport_.wait_readable(timeout_s) && rx_size_ == 0) {
     if (phase_ == Phase::kStreaming && apply_silence_rules(clock_.now_s())) return announce_terminal();
     return LinkPollResult::kIdle;
@@ -454,13 +471,7 @@ LinkPollResult UrRtdeLink::poll(double timeout_s) noexcept {
   }
   const double now = clock_.now_s();
   receipt_s_ = now;
-  rtde::DataView v;
-  (void)v.reset(out_recipe_, data_.data(), data_size_);
-  const std::array<double, 6> q = v.get_vector6d(kActualQ);
-  for (int j = 0; j < 6; ++j) feedback_[j] = q[static_cast<std::size_t>(j)];
-  robot_mode_ = v.get_int32(kRobotMode);
-  safety_mode_ = v.get_int32(kSafetyMode);
-  runtime_state_ = v.get_uint32(kRuntimeState);
+  take_state();
   if (!controller_ok(now)) return announce_terminal();
   if (runtime_state_ != 2) {
     if (playing_seen_) {

@@ -104,6 +104,9 @@ class UrRtdeLink final : public ControllerLink {
   [[nodiscard]] std::uint64_t partial_writes() const { return partial_writes_; }
 
  private:
+  LinkPollResult wind_down() noexcept;
+  bool handshake_overdue() noexcept;
+  void take_state() noexcept;
   enum class Phase { kVersion, kUrControl, kOutputs, kInputs, kStart, kStreaming };
 
   bool read_stream() noexcept;

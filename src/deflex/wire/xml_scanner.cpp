@@ -234,6 +234,15 @@ XmlToken XmlScanner::char_data() noexcept {
   return XmlToken::kText;
 }
 
+// How much of `lit` the input at pos_ matches: 1 all of it, 0 not, -1 it ends inside a match.
+int XmlScanner::prefix(std::string_view lit) const noexcept {
+  for (std::size_t i = 0; i < lit.size(); ++i) {
+    if (pos_ + i == end_) return -1;
+    if (pos_[i] != lit[i]) return 0;
+  }
+  return 1;
+}
+
 XmlToken XmlScanner::next() noexcept {
   if (error_ != XmlError::kNone) return XmlToken::kError;
   if (pending_end_) {
@@ -244,64 +253,71 @@ XmlToken XmlScanner::next() noexcept {
     if (depth_ == 0) where_ = Where::kEpilog;
     return XmlToken::kEnd;
   }
-  // How much of `lit` the input at pos_ matches: 1 all of it, 0 not, -1 it ends inside a match.
-  const auto prefix = [this](std::string_view lit) {
-    for (std::size_t i = 0; i < lit.size(); ++i) {
-      if (pos_ + i == end_) return -1;
-      if (pos_[i] != lit[i]) return 0;
-    }
-    return 1;
-  };
   if (first_) {
     first_ = false;
     if (prefix("<?xml") == 1 && pos_ + 5 < end_ && is_space(pos_[5])) {
       if (declaration() == XmlToken::kError) return XmlToken::kError;
     }
   }
-  for (;;) {
+  // A comment is skipped and the scan goes on; anything else is the token.
+  for (bool again = true; again;) {
+    again = false;
+    XmlToken t = XmlToken::kDone;
     switch (where_) {
       case Where::kDone:
         return XmlToken::kDone;
       case Where::kProlog:
-      case Where::kEpilog: {
-        skip_space();
-        if (pos_ == end_) {
-          if (where_ == Where::kProlog) return fail(XmlError::kTruncated, pos_);
-          where_ = Where::kDone;
-          return XmlToken::kDone;
-        }
-        if (*pos_ != '<') return fail(non_ascii(*pos_) ? XmlError::kUnsupported : XmlError::kSyntax, pos_);
-        const int comment_start = prefix("<!--");
-        if (comment_start == 1) {
-          if (comment() == XmlToken::kError) return XmlToken::kError;
-          continue;
-        }
-        if (comment_start < 0 || pos_ + 1 == end_) return fail(XmlError::kTruncated, pos_);
-        if (pos_[1] == '?' || pos_[1] == '!') return fail(XmlError::kUnsupported, pos_);  // PI, DOCTYPE
-        if (where_ == Where::kEpilog) return fail(XmlError::kSyntax, pos_);               // a second root element
-        return start_tag();
-      }
-      case Where::kContent: {
-        if (pos_ == end_) return fail(XmlError::kTruncated, pos_);
-        if (*pos_ != '<') return char_data();
-        if (pos_ + 1 == end_) return fail(XmlError::kTruncated, pos_);
-        if (pos_[1] == '/') return end_tag();
-        if (pos_[1] == '?') return fail(XmlError::kUnsupported, pos_);
-        if (pos_[1] == '!') {
-          const int comment_start = prefix("<!--");
-          if (comment_start < 0) return fail(XmlError::kTruncated, pos_);
-          if (comment_start == 0) {
-            const int cdata = prefix("<![CDATA[");
-            if (cdata < 0) return fail(XmlError::kTruncated, pos_);
-            return fail(cdata == 1 ? XmlError::kUnsupported : XmlError::kSyntax, pos_);
-          }
-          if (comment() == XmlToken::kError) return XmlToken::kError;
-          continue;
-        }
-        return start_tag();
-      }
+      case Where::kEpilog:
+        t = outside_root(again);
+        break;
+      case Where::kContent:
+        t = in_content(again);
+        break;
     }
+    if (!again) return t;
   }
+  return XmlToken::kDone;  // not reached: the loop returns
+}
+
+// Before and after the root element: space, comments and the root's start tag only.
+XmlToken XmlScanner::outside_root(bool& again) noexcept {
+  skip_space();
+  if (pos_ == end_) {
+    if (where_ == Where::kProlog) return fail(XmlError::kTruncated, pos_);
+    where_ = Where::kDone;
+    return XmlToken::kDone;
+  }
+  if (*pos_ != '<') return fail(non_ascii(*pos_) ? XmlError::kUnsupported : XmlError::kSyntax, pos_);
+  const int comment_start = prefix("<!--");
+  if (comment_start == 1) {
+    if (comment() == XmlToken::kError) return XmlToken::kError;
+    again = true;
+    return XmlToken::kDone;
+  }
+  if (comment_start < 0 || pos_ + 1 == end_) return fail(XmlError::kTruncated, pos_);
+  if (pos_[1] == '?' || pos_[1] == '!') return fail(XmlError::kUnsupported, pos_);  // PI, DOCTYPE
+  if (where_ == Where::kEpilog) return fail(XmlError::kSyntax, pos_);               // a second root element
+  return start_tag();
+}
+
+// Inside the root element: text, tags and comments (no CDATA, no processing instructions).
+XmlToken XmlScanner::in_content(bool& again) noexcept {
+  if (pos_ == end_) return fail(XmlError::kTruncated, pos_);
+  if (*pos_ != '<') return char_data();
+  if (pos_ + 1 == end_) return fail(XmlError::kTruncated, pos_);
+  if (pos_[1] == '/') return end_tag();
+  if (pos_[1] == '?') return fail(XmlError::kUnsupported, pos_);
+  if (pos_[1] != '!') return start_tag();
+  const int comment_start = prefix("<!--");
+  if (comment_start < 0) return fail(XmlError::kTruncated, pos_);
+  if (comment_start == 0) {
+    const int cdata = prefix("<![CDATA[");
+    if (cdata < 0) return fail(XmlError::kTruncated, pos_);
+    return fail(cdata == 1 ? XmlError::kUnsupported : XmlError::kSyntax, pos_);
+  }
+  if (comment() == XmlToken::kError) return XmlToken::kError;
+  again = true;
+  return XmlToken::kDone;
 }
 
 }  // namespace deflex

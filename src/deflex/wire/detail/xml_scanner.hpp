@@ -58,6 +58,9 @@ class XmlScanner {
   [[nodiscard]] std::size_t error_offset() const { return error_offset_; }
 
  private:
+  [[nodiscard]] int prefix(std::string_view lit) const noexcept;
+  XmlToken outside_root(bool& again) noexcept;
+  XmlToken in_content(bool& again) noexcept;
   enum class Where { kProlog, kContent, kEpilog, kDone };
   struct Attribute {
     std::string_view name, value;
