@@ -220,6 +220,37 @@ void Session::open_ur_rtde(const SessionEndpoints& endpoints, ForceSource* force
                         c.register_offset);
 }
 
+void Session::open_simple_message(const SessionEndpoints& endpoints, ForceSource* force,
+                                  std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules) {
+  const NetworkConfig& net = config_.network;
+  SimpleMessageLinkConfig c = config_.simple_message;
+  c.stop = rules;
+  c.history_cycles = config_.history_cycles;
+  c.validate();  // before any connection is made
+  StreamTransport* motion = endpoints.motion;
+  StreamTransport* state = endpoints.state;
+  if (motion == nullptr || state == nullptr) {
+    if (net.robot_host.empty()) {
+      throw InputError("option --robot-host: the simple-message link needs the controller's address");
+    }
+    if (!std::isfinite(net.connect_timeout_s) || !(net.connect_timeout_s > 0.0)) {
+      throw InputError(fmt::format("option --connect-timeout-s: must be > 0 (got {})", net.connect_timeout_s));
+    }
+    const std::uint16_t mp = port_option(net.motion_port, "--motion-port", "", 1);
+    const std::uint16_t sp = port_option(net.state_port, "--state-port", "", 1);
+    own_motion_ = TcpStream::connect(net.robot_host, mp, net.connect_timeout_s);
+    own_state_ = TcpStream::connect(net.robot_host, sp, net.connect_timeout_s);
+    motion = own_motion_.get();
+    state = own_state_.get();
+    where_ = fmt::format("simple message to {} (motion {}, state {}, {}-endian)", net.robot_host, mp, sp,
+                         simple_message::to_string(c.byte_order));
+  } else {
+    where_ = fmt::format("simple message ({}-endian)", simple_message::to_string(c.byte_order));
+  }
+  link_ = std::make_unique<SimpleMessageLink>(*compensator_, *strategy_, std::move(program), *motion, *state, clock_,
+                                              force, c);
+}
+
 void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
                         std::shared_ptr<const JointTrajectory> program) {
   const LinkKindInfo& info = link_kind(config_.link);
@@ -266,35 +297,9 @@ void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
       where_ = fmt::format("RSI on {}; answers <Sen Type=\"{}\">", to_string(t.local_address()), c.sentype);
       break;
     }
-    case LinkKind::kSimpleMessage: {
-      SimpleMessageLinkConfig c = config_.simple_message;
-      c.stop = rules;
-      c.history_cycles = config_.history_cycles;
-      c.validate();  // before any connection is made
-      StreamTransport* motion = endpoints.motion;
-      StreamTransport* state = endpoints.state;
-      if (motion == nullptr || state == nullptr) {
-        if (net.robot_host.empty()) {
-          throw InputError("option --robot-host: the simple-message link needs the controller's address");
-        }
-        if (!std::isfinite(net.connect_timeout_s) || !(net.connect_timeout_s > 0.0)) {
-          throw InputError(fmt::format("option --connect-timeout-s: must be > 0 (got {})", net.connect_timeout_s));
-        }
-        const std::uint16_t mp = port_option(net.motion_port, "--motion-port", "", 1);
-        const std::uint16_t sp = port_option(net.state_port, "--state-port", "", 1);
-        own_motion_ = TcpStream::connect(net.robot_host, mp, net.connect_timeout_s);
-        own_state_ = TcpStream::connect(net.robot_host, sp, net.connect_timeout_s);
-        motion = own_motion_.get();
-        state = own_state_.get();
-        where_ = fmt::format("simple message to {} (motion {}, state {}, {}-endian)", net.robot_host, mp, sp,
-                             simple_message::to_string(c.byte_order));
-      } else {
-        where_ = fmt::format("simple message ({}-endian)", simple_message::to_string(c.byte_order));
-      }
-      link_ = std::make_unique<SimpleMessageLink>(*compensator_, *strategy_, std::move(program), *motion, *state,
-                                                  clock_, force, c);
+    case LinkKind::kSimpleMessage:
+      open_simple_message(endpoints, force, std::move(program), rules);
       break;
-    }
     case LinkKind::kFanucJ519:
       open_fanuc_j519(endpoints, force, std::move(program), rules);
       break;
@@ -499,7 +504,14 @@ const SessionSummary& Session::finish() {
   return summary_;
 }
 
+// The summary: the session's figures, then the same as text (stderr) and as JSON (--summary-json).
 void Session::build_summary() {
+  gather_summary();
+  summary_.text = summary_text();
+  summary_.json_text = summary_json();
+}
+
+void Session::gather_summary() {
   SessionSummary& s = summary_;
   const ControllerLink& l = *link_;
   const LinkCounters& c = l.counters();
@@ -530,7 +542,12 @@ void Session::build_summary() {
     const std::lock_guard<std::mutex> lock(output_failure_mutex_);
     s.output_error = output_failure_;
   }
+}
 
+std::string Session::summary_text() const {
+  const SessionSummary& s = summary_;
+  const ControllerLink& l = *link_;
+  const LinkCounters& c = s.counters;
   const bool tcp = s.limits.form == CommandForm::kTcpOffset;
   const std::string invariants =
       tcp ? fmt::format(
@@ -591,8 +608,12 @@ void Session::build_summary() {
                         ? fmt::format(" ({} cycles never reached it: the disk was slower than the loop)", s.log_dropped)
                         : std::string());
   }
-  s.text = text;
+  return text;
+}
 
+std::string Session::summary_json() const {
+  const SessionSummary& s = summary_;
+  const LinkCounters& c = s.counters;
   const auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   nlohmann::json j = {{"link", s.link},
                       {"strategy", to_string(config_.strategy)},
@@ -638,7 +659,7 @@ void Session::build_summary() {
         {"time_s", s.program_time_s}, {"duration_s", program_->duration_s()}, {"behind_s", s.program_behind_s}};
   }
   // A path that is not UTF-8 (a log folder) is written with U+FFFD rather than refused.
-  s.json_text = j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace deflex::runtime

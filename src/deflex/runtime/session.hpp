@@ -129,6 +129,8 @@ class Session {
                        std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules);
   void open_motoros2_rt(const SessionEndpoints& endpoints, ForceSource* force,
                         std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules);
+  void open_simple_message(const SessionEndpoints& endpoints, ForceSource* force,
+                           std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules);
   void open_ur_rtde(const SessionEndpoints& endpoints, ForceSource* force,
                     std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules);
   void push(SessionEntry::Kind kind, double now) noexcept;
@@ -136,6 +138,9 @@ class Session {
   void reporter_loop();
   void drain_reporter(double now);
   void build_summary();
+  void gather_summary();
+  [[nodiscard]] std::string summary_text() const;
+  [[nodiscard]] std::string summary_json() const;
 
   SessionConfig config_;
   const Clock& clock_;
