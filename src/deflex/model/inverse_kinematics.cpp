@@ -25,7 +25,9 @@ void fill_errors(const RobotModel& model, Workspace& ws, const Pose& target, IkR
   r.orientation_error_rad = e.tail<3>().norm();
 }
 
-IkResult numerical_ik(const RobotModel& model, Workspace& ws, const Pose& target, const IkRequest& req) {
+// Where damped least squares starts: the caller's seed, zero, mid-range, and a few deterministic
+// spread starts (reproducible, and enough for reachable poses in practice).
+std::vector<JointVector> ik_starts(const RobotModel& model, const IkRequest& req) {
   const int n = model.dof();
   std::vector<JointVector> starts;
   if (req.seed) {
@@ -39,7 +41,6 @@ IkResult numerical_ik(const RobotModel& model, Workspace& ws, const Pose& target
   }
   starts.push_back(JointVector::Zero(n));
   starts.push_back(mid);
-  // A few deterministic spread starts: reproducible, and enough for reachable poses in practice.
   for (int k = 1; k <= 6; ++k) {
     JointVector s(n);
     for (int i = 0; i < n; ++i) {
@@ -47,38 +48,51 @@ IkResult numerical_ik(const RobotModel& model, Workspace& ws, const Pose& target
     }
     starts.push_back(s);
   }
+  return starts;
+}
+
+// Damped least squares from `start` (Levenberg-Marquardt on the pose error, steps of at most 0.3 rad
+// a joint, within the limits); returns the joints and their error norm.
+JointVector descend(const RobotModel& model, Workspace& ws, const Pose& target, const IkRequest& req,
+                    const JointVector& start, double& err_norm) {
+  Jacobian J;
+  JointVector q = start.cwiseMax(model.lower_limits()).cwiseMin(model.upper_limits());
+  double lambda = 1e-3;
+  err_norm = HUGE_VAL;
+  for (int it = 0; it < 300; ++it) {
+    forward_kinematics(model, ws, q);
+    const Displacement e = pose_difference(ws.base_T_tcp, target);
+    err_norm = e.norm();
+    if (e.head<3>().norm() < req.tolerance && e.tail<3>().norm() < req.tolerance) {
+      break;
+    }
+    point_jacobian(ws, ws.base_T_tcp.translation(), J);
+    const Matrix6 A = J * J.transpose() + lambda * lambda * Matrix6::Identity();
+    JointVector dq = J.transpose() * A.ldlt().solve(e);
+    const double step = dq.cwiseAbs().maxCoeff();
+    if (step > 0.3) {
+      dq *= 0.3 / step;
+    }
+    JointVector q_new = (q + dq).cwiseMax(model.lower_limits()).cwiseMin(model.upper_limits());
+    forward_kinematics(model, ws, q_new);
+    const double new_err = pose_difference(ws.base_T_tcp, target).norm();
+    if (new_err < err_norm) {
+      q = q_new;
+      lambda = std::max(1e-6, lambda * 0.5);
+    } else {
+      lambda = std::min(1.0, lambda * 4.0);
+    }
+  }
+  return q;
+}
+
+IkResult numerical_ik(const RobotModel& model, Workspace& ws, const Pose& target, const IkRequest& req) {
   IkResult best;
   best.status = IkStatus::kNotConverged;
   double best_err = HUGE_VAL;
-  Jacobian J;
-  for (const JointVector& start : starts) {
-    JointVector q = start.cwiseMax(model.lower_limits()).cwiseMin(model.upper_limits());
-    double lambda = 1e-3;
+  for (const JointVector& start : ik_starts(model, req)) {
     double err_norm = HUGE_VAL;
-    for (int it = 0; it < 300; ++it) {
-      forward_kinematics(model, ws, q);
-      const Displacement e = pose_difference(ws.base_T_tcp, target);
-      err_norm = e.norm();
-      if (e.head<3>().norm() < req.tolerance && e.tail<3>().norm() < req.tolerance) {
-        break;
-      }
-      point_jacobian(ws, ws.base_T_tcp.translation(), J);
-      const Matrix6 A = J * J.transpose() + lambda * lambda * Matrix6::Identity();
-      JointVector dq = J.transpose() * A.ldlt().solve(e);
-      const double step = dq.cwiseAbs().maxCoeff();
-      if (step > 0.3) {
-        dq *= 0.3 / step;
-      }
-      JointVector q_new = (q + dq).cwiseMax(model.lower_limits()).cwiseMin(model.upper_limits());
-      forward_kinematics(model, ws, q_new);
-      const double new_err = pose_difference(ws.base_T_tcp, target).norm();
-      if (new_err < err_norm) {
-        q = q_new;
-        lambda = std::max(1e-6, lambda * 0.5);
-      } else {
-        lambda = std::min(1.0, lambda * 4.0);
-      }
-    }
+    const JointVector q = descend(model, ws, target, req, start, err_norm);
     if (err_norm < best_err) {
       best_err = err_norm;
       best.q = q;
@@ -311,6 +325,25 @@ void fill_configuration(const RobotModel& model, IkResult& r) {
   opw_configuration(*model.opw(), r.q, r.configuration, r.kuka);
 }
 
+// The message when no solution has the configuration asked for: what was asked, what is on offer.
+std::string unavailable_configuration(const IkRequest& request,
+                                      const std::pair<ArmConfiguration, KukaConfiguration>* available, int count) {
+  std::string wanted;
+  if (request.configuration) {
+    const ArmConfiguration& w = *request.configuration;
+    wanted += fmt::format(" configuration [{},{},{},{}]", w.cf1, w.cf4, w.cf6, w.cfx);
+  }
+  if (request.kuka_configuration) {
+    wanted += fmt::format(" Status {} Turn {}", request.kuka_configuration->status, request.kuka_configuration->turn);
+  }
+  std::string offered;
+  for (int k = 0; k < count; ++k) {
+    offered += ' ';
+    offered += configuration_text(available[k].first, available[k].second);
+  }
+  return fmt::format("no solution with{}; available [cf1,cf4,cf6,cfx] (S T):{}", wanted, offered);
+}
+
 }  // namespace
 
 std::vector<IkResult> all_ik_solutions(const RobotModel& model, Workspace& ws, const Pose& base_T_tcp,
@@ -438,21 +471,7 @@ IkResult inverse_kinematics(const RobotModel& model, Workspace& ws, const Pose& 
   }
   if (!std::isfinite(best_score)) {
     fail.status = IkStatus::kConfigurationUnavailable;
-    std::string wanted;
-    if (request.configuration) {
-      const ArmConfiguration& w = *request.configuration;
-      wanted += fmt::format(" configuration [{},{},{},{}]", w.cf1, w.cf4, w.cf6, w.cfx);
-    }
-    if (request.kuka_configuration) {
-      wanted += fmt::format(" Status {} Turn {}", request.kuka_configuration->status, request.kuka_configuration->turn);
-    }
-    std::string offered;
-    for (int k = 0; k < available_count; ++k) {
-      offered += ' ';
-      offered += configuration_text(available[static_cast<std::size_t>(k)].first,
-                                    available[static_cast<std::size_t>(k)].second);
-    }
-    fail.message = fmt::format("no solution with{}; available [cf1,cf4,cf6,cfx] (S T):{}", wanted, offered);
+    fail.message = unavailable_configuration(request, available.data(), available_count);
     return fail;
   }
   best.analytic = true;
