@@ -69,62 +69,28 @@ SensorConfig load_sensor_config_or_defaults(const std::string& yaml_path) {
   return load_sensor_config(yaml_path);
 }
 
-SensorConfig load_sensor_config(const std::string& yaml_path) {
-  const yaml::Field root = yaml::Field::load_file(yaml_path);
-  root.only_keys({"deflex_sensor", "name", "components", "sample_rate_hz", "crosstalk", "flange_T_sensor_m_deg", "bias",
-                  "payload", "gravity_base_m_s2", "lowpass", "dead_band", "fault_threshold"});
-  SensorConfig c;
-  c.source = yaml_path;
-  c.name = root.get("name", c.name);
-  c.components = root.get("components", c.components);
-  if (c.components != 3 && c.components != 6) {
-    root.at("components").fail("must be 3 or 6");
+namespace {
+
+// The crosstalk matrix: a 3x3 or 6x6 list of rows, not singular.
+void read_crosstalk(const yaml::Field& m, SensorConfig& c) {
+  const std::size_t n = m.size();
+  if (!m.is_sequence() || (n != 3 && n != 6)) {
+    m.fail("must be a 3x3 or 6x6 matrix written as a list of rows");
   }
-  c.sample_rate_hz = root.get("sample_rate_hz", c.sample_rate_hz);
-  if (root.has("crosstalk")) {
-    const yaml::Field m = root.at("crosstalk");
-    const std::size_t n = m.size();
-    if (!m.is_sequence() || (n != 3 && n != 6)) {
-      m.fail("must be a 3x3 or 6x6 matrix written as a list of rows");
-    }
-    c.crosstalk.setIdentity();
-    for (std::size_t r = 0; r < n; ++r) {
-      const std::vector<double> row = m.at(r).as_doubles(n);
-      for (std::size_t k = 0; k < n; ++k) {
-        c.crosstalk(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k)) = row[k];
-      }
-    }
-    if (std::abs(c.crosstalk.determinant()) < 1e-12) {
-      m.fail("matrix is singular");
+  c.crosstalk.setIdentity();
+  for (std::size_t r = 0; r < n; ++r) {
+    const std::vector<double> row = m.at(r).as_doubles(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      c.crosstalk(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k)) = row[k];
     }
   }
-  if (root.has("flange_T_sensor_m_deg")) {
-    c.flange_T_sensor = yaml::parse_pose(root.at("flange_T_sensor_m_deg"), 1.0, deg_to_rad(1.0));
+  if (std::abs(c.crosstalk.determinant()) < 1e-12) {
+    m.fail("matrix is singular");
   }
-  if (root.has("bias")) {
-    const yaml::Field b = root.at("bias");
-    b.only_keys({"force_N", "moment_Nm"});
-    if (b.has("force_N")) {
-      c.bias_sensor.head<3>() = read_vector3(b.at("force_N"));
-    }
-    if (b.has("moment_Nm")) {
-      c.bias_sensor.tail<3>() = read_vector3(b.at("moment_Nm"));
-    }
-  }
-  if (root.has("payload")) {
-    const yaml::Field p = root.at("payload");
-    p.only_keys({"mass_kg", "cog_sensor_m"});
-    c.payload_mass_kg = p.get("mass_kg", 0.0);
-    if (c.payload_mass_kg < 0.0) {
-      p.at("mass_kg").fail("must be >= 0");
-    }
-    if (p.has("cog_sensor_m")) {
-      c.payload_cog_sensor_m = read_vector3(p.at("cog_sensor_m"));
-    }
-  }
-  if (root.has("gravity_base_m_s2")) {
-    c.gravity_base_m_s2 = read_vector3(root.at("gravity_base_m_s2"));
-  }
+}
+
+// The conditioning the online cycle applies: the low-pass filter, the dead band, the fault threshold.
+void read_conditioning(const yaml::Field& root, SensorConfig& c) {
   if (root.has("lowpass")) {
     const yaml::Field l = root.at("lowpass");
     l.only_keys({"cutoff_hz", "order"});
@@ -155,6 +121,51 @@ SensorConfig load_sensor_config(const std::string& yaml_path) {
       t.fail("must be above the dead band");
     }
   }
+}
+
+}  // namespace
+
+SensorConfig load_sensor_config(const std::string& yaml_path) {
+  const yaml::Field root = yaml::Field::load_file(yaml_path);
+  root.only_keys({"deflex_sensor", "name", "components", "sample_rate_hz", "crosstalk", "flange_T_sensor_m_deg", "bias",
+                  "payload", "gravity_base_m_s2", "lowpass", "dead_band", "fault_threshold"});
+  SensorConfig c;
+  c.source = yaml_path;
+  c.name = root.get("name", c.name);
+  c.components = root.get("components", c.components);
+  if (c.components != 3 && c.components != 6) {
+    root.at("components").fail("must be 3 or 6");
+  }
+  c.sample_rate_hz = root.get("sample_rate_hz", c.sample_rate_hz);
+  if (root.has("crosstalk")) read_crosstalk(root.at("crosstalk"), c);
+  if (root.has("flange_T_sensor_m_deg")) {
+    c.flange_T_sensor = yaml::parse_pose(root.at("flange_T_sensor_m_deg"), 1.0, deg_to_rad(1.0));
+  }
+  if (root.has("bias")) {
+    const yaml::Field b = root.at("bias");
+    b.only_keys({"force_N", "moment_Nm"});
+    if (b.has("force_N")) {
+      c.bias_sensor.head<3>() = read_vector3(b.at("force_N"));
+    }
+    if (b.has("moment_Nm")) {
+      c.bias_sensor.tail<3>() = read_vector3(b.at("moment_Nm"));
+    }
+  }
+  if (root.has("payload")) {
+    const yaml::Field p = root.at("payload");
+    p.only_keys({"mass_kg", "cog_sensor_m"});
+    c.payload_mass_kg = p.get("mass_kg", 0.0);
+    if (c.payload_mass_kg < 0.0) {
+      p.at("mass_kg").fail("must be >= 0");
+    }
+    if (p.has("cog_sensor_m")) {
+      c.payload_cog_sensor_m = read_vector3(p.at("cog_sensor_m"));
+    }
+  }
+  if (root.has("gravity_base_m_s2")) {
+    c.gravity_base_m_s2 = read_vector3(root.at("gravity_base_m_s2"));
+  }
+  read_conditioning(root, c);
   if (c.components == 3) {
     // A 3-component sensor measures no moments: its bias moments are meaningless.
     c.bias_sensor.tail<3>().setZero();
