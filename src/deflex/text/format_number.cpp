@@ -33,6 +33,42 @@ void ten_digits(char* d, std::uint64_t n) noexcept {
   }
 }
 
+// The `len` significant digits `d` of a number of decimal exponent `e` as %g writes them: with an
+// exponent below 1e-4, else plain.
+char* place_digits(char* p, const char* d, int len, int e) noexcept {
+  if (e < -4) {  // d.ddde-XX; e >= -13 here, so two exponent digits
+    *p++ = d[0];
+    if (len > 1) {
+      *p++ = '.';
+      std::memcpy(p, d + 1, static_cast<std::size_t>(len - 1));
+      p += len - 1;
+    }
+    const int x = -e;
+    *p++ = 'e';
+    *p++ = '-';
+    *p++ = static_cast<char>('0' + x / 10);
+    *p++ = static_cast<char>('0' + x % 10);
+  } else if (e >= 0) {  // integer digits, then what is left of the ten
+    const int whole_digits = e + 1;
+    std::memcpy(p, d, static_cast<std::size_t>(whole_digits));
+    p += whole_digits;
+    if (len > whole_digits) {
+      *p++ = '.';
+      std::memcpy(p, d + whole_digits, static_cast<std::size_t>(len - whole_digits));
+      p += len - whole_digits;
+    }
+  } else {  // 0.000ddd
+    *p++ = '0';
+    *p++ = '.';
+    for (int k = 0; k < -e - 1; ++k) {
+      *p++ = '0';
+    }
+    std::memcpy(p, d, static_cast<std::size_t>(len));
+    p += len;
+  }
+  return p;
+}
+
 }  // namespace
 
 char* format_g10(char* out, double v) noexcept {
@@ -91,37 +127,7 @@ char* format_g10(char* out, double v) noexcept {
   if (v < 0.0) {
     *p++ = '-';
   }
-  if (e < -4) {  // d.ddde-XX; e >= -13 here, so two exponent digits
-    *p++ = d[0];
-    if (len > 1) {
-      *p++ = '.';
-      std::memcpy(p, d + 1, static_cast<std::size_t>(len - 1));
-      p += len - 1;
-    }
-    const int x = -e;
-    *p++ = 'e';
-    *p++ = '-';
-    *p++ = static_cast<char>('0' + x / 10);
-    *p++ = static_cast<char>('0' + x % 10);
-  } else if (e >= 0) {  // integer digits, then what is left of the ten
-    const int whole_digits = e + 1;
-    std::memcpy(p, d, static_cast<std::size_t>(whole_digits));
-    p += whole_digits;
-    if (len > whole_digits) {
-      *p++ = '.';
-      std::memcpy(p, d + whole_digits, static_cast<std::size_t>(len - whole_digits));
-      p += len - whole_digits;
-    }
-  } else {  // 0.000ddd
-    *p++ = '0';
-    *p++ = '.';
-    for (int k = 0; k < -e - 1; ++k) {
-      *p++ = '0';
-    }
-    std::memcpy(p, d, static_cast<std::size_t>(len));
-    p += len;
-  }
-  return p;
+  return place_digits(p, d, len, e);
 }
 
 }  // namespace deflex
