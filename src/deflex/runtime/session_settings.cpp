@@ -136,6 +136,10 @@ void bound_settings(std::vector<SessionSetting>& t) {
                     .help = "bound on the TCP displacement of the correction",
                     .why = "a compliance correction is a few millimetres"},
                    [](C& c) -> double& { return c.online.max_tcp_correction_m; }));
+}
+
+// How fast the correction may change, and where its Jacobian is taken.
+void rate_settings(std::vector<SessionSetting>& t) {
   t.push_back(real({.key = "max_correction_rate_rad_s",
                     .option = "--max-rate-deg-s",
                     .unit = "rad/s",
@@ -186,7 +190,7 @@ void bound_settings(std::vector<SessionSetting>& t) {
       }));
 }
 
-// When a session ends, and what it writes.
+// When a session ends.
 void stop_settings(std::vector<SessionSetting>& t) {
   t.push_back({.key = "stop_silence_s",
                .option = "--stop-silence-s",
@@ -230,6 +234,10 @@ void stop_settings(std::vector<SessionSetting>& t) {
                     .help = "a planned stop while moving: streamed programs come to rest on their path over this "
                             "long, corrections ramp out at the rate bound; a second stop request stops at once"},
                    [](C& c) -> double& { return c.stop_ramp_s; }));
+}
+
+// What a session reports and writes while it runs, and how its loop is scheduled.
+void report_settings(std::vector<SessionSetting>& t) {
   t.push_back(real({.key = "status_interval_s",
                     .option = "--status-interval-s",
                     .unit = "s",
@@ -341,7 +349,8 @@ void network_settings(std::vector<SessionSetting>& t) {
                    [](C& c) -> double& { return c.network.connect_timeout_s; }));
 }
 
-void egm_rsi_settings(std::vector<SessionSetting>& t) {
+// ABB EGM's own settings (the ramp-in is the streaming links').
+void egm_settings(std::vector<SessionSetting>& t) {
   t.push_back(real({.key = "ramp_in_s",
                     .option = "--ramp-in-s",
                     .unit = "s",
@@ -391,6 +400,10 @@ void egm_rsi_settings(std::vector<SessionSetting>& t) {
                     .help = "report when the model predicts a TCP rotation above this (path correction cannot "
                             "correct it)"},
                    [](C& c) -> double& { return c.egm_path.rotation_warning_rad; }));
+}
+
+// KUKA RSI's own settings.
+void rsi_settings(std::vector<SessionSetting>& t) {
   t.push_back(text(
       {.key = "rsi_sentype",
        .option = "--rsi-sentype",
@@ -688,9 +701,12 @@ void force_settings(std::vector<SessionSetting>& t) {
 std::vector<SessionSetting> make_table() {
   std::vector<SessionSetting> t;
   bound_settings(t);
+  rate_settings(t);
   stop_settings(t);
+  report_settings(t);
   network_settings(t);
-  egm_rsi_settings(t);
+  egm_settings(t);
+  rsi_settings(t);
   simple_message_settings(t);
   fanuc_settings(t);
   motoros2_settings(t);
