@@ -35,13 +35,25 @@ Strategy parse_strategy(const yaml::Field& f) {
   f.fail("unknown strategy '" + s + "' (offline, online, hybrid, predictive)");
 }
 
-LinkKind parse_link(const yaml::Field& f) {
+// The links `pick` accepts, by name: "program, egm-joint, ...".
+std::string link_names(bool (*pick)(LinkKind)) {
+  std::string names;
+  for (LinkKind k : kAllLinks) {
+    if (pick(k)) names += (names.empty() ? "" : ", ") + std::string(to_string(k));
+  }
+  return names;
+}
+
+bool any_link(LinkKind) { return true; }
+bool controller_link(LinkKind k) { return k != LinkKind::kProgram; }
+bool streaming_link(LinkKind k) { return streams_program(k); }
+
+LinkKind parse_link(const yaml::Field& f, const std::string& setup) {
   const std::string s = f.as_string();
-  if (s == "program") return LinkKind::kProgram;
-  if (s == "egm-joint") return LinkKind::kEgmJoint;
-  if (s == "egm-path") return LinkKind::kEgmPath;
-  if (s == "simple-message") return LinkKind::kSimpleMessage;
-  f.fail("unknown link '" + s + "' (program, egm-joint, egm-path, simple-message)");
+  for (LinkKind k : kAllLinks) {
+    if (s == to_string(k)) return k;
+  }
+  f.fail(fmt::format("setup '{}': unknown link '{}' ({})", setup, s, link_names(any_link)));
 }
 
 double positive(const yaml::Field& f) {
@@ -95,8 +107,33 @@ const char* to_string(LinkKind k) {
       return "egm-path";
     case LinkKind::kSimpleMessage:
       return "simple-message";
+    case LinkKind::kRsi:
+      return "rsi";
+    case LinkKind::kFanucJ519:
+      return "fanuc-j519";
+    case LinkKind::kMotoros2Rt:
+      return "motoros2-rt";
+    case LinkKind::kUrRtde:
+      return "ur-rtde";
   }
   return "?";
+}
+
+bool streams_program(LinkKind k) { return k != LinkKind::kProgram && k != LinkKind::kEgmPath && k != LinkKind::kRsi; }
+
+std::vector<std::size_t> budget_setups(const CaseConfig& config) {
+  std::vector<std::size_t> out;
+  bool have_offline = false, have_online = false;
+  for (std::size_t i = 0; i < config.setups.size(); ++i) {
+    const SetupConfig& sc = config.setups[i];
+    const bool offline = sc.strategy == Strategy::kOffline && !have_offline;
+    const bool online = sc.strategy == Strategy::kOnline && sc.link == LinkKind::kEgmJoint && !have_online;
+    if (!offline && !online) continue;
+    have_offline = have_offline || offline;
+    have_online = have_online || online;
+    out.push_back(i);
+  }
+  return out;
 }
 
 double CaseConfig::radius_m() const { return cell.ldbb.bar_length_m * std::cos(cell.ldbb.inclination_rad); }
@@ -192,13 +229,19 @@ SetupConfig read_case_setup(const yaml::Field& s, const std::vector<SetupConfig>
   sc.name = s.at("name").as_string();
   sc.strategy = parse_strategy(s.at("strategy"));
   sc.link = sc.strategy == Strategy::kOffline ? LinkKind::kProgram : LinkKind::kEgmJoint;
-  if (s.has("link")) sc.link = parse_link(s.at("link"));
+  if (s.has("link")) sc.link = parse_link(s.at("link"), sc.name);
   if (sc.strategy == Strategy::kOffline && sc.link != LinkKind::kProgram)
-    s.at("link").fail("the offline strategy runs a program: its link is 'program'");
-  if (sc.strategy != Strategy::kOffline && sc.link == LinkKind::kProgram)
-    s.at("link").fail("an online strategy needs a controller link (egm-joint, egm-path or simple-message)");
-  if (sc.strategy == Strategy::kHybrid && sc.link == LinkKind::kEgmPath)
-    s.at("link").fail("the hybrid strategy streams the offline program: its link is egm-joint or simple-message");
+    s.at("link").fail(fmt::format("setup '{}': the offline strategy runs a program: its link is 'program'", sc.name));
+  if (sc.strategy != Strategy::kOffline && sc.link == LinkKind::kProgram) {
+    s.at("link").fail(fmt::format("setup '{}': an online strategy needs a controller link ({})", sc.name,
+                                  link_names(controller_link)));
+  }
+  // The study's hybrid strategy is the offline program streamed with an online correction on top: a
+  // link over which the controller runs its own program (and deflex sends offsets) has no such stream.
+  if (sc.strategy == Strategy::kHybrid && !streams_program(sc.link)) {
+    s.at("link").fail(fmt::format("setup '{}': the hybrid strategy streams the offline program: its link is one of {}",
+                                  sc.name, link_names(streaming_link)));
+  }
   sc.sensor_mounted = s.at("sensor").as_bool();
   if (sc.strategy != Strategy::kOffline && !sc.sensor_mounted) s.at("sensor").fail("online strategies need the sensor");
   for (const auto& other : others) {
@@ -542,7 +585,8 @@ void read_case_drift_and_budget(const yaml::Field& root, CaseConfig& c) {
     b.only_keys({"speed_mm_s", "load_index"});
     c.budget.speed_m_s = positive(b.at("speed_mm_s")) * kMm;
     c.budget.load_index = b.at("load_index").as_int();
-    for (const auto& sc : c.setups) {
+    for (std::size_t i : budget_setups(c)) {
+      const SetupConfig& sc = c.setups[i];
       if (c.budget.load_index < 0 || c.budget.load_index >= static_cast<int>(sc.loads_n.size())) {
         b.at("load_index").fail(fmt::format("out of range for setup '{}'", sc.name));
       }
