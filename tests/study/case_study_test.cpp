@@ -250,7 +250,9 @@ TEST(CaseStudy, EveryFurtherControllerLinkCompensatesTheLoad) {
     EXPECT_LE(l.max_command_deviation_rad, l.bound_rad);
     // The streaming links measure their delay from the controller's feedback; RSI's stand-in reports its
     // axes without lag, so its link has none to measure.
-    if (c.setups[i].link != LinkKind::kRsi) EXPECT_GT(l.measured_delay_s, 0.0);
+    if (c.setups[i].link != LinkKind::kRsi) {
+      EXPECT_GT(l.measured_delay_s, 0.0);
+    }
     EXPECT_FALSE(l.controller_note.empty());
     // The row's figures are the setup's, and C is well under UC.
     EXPECT_DOUBLE_EQ(l.load_n, 650.0);
