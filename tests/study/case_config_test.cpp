@@ -124,6 +124,16 @@ TEST(CaseConfig, AnUnknownOrRefusedLinkNamesTheSetupAndTheLinks) {
             "");
 }
 
+TEST(CaseConfig, SettingsTheRuntimeRefusesForALinkAreRefusedNamingTheSetup) {
+  // deflex online bounds a joint's correction rate at 30 deg/s (0.52 rad/s); the case's own check takes
+  // any positive rate, the runtime's refuses 1 rad/s for the first setup that runs over a link.
+  const std::string fast = error_of(paper_with("max_rate_mrad_s: 50", "max_rate_mrad_s: 1000"));
+  EXPECT_NE(fast.find("setups[2]"), std::string::npos) << fast;
+  EXPECT_NE(fast.find("setup 'online'"), std::string::npos) << fast;
+  EXPECT_NE(fast.find("--link egm-joint"), std::string::npos) << fast;
+  EXPECT_NE(fast.find("max_correction_rate_rad_s"), std::string::npos) << fast;
+}
+
 TEST(CaseConfig, TheBudgetsLoadIndexIsCheckedOnTheSetupsTheBudgetRuns) {
   // A setup the budget does not run may have one load; the budget's own setups must have the index.
   EXPECT_EQ(error_of(paper_case_yaml()), "");  // the links' setups have one load, the index is 2

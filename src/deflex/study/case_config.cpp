@@ -12,6 +12,7 @@
 #include <optional>
 #include <sstream>
 
+#include "deflex/runtime/session_settings.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/input_file.hpp"
 #include "deflex/text/yaml_fields.hpp"
@@ -120,6 +121,21 @@ const char* to_string(LinkKind k) {
 }
 
 bool streams_program(LinkKind k) { return k != LinkKind::kProgram && k != LinkKind::kEgmPath && k != LinkKind::kRsi; }
+
+double link_period_s(const CaseConfig& config, LinkKind link) {
+  switch (link) {
+    case LinkKind::kEgmJoint:
+      return config.cell.controller.egm_period_s;
+    case LinkKind::kEgmPath:
+      return config.cell.controller.path_corr_period_s;
+    case LinkKind::kSimpleMessage:
+      return config.online.stream_period_s;
+    case LinkKind::kProgram:
+      return 0.0;
+    default:
+      return runtime::default_session_config(runtime::parse_link_kind(to_string(link))).online.period_s;
+  }
+}
 
 std::vector<std::size_t> budget_setups(const CaseConfig& config) {
   std::vector<std::size_t> out;
@@ -596,6 +612,50 @@ void read_case_drift_and_budget(const yaml::Field& root, CaseConfig& c) {
 
 }  // namespace
 
+namespace {
+
+// What `deflex online --link L --strategy S` would be given for a setup's runs: the case's online
+// section (the watchdog at least two cycles, as the study runs it), each setting the link takes.
+std::vector<runtime::GivenSetting> runtime_settings(const CaseConfig& c, const SetupConfig& sc) {
+  const runtime::LinkKind kind = runtime::parse_link_kind(to_string(sc.link));
+  const double period_s = link_period_s(c, sc.link);
+  const std::pair<const char*, runtime::SettingValue> values[] = {
+      {"period_s", period_s},
+      {"max_joint_correction_rad", c.online.max_joint_correction_rad},
+      {"max_tcp_correction_m", c.online.max_tcp_correction_m},
+      {"max_correction_rate_rad_s", c.online.max_rate_rad_s},
+      {"max_tcp_rate_m_s", c.online.max_tcp_rate_m_s},
+      {"watchdog_s", std::max(c.online.watchdog_s, 2.0 * period_s)},
+      {"ramp_in_s", c.online.ramp_in_s},
+      {"buffer_depth", static_cast<double>(c.online.stream_buffer_depth)},
+      {"path_corr_frame", c.cell.controller.path_corr_frame}};
+  std::vector<runtime::GivenSetting> given;
+  for (const auto& [key, value] : values) {
+    const runtime::SessionSetting* s = runtime::find_session_setting(key);
+    if (s != nullptr && (s->links & runtime::link_bit(kind)) != 0) given.push_back({s, value});
+  }
+  return given;
+}
+
+// Every online setup's link, strategy and the case's settings as the runtime takes them: what
+// `deflex online` would refuse, the case refuses, naming the setup.
+void check_setups_with_runtime(const yaml::Field& root, const CaseConfig& c) {
+  for (std::size_t i = 0; i < c.setups.size(); ++i) {
+    const SetupConfig& sc = c.setups[i];
+    if (sc.link == LinkKind::kProgram) continue;
+    try {
+      (void)runtime::make_session_config(to_string(sc.link), to_string(sc.strategy), runtime_settings(c, sc));
+    } catch (const InputError& e) {
+      root.at("setups").at(i).fail(
+          fmt::format("setup '{}': deflex online --link {} --strategy {} refuses the "
+                      "case's settings: {}",
+                      sc.name, to_string(sc.link), to_string(sc.strategy), e.what()));
+    }
+  }
+}
+
+}  // namespace
+
 CaseConfig load_case_text(const std::string& text, const std::string& source) {
   const yaml::Field root = yaml::Field::load_string(text, source);
   root.only_keys({"deflex_case", "name", "robot", "seed", "circle", "protocol", "setups", "true_robot", "tool",
@@ -617,6 +677,7 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   read_case_online(root, c);
   read_case_calibration(root, c);
   read_case_drift_and_budget(root, c);
+  check_setups_with_runtime(root, c);
   return c;
 }
 

@@ -46,6 +46,10 @@ inline constexpr std::array<LinkKind, 8> kAllLinks = {
 [[nodiscard]] const char* to_string(LinkKind k);
 /// Whether deflex streams the program over the link (the controller then runs none of its own).
 [[nodiscard]] bool streams_program(LinkKind k);
+struct CaseConfig;
+/// The controller's cycle deflex runs a link at in the study (s): EGM's and simple message's from the
+/// case file, every other link's the runtime's default (0 for kProgram).
+[[nodiscard]] double link_period_s(const CaseConfig& config, LinkKind link);
 
 /// One strategy setup of the protocol (a row group of the paper's tables).
 struct SetupConfig {

@@ -355,11 +355,7 @@ runtime::LinkKind runtime_link(LinkKind link) {
 runtime::SessionConfig session_config_of(const CaseConfig& config, const RunSpec& spec, bool compensated) {
   const cell::CellConfig& c = config.cell;
   runtime::SessionConfig sc = runtime::default_session_config(runtime_link(spec.link));
-  double period_s = sc.online.period_s;
-  if (spec.link == LinkKind::kEgmJoint) period_s = c.controller.egm_period_s;
-  if (spec.link == LinkKind::kEgmPath) period_s = c.controller.path_corr_period_s;
-  if (spec.link == LinkKind::kSimpleMessage) period_s = config.online.stream_period_s;
-  sc.online = online_config_from_case(config, period_s);
+  if (spec.link != LinkKind::kProgram) sc.online = online_config_from_case(config, link_period_s(config, spec.link));
   sc.strategy = StrategyKind::kNone;
   if (compensated) {
     sc.strategy = spec.strategy == Strategy::kHybrid       ? StrategyKind::kHybrid
