@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -139,10 +140,14 @@ void run(const CaseStudyOpts& o, int& exit_code) {
                 ? fmt::format("largest correction {:.3f} mrad of the {:.1f} mrad bound ({:.3f} mm at the TCP)",
                               l.max_command_deviation_rad * 1e3, l.bound_rad * 1e3, l.max_tcp_correction_m * 1e3)
                 : fmt::format("largest offset {:.3f} mm at the TCP", l.max_tcp_correction_m * 1e3);
+        // The compensation from the two figures as printed beside it.
         std::cout << fmt::format(
             "  {:<16} {:<14} {:>8} cycles answered, {} datagrams rejected, {} commands stopped by the guard; {}; "
-            "measured delay {:.0f} ms\n",
-            l.setup, l.link, l.cycles, l.rejected, l.guard_trips, correction, l.measured_delay_s * 1e3);
+            "measured delay {}; at {:.0f} N UC {:.3f} mm, C {:.3f} mm ({} compensated){}\n",
+            l.setup, l.link, l.cycles, l.rejected, l.guard_trips, correction,
+            std::isfinite(l.measured_delay_s) ? fmt::format("{:.0f} ms", l.measured_delay_s * 1e3) : "n/a", l.load_n,
+            l.uc_mm, l.c_mm, percent_text(l.compensation),
+            l.controller_note.empty() ? std::string() : "; " + l.controller_note);
       }
     }
     std::cout << "\nThe cell: " << study::describe_coupled_solves(result.coupled, result.coupled_options) << "\n";

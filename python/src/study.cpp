@@ -32,7 +32,9 @@ py::list links_to_python(const std::vector<study::LinkSummary>& links) {
     out.append(py::dict("setup"_a = l.setup, "link"_a = l.link, "joint_commands"_a = l.joint_commands,
                         "cycles"_a = l.cycles, "rejected"_a = l.rejected, "guard_trips"_a = l.guard_trips,
                         "max_command_deviation_rad"_a = l.max_command_deviation_rad, "bound_rad"_a = l.bound_rad,
-                        "max_tcp_correction_m"_a = l.max_tcp_correction_m, "measured_delay_s"_a = l.measured_delay_s));
+                        "max_tcp_correction_m"_a = l.max_tcp_correction_m, "measured_delay_s"_a = l.measured_delay_s,
+                        "load_N"_a = l.load_n, "uc_mm"_a = l.uc_mm, "c_mm"_a = l.c_mm,
+                        "compensation"_a = l.compensation, "controller_note"_a = l.controller_note));
   }
   return out;
 }

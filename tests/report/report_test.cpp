@@ -213,6 +213,40 @@ TEST(HtmlReport, SelfContainedWellFormedAndComplete) {
   EXPECT_EQ(test::count_of(html, "http"), test::count_of(html, "xmlns=\"http://www.w3.org/2000/svg\""));
 }
 
+TEST(HtmlReport, TheControllerLinksTableHasARowPerLinkWithItsCompensation) {
+  ReportContent content = test::synthetic_report();
+  EXPECT_EQ(html_report(content).find("id=\"links\""), std::string::npos);  // no links, no table
+  study::LinkSummary l;
+  l.setup = "online-fanuc";
+  l.link = "fanuc-j519";
+  l.cycles = 491008;
+  l.rejected = 2;
+  l.guard_trips = 0;
+  l.max_command_deviation_rad = 1.618e-3;
+  l.bound_rad = 0.01;
+  l.max_tcp_correction_m = 1.442e-3;
+  l.measured_delay_s = 0.061;
+  l.load_n = 650;
+  l.uc_mm = 1.051;
+  l.c_mm = 0.142;
+  l.compensation = 1.0 - 0.142 / 1.051;  // 86.5 %: prints 86%, halves away from zero
+  l.controller_note = "peak jerk 40 % of the controller's limit <J519>";
+  study::LinkSummary rsi = l;
+  rsi.setup = "online-rsi";
+  rsi.link = "rsi";
+  rsi.measured_delay_s = NAN;  // a link that measured no delay
+  content.links = {l, rsi};
+  const std::string html = html_report(content);
+  EXPECT_EQ(test::xml_problem(html), "");
+  EXPECT_NE(html.find("<h2 id=\"links\">Controller links</h2>"), std::string::npos);
+  EXPECT_NE(html.find("<tr><td class=\"l\">online-fanuc</td><td class=\"l\">fanuc-j519</td><td>491008</td><td>2</td>"
+                      "<td>0</td><td>1.618</td><td>10.0</td><td>1.442</td><td>61</td><td>650 N</td><td>1.051</td>"
+                      "<td>0.142</td><td>86%</td><td class=\"l\">peak jerk 40 % of the controller&#39;s limit "
+                      "&lt;J519&gt;</td></tr>"),
+            std::string::npos);
+  EXPECT_NE(html.find("<td>1.442</td><td>n/a</td>"), std::string::npos);
+}
+
 TEST(HtmlReport, WritesTheReportAndFigures) {
   // DEFLEX_REPORT_EXAMPLE_DIR keeps the example (to look at it in a browser); otherwise a temp dir.
   const char* keep = std::getenv("DEFLEX_REPORT_EXAMPLE_DIR");

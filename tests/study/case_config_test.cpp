@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "deflex/text/errors.hpp"
 
 namespace deflex::study {
@@ -71,6 +73,75 @@ TEST(CaseConfig, ErrorsNameTheFileLineAndField) {
   const std::string latency = error_of(paper_with("network_latency_ms: 0.2", "network_latency_ms: 3"));
   EXPECT_NE(latency.find("half a servo period"), std::string::npos) << latency;
   EXPECT_THROW((void)load_case("/nonexistent/case.yaml"), ModelError);
+}
+
+TEST(CaseConfig, ASetupMayNameEveryLinkOfTheRuntime) {
+  // The paper's case runs one setup over each further controller link, at its highest load only.
+  const CaseConfig c = paper_case();
+  std::vector<LinkKind> links;
+  for (const auto& s : c.setups) {
+    links.push_back(s.link);
+    if (s.link == LinkKind::kRsi || s.link == LinkKind::kFanucJ519 || s.link == LinkKind::kMotoros2Rt ||
+        s.link == LinkKind::kUrRtde) {
+      EXPECT_EQ(s.strategy, Strategy::kOnline) << s.name;
+      EXPECT_TRUE(s.sensor_mounted) << s.name;
+      EXPECT_EQ(s.loads_n, (std::vector<double>{650})) << s.name;
+      EXPECT_TRUE(s.paper_uc_mm.empty()) << s.name;
+    }
+  }
+  for (LinkKind k : kAllLinks) {
+    EXPECT_NE(std::find(links.begin(), links.end(), k), links.end()) << to_string(k);
+  }
+  // Each name reads back as its link.
+  for (const char* name : {"rsi", "fanuc-j519", "motoros2-rt", "ur-rtde"}) {
+    const CaseConfig one =
+        load_case_text(paper_with("name: online-100ms, strategy: online, link: simple-message",
+                                  std::string("name: online-100ms, strategy: online, link: ") + name),
+                       "case.yaml");
+    EXPECT_STREQ(to_string(one.setups[5].link), name);
+  }
+}
+
+TEST(CaseConfig, AnUnknownOrRefusedLinkNamesTheSetupAndTheLinks) {
+  const std::string unknown = error_of(paper_with("name: online-ur, strategy: online, link: ur-rtde",
+                                                  "name: online-ur, strategy: online, link: ur-rtdx"));
+  EXPECT_NE(unknown.find("setups[10].link"), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("setup 'online-ur'"), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("unknown link 'ur-rtdx'"), std::string::npos) << unknown;
+  for (const char* name :
+       {"program", "egm-joint", "egm-path", "rsi", "simple-message", "fanuc-j519", "motoros2-rt", "ur-rtde"}) {
+    EXPECT_NE(unknown.find(name), std::string::npos) << name << ": " << unknown;
+  }
+  // The hybrid strategy streams the offline program: not over RSI, where the KRL program runs itself.
+  const std::string hybrid = error_of(
+      paper_with("name: hybrid, strategy: hybrid, link: egm-joint", "name: hybrid, strategy: hybrid, link: rsi"));
+  EXPECT_NE(hybrid.find("setup 'hybrid'"), std::string::npos) << hybrid;
+  EXPECT_NE(hybrid.find("hybrid strategy streams the offline program"), std::string::npos) << hybrid;
+  EXPECT_NE(hybrid.find("fanuc-j519"), std::string::npos) << hybrid;
+  // Over FANUC the hybrid strategy is a setup like any other.
+  EXPECT_EQ(error_of(paper_with("name: hybrid, strategy: hybrid, link: egm-joint",
+                                "name: hybrid, strategy: hybrid, link: fanuc-j519")),
+            "");
+}
+
+TEST(CaseConfig, SettingsTheRuntimeRefusesForALinkAreRefusedNamingTheSetup) {
+  // deflex online bounds a joint's correction rate at 30 deg/s (0.52 rad/s); the case's own check takes
+  // any positive rate, the runtime's refuses 1 rad/s for the first setup that runs over a link.
+  const std::string fast = error_of(paper_with("max_rate_mrad_s: 50", "max_rate_mrad_s: 1000"));
+  EXPECT_NE(fast.find("setups[2]"), std::string::npos) << fast;
+  EXPECT_NE(fast.find("setup 'online'"), std::string::npos) << fast;
+  EXPECT_NE(fast.find("--link egm-joint"), std::string::npos) << fast;
+  EXPECT_NE(fast.find("max_correction_rate_rad_s"), std::string::npos) << fast;
+}
+
+TEST(CaseConfig, TheBudgetsLoadIndexIsCheckedOnTheSetupsTheBudgetRuns) {
+  // A setup the budget does not run may have one load; the budget's own setups must have the index.
+  EXPECT_EQ(error_of(paper_case_yaml()), "");  // the links' setups have one load, the index is 2
+  const std::string short_online = error_of(paper_with(
+      "name: online, strategy: online, link: egm-joint, sensor: true, loads_N: [150, 400, 650],\n     paper_uc_mm: "
+      "[0.23, 0.65, 1.10],\n     paper_c_mm: [[0.07, 0.07, 0.08], [0.16, 0.15, 0.15], [0.25, 0.19, 0.21]]",
+      "name: online, strategy: online, link: egm-joint, sensor: true, loads_N: [650]"));
+  EXPECT_NE(short_online.find("out of range for setup 'online'"), std::string::npos) << short_online;
 }
 
 TEST(CaseConfig, EffectSwitchesTurnOffTheirEffect) {

@@ -216,6 +216,73 @@ TEST(CaseStudy, SameSeedGivesTheSameFiguresOnAnyNumberOfThreads) {
   EXPECT_GT(a.links[0].max_command_deviation_rad, 0.0);
 }
 
+TEST(CaseStudy, EveryFurtherControllerLinkCompensatesTheLoad) {
+  // The paper's case's setups over RSI, FANUC Stream Motion, MotoROS2 and UR RTDE, one lap at 50 mm/s
+  // and 650 N: each runs deflex's link against its simulated controller and the compensated path lies
+  // clearly closer to the unloaded one than the uncompensated path of the same cell and seed does.
+  const CaseConfig paper = paper_case();
+  CaseConfig c = short_case(paper);
+  c.setups.clear();
+  for (const auto& s : paper.setups) {
+    if (s.link == LinkKind::kRsi || s.link == LinkKind::kFanucJ519 || s.link == LinkKind::kMotoros2Rt ||
+        s.link == LinkKind::kUrRtde) {
+      c.setups.push_back(s);
+    }
+  }
+  ASSERT_EQ(c.setups.size(), 4u);
+  CaseStudyOptions o;
+  o.speed_sweep = false;
+  o.error_budget = false;
+  o.threads = 2;
+  const CaseStudyOutput out = run_case_study(c, o);
+  ASSERT_EQ(out.links.size(), 4u);
+  ASSERT_EQ(out.study.setups.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const LinkSummary& l = out.links[i];
+    const LoadResult& load = out.study.setups[i].loads.at(0);
+    SCOPED_TRACE(l.link);
+    EXPECT_EQ(l.link, to_string(c.setups[i].link));
+    // One lap and its hold at 50 mm/s is ~10 s: at least one answer every 10 ms.
+    EXPECT_GT(l.cycles, 1000u);
+    EXPECT_EQ(l.rejected, 0u);
+    EXPECT_EQ(l.guard_trips, 0u);
+    EXPECT_GT(l.max_command_deviation_rad, 0.0);
+    EXPECT_LE(l.max_command_deviation_rad, l.bound_rad);
+    // The streaming links measure their delay from the controller's feedback; RSI's stand-in reports its
+    // axes without lag, so its link has none to measure.
+    if (c.setups[i].link != LinkKind::kRsi) {
+      EXPECT_GT(l.measured_delay_s, 0.0);
+    }
+    EXPECT_FALSE(l.controller_note.empty());
+    // The row's figures are the setup's, and C is well under UC.
+    EXPECT_DOUBLE_EQ(l.load_n, 650.0);
+    EXPECT_DOUBLE_EQ(l.uc_mm, load.uc_mm.at(50));
+    EXPECT_DOUBLE_EQ(l.c_mm, load.c_mm.at(50));
+    EXPECT_GT(l.uc_mm, 0.3);
+    EXPECT_LT(l.c_mm, 0.5 * l.uc_mm);
+    EXPECT_NEAR(l.compensation, 1.0 - as_printed(l.c_mm) / as_printed(l.uc_mm), 1e-12);
+  }
+}
+
+TEST(SimulatedRun, EachFurtherLinksCompensatedPathIsCloserThanTheSameCellsUncompensatedOne) {
+  // Against the traces themselves (the evaluation's nearest-point distance, not the study's figures):
+  // a run over each further link, compensated, against the uncompensated run of the same seed.
+  const CaseConfig c = short_case(paper_case());
+  const SetupCell cell = build_setup_cell(c, true);
+  for (LinkKind link : {LinkKind::kRsi, LinkKind::kFanucJ519, LinkKind::kMotoros2Rt, LinkKind::kUrRtde}) {
+    SCOPED_TRACE(to_string(link));
+    const RunOutput unloaded = simulate_run(c, cell, spec(RunKind::kUnloaded, Strategy::kOnline, 0.0, 1, link));
+    const RunOutput uc = simulate_run(c, cell, spec(RunKind::kUncompensated, Strategy::kOnline, 650.0, 2, link));
+    const RunOutput comp = simulate_run(c, cell, spec(RunKind::kCompensated, Strategy::kOnline, 650.0, 2, link));
+    const double uc_m = mean_distance_to_path_m(uc.trace, unloaded.trace);
+    const double c_m = mean_distance_to_path_m(comp.trace, unloaded.trace);
+    EXPECT_GT(uc_m, 3e-4);
+    EXPECT_LT(c_m, 0.5 * uc_m) << "UC " << uc_m << " C " << c_m;
+    EXPECT_GT(comp.link_cycles, 1000u);
+    EXPECT_EQ(comp.link_counters.guard_trips, 0u);
+  }
+}
+
 TEST(CaseStudy, SeveralSeedsGiveEachSeedsOwnFiguresTheirMeanAndSpread) {
   CaseConfig c = short_case(paper_case());
   c.setups[0].loads_n = {650.0};

@@ -358,6 +358,7 @@ std::vector<BadInput> file_cases() {
         {"tracker_rate_huge", "rate_Hz: 1000\n", "rate_Hz: 1e12\n", "rate_Hz"},
         {"servo_period_tiny", "servo_period_ms: 4", "servo_period_ms: 1e-9", "controller.servo_period_ms"},
         {"paper_uc_short", "paper_uc_mm: [0.12, 0.38, 0.62]", "paper_uc_mm: [0.12, 0.38]", "setups[1].paper_uc_mm"},
+        {"link_unknown", "link: ur-rtde", "link: ur-rtdx", "setups[10].link"},
         {"points_huge", "points: 81 ", "points: 1e9 ", "circle.points"},
         {"lost_motion_short", "lost_motion_urad: [35, 35, 35, 60, 60, 60]", "lost_motion_urad: [35, 35, 35]",
          "true_robot.lost_motion_urad"},

@@ -204,6 +204,7 @@ ReportContent case_report(const CaseConfig& config, const CaseStudyOutput& outpu
   }
   report.notes = honest_notes(config, output.study, case_text);
   report.case_text = case_text;
+  report.links = output.links;
   return report;
 }
 

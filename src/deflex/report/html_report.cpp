@@ -218,6 +218,35 @@ std::string sync_table(const StudyResult& study) {
   return h + "</tr>\n" + rows + "</table>\n<p class=\"caption\">UC columns: the mean over the speeds.</p>\n";
 }
 
+// What each online setup's controller link did, and the compensation that setup reached at its
+// highest load: each controller's timing shows in the last columns.
+std::string links_table(const std::vector<study::LinkSummary>& links) {
+  if (links.empty()) {
+    return "";
+  }
+  std::string h =
+      "<h2 id=\"links\">Controller links</h2>\n<p class=\"caption\">Every online setup runs deflex's deployable link "
+      "code over the cell's network against a simulated controller with that controller's own cycle, dead time, "
+      "lag and limits. Cycles, rejected datagrams, guard trips and the largest correction are over the setup's "
+      "compensated runs; the delay is the link's own measurement (the mean over those runs); UC and C are the "
+      "setup's figures at its highest load (means over the speeds and seeds), the compensation 1 - C/UC from "
+      "them as printed.</p>\n<table>\n<tr><th class=\"l\">setup</th><th class=\"l\">link</th><th>cycles "
+      "answered</th><th>datagrams rejected</th><th>guard trips</th><th>largest correction (mrad)</th><th>bound "
+      "(mrad)</th><th>largest at the TCP (mm)</th><th>measured delay (ms)</th><th>load</th><th>UC (mm)</th><th>C "
+      "(mm)</th><th>compensation</th><th class=\"l\">the controller counted</th></tr>\n";
+  for (const auto& l : links) {
+    h += fmt::format(
+        "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1f}"
+        "</td><td>{}</td><td>{}</td><td>{:g} N</td><td>{}</td><td>{}</td><td>{}</td><td class=\"l\">{}</td></tr>\n",
+        esc(l.setup), esc(l.link), l.cycles, l.rejected, l.guard_trips,
+        l.joint_commands ? fmt::format("{:.3f}", l.max_command_deviation_rad * 1e3) : std::string("(TCP offsets)"),
+        l.bound_rad * 1e3, mm(l.max_tcp_correction_m * 1e3),
+        std::isfinite(l.measured_delay_s) ? fmt::format("{:.0f}", l.measured_delay_s * 1e3) : "n/a", l.load_n,
+        mm(l.uc_mm), mm(l.c_mm), percent_text(l.compensation), esc(l.controller_note));
+  }
+  return h + "</table>\n";
+}
+
 std::string compensation_table(const StudyResult& study) {
   const PaperFigures paper = paper_reference();
   const std::vector<int> speeds = study_speeds_mm_s(study);
@@ -509,6 +538,7 @@ std::string html_report(const ReportContent& content) {
   h += sync_table(study);
   h += figures_html(study);
   h += iso_table(study);
+  h += links_table(content.links);
   if (!content.path_plots.empty()) {
     h += "<h2 id=\"paths\">Paths, laps and directions</h2>\n";
     for (const auto& p : content.path_plots) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "deflex/report/svg_charts.hpp"
+#include "deflex/study/case_study.hpp"
 #include "deflex/study/error_budget.hpp"
 #include "deflex/study/study_tables.hpp"
 
@@ -21,6 +22,8 @@ struct ReportContent {
   std::vector<std::string> notes;
   /// Optional: the case file as given (shown verbatim in a <pre> block).
   std::string case_text;
+  /// Optional: what the online setups' controller links did (one table row a setup).
+  std::vector<study::LinkSummary> links;
 };
 
 std::string html_report(const ReportContent& content);

@@ -12,6 +12,7 @@
 #include <optional>
 #include <sstream>
 
+#include "deflex/runtime/session_settings.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/text/input_file.hpp"
 #include "deflex/text/yaml_fields.hpp"
@@ -35,13 +36,25 @@ Strategy parse_strategy(const yaml::Field& f) {
   f.fail("unknown strategy '" + s + "' (offline, online, hybrid, predictive)");
 }
 
-LinkKind parse_link(const yaml::Field& f) {
+// The links `pick` accepts, by name: "program, egm-joint, ...".
+std::string link_names(bool (*pick)(LinkKind)) {
+  std::string names;
+  for (LinkKind k : kAllLinks) {
+    if (pick(k)) names += (names.empty() ? "" : ", ") + std::string(to_string(k));
+  }
+  return names;
+}
+
+bool any_link(LinkKind) { return true; }
+bool controller_link(LinkKind k) { return k != LinkKind::kProgram; }
+bool streaming_link(LinkKind k) { return streams_program(k); }
+
+LinkKind parse_link(const yaml::Field& f, const std::string& setup) {
   const std::string s = f.as_string();
-  if (s == "program") return LinkKind::kProgram;
-  if (s == "egm-joint") return LinkKind::kEgmJoint;
-  if (s == "egm-path") return LinkKind::kEgmPath;
-  if (s == "simple-message") return LinkKind::kSimpleMessage;
-  f.fail("unknown link '" + s + "' (program, egm-joint, egm-path, simple-message)");
+  for (LinkKind k : kAllLinks) {
+    if (s == to_string(k)) return k;
+  }
+  f.fail(fmt::format("setup '{}': unknown link '{}' ({})", setup, s, link_names(any_link)));
 }
 
 double positive(const yaml::Field& f) {
@@ -95,8 +108,48 @@ const char* to_string(LinkKind k) {
       return "egm-path";
     case LinkKind::kSimpleMessage:
       return "simple-message";
+    case LinkKind::kRsi:
+      return "rsi";
+    case LinkKind::kFanucJ519:
+      return "fanuc-j519";
+    case LinkKind::kMotoros2Rt:
+      return "motoros2-rt";
+    case LinkKind::kUrRtde:
+      return "ur-rtde";
   }
   return "?";
+}
+
+bool streams_program(LinkKind k) { return k != LinkKind::kProgram && k != LinkKind::kEgmPath && k != LinkKind::kRsi; }
+
+double link_period_s(const CaseConfig& config, LinkKind link) {
+  switch (link) {
+    case LinkKind::kEgmJoint:
+      return config.cell.controller.egm_period_s;
+    case LinkKind::kEgmPath:
+      return config.cell.controller.path_corr_period_s;
+    case LinkKind::kSimpleMessage:
+      return config.online.stream_period_s;
+    case LinkKind::kProgram:
+      return 0.0;
+    default:
+      return runtime::default_session_config(runtime::parse_link_kind(to_string(link))).online.period_s;
+  }
+}
+
+std::vector<std::size_t> budget_setups(const CaseConfig& config) {
+  std::vector<std::size_t> out;
+  bool have_offline = false, have_online = false;
+  for (std::size_t i = 0; i < config.setups.size(); ++i) {
+    const SetupConfig& sc = config.setups[i];
+    const bool offline = sc.strategy == Strategy::kOffline && !have_offline;
+    const bool online = sc.strategy == Strategy::kOnline && sc.link == LinkKind::kEgmJoint && !have_online;
+    if (!offline && !online) continue;
+    have_offline = have_offline || offline;
+    have_online = have_online || online;
+    out.push_back(i);
+  }
+  return out;
 }
 
 double CaseConfig::radius_m() const { return cell.ldbb.bar_length_m * std::cos(cell.ldbb.inclination_rad); }
@@ -192,13 +245,19 @@ SetupConfig read_case_setup(const yaml::Field& s, const std::vector<SetupConfig>
   sc.name = s.at("name").as_string();
   sc.strategy = parse_strategy(s.at("strategy"));
   sc.link = sc.strategy == Strategy::kOffline ? LinkKind::kProgram : LinkKind::kEgmJoint;
-  if (s.has("link")) sc.link = parse_link(s.at("link"));
+  if (s.has("link")) sc.link = parse_link(s.at("link"), sc.name);
   if (sc.strategy == Strategy::kOffline && sc.link != LinkKind::kProgram)
-    s.at("link").fail("the offline strategy runs a program: its link is 'program'");
-  if (sc.strategy != Strategy::kOffline && sc.link == LinkKind::kProgram)
-    s.at("link").fail("an online strategy needs a controller link (egm-joint, egm-path or simple-message)");
-  if (sc.strategy == Strategy::kHybrid && sc.link == LinkKind::kEgmPath)
-    s.at("link").fail("the hybrid strategy streams the offline program: its link is egm-joint or simple-message");
+    s.at("link").fail(fmt::format("setup '{}': the offline strategy runs a program: its link is 'program'", sc.name));
+  if (sc.strategy != Strategy::kOffline && sc.link == LinkKind::kProgram) {
+    s.at("link").fail(fmt::format("setup '{}': an online strategy needs a controller link ({})", sc.name,
+                                  link_names(controller_link)));
+  }
+  // The study's hybrid strategy is the offline program streamed with an online correction on top: a
+  // link over which the controller runs its own program (and deflex sends offsets) has no such stream.
+  if (sc.strategy == Strategy::kHybrid && !streams_program(sc.link)) {
+    s.at("link").fail(fmt::format("setup '{}': the hybrid strategy streams the offline program: its link is one of {}",
+                                  sc.name, link_names(streaming_link)));
+  }
   sc.sensor_mounted = s.at("sensor").as_bool();
   if (sc.strategy != Strategy::kOffline && !sc.sensor_mounted) s.at("sensor").fail("online strategies need the sensor");
   for (const auto& other : others) {
@@ -542,10 +601,55 @@ void read_case_drift_and_budget(const yaml::Field& root, CaseConfig& c) {
     b.only_keys({"speed_mm_s", "load_index"});
     c.budget.speed_m_s = positive(b.at("speed_mm_s")) * kMm;
     c.budget.load_index = b.at("load_index").as_int();
-    for (const auto& sc : c.setups) {
+    for (std::size_t i : budget_setups(c)) {
+      const SetupConfig& sc = c.setups[i];
       if (c.budget.load_index < 0 || c.budget.load_index >= static_cast<int>(sc.loads_n.size())) {
         b.at("load_index").fail(fmt::format("out of range for setup '{}'", sc.name));
       }
+    }
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// What `deflex online --link L --strategy S` would be given for a setup's runs: the case's online
+// section (the watchdog at least two cycles, as the study runs it), each setting the link takes.
+std::vector<runtime::GivenSetting> runtime_settings(const CaseConfig& c, const SetupConfig& sc) {
+  const runtime::LinkKind kind = runtime::parse_link_kind(to_string(sc.link));
+  const double period_s = link_period_s(c, sc.link);
+  const std::pair<const char*, runtime::SettingValue> values[] = {
+      {"period_s", period_s},
+      {"max_joint_correction_rad", c.online.max_joint_correction_rad},
+      {"max_tcp_correction_m", c.online.max_tcp_correction_m},
+      {"max_correction_rate_rad_s", c.online.max_rate_rad_s},
+      {"max_tcp_rate_m_s", c.online.max_tcp_rate_m_s},
+      {"watchdog_s", std::max(c.online.watchdog_s, 2.0 * period_s)},
+      {"ramp_in_s", c.online.ramp_in_s},
+      {"buffer_depth", static_cast<double>(c.online.stream_buffer_depth)},
+      {"path_corr_frame", c.cell.controller.path_corr_frame}};
+  std::vector<runtime::GivenSetting> given;
+  for (const auto& [key, value] : values) {
+    const runtime::SessionSetting* s = runtime::find_session_setting(key);
+    if (s != nullptr && (s->links & runtime::link_bit(kind)) != 0) given.push_back({s, value});
+  }
+  return given;
+}
+
+// Every online setup's link, strategy and the case's settings as the runtime takes them: what
+// `deflex online` would refuse, the case refuses, naming the setup.
+void check_setups_with_runtime(const yaml::Field& root, const CaseConfig& c) {
+  for (std::size_t i = 0; i < c.setups.size(); ++i) {
+    const SetupConfig& sc = c.setups[i];
+    if (sc.link == LinkKind::kProgram) continue;
+    try {
+      (void)runtime::make_session_config(to_string(sc.link), to_string(sc.strategy), runtime_settings(c, sc));
+    } catch (const InputError& e) {
+      root.at("setups").at(i).fail(
+          fmt::format("setup '{}': deflex online --link {} --strategy {} refuses the "
+                      "case's settings: {}",
+                      sc.name, to_string(sc.link), to_string(sc.strategy), e.what()));
     }
   }
 }
@@ -573,6 +677,7 @@ CaseConfig load_case_text(const std::string& text, const std::string& source) {
   read_case_online(root, c);
   read_case_calibration(root, c);
   read_case_drift_and_budget(root, c);
+  check_setups_with_runtime(root, c);
   return c;
 }
 

@@ -33,8 +33,23 @@ enum class LinkKind {
   /// ROS-Industrial simple message over TCP: deflex streams joint points to the robot program's
   /// streaming server (the paper's own kind of link, ~100 ms; simple_message_link.hpp)
   kSimpleMessage,
+  // The values above seed the runs of their setups (run_seed): a further link is added at the end.
+  kRsi,         ///< KUKA RSI axis correction: the controller runs its KRL program, deflex answers offsets
+  kFanucJ519,   ///< FANUC Stream Motion: deflex streams the program, one command a status
+  kMotoros2Rt,  ///< Yaskawa MotoROS2 real-time: deflex streams the program as joint increments
+  kUrRtde,      ///< Universal Robots RTDE: deflex streams the program into the registers servoj reads
 };
+/// Every link a setup may name, in the order the case file's error lists them.
+inline constexpr std::array<LinkKind, 8> kAllLinks = {
+    LinkKind::kProgram,       LinkKind::kEgmJoint,  LinkKind::kEgmPath,    LinkKind::kRsi,
+    LinkKind::kSimpleMessage, LinkKind::kFanucJ519, LinkKind::kMotoros2Rt, LinkKind::kUrRtde};
 [[nodiscard]] const char* to_string(LinkKind k);
+/// Whether deflex streams the program over the link (the controller then runs none of its own).
+[[nodiscard]] bool streams_program(LinkKind k);
+struct CaseConfig;
+/// The controller's cycle deflex runs a link at in the study (s): EGM's and simple message's from the
+/// case file, every other link's the runtime's default (0 for kProgram).
+[[nodiscard]] double link_period_s(const CaseConfig& config, LinkKind link);
 
 /// One strategy setup of the protocol (a row group of the paper's tables).
 struct SetupConfig {
@@ -88,7 +103,7 @@ struct CircleConfig {
 /// protocol's laps: its "every effect" figure is the table's own run.
 struct BudgetConfig {
   double speed_m_s = 0.05;
-  int load_index = 2;
+  int load_index = 2;  ///< into the loads of each setup the budget runs (budget_setups())
 };
 
 struct CaseConfig {
@@ -121,6 +136,10 @@ struct CaseConfig {
   /// The nominal pivot (the force model's), below the circle centre by L sin(phi).
   [[nodiscard]] Vector3 pivot_m() const;
 };
+
+/// The setups the error budget runs (indexes into config.setups): the first offline setup and the
+/// first online one over EGM position guidance (the paper's two).
+[[nodiscard]] std::vector<std::size_t> budget_setups(const CaseConfig& config);
 
 /// Loads a case file; every error names the file, line and field. Throws ModelError.
 CaseConfig load_case(const std::string& path);

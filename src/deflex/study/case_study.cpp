@@ -158,6 +158,15 @@ std::string describe(Strategy s, LinkKind link, double stream_period_s) {
               "online compensation from the force sensor (paper, Figure 3) streamed every {:g} ms over TCP to the "
               "robot program (simple message): the paper's own kind of link",
               stream_period_s * 1e3);
+        case LinkKind::kRsi:
+          return "online compensation from the force sensor (paper, Figure 3) over KUKA RSI axis correction";
+        case LinkKind::kFanucJ519:
+          return "online compensation from the force sensor (paper, Figure 3) streamed over FANUC Stream Motion (J519)";
+        case LinkKind::kMotoros2Rt:
+          return "online compensation from the force sensor (paper, Figure 3) streamed over Yaskawa MotoROS2 real-time";
+        case LinkKind::kUrRtde:
+          return "online compensation from the force sensor (paper, Figure 3) streamed over Universal Robots RTDE to "
+                 "servoj";
         default:
           return "online compensation from the force sensor (paper, Figure 3) over ABB EGM position guidance";
       }
@@ -183,8 +192,8 @@ struct LoadedJob {
   Figures figures;
   bool plot = false;
   bool write_trace = false;
-  std::uint64_t link_cycles = 0, rejected = 0, guard_trips = 0;
-  double max_deviation_rad = 0.0, max_tcp_m = 0.0, delay_s = 0.0;
+  std::uint64_t link_cycles = 0, rejected = 0, guard_trips = 0, controller_events = 0;
+  double max_deviation_rad = 0.0, max_tcp_m = 0.0, delay_s = 0.0, controller_peak = 0.0;
   cell::CoupledTickCounters coupled{};  // the run's coupled solves of the arm and the bar
 };
 
@@ -385,6 +394,8 @@ void plan_loaded_runs(StudyContext& x) {
   }
   if (x.options.error_budget) {
     for (const auto& s : config.setups) {
+      // A setup the budget does not run may have fewer loads (the case file checks only the budget's).
+      if (static_cast<std::size_t>(config.budget.load_index) >= s.loads_n.size()) continue;
       const double load = s.loads_n[static_cast<std::size_t>(config.budget.load_index)];
       add_loaded_run(x, 0, x.family_of(s), RunKind::kUncompensated, s.strategy, load, config.budget.speed_m_s);
       add_loaded_run(x, 0, x.family_of(s), RunKind::kCompensated, s.strategy, load, config.budget.speed_m_s);
@@ -409,14 +420,10 @@ void plan_loaded_runs(StudyContext& x) {
 // calibration) running the same runs with the same seeds.
 void plan_error_budget(StudyContext& x) {
   if (!x.options.error_budget) return;
-  bool have_offline = false, have_online = false;
-  for (std::size_t i = 0; i < x.config.setups.size(); ++i) {
+  for (std::size_t i : budget_setups(x.config)) {
     const auto& sc = x.config.setups[i];
-    const bool offline = sc.strategy == Strategy::kOffline && !have_offline;
-    const bool online = sc.strategy == Strategy::kOnline && sc.link == LinkKind::kEgmJoint && !have_online;
-    if (!offline && !online) continue;
-    have_offline = have_offline || offline;
-    have_online = have_online || online;
+    const bool offline = sc.strategy == Strategy::kOffline;
+    if (static_cast<std::size_t>(x.config.budget.load_index) >= sc.loads_n.size()) continue;
     x.budget_setups.push_back(static_cast<int>(i));
     for (Effect e : kAllEffects) {
       const bool sensor_only =
@@ -524,6 +531,8 @@ void run_loaded_job(StudyContext& x, LoadedJob& j) {
   j.max_deviation_rad = run.max_command_deviation_rad;
   j.max_tcp_m = run.max_tcp_correction_m;
   j.delay_s = run.measured_delay_s;
+  j.controller_events = run.controller_events;
+  j.controller_peak = run.controller_peak;
   j.coupled = run.coupled;
   if (j.write_trace) {
     x.sink(fmt::format("{}_{}_{:.0f}N_{}mm_s", family_label(fam),
@@ -602,8 +611,25 @@ double mean_over_seeds(const std::vector<double>& values) {
   return n > 0 ? sum / n : NAN;
 }
 
-// What the link of a setup did over its compensated runs; none for a setup that runs a program.
-std::optional<LinkSummary> summarize_link(const StudyContext& x, const SetupConfig& s, int fam) {
+// What a setup's controller counted of deflex's stream, in words (see LinkSummary::controller_note).
+std::string controller_note(LinkKind link, std::uint64_t events, double peak) {
+  switch (link) {
+    case LinkKind::kRsi:
+      return fmt::format("{} late cycles (RSI's Delay)", events);
+    case LinkKind::kFanucJ519:
+      return fmt::format("peak jerk {:.0f} % of the controller's limit, no limit stop", peak * 100.0);
+    case LinkKind::kMotoros2Rt:
+      return fmt::format("{} increments truncated by the safety unit", events);
+    case LinkKind::kUrRtde:
+      return "no protective stop";
+    default:
+      return "";
+  }
+}
+
+// What the link of a setup did over its compensated runs, and the compensation it reached at its
+// highest load (`top`, the setup's figures there); none for a setup that runs a program.
+std::optional<LinkSummary> summarize_link(const StudyContext& x, const SetupConfig& s, int fam, const LoadResult& top) {
   if (s.link == LinkKind::kProgram) return std::nullopt;
   LinkSummary ls;
   ls.setup = s.name;
@@ -611,6 +637,8 @@ std::optional<LinkSummary> summarize_link(const StudyContext& x, const SetupConf
   ls.joint_commands = s.link != LinkKind::kEgmPath;
   ls.bound_rad = x.config.online.max_joint_correction_rad;
   int delay_runs = 0;
+  std::uint64_t events = 0;
+  double peak = 0.0;
   for (const auto& j : x.loaded) {
     if (j.family != fam || j.kind != RunKind::kCompensated || j.strategy != s.strategy) continue;
     ls.cycles += j.link_cycles;
@@ -618,12 +646,23 @@ std::optional<LinkSummary> summarize_link(const StudyContext& x, const SetupConf
     ls.guard_trips += j.guard_trips;
     ls.max_command_deviation_rad = std::max(ls.max_command_deviation_rad, j.max_deviation_rad);
     ls.max_tcp_correction_m = std::max(ls.max_tcp_correction_m, j.max_tcp_m);
+    events += j.controller_events;
+    peak = std::max(peak, j.controller_peak);
     if (std::isfinite(j.delay_s)) {
       ls.measured_delay_s += j.delay_s;
       ++delay_runs;
     }
   }
   ls.measured_delay_s = delay_runs > 0 ? ls.measured_delay_s / delay_runs : NAN;
+  ls.controller_note = controller_note(s.link, events, peak);
+  ls.load_n = top.load_N;
+  ls.uc_mm = top.uc_mean_mm();
+  std::vector<double> c;
+  for (const auto& [speed, value] : top.c_mm) c.push_back(value);
+  ls.c_mm = mean_over_seeds(c);
+  std::vector<int> speeds;
+  for (double v : x.config.speeds_m_s) speeds.push_back(mm_s(v));
+  ls.compensation = printed_compensation_spread(top, speeds).mean;
   return ls;
 }
 
@@ -720,8 +759,8 @@ void assemble_setups(const StudyContext& x, CaseStudyOutput& out) {
       sr.paper_label =
           fmt::format("simple message, {:g} ms (the paper's kind of link)", x.config.online.stream_period_s * 1e3);
     }
-    if (const auto ls = summarize_link(x, s, fam)) out.links.push_back(*ls);
     for (double load : s.loads_n) sr.loads.push_back(load_result(x, s, fam, load));
+    if (const auto ls = summarize_link(x, s, fam, sr.loads.back())) out.links.push_back(*ls);
     out.study.setups.push_back(sr);
     if (x.options.speed_sweep) add_sweep_points(x, s, fam, out.study);
     add_plot_traces(x, s, fam, out);

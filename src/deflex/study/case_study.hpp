@@ -62,6 +62,16 @@ struct LinkSummary {
   double bound_rad = 0.0;                  ///< the bound it must stay within
   double max_tcp_correction_m = 0.0;
   double measured_delay_s = 0.0;  ///< the link's measured delay (mean over the runs)
+  /// What the setup's compensation came to at its highest load, so each link's timing shows in it: UC
+  /// (the mean over the speeds and seeds), C (the same) and 1 - C/UC from the two as printed.
+  double load_n = 0.0;
+  double uc_mm = 0.0;
+  double c_mm = 0.0;
+  double compensation = 0.0;
+  /// What the controller itself counted of deflex's stream over the compensated runs, in words ("" for a
+  /// controller that counts nothing of the kind): RSI's late cycles, FANUC's peak jerk against its limit,
+  /// MotoROS2's truncated increments, UR's protective stops (a stop of any controller ends the study).
+  std::string controller_note;
 };
 
 /// Where a study's CPU time went, summed over its threads (s of thread CPU time).

@@ -9,18 +9,23 @@
 #include "deflex/cell/daq_stream.hpp"
 #include "deflex/cell/egm_path_controller.hpp"
 #include "deflex/cell/egm_position_controller.hpp"
+#include "deflex/cell/fanuc_j519_controller.hpp"
 #include "deflex/cell/force_sensor.hpp"
 #include "deflex/cell/laser_tracker.hpp"
 #include "deflex/cell/ldbb_device.hpp"
+#include "deflex/cell/motoros2_rt_controller.hpp"
 #include "deflex/cell/path_drift.hpp"
 #include "deflex/cell/robot_controller.hpp"
+#include "deflex/cell/rsi_controller.hpp"
 #include "deflex/cell/simple_message_server.hpp"
+#include "deflex/cell/ur_rtde_controller.hpp"
 #include "deflex/force/ldbb_force_model.hpp"
 #include "deflex/model/compliance.hpp"
 #include "deflex/offline/compensate_path.hpp"
 #include "deflex/online/online_strategy.hpp"
 #include "deflex/paths/circle_path.hpp"
 #include "deflex/runtime/session.hpp"
+#include "deflex/runtime/session_settings.hpp"
 #include "deflex/sensors/datagram_force_source.hpp"
 #include "deflex/sensors/wrench_tare.hpp"
 #include "deflex/study/detail/cell_arm.hpp"
@@ -37,11 +42,30 @@ std::uint64_t component_seed(std::uint64_t run, Component c) {
   return splitmix(run ^ (static_cast<std::uint64_t>(c) * 0x632be59bd9b4e019ULL));
 }
 
-// The cell's network: the controller, the cell PC running deflex, and the DAQ.
-const DatagramAddress kDeflexEgm{0x0a000001, 6510};    // 10.0.0.1:6510
+// The cell's network: the controller (10.0.0.2), the cell PC running deflex (10.0.0.1), and the DAQ.
 const DatagramAddress kDeflexForce{0x0a000001, 6600};  // 10.0.0.1:6600
-const DatagramAddress kController{0x0a000002, 6511};   // 10.0.0.2:6511
 const DatagramAddress kDaq{0x0a000003, 5000};          // 10.0.0.3:5000
+
+// Where a link's two ends listen: the ports a user would give `deflex online` and set on the controller
+// (EGM's and RSI's controller sends to deflex's port; FANUC's and MotoROS2's listens on the protocol's
+// own; UR RTDE is a TCP connection, the cell's stream pair).
+struct LinkAddresses {
+  DatagramAddress deflex;
+  DatagramAddress controller;
+};
+LinkAddresses link_addresses(LinkKind link) {
+  constexpr std::uint32_t kPc = 0x0a000001, kRobot = 0x0a000002;
+  switch (link) {
+    case LinkKind::kRsi:
+      return {{kPc, 49152}, {kRobot, 49152}};
+    case LinkKind::kFanucJ519:
+      return {{kPc, 6510}, {kRobot, 60015}};
+    case LinkKind::kMotoros2Rt:
+      return {{kPc, 6510}, {kRobot, motoros2_rt::kDefaultPort}};
+    default:
+      return {{kPc, 6510}, {kRobot, 6511}};
+  }
+}
 
 }  // namespace
 
@@ -81,9 +105,41 @@ SetupCell build_setup_cell(const CaseConfig& config, bool sensor_mounted) {
   return SetupCell{std::move(robot), std::move(calibration), std::move(poses), std::move(path)};
 }
 
+namespace {
+
+// The protocol's program timed with its speed ramped over `ramp_points` segments into and out of every
+// point where it is at rest (the start, the turn from clockwise to anticlockwise, the end): segment i
+// of a ramp runs at sin(pi/2 i / (ramp_points + 1)) of the speed.
+JointTrajectory ramped_program(const std::vector<Pose>& poses, std::vector<JointVector> joints, double speed_m_s,
+                               double settle_s, std::size_t turn, int ramp_points, const RobotModel& model) {
+  const std::size_t last = poses.size() - 1;
+  std::vector<double> t;
+  std::vector<JointVector> q;
+  if (settle_s > 0.0) {
+    t.push_back(0.0);
+    q.push_back(joints.front());
+  }
+  t.push_back(settle_s);
+  q.push_back(joints.front());
+  for (std::size_t i = 1; i <= last; ++i) {
+    // Segment i joins points i - 1 and i: its distance in segments from the nearest point at rest.
+    std::size_t from_rest = std::min(i, last - i + 1);
+    if (turn > 0 && turn < last) from_rest = std::min(from_rest, i <= turn ? turn - i + 1 : i - turn);
+    const double x = std::min(1.0, static_cast<double>(from_rest) / (ramp_points + 1));
+    const double share = std::sin(0.5 * kPi * x);  // full speed with no step in the acceleration
+    const double d = (poses[i].translation() - poses[i - 1].translation()).norm();
+    t.push_back(t.back() + std::max(d / (speed_m_s * share), 1e-3));
+    q.push_back(std::move(joints[i]));
+  }
+  return JointTrajectory(std::move(t), std::move(q), model,
+                         fmt::format("path at {:g} mm/s, ramped at rest", speed_m_s * 1e3));
+}
+
+}  // namespace
+
 JointTrajectory protocol_program(const std::vector<Pose>& circle_poses, const std::vector<JointVector>& q,
-                                 double speed_m_s, double settle_s, int laps_cw, int laps_ccw,
-                                 const RobotModel& model) {
+                                 double speed_m_s, double settle_s, int laps_cw, int laps_ccw, const RobotModel& model,
+                                 int ramp_points) {
   if (circle_poses.size() != q.size() || q.size() < 4) {
     throw InputError("protocol program: a closed circle of at least 4 points is needed");
   }
@@ -99,11 +155,18 @@ JointTrajectory protocol_program(const std::vector<Pose>& circle_poses, const st
       joints.push_back(q[n - k]);
     }
   }
+  const std::size_t turn = laps_ccw > 0 ? poses.size() - 1 : 0;
   for (int lap = 0; lap < laps_ccw; ++lap) {
     for (std::size_t k = 1; k <= n; ++k) {
       poses.push_back(circle_poses[k]);
       joints.push_back(q[k]);
     }
+  }
+  if (ramp_points > 0) {
+    if (!std::isfinite(speed_m_s) || !(speed_m_s > 0.0) || !(settle_s >= 0.0)) {
+      throw InputError("protocol program: a positive speed and a hold of >= 0 s are needed");
+    }
+    return ramped_program(poses, std::move(joints), speed_m_s, settle_s, turn, ramp_points, model);
   }
   return trajectory_at_tcp_speed(poses, joints, speed_m_s, model, settle_s);
 }
@@ -222,15 +285,17 @@ struct RunPlan {
   double run_end_s;
   double dt;
   long ticks;
+  runtime::SessionConfig session;  // deflex's settings on a link (the link's defaults otherwise)
 };
 
 // The cell's network and its three hosts, and the robot program's motion and state connections
-// (simple message), on a clock this simulation advances.
+// (simple message; UR RTDE's one connection is the motion one), on a clock this simulation advances.
 struct RunNetwork {
-  explicit RunNetwork(const cell::CellConfig& c)
-      : network(clock),
-        controller_port(network.add_endpoint(kController, c.controller.network_latency_s)),
-        deflex_egm_port(network.add_endpoint(kDeflexEgm, c.controller.network_latency_s)),
+  RunNetwork(const cell::CellConfig& c, LinkKind link)
+      // MotoROS2's reply is 2053 bytes.
+      : network(clock, link == LinkKind::kMotoros2Rt ? 4096 : 2048),
+        controller_port(network.add_endpoint(link_addresses(link).controller, c.controller.network_latency_s)),
+        deflex_egm_port(network.add_endpoint(link_addresses(link).deflex, c.controller.network_latency_s)),
         daq_port(network.add_endpoint(kDaq, c.sensor.daq_latency_s)),
         deflex_force_port(network.add_endpoint(kDeflexForce, 0.0)),
         motion_stream(clock, c.controller.network_latency_s),
@@ -261,6 +326,57 @@ struct RunInstruments {
   cell::LaserTracker tracker;
 };
 
+// The runtime's kind of a study's controller link.
+runtime::LinkKind runtime_link(LinkKind link) {
+  switch (link) {
+    case LinkKind::kEgmPath:
+      return runtime::LinkKind::kEgmPath;
+    case LinkKind::kRsi:
+      return runtime::LinkKind::kRsi;
+    case LinkKind::kSimpleMessage:
+      return runtime::LinkKind::kSimpleMessage;
+    case LinkKind::kFanucJ519:
+      return runtime::LinkKind::kFanucJ519;
+    case LinkKind::kMotoros2Rt:
+      return runtime::LinkKind::kMotoros2Rt;
+    case LinkKind::kUrRtde:
+      return runtime::LinkKind::kUrRtde;
+    case LinkKind::kProgram:
+    case LinkKind::kEgmJoint:
+      break;
+  }
+  return runtime::LinkKind::kEgmJoint;
+}
+
+// deflex's settings for a run on a link, as `deflex online --link ...` starts from them (the link's
+// cycle and defaults: runtime::default_session_config), with the case file's online section applied
+// (bounds, rates, watchdog, ramp-in); the EGM cycles come from the case's controller, simple
+// message's from its online section. The reference runs stream the program uncorrected.
+runtime::SessionConfig session_config_of(const CaseConfig& config, const RunSpec& spec, bool compensated) {
+  const cell::CellConfig& c = config.cell;
+  runtime::SessionConfig sc = runtime::default_session_config(runtime_link(spec.link));
+  if (spec.link != LinkKind::kProgram) sc.online = online_config_from_case(config, link_period_s(config, spec.link));
+  sc.strategy = StrategyKind::kNone;
+  if (compensated) {
+    sc.strategy = spec.strategy == Strategy::kHybrid       ? StrategyKind::kHybrid
+                  : spec.strategy == Strategy::kPredictive ? StrategyKind::kPredictive
+                                                           : StrategyKind::kOnline;
+  }
+  const double ramp_in_s = config.online.ramp_in_s;
+  sc.egm_joint.stream.ramp_in_s = ramp_in_s;
+  sc.simple_message.stream.ramp_in_s = ramp_in_s;
+  sc.fanuc_j519.stream.ramp_in_s = ramp_in_s;
+  sc.motoros2_rt.stream.ramp_in_s = ramp_in_s;
+  sc.ur_rtde.stream.ramp_in_s = ramp_in_s;
+  sc.simple_message.buffer_depth = config.online.stream_buffer_depth;
+  sc.egm_path.frame = parse_path_corr_frame(c.controller.path_corr_frame);
+  // deflex is the client of FANUC's and MotoROS2's controller: it is told where the controller listens.
+  sc.fanuc_j519.controller = link_addresses(spec.link).controller;
+  sc.motoros2_rt.controller = link_addresses(spec.link).controller;
+  sc.history_cycles = 16;
+  return sc;
+}
+
 // Checks the run and plans it: its program (the offline strategy's compensated one when it has one)
 // and how long the run lasts.
 RunPlan plan_simulated_run(const CaseConfig& config, const SetupCell& setup, const RunSpec& spec) {
@@ -278,45 +394,107 @@ RunPlan plan_simulated_run(const CaseConfig& config, const SetupCell& setup, con
       compensated && (spec.strategy == Strategy::kOffline || spec.strategy == Strategy::kHybrid);
   const std::vector<JointVector> configurations =
       offline_program ? offline_configurations(config, setup, spec.load_n) : setup.nominal_path.q;
-  auto program = std::make_shared<const JointTrajectory>(protocol_program(
-      setup.circle_poses, configurations, spec.speed_m_s, c.ldbb.settle_s, spec.laps_cw, spec.laps_ccw, identified));
+  // FANUC's controller checks the jerk of every command step at its interval: a program that starts,
+  // turns or stops at full speed makes it stop the stream (deflex refuses such a program), so a user
+  // streaming to it ramps the speed there.
+  const int ramp_points = spec.link == LinkKind::kFanucJ519 ? kFanucRampPoints : 0;
+  auto program = std::make_shared<const JointTrajectory>(protocol_program(setup.circle_poses, configurations,
+                                                                          spec.speed_m_s, c.ldbb.settle_s, spec.laps_cw,
+                                                                          spec.laps_ccw, identified, ramp_points));
 
   const double motion_end_s = program->end_time_s();
   // The arm follows a streamed program a little late: let the tracker see the motion to its end.
   // (The streaming server runs a buffer of points behind: a second.)
   const double run_end_s = motion_end_s + (spec.link == LinkKind::kSimpleMessage ? 1.0 : linked ? 0.5 : 0.0);
-  const double dt = c.controller.servo_period_s;
+  runtime::SessionConfig session = session_config_of(config, spec, compensated);
+  // A controller whose cycle can be shorter than the servo's (UR's 2 ms, FANUC's 1 ms) is ticked at its cycle.
+  const bool fast_cycle = spec.link == LinkKind::kUrRtde || spec.link == LinkKind::kFanucJ519;
+  const double dt =
+      fast_cycle ? std::min(c.controller.servo_period_s, session.online.period_s) : c.controller.servo_period_s;
   const auto ticks = static_cast<long>(std::ceil(run_end_s / dt));
-  return RunPlan{config,          setup,     spec, robot, c, loaded, compensated, linked, std::move(program),
-                 c.ldbb.settle_s, run_end_s, dt,   ticks};
+  return RunPlan{config,
+                 setup,
+                 spec,
+                 robot,
+                 c,
+                 loaded,
+                 compensated,
+                 linked,
+                 std::move(program),
+                 c.ldbb.settle_s,
+                 run_end_s,
+                 dt,
+                 ticks,
+                 std::move(session)};
+}
+
+// The controllers whose own cycle deflex's settings set (the stand-ins' defaults otherwise: their
+// dead time, lag and limits, as deflex's stand-in session runs them).
+std::unique_ptr<cell::RobotController> make_streamed_controller(const RunPlan& plan, RunNetwork& net) {
+  const runtime::SessionConfig& sc = plan.session;
+  const JointVector& q_start = plan.program->points().front();
+  switch (plan.spec.link) {
+    case LinkKind::kFanucJ519: {
+      cell::FanucJ519ControllerConfig fc;
+      fc.interval_s = sc.online.period_s;
+      fc.version = sc.fanuc_j519.version;
+      return std::make_unique<cell::FanucJ519Controller>(fc, q_start, net.controller_port);
+    }
+    case LinkKind::kMotoros2Rt: {
+      cell::Motoros2RtControllerConfig mc;
+      mc.period_s = sc.online.period_s;
+      mc.group = sc.motoros2_rt.group;
+      return std::make_unique<cell::Motoros2RtController>(mc, q_start, net.controller_port);
+    }
+    case LinkKind::kUrRtde: {
+      cell::UrRtdeControllerConfig uc;
+      uc.e_series = sc.online.period_s < 0.005;
+      uc.register_offset = sc.ur_rtde.register_offset;
+      return std::make_unique<cell::UrRtdeController>(uc, q_start, net.motion_stream.server());
+    }
+    default:
+      return std::make_unique<cell::SimpleMessageServer>(cell::SimpleMessageServerConfig{}, plan.robot.nominal_model(),
+                                                         q_start, net.motion_stream.server(),
+                                                         net.state_stream.server());
+  }
 }
 
 // The controller the run's link talks to: the robot program itself, EGM position guidance, EGM path
-// correction or the robot program's simple message server.
+// correction, KUKA RSI, or one deflex streams the program to (make_streamed_controller).
 std::unique_ptr<cell::RobotController> make_run_controller(const RunPlan& plan, RunNetwork& net) {
   const cell::CellConfig& c = plan.c;
   const cell::TrueRobot& robot = plan.robot;
   const std::shared_ptr<const JointTrajectory>& program = plan.program;
-  std::unique_ptr<cell::RobotController> controller;
+  const DatagramAddress deflex = link_addresses(plan.spec.link).deflex;
   switch (plan.spec.link) {
     case LinkKind::kProgram:
-      controller = std::make_unique<cell::ProgramController>(program);
-      break;
+      return std::make_unique<cell::ProgramController>(program);
     case LinkKind::kEgmJoint:
-      controller = std::make_unique<cell::EgmPositionGuidanceController>(c.controller, program->points().front(),
-                                                                         net.controller_port, kDeflexEgm);
-      break;
+      return std::make_unique<cell::EgmPositionGuidanceController>(c.controller, program->points().front(),
+                                                                   net.controller_port, deflex);
     case LinkKind::kEgmPath:
-      controller = std::make_unique<cell::EgmPathCorrectionController>(c.controller, robot.nominal_model(), program,
-                                                                       net.controller_port, kDeflexEgm);
-      break;
+      return std::make_unique<cell::EgmPathCorrectionController>(c.controller, robot.nominal_model(), program,
+                                                                 net.controller_port, deflex);
+    case LinkKind::kRsi: {
+      // AXISCORR's limits as deflex controller-setup writes them: deflex's bound, AXISCORRMON 1.2 times it.
+      const runtime::SessionConfig& sc = plan.session;
+      cell::RsiControllerConfig rc;
+      const double bound_deg = rad_to_deg(sc.online.max_joint_correction_rad);
+      rc.upper_limit_deg = bound_deg;
+      rc.lower_limit_deg = -bound_deg;
+      rc.max_correction_deg = 1.2 * bound_deg;
+      rc.cycle_s = sc.online.period_s;
+      rc.timeout = sc.rsi.controller_timeout;
+      rc.sentype = sc.rsi.sentype;
+      return std::make_unique<cell::RsiController>(rc, robot.nominal_model(), program, net.controller_port, deflex);
+    }
     case LinkKind::kSimpleMessage:
-      controller = std::make_unique<cell::SimpleMessageServer>(cell::SimpleMessageServerConfig{}, robot.nominal_model(),
-                                                               program->points().front(), net.motion_stream.server(),
-                                                               net.state_stream.server());
+    case LinkKind::kFanucJ519:
+    case LinkKind::kMotoros2Rt:
+    case LinkKind::kUrRtde:
       break;
   }
-  return controller;
+  return make_streamed_controller(plan, net);
 }
 
 // deflex's side, run as `deflex online` runs it: a session of the runtime on the cell's network, from
@@ -328,29 +506,11 @@ DeflexSide start_deflex_session(const RunPlan& plan, RunNetwork& net, cell::Forc
   const CaseConfig& config = plan.config;
   const cell::CellConfig& c = plan.c;
   const RunSpec& spec = plan.spec;
-  runtime::SessionConfig sc;
-  sc.link = spec.link == LinkKind::kEgmPath         ? runtime::LinkKind::kEgmPath
-            : spec.link == LinkKind::kSimpleMessage ? runtime::LinkKind::kSimpleMessage
-                                                    : runtime::LinkKind::kEgmJoint;
-  sc.online = online_config_from_case(config, spec.link == LinkKind::kEgmPath         ? c.controller.path_corr_period_s
-                                              : spec.link == LinkKind::kSimpleMessage ? config.online.stream_period_s
-                                                                                      : c.controller.egm_period_s);
-  StrategyKind kind = StrategyKind::kNone;  // the reference runs stream the program uncorrected
-  if (plan.compensated) {
-    kind = spec.strategy == Strategy::kHybrid       ? StrategyKind::kHybrid
-           : spec.strategy == Strategy::kPredictive ? StrategyKind::kPredictive
-                                                    : StrategyKind::kOnline;
-  }
-  sc.strategy = kind;
-  if (kind == StrategyKind::kHybrid || kind == StrategyKind::kPredictive) {
+  const runtime::SessionConfig& sc = plan.session;
+  if (sc.strategy == StrategyKind::kHybrid || sc.strategy == StrategyKind::kPredictive) {
     // The user's force model: the LDBB with its nominal pivot and set-point force.
     side.force_model = std::make_unique<LdbbForceModel>(config.pivot_m(), std::max(spec.load_n, 1.0), c.ldbb.push);
   }
-  sc.egm_joint.stream.ramp_in_s = config.online.ramp_in_s;
-  sc.simple_message.buffer_depth = config.online.stream_buffer_depth;
-  sc.simple_message.stream.ramp_in_s = config.online.ramp_in_s;
-  sc.egm_path.frame = parse_path_corr_frame(c.controller.path_corr_frame);
-  sc.history_cycles = 16;
   side.force_source = std::make_unique<DatagramForceSource>(net.deflex_force_port);
   runtime::SessionEndpoints endpoints;
   endpoints.datagram = &net.deflex_egm_port;
@@ -360,8 +520,8 @@ DeflexSide start_deflex_session(const RunPlan& plan, RunNetwork& net, cell::Forc
       sc, plan.setup.calibration.identified,
       tare_sensor(sensor_config_from_sheet(config, sensor.calibration()), sensor, plan.robot,
                   plan.program->points().front(), tare_limit_n(c.sensor)),
-      spec.link == LinkKind::kEgmPath ? nullptr : plan.program, side.force_model.get(), side.force_source.get(),
-      net.clock, endpoints);
+      streams_program(spec.link) ? plan.program : nullptr, side.force_model.get(), side.force_source.get(), net.clock,
+      endpoints);
   return side;
 }
 
@@ -383,7 +543,7 @@ RunInstruments make_run_instruments(const RunPlan& plan) {
 struct SimulatedRun {
   SimulatedRun(const CaseConfig& config, const SetupCell& setup, const RunSpec& spec)
       : plan(plan_simulated_run(config, setup, spec)),
-        net(plan.c),
+        net(plan.c, spec.link),
         controller(make_run_controller(plan, net)),
         // One physical sensor for the whole case: its crosstalk and true sensitivities come from the
         // case seed; its noise from the run's.
@@ -457,9 +617,38 @@ RunOutput drive_simulated_run(SimulatedRun& run) {
   return out;
 }
 
+// What the controller itself counted that deflex's link must keep at zero or low (RSI's late cycles,
+// MotoROS2's truncated increments, FANUC's peak jerk against its limit); throws when the controller
+// stopped the motion (a broken setup, never a result). Read before the session's end stops the stream.
+void check_controller(const cell::RobotController& controller, RunOutput& out) {
+  if (const auto* rsi = dynamic_cast<const cell::RsiController*>(&controller)) {
+    if (!rsi->running()) {
+      throw Error(
+          fmt::format("run: the simulated RSI controller stopped ({})", cell::to_string(rsi->counters().stopped)));
+    }
+    out.controller_events = rsi->counters().late;
+  } else if (const auto* fanuc = dynamic_cast<const cell::FanucJ519Controller*>(&controller)) {
+    if (!fanuc->alarm().empty())
+      throw Error("run: the simulated FANUC controller stopped the stream: " + fanuc->alarm());
+    double peak = 0.0;
+    for (const auto& l : cell::FanucJ519ControllerConfig{}.limits)
+      peak = std::max(peak, fanuc->check().peak().jerk / l.jerk);
+    out.controller_peak = peak;
+  } else if (const auto* moto = dynamic_cast<const cell::Motoros2RtController*>(&controller)) {
+    if (!moto->dropped().empty())
+      throw Error("run: the simulated MotoROS2 controller dropped the session: " + moto->dropped());
+    out.controller_events = moto->counters().truncated;
+  } else if (const auto* ur = dynamic_cast<const cell::UrRtdeController*>(&controller)) {
+    if (ur->safety_mode() != 1 || (!ur->stopped().empty() && ur->stopped().rfind("the program ended", 0) != 0)) {
+      throw Error("run: the simulated UR controller stopped: " + ur->stopped());
+    }
+  }
+}
+
 // What deflex's link did over the run, from its session's summary; throws when the simulated
-// controller stopped EGM for lack of answers.
+// controller stopped EGM for lack of answers, or stopped the motion itself.
 void summarize_deflex_link(SimulatedRun& run, RunOutput& out) {
+  check_controller(*run.controller, out);
   const runtime::SessionSummary& summary = run.deflex.session->finish();
   out.link_counters = summary.counters;
   out.measured_delay_s = summary.measured_delay_s;

@@ -2,7 +2,7 @@
 // speed for the laps of the protocol, the LDBB loads the TCP (or not), the laser tracker records it.
 // A compensated run gets its correction the way a real cell would: the offline strategy as a
 // compensated robot program the controller runs, the online strategies from deflex's own controller
-// link (egm-joint or egm-path) over the cell's network, fed by the cell's force-sensor DAQ. The
+// link (any of the runtime's) over the cell's network, fed by the cell's force-sensor DAQ. The
 // study builds deflex's side exactly as `deflex online` would; the cell never sees it.
 #pragma once
 
@@ -60,7 +60,11 @@ struct RunOutput {
   LinkCounters link_counters;
   double max_command_deviation_rad = 0.0;  ///< largest |command - nominal| of any joint, any cycle
   double max_tcp_correction_m = 0.0;
-  double measured_delay_s = 0.0;      ///< the mean of the link's delay measurements over the run
+  double measured_delay_s = 0.0;  ///< the mean of the link's delay measurements over the run
+  /// What the controller counted of deflex's stream: RSI's late cycles (its <Delay>), MotoROS2's
+  /// increments its safety unit truncated; 0 for the other links.
+  std::uint64_t controller_events = 0;
+  double controller_peak = 0.0;       ///< FANUC: the stream's peak jerk over the controller's jerk limit (0 otherwise)
   cell::CoupledTickCounters coupled;  ///< what the loaded ticks' coupled solves of the arm and the bar did
 };
 
@@ -74,10 +78,16 @@ struct RunOutput {
 
 /// The protocol's program for a closed list of configurations around the circle (last = first):
 /// hold at the start for `settle_s`, `laps_cw` clockwise laps, then `laps_ccw` anticlockwise ones,
-/// at the TCP speed. The circle poses give the distances.
+/// at the TCP speed. The circle poses give the distances. `ramp_points` > 0: the speed ramps over that
+/// many points into and out of every rest (start, turn, end), segment i of a ramp at sin(pi/2 i /
+/// (ramp_points + 1)) of the speed (what a controller that checks the jerk of the stream needs: FANUC's).
 [[nodiscard]] JointTrajectory protocol_program(const std::vector<Pose>& circle_poses, const std::vector<JointVector>& q,
                                                double speed_m_s, double settle_s, int laps_cw, int laps_ccw,
-                                               const RobotModel& model);
+                                               const RobotModel& model, int ramp_points = 0);
+
+/// The points of the FANUC setups' speed ramps (12: full speed 54 deg of the circle after a rest, so
+/// the program's jerk at 200 mm/s stays within what J519's check leaves it).
+inline constexpr int kFanucRampPoints = 12;
 
 /// The compensated configurations of the offline strategy (paper, Figure 2) for a load, closed, from
 /// the identified model and the LDBB force model (nominal pivot, set-point force).
