@@ -25,8 +25,8 @@ struct ControllerSetupOpts : runtime::ControllerSetupSettings {
   bool json = false;
 };
 
-/// The options of `deflex controller-setup`, in the order --help lists them.
-void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
+// The link, where the files go, and the settings every link shares.
+void add_controller_link_options(CLI::App& sub, ControllerSetupOpts& o) {
   sub.add_option("--link", o.link,
                  "egm-joint, egm-path, rsi, fanuc-j519, motoros2-rt or ur-rtde (as deflex online --link)")
       ->required();
@@ -48,6 +48,10 @@ void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
       ->capture_default_str();
   sub.add_option("--max-tcp-correction-mm", o.max_tcp_mm, "deflex online --max-tcp-correction-mm")
       ->capture_default_str();
+}
+
+// ABB EGM's RAPID and UdpUc settings.
+void add_controller_egm_options(CLI::App& sub, ControllerSetupOpts& o) {
   sub.add_option("--ramp-in-s", o.ramp_in_s, "egm-joint: deflex online --ramp-in-s (EGMRunJoint \\RampInTime)")
       ->capture_default_str();
   sub.add_option("--path-corr-frame", o.path_frame, "egm-path: deflex online --path-corr-frame (tool, flange, path)")
@@ -76,6 +80,10 @@ void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
   sub.add_option("--max-speed-deviation-deg-s", o.max_speed_deviation_deg_s,
                  "egm-joint: EGMActJoint \\MaxSpeedDeviation, deg/s (default: 1.25 x the fastest deflex's command may "
                  "move)");
+}
+
+// KUKA RSI, FANUC J519, MotoROS2 and UR RTDE settings.
+void add_controller_other_options(CLI::App& sub, ControllerSetupOpts& o) {
   sub.add_option("--context", o.context, "rsi: base name of the files and the KRL program")->capture_default_str();
   sub.add_option("--rsi-timeout", o.rsi_timeout, "rsi: ETHERNET Timeout, late answers before RSI stops")
       ->capture_default_str();
@@ -112,6 +120,13 @@ void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
                  "fanuc-j519: the TP program's joint move to --program's start, % of the joints' top speed")
       ->capture_default_str();
   sub.add_flag("--json", o.json, "Print one JSON document (the files written and where each goes) on stdout");
+}
+
+/// The options of `deflex controller-setup`, in the order --help lists them.
+void add_controller_setup_options(CLI::App& sub, ControllerSetupOpts& o) {
+  add_controller_link_options(sub, o);
+  add_controller_egm_options(sub, o);
+  add_controller_other_options(sub, o);
 }
 
 /// Writes the files into --output-dir and lists them with where each goes (JSON with --json).

@@ -116,41 +116,36 @@ std::string coefficient_line(const CoefficientFit& fit, int i) {
              : fmt::format("  {:<10} {:9.4g} (no standard error from two cuts) {}", kCoefficientKeys[i], v, unit);
 }
 
-void run(const CoeffOpts& o, int& exit_code) {
-  if (o.cuts.size() < 2) throw InputError("give two or more --cut options (full slots at different feeds per tooth)");
-  OutputFile out(o.out, "option -o");  // prepared first: the file written is never one read
-  const Cutter cutter = parse_cutter_spec(o.cutter);
-  std::vector<SlotCut> cuts;
-  std::vector<std::string> notes;
-  for (const std::string& spec : o.cuts) {
-    ParsedCut c = parse_cut(spec);
-    c.options.spindle_rpm = c.spindle_rpm;
-    const SlotLogMean m = read_slot_log(c.log, c.options);
-    const double revolutions = m.revolutions;
-    if (revolutions < 1.0) {
-      throw InputError(
-          fmt::format("{}: the cut window spans {:.4g} s, less than a revolution at {:g} rpm: a slot's "
-                      "mean force needs whole revolutions (10 or more)",
-                      c.log, m.duration_s, c.spindle_rpm));
-    }
-    if (revolutions < kFewRevolutions) {
-      notes.push_back(
-          fmt::format("{}: the cut window holds only {:g} whole revolutions: its mean leans on the "
-                      "sampling of the force's ripple ({:g} or more are safe)",
-                      c.log, revolutions, kFewRevolutions));
-    }
-    SlotCut s;
-    s.fz_m = feed_per_tooth_m(c.feed_mm_min, c.spindle_rpm, cutter.flutes);
-    s.ap_m = c.ap_mm * 1e-3;
-    s.flutes = cutter.flutes;
-    s.turn = c.turn;
-    s.mean_force_n = m.mean_force_n;
-    s.label = c.log;
-    cuts.push_back(s);
+// One --cut: its log's mean force over the window, with a note when the window holds few revolutions.
+SlotCut read_slot_cut(const std::string& spec, const Cutter& cutter, std::vector<std::string>& notes) {
+  ParsedCut c = parse_cut(spec);
+  c.options.spindle_rpm = c.spindle_rpm;
+  const SlotLogMean m = read_slot_log(c.log, c.options);
+  const double revolutions = m.revolutions;
+  if (revolutions < 1.0) {
+    throw InputError(
+        fmt::format("{}: the cut window spans {:.4g} s, less than a revolution at {:g} rpm: a slot's "
+                    "mean force needs whole revolutions (10 or more)",
+                    c.log, m.duration_s, c.spindle_rpm));
   }
-  const CoefficientFit fit = fit_cutting_coefficients(cuts);
-  notes.insert(notes.end(), fit.warnings.begin(), fit.warnings.end());
+  if (revolutions < kFewRevolutions) {
+    notes.push_back(
+        fmt::format("{}: the cut window holds only {:g} whole revolutions: its mean leans on the "
+                    "sampling of the force's ripple ({:g} or more are safe)",
+                    c.log, revolutions, kFewRevolutions));
+  }
+  SlotCut s;
+  s.fz_m = feed_per_tooth_m(c.feed_mm_min, c.spindle_rpm, cutter.flutes);
+  s.ap_m = c.ap_mm * 1e-3;
+  s.flutes = cutter.flutes;
+  s.turn = c.turn;
+  s.mean_force_n = m.mean_force_n;
+  s.label = c.log;
+  return s;
+}
 
+std::string coefficient_file(const CoeffOpts& o, const Cutter& cutter, const CoefficientFit& fit,
+                             const std::vector<SlotCut>& cuts, const std::vector<std::string>& notes) {
   CoefficientSet set;
   set.k = fit.k;
   if (fit.cuts > 2) set.standard_error = fit.standard_error;
@@ -170,30 +165,47 @@ void run(const CoeffOpts& o, int& exit_code) {
                            c.mean_force_n[0], c.mean_force_n[1], c.mean_force_n[2]);
   }
   for (const std::string& n : notes) comment += "\nwarning: " + n;
-  out.write(coefficient_file_text(set, comment));
+  return coefficient_file_text(set, comment);
+}
+
+void print_coefficients_json(const CoeffOpts& o, const CoefficientFit& fit, const std::vector<SlotCut>& cuts,
+                             const std::vector<std::string>& notes) {
+  nlohmann::json k, se, cut_list = nlohmann::json::array();
+  for (int i = 0; i < 6; ++i) {
+    k[kCoefficientKeys[i]] = coefficient_in_user_units(fit.k, i);
+    const double e = coefficient_in_user_units(fit.standard_error, i);
+    se[kCoefficientKeys[i]] = std::isfinite(e) ? nlohmann::json(e) : nlohmann::json(nullptr);
+  }
+  for (const SlotCut& c : cuts) {
+    cut_list.push_back({{"log", c.label},
+                        {"fz_mm", c.fz_m * 1e3},
+                        {"ap_mm", c.ap_m * 1e3},
+                        {"mean_force_N", vector_to_json(c.mean_force_n)}});
+  }
+  print_json({{"coefficients", k},
+              {"standard_error", se},
+              {"residual_rms_N", vector_to_json(fit.residual_rms_n)},
+              {"force_frame", "feed, normal, axis (force on the tool)"},
+              {"cuts", cut_list},
+              {"warnings", notes},
+              {"output", o.out}});
+}
+
+void run(const CoeffOpts& o, int& exit_code) {
+  if (o.cuts.size() < 2) throw InputError("give two or more --cut options (full slots at different feeds per tooth)");
+  OutputFile out(o.out, "option -o");  // prepared first: the file written is never one read
+  const Cutter cutter = parse_cutter_spec(o.cutter);
+  std::vector<SlotCut> cuts;
+  std::vector<std::string> notes;
+  for (const std::string& spec : o.cuts) cuts.push_back(read_slot_cut(spec, cutter, notes));
+  const CoefficientFit fit = fit_cutting_coefficients(cuts);
+  notes.insert(notes.end(), fit.warnings.begin(), fit.warnings.end());
+  out.write(coefficient_file(o, cutter, fit, cuts, notes));
   out.commit();
 
   for (const std::string& n : notes) std::cerr << "deflex cutting-coefficients: warning: " << n << "\n";
   if (o.json) {
-    nlohmann::json k, se, cut_list = nlohmann::json::array();
-    for (int i = 0; i < 6; ++i) {
-      k[kCoefficientKeys[i]] = coefficient_in_user_units(fit.k, i);
-      const double e = coefficient_in_user_units(fit.standard_error, i);
-      se[kCoefficientKeys[i]] = std::isfinite(e) ? nlohmann::json(e) : nlohmann::json(nullptr);
-    }
-    for (const SlotCut& c : cuts) {
-      cut_list.push_back({{"log", c.label},
-                          {"fz_mm", c.fz_m * 1e3},
-                          {"ap_mm", c.ap_m * 1e3},
-                          {"mean_force_N", vector_to_json(c.mean_force_n)}});
-    }
-    print_json({{"coefficients", k},
-                {"standard_error", se},
-                {"residual_rms_N", vector_to_json(fit.residual_rms_n)},
-                {"force_frame", "feed, normal, axis (force on the tool)"},
-                {"cuts", cut_list},
-                {"warnings", notes},
-                {"output", o.out}});
+    print_coefficients_json(o, fit, cuts, notes);
   } else {
     std::cout << fmt::format("{} full-slot cuts, feed per tooth {:.4g}..{:.4g} mm, cutter {}:\n", fit.cuts,
                              fit.fz_min_m * 1e3, fit.fz_max_m * 1e3, describe_cutter(cutter));

@@ -74,30 +74,19 @@ std::string existing_poses(const std::string& path, const std::string& header, i
   return text;
 }
 
-// --force-source: the arm held still at --joints-deg, the mean raw reading over --window-s (refused
-// when the arm or the tool moves, as the tare is), added as one row to --record's poses CSV. The file
-// is rewritten whole through a temporary file and renamed into place: a failed recording leaves it
-// as it was.
-void record_pose(const PayloadOpts& o, int& exit_code) {
-  const RobotModel model = load_cli_robot("identify-payload", o.robot);
-  const SensorConfig sensor = load_sensor_config_or_defaults(o.sensor);
-  const JointVector q = parse_joints_deg(o.joints_deg, model, "--joints-deg");
-  const bool moments = sensor.components == 6;
-  const std::string header = pose_header(model.dof(), moments);
-  int rows = 0;
-  const std::string previous = existing_poses(o.record, header, rows);
-  OutputFile out(o.record, "option --record");
-  if (!(o.window_s > 0.0 && o.window_s <= 60.0)) throw InputError("option --window-s: 0 < s <= 60");
-  if (!(o.timeout_s > 0.0 && o.timeout_s <= 60.0)) throw InputError("option --timeout-s: 0 < s <= 60");
-
+OpenedForceSource open_recording_source(const PayloadOpts& o) {
   ForceSourceOptions fo;
   fo.bind_address = o.bind;
   fo.rdt_calibration.spec = o.rdt_calibration;
   fo.rdt_calibration.rate_hz = o.rdt_rate_hz;
   fo.rdt_stream.buffered = o.rdt_buffered;
-  const OpenedForceSource force = open_force_source(o.force_source, fo);
-  const double rate_hz = force.sample_rate_hz > 0.0 ? force.sample_rate_hz : sensor.sample_rate_hz;
-  TareSettings settings;  // the window's statistics: expected zero, so the "offset" is the mean reading
+  return open_force_source(o.force_source, fo);
+}
+
+// The window's statistics (expected zero, so the "offset" is the mean reading), read until the window
+// is full or refused, or until --timeout-s past its length.
+TareResult read_still_window(const PayloadOpts& o, const OpenedForceSource& force, double rate_hz) {
+  TareSettings settings;
   settings.window_s = o.window_s;
   settings.max_std_force_n = o.max_std_n;
   settings.max_std_torque_nm = o.max_std_nm;
@@ -122,25 +111,79 @@ void record_pose(const PayloadOpts& o, int& exit_code) {
     }
     if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
-  const TareResult& r = window.result();
-  if (r.state != TareState::kDone) {
-    if (r.faulty > 0) {
-      throw InputError(
-          fmt::format("identify-payload: the pose was not recorded: {} of the window's samples were "
-                      "faulty (flagged by the sensor or saturated)",
-                      r.faulty));
-    }
-    throw InputError(fmt::format(
-        "identify-payload: the pose was not recorded: the reading moved during the {:g} s window (standard deviation "
-        "{:.3f} {:.3f} {:.3f} N, {:.4f} {:.4f} {:.4f} Nm; limits {:g} N, {:g} Nm): hold the arm still and stop the "
-        "tool",
-        o.window_s, r.std_sensor[0], r.std_sensor[1], r.std_sensor[2], r.std_sensor[3], r.std_sensor[4],
-        r.std_sensor[5], o.max_std_n, o.max_std_nm));
+  return window.result();
+}
+
+void require_still_window(const PayloadOpts& o, const TareResult& r) {
+  if (r.state == TareState::kDone) return;
+  if (r.faulty > 0) {
+    throw InputError(
+        fmt::format("identify-payload: the pose was not recorded: {} of the window's samples were "
+                    "faulty (flagged by the sensor or saturated)",
+                    r.faulty));
   }
+  throw InputError(fmt::format(
+      "identify-payload: the pose was not recorded: the reading moved during the {:g} s window (standard deviation "
+      "{:.3f} {:.3f} {:.3f} N, {:.4f} {:.4f} {:.4f} Nm; limits {:g} N, {:g} Nm): hold the arm still and stop the "
+      "tool",
+      o.window_s, r.std_sensor[0], r.std_sensor[1], r.std_sensor[2], r.std_sensor[3], r.std_sensor[4], r.std_sensor[5],
+      o.max_std_n, o.max_std_nm));
+}
+
+std::string pose_row(const JointVector& q, int dof, const TareResult& r, bool moments) {
   std::string row;
-  for (int j = 0; j < model.dof(); ++j) row += fmt::format("{:.6f},", q[j] * 180.0 / kPi);
+  for (int j = 0; j < dof; ++j) row += fmt::format("{:.6f},", q[j] * 180.0 / kPi);
   row += fmt::format("{:.6f},{:.6f},{:.6f}", r.mean_sensor[0], r.mean_sensor[1], r.mean_sensor[2]);
   if (moments) row += fmt::format(",{:.7f},{:.7f},{:.7f}", r.mean_sensor[3], r.mean_sensor[4], r.mean_sensor[5]);
+  return row;
+}
+
+void print_recorded_pose(const PayloadOpts& o, const JointVector& q, const TareResult& r, bool moments, int rows) {
+  if (o.json) {
+    print_json({{"record", o.record},
+                {"poses", rows},
+                {"joints_deg", vector_to_json(q * (180.0 / kPi))},
+                {"mean_sensor", vector_to_json(r.mean_sensor)},
+                {"std_sensor", vector_to_json(r.std_sensor)},
+                {"units", "N, N, N, Nm, Nm, Nm (sensor frame, raw)"},
+                {"samples", r.samples}});
+    return;
+  }
+  std::cout << fmt::format(
+      "pose {} recorded into {}: {:.3f} {:.3f} {:.3f} N{} (mean of {} samples; std up to {:.3f} N)\n", rows, o.record,
+      r.mean_sensor[0], r.mean_sensor[1], r.mean_sensor[2],
+      moments ? fmt::format(", {:.4f} {:.4f} {:.4f} Nm", r.mean_sensor[3], r.mean_sensor[4], r.mean_sensor[5]) : "",
+      r.samples, r.std_sensor.head<3>().maxCoeff());
+  if (rows < 6) {
+    std::cout << fmt::format(
+        "record {} more (6 or more poses that turn the tool about different axes), then: "
+        "deflex identify-payload --data {} -o payload.yaml\n",
+        6 - rows, o.record);
+  } else {
+    std::cout << fmt::format("identify with: deflex identify-payload --data {} -o payload.yaml\n", o.record);
+  }
+}
+
+// --force-source: the arm held still at --joints-deg, the mean raw reading over --window-s (refused
+// when the arm or the tool moves, as the tare is), added as one row to --record's poses CSV. The file
+// is rewritten whole through a temporary file and renamed into place: a failed recording leaves it
+// as it was.
+void record_pose(const PayloadOpts& o, int& exit_code) {
+  const RobotModel model = load_cli_robot("identify-payload", o.robot);
+  const SensorConfig sensor = load_sensor_config_or_defaults(o.sensor);
+  const JointVector q = parse_joints_deg(o.joints_deg, model, "--joints-deg");
+  const bool moments = sensor.components == 6;
+  const std::string header = pose_header(model.dof(), moments);
+  int rows = 0;
+  const std::string previous = existing_poses(o.record, header, rows);
+  OutputFile out(o.record, "option --record");
+  if (!(o.window_s > 0.0 && o.window_s <= 60.0)) throw InputError("option --window-s: 0 < s <= 60");
+  if (!(o.timeout_s > 0.0 && o.timeout_s <= 60.0)) throw InputError("option --timeout-s: 0 < s <= 60");
+
+  const OpenedForceSource force = open_recording_source(o);
+  const double rate_hz = force.sample_rate_hz > 0.0 ? force.sample_rate_hz : sensor.sample_rate_hz;
+  const TareResult r = read_still_window(o, force, rate_hz);
+  require_still_window(o, r);
   if (previous.empty()) {
     out.write(
         fmt::format("# Static poses for deflex identify-payload, recorded from {}: the raw readings (sensor "
@@ -150,32 +193,10 @@ void record_pose(const PayloadOpts& o, int& exit_code) {
   } else {
     out.write(previous);
   }
-  out.write(row + "\n");
+  out.write(pose_row(q, model.dof(), r, moments) + "\n");
   out.commit();
   ++rows;
-  if (o.json) {
-    print_json({{"record", o.record},
-                {"poses", rows},
-                {"joints_deg", vector_to_json(q * (180.0 / kPi))},
-                {"mean_sensor", vector_to_json(r.mean_sensor)},
-                {"std_sensor", vector_to_json(r.std_sensor)},
-                {"units", "N, N, N, Nm, Nm, Nm (sensor frame, raw)"},
-                {"samples", r.samples}});
-  } else {
-    std::cout << fmt::format(
-        "pose {} recorded into {}: {:.3f} {:.3f} {:.3f} N{} (mean of {} samples; std up to {:.3f} N)\n", rows, o.record,
-        r.mean_sensor[0], r.mean_sensor[1], r.mean_sensor[2],
-        moments ? fmt::format(", {:.4f} {:.4f} {:.4f} Nm", r.mean_sensor[3], r.mean_sensor[4], r.mean_sensor[5]) : "",
-        r.samples, r.std_sensor.head<3>().maxCoeff());
-    if (rows < 6) {
-      std::cout << fmt::format(
-          "record {} more (6 or more poses that turn the tool about different axes), then: "
-          "deflex identify-payload --data {} -o payload.yaml\n",
-          6 - rows, o.record);
-    } else {
-      std::cout << fmt::format("identify with: deflex identify-payload --data {} -o payload.yaml\n", o.record);
-    }
-  }
+  print_recorded_pose(o, q, r, moments, rows);
   exit_code = 0;
 }
 

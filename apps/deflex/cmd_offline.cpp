@@ -467,27 +467,26 @@ void run(const OfflineOpts& o, int& exit_code) {
   exit_code = 0;
 }
 
-void setup_offline(CLI::App& sub, int& exit_code) {
-  auto o = std::make_shared<OfflineOpts>();
-  sub.add_option("--robot", o->robot,
+// The robot, the path and the force along it.
+void add_offline_path_options(CLI::App& sub, OfflineOpts& o) {
+  sub.add_option("--robot", o.robot,
                  "Robot file (.yaml deflex format or .urdf) with joint stiffness; default: the built-in ABB IRB 6700");
-  sub.add_option("--stiffness-Nm-per-rad", o->stiffness, kStiffnessHelp);
-  sub.add_option("--circle", o->circle,
+  sub.add_option("--stiffness-Nm-per-rad", o.stiffness, kStiffnessHelp);
+  sub.add_option("--circle", o.circle,
                  "Circle path \"centre_mm=X;Y;Z,radius_mm=R,normal=NX;NY;NZ,start_deg=A,direction=ccw|cw,points=N\"; "
                  "every key optional (default: centre 1500;0;1000 mm, radius 100 mm, normal +z, ccw, 81 points, the "
                  "last repeating the first); \"--circle default\" takes them all")
       ->expected(0, 1);
-  sub.add_option("--line", o->line, "Straight path \"start_mm=X;Y;Z,end_mm=X;Y;Z,points=N\"");
-  sub.add_option("--path", o->path_csv, "Path CSV with columns x_mm,y_mm,z_mm,qw,qx,qy,qz (base frame)");
-  sub.add_option("--orientation-wxyz", o->orientation,
+  sub.add_option("--line", o.line, "Straight path \"start_mm=X;Y;Z,end_mm=X;Y;Z,points=N\"");
+  sub.add_option("--path", o.path_csv, "Path CSV with columns x_mm,y_mm,z_mm,qw,qx,qy,qz (base frame)");
+  sub.add_option("--orientation-wxyz", o.orientation,
                  "TCP orientation held along a circle or line, unit quaternion \"w,x,y,z\" (default 0,0,1,0: tool "
                  "z axis pointing down for the IRB6700's tool0)");
-  sub.add_option("--config", o->config,
-                 "ABB confdata \"cf1,cf4,cf6,cfx\" at the first point (cfx kept along the path)");
-  sub.add_option("--seed-deg", o->seed,
+  sub.add_option("--config", o.config, "ABB confdata \"cf1,cf4,cf6,cfx\" at the first point (cfx kept along the path)");
+  sub.add_option("--seed-deg", o.seed,
                  "Preferred joint values at the first point, degrees \"j1,...,j6\"; with --program-in the arm's joints "
                  "when the program starts (ConfJ\\Off's first target, a KRL point without Status and Turn)");
-  sub.add_option("--force", o->forces,
+  sub.add_option("--force", o.forces,
                  "Force model (repeatable): \"ldbb:pivot_mm=X;Y;Z,force_N=F[;F2..],mode=push|pull\", "
                  "\"ldbb:phi_deg=A,force_N=...\" (circle only: pivot on the circle's axis, bar inclined by A), "
                  "\"constant:fx_N=..,fy_N=..,fz_N=..,mx_Nm=..,my_Nm=..,mz_Nm=..\" (base frame), \"tool:fz_N=..,...\" "
@@ -495,61 +494,76 @@ void setup_offline(CLI::App& sub, int& exit_code) {
                  "\"table:FILE.csv\", \"milling:Ktc_N_mm2=..,...|file=COEFFS.yaml[,ae_mm=..,ap_mm=..]\" (with "
                  "--toolpath)")
       ->required();
-  sub.add_option("--speed-mm-s", o->speed_mm_s,
+}
+
+// The files written: joint trajectories, CSV, RAPID, a compensated program.
+void add_offline_output_options(CLI::App& sub, OfflineOpts& o) {
+  sub.add_option("--speed-mm-s", o.speed_mm_s,
                  "TCP speed, mm/s (default 10): the RAPID speeddata and the timing of the joint trajectories");
   sub.add_option(
-      "--joint-trajectory", o->trajectory_out,
+      "--joint-trajectory", o.trajectory_out,
       "Write the compensated path as a timed joint trajectory CSV (t_s,q1_deg..) at --speed-mm-s, for deflex "
       "online --program (hybrid strategy); one file per load when several");
-  sub.add_option("--nominal-trajectory", o->nominal_trajectory_out,
+  sub.add_option("--nominal-trajectory", o.nominal_trajectory_out,
                  "Write the uncompensated path as a timed joint trajectory CSV at --speed-mm-s, for deflex online "
                  "--program (online and predictive strategies)");
-  sub.add_option("--hold-start-s", o->hold_start_s,
+  sub.add_option("--hold-start-s", o.hold_start_s,
                  "Joint trajectories: hold the first point this long before moving, s (default 0)");
-  sub.add_option("--zone", o->zone, "RAPID zonedata: fine (default) or z0, z1, z5, z10, ...");
-  sub.add_option("--motion", o->motion,
+  sub.add_option("--zone", o.zone, "RAPID zonedata: fine (default) or z0, z1, z5, z10, ...");
+  sub.add_option("--motion", o.motion,
                  "RAPID motion: absj (MoveAbsJ over jointtargets, default) or movel "
                  "(MoveL over robtargets with confdata)");
-  sub.add_option("--tool", o->tool, "RAPID tooldata name (default tool0)");
-  sub.add_option("--wobj", o->wobj, "RAPID wobjdata name (default wobj0)");
-  sub.add_option("--module", o->module, "RAPID module name (default DeflexOffline; the load is appended when several)");
-  sub.add_option("-o,--output", o->csv_out, "Write the per-point CSV here (one file per load when several)");
-  sub.add_option("--rapid", o->rapid_out, "Write the ABB RAPID module here (.mod; one per load when several)");
-  sub.add_option("--program-in", o->program_in,
+  sub.add_option("--tool", o.tool, "RAPID tooldata name (default tool0)");
+  sub.add_option("--wobj", o.wobj, "RAPID wobjdata name (default wobj0)");
+  sub.add_option("--module", o.module, "RAPID module name (default DeflexOffline; the load is appended when several)");
+  sub.add_option("-o,--output", o.csv_out, "Write the per-point CSV here (one file per load when several)");
+  sub.add_option("--rapid", o.rapid_out, "Write the ABB RAPID module here (.mod; one per load when several)");
+  sub.add_option("--program-in", o.program_in,
                  "An existing robot program to compensate target by target: ABB RAPID module (.mod, .modx, .prg, "
                  ".sys) or KUKA KRL program (.src, its .dat beside it); every other byte is kept");
-  sub.add_option("--program-out", o->program_out,
+  sub.add_option("--program-out", o.program_out,
                  "Where the compensated program goes (KRL: the .src; its .dat is written beside it). With --toolpath: "
                  ".nc/.gcode/.tap (G-code over the source), .mod/.modx/.prg (RAPID) or .src (KRL)");
-  sub.add_option("--tooldata", o->tooldata,
+  sub.add_option("--tooldata", o.tooldata,
                  "Tool declared outside the program, in its own syntax (repeatable): RAPID "
                  "\"tGun=[TRUE,[[x,y,z],[q1,q2,q3,q4]],[mass,[cx,cy,cz],[1,0,0,0],0,0,0]]\" (mm), KRL "
                  "\"TOOL_DATA[1]={X ..,Y ..,Z ..,A ..,B ..,C ..}\" or \"$TOOL={...}\" (mm, deg)");
-  sub.add_option("--wobjdata", o->wobjdata,
+  sub.add_option("--wobjdata", o.wobjdata,
                  "Work object or base declared outside the program (repeatable): RAPID "
                  "\"wobjTable=[FALSE,TRUE,\"\",[[x,y,z],[q1,q2,q3,q4]],[[0,0,0],[1,0,0,0]]]\", KRL "
                  "\"BASE_DATA[2]={X ..,Y ..,Z ..,A ..,B ..,C ..}\" or \"$BASE={...}\"");
-  sub.add_option("--toolpath", o->toolpath,
+}
+
+// A CAM toolpath compensated for its milling force.
+void add_offline_toolpath_options(CLI::App& sub, OfflineOpts& o) {
+  sub.add_option("--toolpath", o.toolpath,
                  "A CAM toolpath to compensate for its milling force: G-code (.nc, .gcode, .tap) or APT/CL data (.apt, "
                  ".cls), points in the workpiece frame (docs/machining.md)");
   sub.add_option(
-      "--workpiece", o->workpiece,
+      "--workpiece", o.workpiece,
       "--toolpath: the workpiece frame in the robot's base frame \"x_mm=..,y_mm=..,z_mm=..,qw=..,qx=..,qy=..,"
       "qz=..\" (the quaternion optional)");
-  sub.add_option("--cutter", o->cutter,
+  sub.add_option("--cutter", o.cutter,
                  "--toolpath: the milling cutter \"diameter_mm=..,flutes=..,helix_deg=..[,corner_radius_mm=..]\"");
-  sub.add_option("--stock", o->stock,
+  sub.add_option("--stock", o.stock,
                  "--toolpath: the stock the program cuts, workpiece frame \"box:min_mm=X;Y;Z,max_mm=X;Y;Z,cell_mm=C"
                  "[,model=zmap|dexel][,layer_mm=L]\" (z-map by default)");
-  sub.add_option("--tool-spin", o->tool_spin,
+  sub.add_option("--tool-spin", o.tool_spin,
                  "--toolpath: the spindle's free angle: optimize (default: chosen for stiffness; keys step_deg, "
                  "rate_deg_per_mm, limit_margin_deg, singularity_floor, lag_stages after optimize:) or fixed:DEG");
-  sub.add_option("--toolpath-options", o->toolpath_options,
+  sub.add_option("--toolpath-options", o.toolpath_options,
                  "--toolpath: reading \"chord_mm=0.01,arc_tolerance_mm=0.01,step_mm=0,rotary=head-head|table-table,"
                  "dialect=iso|siemens,apt_units=mm|inch\"");
-  sub.add_option("--plot", o->plot_out,
+  sub.add_option("--plot", o.plot_out,
                  "--toolpath: write an SVG chart of the force, the deflection with and without compensation and the "
                  "spindle angle along the path");
+}
+
+void setup_offline(CLI::App& sub, int& exit_code) {
+  auto o = std::make_shared<OfflineOpts>();
+  add_offline_path_options(sub, *o);
+  add_offline_output_options(sub, *o);
+  add_offline_toolpath_options(sub, *o);
   sub.add_flag("--json", o->json, "Print one JSON document on stdout");
   sub.callback([o, &exit_code, &sub] {
     o->circle_given = sub.count("--circle") > 0;

@@ -116,7 +116,7 @@ runtime::LogSink log_sink(const std::shared_ptr<spdlog::logger>& log) {
   };
 }
 
-void run_online(const OnlineOpts& o, int& exit_code) {
+runtime::SessionConfig online_session_config(const OnlineOpts& o) {
   runtime::SessionConfig config = runtime::make_session_config(o.link, o.strategy, given_settings(o));
   config.monitor = !o.monitor.empty();
   if (o.log_report && config.log_path.empty()) {
@@ -124,6 +124,69 @@ void run_online(const OnlineOpts& o, int& exit_code) {
   }
   if (!o.monitor.empty()) (void)monitor::parse_monitor_address(o.monitor, o.monitor_remote, "--monitor");
   if (o.monitor_remote && o.monitor.empty()) throw InputError("option --monitor-remote: only with --monitor");
+  return config;
+}
+
+// The monitor binds before anything is answered: a port in use is an error now, not mid-session.
+std::unique_ptr<monitor::MonitorServer> start_monitor(const OnlineOpts& o, const runtime::SessionConfig& config,
+                                                      runtime::Session& session,
+                                                      const std::shared_ptr<spdlog::logger>& log) {
+  if (!config.monitor) return nullptr;
+  auto server = std::make_unique<monitor::MonitorServer>(
+      session.monitor_feed(), monitor::parse_monitor_address(o.monitor, o.monitor_remote, "--monitor"));
+  log->info("monitor on {} (the last {:g} s of the session, 10 updates a second)", server->url(),
+            config.monitor_window_s);
+  return server;
+}
+
+void install_stop_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+// The summary's lines: info when the session ended as planned, errors when not.
+void log_summary(const runtime::SessionSummary& summary, const std::shared_ptr<spdlog::logger>& log) {
+  const bool planned = summary.exit_code == 0;
+  for (std::string_view text = summary.text; !text.empty();) {
+    const std::size_t eol = text.find('\n');
+    const std::string_view line = text.substr(0, eol);
+    if (planned) {
+      log->info("{}", line);
+    } else {
+      log->error("{}", line);
+    }
+    text = eol == std::string_view::npos ? std::string_view() : text.substr(eol + 1);
+  }
+}
+
+int online_exit_code(const runtime::SessionSummary& summary, const FieldLogHealth& log_health) {
+  int exit_code = summary.exit_code;
+  // A session that ended as planned but whose cycle log could not be written failed all the same.
+  if (!summary.output_error.empty() && exit_code == 0) exit_code = 1;
+  if (log_health.failed()) {
+    // The summary's lines may not have reached the file: say so where they did arrive.
+    std::fprintf(stderr, "deflex online: %s: the lines after it are on stderr only\n", log_health.error().c_str());
+    if (exit_code == 0) exit_code = 1;
+  }
+  return exit_code;
+}
+
+void write_online_log_report(const runtime::SessionConfig& config, const runtime::SessionSummary& summary,
+                             const std::shared_ptr<spdlog::logger>& log) {
+  const std::string report = log_report_path(config.log_path);
+  write_output_file(
+      report,
+      monitor::monitor_report(*monitor::read_cycle_log_feed(config.log_path),
+                              fmt::format("deflex online: {} ({})", config.log_path, summary.reason_text)),
+      "option --log-report");
+  log->info("the session's charts: {}", report);
+}
+
+void run_online(const OnlineOpts& o, int& exit_code) {
+  const runtime::SessionConfig config = online_session_config(o);
   const runtime::LinkKindInfo& info = runtime::link_kind(config.link);
   const RobotModel model = load_cli_robot("online", o.robot);
   SensorConfig sensor = load_sensor_config_or_defaults(o.sensor);
@@ -138,14 +201,7 @@ void run_online(const OnlineOpts& o, int& exit_code) {
   SteadyClock clock;
   runtime::Session session(config, model, sensor, program, force_model.get(), force.source.get(), clock, {},
                            log_sink(log));
-  // The monitor binds before anything is answered: a port in use is an error now, not mid-session.
-  std::unique_ptr<monitor::MonitorServer> monitor_server;
-  if (config.monitor) {
-    monitor_server = std::make_unique<monitor::MonitorServer>(
-        session.monitor_feed(), monitor::parse_monitor_address(o.monitor, o.monitor_remote, "--monitor"));
-    log->info("monitor on {} (the last {:g} s of the session, 10 updates a second)", monitor_server->url(),
-              config.monitor_window_s);
-  }
+  const std::unique_ptr<monitor::MonitorServer> monitor_server = start_monitor(o, config, session, log);
   if (info.streams_program && !model.has_max_speed()) {
     log->warn(
         "the robot file gives no joint speed limits, so the program's speeds were not checked (add max_speed "
@@ -162,47 +218,18 @@ void run_online(const OnlineOpts& o, int& exit_code) {
   struct Unhook {  // the handlers never see a session that is gone, however this function is left
     ~Unhook() { g_session.store(nullptr); }
   } unhook;
-  struct sigaction sa {};
-  sa.sa_handler = on_stop_signal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
+  install_stop_handlers();
   (void)session.run(0.0);  // real time is asked for (and refused, exit 2) before anything is answered
   if (config.realtime.enabled) log->info("real time: {}", session.realtime_text());
   while (!session.ended()) (void)session.run(0.1);
   const runtime::SessionSummary& summary = session.finish();
-  const bool planned = summary.exit_code == 0;
-  for (std::string_view text = summary.text; !text.empty();) {
-    const std::size_t eol = text.find('\n');
-    const std::string_view line = text.substr(0, eol);
-    if (planned) {
-      log->info("{}", line);
-    } else {
-      log->error("{}", line);
-    }
-    text = eol == std::string_view::npos ? std::string_view() : text.substr(eol + 1);
-  }
+  log_summary(summary, log);
   if (o.json) {
     nlohmann::json doc = nlohmann::json::parse(summary.json_text);
     print_json(doc);
   }
-  exit_code = summary.exit_code;
-  // A session that ended as planned but whose cycle log could not be written failed all the same.
-  if (!summary.output_error.empty() && exit_code == 0) exit_code = 1;
-  if (log_health->failed()) {
-    // The summary's lines may not have reached the file: say so where they did arrive.
-    std::fprintf(stderr, "deflex online: %s: the lines after it are on stderr only\n", log_health->error().c_str());
-    if (exit_code == 0) exit_code = 1;
-  }
-  if (o.log_report && summary.output_error.empty()) {
-    const std::string report = log_report_path(config.log_path);
-    write_output_file(
-        report,
-        monitor::monitor_report(*monitor::read_cycle_log_feed(config.log_path),
-                                fmt::format("deflex online: {} ({})", config.log_path, summary.reason_text)),
-        "option --log-report");
-    log->info("the session's charts: {}", report);
-  }
+  exit_code = online_exit_code(summary, *log_health);
+  if (o.log_report && summary.output_error.empty()) write_online_log_report(config, summary, log);
   if (monitor_server && o.monitor_linger_s > 0.0) {
     log->info("monitor: the page stays up {:g} s more (--monitor-linger-s)", o.monitor_linger_s);
     std::this_thread::sleep_for(std::chrono::duration<double>(o.monitor_linger_s));

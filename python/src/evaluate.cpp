@@ -87,7 +87,10 @@ bool is_one_trace(const py::handle& obj) {
 
 }  // namespace
 
-void bind_evaluate(py::module_& m) {
+namespace {
+
+// The figures the path measures return.
+void bind_evaluate_result_types(py::module_& m) {
   py::class_<PathDeviationStats>(m, "PathDeviationStats", "Distances of a loaded path from a reference, m.")
       .def_readonly("mean_m", &PathDeviationStats::mean_m, "the paper's mean deformation")
       .def_readonly("max_m", &PathDeviationStats::max_m)
@@ -109,7 +112,10 @@ void bind_evaluate(py::module_& m) {
         return fmt::format("Iso9283Path(accuracy_m={:.6g}, repeatability_m={:.6g}, evaluation_points={}, runs={})",
                            s.accuracy_m, s.repeatability_m, s.evaluation_points, s.runs);
       });
+}
 
+// Tracker traces: reading, laps and the reference path.
+void bind_evaluate_traces(py::module_& m) {
   m.def(
       "read_tracker_csv", [](const PathArg& path) { return from_trace(read_tracker_csv(path_text(path))); }, "path"_a,
       "A tracker CSV (t_s,x_mm,y_mm,z_mm) as an (N, 4) array [t_s, x_m, y_m, z_m].");
@@ -158,6 +164,10 @@ void bind_evaluate(py::module_& m) {
       "runs), binned by their angle about the centroid in the plane of best fit (bins equal sectors; `deflex "
       "evaluate --mean-reference` takes about two samples a lap a bin, 36..3600), each bin's positions averaged. "
       "Refuses fewer than 90 % of the bins holding a sample.");
+}
+
+// Distances from a path: the paper's mean, ISO 9283 and the compensation ratio.
+void bind_evaluate_deviation(py::module_& m) {
   m.def(
       "mean_distance_to_path_m",
       [](const ArrayLike& loaded, const ArrayLike& reference) {
@@ -203,7 +213,9 @@ void bind_evaluate(py::module_& m) {
       "ISO 9283 path accuracy and repeatability of repeated runs (a list of traces) against the commanded or "
       "unloaded reference.");
   m.def("compensation_ratio", &compensation_ratio, "uc"_a, "c"_a, "1 - C/UC (NaN when UC is not positive).");
+}
 
+void bind_evaluate_tracker_files(py::module_& m) {
   // Tracker sessions: SA exports and unit-named CSV, registration, time alignment (docs/evaluation.md).
   m.def(
       "read_tracker_file",
@@ -249,6 +261,10 @@ void bind_evaluate(py::module_& m) {
       },
       "path"_a, "trace"_a, "frame"_a = "Robot Base",
       "Writes an (N, 4) trace [t_s, x_m, y_m, z_m] as a Spatial Analyzer ASCII export (mm, named working frame).");
+}
+
+// The tracker frame and clock against the robot's.
+void bind_evaluate_registration(py::module_& m) {
   m.def(
       "register_frames",
       [](const TrackerPointsArg& tracker_points, const TrackerPointsArg& base_points, double max_rms_m,
@@ -311,6 +327,16 @@ void bind_evaluate(py::module_& m) {
       "The clock offset (program time = tracker time + offset_s [+ drift (t - reference_t_s)]; reference_t_s the "
       "tracker time of the run's middle) that best puts the measured (N, 4) trace on the commanded one, with its "
       "uncertainty from the spread over the run's blocks. Both traces need times: (N, 3) is refused.");
+}
+
+}  // namespace
+
+void bind_evaluate(py::module_& m) {
+  bind_evaluate_result_types(m);
+  bind_evaluate_traces(m);
+  bind_evaluate_deviation(m);
+  bind_evaluate_tracker_files(m);
+  bind_evaluate_registration(m);
 }
 
 }  // namespace deflex::python

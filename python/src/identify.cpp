@@ -107,7 +107,10 @@ CalibrationPlan plan_from_state(const py::tuple& t) {
 
 }  // namespace
 
-void bind_identify(py::module_& m) {
+namespace {
+
+// StiffnessEstimate: the identified stiffness, its errors and its pickle.
+void bind_identify_estimate(py::module_& m) {
   py::class_<StiffnessEstimate>(m, "StiffnessEstimate",
                                 "Identified joint stiffness (Nm/rad) with standard errors and identifiability flags.")
       .def_property_readonly("stiffness_nm_per_rad",
@@ -177,7 +180,10 @@ void bind_identify(py::module_& m) {
           s += fmt::format(", poorly identified (shown, not to be used): joints {}", fmt::join(poor, ", "));
         return s + fmt::format(", {} warnings)", e.warnings.size());
       });
+}
 
+// Measurements and the stiffness fit.
+void bind_identify_stiffness(py::module_& m) {
   m.def(
       "read_stiffness_measurements",
       [](const PathArg& path) { return measurements_to_dict(read_stiffness_measurements(path_text(path))); }, "path"_a,
@@ -244,7 +250,9 @@ void bind_identify(py::module_& m) {
       "frame, moment about the WAP) and dp (m, 3) m, positionally (robot, q, wrench, dp, drot, weight) or by keyword; "
       "optional drot (m, 3) rad and weight (m,). fixed_stiffness_nm_per_rad: one entry a joint, a value to hold or "
       "None to estimate. data= takes either form.");
+}
 
+void bind_identify_robot(py::module_& m) {
   m.def(
       "identified_robot",
       [](const RobotModel& model, const StiffnessEstimate& estimate, const std::string& data_name) {
@@ -253,7 +261,10 @@ void bind_identify(py::module_& m) {
       "robot"_a, "estimate"_a, "data_name"_a = "<arrays>",
       "The robot with its identified stiffness, as `deflex identify --write-robot` writes it: a joint the estimate "
       "did not identify keeps the robot file's value (the note says which); InputError when it has none to keep.");
+}
 
+// Planning a calibration: CalibrationPlan and plan_calibration.
+void bind_identify_plan(py::module_& m) {
   py::class_<CalibrationPlan>(m, "CalibrationPlan", "Poses and loads of a compliance-calibration experiment.")
       .def_property_readonly(
           "pose",
@@ -318,6 +329,15 @@ void bind_identify(py::module_& m) {
       "noise_m"_a = 10e-6,
       "Chooses calibration poses and loads in a box of TCP positions (m, base frame) so that every joint's "
       "compliance is observable; load in N, lever and noise in m.");
+}
+
+}  // namespace
+
+void bind_identify(py::module_& m) {
+  bind_identify_estimate(m);
+  bind_identify_stiffness(m);
+  bind_identify_robot(m);
+  bind_identify_plan(m);
 }
 
 }  // namespace deflex::python

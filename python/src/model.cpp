@@ -336,7 +336,10 @@ std::optional<ArmConfiguration> arm_configuration_arg(const py::handle& c) {
   return ArmConfiguration{v[0], v[1], v[2], v[3]};
 }
 
-void bind_model(py::module_& m) {
+namespace {
+
+// What deflect() and ik() return.
+void bind_model_result_types(py::module_& m) {
   py::class_<Deflection>(m, "Deflection",
                          "Joint deflection dtheta_rad = K^-1 J_wap^T W (rad) and the first-order TCP deflection "
                          "J_tcp dtheta [m, m, m, rad, rad, rad] (base frame), J at q itself.")
@@ -392,12 +395,11 @@ void bind_model(py::module_& m) {
                            py::repr(from_vector(r.q)).cast<std::string>(), r.configuration.cf1, r.configuration.cf4,
                            r.configuration.cf6, r.configuration.cfx);
       });
+}
 
-  py::class_<RobotModel, RobotHolder>(
-      m, "Robot",
-      "A validated, immutable robot (kinematics, joint limits, joint stiffness). Joints in rad, lengths in m, "
-      "wrenches [Fx Fy Fz Mx My Mz] in N and Nm in the base frame with the moment about the WAP (moment_about='tcp' "
-      "to give it about the TCP). Pickles (as its deflex YAML).")
+// Robot's constructors and what the robot file says.
+void bind_model_robot_description(py::class_<RobotModel, RobotHolder>& robot_class) {
+  robot_class
       .def_static(
           "builtin", [] { return std::make_shared<RobotModel>(builtin_irb6700()); },
           "The built-in ABB IRB 6700-300/2.70.")
@@ -437,12 +439,16 @@ void bind_model(py::module_& m) {
           },
           "The frames fk() and jacobian() take: tcp, flange, wap and the moving frame of each joint (joint1.., "
           "also by the joint's name in the robot file).")
-      .def_property_readonly("joint_names",
-                             [](const RobotModel& r) {
-                               std::vector<std::string> names;
-                               for (int i = 0; i < r.dof(); ++i) names.push_back(r.joint(i).name);
-                               return names;
-                             })
+      .def_property_readonly("joint_names", [](const RobotModel& r) {
+        std::vector<std::string> names;
+        for (int i = 0; i < r.dof(); ++i) names.push_back(r.joint(i).name);
+        return names;
+      });
+}
+
+// Robot's stiffness copy, limits check, YAML and pickle.
+void bind_model_robot_copies(py::class_<RobotModel, RobotHolder>& robot_class) {
+  robot_class
       .def(
           "with_stiffness",
           [](const RobotModel& r, const ArrayLike& k, const std::string& note) {
@@ -469,7 +475,12 @@ void bind_model(py::module_& m) {
       .def(
           "to_yaml", [](const RobotModel& r) { return robot_to_yaml(r); }, "deflex YAML of the robot (m, deg).")
       .def(py::pickle([](const RobotModel& r) { return py::make_tuple(robot_to_yaml(r), r.description().source); },
-                      &robot_from_state))
+                      &robot_from_state));
+}
+
+// Robot's kinematics, deflection and compensation, batched.
+void bind_model_robot_kinematics(py::class_<RobotModel, RobotHolder>& robot_class) {
+  robot_class
       .def("fk", &fk, "q"_a, "point"_a = "tcp", "threads"_a = 0,
            "Pose of a frame in the base frame as a 4x4 homogeneous matrix (m): 'tcp' (default), 'flange', 'wap' or a "
            "joint's moving frame ('joint1'.., or its name; see .frames). q: (dof,) rad, or (N, dof) for a batch "
@@ -521,7 +532,9 @@ void bind_model(py::module_& m) {
         return fmt::format("<deflex.Robot '{}', {} joints, {}, from {}>", r.name(), r.dof(),
                            r.has_stiffness() ? "with stiffness" : "no stiffness", r.description().source);
       });
+}
 
+void bind_model_functions(py::module_& m) {
   m.def(
       "load_robot", [](const PathArg& path) { return std::make_shared<RobotModel>(load_robot(path_text(path))); },
       "path"_a, "Robot.from_file(path).");
@@ -536,6 +549,21 @@ void bind_model(py::module_& m) {
       },
       "position_m"_a, "quaternion_wxyz"_a,
       "A 4x4 homogeneous transform from a position (m) and a unit quaternion (w, x, y, z).");
+}
+
+}  // namespace
+
+void bind_model(py::module_& m) {
+  bind_model_result_types(m);
+  py::class_<RobotModel, RobotHolder> robot_class(
+      m, "Robot",
+      "A validated, immutable robot (kinematics, joint limits, joint stiffness). Joints in rad, lengths in m, "
+      "wrenches [Fx Fy Fz Mx My Mz] in N and Nm in the base frame with the moment about the WAP (moment_about='tcp' "
+      "to give it about the TCP). Pickles (as its deflex YAML).");
+  bind_model_robot_description(robot_class);
+  bind_model_robot_copies(robot_class);
+  bind_model_robot_kinematics(robot_class);
+  bind_model_functions(m);
 }
 
 }  // namespace deflex::python

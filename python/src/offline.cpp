@@ -221,7 +221,10 @@ Array point_rows(const OfflineResult& r, JointVector OfflinePoint::*field) {
 
 }  // namespace
 
-void bind_offline(py::module_& m) {
+namespace {
+
+// Circle: a circular path, its poses and its pickle.
+void bind_offline_circle(py::module_& m) {
   py::class_<CirclePath> circle(m, "Circle",
                                 "A circle in the base frame (m): centre_m, radius_m, normal, start_angle_rad, "
                                 "clockwise, points (closed: the last repeats the first). Circle() is `deflex offline "
@@ -281,7 +284,10 @@ void bind_offline(py::module_& m) {
             c.centre_m.x(), c.centre_m.y(), c.centre_m.z(), c.radius_m, c.normal.x(), c.normal.y(), c.normal.z(),
             c.start_angle_rad, c.clockwise ? "True" : "False", c.points);
       });
+}
 
+// Paths as poses, their IK and the force along them.
+void bind_offline_paths(py::module_& m) {
   m.def(
       "line_path",
       [](const ArrayLike& start, const ArrayLike& end, int points, const ArrayLike& orientation) {
@@ -346,8 +352,11 @@ void bind_offline(py::module_& m) {
       "The force model evaluated at every path pose, one dict a load (a spec with several force_N values gives "
       "several): `wrench` (N, 6) N, Nm in the base frame with the moment about the WAP (or the TCP), `description`, "
       "`label`, and for an LDBB the bar's `bar_length_m` and `bar_inclination_rad` (to the base XY plane) a point.");
+}
 
-  py::class_<OfflineResult>(m, "OfflineResult", "A compensated path: one row a point (rad, m, N, Nm).")
+// OfflineResult's arrays and figures.
+void bind_offline_result_arrays(py::class_<OfflineResult>& offline_result) {
+  offline_result
       .def_property_readonly(
           "q_desired", [](const OfflineResult& r) { return point_rows(r, &OfflinePoint::q_desired); },
           "(N, dof) rad, from the path's IK")
@@ -382,7 +391,12 @@ void bind_offline(py::module_& m) {
       .def_readonly("max_residual_rad", &OfflineResult::max_residual_rad)
       .def_readonly("max_correction_m", &OfflineResult::max_correction_m)
       .def_readonly("max_joint_correction_rad", &OfflineResult::max_joint_correction_rad)
-      .def_readonly("force_description", &OfflineResult::force_description)
+      .def_readonly("force_description", &OfflineResult::force_description);
+}
+
+// OfflineResult's summary, CSV, RAPID and joint trajectories.
+void bind_offline_result_outputs(py::class_<OfflineResult>& offline_result) {
+  offline_result
       .def(
           "summary", [](const OfflineResult& r) { return offline_summary(r); }, "The summary `deflex offline` prints.")
       .def(
@@ -424,7 +438,12 @@ void bind_offline(py::module_& m) {
             timed(model, r, speed_mm_s, hold_start_s, nominal).write_csv(path_text(path), comment);
           },
           "path"_a, "robot"_a, "speed_mm_s"_a = 10.0, "hold_start_s"_a = 0.0, "nominal"_a = false, "comment"_a = "",
-          "joint_trajectory() as the CSV `t_s,q1_deg,...` deflex online --program reads.")
+          "joint_trajectory() as the CSV `t_s,q1_deg,...` deflex online --program reads.");
+}
+
+// OfflineResult's pickle and repr.
+void bind_offline_result_pickle(py::class_<OfflineResult>& offline_result) {
+  offline_result
       .def(py::pickle(
           [](const OfflineResult& r) {
             py::list points;
@@ -475,7 +494,10 @@ void bind_offline(py::module_& m) {
             "<deflex.OfflineResult {} points, force: {}, max deflection {:.4f} mm, max residual {:.2e} mm>",
             r.point_count, r.force_description, r.max_deflection_m * 1e3, r.max_residual_m * 1e3);
       });
+}
 
+// Offline compensation of a path for one or several loads.
+void bind_offline_compensate(py::module_& m) {
   m.def(
       "compensate_path",
       [](const RobotModel& model, const PathOrPoses& path, const ForceArg& force, const ConfigurationArg& configuration,
@@ -508,7 +530,10 @@ void bind_offline(py::module_& m) {
       "compensate_path for several loads on one path (one IK): a spec with several force_N values "
       "('ldbb:phi_deg=30,force_N=125;325;650'), or a list of specs and wrench arrays; one OfflineResult a load, in "
       "order, as `deflex offline` with several --force options.");
+}
 
+// Offline compensation of an existing robot program.
+void bind_offline_program(py::module_& m) {
   m.def(
       "compensate_program",
       [](const RobotModel& model, const ForceArg& force, const PathArg& program_in, const PathArg& program_out,
@@ -540,7 +565,10 @@ void bind_offline(py::module_& m) {
       "never overwritten. force: one load (spec or wrench about the TCP). Returns the dict of that command's --json "
       "in SI units (targets with deflection_m, correction_m, joint_correction_rad, ...; unresolved; outputs), the "
       "summary text and the output texts; write=False writes nothing.");
+}
 
+// Timed joint trajectory files.
+void bind_offline_trajectory_files(py::module_& m) {
   m.def(
       "read_joint_trajectory",
       [](const PathArg& path, const RobotModel& model) {
@@ -556,6 +584,20 @@ void bind_offline(py::module_& m) {
       "path"_a, "robot"_a, "t_s"_a, "q"_a, "comment"_a = "",
       "Times (s) and joints (N, dof) rad written as the CSV deflex online --program reads (deg), checked as it reads "
       "them; all or nothing.");
+}
+
+}  // namespace
+
+void bind_offline(py::module_& m) {
+  bind_offline_circle(m);
+  bind_offline_paths(m);
+  py::class_<OfflineResult> offline_result(m, "OfflineResult", "A compensated path: one row a point (rad, m, N, Nm).");
+  bind_offline_result_arrays(offline_result);
+  bind_offline_result_outputs(offline_result);
+  bind_offline_result_pickle(offline_result);
+  bind_offline_compensate(m);
+  bind_offline_program(m);
+  bind_offline_trajectory_files(m);
 }
 
 }  // namespace deflex::python

@@ -134,9 +134,84 @@ Array sensor_wrench_rows(const OnlineCompensator& c, const py::handle& obj, py::
   return out;
 }
 
+// OnlineCompensator.replay: every force sample stamped at or before a cycle pushed, then one step().
+py::dict replay_force_log(OnlineCompensator& c, const ArrayLike& t_force, const ArrayLike& w_obj,
+                          const ArrayLike& t_cycle, const ArrayLike& q_obj, const std::optional<ArrayLike>& valid_obj) {
+  const int dof = c.model().dof();
+  const Array tf = to_array(t_force, "t_force_s", 1);
+  require_finite(tf, "t_force_s");
+  const Array w = sensor_wrench_rows(c, w_obj, tf.shape(0));
+  const Array tc = to_array(t_cycle, "t_cycle_s", 1);
+  require_finite(tc, "t_cycle_s");
+  const py::ssize_t n = tc.shape(0), m_samples = tf.shape(0);
+  bool batch = false;
+  const Array q = joint_rows(q_obj, "q_planned", dof, batch);
+  if (batch && q.shape(0) != n) {
+    throw InputError(fmt::format("argument q_planned: expected shape ({},) or ({}, {}), got ({}, {})", dof, n, dof,
+                                 q.shape(0), dof));
+  }
+  std::vector<char> valid(static_cast<std::size_t>(m_samples), 1);
+  if (valid_obj && !valid_obj->is_none()) {
+    const Array v = to_array(*valid_obj, "valid", 1);
+    if (v.shape(0) != m_samples) throw InputError("argument valid: one value a force sample");
+    for (py::ssize_t i = 0; i < m_samples; ++i) valid[static_cast<std::size_t>(i)] = v.data()[i] != 0.0;
+  }
+  for (py::ssize_t i = 1; i < m_samples; ++i) {
+    if (tf.data()[i] < tf.data()[i - 1]) {
+      throw InputError(fmt::format("argument t_force_s: sample {} ({} s) is before sample {} ({} s)", i, tf.data()[i],
+                                   i - 1, tf.data()[i - 1]));
+    }
+  }
+  Array q_cmd = new_array({n, dof}), dtheta = new_array({n, dof}), wrench = new_array({n, 6});
+  py::array_t<int> status(n);
+  Array used = new_array({n});
+  {
+    py::gil_scoped_release release;
+    CycleInput in;
+    py::ssize_t next = 0;
+    for (py::ssize_t k = 0; k < n; ++k) {
+      if (k > 0 && !(tc.data()[k] > tc.data()[k - 1])) {
+        throw InputError(
+            fmt::format("argument t_cycle_s: cycle {} ({} s) is not after cycle {}", k, tc.data()[k], k - 1));
+      }
+      int pushed = 0;
+      for (; next < m_samples && tf.data()[next] <= tc.data()[k]; ++next, ++pushed) {
+        if (c.queued() == c.queue_capacity()) {
+          throw Error(
+              fmt::format("replay: {} force samples fall before cycle {} ({} s), more than the "
+                          "queue's {} (two cycles at the sensor's rate): the cycles are further "
+                          "apart than SensorConfig.sample_rate_hz and OnlineConfig.period_s say",
+                          pushed + 1, k, tc.data()[k], c.queue_capacity()));
+        }
+        ForceSample s;
+        s.t_s = tf.data()[next];
+        s.wrench_sensor = Eigen::Map<const Vector6>(w.data() + 6 * next);
+        s.valid = valid[static_cast<std::size_t>(next)] != 0;
+        c.push_force(s);
+      }
+      in.t_s = tc.data()[k];
+      in.q_planned = Eigen::Map<const Eigen::VectorXd>(q.data() + (batch ? k * dof : 0), dof);
+      in.q_feedback = in.q_planned;
+      const CycleOutput o = c.step(in);
+      Eigen::Map<Eigen::VectorXd>(q_cmd.mutable_data() + k * dof, dof) = o.q_command;
+      Eigen::Map<Eigen::VectorXd>(dtheta.mutable_data() + k * dof, dof) = o.dtheta;
+      Eigen::Map<Wrench>(wrench.mutable_data() + 6 * k) = o.wrench_base;
+      status.mutable_data()[k] = static_cast<int>(o.status);
+      used.mutable_data()[k] = o.samples_used;
+    }
+  }
+  py::list names;
+  for (py::ssize_t k = 0; k < n; ++k) names.append(to_string(static_cast<CycleStatus>(status.data()[k])));
+  return py::dict("q_command"_a = q_cmd, "dtheta"_a = dtheta, "wrench_base"_a = wrench, "status"_a = names,
+                  "usable"_a = py::array(status).attr("__ge__")(0), "samples_used"_a = used);
+}
+
 }  // namespace
 
-void bind_online(py::module_& m) {
+namespace {
+
+// SensorConfig: the force sensor, its payload and filter, and its file.
+void bind_online_sensor_config(py::module_& m) {
   py::class_<SensorConfig> sensor_class(m, "SensorConfig",
                                         "Force-sensor conditioning (docs/online.md): crosstalk, frame, payload, bias, "
                                         "low-pass, dead band, fault threshold. SI units.");
@@ -170,7 +245,10 @@ void bind_online(py::module_& m) {
   m.def(
       "load_sensor_config", [](const PathArg& p) { return load_sensor_config(path_text(p)); }, "path"_a,
       "A sensor configuration YAML (docs/online.md).");
+}
 
+// The cycle's settings and one cycle's result.
+void bind_online_cycle_types(py::module_& m) {
   py::class_<OnlineConfig>(m, "OnlineConfig", "Bounds and timing of the compensation cycle (s, rad, m).")
       .def(py::init<>())
       .def_readwrite("period_s", &OnlineConfig::period_s)
@@ -219,10 +297,11 @@ void bind_online(py::module_& m) {
       .def_readonly("force_age_s", &CycleOutput::force_age_s)
       .def_readonly("samples_used", &CycleOutput::samples_used)
       .def(py::pickle(&cycle_state, &cycle_from_state));
+}
 
-  py::class_<OnlineCompensator>(m, "OnlineCompensator",
-                                "The online compensation cycle (paper, Figure 3) for a loop of your own: push_force() "
-                                "the sensor's samples, step() once a cycle.")
+// OnlineCompensator's construction and force queue.
+void bind_online_compensator_setup(py::class_<OnlineCompensator>& compensator) {
+  compensator
       .def(py::init([](const RobotModel& robot, const SensorConfig& sensor, const OnlineConfig& config) {
              return std::make_unique<OnlineCompensator>(robot, sensor, config);
            }),
@@ -255,7 +334,12 @@ void bind_online(py::module_& m) {
           "the C++ cycle does).")
       .def_property_readonly("queue_capacity", &OnlineCompensator::queue_capacity,
                              "Samples push_force() queues between two step() calls.")
-      .def_property_readonly("queued", &OnlineCompensator::queued, "Samples queued now.")
+      .def_property_readonly("queued", &OnlineCompensator::queued, "Samples queued now.");
+}
+
+// OnlineCompensator's cycle: step, replay, reset and counters.
+void bind_online_compensator_cycle(py::class_<OnlineCompensator>& compensator) {
+  compensator
       .def(
           "step",
           [](OnlineCompensator& c, double t_s, const ArrayLike& q_planned, const std::optional<ArrayLike>& q_feedback,
@@ -291,73 +375,7 @@ void bind_online(py::module_& m) {
           "replay",
           [](OnlineCompensator& c, const ArrayLike& t_force, const ArrayLike& w_obj, const ArrayLike& t_cycle,
              const ArrayLike& q_obj, const std::optional<ArrayLike>& valid_obj) {
-            const int dof = c.model().dof();
-            const Array tf = to_array(t_force, "t_force_s", 1);
-            require_finite(tf, "t_force_s");
-            const Array w = sensor_wrench_rows(c, w_obj, tf.shape(0));
-            const Array tc = to_array(t_cycle, "t_cycle_s", 1);
-            require_finite(tc, "t_cycle_s");
-            const py::ssize_t n = tc.shape(0), m_samples = tf.shape(0);
-            bool batch = false;
-            const Array q = joint_rows(q_obj, "q_planned", dof, batch);
-            if (batch && q.shape(0) != n) {
-              throw InputError(fmt::format("argument q_planned: expected shape ({},) or ({}, {}), got ({}, {})", dof, n,
-                                           dof, q.shape(0), dof));
-            }
-            std::vector<char> valid(static_cast<std::size_t>(m_samples), 1);
-            if (valid_obj && !valid_obj->is_none()) {
-              const Array v = to_array(*valid_obj, "valid", 1);
-              if (v.shape(0) != m_samples) throw InputError("argument valid: one value a force sample");
-              for (py::ssize_t i = 0; i < m_samples; ++i) valid[static_cast<std::size_t>(i)] = v.data()[i] != 0.0;
-            }
-            for (py::ssize_t i = 1; i < m_samples; ++i) {
-              if (tf.data()[i] < tf.data()[i - 1]) {
-                throw InputError(fmt::format("argument t_force_s: sample {} ({} s) is before sample {} ({} s)", i,
-                                             tf.data()[i], i - 1, tf.data()[i - 1]));
-              }
-            }
-            Array q_cmd = new_array({n, dof}), dtheta = new_array({n, dof}), wrench = new_array({n, 6});
-            py::array_t<int> status(n);
-            Array used = new_array({n});
-            {
-              py::gil_scoped_release release;
-              CycleInput in;
-              py::ssize_t next = 0;
-              for (py::ssize_t k = 0; k < n; ++k) {
-                if (k > 0 && !(tc.data()[k] > tc.data()[k - 1])) {
-                  throw InputError(
-                      fmt::format("argument t_cycle_s: cycle {} ({} s) is not after cycle {}", k, tc.data()[k], k - 1));
-                }
-                int pushed = 0;
-                for (; next < m_samples && tf.data()[next] <= tc.data()[k]; ++next, ++pushed) {
-                  if (c.queued() == c.queue_capacity()) {
-                    throw Error(
-                        fmt::format("replay: {} force samples fall before cycle {} ({} s), more than the "
-                                    "queue's {} (two cycles at the sensor's rate): the cycles are further "
-                                    "apart than SensorConfig.sample_rate_hz and OnlineConfig.period_s say",
-                                    pushed + 1, k, tc.data()[k], c.queue_capacity()));
-                  }
-                  ForceSample s;
-                  s.t_s = tf.data()[next];
-                  s.wrench_sensor = Eigen::Map<const Vector6>(w.data() + 6 * next);
-                  s.valid = valid[static_cast<std::size_t>(next)] != 0;
-                  c.push_force(s);
-                }
-                in.t_s = tc.data()[k];
-                in.q_planned = Eigen::Map<const Eigen::VectorXd>(q.data() + (batch ? k * dof : 0), dof);
-                in.q_feedback = in.q_planned;
-                const CycleOutput o = c.step(in);
-                Eigen::Map<Eigen::VectorXd>(q_cmd.mutable_data() + k * dof, dof) = o.q_command;
-                Eigen::Map<Eigen::VectorXd>(dtheta.mutable_data() + k * dof, dof) = o.dtheta;
-                Eigen::Map<Wrench>(wrench.mutable_data() + 6 * k) = o.wrench_base;
-                status.mutable_data()[k] = static_cast<int>(o.status);
-                used.mutable_data()[k] = o.samples_used;
-              }
-            }
-            py::list names;
-            for (py::ssize_t k = 0; k < n; ++k) names.append(to_string(static_cast<CycleStatus>(status.data()[k])));
-            return py::dict("q_command"_a = q_cmd, "dtheta"_a = dtheta, "wrench_base"_a = wrench, "status"_a = names,
-                            "usable"_a = py::array(status).attr("__ge__")(0), "samples_used"_a = used);
+            return replay_force_log(c, t_force, w_obj, t_cycle, q_obj, valid_obj);
           },
           "t_force_s"_a, "wrench_sensor"_a, "t_cycle_s"_a, "q_planned"_a, "valid"_a = py::none(),
           "A recorded force log (wrench_sensor (N, 6) N, Nm in the sensor frame; (N, 3) forces for a 3-axis sensor) "
@@ -373,7 +391,10 @@ void bind_online(py::module_& m) {
                         "samples_fault"_a = k.samples_fault, "samples_invalid"_a = k.samples_invalid,
                         "samples_dropped"_a = k.samples_dropped);
       });
+}
 
+// Payload identification from static poses.
+void bind_online_identify_payload(py::module_& m) {
   m.def(
       "identify_payload",
       [](const DataArg& data, const std::shared_ptr<RobotModel>& robot, const std::optional<SensorConfig>& sensor_arg,
@@ -437,6 +458,20 @@ void bind_online(py::module_& m) {
       "joints q1_deg.., which need robot and sensor.flange_T_sensor), or base_R_sensor (N, 3, 3) with raw readings "
       "wrench_sensor (N, 3) or (N, 6) (sensor.crosstalk applied). Returns the figures and `sensor`: a copy of the "
       "sensor configuration with the payload and bias in it (its to_yaml() is the file that command writes).");
+}
+
+}  // namespace
+
+void bind_online(py::module_& m) {
+  bind_online_sensor_config(m);
+  bind_online_cycle_types(m);
+  py::class_<OnlineCompensator> compensator(
+      m, "OnlineCompensator",
+      "The online compensation cycle (paper, Figure 3) for a loop of your own: push_force() "
+      "the sensor's samples, step() once a cycle.");
+  bind_online_compensator_setup(compensator);
+  bind_online_compensator_cycle(compensator);
+  bind_online_identify_payload(m);
 }
 
 }  // namespace deflex::python

@@ -168,7 +168,10 @@ runtime::StopReason run_releasing(runtime::Session& session, double seconds) {
 
 }  // namespace
 
-void bind_runtime(py::module_& m) {
+namespace {
+
+// Session: the online session against a real controller.
+void bind_runtime_session(py::module_& m) {
   py::class_<PySession>(m, "Session",
                         "An online compensation session on a controller link, run as `deflex online` runs it "
                         "(docs/online.md): link 'egm-joint', 'egm-path', 'rsi' or 'simple-message'; force_source "
@@ -220,44 +223,43 @@ void bind_runtime(py::module_& m) {
           "Every cycle so far as NumPy arrays (SI units): t_s, program_t_s, q_nominal_rad (N, dof), q_blend_rad, "
           "q_feedback_rad, q_command_rad, dtheta_rad, tcp_correction_m (N, 3), wrench_base (N, 6), deviation and step "
           "against the invariants, delay_s, compute_s, answer_s ...");
+}
 
-  py::class_<standin::StandInSession>(
-      m, "StandIn",
-      "A session against an in-memory stand-in of the controller (the simulated cell's, with the real controller's "
-      "behaviour, dead time included), on a clock it advances itself, with the faults of a cell on request: "
-      "outage(), reorder(), stall(), restart(), end_session(), motors_off(), sensor_silent(), stop(). force_base_N: "
-      "the process force "
-      "at the TCP in the base frame; server_read_period_s: simple message, the robot program takes a point at most "
-      "this "
-      "often (a slow consumer); comm_timeout_s: EGM's \\CommTimeout, s. Settings as deflex.Session's.")
-      .def(
-          py::init([](const RobotHolder& robot, const std::string& link, const py::object& program,
-                      const py::handle& force_base_n, const py::object& sensor, const std::string& strategy,
-                      double server_read_period_s, double comm_timeout_s, const py::kwargs& kwargs) {
-            for (const char* key : {"force_source", "loop", "rdt_calibration", "rdt_rate_hz", "rdt_buffered", "tare"}) {
-              if (kwargs.contains(key)) {
-                throw InputError(fmt::format("{}: a stand-in has its own sensor (force_base_N, sensor_silent())",
-                                             runtime::setting_name(*runtime::find_session_setting(key))));
-              }
-            }
-            const runtime::SessionConfig config = config_from(link, strategy, kwargs);
-            standin::StandInConfig sc;
-            sc.force_base_n = vector3(force_base_n, "force_base_N");
-            if (!(server_read_period_s >= 0.0 && server_read_period_s <= 10.0)) {
-              throw InputError(fmt::format("server_read_period_s: {} s is not in 0..10 s", server_read_period_s));
-            }
-            sc.server.read_period_s = server_read_period_s;
-            if (!(comm_timeout_s > 0.0 && comm_timeout_s <= 60.0)) {
-              throw InputError(fmt::format("comm_timeout_s: {} s is not in 0..60 s", comm_timeout_s));
-            }
-            sc.controller.egm_comm_timeout_s = comm_timeout_s;
-            const SensorConfig sensor_config = sensor.is_none() ? SensorConfig{} : sensor.cast<SensorConfig>();
-            return std::make_unique<standin::StandInSession>(config, *robot, sensor_config, program_of(program, *robot),
-                                                             nullptr, sc);
-          }),
-          "robot"_a, "link"_a, "program"_a, py::kw_only(), "force_base_N"_a = std::vector<double>{0.0, 0.0, 0.0},
-          "sensor"_a = py::none(), "strategy"_a = "online", "server_read_period_s"_a = 0.0, "comm_timeout_s"_a = 1.0,
-          py::keep_alive<1, 2>())
+// StandIn's construction: the session's settings and the stand-in's own.
+void bind_runtime_standin_init(py::class_<standin::StandInSession>& standin_class) {
+  standin_class.def(
+      py::init([](const RobotHolder& robot, const std::string& link, const py::object& program,
+                  const py::handle& force_base_n, const py::object& sensor, const std::string& strategy,
+                  double server_read_period_s, double comm_timeout_s, const py::kwargs& kwargs) {
+        for (const char* key : {"force_source", "loop", "rdt_calibration", "rdt_rate_hz", "rdt_buffered", "tare"}) {
+          if (kwargs.contains(key)) {
+            throw InputError(fmt::format("{}: a stand-in has its own sensor (force_base_N, sensor_silent())",
+                                         runtime::setting_name(*runtime::find_session_setting(key))));
+          }
+        }
+        const runtime::SessionConfig config = config_from(link, strategy, kwargs);
+        standin::StandInConfig sc;
+        sc.force_base_n = vector3(force_base_n, "force_base_N");
+        if (!(server_read_period_s >= 0.0 && server_read_period_s <= 10.0)) {
+          throw InputError(fmt::format("server_read_period_s: {} s is not in 0..10 s", server_read_period_s));
+        }
+        sc.server.read_period_s = server_read_period_s;
+        if (!(comm_timeout_s > 0.0 && comm_timeout_s <= 60.0)) {
+          throw InputError(fmt::format("comm_timeout_s: {} s is not in 0..60 s", comm_timeout_s));
+        }
+        sc.controller.egm_comm_timeout_s = comm_timeout_s;
+        const SensorConfig sensor_config = sensor.is_none() ? SensorConfig{} : sensor.cast<SensorConfig>();
+        return std::make_unique<standin::StandInSession>(config, *robot, sensor_config, program_of(program, *robot),
+                                                         nullptr, sc);
+      }),
+      "robot"_a, "link"_a, "program"_a, py::kw_only(), "force_base_N"_a = std::vector<double>{0.0, 0.0, 0.0},
+      "sensor"_a = py::none(), "strategy"_a = "online", "server_read_period_s"_a = 0.0, "comm_timeout_s"_a = 1.0,
+      py::keep_alive<1, 2>());
+}
+
+// StandIn's clock, the cell's faults on request, and the session's end.
+void bind_runtime_standin_faults(py::class_<standin::StandInSession>& standin_class) {
+  standin_class
       .def("run_for", &standin::StandInSession::run_for, "seconds"_a,
            "Ticks the stand-in for `seconds` of its own clock (or until the session ended).")
       .def("outage", &standin::StandInSession::outage, "seconds"_a, "Every datagram of the next `seconds` is lost.")
@@ -305,6 +307,23 @@ void bind_runtime(py::module_& m) {
           "the offset for rsi, the command position each increment moved the controller to for motoros2-rt, each "
           "target the servo program handed to servoj for ur-rtde), "
           "offset_m (egm-path, in its correction frame)");
+}
+
+}  // namespace
+
+void bind_runtime(py::module_& m) {
+  bind_runtime_session(m);
+  py::class_<standin::StandInSession> standin_class(
+      m, "StandIn",
+      "A session against an in-memory stand-in of the controller (the simulated cell's, with the real controller's "
+      "behaviour, dead time included), on a clock it advances itself, with the faults of a cell on request: "
+      "outage(), reorder(), stall(), restart(), end_session(), motors_off(), sensor_silent(), stop(). force_base_N: "
+      "the process force "
+      "at the TCP in the base frame; server_read_period_s: simple message, the robot program takes a point at most "
+      "this "
+      "often (a slow consumer); comm_timeout_s: EGM's \\CommTimeout, s. Settings as deflex.Session's.");
+  bind_runtime_standin_init(standin_class);
+  bind_runtime_standin_faults(standin_class);
 }
 
 }  // namespace deflex::python

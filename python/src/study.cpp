@@ -78,7 +78,10 @@ std::string case_over_paper(const std::string& json_text) {
 
 }  // namespace
 
-void bind_study(py::module_& m) {
+namespace {
+
+// CaseStudyRun: a case study's tables, figures, report and pickle.
+void bind_study_case_run(py::module_& m) {
   py::class_<CaseStudyRun>(
       m, "CaseStudyResult",
       "A case study's figures: tables (the dict of `deflex case-study --json`; lengths in mm as its "
@@ -140,7 +143,9 @@ void bind_study(py::module_& m) {
         return fmt::format("<deflex.CaseStudyResult '{}': {} runs, {} calibrations, {} setups, {} traces>",
                            r.config.name, r.out.runs, r.out.calibrations, r.out.study.setups.size(), r.traces.size());
       });
+}
 
+void bind_study_run(py::module_& m) {
   m.def(
       "run_case_study",
       [](const CaseArg& case_in, int seeds, std::optional<long long> seed, bool quick, bool speed_sweep,
@@ -194,6 +199,13 @@ void bind_study(py::module_& m) {
       "(data/cases/paper.yaml's) merged over the paper's case (a nested dict key by key, a list such as setups "
       "whole); seeds 0 for the case's own count, threads 0 for every core. Writes no files "
       "(write_report() and write_traces() do).");
+}
+
+}  // namespace
+
+void bind_study(py::module_& m) {
+  bind_study_case_run(m);
+  bind_study_run(m);
 }
 
 }  // namespace deflex::python
