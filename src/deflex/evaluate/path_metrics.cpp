@@ -18,6 +18,19 @@ namespace {
 
 constexpr std::uint32_t kLeafSize = 4;
 
+// The largest float at most x (x a lower bound: so is the float); NaN certifies nothing.
+float float_below(double x) {
+  if (std::isnan(x)) return -std::numeric_limits<float>::infinity();
+  if (!(x < static_cast<double>(std::numeric_limits<float>::max()))) {
+    return x == std::numeric_limits<double>::infinity() ? std::numeric_limits<float>::infinity()
+                                                        : std::numeric_limits<float>::max();
+  }
+  if (x <= -static_cast<double>(std::numeric_limits<float>::max())) return -std::numeric_limits<float>::infinity();
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  return f;
+}
+
 }  // namespace
 
 // A bounding-volume hierarchy over the segments: each node holds the box around its segments, and
@@ -50,14 +63,13 @@ struct PolylineIndex::Impl {
   std::vector<std::uint32_t> parent;   // per node (the root's is itself)
   std::vector<std::uint32_t> leaf_of;  // per vertex that starts a segment: the leaf holding that segment
   static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-  // The segments again in path order (pieces concatenated), for the walk and the certificate: start,
-  // direction, squared length and first vertex; per vertex that starts a segment, its place there;
-  // per place, the clearances C_w for the windows kWindows (m; -inf where none holds).
+  // The segments in path order (pieces concatenated), for the walk and the certificate: per place
+  // its index in `segments`; per vertex that starts a segment, its place; per place, the clearances
+  // C_w for the windows kWindows (m, rounded down to floats: a lower bound stays one, in half the
+  // memory).
   static constexpr std::array<std::uint32_t, 8> kWindows{1, 2, 3, 4, 6, 8, 11, 16};
-  std::vector<Vector3> path_a, path_ab;
-  std::vector<double> path_len2;
-  std::vector<std::uint32_t> path_vertex, path_place;
-  std::vector<std::array<double, kWindows.size()>> clearance;
+  std::vector<std::uint32_t> path_slot, path_place;
+  std::vector<std::array<float, kWindows.size()>> clearance;
 
   // The closest point of a segment (start a, direction ab, squared length len2) to q: its fraction
   // along it and its squared distance. One expression for every search, so all agree to the bit.
@@ -69,7 +81,8 @@ struct PolylineIndex::Impl {
   double place_distance2(std::uint32_t k, const Vector3& q) const {
     double f;
     Vector3 c;
-    return closest(path_a[k], path_ab[k], path_len2[k], q, f, c);
+    const std::uint32_t i = path_slot[k];
+    return closest(seg_a[i], seg_ab[i], seg_len2[i], q, f, c);
   }
 
   std::uint32_t build(std::uint32_t start, std::uint32_t end) {
@@ -143,11 +156,12 @@ struct PolylineIndex::Impl {
   void consider_place(std::uint32_t k, const Vector3& q, Nearest& best, double& best2) const {
     double f;
     Vector3 c;
-    const double d2 = closest(path_a[k], path_ab[k], path_len2[k], q, f, c);
+    const std::uint32_t i = path_slot[k];
+    const double d2 = closest(seg_a[i], seg_ab[i], seg_len2[i], q, f, c);
     if (d2 < best2) {
       best2 = d2;
       best.point_m = c;
-      best.segment = path_vertex[k];
+      best.segment = segments[i].a;
       best.fraction = f;
     }
   }
@@ -156,7 +170,7 @@ struct PolylineIndex::Impl {
   // steps: consecutive tracker points are close); returns the place reached and its squared distance.
   std::uint32_t walk(std::uint32_t k, const Vector3& q, double& d2) const {
     d2 = place_distance2(k, q);
-    const auto n = static_cast<std::int64_t>(path_a.size());
+    const auto n = static_cast<std::int64_t>(path_slot.size());
     int steps = 0;
     const auto go = [&](std::int64_t dir) {
       for (; steps < 64; ++steps) {
@@ -178,7 +192,7 @@ struct PolylineIndex::Impl {
   // certificate holds (`best` then holds place k).
   bool certified(std::uint32_t k, double d2, const Vector3& q, Nearest& best, double& best2) const {
     const double dk = std::sqrt(d2);
-    const auto n = static_cast<std::uint32_t>(path_a.size());
+    const auto n = static_cast<std::uint32_t>(path_slot.size());
     consider_place(k, q, best, best2);
     for (std::size_t w = 0; w < kWindows.size(); ++w) {
       if (2.0 * dk <= clearance[k][w]) {
@@ -207,11 +221,8 @@ struct PolylineIndex::Impl {
     for (std::uint32_t v = 0; v < vertices.size(); ++v) {
       const std::uint32_t i = slot_of[v];
       if (i == kNone) continue;
-      path_place[v] = static_cast<std::uint32_t>(path_vertex.size());
-      path_vertex.push_back(v);
-      path_a.push_back(seg_a[i]);
-      path_ab.push_back(seg_ab[i]);
-      path_len2.push_back(seg_len2[i]);
+      path_place[v] = static_cast<std::uint32_t>(path_slot.size());
+      path_slot.push_back(i);
     }
     build_clearances();
   }
@@ -221,13 +232,14 @@ struct PolylineIndex::Impl {
   // first of them), less half the segment's length (a point of the segment is at most that from its
   // midpoint) and a picometre for rounding.
   void build_clearances() {
-    const auto n = static_cast<std::int64_t>(path_a.size());
+    const auto n = static_cast<std::int64_t>(path_slot.size());
     constexpr std::int64_t kFar = kWindows.back();
-    clearance.resize(path_a.size());
+    clearance.resize(path_slot.size());
     for (std::int64_t k = 0; k < n; ++k) {
       const auto uk = static_cast<std::size_t>(k);
-      const Vector3 mid = path_a[uk] + 0.5 * path_ab[uk];
-      const double half = 0.5 * std::sqrt(path_len2[uk]);
+      const std::uint32_t slot = path_slot[uk];
+      const Vector3 mid = seg_a[slot] + 0.5 * seg_ab[slot];
+      const double half = 0.5 * std::sqrt(seg_len2[slot]);
       const auto d2_at = [&](std::int64_t j) {
         return j < 0 || j >= n ? std::numeric_limits<double>::infinity()
                                : place_distance2(static_cast<std::uint32_t>(j), mid);
@@ -242,7 +254,7 @@ struct PolylineIndex::Impl {
       std::size_t w = kWindows.size();
       for (std::int64_t m = kFar; m >= 1; --m) {
         if (w > 0 && kWindows[w - 1] == m) {
-          clearance[uk][--w] = std::sqrt(s2) - half - 1e-12;
+          clearance[uk][--w] = float_below(std::sqrt(s2) - half - 1e-12);
         }
         s2 = std::min({s2, d2_at(k - m), d2_at(k + m)});
       }
@@ -373,7 +385,7 @@ PolylineIndex::Nearest PolylineIndex::nearest(const Vector3& p_m, const Nearest*
     double d2 = 0.0;
     const std::uint32_t k = m.walk(m.path_place[hint->segment], p_m, d2);
     if (!m.certified(k, d2, p_m, best, best2)) {
-      m.search_from_leaf(m.leaf_of[m.path_vertex[k]], p_m, best, best2);
+      m.search_from_leaf(m.leaf_of[m.segments[m.path_slot[k]].a], p_m, best, best2);
     }
   } else if (hint != nullptr && hint->segment < m.leaf_of.size() && m.leaf_of[hint->segment] != Impl::kNone) {
     m.search_from_leaf(m.leaf_of[hint->segment], p_m, best, best2);
