@@ -39,8 +39,8 @@ float float_below(double x) {
 // of segment lengths (dense tracker laps, sparse commanded points, drop-outs). A query seeded with
 // the previous query's segment (consecutive tracker points are close) first walks along the path to
 // the nearest segment there, then tries a certificate kept per segment: a lower bound C_w on the
-// distance from that segment to every segment more than w places away along the path (w = 1, 2, 4,
-// 8, 16). A point at d from segment k is at least C_w - d from each of those (triangle inequality),
+// distance from that segment to every segment more than w places away along the path (w from 1 to
+// 16). A point at d from segment k is at least C_w - d from each of those (triangle inequality),
 // so when d <= C_w - d the segments within w places hold the nearest one and the tree is not
 // searched at all; otherwise the search starts at the walked-to segment's leaf and climbs, its bound
 // tight from the start. Either way the answer is the exact nearest segment.
