@@ -2,8 +2,10 @@
 // runs, the loaded runs, their evaluation, the error budget, the assembly of the tables, and the
 // report written from them), in the exact mode (the reference computation) and the default fast one.
 // One iteration each: a study is seconds to minutes. The phases are thread CPU time summed over the
-// study's threads. By default one seed of the paper's case, quick (a clockwise and an anticlockwise
-// lap a run); DEFLEX_BENCH_FULL=1 runs the whole default study (four seeds, 3 + 3 laps: minutes).
+// study's threads; beside them what it simulated (servo ticks, loaded ticks and the arm's solves in
+// them, tracker samples, link cycles) and its CPU per servo tick. By default one seed of the paper's
+// case, quick (a clockwise and an anticlockwise lap a run); DEFLEX_BENCH_FULL=1 runs the whole
+// default study (four seeds, 3 + 3 laps: minutes).
 // Run: build/bench/case_study_bench --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 #include <time.h>
@@ -53,6 +55,16 @@ void BM_CaseStudy(benchmark::State& state) {
     state.counters["study_cpu_s"] = study_end - start;
     state.counters["runs"] = out.runs;
     state.counters["calibrations"] = out.calibrations;
+    // What the study simulated, to set beside cell_tick_bench's cost of each (the floor).
+    const double servo_ticks = out.simulated_s / config.cell.controller.servo_period_s;
+    double cycles = 0.0;
+    for (const auto& link : out.links) cycles += static_cast<double>(link.cycles);
+    state.counters["servo_ticks"] = servo_ticks;
+    state.counters["loaded_ticks"] = static_cast<double>(out.coupled.ticks);
+    state.counters["arm_solves"] = static_cast<double>(out.coupled.arm_solves);
+    state.counters["tracker_samples"] = out.simulated_s * config.cell.tracker.rate_hz;
+    state.counters["link_cycles"] = cycles;
+    state.counters["us_per_tick"] = (study_end - start) / servo_ticks * 1e6;
   }
   std::filesystem::remove_all(out_dir);
 }

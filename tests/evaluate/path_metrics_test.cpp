@@ -160,6 +160,51 @@ TEST(PathMetrics, IndexAgreesWithBruteForceOnRandomPaths) {
   }
 }
 
+TEST(PathMetrics, TrackerOrderQueriesSeededByTheLastAnswerAgreeWithBruteForce) {
+  // The study's use: a closed, slightly noisy reference of a few thousand segments (its start and end
+  // meet, far apart along the path), and a run's samples in time order, each seeded with the answer
+  // for the one before. The offsets sweep from far below a segment's length (the answer certified
+  // from a few neighbours) to many segments' lengths (the tree searched), and the run crosses the
+  // reference's seam; a second reference is a figure eight, whose two loops cross, a third two laps of
+  // a spiral side by side.
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 2e-6);
+  TrackerTrace ring = test::with_noise(test::closed_circle(0.13, Vector3(1.8, 0.0, 0.9), 3600), 1e-6, 5);
+  ring.push_back(ring.front());  // closed exactly: the seam's two segments share a vertex
+  TrackerTrace eight;
+  for (int i = 0; i <= 2000; ++i) {
+    const double a = 2.0 * kPi * i / 2000;
+    eight.push_back({i * 1e-3, Vector3(1.0 + 0.1 * std::sin(a), 0.05 * std::sin(2.0 * a), 0.5)});
+  }
+  TrackerTrace spiral;  // two laps 0.6 mm apart: the other lap is nearer than the path's next few metres
+  for (int i = 0; i <= 6000; ++i) {
+    const double a = 2.0 * kPi * i / 3000;
+    const double r = 0.13 + 0.6e-3 * a / (2.0 * kPi);
+    spiral.push_back({i * 1e-3, Vector3(1.8 + r * std::cos(a), r * std::sin(a), 0.9)});
+  }
+  for (const TrackerTrace& reference : {ring, eight, spiral}) {
+    const std::vector<TrackerTrace> pieces{reference};
+    const PolylineIndex index(reference);
+    PolylineIndex::Nearest previous;
+    const int n = 4000;
+    for (int i = 0; i < n; ++i) {
+      // Along the reference from just before its seam, a little faster than it was sampled, the
+      // offset from the path growing from 1 um to 5 mm and back.
+      const double u = std::fmod(0.97 + 1.3 * i / n, 1.0) * static_cast<double>(reference.size() - 1);
+      const auto j = static_cast<std::size_t>(u);
+      const Vector3 on = reference[j].p_m + (u - static_cast<double>(j)) * (reference[j + 1].p_m - reference[j].p_m);
+      const double offset = 1e-6 * std::pow(5000.0, std::sin(kPi * i / n));
+      const Vector3 p = on + Vector3(offset * std::cos(0.001 * i), 0.3 * offset, offset * std::sin(0.001 * i)) +
+                        Vector3(noise(rng), noise(rng), noise(rng));
+      const auto seeded = index.nearest(p, i > 0 ? &previous : nullptr);
+      ASSERT_NEAR(seeded.distance_m, brute_force_distance(pieces, p), 1e-15) << "sample " << i;
+      ASSERT_EQ(seeded.distance_m, index.nearest(p).distance_m) << "sample " << i;
+      ASSERT_NEAR((seeded.point_m - p).norm(), seeded.distance_m, 1e-15);
+      previous = seeded;
+    }
+  }
+}
+
 TEST(PathMetrics, PiecesAreNotJoined) {
   // Two parallel lines as separate pieces: a point between their ends is far from both, though it
   // would lie on a segment joining the end of one to the start of the other.

@@ -267,8 +267,9 @@ Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd_in, const Wrenc
   // The process deflection's scale per joint: stiffer when moving, and more yielding with the torque
   // than against it. It scales the torque each gear yields to, so a coupled joint's share of another
   // joint's deflection does not jump when its own torque changes sign.
+  // Unloaded, it scales a zero torque: not computed (six tanh a tick).
   JointVector scale = JointVector::Ones(n);
-  if (dt_s > 0.0 && (rc.speed_stiffening != 0.0 || rc.direction_asymmetry != 0.0)) {
+  if (loaded && dt_s > 0.0 && (rc.speed_stiffening != 0.0 || rc.direction_asymmetry != 0.0)) {
     for (int i = 0; i < n; ++i) {
       const double u = std::tanh(speed[i] / rc.speed_ref_rad_s);
       scale[i] = (1.0 - rc.speed_stiffening * std::abs(u)) *
@@ -282,7 +283,11 @@ Vector3 TrueRobot::solve(Workspace& ws, const JointVector& q_cmd_in, const Wrenc
       state.torque_lowpass_nm = tau;  // a static start: the integrator holds the present torque
       state.have_torque_lowpass = true;
     } else if (dt_s > 0.0) {
-      state.torque_lowpass_nm += (1.0 - std::exp(-dt_s / rc.servo_integral_s)) * (tau - state.torque_lowpass_nm);
+      if (dt_s != state.torque_lowpass_dt_s) {  // a run's ticks are of one length: one exp() a run
+        state.torque_lowpass_dt_s = dt_s;
+        state.torque_lowpass_gain = 1.0 - std::exp(-dt_s / rc.servo_integral_s);
+      }
+      state.torque_lowpass_nm += state.torque_lowpass_gain * (tau - state.torque_lowpass_nm);
     }
     for (int i = 0; i < n; ++i) {
       servo[i] = rc.servo_compliance_fraction * joint_compliance_(i, i) * (tau[i] - state.torque_lowpass_nm[i]);

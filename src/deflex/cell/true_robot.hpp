@@ -57,6 +57,8 @@ struct TrueRobotState {
   JointVector gravity_equivalent_nm;
   JointVector torque_lowpass_nm;  ///< the servo's integral action: the process torque it has taken over
   bool have_torque_lowpass = false;
+  /// Its gain per tick, 1 - exp(-dt / servo_integral_s), for the tick length it was taken at.
+  double torque_lowpass_dt_s = -1.0, torque_lowpass_gain = 0.0;
 };
 
 /// Thread safety: immutable once built: one true robot may serve runs on any number of threads,

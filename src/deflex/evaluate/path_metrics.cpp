@@ -2,6 +2,7 @@
 #include "deflex/evaluate/path_metrics.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -17,14 +18,32 @@ namespace {
 
 constexpr std::uint32_t kLeafSize = 4;
 
+// The largest float at most x (x a lower bound: so is the float); NaN certifies nothing.
+float float_below(double x) {
+  if (std::isnan(x)) return -std::numeric_limits<float>::infinity();
+  if (!(x < static_cast<double>(std::numeric_limits<float>::max()))) {
+    return x == std::numeric_limits<double>::infinity() ? std::numeric_limits<float>::infinity()
+                                                        : std::numeric_limits<float>::max();
+  }
+  if (x <= -static_cast<double>(std::numeric_limits<float>::max())) return -std::numeric_limits<float>::infinity();
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  return f;
+}
+
 }  // namespace
 
 // A bounding-volume hierarchy over the segments: each node holds the box around its segments, and
 // a query descends nearer child first, skipping every node whose box is farther than the best
 // distance found so far. Boxes bound the segments exactly, so the answer is exact, whatever the mix
 // of segment lengths (dense tracker laps, sparse commanded points, drop-outs). A query seeded with
-// the previous query's segment (consecutive tracker points are close) starts at that segment's leaf
-// and climbs, so the bound is tight from the start.
+// the previous query's segment (consecutive tracker points are close) first walks along the path to
+// the nearest segment there, then tries a certificate kept per segment: a lower bound C_w on the
+// distance from that segment to every segment more than w places away along the path (w from 1 to
+// 16). A point at d from segment k is at least C_w - d from each of those (triangle inequality),
+// so when d <= C_w - d the segments within w places hold the nearest one and the tree is not
+// searched at all; otherwise the search starts at the walked-to segment's leaf and climbs, its bound
+// tight from the start. Either way the answer is the exact nearest segment.
 struct PolylineIndex::Impl {
   struct Segment {
     std::uint32_t a, b;  // vertex indices; a == b for a piece of a single sample
@@ -44,6 +63,27 @@ struct PolylineIndex::Impl {
   std::vector<std::uint32_t> parent;   // per node (the root's is itself)
   std::vector<std::uint32_t> leaf_of;  // per vertex that starts a segment: the leaf holding that segment
   static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  // The segments in path order (pieces concatenated), for the walk and the certificate: per place
+  // its index in `segments`; per vertex that starts a segment, its place; per place, the clearances
+  // C_w for the windows kWindows (m, rounded down to floats: a lower bound stays one, in half the
+  // memory).
+  static constexpr std::array<std::uint32_t, 8> kWindows{1, 2, 3, 4, 6, 8, 11, 16};
+  std::vector<std::uint32_t> path_slot, path_place;
+  std::vector<std::array<float, kWindows.size()>> clearance;
+
+  // The closest point of a segment (start a, direction ab, squared length len2) to q: its fraction
+  // along it and its squared distance. One expression for every search, so all agree to the bit.
+  static double closest(const Vector3& a, const Vector3& ab, double len2, const Vector3& q, double& f, Vector3& c) {
+    f = len2 <= 0.0 ? 0.0 : std::clamp((q - a).dot(ab) / len2, 0.0, 1.0);
+    c = a + f * ab;
+    return (c - q).squaredNorm();
+  }
+  double place_distance2(std::uint32_t k, const Vector3& q) const {
+    double f;
+    Vector3 c;
+    const std::uint32_t i = path_slot[k];
+    return closest(seg_a[i], seg_ab[i], seg_len2[i], q, f, c);
+  }
 
   std::uint32_t build(std::uint32_t start, std::uint32_t end) {
     Node node;
@@ -84,12 +124,9 @@ struct PolylineIndex::Impl {
   // Segment i (of `segments`) against the best so far: its closest point to q, as the fraction
   // along it (0 for a segment of one sample), from the kept start, direction and squared length.
   void consider(std::uint32_t i, const Vector3& q, Nearest& best, double& best2) const {
-    const Vector3& a = seg_a[i];
-    const Vector3& ab = seg_ab[i];
-    const double len2 = seg_len2[i];
-    const double f = len2 <= 0.0 ? 0.0 : std::clamp((q - a).dot(ab) / len2, 0.0, 1.0);
-    const Vector3 c = a + f * ab;
-    const double d2 = (c - q).squaredNorm();
+    double f;
+    Vector3 c;
+    const double d2 = closest(seg_a[i], seg_ab[i], seg_len2[i], q, f, c);
     if (d2 < best2) {
       best2 = d2;
       best.point_m = c;
@@ -112,6 +149,128 @@ struct PolylineIndex::Impl {
   }
 
   void search(std::uint32_t root, const Vector3& q, Nearest& best, double& best2) const {
+    descend(root, q, best2, [&](std::uint32_t i) { consider(i, q, best, best2); });
+  }
+
+  // Place k of the path against the best so far.
+  void consider_place(std::uint32_t k, const Vector3& q, Nearest& best, double& best2) const {
+    double f;
+    Vector3 c;
+    const std::uint32_t i = path_slot[k];
+    const double d2 = closest(seg_a[i], seg_ab[i], seg_len2[i], q, f, c);
+    if (d2 < best2) {
+      best2 = d2;
+      best.point_m = c;
+      best.segment = segments[i].a;
+      best.fraction = f;
+    }
+  }
+
+  // From the place of the hint's segment downhill along the path while the distance falls (a few
+  // steps: consecutive tracker points are close); returns the place reached and its squared distance.
+  std::uint32_t walk(std::uint32_t k, const Vector3& q, double& d2) const {
+    d2 = place_distance2(k, q);
+    const auto n = static_cast<std::int64_t>(path_slot.size());
+    int steps = 0;
+    const auto go = [&](std::int64_t dir) {
+      for (; steps < 64; ++steps) {
+        const std::int64_t j = static_cast<std::int64_t>(k) + dir;
+        if (j < 0 || j >= n) return;
+        const double d2j = place_distance2(static_cast<std::uint32_t>(j), q);
+        if (!(d2j < d2)) return;
+        k = static_cast<std::uint32_t>(j);
+        d2 = d2j;
+      }
+    };
+    const std::uint32_t start = k;
+    go(1);
+    if (k == start) go(-1);
+    return k;
+  }
+
+  // The nearest segment with the certificate of place k (see above); false when no window's
+  // certificate holds (`best` then holds place k).
+  bool certified(std::uint32_t k, double d2, const Vector3& q, Nearest& best, double& best2) const {
+    const double dk = std::sqrt(d2);
+    const auto n = static_cast<std::uint32_t>(path_slot.size());
+    consider_place(k, q, best, best2);
+    for (std::size_t w = 0; w < kWindows.size(); ++w) {
+      if (2.0 * dk <= clearance[k][w]) {
+        const std::uint32_t lo = k >= kWindows[w] ? k - kWindows[w] : 0;
+        const std::uint32_t hi = std::min(n - 1, k + kWindows[w]);
+        for (std::uint32_t j = lo; j <= hi; ++j) {
+          if (j != k) consider_place(j, q, best, best2);
+        }
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // Paths of more segments than this search from the hint's leaf without the certificate: their
+  // clearances cost a tree search each to build, and a long reference is mostly a raw trace of
+  // several laps over each other, whose clearances are too small to certify anything.
+  static constexpr std::size_t kMaxCertifiedSegments = 1u << 16;
+
+  void build_path_order() {
+    if (segments.size() > kMaxCertifiedSegments) return;
+    // The tree's build reordered `segments`; their first vertices give back the path's order.
+    path_place.assign(vertices.size(), kNone);
+    std::vector<std::uint32_t> slot_of(vertices.size(), kNone);
+    for (std::uint32_t i = 0; i < segments.size(); ++i) slot_of[segments[i].a] = i;
+    for (std::uint32_t v = 0; v < vertices.size(); ++v) {
+      const std::uint32_t i = slot_of[v];
+      if (i == kNone) continue;
+      path_place[v] = static_cast<std::uint32_t>(path_slot.size());
+      path_slot.push_back(i);
+    }
+    build_clearances();
+  }
+
+  // C_w of every place: the distance from the segment's midpoint to every segment more than w places
+  // away (the nearer ones one by one, those beyond the largest window by the tree, bounded by the
+  // first of them), less half the segment's length (a point of the segment is at most that from its
+  // midpoint) and a picometre for rounding.
+  void build_clearances() {
+    const auto n = static_cast<std::int64_t>(path_slot.size());
+    constexpr std::int64_t kFar = kWindows.back();
+    clearance.resize(path_slot.size());
+    for (std::int64_t k = 0; k < n; ++k) {
+      const auto uk = static_cast<std::size_t>(k);
+      const std::uint32_t slot = path_slot[uk];
+      const Vector3 mid = seg_a[slot] + 0.5 * seg_ab[slot];
+      const double half = 0.5 * std::sqrt(seg_len2[slot]);
+      const auto d2_at = [&](std::int64_t j) {
+        return j < 0 || j >= n ? std::numeric_limits<double>::infinity()
+                               : place_distance2(static_cast<std::uint32_t>(j), mid);
+      };
+      double far2 = std::min(d2_at(k - kFar - 1), d2_at(k + kFar + 1));
+      descend(0, mid, far2, [&](std::uint32_t i) {
+        const std::int64_t place = path_place[segments[i].a];
+        if (std::abs(place - k) <= kFar) return;
+        far2 = std::min(far2, closest_d2(i, mid));
+      });
+      double s2 = far2;
+      std::size_t w = kWindows.size();
+      for (std::int64_t m = kFar; m >= 1; --m) {
+        if (w > 0 && kWindows[w - 1] == m) {
+          clearance[uk][--w] = float_below(std::sqrt(s2) - half - 1e-12);
+        }
+        s2 = std::min({s2, d2_at(k - m), d2_at(k + m)});
+      }
+    }
+  }
+
+  double closest_d2(std::uint32_t i, const Vector3& q) const {
+    double f;
+    Vector3 c;
+    return closest(seg_a[i], seg_ab[i], seg_len2[i], q, f, c);
+  }
+
+  // The tree from `root`, nearer child first, every node nearer than best2 opened: `visit(i)` for each
+  // segment of its leaves (it may lower best2).
+  template <class Visit>
+  void descend(std::uint32_t root, const Vector3& q, const double& best2, Visit visit) const {
     std::uint32_t stack[128];
     int top = 0;
     stack[top++] = root;
@@ -122,7 +281,7 @@ struct PolylineIndex::Impl {
       }
       if (n.left == 0) {
         for (std::uint32_t i = n.start; i < n.end; ++i) {
-          consider(i, q, best, best2);
+          visit(i);
         }
         continue;
       }
@@ -199,6 +358,7 @@ void PolylineIndex::init(const std::vector<const TrackerTrace*>& piece_ptrs) {
     m.seg_ab.push_back(m.vertices[sg.b] - m.vertices[sg.a]);
     m.seg_len2.push_back(m.seg_ab.back().squaredNorm());
   }
+  m.build_path_order();
   impl_ = owner.release();
 }
 
@@ -221,7 +381,13 @@ PolylineIndex::Nearest PolylineIndex::nearest(const Vector3& p_m, const Nearest*
     best.distance_m = std::numeric_limits<double>::quiet_NaN();
     return best;
   }
-  if (hint != nullptr && hint->segment < m.leaf_of.size() && m.leaf_of[hint->segment] != Impl::kNone) {
+  if (hint != nullptr && hint->segment < m.path_place.size() && m.path_place[hint->segment] != Impl::kNone) {
+    double d2 = 0.0;
+    const std::uint32_t k = m.walk(m.path_place[hint->segment], p_m, d2);
+    if (!m.certified(k, d2, p_m, best, best2)) {
+      m.search_from_leaf(m.leaf_of[m.segments[m.path_slot[k]].a], p_m, best, best2);
+    }
+  } else if (hint != nullptr && hint->segment < m.leaf_of.size() && m.leaf_of[hint->segment] != Impl::kNone) {
     m.search_from_leaf(m.leaf_of[hint->segment], p_m, best, best2);
   } else {
     m.search(0, p_m, best, best2);
