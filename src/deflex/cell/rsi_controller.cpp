@@ -43,7 +43,7 @@ RsiController::RsiController(const RsiControllerConfig& config, const RobotModel
   pending_.resize(64);
   for (Pending& p : pending_) p.offset_rad = JointVector::Zero(n);
   applied_ = JointVector::Zero(n);
-  planned_ = position_ = program_->points().front();
+  planned_ = position_ = encoders_ = program_->points().front();
   robot_.actual_deg = robot_.setpoint_deg = JointVector::Zero(n);
   robot_.has_setpoint = robot_.has_rist = robot_.has_rsol = true;
   answer_.correction_deg = JointVector::Zero(n);
@@ -148,11 +148,12 @@ const JointVector& RsiController::tick(double t_s) {
       next_ipoc_ += static_cast<std::uint64_t>(std::llround(config_.cycle_s * 1e3));
       if (config_.ipoc_bits == 32) next_ipoc_ &= 0xFFFFFFFFULL;
       robot_.delay = counters_.late;
+      const JointVector& actual = have_encoders_ ? encoders_ : position_;
       for (int i = 0; i < n; ++i) {
-        robot_.actual_deg[i] = rad_to_deg(position_[i]);
+        robot_.actual_deg[i] = rad_to_deg(actual[i]);
         robot_.setpoint_deg[i] = rad_to_deg(planned_[i]);
       }
-      pose_of(position_, robot_.rist);
+      pose_of(actual, robot_.rist);
       pose_of(planned_, robot_.rsol);
       const std::size_t size = encode_rsi_robot(robot_, config_.precision, buffer_.data(), buffer_.size());
       if (size > 0 && transport_.send_to(buffer_.data(), size, sensor_)) ++counters_.sent;
@@ -163,6 +164,11 @@ const JointVector& RsiController::tick(double t_s) {
     }
   }
   return position_;
+}
+
+void RsiController::encoders(const JointVector& q_motor_rad) {
+  encoders_ = q_motor_rad;
+  have_encoders_ = true;
 }
 
 }  // namespace deflex::cell

@@ -71,6 +71,9 @@ class RsiController final : public RobotController {
                 const DatagramAddress& sensor);
 
   const JointVector& tick(double t_s) override;
+  /// AIPos and RIst are the encoders' (behind the command by the servo's following error), as on the
+  /// real controller; without a reading (no arm in the loop) they are the commanded axes.
+  void encoders(const JointVector& q_motor_rad) override;
   [[nodiscard]] const char* name() const override { return "KUKA RSI axis correction"; }
   [[nodiscard]] const RsiControllerCounters& counters() const { return counters_; }
   /// The offset the axes have now (rad), from where RSI started.
@@ -106,6 +109,8 @@ class RsiController final : public RobotController {
   std::vector<Pending> pending_;
   std::size_t pending_head_ = 0, pending_count_ = 0;
   JointVector applied_, planned_, position_;
+  JointVector encoders_;  // the last encoder reading: what AIPos reports
+  bool have_encoders_ = false;
   double next_cycle_s_ = 0.0, program_t_s_ = 0.0, last_t_s_ = 0.0;
   bool started_ = false, awaiting_ = false, answered_ = false;
   double pause_from_s_ = 0.0, pause_to_s_ = 0.0;
