@@ -102,6 +102,23 @@ TEST(CaseConfig, ASetupMayNameEveryLinkOfTheRuntime) {
   }
 }
 
+TEST(CaseConfig, ASetupsSeedsAreOneToAThousandOrEverySeed) {
+  // The paper's case runs its further links on the first seed only, every other setup on every seed.
+  for (const auto& s : paper_case().setups) {
+    const bool further_link = s.link == LinkKind::kRsi || s.link == LinkKind::kFanucJ519 ||
+                              s.link == LinkKind::kMotoros2Rt || s.link == LinkKind::kUrRtde;
+    EXPECT_EQ(s.seeds, further_link ? 1 : 0) << s.name;
+  }
+  const std::string from = "link: ur-rtde, sensor: true, loads_N: [650], seeds: 1}";
+  EXPECT_EQ(load_case_text(paper_with(from, "link: ur-rtde, sensor: true, loads_N: [650], seeds: 3}"), "case.yaml")
+                .setups.back()
+                .seeds,
+            3);
+  const std::string zero = error_of(paper_with(from, "link: ur-rtde, sensor: true, loads_N: [650], seeds: 0}"));
+  EXPECT_NE(zero.find("setups[10].seeds"), std::string::npos) << zero;
+  EXPECT_NE(zero.find("1..1000"), std::string::npos) << zero;
+}
+
 TEST(CaseConfig, AnUnknownOrRefusedLinkNamesTheSetupAndTheLinks) {
   const std::string unknown = error_of(paper_with("name: online-ur, strategy: online, link: ur-rtde",
                                                   "name: online-ur, strategy: online, link: ur-rtdx"));

@@ -311,6 +311,22 @@ TEST(CaseStudy, SeveralSeedsGiveEachSeedsOwnFiguresTheirMeanAndSpread) {
     EXPECT_NEAR(sp.sd, std::abs(l.c_mm_by_seed.at(50)[0] - l.c_mm_by_seed.at(50)[1]) / std::sqrt(2.0), 1e-12);
     EXPECT_NE(l.c_mm_by_seed.at(50)[0], l.c_mm_by_seed.at(50)[1]);  // two cells, two results
   }
+  // A setup that runs the first seed only: its figures are that seed's, the other setup keeps both
+  // seeds, and the study runs the setup's family (its unloaded, uncompensated and compensated runs) once.
+  CaseConfig one_seed = c;
+  one_seed.setups[1].seeds = 1;
+  o.seeds = 2;
+  const CaseStudyOutput mixed = run_case_study(one_seed, o);
+  const LoadResult& kept = mixed.study.setups[0].loads[0];
+  const LoadResult& first_only = mixed.study.setups[1].loads[0];
+  ASSERT_EQ(kept.c_mm_by_seed.at(50).size(), 2u);
+  EXPECT_EQ(kept.c_mm_by_seed.at(50), both.study.setups[0].loads[0].c_mm_by_seed.at(50));
+  ASSERT_EQ(first_only.c_mm_by_seed.at(50).size(), 1u);
+  EXPECT_EQ(first_only.c_mm.at(50), first.study.setups[1].loads[0].c_mm.at(50));
+  EXPECT_EQ(first_only.uc_mm.at(50), first.study.setups[1].loads[0].uc_mm.at(50));
+  // Each setup here is its own family: 1 unloaded, 1 uncompensated and 1 compensated run a seed.
+  EXPECT_EQ(both.runs, 2 * 2 * 3);
+  EXPECT_EQ(mixed.runs, 2 * 3 + 1 * 3);
 }
 
 TEST(CaseStudy, TheErrorBudgetsEveryEffectFigureIsTheTablesOwnRun) {

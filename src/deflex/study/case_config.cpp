@@ -240,7 +240,7 @@ yaml::Field read_case_protocol(const yaml::Field& root, CaseConfig& c) {
 
 // One entry of the case file's "setups"; `others` are the setups before it (names must differ).
 SetupConfig read_case_setup(const yaml::Field& s, const std::vector<SetupConfig>& others) {
-  s.only_keys({"name", "strategy", "link", "sensor", "loads_N", "paper_uc_mm", "paper_c_mm"});
+  s.only_keys({"name", "strategy", "link", "sensor", "loads_N", "seeds", "paper_uc_mm", "paper_c_mm"});
   SetupConfig sc;
   sc.name = s.at("name").as_string();
   sc.strategy = parse_strategy(s.at("strategy"));
@@ -264,6 +264,8 @@ SetupConfig read_case_setup(const yaml::Field& s, const std::vector<SetupConfig>
     if (other.name == sc.name) s.at("name").fail("two setups have this name");
   }
   sc.loads_n = s.at("loads_N").as_doubles();
+  if (s.has("seeds"))
+    sc.seeds = case_whole(s, "seeds", std::nullopt, 1, 1000, "must be 1..1000 (or left out: every seed)");
   for (double l : sc.loads_n) {
     if (!(l > 0.0)) s.at("loads_N").fail("loads must be positive");
   }

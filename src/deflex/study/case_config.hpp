@@ -58,6 +58,10 @@ struct SetupConfig {
   LinkKind link = LinkKind::kProgram;
   bool sensor_mounted = false;
   std::vector<double> loads_n;
+  /// How many of the study's seeds the setup runs (its first ones); 0: every seed. A setup that only
+  /// shows how a controller's timing costs compensation needs no spread over seeds, and its own
+  /// unloaded and uncompensated runs per seed are most of its time (case file "seeds", 1..1000).
+  int seeds = 0;
   std::vector<double> paper_uc_mm;                ///< paper's UC per load (empty: none)
   std::vector<std::array<double, 3>> paper_c_mm;  ///< paper's C1..C3 per load
 };

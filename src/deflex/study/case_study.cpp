@@ -225,6 +225,9 @@ struct StudyContext {
   const CaseStudyOptions& options;
   const int laps_cw, laps_ccw, laps;
   const int n_seeds;
+  // How many seeds a setup runs (its first ones), and a family (the most of its setups').
+  [[nodiscard]] int seeds_of(const SetupConfig& s) const { return s.seeds > 0 ? std::min(s.seeds, n_seeds) : n_seeds; }
+  std::vector<int> family_seeds;
   std::vector<CaseConfig> seed_config;  // each seed its own cell (true robot, sensor, calibrations) and runs
   bool need_cell[2] = {false, false};   // the physical setups: without, with the sensor
   std::vector<Family> families;
@@ -349,7 +352,12 @@ void plan_seeds_and_families(StudyContext& x) {
   }
   for (const auto& s : config.setups) {
     x.need_cell[s.sensor_mounted ? 1 : 0] = true;
-    if (x.family_of(s) < 0) x.families.push_back(Family{s.sensor_mounted, s.link});
+    if (x.family_of(s) < 0) {
+      x.families.push_back(Family{s.sensor_mounted, s.link});
+      x.family_seeds.push_back(0);
+    }
+    int& fs = x.family_seeds[static_cast<std::size_t>(x.family_of(s))];
+    fs = std::max(fs, x.seeds_of(s));
   }
   x.cells.resize(static_cast<std::size_t>(x.n_seeds));
   x.speeds = config.speeds_m_s;
@@ -377,6 +385,7 @@ void plan_loaded_runs(StudyContext& x) {
   const CaseConfig& config = x.config;
   for (int si = 0; si < x.n_seeds; ++si) {
     for (const auto& s : config.setups) {
+      if (si >= x.seeds_of(s)) continue;
       const int fam = x.family_of(s);
       for (double load : s.loads_n) {
         for (double v : config.speeds_m_s) {
@@ -446,6 +455,7 @@ void weigh_progress(StudyContext& x) {
       if (x.need_cell[f]) x.progress.total += x.cal_cost;
     }
     for (std::size_t f = 0; f < x.families.size(); ++f) {
+      if (si >= x.family_seeds[f]) continue;
       for (double v : x.speeds) x.progress.total += run_cost(config, v, x.laps);
     }
   }
@@ -481,6 +491,7 @@ int run_calibrations(StudyContext& x) {
 // both cores finish together).
 void run_unloaded_references(StudyContext& x, int si) {
   for (std::size_t f = 0; f < x.families.size(); ++f) {
+    if (si >= x.family_seeds[f]) continue;
     for (double v : x.speeds) x.unloaded[{si, static_cast<int>(f), mm_s(v)}];  // slots before the threads start
   }
   std::vector<double> speeds = x.speeds;
@@ -488,6 +499,7 @@ void run_unloaded_references(StudyContext& x, int si) {
   std::vector<std::function<void()>> jobs;
   for (double v : speeds) {
     for (std::size_t f = 0; f < x.families.size(); ++f) {
+      if (si >= x.family_seeds[f]) continue;
       jobs.emplace_back([&x, si, f, v] {
         const Family& fam = x.families[f];
         const double start = thread_cpu_s();
@@ -673,7 +685,7 @@ LoadResult load_result(const StudyContext& x, const SetupConfig& s, int fam, dou
   for (double v : x.config.speeds_m_s) {
     const int key = mm_s(v);
     std::vector<double> uc_std, uc_max, iso_uc, c_std, c_max, iso_c, iso_rep;
-    for (int si = 0; si < x.n_seeds; ++si) {
+    for (int si = 0; si < x.seeds_of(s); ++si) {
       const LoadedJob* uc = x.find(si, fam, RunKind::kUncompensated, s.strategy, load, v);
       const LoadedJob* c = x.find(si, fam, RunKind::kCompensated, s.strategy, load, v);
       lr.uc_mm_by_seed[key].push_back(uc->figures.mean_mm);
@@ -708,7 +720,7 @@ void add_sweep_points(const StudyContext& x, const SetupConfig& s, int fam, Stud
     p.setup = s.name;
     p.load_N = load;
     p.speed_mm_s = v * 1e3;
-    for (int si = 0; si < x.n_seeds; ++si) {
+    for (int si = 0; si < x.seeds_of(s); ++si) {
       const LoadedJob* uc = x.find(si, fam, RunKind::kUncompensated, s.strategy, load, v);
       const LoadedJob* c = x.find(si, fam, RunKind::kCompensated, s.strategy, load, v);
       p.uc_mm_by_seed.push_back(uc->figures.mean_mm);
@@ -940,7 +952,7 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
   }
   out.setup_paragraphs.push_back(describe_protocol(x));
   out.runs = static_cast<int>(x.loaded.size()) + static_cast<int>(x.budget_jobs.size()) * 2;
-  out.runs += x.n_seeds * static_cast<int>(x.families.size() * x.speeds.size());
+  for (int fs : x.family_seeds) out.runs += fs * static_cast<int>(x.speeds.size());
   out.calibrations += static_cast<int>(x.budget_jobs.size());
   out.simulated_s = x.progress.total;
   for (const auto& j : x.loaded) out.coupled.add(j.coupled);
