@@ -28,10 +28,10 @@ if [ ${#bad[@]} -gt 0 ]; then
   exit 1
 fi
 
-# The sources to lint: the library's and the program's (tests, benchmarks and the Python module's
-# bindings are left to the compiler's warnings).
+# The sources to lint: the library's, the program's and the Python module's bindings (tests and
+# benchmarks are left to the compiler's warnings).
 if [ "$mode" = "--all" ]; then
-  mapfile -t sources < <(git ls-files 'src/*.cpp' 'apps/*.cpp')
+  mapfile -t sources < <(git ls-files 'src/*.cpp' 'apps/*.cpp' 'python/src/*.cpp')
 else
   base=$(sed -n '1p' .ci/lint-base)
   if ! git cat-file -e "$base^{commit}" 2>/dev/null; then
@@ -53,13 +53,17 @@ else
         # A header is linted through the source of the same name, else the first source that includes it.
         src="${f%.hpp}.cpp"
         if [ ! -f "$src" ]; then
-          inc=${f#src/}
-          src=$(git grep -l "#include \"$inc\"" -- 'src/*.cpp' 'apps/*.cpp' | head -n 1 || true)
+          case "$f" in
+            python/src/*) inc=${f#python/src/} ;;
+            *) inc=${f#src/} ;;
+          esac
+          src=$(git grep -l "#include \"$inc\"" -- 'src/*.cpp' 'apps/*.cpp' 'python/src/*.cpp' | head -n 1 || true)
         fi
         [ -n "$src" ] && sources+=("$src")
         ;;
     esac
-  done < <(git diff --name-only "$base" HEAD -- 'src/*.cpp' 'src/*.hpp' 'apps/*.cpp' 'apps/*.hpp')
+  done < <(git diff --name-only "$base" HEAD -- 'src/*.cpp' 'src/*.hpp' 'apps/*.cpp' 'apps/*.hpp' 'python/src/*.cpp' \
+    'python/src/*.hpp')
   mapfile -t sources < <(printf '%s\n' "${sources[@]}" | sort -u | sed '/^$/d')
 fi
 echo "clang-tidy: ${#sources[@]} sources${mode:+ ($mode)}"
@@ -67,7 +71,7 @@ echo "clang-tidy: ${#sources[@]} sources${mode:+ ($mode)}"
 
 dir=build-lint
 cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=OFF -DCMAKE_EXPORT_COMPILE_COMMANDS=ON \
-  -DDEFLEX_BUILD_TESTS=OFF -DDEFLEX_BUILD_BENCHMARKS=OFF -DDEFLEX_PYTHON=OFF >/dev/null
+  -DDEFLEX_BUILD_TESTS=OFF -DDEFLEX_BUILD_BENCHMARKS=OFF -DDEFLEX_PYTHON=ON >/dev/null
 cmake --build "$dir" --target deflex_egm_proto -j"$(nproc)" >/dev/null  # the generated headers
 printf '%s\n' "${sources[@]}" | xargs -P "$(nproc)" -n 1 clang-tidy -p "$dir" --quiet 2>&1 |
   grep -v '^[0-9]* warnings\? generated\.$' | tee "$dir/clang-tidy.log" || true

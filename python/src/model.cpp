@@ -25,7 +25,7 @@ bool moment_about_tcp(const std::string& about) {
 
 Wrench wrench_at_wap(const RobotModel& model, Workspace& ws, const JointVector& q, const double* wrenches, bool per_row,
                      std::ptrdiff_t row, bool about_tcp) {
-  const Wrench w = Eigen::Map<const Wrench>(wrenches + (per_row ? 6 * row : 0));
+  Wrench w = Eigen::Map<const Wrench>(wrenches + (per_row ? 6 * row : 0));
   if (!about_tcp) return w;
   forward_kinematics(model, ws, q);
   return moment_moved(w, ws.base_T_tcp.translation(), ws.base_T_wap.translation());
@@ -148,7 +148,7 @@ struct Deflection {
 
 /// Wrenches (6,) or one a configuration (N, 6) beside q (dof,) or (N, dof).
 Array wrenches_for(const py::handle& w_obj, bool batch, py::ssize_t rows, bool& w_batch) {
-  const Array w = wrench_rows(w_obj, "wrench", w_batch);
+  Array w = wrench_rows(w_obj, "wrench", w_batch);
   if (w_batch && (!batch || w.shape(0) != rows)) {
     throw InputError(
         fmt::format("argument wrench: expected shape (6,) or ({}, 6) (one wrench a configuration), got "
@@ -201,7 +201,7 @@ Array configurations_under(const RobotModel& model, const ArrayLike& q_obj, cons
     JointVector r(dof);
     if (deflected) {
       failed[static_cast<std::size_t>(i)] =
-          deflected_configuration(model, ws, qi, wi, r) != DeflectionStatus::kConverged;
+          deflected_configuration(model, ws, qi, wi, r) != DeflectionStatus::kConverged ? 1 : 0;
     } else {
       compensated_configuration(model, ws, qi, wi, r);
     }

@@ -154,7 +154,7 @@ py::dict replay_force_log(OnlineCompensator& c, const ArrayLike& t_force, const 
   if (valid_obj && !valid_obj->is_none()) {
     const Array v = to_array(*valid_obj, "valid", 1);
     if (v.shape(0) != m_samples) throw InputError("argument valid: one value a force sample");
-    for (py::ssize_t i = 0; i < m_samples; ++i) valid[static_cast<std::size_t>(i)] = v.data()[i] != 0.0;
+    for (py::ssize_t i = 0; i < m_samples; ++i) valid[static_cast<std::size_t>(i)] = v.data()[i] != 0.0 ? 1 : 0;
   }
   for (py::ssize_t i = 1; i < m_samples; ++i) {
     if (tf.data()[i] < tf.data()[i - 1]) {
