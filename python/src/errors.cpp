@@ -84,7 +84,9 @@ void bind_errors(py::module_& m) {
   g_input_error =
       new_exception(m, "InputError", input_bases.ptr(),
                     "A value given is out of its domain (bad array shape or dtype, NaN, unreachable pose).");
-  py::register_exception_translator([](const std::exception_ptr& p) {
+  // pybind11's translator type takes the exception_ptr by value.
+  // NOLINTNEXTLINE(performance-unnecessary-value-param)
+  py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const InputError& e) {

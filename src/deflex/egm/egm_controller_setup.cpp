@@ -111,6 +111,87 @@ EgmSupervision egm_supervision(const EgmSetupOptions& o) {
   return s;
 }
 
+namespace {
+
+// Position guidance: the procedure that hands the arm to deflex's stream, supervised from deflex's limits.
+std::string egm_joint_procedure(const EgmSetupOptions& o, const EgmSupervision& sup) {
+  std::string conditions, joints;
+  for (int j = 1; j <= 6; ++j) {
+    conditions += fmt::format("\\J{}:=deflex_converged", j);
+    joints += fmt::format("\\J{}", j);
+  }
+  return fmt::format(
+      "  ! EGMRunJoint returns once every joint stayed within this of deflex's target (deg) for \\CondTime; deflex\n"
+      "  ! holds the program's last point when the program ends.\n"
+      "  LOCAL CONST egm_minmax deflex_converged:=[{neg},{pos}];\n"
+      "\n"
+      "  ! Supervision from deflex's own limits ({basis}): deflex's command moves at most {fastest} deg/s\n"
+      "  ! and stays within {joint} deg of its nominal, so the controller stops EGM beyond {maxspeed} deg/s or\n"
+      "  ! {maxpos} deg from the arm; it gives up on a silent deflex after {timeout} s, as deflex gives up on it.\n"
+      "  ! Position guidance: deflex streams the program. Call with the arm at the program's start (within 1 deg).\n"
+      "  PROC deflex_egm_joint()\n"
+      "    EGMReset deflex_egm_id;\n"
+      "    EGMGetId deflex_egm_id;\n"
+      "    EGMSetupUC ROB_1,deflex_egm_id,\"{config}\",\"{device}\"\\Joint\\CommTimeout:={timeout};\n"
+      "    EGMActJoint deflex_egm_id\\Tool:={tool}\\WObj:=wobj0{conditions}\n"
+      "      \\LpFilter:={lp}\\SampleRate:={period}\\MaxPosDeviation:={maxpos}\\MaxSpeedDeviation:={maxspeed};\n"
+      "    EGMRunJoint deflex_egm_id,EGM_STOP_HOLD{joints}\\CondTime:={cond}\\RampInTime:={ramp}\\PosCorrGain:=1;\n"
+      "    EGMReset deflex_egm_id;\n"
+      "  ENDPROC\n",
+      fmt::arg("neg", plain_number(-o.convergence_deg)), fmt::arg("pos", plain_number(o.convergence_deg)),
+      fmt::arg("config", o.egm_config), fmt::arg("device", o.device),
+      fmt::arg("timeout", plain_number(sup.comm_timeout_s)), fmt::arg("basis", sup.basis),
+      fmt::arg("fastest", plain_number(std::round(sup.fastest_command_deg_s * 10.0) / 10.0)),
+      fmt::arg("joint", plain_number(o.max_joint_correction_deg)), fmt::arg("tool", o.tool),
+      fmt::arg("conditions", conditions), fmt::arg("lp", plain_number(o.lowpass_hz)),
+      fmt::arg("period", plain_number(o.period_ms)), fmt::arg("maxpos", plain_number(sup.max_pos_deviation_deg)),
+      fmt::arg("maxspeed", plain_number(sup.max_speed_deviation_deg_s)), fmt::arg("joints", joints),
+      fmt::arg("cond", plain_number(o.cond_time_s)), fmt::arg("ramp", plain_number(o.ramp_in_s)));
+}
+
+// Path correction: the procedures around the program's own corrected moves, in deflex's frame.
+std::string egm_path_procedures(const EgmSetupOptions& o, const EgmSupervision& sup) {
+  std::string text;
+  // The frame EGMActMove is given is the frame deflex expresses its offsets in.
+  std::string frame = o.tool + ".tframe";
+  std::string frame_note = "deflex's offsets are in the tool frame (--path-corr-frame tool)";
+  if (o.path_frame == "flange") {
+    text += "  LOCAL CONST pose deflex_flange_frame:=[[0,0,0],[1,0,0,0]];\n";
+    frame = "deflex_flange_frame";
+    frame_note = "deflex's offsets are in the flange frame, tool0 (--path-corr-frame flange)";
+  } else if (o.path_frame == "path") {
+    frame_note = "deflex's offsets are in path coordinates: x along the travel (--path-corr-frame path)";
+  }
+  text += fmt::format(
+      "\n"
+      "  ! Path correction: the program's own EGMMoveL/EGMMoveC run, deflex sends whole offsets every {period} ms;\n"
+      "  ! {frame_note}. Call before the corrected moves.\n"
+      "  PROC deflex_egm_path_begin()\n"
+      "    EGMReset deflex_egm_id;\n"
+      "    EGMGetId deflex_egm_id;\n"
+      "    EGMSetupUC ROB_1,deflex_egm_id,\"{config}\",\"{device}\"\\PathCorr\\APTR\\CommTimeout:={timeout};\n"
+      "    EGMActMove deflex_egm_id,{frame}\\SampleRate:={period};\n"
+      "  ENDPROC\n"
+      "\n"
+      "  ! Call after the corrected moves.\n"
+      "  PROC deflex_egm_path_end()\n"
+      "    EGMStop deflex_egm_id,EGM_STOP_HOLD;\n"
+      "    EGMReset deflex_egm_id;\n"
+      "  ENDPROC\n"
+      "\n"
+      "  ! How a program moves with the corrections (use your own targets, speeds and zones):\n"
+      "  !   deflex_egm_path_begin;\n"
+      "  !   EGMMoveL deflex_egm_id,p10,v50,z1,{tool}\\WObj:=wobj0;\n"
+      "  !   EGMMoveC deflex_egm_id,p20,p30,v50,fine,{tool}\\WObj:=wobj0;\n"
+      "  !   deflex_egm_path_end;\n",
+      fmt::arg("period", plain_number(o.period_ms)), fmt::arg("frame_note", frame_note),
+      fmt::arg("config", o.egm_config), fmt::arg("device", o.device),
+      fmt::arg("timeout", plain_number(sup.comm_timeout_s)), fmt::arg("frame", frame), fmt::arg("tool", o.tool));
+  return text;
+}
+
+}  // namespace
+
 std::vector<ControllerFile> egm_controller_setup(const EgmSetupOptions& o) {
   o.validate();
   const EgmSupervision sup = egm_supervision(o);
@@ -128,76 +209,7 @@ std::vector<ControllerFile> egm_controller_setup(const EgmSetupOptions& o) {
       fmt::arg("tcp", plain_number(o.max_tcp_correction_mm)), fmt::arg("period", plain_number(o.period_ms)),
       fmt::arg("more", o.path_correction ? fmt::format(" --path-corr-frame {}", o.path_frame)
                                          : fmt::format(" --ramp-in-s {} --program P.csv", plain_number(o.ramp_in_s))));
-  if (!o.path_correction) {
-    std::string conditions, joints;
-    for (int j = 1; j <= 6; ++j) {
-      conditions += fmt::format("\\J{}:=deflex_converged", j);
-      joints += fmt::format("\\J{}", j);
-    }
-    mod += fmt::format(
-        "  ! EGMRunJoint returns once every joint stayed within this of deflex's target (deg) for \\CondTime; deflex\n"
-        "  ! holds the program's last point when the program ends.\n"
-        "  LOCAL CONST egm_minmax deflex_converged:=[{neg},{pos}];\n"
-        "\n"
-        "  ! Supervision from deflex's own limits ({basis}): deflex's command moves at most {fastest} deg/s\n"
-        "  ! and stays within {joint} deg of its nominal, so the controller stops EGM beyond {maxspeed} deg/s or\n"
-        "  ! {maxpos} deg from the arm; it gives up on a silent deflex after {timeout} s, as deflex gives up on it.\n"
-        "  ! Position guidance: deflex streams the program. Call with the arm at the program's start (within 1 deg).\n"
-        "  PROC deflex_egm_joint()\n"
-        "    EGMReset deflex_egm_id;\n"
-        "    EGMGetId deflex_egm_id;\n"
-        "    EGMSetupUC ROB_1,deflex_egm_id,\"{config}\",\"{device}\"\\Joint\\CommTimeout:={timeout};\n"
-        "    EGMActJoint deflex_egm_id\\Tool:={tool}\\WObj:=wobj0{conditions}\n"
-        "      \\LpFilter:={lp}\\SampleRate:={period}\\MaxPosDeviation:={maxpos}\\MaxSpeedDeviation:={maxspeed};\n"
-        "    EGMRunJoint deflex_egm_id,EGM_STOP_HOLD{joints}\\CondTime:={cond}\\RampInTime:={ramp}\\PosCorrGain:=1;\n"
-        "    EGMReset deflex_egm_id;\n"
-        "  ENDPROC\n",
-        fmt::arg("neg", plain_number(-o.convergence_deg)), fmt::arg("pos", plain_number(o.convergence_deg)),
-        fmt::arg("config", o.egm_config), fmt::arg("device", o.device),
-        fmt::arg("timeout", plain_number(sup.comm_timeout_s)), fmt::arg("basis", sup.basis),
-        fmt::arg("fastest", plain_number(std::round(sup.fastest_command_deg_s * 10.0) / 10.0)),
-        fmt::arg("joint", plain_number(o.max_joint_correction_deg)), fmt::arg("tool", o.tool),
-        fmt::arg("conditions", conditions), fmt::arg("lp", plain_number(o.lowpass_hz)),
-        fmt::arg("period", plain_number(o.period_ms)), fmt::arg("maxpos", plain_number(sup.max_pos_deviation_deg)),
-        fmt::arg("maxspeed", plain_number(sup.max_speed_deviation_deg_s)), fmt::arg("joints", joints),
-        fmt::arg("cond", plain_number(o.cond_time_s)), fmt::arg("ramp", plain_number(o.ramp_in_s)));
-  } else {
-    // The frame EGMActMove is given is the frame deflex expresses its offsets in.
-    std::string frame = o.tool + ".tframe";
-    std::string frame_note = "deflex's offsets are in the tool frame (--path-corr-frame tool)";
-    if (o.path_frame == "flange") {
-      mod += "  LOCAL CONST pose deflex_flange_frame:=[[0,0,0],[1,0,0,0]];\n";
-      frame = "deflex_flange_frame";
-      frame_note = "deflex's offsets are in the flange frame, tool0 (--path-corr-frame flange)";
-    } else if (o.path_frame == "path") {
-      frame_note = "deflex's offsets are in path coordinates: x along the travel (--path-corr-frame path)";
-    }
-    mod += fmt::format(
-        "\n"
-        "  ! Path correction: the program's own EGMMoveL/EGMMoveC run, deflex sends whole offsets every {period} ms;\n"
-        "  ! {frame_note}. Call before the corrected moves.\n"
-        "  PROC deflex_egm_path_begin()\n"
-        "    EGMReset deflex_egm_id;\n"
-        "    EGMGetId deflex_egm_id;\n"
-        "    EGMSetupUC ROB_1,deflex_egm_id,\"{config}\",\"{device}\"\\PathCorr\\APTR\\CommTimeout:={timeout};\n"
-        "    EGMActMove deflex_egm_id,{frame}\\SampleRate:={period};\n"
-        "  ENDPROC\n"
-        "\n"
-        "  ! Call after the corrected moves.\n"
-        "  PROC deflex_egm_path_end()\n"
-        "    EGMStop deflex_egm_id,EGM_STOP_HOLD;\n"
-        "    EGMReset deflex_egm_id;\n"
-        "  ENDPROC\n"
-        "\n"
-        "  ! How a program moves with the corrections (use your own targets, speeds and zones):\n"
-        "  !   deflex_egm_path_begin;\n"
-        "  !   EGMMoveL deflex_egm_id,p10,v50,z1,{tool}\\WObj:=wobj0;\n"
-        "  !   EGMMoveC deflex_egm_id,p20,p30,v50,fine,{tool}\\WObj:=wobj0;\n"
-        "  !   deflex_egm_path_end;\n",
-        fmt::arg("period", plain_number(o.period_ms)), fmt::arg("frame_note", frame_note),
-        fmt::arg("config", o.egm_config), fmt::arg("device", o.device),
-        fmt::arg("timeout", plain_number(sup.comm_timeout_s)), fmt::arg("frame", frame), fmt::arg("tool", o.tool));
-  }
+  mod += o.path_correction ? egm_path_procedures(o, sup) : egm_joint_procedure(o, sup);
   mod += "ENDMODULE\n";
 
   const std::string cfg = fmt::format(
