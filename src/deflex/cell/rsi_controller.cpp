@@ -144,26 +144,33 @@ const JointVector& RsiController::tick(double t_s) {
       if (counters_.late >= static_cast<std::uint64_t>(config_.timeout)) stop(RsiStop::kTimeout);
     }
     if (running()) {
-      robot_.ipoc = next_ipoc_;
-      next_ipoc_ += static_cast<std::uint64_t>(std::llround(config_.cycle_s * 1e3));
-      if (config_.ipoc_bits == 32) next_ipoc_ &= 0xFFFFFFFFULL;
-      robot_.delay = counters_.late;
-      const JointVector& actual = have_encoders_ ? encoders_ : position_;
-      for (int i = 0; i < n; ++i) {
-        robot_.actual_deg[i] = rad_to_deg(actual[i]);
-        robot_.setpoint_deg[i] = rad_to_deg(planned_[i]);
-      }
-      pose_of(actual, robot_.rist);
-      pose_of(planned_, robot_.rsol);
-      const std::size_t size = encode_rsi_robot(robot_, config_.precision, buffer_.data(), buffer_.size());
-      if (size > 0 && transport_.send_to(buffer_.data(), size, sensor_)) ++counters_.sent;
-      awaiting_ = true;
-      answered_ = false;
+      send_robot_message();
     } else {
       awaiting_ = false;
     }
   }
   return position_;
+}
+
+// This cycle's <Rob>: AIPos and RIst from the encoders, ASPos and RSol from the program, the late
+// count and the next IPOC.
+void RsiController::send_robot_message() {
+  const int n = static_cast<int>(planned_.size());
+  robot_.ipoc = next_ipoc_;
+  next_ipoc_ += static_cast<std::uint64_t>(std::llround(config_.cycle_s * 1e3));
+  if (config_.ipoc_bits == 32) next_ipoc_ &= 0xFFFFFFFFULL;
+  robot_.delay = counters_.late;
+  const JointVector& actual = have_encoders_ ? encoders_ : position_;
+  for (int i = 0; i < n; ++i) {
+    robot_.actual_deg[i] = rad_to_deg(actual[i]);
+    robot_.setpoint_deg[i] = rad_to_deg(planned_[i]);
+  }
+  pose_of(actual, robot_.rist);
+  pose_of(planned_, robot_.rsol);
+  const std::size_t size = encode_rsi_robot(robot_, config_.precision, buffer_.data(), buffer_.size());
+  if (size > 0 && transport_.send_to(buffer_.data(), size, sensor_)) ++counters_.sent;
+  awaiting_ = true;
+  answered_ = false;
 }
 
 void RsiController::encoders(const JointVector& q_motor_rad) {

@@ -109,6 +109,7 @@ class RsiController final : public RobotController {
   std::vector<Pending> pending_;
   std::size_t pending_head_ = 0, pending_count_ = 0;
   JointVector applied_, planned_, position_;
+  void send_robot_message();
   JointVector encoders_;  // the last encoder reading: what AIPos reports
   bool have_encoders_ = false;
   double next_cycle_s_ = 0.0, program_t_s_ = 0.0, last_t_s_ = 0.0;
