@@ -82,6 +82,7 @@ void JointMoveQueue::take(const JointVector& from, double /*start_s*/) {
   ++counters_.taken;
 }
 
+// NOLINTNEXTLINE(readability-function-size): listed in docs/architecture.md, "Functions over 80 lines"
 const JointVector& JointMoveQueue::advance(double t_s) noexcept {
   const double t = std::max(t_s, last_t_s_);
   last_t_s_ = t;

@@ -146,6 +146,7 @@ CircleFit fit_circle(const std::vector<Vector3>& points, const std::string& what
   return fit;
 }
 
+// NOLINTNEXTLINE(readability-function-size): listed in docs/architecture.md, "Functions over 80 lines"
 FrameRegistration register_frames(const RegistrationInput& in) {
   if (in.tracker_m.size() != in.base_m.size()) {
     throw InputError(fmt::format("registration: {} tracker point(s) and {} base point(s): they must pair up",

@@ -85,6 +85,7 @@ Vector3 nearest_crossing(const BlockedRun& b, const Vector3& c, const Vector3& n
 
 }  // namespace
 
+// NOLINTNEXTLINE(readability-function-size): listed in docs/architecture.md, "Functions over 80 lines"
 Iso9283Path iso9283_path(const std::vector<TrackerTrace>& repeated_runs, const TrackerTrace& reference,
                          int evaluation_points, double max_offset_m) {
   if (repeated_runs.empty()) {

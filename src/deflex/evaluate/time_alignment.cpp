@@ -105,6 +105,7 @@ Model refine(const TrackerTrace& m, std::size_t first, std::size_t last, Command
 
 }  // namespace
 
+// NOLINTNEXTLINE(readability-function-size): listed in docs/architecture.md, "Functions over 80 lines"
 TimeAlignment align_time(const TrackerTrace& measured, const TrackerTrace& commanded, const TimeAlignmentOptions& o) {
   if (measured.size() < 10 || commanded.size() < 10) {
     throw InputError(fmt::format("time alignment: {} measured and {} commanded samples; at least 10 of each are needed",

@@ -50,6 +50,7 @@ PathCompensator::PathCompensator(const RobotModel& model, const ForceModel& forc
   result_.predicted = options.predict;
 }
 
+// NOLINTNEXTLINE(readability-function-size): listed in docs/architecture.md, "Functions over 80 lines"
 const OfflinePoint& PathCompensator::compensate(std::size_t i, const JointVector& q_desired, const Pose& tcp_desired) {
   const RobotModel& model = model_;
   Workspace& ws = ws_;

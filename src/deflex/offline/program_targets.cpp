@@ -41,6 +41,7 @@ const RobotModel& model_with_tool(const RobotModel& model, const Pose& tool,
 
 }  // namespace
 
+// NOLINTNEXTLINE(readability-function-size): listed in docs/architecture.md, "Functions over 80 lines"
 std::vector<ProgramTargetResult> compensate_program_targets(const RobotModel& model,
                                                             const std::vector<ProgramTargetUse>& uses,
                                                             const ForceModel& force,

@@ -66,6 +66,7 @@ class StandInSession::Tap final : public DatagramTransport {
   StandInSession& owner_;
 };
 
+// NOLINTNEXTLINE(readability-function-size): listed in docs/architecture.md, "Functions over 80 lines"
 StandInSession::StandInSession(const runtime::SessionConfig& config, const RobotModel& robot,
                                const SensorConfig& sensor, std::shared_ptr<const JointTrajectory> program,
                                const ForceModel* force_model, const StandInConfig& standin)
