@@ -487,42 +487,36 @@ int run_calibrations(StudyContext& x) {
   return calibrations;
 }
 
-// Phase 2 of a seed: its unloaded runs, the references of every family and speed (slowest first so
+// Phase 2 of a seed and family: its unloaded runs, the references at every speed (slowest first so
 // both cores finish together).
-void run_unloaded_references(StudyContext& x, int si) {
-  for (std::size_t f = 0; f < x.families.size(); ++f) {
-    if (si >= x.family_seeds[f]) continue;
-    for (double v : x.speeds) x.unloaded[{si, static_cast<int>(f), mm_s(v)}];  // slots before the threads start
-  }
+void run_unloaded_references(StudyContext& x, int si, std::size_t f) {
+  for (double v : x.speeds) x.unloaded[{si, static_cast<int>(f), mm_s(v)}];  // slots before the threads start
   std::vector<double> speeds = x.speeds;
   std::stable_sort(speeds.begin(), speeds.end());
   std::vector<std::function<void()>> jobs;
   for (double v : speeds) {
-    for (std::size_t f = 0; f < x.families.size(); ++f) {
-      if (si >= x.family_seeds[f]) continue;
-      jobs.emplace_back([&x, si, f, v] {
-        const Family& fam = x.families[f];
-        const double start = thread_cpu_s();
-        RunOutput run = simulate_run(x.cfg_of(si), x.cell_of(si, fam.sensor), x.unloaded_spec(si, fam, v));
-        const double simulated = x.charge(&StudyPhaseTimes::unloaded_s, start);
-        if (si == 0 && x.options.trace_sink && mm_s(v) == mm_s(x.config.budget.speed_m_s)) {
-          x.sink(fmt::format("{}_unloaded_{}mm_s", family_label(fam), mm_s(v)), run.trace);
-        }
-        x.unloaded.at({si, static_cast<int>(f), mm_s(v)}) = make_reference(std::move(run), x.plotted(si, v));
-        x.charge(&StudyPhaseTimes::evaluation_s, simulated);
-        x.progress.add(run_cost(x.config, v, x.laps),
-                       fmt::format("seed {}: unloaded {} mm/s", x.cfg_of(si).seed, mm_s(v)));
-      });
-    }
+    jobs.emplace_back([&x, si, f, v] {
+      const Family& fam = x.families[f];
+      const double start = thread_cpu_s();
+      RunOutput run = simulate_run(x.cfg_of(si), x.cell_of(si, fam.sensor), x.unloaded_spec(si, fam, v));
+      const double simulated = x.charge(&StudyPhaseTimes::unloaded_s, start);
+      if (si == 0 && x.options.trace_sink && mm_s(v) == mm_s(x.config.budget.speed_m_s)) {
+        x.sink(fmt::format("{}_unloaded_{}mm_s", family_label(fam), mm_s(v)), run.trace);
+      }
+      x.unloaded.at({si, static_cast<int>(f), mm_s(v)}) = make_reference(std::move(run), x.plotted(si, v));
+      x.charge(&StudyPhaseTimes::evaluation_s, simulated);
+      x.progress.add(run_cost(x.config, v, x.laps),
+                     fmt::format("seed {}: unloaded {} mm/s", x.cfg_of(si).seed, mm_s(v)));
+    });
   }
   run_parallel(jobs, x.options.threads);
 }
 
-// After a seed's runs: its references' traces and indexes are no longer needed (the tables keep
-// figures, the plots thinned laps), so the study holds one seed's references at a time.
-void release_references(StudyContext& x, int si) {
+// After a family's runs of a seed: its references' traces and indexes are no longer needed (the
+// tables keep figures, the plots thinned laps), so the study holds one family's references at a time.
+void release_references(StudyContext& x, int si, std::size_t f) {
   for (auto& [key, ref] : x.unloaded) {
-    if (std::get<0>(key) != si) continue;
+    if (std::get<0>(key) != si || std::get<1>(key) != static_cast<int>(f)) continue;
     ref.run.trace = TrackerTrace();
     ref.index.reset();
   }
@@ -593,18 +587,18 @@ void run_budget_job(StudyContext& x, BudgetJob& bj) {
   x.progress.add(x.cal_cost + 2.0 * run_cost(config, v, x.laps), fmt::format("budget: {}", budget_label(bj)));
 }
 
-// Phase 3 of a seed: its loaded runs (slowest first so both cores finish together) and, with the
-// first seed, the error budget's runs.
-void run_loaded_and_budget_runs(StudyContext& x, int si) {
+// Phase 3 of a seed and family: its loaded runs (slowest first so both cores finish together) and,
+// with `budget`, the error budget's runs (they make their own references).
+void run_loaded_and_budget_runs(StudyContext& x, int si, std::size_t f, bool budget) {
   std::vector<std::size_t> order;
   for (std::size_t i = 0; i < x.loaded.size(); ++i) {
-    if (x.loaded[i].seed == si) order.push_back(i);
+    if (x.loaded[i].seed == si && x.loaded[i].family == static_cast<int>(f)) order.push_back(i);
   }
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t a, std::size_t b) { return x.loaded[a].speed < x.loaded[b].speed; });
   std::vector<std::function<void()>> jobs;
   for (std::size_t i : order) jobs.emplace_back([&x, i] { run_loaded_job(x, x.loaded[i]); });
-  if (si == 0) {
+  if (budget) {
     for (auto& bj : x.budget_jobs) jobs.emplace_back([&x, &bj] { run_budget_job(x, bj); });
   }
   run_parallel(jobs, x.options.threads);
@@ -929,11 +923,20 @@ CaseStudyOutput run_case_study(const CaseConfig& config, const CaseStudyOptions&
   plan_error_budget(x);
   weigh_progress(x);
   out.calibrations = run_calibrations(x);
-  // Seed by seed, so that only one seed's unloaded references are held at a time.
+  // Seed by seed and family by family, so that only one family's unloaded references (the long
+  // traces) are held at a time; the budget's runs go with the first seed's last family. Every run's
+  // seed comes from what it is, never from when it runs, so the order moves no figure.
   for (int si = 0; si < x.n_seeds; ++si) {
-    run_unloaded_references(x, si);
-    run_loaded_and_budget_runs(x, si);
-    release_references(x, si);
+    std::size_t last = 0;
+    for (std::size_t f = 0; f < x.families.size(); ++f) {
+      if (si < x.family_seeds[f]) last = f;
+    }
+    for (std::size_t f = 0; f < x.families.size(); ++f) {
+      if (si >= x.family_seeds[f]) continue;
+      run_unloaded_references(x, si, f);
+      run_loaded_and_budget_runs(x, si, f, si == 0 && f == last);
+      release_references(x, si, f);
+    }
   }
 
   // Assemble the study: per setup, load and speed the seeds' figures, their means and spread.
