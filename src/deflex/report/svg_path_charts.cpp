@@ -259,91 +259,117 @@ SectorVectors sector_vectors(const std::vector<DirectedLap>& laps, const Referen
   return v;
 }
 
+// The angle axis under a panel: ticks every 45 deg (compass names on a horizontal path), and with
+// `grid` a line across the panel every 90 deg.
+void angle_axis(Canvas& c, const Scale& x, double top, double bottom, bool horizontal, bool grid) {
+  c.line(x.p0, bottom, x.p1, bottom, "#444", 1.0);
+  for (int deg = 0; deg <= 360; deg += 45) {
+    c.line(x(deg), bottom, x(deg), bottom + 5.0, "#444", 1.0);
+    c.text(x(deg), bottom + 18.0, fmt::format("{}", deg), kMinFont, "middle");
+    if (horizontal && deg % 90 == 0) {
+      c.text(x(deg), bottom + 32.0, compass(deg % 360), kMinFont, "middle", R"(fill="#666")");
+    }
+    if (grid && deg % 90 == 0) {
+      c.line(x(deg), top, x(deg), bottom, deg % 360 == 0 ? "#777" : "#d8d8d8", 1.0,
+             deg % 360 == 0 ? "" : R"(stroke-dasharray="3 3")");
+    }
+  }
+  c.text((x.p0 + x.p1) / 2.0, bottom + 50.0, "angle about the circle's centre (deg)", 12.0, "middle");
+}
+
+// SVG path data through `steps` sector means (sector k % means.size()), lifting the pen over empty
+// (NaN) sectors; `to_px(sector, mean)` places a point.
+template <class ToPx>
+std::string sector_path(const std::vector<double>& means, std::size_t steps, ToPx to_px) {
+  std::string d;
+  bool pen = false;
+  for (std::size_t k = 0; k < steps; ++k) {
+    const std::size_t s = k % means.size();
+    if (!std::isfinite(means[s])) {
+      pen = false;
+      continue;
+    }
+    const auto [x, y] = to_px(s, means[s]);
+    d += fmt::format("{}{:.1f},{:.1f}", pen ? " L" : (d.empty() ? "M" : " M"), x, y);
+    pen = true;
+  }
+  return d;
+}
+
 }  // namespace
 
-std::string svg_path_plot(const PathPlot& plot) {
-  const double width = 500.0, height = 640.0;
-  Canvas c(width, height);
-  titles(c, "The last laps, deviations magnified", plot.title);
-  const std::optional<Reference> ref = reference_of(plot);
-  if (!ref) {
-    no_data(c, "no unloaded path to plot (fewer than 2 samples)");
-    return c.str();
-  }
-  const Vector3& centroid = ref->plane.centroid_m;
-  const Vector3& u = ref->plane.u;
-  const Vector3& v = ref->plane.v;
-  struct Dev {
-    Vector3 on_path, d;
-  };
-  auto deviations = [&](const TrackerTrace& t) {
-    std::vector<Dev> out;
-    const std::size_t stride = std::max<std::size_t>(1, (t.size() + 1499) / 1500);
-    for (std::size_t i = 0; i < t.size(); i += stride) {
-      if (t[i].p_m.allFinite()) {
-        const auto near = ref->index->nearest(t[i].p_m);
-        out.push_back({near.point_m, t[i].p_m - near.point_m});
-      }
-    }
-    return out;
-  };
-  const std::vector<Dev> uc = deviations(plot.uc);
-  const std::vector<Dev> cc = deviations(plot.c);
-  double max_dev = 0.0;
-  for (const auto* set : {&uc, &cc}) {
-    for (const auto& d : *set) {
-      max_dev = std::max(max_dev, d.d.norm());
-    }
-  }
-  const double mag = plot.magnification > 0.0 ? plot.magnification
-                     : max_dev > 0.0          ? svg::nice_floor(0.12 * ref->size_m / max_dev)
-                                              : 1.0;
-  auto mean_text = [&](const char* name, const std::vector<Dev>& ds, const TrackerTrace& lap) {
-    if (ds.empty()) {
-      return fmt::format("{} (no data)", name);
-    }
-    double s = 0.0;
-    for (const auto& d : ds) {
-      s += d.d.norm();
-    }
-    const std::string dir = ref->closed ? ", " + direction_name(turns_clockwise(finite_only(lap), *ref)) : "";
-    return fmt::format("{}, last lap{}: mean {:.3f} mm", name, dir, s / static_cast<double>(ds.size()) * 1e3);
-  };
-  svg::legend_entry(c, 40.0, 72.0, "line", svg::kUnloadedColour,
-                    ref->is_mean ? "unloaded, mean of the laps (the reference)" : "unloaded, last lap (the reference)");
-  svg::legend_entry(c, 40.0, 92.0, "line", svg::kUcColour, mean_text("UC", uc, plot.uc));
-  svg::legend_entry(c, 40.0, 112.0, "line", svg::kCColour, mean_text("C", cc, plot.c));
+namespace {
 
-  // The path in its plane, equal scales, deviations magnified.
-  const double pl = 76.0, pt = 130.0, pw = 400.0, ph = 400.0;
-  double lo_u = HUGE_VAL, hi_u = -HUGE_VAL, lo_v = HUGE_VAL, hi_v = -HUGE_VAL;
-  for (const auto& s : ref->path) {
-    const Vector3 d = s.p_m - centroid;
-    lo_u = std::min(lo_u, d.dot(u));
-    hi_u = std::max(hi_u, d.dot(u));
-    lo_v = std::min(lo_v, d.dot(v));
-    hi_v = std::max(hi_v, d.dot(v));
+// A tracker sample as drawn on the path plot: its nearest reference point and its deviation from it.
+struct PathDeviation {
+  Vector3 on_path, d;
+};
+
+// A trace's deviations, thinned to at most about 1500.
+std::vector<PathDeviation> path_deviations(const TrackerTrace& t, const Reference& ref) {
+  std::vector<PathDeviation> out;
+  const std::size_t stride = std::max<std::size_t>(1, (t.size() + 1499) / 1500);
+  for (std::size_t i = 0; i < t.size(); i += stride) {
+    if (t[i].p_m.allFinite()) {
+      const auto near = ref.index->nearest(t[i].p_m);
+      out.push_back({near.point_m, t[i].p_m - near.point_m});
+    }
   }
-  const double half = 0.5 * ref->size_m * 1.3 + 1e-9;
-  const double mid_u = 0.5 * (lo_u + hi_u), mid_v = 0.5 * (lo_v + hi_v);
-  const Scale xs{(mid_u - half) * 1e3, (mid_u + half) * 1e3, pl, pl + pw};
-  const Scale ys{(mid_v - half) * 1e3, (mid_v + half) * 1e3, pt + ph, pt};
-  c.rect(pl, pt, pw, ph, "none", R"(stroke="#ccc")");
-  const std::string axis_u = ref->horizontal ? "x" : "u", axis_v = ref->horizontal ? "y" : "v";
-  svg::value_axis(c, ys, pl, pl + pw, fmt::format("{} about the centre (mm)", axis_v), 1.0, 50.0);
-  svg::position_axis(c, xs, pt + ph, fmt::format("{} about the centre (mm)", axis_u));
-  auto to_px = [&](const Vector3& p) {
+  return out;
+}
+
+std::string path_mean_text(const char* name, const std::vector<PathDeviation>& ds, const TrackerTrace& lap,
+                           const Reference& ref) {
+  if (ds.empty()) {
+    return fmt::format("{} (no data)", name);
+  }
+  double s = 0.0;
+  for (const auto& d : ds) {
+    s += d.d.norm();
+  }
+  const std::string dir = ref.closed ? ", " + direction_name(turns_clockwise(finite_only(lap), ref)) : "";
+  return fmt::format("{}, last lap{}: mean {:.3f} mm", name, dir, s / static_cast<double>(ds.size()) * 1e3);
+}
+
+// The path's plane mapped to pixels, equal scales, centred on the path.
+struct PlaneMap {
+  Vector3 centroid, u, v;
+  Scale xs, ys;
+  double half = 0.0;  // half the span drawn (m)
+  [[nodiscard]] std::pair<double, double> operator()(const Vector3& p) const {
     const Vector3 d = p - centroid;
     return std::pair{xs(d.dot(u) * 1e3), ys(d.dot(v) * 1e3)};
-  };
+  }
+};
+
+PlaneMap plane_map(const Reference& ref, double pl, double pt, double pw, double ph) {
+  PlaneMap m{ref.plane.centroid_m, ref.plane.u, ref.plane.v, {}, {}};
+  double lo_u = HUGE_VAL, hi_u = -HUGE_VAL, lo_v = HUGE_VAL, hi_v = -HUGE_VAL;
+  for (const auto& s : ref.path) {
+    const Vector3 d = s.p_m - m.centroid;
+    lo_u = std::min(lo_u, d.dot(m.u));
+    hi_u = std::max(hi_u, d.dot(m.u));
+    lo_v = std::min(lo_v, d.dot(m.v));
+    hi_v = std::max(hi_v, d.dot(m.v));
+  }
+  m.half = 0.5 * ref.size_m * 1.3 + 1e-9;
+  const double mid_u = 0.5 * (lo_u + hi_u), mid_v = 0.5 * (lo_v + hi_v);
+  m.xs = Scale{(mid_u - m.half) * 1e3, (mid_u + m.half) * 1e3, pl, pl + pw};
+  m.ys = Scale{(mid_v - m.half) * 1e3, (mid_v + m.half) * 1e3, pt + ph, pt};
+  return m;
+}
+
+// The reference wide, then each run's deviations magnified, each with an arrowhead for its travel.
+void path_plot_lines(Canvas& c, const Reference& ref, const PlaneMap& to_px, const std::vector<PathDeviation>& uc,
+                     const std::vector<PathDeviation>& cc, double mag) {
   {
     std::vector<double> xy;
-    const std::size_t stride = std::max<std::size_t>(1, (ref->path.size() + 1499) / 1500);
-    for (std::size_t i = 0; i < ref->path.size(); i += stride) {
-      const auto [x, y] = to_px(ref->path[i].p_m);
+    const std::size_t stride = std::max<std::size_t>(1, (ref.path.size() + 1499) / 1500);
+    for (std::size_t i = 0; i < ref.path.size(); i += stride) {
+      const auto [x, y] = to_px(ref.path[i].p_m);
       xy.insert(xy.end(), {x, y});
     }
-    const auto [x, y] = to_px(ref->path.back().p_m);
+    const auto [x, y] = to_px(ref.path.back().p_m);
     xy.insert(xy.end(), {x, y});
     c.polyline(xy, svg::kUnloadedColour, 4.5);  // wide, so it shows beside a C path lying on it
   }
@@ -362,24 +388,68 @@ std::string svg_path_plot(const PathPlot& plot) {
       arrowhead(c, x0, y0, x1 - x0, y1 - y0, col, 11.0);
     }
   }
-  if (ref->closed) {
-    // The centre and the 0 deg ray of the angle the other figures use.
-    const auto [cx, cy] = to_px(centroid);
-    c.line(cx - 5.0, cy, cx + 5.0, cy, "#666", 1.0);
-    c.line(cx, cy - 5.0, cx, cy + 5.0, "#666", 1.0);
-    const double ray = 0.5 * ref->size_m * 0.75 * pw / (2.0 * half);
-    c.line(cx, cy, cx + ray, cy, "#666", 1.0, R"(stroke-dasharray="3 3")");
-    c.text(cx + 8.0, cy - 6.0, ref->horizontal ? "0 deg (+x)" : "0 deg (+u)", kMinFont, "start", R"(fill="#444")");
-  }
-  // Below the axes, clear of every line: how to read the figure.
-  c.text(pl + pw / 2.0, pt + ph + 62.0, fmt::format("Deviations magnified x{:g}", mag), 12.0, "middle",
-         R"(font-weight="bold")");
-  c.text(pl + pw / 2.0, pt + ph + 78.0,
+}
+
+// The centre and the 0 deg ray of the angle the other figures use.
+void path_plot_centre(Canvas& c, const Reference& ref, const PlaneMap& to_px, double pw) {
+  const auto [cx, cy] = to_px(to_px.centroid);
+  c.line(cx - 5.0, cy, cx + 5.0, cy, "#666", 1.0);
+  c.line(cx, cy - 5.0, cx, cy + 5.0, "#666", 1.0);
+  const double ray = 0.5 * ref.size_m * 0.75 * pw / (2.0 * to_px.half);
+  c.line(cx, cy, cx + ray, cy, "#666", 1.0, R"(stroke-dasharray="3 3")");
+  c.text(cx + 8.0, cy - 6.0, ref.horizontal ? "0 deg (+x)" : "0 deg (+u)", kMinFont, "start", R"(fill="#444")");
+}
+
+// Below the axes, clear of every line: how to read the figure.
+void path_plot_notes(Canvas& c, const Reference& ref, double mag, double xc, double y0) {
+  c.text(xc, y0, fmt::format("Deviations magnified x{:g}", mag), 12.0, "middle", R"(font-weight="bold")");
+  c.text(xc, y0 + 16.0,
          fmt::format("each point drawn from its nearest reference point; seen from {},",
-                     ref->horizontal ? "above" : "the plane's normal"),
+                     ref.horizontal ? "above" : "the plane's normal"),
          12.0, "middle", R"(fill="#555")");
-  c.text(pl + pw / 2.0, pt + ph + 94.0, "projected on the path's plane (the out-of-plane part is not drawn)", 12.0,
-         "middle", R"(fill="#555")");
+  c.text(xc, y0 + 32.0, "projected on the path's plane (the out-of-plane part is not drawn)", 12.0, "middle",
+         R"(fill="#555")");
+}
+
+}  // namespace
+
+std::string svg_path_plot(const PathPlot& plot) {
+  const double width = 500.0, height = 640.0;
+  Canvas c(width, height);
+  titles(c, "The last laps, deviations magnified", plot.title);
+  const std::optional<Reference> ref = reference_of(plot);
+  if (!ref) {
+    no_data(c, "no unloaded path to plot (fewer than 2 samples)");
+    return c.str();
+  }
+  const std::vector<PathDeviation> uc = path_deviations(plot.uc, *ref);
+  const std::vector<PathDeviation> cc = path_deviations(plot.c, *ref);
+  double max_dev = 0.0;
+  for (const auto* set : {&uc, &cc}) {
+    for (const auto& d : *set) {
+      max_dev = std::max(max_dev, d.d.norm());
+    }
+  }
+  const double mag = plot.magnification > 0.0 ? plot.magnification
+                     : max_dev > 0.0          ? svg::nice_floor(0.12 * ref->size_m / max_dev)
+                                              : 1.0;
+  svg::legend_entry(c, 40.0, 72.0, "line", svg::kUnloadedColour,
+                    ref->is_mean ? "unloaded, mean of the laps (the reference)" : "unloaded, last lap (the reference)");
+  svg::legend_entry(c, 40.0, 92.0, "line", svg::kUcColour, path_mean_text("UC", uc, plot.uc, *ref));
+  svg::legend_entry(c, 40.0, 112.0, "line", svg::kCColour, path_mean_text("C", cc, plot.c, *ref));
+
+  // The path in its plane, equal scales, deviations magnified.
+  const double pl = 76.0, pt = 130.0, pw = 400.0, ph = 400.0;
+  const PlaneMap to_px = plane_map(*ref, pl, pt, pw, ph);
+  c.rect(pl, pt, pw, ph, "none", R"(stroke="#ccc")");
+  const std::string axis_u = ref->horizontal ? "x" : "u", axis_v = ref->horizontal ? "y" : "v";
+  svg::value_axis(c, to_px.ys, pl, pl + pw, fmt::format("{} about the centre (mm)", axis_v), 1.0, 50.0);
+  svg::position_axis(c, to_px.xs, pt + ph, fmt::format("{} about the centre (mm)", axis_u));
+  path_plot_lines(c, *ref, to_px, uc, cc, mag);
+  if (ref->closed) {
+    path_plot_centre(c, *ref, to_px, pw);
+  }
+  path_plot_notes(c, *ref, mag, pl + pw / 2.0, pt + ph + 62.0);
   return c.str();
 }
 
@@ -656,54 +726,52 @@ std::string svg_polar_deviation(const PathPlot& plot) {
   return c.str();
 }
 
-std::string svg_signed_error(const PathPlot& plot) {
-  const double width = svg::kMaxWidth, height = 470.0;
-  Canvas c(width, height);
-  titles(c, "Signed error of the compensated run along the uncompensated deflection", plot.title);
-  const std::optional<Reference> ref = reference_of(plot);
-  if (!ref || !ref->closed) {
-    no_data(c, !ref ? "no unloaded path to plot (fewer than 2 samples)" : "the path is not closed: no angle to plot");
-    return c.str();
-  }
-  // The direction the load pushed the arm, per direction of travel and sector: the UC laps' mean
-  // deviation there. Each C sample's deviation is projected on it.
-  const SectorVectors uc = sector_vectors(laps_or_last(plot.uc_laps, plot.uc, *ref), *ref);
-  const std::vector<DirectedLap> c_laps = laps_or_last(plot.c_laps, plot.c, *ref);
+namespace {
+
+// The compensated run's signed error per direction of travel (index 1: clockwise): its sector means
+// (NaN where no sample fell), its mean over its samples, and the largest sector mean's size (mm).
+struct SignedError {
+  std::vector<double> means[2];
+  double overall[2] = {kNaN, kNaN};
+  double max_abs = 0.0;
+};
+
+// Each C sample's deviation projected on the UC laps' mean deviation in its sector and direction.
+SignedError signed_error_of(const std::vector<DirectedLap>& c_laps, const SectorVectors& uc, const Reference& ref) {
   std::vector<double> sum[2] = {std::vector<double>(kSectors, 0.0), std::vector<double>(kSectors, 0.0)};
   std::vector<int> n[2] = {std::vector<int>(kSectors, 0), std::vector<int>(kSectors, 0)};
   for (const auto& lap : c_laps) {
     const int d = lap.clockwise ? 1 : 0;
     for (const auto& sample : lap.trace) {
       if (!sample.p_m.allFinite()) continue;
-      const std::size_t s = sector_of(angle_deg(*ref, sample.p_m));
+      const std::size_t s = sector_of(angle_deg(ref, sample.p_m));
       const Vector3 along = uc.mean(lap.clockwise, s);
       if (!(along.norm() > 0.0)) continue;
-      const Vector3 dev = sample.p_m - ref->index->nearest(sample.p_m).point_m;
+      const Vector3 dev = sample.p_m - ref.index->nearest(sample.p_m).point_m;
       sum[d][s] += dev.dot(along.normalized()) * 1e3;
       ++n[d][s];
     }
   }
-  // Sector means (NaN where no sample fell) and each direction's mean over its samples.
-  std::vector<double> means[2];
-  double overall[2] = {kNaN, kNaN}, max_abs = 0.0;
+  SignedError e;
   for (int d = 0; d < 2; ++d) {
-    means[d].assign(kSectors, kNaN);
+    e.means[d].assign(kSectors, kNaN);
     double total = 0.0;
     int count = 0;
     for (std::size_t s = 0; s < kSectors; ++s) {
       if (n[d][s] == 0) continue;
-      means[d][s] = sum[d][s] / n[d][s];
-      max_abs = std::max(max_abs, std::abs(means[d][s]));
+      e.means[d][s] = sum[d][s] / n[d][s];
+      e.max_abs = std::max(e.max_abs, std::abs(e.means[d][s]));
       total += sum[d][s];
       count += n[d][s];
     }
-    if (count > 0) overall[d] = total / count;
+    if (count > 0) e.overall[d] = total / count;
   }
-  if (!std::isfinite(overall[0]) && !std::isfinite(overall[1])) {
-    no_data(c, "no compensated lap with an uncompensated one to compare with");
-    return c.str();
-  }
-  // UC's own size along its direction, for scale.
+  return e;
+}
+
+// The legend, a row a direction with C laps; beside it UC's own size along its direction, for scale.
+// Returns the baseline below the last row.
+double signed_error_legend(Canvas& c, const SignedError& e, const SectorVectors& uc) {
   double uc_sum = 0.0;
   int uc_n = 0;
   for (int d = 0; d < 2; ++d) {
@@ -717,9 +785,9 @@ std::string svg_signed_error(const PathPlot& plot) {
   double ly = 70.0;
   for (const bool cw : {true, false}) {
     const int d = cw ? 1 : 0;
-    if (!std::isfinite(overall[d])) continue;
+    if (!std::isfinite(e.overall[d])) continue;
     c.line(80.0, ly - 4.0, 98.0, ly - 4.0, direction_colour(cw), 2.4, direction_dash(cw));
-    c.text(104.0, ly, fmt::format("C, {} laps (5 deg sector means): mean {:+.3f} mm", direction_name(cw), overall[d]),
+    c.text(104.0, ly, fmt::format("C, {} laps (5 deg sector means): mean {:+.3f} mm", direction_name(cw), e.overall[d]),
            12.0);
     ly += 18.0;
   }
@@ -727,10 +795,12 @@ std::string svg_signed_error(const PathPlot& plot) {
     c.text(590.0, 70.0, fmt::format("for scale: the UC deflection itself, {:.3f} mm on average", uc_sum / uc_n), 12.0,
            "start", R"(fill="#444")");
   }
-  const double left = 90.0, right = width - 30.0, top = std::max(ly + 14.0, 118.0), bottom = height - 96.0;
-  const double r = svg::nice_ceiling(std::max(max_abs, 1e-6) * 1.1);
-  const Scale x{0.0, 360.0, left, right};
-  const Scale y{-r, r, bottom, top};
+  return ly;
+}
+
+// The value axis about zero, its two halves shaded and named (under- and over-compensated).
+void signed_error_frame(Canvas& c, const Scale& x, const Scale& y) {
+  const double left = x.p0, right = x.p1, top = y.p1, bottom = y.p0;
   c.rect(left, top, right - left, y(0.0) - top, "#fdecea");
   c.rect(left, y(0.0), right - left, bottom - y(0.0), "#e8f1fb");
   svg::value_axis(c, y, left, right, "C along the UC deflection (mm)", 1.0, 56.0);
@@ -739,32 +809,43 @@ std::string svg_signed_error(const PathPlot& plot) {
          R"(fill="#8a1c1c")");
   c.text(left + 8.0, bottom - 8.0, "- over-compensated: pushed past the unloaded path, against the load", 12.0, "start",
          R"(fill="#1c4f8a")");
-  c.line(left, bottom, right, bottom, "#444", 1.0);
-  for (int deg = 0; deg <= 360; deg += 45) {
-    c.line(x(deg), bottom, x(deg), bottom + 5.0, "#444", 1.0);
-    c.text(x(deg), bottom + 18.0, fmt::format("{}", deg), kMinFont, "middle");
-    if (ref->horizontal && deg % 90 == 0) {
-      c.text(x(deg), bottom + 32.0, compass(deg % 360), kMinFont, "middle", R"(fill="#666")");
-    }
+}
+
+}  // namespace
+
+std::string svg_signed_error(const PathPlot& plot) {
+  const double width = svg::kMaxWidth, height = 470.0;
+  Canvas c(width, height);
+  titles(c, "Signed error of the compensated run along the uncompensated deflection", plot.title);
+  const std::optional<Reference> ref = reference_of(plot);
+  if (!ref || !ref->closed) {
+    no_data(c, !ref ? "no unloaded path to plot (fewer than 2 samples)" : "the path is not closed: no angle to plot");
+    return c.str();
   }
-  c.text((left + right) / 2.0, bottom + 50.0, "angle about the circle's centre (deg)", 12.0, "middle");
+  // The direction the load pushed the arm, per direction of travel and sector: the UC laps' mean
+  // deviation there. Each C sample's deviation is projected on it.
+  const SectorVectors uc = sector_vectors(laps_or_last(plot.uc_laps, plot.uc, *ref), *ref);
+  const SignedError e = signed_error_of(laps_or_last(plot.c_laps, plot.c, *ref), uc, *ref);
+  if (!std::isfinite(e.overall[0]) && !std::isfinite(e.overall[1])) {
+    no_data(c, "no compensated lap with an uncompensated one to compare with");
+    return c.str();
+  }
+  const double ly = signed_error_legend(c, e, uc);
+  const double left = 90.0, right = width - 30.0, top = std::max(ly + 14.0, 118.0), bottom = height - 96.0;
+  const double r = svg::nice_ceiling(std::max(e.max_abs, 1e-6) * 1.1);
+  const Scale x{0.0, 360.0, left, right};
+  const Scale y{-r, r, bottom, top};
+  signed_error_frame(c, x, y);
+  angle_axis(c, x, top, bottom, ref->horizontal, false);
   for (const bool cw : {true, false}) {
     const int d = cw ? 1 : 0;
-    if (!std::isfinite(overall[d])) continue;
-    std::string path;
-    bool pen = false;
-    for (std::size_t s = 0; s < kSectors; ++s) {
-      if (!std::isfinite(means[d][s])) {
-        pen = false;
-        continue;
-      }
-      path += fmt::format("{}{:.1f},{:.1f}", pen ? " L" : (path.empty() ? "M" : " M"), x(sector_centre_deg(s)),
-                          y(means[d][s]));
-      pen = true;
-    }
+    if (!std::isfinite(e.overall[d])) continue;
+    const std::string path = sector_path(e.means[d], e.means[d].size(), [&](std::size_t s, double m) {
+      return std::pair{x(sector_centre_deg(s)), y(m)};
+    });
     c.path(path, direction_colour(cw), 2.2,
            fmt::format(R"({} class="signed-error" data-direction="{}" data-mean-mm="{:.6g}")", direction_dash(cw),
-                       cw ? "cw" : "ccw", overall[d]));
+                       cw ? "cw" : "ccw", e.overall[d]));
   }
   c.text(width / 2.0, height - 18.0,
          "Each C sample's deviation from the reference projected on the UC laps' mean deviation in its 5 deg sector "
