@@ -453,20 +453,11 @@ std::string svg_path_plot(const PathPlot& plot) {
   return c.str();
 }
 
-std::string svg_lap_overlay(const PathPlot& plot) {
-  const double width = svg::kMaxWidth, height = 530.0;
-  Canvas c(width, height);
-  titles(c, "Every lap: distance from the reference against the angle on the circle", plot.title);
-  const std::optional<Reference> ref = reference_of(plot);
-  if (!ref || !ref->closed) {
-    no_data(c, !ref ? "no unloaded path to plot (fewer than 2 samples)" : "the path is not closed: no angle to plot");
-    return c.str();
-  }
-  const std::vector<LapDeviation> runs[] = {lap_deviations(plot.uc_laps, plot.uc, *ref),
-                                            lap_deviations(plot.c_laps, plot.c, *ref)};
-  const char* const names[] = {"UC, uncompensated", "C, compensated"};
-  // Legend: colour and dash by direction, with the direction of travel on the angle axis; below,
-  // the direction's mean, which the eye cannot find in six noisy laps.
+namespace {
+
+// Legend: colour and dash by direction, with the direction of travel on the angle axis; below, the
+// direction's mean, which the eye cannot find in six noisy laps.
+void lap_overlay_legend(Canvas& c) {
   for (const bool cw : {true, false}) {
     const double lx = cw ? 80.0 : 590.0;
     const std::string label = fmt::format("{} laps: travel {} (angle {})", direction_name(cw),
@@ -477,103 +468,122 @@ std::string svg_lap_overlay(const PathPlot& plot) {
     c.line(lx, 86.0, lx + 18.0, 86.0, direction_mean_colour(cw), 2.6, direction_dash(cw));
     c.text(lx + 24.0, 90.0, fmt::format("{} laps' mean in 5 deg sectors", direction_name(cw)), 12.0);
   }
-  const double top = 140.0, panel_h = 266.0, panel_w = 400.0;
-  const double lefts[] = {80.0, 590.0};
-  for (int r = 0; r < 2; ++r) {
-    const double left = lefts[r];
-    const Scale x{0.0, 360.0, left, left + panel_w};
-    double max_d = 0.0;
-    for (const auto& lap : runs[r]) {
-      for (const double d : lap.distance_mm) {
-        max_d = std::max(max_d, d);
-      }
-    }
-    const Scale y{0.0, svg::nice_ceiling(max_d * 1.05), top + panel_h, top};
-    c.text(left, top - 26.0, names[r], 13.0, "start", R"(font-weight="bold")");
-    std::string summary;
-    for (const bool cw : {true, false}) {
-      const int n = count_of(runs[r], cw);
-      if (n > 0) {
-        summary += fmt::format("{}{} {} lap{}: mean {:.3f} mm", summary.empty() ? "" : "; ", direction_name(cw), n,
-                               n == 1 ? "" : "s", mean_of(runs[r], cw ? 1 : 0));
-      }
-    }
-    c.text(left, top - 9.0, summary.empty() ? "no laps" : summary, 12.0, "start", R"(fill="#444")");
-    svg::value_axis(c, y, left, left + panel_w, "distance from the reference (mm)", 1.0, 46.0);
-    c.line(left, top + panel_h, left + panel_w, top + panel_h, "#444", 1.0);
-    for (int deg = 0; deg <= 360; deg += 45) {
-      c.line(x(deg), top + panel_h, x(deg), top + panel_h + 5.0, "#444", 1.0);
-      c.text(x(deg), top + panel_h + 18.0, fmt::format("{}", deg), kMinFont, "middle");
-      if (ref->horizontal && deg % 90 == 0) {
-        c.text(x(deg), top + panel_h + 32.0, compass(deg % 360), kMinFont, "middle", R"(fill="#666")");
-      }
-      if (deg % 90 == 0) {
-        c.line(x(deg), top, x(deg), top + panel_h, deg % 360 == 0 ? "#777" : "#d8d8d8", 1.0,
-               deg % 360 == 0 ? "" : R"(stroke-dasharray="3 3")");
-      }
-    }
-    c.text(left + panel_w / 2.0, top + panel_h + 50.0, "angle about the circle's centre (deg)", 12.0, "middle");
-    struct Arrow {
-      double x, y, dx;
-      std::string colour;
-    };
-    std::vector<Arrow> arrows;
-    for (std::size_t k = 0; k < runs[r].size(); ++k) {
-      const LapDeviation& lap = runs[r][k];
-      std::string d;
-      for (std::size_t i = 0; i < lap.angle_deg.size(); ++i) {
-        const bool wrap = i > 0 && std::abs(lap.angle_deg[i] - lap.angle_deg[i - 1]) > 180.0;
-        d += fmt::format("{}{:.1f},{:.1f}", i == 0 || wrap ? (i == 0 ? "M" : " M") : " L", x(lap.angle_deg[i]),
-                         y(lap.distance_mm[i]));
-      }
-      const std::string col = direction_colour(lap.clockwise);
-      c.path(d, col, 1.1,
-             fmt::format(R"(stroke-opacity="0.85" {} class="lap" data-run="{}" data-direction="{}")",
-                         direction_dash(lap.clockwise), r == 0 ? "UC" : "C", lap.clockwise ? "cw" : "ccw"));
-      // The direction of travel, from the samples themselves: an arrowhead at this lap's own angle
-      // (the laps' arrows spread evenly along the axis, so they do not stack).
-      const std::size_t n = lap.angle_deg.size();
-      if (n >= 12) {
-        const double target = (static_cast<double>(k) + 0.5) * 360.0 / static_cast<double>(runs[r].size());
-        std::size_t i = 0;
-        for (std::size_t j = 1; j + 3 < n; ++j) {
-          if (std::abs(std::remainder(lap.angle_deg[j] - target, 360.0)) <
-              std::abs(std::remainder(lap.angle_deg[i] - target, 360.0))) {
-            i = j;
-          }
-        }
-        double da = lap.angle_deg[i + 3] - lap.angle_deg[i];
-        da = std::remainder(da, 360.0);
-        if (std::abs(da) < 90.0 && da != 0.0) {
-          arrows.push_back({x(lap.angle_deg[i]), y(lap.distance_mm[i]), da, col});
-        }
-      }
-    }
-    // Each direction's mean over its laps, over the laps.
-    for (const bool cw : {true, false}) {
-      const std::vector<double> means = sector_means(runs[r], cw);
-      std::string d;
-      bool pen = false;
-      for (std::size_t k = 0; k < means.size(); ++k) {
-        if (!std::isfinite(means[k])) {
-          pen = false;
-          continue;
-        }
-        d +=
-            fmt::format("{}{:.1f},{:.1f}", pen ? " L" : (d.empty() ? "M" : " M"), x(sector_centre_deg(k)), y(means[k]));
-        pen = true;
-      }
-      if (!d.empty()) {
-        c.path(d, direction_mean_colour(cw), 2.6,
-               fmt::format(R"({} class="direction-mean" data-run="{}" data-direction="{}")", direction_dash(cw),
-                           r == 0 ? "UC" : "C", cw ? "cw" : "ccw"));
-      }
-    }
-    // Over every line, outlined in white, so no later lap hides an earlier one's arrow.
-    for (const auto& a : arrows) {
-      arrowhead(c, a.x, a.y, a.dx, 0.0, a.colour, 13.0);
+}
+
+// A panel's name and, under it, each direction's lap count and mean distance.
+void lap_panel_heading(Canvas& c, const std::vector<LapDeviation>& laps, const char* name, double left, double top) {
+  c.text(left, top - 26.0, name, 13.0, "start", R"(font-weight="bold")");
+  std::string summary;
+  for (const bool cw : {true, false}) {
+    const int n = count_of(laps, cw);
+    if (n > 0) {
+      summary += fmt::format("{}{} {} lap{}: mean {:.3f} mm", summary.empty() ? "" : "; ", direction_name(cw), n,
+                             n == 1 ? "" : "s", mean_of(laps, cw ? 1 : 0));
     }
   }
+  c.text(left, top - 9.0, summary.empty() ? "no laps" : summary, 12.0, "start", R"(fill="#444")");
+}
+
+struct LapArrow {
+  double x, y, dx;
+  std::string colour;
+};
+
+// The sample of lap `k` of `count` nearest its own share of the angle axis, with the angle travelled
+// over the next 3 samples; nullopt when the lap is short or turns too fast there.
+std::optional<std::pair<std::size_t, double>> lap_arrow_at(const LapDeviation& lap, std::size_t k, std::size_t count) {
+  const std::size_t n = lap.angle_deg.size();
+  if (n < 12) {
+    return std::nullopt;
+  }
+  const double target = (static_cast<double>(k) + 0.5) * 360.0 / static_cast<double>(count);
+  std::size_t i = 0;
+  for (std::size_t j = 1; j + 3 < n; ++j) {
+    if (std::abs(std::remainder(lap.angle_deg[j] - target, 360.0)) <
+        std::abs(std::remainder(lap.angle_deg[i] - target, 360.0))) {
+      i = j;
+    }
+  }
+  double da = lap.angle_deg[i + 3] - lap.angle_deg[i];
+  da = std::remainder(da, 360.0);
+  if (std::abs(da) < 90.0 && da != 0.0) {
+    return std::pair{i, da};
+  }
+  return std::nullopt;
+}
+
+// A line a lap; returns the arrowheads showing each lap's travel, to draw over every line.
+std::vector<LapArrow> lap_lines(Canvas& c, const std::vector<LapDeviation>& laps, const char* run, const Scale& x,
+                                const Scale& y) {
+  std::vector<LapArrow> arrows;
+  for (std::size_t k = 0; k < laps.size(); ++k) {
+    const LapDeviation& lap = laps[k];
+    std::string d;
+    for (std::size_t i = 0; i < lap.angle_deg.size(); ++i) {
+      const bool wrap = i > 0 && std::abs(lap.angle_deg[i] - lap.angle_deg[i - 1]) > 180.0;
+      d += fmt::format("{}{:.1f},{:.1f}", i == 0 || wrap ? (i == 0 ? "M" : " M") : " L", x(lap.angle_deg[i]),
+                       y(lap.distance_mm[i]));
+    }
+    const std::string col = direction_colour(lap.clockwise);
+    c.path(d, col, 1.1,
+           fmt::format(R"(stroke-opacity="0.85" {} class="lap" data-run="{}" data-direction="{}")",
+                       direction_dash(lap.clockwise), run, lap.clockwise ? "cw" : "ccw"));
+    // The direction of travel, from the samples themselves: an arrowhead at this lap's own angle
+    // (the laps' arrows spread evenly along the axis, so they do not stack).
+    if (const auto at = lap_arrow_at(lap, k, laps.size())) {
+      arrows.push_back({x(lap.angle_deg[at->first]), y(lap.distance_mm[at->first]), at->second, col});
+    }
+  }
+  return arrows;
+}
+
+// One run's panel: heading, axes, its laps, each direction's mean over its laps, the arrowheads.
+void lap_panel(Canvas& c, const std::vector<LapDeviation>& laps, const char* name, const char* run, bool horizontal,
+               double left, double top) {
+  const double panel_h = 266.0, panel_w = 400.0;
+  const Scale x{0.0, 360.0, left, left + panel_w};
+  double max_d = 0.0;
+  for (const auto& lap : laps) {
+    for (const double d : lap.distance_mm) {
+      max_d = std::max(max_d, d);
+    }
+  }
+  const Scale y{0.0, svg::nice_ceiling(max_d * 1.05), top + panel_h, top};
+  lap_panel_heading(c, laps, name, left, top);
+  svg::value_axis(c, y, left, left + panel_w, "distance from the reference (mm)", 1.0, 46.0);
+  angle_axis(c, x, top, top + panel_h, horizontal, true);
+  const std::vector<LapArrow> arrows = lap_lines(c, laps, run, x, y);
+  for (const bool cw : {true, false}) {
+    const std::vector<double> means = sector_means(laps, cw);
+    const std::string d = sector_path(means, means.size(), [&](std::size_t k, double m) {
+      return std::pair{x(sector_centre_deg(k)), y(m)};
+    });
+    if (!d.empty()) {
+      c.path(d, direction_mean_colour(cw), 2.6,
+             fmt::format(R"({} class="direction-mean" data-run="{}" data-direction="{}")", direction_dash(cw), run,
+                         cw ? "cw" : "ccw"));
+    }
+  }
+  // Over every line, outlined in white, so no later lap hides an earlier one's arrow.
+  for (const auto& a : arrows) {
+    arrowhead(c, a.x, a.y, a.dx, 0.0, a.colour, 13.0);
+  }
+}
+
+}  // namespace
+
+std::string svg_lap_overlay(const PathPlot& plot) {
+  const double width = svg::kMaxWidth, height = 530.0;
+  Canvas c(width, height);
+  titles(c, "Every lap: distance from the reference against the angle on the circle", plot.title);
+  const std::optional<Reference> ref = reference_of(plot);
+  if (!ref || !ref->closed) {
+    no_data(c, !ref ? "no unloaded path to plot (fewer than 2 samples)" : "the path is not closed: no angle to plot");
+    return c.str();
+  }
+  lap_overlay_legend(c);
+  lap_panel(c, lap_deviations(plot.uc_laps, plot.uc, *ref), "UC, uncompensated", "UC", ref->horizontal, 80.0, 140.0);
+  lap_panel(c, lap_deviations(plot.c_laps, plot.c, *ref), "C, compensated", "C", ref->horizontal, 590.0, 140.0);
   c.text(width / 2.0, height - 36.0,
          fmt::format("Angle: about the centre of the reference, 0 deg = the base's {} direction from the centre{}, "
                      "growing anticlockwise seen from {}.",
@@ -587,26 +597,22 @@ std::string svg_lap_overlay(const PathPlot& plot) {
   return c.str();
 }
 
-std::string svg_polar_deviation(const PathPlot& plot) {
-  const double width = 500.0, height = 640.0;
-  Canvas c(width, height);
-  titles(c, "Distance from the reference around the circle", plot.title);
-  const std::optional<Reference> ref = reference_of(plot);
-  if (!ref || !ref->closed) {
-    no_data(c, !ref ? "no unloaded path to plot (fewer than 2 samples)" : "the path is not closed: no angle to plot");
-    return c.str();
-  }
-  // Each run's laps in one direction averaged in 5 deg sectors.
-  struct Curve {
-    const char* run;
-    bool clockwise;
-    std::string colour;
-    std::vector<double> mean_mm;  // per sector, NaN when empty
-  };
-  std::vector<Curve> curves;
-  const std::vector<LapDeviation> runs[] = {lap_deviations(plot.uc_laps, plot.uc, *ref),
-                                            lap_deviations(plot.c_laps, plot.c, *ref)};
-  double max_mm = 0.0;
+namespace {
+
+// Each run's laps in one direction averaged in 5 deg sectors.
+struct PolarCurve {
+  const char* run;
+  bool clockwise;
+  std::string colour;
+  std::vector<double> mean_mm;  // per sector, NaN when empty
+};
+
+// The curves of both runs; `max_mm` gets the largest sector mean.
+std::vector<PolarCurve> polar_curves(const PathPlot& plot, const Reference& ref, double& max_mm) {
+  std::vector<PolarCurve> curves;
+  const std::vector<LapDeviation> runs[] = {lap_deviations(plot.uc_laps, plot.uc, ref),
+                                            lap_deviations(plot.c_laps, plot.c, ref)};
+  max_mm = 0.0;
   for (int r = 0; r < 2; ++r) {
     for (const bool cw : {true, false}) {
       std::vector<double> means = sector_means(runs[r], cw);
@@ -621,7 +627,11 @@ std::string svg_polar_deviation(const PathPlot& plot) {
       curves.push_back({r == 0 ? "UC" : "C", cw, r == 0 ? svg::kUcColour : svg::kCColour, std::move(means)});
     }
   }
-  // Legend: run by colour, direction by dash.
+  return curves;
+}
+
+// Legend: run by colour, direction by dash. Returns the baseline below the last row.
+double polar_legend(Canvas& c, const std::vector<PolarCurve>& curves) {
   double ly = 72.0;
   for (const auto& cv : curves) {
     const std::string label = fmt::format("{}, {} laps (5 deg sector means)", cv.run, direction_name(cv.clockwise));
@@ -629,100 +639,136 @@ std::string svg_polar_deviation(const PathPlot& plot) {
     c.text(64.0, ly, label, 12.0);
     ly += 18.0;
   }
-  const double cx = 250.0, cy = std::max(ly + 196.0, 340.0), r0 = 70.0, r_out = 165.0;
-  // Rings at a round step, the outermost the first at or beyond the largest sector mean.
-  const auto steps = svg::nice_ticks(0.0, std::max(max_mm, 1e-6) * 1.02, 3);
-  const double ring_step = steps.size() > 1 ? steps[1] - steps[0] : std::max(max_mm, 1e-6);
-  const double ring_max = std::max(1.0, std::ceil(max_mm * 1.02 / ring_step - 1e-9)) * ring_step;
-  const double px_per_mm = (r_out - r0) / ring_max;
-  auto radius = [&](double mm) { return r0 + mm * px_per_mm; };
-  auto point = [&](double deg, double mm) {
+  return ly;
+}
+
+// The polar frame: distance drawn outward from the 0 mm ring at r0, rings at a round step, the
+// outermost the first at or beyond the largest sector mean.
+struct PolarFrame {
+  double cx, cy, r0, r_out;
+  double ring_step = 1.0, ring_max = 1.0, px_per_mm = 1.0;
+  [[nodiscard]] double radius(double mm) const { return r0 + mm * px_per_mm; }
+  [[nodiscard]] std::pair<double, double> point(double deg, double mm) const {
     const double a = deg_to_rad(deg);
     return std::pair{cx + radius(mm) * std::cos(a), cy - radius(mm) * std::sin(a)};
-  };
-  // Spokes every 45 deg, labelled outside the outer ring.
+  }
+};
+
+PolarFrame polar_frame(double cx, double cy, double max_mm) {
+  PolarFrame f{cx, cy, 70.0, 165.0};
+  const auto steps = svg::nice_ticks(0.0, std::max(max_mm, 1e-6) * 1.02, 3);
+  f.ring_step = steps.size() > 1 ? steps[1] - steps[0] : std::max(max_mm, 1e-6);
+  f.ring_max = std::max(1.0, std::ceil(max_mm * 1.02 / f.ring_step - 1e-9)) * f.ring_step;
+  f.px_per_mm = (f.r_out - f.r0) / f.ring_max;
+  return f;
+}
+
+// Spokes every 45 deg, labelled outside the outer ring.
+void polar_spokes(Canvas& c, const PolarFrame& f, bool horizontal) {
   for (int deg = 0; deg < 360; deg += 45) {
-    const auto [x0, y0] = point(deg, 0.0);
-    const auto [x1, y1] = point(deg, ring_max);
+    const auto [x0, y0] = f.point(deg, 0.0);
+    const auto [x1, y1] = f.point(deg, f.ring_max);
     c.line(x0, y0, x1, y1, "#e0e0e0", 1.0);
     const double a = deg_to_rad(deg);
-    const double lr = r_out + 12.0;
+    const double lr = f.r_out + 12.0;
     const std::string label =
-        ref->horizontal && deg % 90 == 0 ? fmt::format("{} deg ({})", deg, compass(deg)) : fmt::format("{} deg", deg);
-    const double tx = cx + lr * std::cos(a), ty = cy - lr * std::sin(a) + 4.0;
+        horizontal && deg % 90 == 0 ? fmt::format("{} deg ({})", deg, compass(deg)) : fmt::format("{} deg", deg);
+    const double tx = f.cx + lr * std::cos(a), ty = f.cy - lr * std::sin(a) + 4.0;
     const std::string anchor = std::abs(std::cos(a)) < 0.3 ? "middle" : std::cos(a) > 0.0 ? "start" : "end";
     c.text(tx, ty, label, kMinFont, anchor, deg == 0 ? R"(font-weight="bold")" : R"(fill="#555")");
   }
-  // Rings: the reference (0 mm) solid, the others dashed, each labelled in mm.
+}
+
+// Rings: the reference (0 mm) solid, the others dashed. Returns their distances (mm).
+std::vector<double> polar_rings(Canvas& c, const PolarFrame& f) {
   std::vector<double> rings;
-  for (int k = 0; k * ring_step <= ring_max * (1.0 + 1e-9); ++k) {
-    rings.push_back(k * ring_step);
+  for (int k = 0; k * f.ring_step <= f.ring_max * (1.0 + 1e-9); ++k) {
+    rings.push_back(k * f.ring_step);
   }
   for (const double mm : rings) {
     c.circle(
-        cx, cy, radius(mm), "none",
+        f.cx, f.cy, f.radius(mm), "none",
         fmt::format(R"(stroke="{}" stroke-width="{}" {} class="ring" data-mm="{:.6g}")", mm == 0.0 ? "#888" : "#bbb",
                     mm == 0.0 ? "1.5" : "1", mm == 0.0 ? "" : R"(stroke-dasharray="4 3")", mm));
   }
-  for (const auto& cv : curves) {
-    std::string d;
-    bool pen = false;
-    for (int s = 0; s <= kSectors; ++s) {
-      const double m = cv.mean_mm[static_cast<std::size_t>(s % kSectors)];
-      if (!std::isfinite(m)) {
-        pen = false;
-        continue;
-      }
-      const auto [x, y] = point(sector_centre_deg(static_cast<std::size_t>(s % kSectors)), m);
-      d += fmt::format("{}{:.1f},{:.1f}", pen ? " L" : (d.empty() ? "M" : " M"), x, y);
-      pen = true;
+  return rings;
+}
+
+// Where a ring's label goes: the sector between the spokes (over the label's own width) whose nearest
+// curve is the most pixels away from the ring; all else equal, nearest 112.5 deg.
+double ring_label_deg(const PolarFrame& f, const std::vector<PolarCurve>& curves, double mm, double half_span_deg) {
+  double best_deg = 112.5, best_clearance = -1.0;
+  for (std::size_t k = 0; k < kSectors; ++k) {
+    const double deg = sector_centre_deg(k);
+    if (std::abs(std::remainder(deg - 22.5, 45.0)) > 12.5) {
+      continue;  // between the spokes, away from their labels
     }
-    c.path(d, cv.colour, 1.6,
-           fmt::format(R"({} class="polar" data-run="{}" data-direction="{}")", direction_dash(cv.clockwise), cv.run,
-                       cv.clockwise ? "cw" : "ccw"));
+    double clearance = HUGE_VAL;
+    for (const auto& cv : curves) {
+      for (std::size_t j = 0; j < kSectors; ++j) {
+        const double sector_deg = sector_centre_deg(j);
+        const double m = cv.mean_mm[j];
+        if (std::isfinite(m) && std::abs(std::remainder(sector_deg - deg, 360.0)) <= half_span_deg) {
+          clearance = std::min(clearance, std::abs(f.radius(m) - f.radius(mm)));
+        }
+      }
+    }
+    const double score = clearance - 1e-3 * std::abs(std::remainder(deg - 112.5, 360.0));
+    if (score > best_clearance) {
+      best_clearance = score;
+      best_deg = deg;
+    }
   }
-  // Ring labels last, on a white halo, each where the curves keep farthest from it: the sector
-  // (over the label's own width) whose nearest curve is the most pixels away from the ring. The
-  // 0 mm ring is named inside, where no distance is drawn.
+  return best_deg;
+}
+
+// Ring labels last, on a white halo, each where the curves keep farthest from it. The 0 mm ring is
+// named inside, where no distance is drawn.
+void polar_ring_labels(Canvas& c, const PolarFrame& f, const std::vector<PolarCurve>& curves,
+                       const std::vector<double>& rings) {
   const std::string halo = R"(stroke="white" stroke-width="3" paint-order="stroke" fill="#333")";
-  c.text(cx, cy - 2.0, "0 mm ring:", kMinFont, "middle", R"(class="ring-label" fill="#555")");
-  c.text(cx, cy + 12.0, "the reference", kMinFont, "middle", R"(class="ring-label" fill="#555")");
+  c.text(f.cx, f.cy - 2.0, "0 mm ring:", kMinFont, "middle", R"(class="ring-label" fill="#555")");
+  c.text(f.cx, f.cy + 12.0, "the reference", kMinFont, "middle", R"(class="ring-label" fill="#555")");
   for (const double mm : rings) {
     if (mm == 0.0) {
       continue;
     }
-    const std::string label = svg::tick_label(mm, ring_step) + " mm";
-    const double half_span_deg = rad_to_deg(0.5 * svg::text_width(label, kMinFont) / radius(mm)) + 2.5;
-    double best_deg = 112.5, best_clearance = -1.0;
-    for (std::size_t k = 0; k < kSectors; ++k) {
-      const double deg = sector_centre_deg(k);
-      if (std::abs(std::remainder(deg - 22.5, 45.0)) > 12.5) {
-        continue;  // between the spokes, away from their labels
-      }
-      double clearance = HUGE_VAL;
-      for (const auto& cv : curves) {
-        for (std::size_t j = 0; j < kSectors; ++j) {
-          const double sector_deg = sector_centre_deg(j);
-          const double m = cv.mean_mm[j];
-          if (std::isfinite(m) && std::abs(std::remainder(sector_deg - deg, 360.0)) <= half_span_deg) {
-            clearance = std::min(clearance, std::abs(radius(m) - radius(mm)));
-          }
-        }
-      }
-      // All else equal, nearest 112.5 deg.
-      const double score = clearance - 1e-3 * std::abs(std::remainder(deg - 112.5, 360.0));
-      if (score > best_clearance) {
-        best_clearance = score;
-        best_deg = deg;
-      }
-    }
-    const auto [x, y] = point(best_deg, mm);
+    const std::string label = svg::tick_label(mm, f.ring_step) + " mm";
+    const double half_span_deg = rad_to_deg(0.5 * svg::text_width(label, kMinFont) / f.radius(mm)) + 2.5;
+    const auto [x, y] = f.point(ring_label_deg(f, curves, mm, half_span_deg), mm);
     c.text(x, y + 4.0, label, kMinFont, "middle", R"(class="ring-label" )" + halo);
   }
-  c.text(cx, cy + r_out + 44.0, "Distance from the reference drawn outward from the 0 mm ring", 12.0, "middle",
+}
+
+}  // namespace
+
+std::string svg_polar_deviation(const PathPlot& plot) {
+  const double width = 500.0, height = 640.0;
+  Canvas c(width, height);
+  titles(c, "Distance from the reference around the circle", plot.title);
+  const std::optional<Reference> ref = reference_of(plot);
+  if (!ref || !ref->closed) {
+    no_data(c, !ref ? "no unloaded path to plot (fewer than 2 samples)" : "the path is not closed: no angle to plot");
+    return c.str();
+  }
+  double max_mm = 0.0;
+  const std::vector<PolarCurve> curves = polar_curves(plot, *ref, max_mm);
+  const double ly = polar_legend(c, curves);
+  const PolarFrame f = polar_frame(250.0, std::max(ly + 196.0, 340.0), max_mm);
+  polar_spokes(c, f, ref->horizontal);
+  const std::vector<double> rings = polar_rings(c, f);
+  for (const auto& cv : curves) {
+    const std::string d = sector_path(cv.mean_mm, static_cast<std::size_t>(kSectors) + 1,
+                                      [&](std::size_t s, double m) { return f.point(sector_centre_deg(s), m); });
+    c.path(d, cv.colour, 1.6,
+           fmt::format(R"({} class="polar" data-run="{}" data-direction="{}")", direction_dash(cv.clockwise), cv.run,
+                       cv.clockwise ? "cw" : "ccw"));
+  }
+  polar_ring_labels(c, f, curves, rings);
+  c.text(f.cx, f.cy + f.r_out + 44.0, "Distance from the reference drawn outward from the 0 mm ring", 12.0, "middle",
          R"(fill="#444")");
-  c.text(cx, cy + r_out + 60.0, fmt::format("(1 mm = {:.0f} px); angle as in the per-lap figure", px_per_mm), 12.0,
-         "middle", R"(fill="#444")");
+  c.text(f.cx, f.cy + f.r_out + 60.0, fmt::format("(1 mm = {:.0f} px); angle as in the per-lap figure", f.px_per_mm),
+         12.0, "middle", R"(fill="#444")");
   return c.str();
 }
 
