@@ -836,7 +836,8 @@ std::string svg_speed_sweep(const StudyResult& study) {
   const double x_max = svg::nice_ceiling(max_speed);
   for (int q = 0; q < 4; ++q) {
     const double x_left = xs_left[q % 2];
-    const double top = top0 + (q / 2) * (panel_h + 56.0);
+    const int row = q / 2;  // the panel's row
+    const double top = top0 + row * (panel_h + 56.0);
     sweep_panel(c, study, series, style, q, Scale{0.0, x_max, x_left, x_left + panel_w}, top, panel_h);
   }
   return c.str();
