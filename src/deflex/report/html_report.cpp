@@ -504,9 +504,8 @@ std::string figures_html(const StudyResult& study) {
   return h;
 }
 
-}  // namespace
-
-std::string html_report(const ReportContent& content) {
+// The document's head, its title and the line under it naming the case, the seeds and the run time.
+std::string html_head(const ReportContent& content) {
   const StudyResult& study = content.study;
   std::string h;
   h += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n";
@@ -524,6 +523,12 @@ std::string html_report(const ReportContent& content) {
       "<p class=\"sub\">{}. Reference: the paper's Tables 1 and 2 and Figure 5 "
       "(offline and online compliance compensation of an ABB IRB6700 on a loaded circle).</p>\n",
       sub);
+  return h;
+}
+
+// The setup in words and the case file as given.
+std::string html_setup(const ReportContent& content) {
+  std::string h;
   if (!content.setup_paragraphs.empty()) {
     h += "<h2 id=\"setup\">Setup</h2>\n";
     for (const auto& p : content.setup_paragraphs) {
@@ -533,12 +538,12 @@ std::string html_report(const ReportContent& content) {
   if (!content.case_text.empty()) {
     h += fmt::format("<details><summary>Case file</summary>\n<pre>{}</pre>\n</details>\n", esc(content.case_text));
   }
-  h += "<h2 id=\"results\">Results beside the paper</h2>\n";
-  h += results_tables(study);
-  h += sync_table(study);
-  h += figures_html(study);
-  h += iso_table(study);
-  h += links_table(content.links);
+  return h;
+}
+
+// Each path plot's four figures, then one caption for them all.
+std::string html_paths(const ReportContent& content) {
+  std::string h;
   if (!content.path_plots.empty()) {
     h += "<h2 id=\"paths\">Paths, laps and directions</h2>\n";
     for (const auto& p : content.path_plots) {
@@ -561,7 +566,11 @@ std::string html_report(const ReportContent& content) {
          "in 5 deg sectors): above 0 under-compensated (still deflected the way the load pushes), below 0 "
          "over-compensated, which the distances above cannot tell apart. All from the first seed's runs.</p>\n";
   }
-  h += budget_tables(study);
+  return h;
+}
+
+std::string html_sweep(const StudyResult& study) {
+  std::string h;
   if (!study.speed_sweep.empty()) {
     h += "<h2 id=\"sweep\">Speed sweep</h2>\n<div class=\"fig\">\n" + svg_speed_sweep(study) + "</div>\n";
     h +=
@@ -571,12 +580,23 @@ std::string html_report(const ReportContent& content) {
         std::string(study.seed_count() > 1 ? "Points: the mean over the seeds; whiskers: min to max over them. " : "") +
         "Each panel's range is fitted to its data; points at one speed are drawn side by side.</p>\n";
   }
+  return h;
+}
+
+std::string html_notes(const ReportContent& content) {
+  std::string h;
   if (!content.notes.empty()) {
     h += "<h2 id=\"notes\">Notes</h2>\n";
     for (const auto& n : content.notes) {
       h += fmt::format("<div class=\"note\">{}</div>\n", esc(n));
     }
   }
+  return h;
+}
+
+// How every figure of the report is computed.
+std::string html_method(const StudyResult& study) {
+  std::string h;
   h += fmt::format(
       "<h2 id=\"method\">How the figures are computed</h2>\n<ul>\n"
       "<li>Reference path: the unloaded run at the same speed, its laps (clockwise and anticlockwise, as many as "
@@ -601,6 +621,26 @@ std::string html_report(const ReportContent& content) {
       "<li>ISO 9283 path accuracy AT<sub>p</sub> and repeatability RT<sub>p</sub>: section 7.2 of the standard, "
       "positions only, against the same reference (see docs/evaluation.md).</li>\n</ul>\n",
       seeds_text(study));
+  return h;
+}
+
+}  // namespace
+
+std::string html_report(const ReportContent& content) {
+  const StudyResult& study = content.study;
+  std::string h = html_head(content);
+  h += html_setup(content);
+  h += "<h2 id=\"results\">Results beside the paper</h2>\n";
+  h += results_tables(study);
+  h += sync_table(study);
+  h += figures_html(study);
+  h += iso_table(study);
+  h += links_table(content.links);
+  h += html_paths(content);
+  h += budget_tables(study);
+  h += html_sweep(study);
+  h += html_notes(content);
+  h += html_method(study);
   h += "</body>\n</html>\n";
   return h;
 }

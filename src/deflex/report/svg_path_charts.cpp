@@ -259,91 +259,117 @@ SectorVectors sector_vectors(const std::vector<DirectedLap>& laps, const Referen
   return v;
 }
 
+// The angle axis under a panel: ticks every 45 deg (compass names on a horizontal path), and with
+// `grid` a line across the panel every 90 deg.
+void angle_axis(Canvas& c, const Scale& x, double top, double bottom, bool horizontal, bool grid) {
+  c.line(x.p0, bottom, x.p1, bottom, "#444", 1.0);
+  for (int deg = 0; deg <= 360; deg += 45) {
+    c.line(x(deg), bottom, x(deg), bottom + 5.0, "#444", 1.0);
+    c.text(x(deg), bottom + 18.0, fmt::format("{}", deg), kMinFont, "middle");
+    if (horizontal && deg % 90 == 0) {
+      c.text(x(deg), bottom + 32.0, compass(deg % 360), kMinFont, "middle", R"(fill="#666")");
+    }
+    if (grid && deg % 90 == 0) {
+      c.line(x(deg), top, x(deg), bottom, deg % 360 == 0 ? "#777" : "#d8d8d8", 1.0,
+             deg % 360 == 0 ? "" : R"(stroke-dasharray="3 3")");
+    }
+  }
+  c.text((x.p0 + x.p1) / 2.0, bottom + 50.0, "angle about the circle's centre (deg)", 12.0, "middle");
+}
+
+// SVG path data through `steps` sector means (sector k % means.size()), lifting the pen over empty
+// (NaN) sectors; `to_px(sector, mean)` places a point.
+template <class ToPx>
+std::string sector_path(const std::vector<double>& means, std::size_t steps, ToPx to_px) {
+  std::string d;
+  bool pen = false;
+  for (std::size_t k = 0; k < steps; ++k) {
+    const std::size_t s = k % means.size();
+    if (!std::isfinite(means[s])) {
+      pen = false;
+      continue;
+    }
+    const auto [x, y] = to_px(s, means[s]);
+    d += fmt::format("{}{:.1f},{:.1f}", pen ? " L" : (d.empty() ? "M" : " M"), x, y);
+    pen = true;
+  }
+  return d;
+}
+
 }  // namespace
 
-std::string svg_path_plot(const PathPlot& plot) {
-  const double width = 500.0, height = 640.0;
-  Canvas c(width, height);
-  titles(c, "The last laps, deviations magnified", plot.title);
-  const std::optional<Reference> ref = reference_of(plot);
-  if (!ref) {
-    no_data(c, "no unloaded path to plot (fewer than 2 samples)");
-    return c.str();
-  }
-  const Vector3& centroid = ref->plane.centroid_m;
-  const Vector3& u = ref->plane.u;
-  const Vector3& v = ref->plane.v;
-  struct Dev {
-    Vector3 on_path, d;
-  };
-  auto deviations = [&](const TrackerTrace& t) {
-    std::vector<Dev> out;
-    const std::size_t stride = std::max<std::size_t>(1, (t.size() + 1499) / 1500);
-    for (std::size_t i = 0; i < t.size(); i += stride) {
-      if (t[i].p_m.allFinite()) {
-        const auto near = ref->index->nearest(t[i].p_m);
-        out.push_back({near.point_m, t[i].p_m - near.point_m});
-      }
-    }
-    return out;
-  };
-  const std::vector<Dev> uc = deviations(plot.uc);
-  const std::vector<Dev> cc = deviations(plot.c);
-  double max_dev = 0.0;
-  for (const auto* set : {&uc, &cc}) {
-    for (const auto& d : *set) {
-      max_dev = std::max(max_dev, d.d.norm());
-    }
-  }
-  const double mag = plot.magnification > 0.0 ? plot.magnification
-                     : max_dev > 0.0          ? svg::nice_floor(0.12 * ref->size_m / max_dev)
-                                              : 1.0;
-  auto mean_text = [&](const char* name, const std::vector<Dev>& ds, const TrackerTrace& lap) {
-    if (ds.empty()) {
-      return fmt::format("{} (no data)", name);
-    }
-    double s = 0.0;
-    for (const auto& d : ds) {
-      s += d.d.norm();
-    }
-    const std::string dir = ref->closed ? ", " + direction_name(turns_clockwise(finite_only(lap), *ref)) : "";
-    return fmt::format("{}, last lap{}: mean {:.3f} mm", name, dir, s / static_cast<double>(ds.size()) * 1e3);
-  };
-  svg::legend_entry(c, 40.0, 72.0, "line", svg::kUnloadedColour,
-                    ref->is_mean ? "unloaded, mean of the laps (the reference)" : "unloaded, last lap (the reference)");
-  svg::legend_entry(c, 40.0, 92.0, "line", svg::kUcColour, mean_text("UC", uc, plot.uc));
-  svg::legend_entry(c, 40.0, 112.0, "line", svg::kCColour, mean_text("C", cc, plot.c));
+namespace {
 
-  // The path in its plane, equal scales, deviations magnified.
-  const double pl = 76.0, pt = 130.0, pw = 400.0, ph = 400.0;
-  double lo_u = HUGE_VAL, hi_u = -HUGE_VAL, lo_v = HUGE_VAL, hi_v = -HUGE_VAL;
-  for (const auto& s : ref->path) {
-    const Vector3 d = s.p_m - centroid;
-    lo_u = std::min(lo_u, d.dot(u));
-    hi_u = std::max(hi_u, d.dot(u));
-    lo_v = std::min(lo_v, d.dot(v));
-    hi_v = std::max(hi_v, d.dot(v));
+// A tracker sample as drawn on the path plot: its nearest reference point and its deviation from it.
+struct PathDeviation {
+  Vector3 on_path, d;
+};
+
+// A trace's deviations, thinned to at most about 1500.
+std::vector<PathDeviation> path_deviations(const TrackerTrace& t, const Reference& ref) {
+  std::vector<PathDeviation> out;
+  const std::size_t stride = std::max<std::size_t>(1, (t.size() + 1499) / 1500);
+  for (std::size_t i = 0; i < t.size(); i += stride) {
+    if (t[i].p_m.allFinite()) {
+      const auto near = ref.index->nearest(t[i].p_m);
+      out.push_back({near.point_m, t[i].p_m - near.point_m});
+    }
   }
-  const double half = 0.5 * ref->size_m * 1.3 + 1e-9;
-  const double mid_u = 0.5 * (lo_u + hi_u), mid_v = 0.5 * (lo_v + hi_v);
-  const Scale xs{(mid_u - half) * 1e3, (mid_u + half) * 1e3, pl, pl + pw};
-  const Scale ys{(mid_v - half) * 1e3, (mid_v + half) * 1e3, pt + ph, pt};
-  c.rect(pl, pt, pw, ph, "none", R"(stroke="#ccc")");
-  const std::string axis_u = ref->horizontal ? "x" : "u", axis_v = ref->horizontal ? "y" : "v";
-  svg::value_axis(c, ys, pl, pl + pw, fmt::format("{} about the centre (mm)", axis_v), 1.0, 50.0);
-  svg::position_axis(c, xs, pt + ph, fmt::format("{} about the centre (mm)", axis_u));
-  auto to_px = [&](const Vector3& p) {
+  return out;
+}
+
+std::string path_mean_text(const char* name, const std::vector<PathDeviation>& ds, const TrackerTrace& lap,
+                           const Reference& ref) {
+  if (ds.empty()) {
+    return fmt::format("{} (no data)", name);
+  }
+  double s = 0.0;
+  for (const auto& d : ds) {
+    s += d.d.norm();
+  }
+  const std::string dir = ref.closed ? ", " + direction_name(turns_clockwise(finite_only(lap), ref)) : "";
+  return fmt::format("{}, last lap{}: mean {:.3f} mm", name, dir, s / static_cast<double>(ds.size()) * 1e3);
+}
+
+// The path's plane mapped to pixels, equal scales, centred on the path.
+struct PlaneMap {
+  Vector3 centroid, u, v;
+  Scale xs, ys;
+  double half = 0.0;  // half the span drawn (m)
+  [[nodiscard]] std::pair<double, double> operator()(const Vector3& p) const {
     const Vector3 d = p - centroid;
     return std::pair{xs(d.dot(u) * 1e3), ys(d.dot(v) * 1e3)};
-  };
+  }
+};
+
+PlaneMap plane_map(const Reference& ref, double pl, double pt, double pw, double ph) {
+  PlaneMap m{ref.plane.centroid_m, ref.plane.u, ref.plane.v, {}, {}};
+  double lo_u = HUGE_VAL, hi_u = -HUGE_VAL, lo_v = HUGE_VAL, hi_v = -HUGE_VAL;
+  for (const auto& s : ref.path) {
+    const Vector3 d = s.p_m - m.centroid;
+    lo_u = std::min(lo_u, d.dot(m.u));
+    hi_u = std::max(hi_u, d.dot(m.u));
+    lo_v = std::min(lo_v, d.dot(m.v));
+    hi_v = std::max(hi_v, d.dot(m.v));
+  }
+  m.half = 0.5 * ref.size_m * 1.3 + 1e-9;
+  const double mid_u = 0.5 * (lo_u + hi_u), mid_v = 0.5 * (lo_v + hi_v);
+  m.xs = Scale{(mid_u - m.half) * 1e3, (mid_u + m.half) * 1e3, pl, pl + pw};
+  m.ys = Scale{(mid_v - m.half) * 1e3, (mid_v + m.half) * 1e3, pt + ph, pt};
+  return m;
+}
+
+// The reference wide, then each run's deviations magnified, each with an arrowhead for its travel.
+void path_plot_lines(Canvas& c, const Reference& ref, const PlaneMap& to_px, const std::vector<PathDeviation>& uc,
+                     const std::vector<PathDeviation>& cc, double mag) {
   {
     std::vector<double> xy;
-    const std::size_t stride = std::max<std::size_t>(1, (ref->path.size() + 1499) / 1500);
-    for (std::size_t i = 0; i < ref->path.size(); i += stride) {
-      const auto [x, y] = to_px(ref->path[i].p_m);
+    const std::size_t stride = std::max<std::size_t>(1, (ref.path.size() + 1499) / 1500);
+    for (std::size_t i = 0; i < ref.path.size(); i += stride) {
+      const auto [x, y] = to_px(ref.path[i].p_m);
       xy.insert(xy.end(), {x, y});
     }
-    const auto [x, y] = to_px(ref->path.back().p_m);
+    const auto [x, y] = to_px(ref.path.back().p_m);
     xy.insert(xy.end(), {x, y});
     c.polyline(xy, svg::kUnloadedColour, 4.5);  // wide, so it shows beside a C path lying on it
   }
@@ -362,41 +388,76 @@ std::string svg_path_plot(const PathPlot& plot) {
       arrowhead(c, x0, y0, x1 - x0, y1 - y0, col, 11.0);
     }
   }
-  if (ref->closed) {
-    // The centre and the 0 deg ray of the angle the other figures use.
-    const auto [cx, cy] = to_px(centroid);
-    c.line(cx - 5.0, cy, cx + 5.0, cy, "#666", 1.0);
-    c.line(cx, cy - 5.0, cx, cy + 5.0, "#666", 1.0);
-    const double ray = 0.5 * ref->size_m * 0.75 * pw / (2.0 * half);
-    c.line(cx, cy, cx + ray, cy, "#666", 1.0, R"(stroke-dasharray="3 3")");
-    c.text(cx + 8.0, cy - 6.0, ref->horizontal ? "0 deg (+x)" : "0 deg (+u)", kMinFont, "start", R"(fill="#444")");
-  }
-  // Below the axes, clear of every line: how to read the figure.
-  c.text(pl + pw / 2.0, pt + ph + 62.0, fmt::format("Deviations magnified x{:g}", mag), 12.0, "middle",
-         R"(font-weight="bold")");
-  c.text(pl + pw / 2.0, pt + ph + 78.0,
+}
+
+// The centre and the 0 deg ray of the angle the other figures use.
+void path_plot_centre(Canvas& c, const Reference& ref, const PlaneMap& to_px, double pw) {
+  const auto [cx, cy] = to_px(to_px.centroid);
+  c.line(cx - 5.0, cy, cx + 5.0, cy, "#666", 1.0);
+  c.line(cx, cy - 5.0, cx, cy + 5.0, "#666", 1.0);
+  const double ray = 0.5 * ref.size_m * 0.75 * pw / (2.0 * to_px.half);
+  c.line(cx, cy, cx + ray, cy, "#666", 1.0, R"(stroke-dasharray="3 3")");
+  c.text(cx + 8.0, cy - 6.0, ref.horizontal ? "0 deg (+x)" : "0 deg (+u)", kMinFont, "start", R"(fill="#444")");
+}
+
+// Below the axes, clear of every line: how to read the figure.
+void path_plot_notes(Canvas& c, const Reference& ref, double mag, double xc, double y0) {
+  c.text(xc, y0, fmt::format("Deviations magnified x{:g}", mag), 12.0, "middle", R"(font-weight="bold")");
+  c.text(xc, y0 + 16.0,
          fmt::format("each point drawn from its nearest reference point; seen from {},",
-                     ref->horizontal ? "above" : "the plane's normal"),
+                     ref.horizontal ? "above" : "the plane's normal"),
          12.0, "middle", R"(fill="#555")");
-  c.text(pl + pw / 2.0, pt + ph + 94.0, "projected on the path's plane (the out-of-plane part is not drawn)", 12.0,
-         "middle", R"(fill="#555")");
+  c.text(xc, y0 + 32.0, "projected on the path's plane (the out-of-plane part is not drawn)", 12.0, "middle",
+         R"(fill="#555")");
+}
+
+}  // namespace
+
+std::string svg_path_plot(const PathPlot& plot) {
+  const double width = 500.0, height = 640.0;
+  Canvas c(width, height);
+  titles(c, "The last laps, deviations magnified", plot.title);
+  const std::optional<Reference> ref = reference_of(plot);
+  if (!ref) {
+    no_data(c, "no unloaded path to plot (fewer than 2 samples)");
+    return c.str();
+  }
+  const std::vector<PathDeviation> uc = path_deviations(plot.uc, *ref);
+  const std::vector<PathDeviation> cc = path_deviations(plot.c, *ref);
+  double max_dev = 0.0;
+  for (const auto* set : {&uc, &cc}) {
+    for (const auto& d : *set) {
+      max_dev = std::max(max_dev, d.d.norm());
+    }
+  }
+  const double mag = plot.magnification > 0.0 ? plot.magnification
+                     : max_dev > 0.0          ? svg::nice_floor(0.12 * ref->size_m / max_dev)
+                                              : 1.0;
+  svg::legend_entry(c, 40.0, 72.0, "line", svg::kUnloadedColour,
+                    ref->is_mean ? "unloaded, mean of the laps (the reference)" : "unloaded, last lap (the reference)");
+  svg::legend_entry(c, 40.0, 92.0, "line", svg::kUcColour, path_mean_text("UC", uc, plot.uc, *ref));
+  svg::legend_entry(c, 40.0, 112.0, "line", svg::kCColour, path_mean_text("C", cc, plot.c, *ref));
+
+  // The path in its plane, equal scales, deviations magnified.
+  const double pl = 76.0, pt = 130.0, pw = 400.0, ph = 400.0;
+  const PlaneMap to_px = plane_map(*ref, pl, pt, pw, ph);
+  c.rect(pl, pt, pw, ph, "none", R"(stroke="#ccc")");
+  const std::string axis_u = ref->horizontal ? "x" : "u", axis_v = ref->horizontal ? "y" : "v";
+  svg::value_axis(c, to_px.ys, pl, pl + pw, fmt::format("{} about the centre (mm)", axis_v), 1.0, 50.0);
+  svg::position_axis(c, to_px.xs, pt + ph, fmt::format("{} about the centre (mm)", axis_u));
+  path_plot_lines(c, *ref, to_px, uc, cc, mag);
+  if (ref->closed) {
+    path_plot_centre(c, *ref, to_px, pw);
+  }
+  path_plot_notes(c, *ref, mag, pl + pw / 2.0, pt + ph + 62.0);
   return c.str();
 }
 
-std::string svg_lap_overlay(const PathPlot& plot) {
-  const double width = svg::kMaxWidth, height = 530.0;
-  Canvas c(width, height);
-  titles(c, "Every lap: distance from the reference against the angle on the circle", plot.title);
-  const std::optional<Reference> ref = reference_of(plot);
-  if (!ref || !ref->closed) {
-    no_data(c, !ref ? "no unloaded path to plot (fewer than 2 samples)" : "the path is not closed: no angle to plot");
-    return c.str();
-  }
-  const std::vector<LapDeviation> runs[] = {lap_deviations(plot.uc_laps, plot.uc, *ref),
-                                            lap_deviations(plot.c_laps, plot.c, *ref)};
-  const char* const names[] = {"UC, uncompensated", "C, compensated"};
-  // Legend: colour and dash by direction, with the direction of travel on the angle axis; below,
-  // the direction's mean, which the eye cannot find in six noisy laps.
+namespace {
+
+// Legend: colour and dash by direction, with the direction of travel on the angle axis; below, the
+// direction's mean, which the eye cannot find in six noisy laps.
+void lap_overlay_legend(Canvas& c) {
   for (const bool cw : {true, false}) {
     const double lx = cw ? 80.0 : 590.0;
     const std::string label = fmt::format("{} laps: travel {} (angle {})", direction_name(cw),
@@ -407,103 +468,122 @@ std::string svg_lap_overlay(const PathPlot& plot) {
     c.line(lx, 86.0, lx + 18.0, 86.0, direction_mean_colour(cw), 2.6, direction_dash(cw));
     c.text(lx + 24.0, 90.0, fmt::format("{} laps' mean in 5 deg sectors", direction_name(cw)), 12.0);
   }
-  const double top = 140.0, panel_h = 266.0, panel_w = 400.0;
-  const double lefts[] = {80.0, 590.0};
-  for (int r = 0; r < 2; ++r) {
-    const double left = lefts[r];
-    const Scale x{0.0, 360.0, left, left + panel_w};
-    double max_d = 0.0;
-    for (const auto& lap : runs[r]) {
-      for (const double d : lap.distance_mm) {
-        max_d = std::max(max_d, d);
-      }
-    }
-    const Scale y{0.0, svg::nice_ceiling(max_d * 1.05), top + panel_h, top};
-    c.text(left, top - 26.0, names[r], 13.0, "start", R"(font-weight="bold")");
-    std::string summary;
-    for (const bool cw : {true, false}) {
-      const int n = count_of(runs[r], cw);
-      if (n > 0) {
-        summary += fmt::format("{}{} {} lap{}: mean {:.3f} mm", summary.empty() ? "" : "; ", direction_name(cw), n,
-                               n == 1 ? "" : "s", mean_of(runs[r], cw ? 1 : 0));
-      }
-    }
-    c.text(left, top - 9.0, summary.empty() ? "no laps" : summary, 12.0, "start", R"(fill="#444")");
-    svg::value_axis(c, y, left, left + panel_w, "distance from the reference (mm)", 1.0, 46.0);
-    c.line(left, top + panel_h, left + panel_w, top + panel_h, "#444", 1.0);
-    for (int deg = 0; deg <= 360; deg += 45) {
-      c.line(x(deg), top + panel_h, x(deg), top + panel_h + 5.0, "#444", 1.0);
-      c.text(x(deg), top + panel_h + 18.0, fmt::format("{}", deg), kMinFont, "middle");
-      if (ref->horizontal && deg % 90 == 0) {
-        c.text(x(deg), top + panel_h + 32.0, compass(deg % 360), kMinFont, "middle", R"(fill="#666")");
-      }
-      if (deg % 90 == 0) {
-        c.line(x(deg), top, x(deg), top + panel_h, deg % 360 == 0 ? "#777" : "#d8d8d8", 1.0,
-               deg % 360 == 0 ? "" : R"(stroke-dasharray="3 3")");
-      }
-    }
-    c.text(left + panel_w / 2.0, top + panel_h + 50.0, "angle about the circle's centre (deg)", 12.0, "middle");
-    struct Arrow {
-      double x, y, dx;
-      std::string colour;
-    };
-    std::vector<Arrow> arrows;
-    for (std::size_t k = 0; k < runs[r].size(); ++k) {
-      const LapDeviation& lap = runs[r][k];
-      std::string d;
-      for (std::size_t i = 0; i < lap.angle_deg.size(); ++i) {
-        const bool wrap = i > 0 && std::abs(lap.angle_deg[i] - lap.angle_deg[i - 1]) > 180.0;
-        d += fmt::format("{}{:.1f},{:.1f}", i == 0 || wrap ? (i == 0 ? "M" : " M") : " L", x(lap.angle_deg[i]),
-                         y(lap.distance_mm[i]));
-      }
-      const std::string col = direction_colour(lap.clockwise);
-      c.path(d, col, 1.1,
-             fmt::format(R"(stroke-opacity="0.85" {} class="lap" data-run="{}" data-direction="{}")",
-                         direction_dash(lap.clockwise), r == 0 ? "UC" : "C", lap.clockwise ? "cw" : "ccw"));
-      // The direction of travel, from the samples themselves: an arrowhead at this lap's own angle
-      // (the laps' arrows spread evenly along the axis, so they do not stack).
-      const std::size_t n = lap.angle_deg.size();
-      if (n >= 12) {
-        const double target = (static_cast<double>(k) + 0.5) * 360.0 / static_cast<double>(runs[r].size());
-        std::size_t i = 0;
-        for (std::size_t j = 1; j + 3 < n; ++j) {
-          if (std::abs(std::remainder(lap.angle_deg[j] - target, 360.0)) <
-              std::abs(std::remainder(lap.angle_deg[i] - target, 360.0))) {
-            i = j;
-          }
-        }
-        double da = lap.angle_deg[i + 3] - lap.angle_deg[i];
-        da = std::remainder(da, 360.0);
-        if (std::abs(da) < 90.0 && da != 0.0) {
-          arrows.push_back({x(lap.angle_deg[i]), y(lap.distance_mm[i]), da, col});
-        }
-      }
-    }
-    // Each direction's mean over its laps, over the laps.
-    for (const bool cw : {true, false}) {
-      const std::vector<double> means = sector_means(runs[r], cw);
-      std::string d;
-      bool pen = false;
-      for (std::size_t k = 0; k < means.size(); ++k) {
-        if (!std::isfinite(means[k])) {
-          pen = false;
-          continue;
-        }
-        d +=
-            fmt::format("{}{:.1f},{:.1f}", pen ? " L" : (d.empty() ? "M" : " M"), x(sector_centre_deg(k)), y(means[k]));
-        pen = true;
-      }
-      if (!d.empty()) {
-        c.path(d, direction_mean_colour(cw), 2.6,
-               fmt::format(R"({} class="direction-mean" data-run="{}" data-direction="{}")", direction_dash(cw),
-                           r == 0 ? "UC" : "C", cw ? "cw" : "ccw"));
-      }
-    }
-    // Over every line, outlined in white, so no later lap hides an earlier one's arrow.
-    for (const auto& a : arrows) {
-      arrowhead(c, a.x, a.y, a.dx, 0.0, a.colour, 13.0);
+}
+
+// A panel's name and, under it, each direction's lap count and mean distance.
+void lap_panel_heading(Canvas& c, const std::vector<LapDeviation>& laps, const char* name, double left, double top) {
+  c.text(left, top - 26.0, name, 13.0, "start", R"(font-weight="bold")");
+  std::string summary;
+  for (const bool cw : {true, false}) {
+    const int n = count_of(laps, cw);
+    if (n > 0) {
+      summary += fmt::format("{}{} {} lap{}: mean {:.3f} mm", summary.empty() ? "" : "; ", direction_name(cw), n,
+                             n == 1 ? "" : "s", mean_of(laps, cw ? 1 : 0));
     }
   }
+  c.text(left, top - 9.0, summary.empty() ? "no laps" : summary, 12.0, "start", R"(fill="#444")");
+}
+
+struct LapArrow {
+  double x, y, dx;
+  std::string colour;
+};
+
+// The sample of lap `k` of `count` nearest its own share of the angle axis, with the angle travelled
+// over the next 3 samples; nullopt when the lap is short or turns too fast there.
+std::optional<std::pair<std::size_t, double>> lap_arrow_at(const LapDeviation& lap, std::size_t k, std::size_t count) {
+  const std::size_t n = lap.angle_deg.size();
+  if (n < 12) {
+    return std::nullopt;
+  }
+  const double target = (static_cast<double>(k) + 0.5) * 360.0 / static_cast<double>(count);
+  std::size_t i = 0;
+  for (std::size_t j = 1; j + 3 < n; ++j) {
+    if (std::abs(std::remainder(lap.angle_deg[j] - target, 360.0)) <
+        std::abs(std::remainder(lap.angle_deg[i] - target, 360.0))) {
+      i = j;
+    }
+  }
+  double da = lap.angle_deg[i + 3] - lap.angle_deg[i];
+  da = std::remainder(da, 360.0);
+  if (std::abs(da) < 90.0 && da != 0.0) {
+    return std::pair{i, da};
+  }
+  return std::nullopt;
+}
+
+// A line a lap; returns the arrowheads showing each lap's travel, to draw over every line.
+std::vector<LapArrow> lap_lines(Canvas& c, const std::vector<LapDeviation>& laps, const char* run, const Scale& x,
+                                const Scale& y) {
+  std::vector<LapArrow> arrows;
+  for (std::size_t k = 0; k < laps.size(); ++k) {
+    const LapDeviation& lap = laps[k];
+    std::string d;
+    for (std::size_t i = 0; i < lap.angle_deg.size(); ++i) {
+      const bool wrap = i > 0 && std::abs(lap.angle_deg[i] - lap.angle_deg[i - 1]) > 180.0;
+      d += fmt::format("{}{:.1f},{:.1f}", i == 0 || wrap ? (i == 0 ? "M" : " M") : " L", x(lap.angle_deg[i]),
+                       y(lap.distance_mm[i]));
+    }
+    const std::string col = direction_colour(lap.clockwise);
+    c.path(d, col, 1.1,
+           fmt::format(R"(stroke-opacity="0.85" {} class="lap" data-run="{}" data-direction="{}")",
+                       direction_dash(lap.clockwise), run, lap.clockwise ? "cw" : "ccw"));
+    // The direction of travel, from the samples themselves: an arrowhead at this lap's own angle
+    // (the laps' arrows spread evenly along the axis, so they do not stack).
+    if (const auto at = lap_arrow_at(lap, k, laps.size())) {
+      arrows.push_back({x(lap.angle_deg[at->first]), y(lap.distance_mm[at->first]), at->second, col});
+    }
+  }
+  return arrows;
+}
+
+// One run's panel: heading, axes, its laps, each direction's mean over its laps, the arrowheads.
+void lap_panel(Canvas& c, const std::vector<LapDeviation>& laps, const char* name, const char* run, bool horizontal,
+               double left, double top) {
+  const double panel_h = 266.0, panel_w = 400.0;
+  const Scale x{0.0, 360.0, left, left + panel_w};
+  double max_d = 0.0;
+  for (const auto& lap : laps) {
+    for (const double d : lap.distance_mm) {
+      max_d = std::max(max_d, d);
+    }
+  }
+  const Scale y{0.0, svg::nice_ceiling(max_d * 1.05), top + panel_h, top};
+  lap_panel_heading(c, laps, name, left, top);
+  svg::value_axis(c, y, left, left + panel_w, "distance from the reference (mm)", 1.0, 46.0);
+  angle_axis(c, x, top, top + panel_h, horizontal, true);
+  const std::vector<LapArrow> arrows = lap_lines(c, laps, run, x, y);
+  for (const bool cw : {true, false}) {
+    const std::vector<double> means = sector_means(laps, cw);
+    const std::string d = sector_path(means, means.size(), [&](std::size_t k, double m) {
+      return std::pair{x(sector_centre_deg(k)), y(m)};
+    });
+    if (!d.empty()) {
+      c.path(d, direction_mean_colour(cw), 2.6,
+             fmt::format(R"({} class="direction-mean" data-run="{}" data-direction="{}")", direction_dash(cw), run,
+                         cw ? "cw" : "ccw"));
+    }
+  }
+  // Over every line, outlined in white, so no later lap hides an earlier one's arrow.
+  for (const auto& a : arrows) {
+    arrowhead(c, a.x, a.y, a.dx, 0.0, a.colour, 13.0);
+  }
+}
+
+}  // namespace
+
+std::string svg_lap_overlay(const PathPlot& plot) {
+  const double width = svg::kMaxWidth, height = 530.0;
+  Canvas c(width, height);
+  titles(c, "Every lap: distance from the reference against the angle on the circle", plot.title);
+  const std::optional<Reference> ref = reference_of(plot);
+  if (!ref || !ref->closed) {
+    no_data(c, !ref ? "no unloaded path to plot (fewer than 2 samples)" : "the path is not closed: no angle to plot");
+    return c.str();
+  }
+  lap_overlay_legend(c);
+  lap_panel(c, lap_deviations(plot.uc_laps, plot.uc, *ref), "UC, uncompensated", "UC", ref->horizontal, 80.0, 140.0);
+  lap_panel(c, lap_deviations(plot.c_laps, plot.c, *ref), "C, compensated", "C", ref->horizontal, 590.0, 140.0);
   c.text(width / 2.0, height - 36.0,
          fmt::format("Angle: about the centre of the reference, 0 deg = the base's {} direction from the centre{}, "
                      "growing anticlockwise seen from {}.",
@@ -517,26 +597,22 @@ std::string svg_lap_overlay(const PathPlot& plot) {
   return c.str();
 }
 
-std::string svg_polar_deviation(const PathPlot& plot) {
-  const double width = 500.0, height = 640.0;
-  Canvas c(width, height);
-  titles(c, "Distance from the reference around the circle", plot.title);
-  const std::optional<Reference> ref = reference_of(plot);
-  if (!ref || !ref->closed) {
-    no_data(c, !ref ? "no unloaded path to plot (fewer than 2 samples)" : "the path is not closed: no angle to plot");
-    return c.str();
-  }
-  // Each run's laps in one direction averaged in 5 deg sectors.
-  struct Curve {
-    const char* run;
-    bool clockwise;
-    std::string colour;
-    std::vector<double> mean_mm;  // per sector, NaN when empty
-  };
-  std::vector<Curve> curves;
-  const std::vector<LapDeviation> runs[] = {lap_deviations(plot.uc_laps, plot.uc, *ref),
-                                            lap_deviations(plot.c_laps, plot.c, *ref)};
-  double max_mm = 0.0;
+namespace {
+
+// Each run's laps in one direction averaged in 5 deg sectors.
+struct PolarCurve {
+  const char* run;
+  bool clockwise;
+  std::string colour;
+  std::vector<double> mean_mm;  // per sector, NaN when empty
+};
+
+// The curves of both runs; `max_mm` gets the largest sector mean.
+std::vector<PolarCurve> polar_curves(const PathPlot& plot, const Reference& ref, double& max_mm) {
+  std::vector<PolarCurve> curves;
+  const std::vector<LapDeviation> runs[] = {lap_deviations(plot.uc_laps, plot.uc, ref),
+                                            lap_deviations(plot.c_laps, plot.c, ref)};
+  max_mm = 0.0;
   for (int r = 0; r < 2; ++r) {
     for (const bool cw : {true, false}) {
       std::vector<double> means = sector_means(runs[r], cw);
@@ -551,7 +627,11 @@ std::string svg_polar_deviation(const PathPlot& plot) {
       curves.push_back({r == 0 ? "UC" : "C", cw, r == 0 ? svg::kUcColour : svg::kCColour, std::move(means)});
     }
   }
-  // Legend: run by colour, direction by dash.
+  return curves;
+}
+
+// Legend: run by colour, direction by dash. Returns the baseline below the last row.
+double polar_legend(Canvas& c, const std::vector<PolarCurve>& curves) {
   double ly = 72.0;
   for (const auto& cv : curves) {
     const std::string label = fmt::format("{}, {} laps (5 deg sector means)", cv.run, direction_name(cv.clockwise));
@@ -559,151 +639,185 @@ std::string svg_polar_deviation(const PathPlot& plot) {
     c.text(64.0, ly, label, 12.0);
     ly += 18.0;
   }
-  const double cx = 250.0, cy = std::max(ly + 196.0, 340.0), r0 = 70.0, r_out = 165.0;
-  // Rings at a round step, the outermost the first at or beyond the largest sector mean.
-  const auto steps = svg::nice_ticks(0.0, std::max(max_mm, 1e-6) * 1.02, 3);
-  const double ring_step = steps.size() > 1 ? steps[1] - steps[0] : std::max(max_mm, 1e-6);
-  const double ring_max = std::max(1.0, std::ceil(max_mm * 1.02 / ring_step - 1e-9)) * ring_step;
-  const double px_per_mm = (r_out - r0) / ring_max;
-  auto radius = [&](double mm) { return r0 + mm * px_per_mm; };
-  auto point = [&](double deg, double mm) {
+  return ly;
+}
+
+// The polar frame: distance drawn outward from the 0 mm ring at r0, rings at a round step, the
+// outermost the first at or beyond the largest sector mean.
+struct PolarFrame {
+  double cx, cy, r0, r_out;
+  double ring_step = 1.0, ring_max = 1.0, px_per_mm = 1.0;
+  [[nodiscard]] double radius(double mm) const { return r0 + mm * px_per_mm; }
+  [[nodiscard]] std::pair<double, double> point(double deg, double mm) const {
     const double a = deg_to_rad(deg);
     return std::pair{cx + radius(mm) * std::cos(a), cy - radius(mm) * std::sin(a)};
-  };
-  // Spokes every 45 deg, labelled outside the outer ring.
+  }
+};
+
+PolarFrame polar_frame(double cx, double cy, double max_mm) {
+  PolarFrame f{cx, cy, 70.0, 165.0};
+  const auto steps = svg::nice_ticks(0.0, std::max(max_mm, 1e-6) * 1.02, 3);
+  f.ring_step = steps.size() > 1 ? steps[1] - steps[0] : std::max(max_mm, 1e-6);
+  f.ring_max = std::max(1.0, std::ceil(max_mm * 1.02 / f.ring_step - 1e-9)) * f.ring_step;
+  f.px_per_mm = (f.r_out - f.r0) / f.ring_max;
+  return f;
+}
+
+// Spokes every 45 deg, labelled outside the outer ring.
+void polar_spokes(Canvas& c, const PolarFrame& f, bool horizontal) {
   for (int deg = 0; deg < 360; deg += 45) {
-    const auto [x0, y0] = point(deg, 0.0);
-    const auto [x1, y1] = point(deg, ring_max);
+    const auto [x0, y0] = f.point(deg, 0.0);
+    const auto [x1, y1] = f.point(deg, f.ring_max);
     c.line(x0, y0, x1, y1, "#e0e0e0", 1.0);
     const double a = deg_to_rad(deg);
-    const double lr = r_out + 12.0;
+    const double lr = f.r_out + 12.0;
     const std::string label =
-        ref->horizontal && deg % 90 == 0 ? fmt::format("{} deg ({})", deg, compass(deg)) : fmt::format("{} deg", deg);
-    const double tx = cx + lr * std::cos(a), ty = cy - lr * std::sin(a) + 4.0;
+        horizontal && deg % 90 == 0 ? fmt::format("{} deg ({})", deg, compass(deg)) : fmt::format("{} deg", deg);
+    const double tx = f.cx + lr * std::cos(a), ty = f.cy - lr * std::sin(a) + 4.0;
     const std::string anchor = std::abs(std::cos(a)) < 0.3 ? "middle" : std::cos(a) > 0.0 ? "start" : "end";
     c.text(tx, ty, label, kMinFont, anchor, deg == 0 ? R"(font-weight="bold")" : R"(fill="#555")");
   }
-  // Rings: the reference (0 mm) solid, the others dashed, each labelled in mm.
+}
+
+// Rings: the reference (0 mm) solid, the others dashed. Returns their distances (mm).
+std::vector<double> polar_rings(Canvas& c, const PolarFrame& f) {
   std::vector<double> rings;
-  for (int k = 0; k * ring_step <= ring_max * (1.0 + 1e-9); ++k) {
-    rings.push_back(k * ring_step);
+  for (int k = 0; k * f.ring_step <= f.ring_max * (1.0 + 1e-9); ++k) {
+    rings.push_back(k * f.ring_step);
   }
   for (const double mm : rings) {
     c.circle(
-        cx, cy, radius(mm), "none",
+        f.cx, f.cy, f.radius(mm), "none",
         fmt::format(R"(stroke="{}" stroke-width="{}" {} class="ring" data-mm="{:.6g}")", mm == 0.0 ? "#888" : "#bbb",
                     mm == 0.0 ? "1.5" : "1", mm == 0.0 ? "" : R"(stroke-dasharray="4 3")", mm));
   }
-  for (const auto& cv : curves) {
-    std::string d;
-    bool pen = false;
-    for (int s = 0; s <= kSectors; ++s) {
-      const double m = cv.mean_mm[static_cast<std::size_t>(s % kSectors)];
-      if (!std::isfinite(m)) {
-        pen = false;
-        continue;
-      }
-      const auto [x, y] = point(sector_centre_deg(static_cast<std::size_t>(s % kSectors)), m);
-      d += fmt::format("{}{:.1f},{:.1f}", pen ? " L" : (d.empty() ? "M" : " M"), x, y);
-      pen = true;
+  return rings;
+}
+
+// Where a ring's label goes: the sector between the spokes (over the label's own width) whose nearest
+// curve is the most pixels away from the ring; all else equal, nearest 112.5 deg.
+double ring_label_deg(const PolarFrame& f, const std::vector<PolarCurve>& curves, double mm, double half_span_deg) {
+  double best_deg = 112.5, best_clearance = -1.0;
+  for (std::size_t k = 0; k < kSectors; ++k) {
+    const double deg = sector_centre_deg(k);
+    if (std::abs(std::remainder(deg - 22.5, 45.0)) > 12.5) {
+      continue;  // between the spokes, away from their labels
     }
-    c.path(d, cv.colour, 1.6,
-           fmt::format(R"({} class="polar" data-run="{}" data-direction="{}")", direction_dash(cv.clockwise), cv.run,
-                       cv.clockwise ? "cw" : "ccw"));
+    double clearance = HUGE_VAL;
+    for (const auto& cv : curves) {
+      for (std::size_t j = 0; j < kSectors; ++j) {
+        const double sector_deg = sector_centre_deg(j);
+        const double m = cv.mean_mm[j];
+        if (std::isfinite(m) && std::abs(std::remainder(sector_deg - deg, 360.0)) <= half_span_deg) {
+          clearance = std::min(clearance, std::abs(f.radius(m) - f.radius(mm)));
+        }
+      }
+    }
+    const double score = clearance - 1e-3 * std::abs(std::remainder(deg - 112.5, 360.0));
+    if (score > best_clearance) {
+      best_clearance = score;
+      best_deg = deg;
+    }
   }
-  // Ring labels last, on a white halo, each where the curves keep farthest from it: the sector
-  // (over the label's own width) whose nearest curve is the most pixels away from the ring. The
-  // 0 mm ring is named inside, where no distance is drawn.
+  return best_deg;
+}
+
+// Ring labels last, on a white halo, each where the curves keep farthest from it. The 0 mm ring is
+// named inside, where no distance is drawn.
+void polar_ring_labels(Canvas& c, const PolarFrame& f, const std::vector<PolarCurve>& curves,
+                       const std::vector<double>& rings) {
   const std::string halo = R"(stroke="white" stroke-width="3" paint-order="stroke" fill="#333")";
-  c.text(cx, cy - 2.0, "0 mm ring:", kMinFont, "middle", R"(class="ring-label" fill="#555")");
-  c.text(cx, cy + 12.0, "the reference", kMinFont, "middle", R"(class="ring-label" fill="#555")");
+  c.text(f.cx, f.cy - 2.0, "0 mm ring:", kMinFont, "middle", R"(class="ring-label" fill="#555")");
+  c.text(f.cx, f.cy + 12.0, "the reference", kMinFont, "middle", R"(class="ring-label" fill="#555")");
   for (const double mm : rings) {
     if (mm == 0.0) {
       continue;
     }
-    const std::string label = svg::tick_label(mm, ring_step) + " mm";
-    const double half_span_deg = rad_to_deg(0.5 * svg::text_width(label, kMinFont) / radius(mm)) + 2.5;
-    double best_deg = 112.5, best_clearance = -1.0;
-    for (std::size_t k = 0; k < kSectors; ++k) {
-      const double deg = sector_centre_deg(k);
-      if (std::abs(std::remainder(deg - 22.5, 45.0)) > 12.5) {
-        continue;  // between the spokes, away from their labels
-      }
-      double clearance = HUGE_VAL;
-      for (const auto& cv : curves) {
-        for (std::size_t j = 0; j < kSectors; ++j) {
-          const double sector_deg = sector_centre_deg(j);
-          const double m = cv.mean_mm[j];
-          if (std::isfinite(m) && std::abs(std::remainder(sector_deg - deg, 360.0)) <= half_span_deg) {
-            clearance = std::min(clearance, std::abs(radius(m) - radius(mm)));
-          }
-        }
-      }
-      // All else equal, nearest 112.5 deg.
-      const double score = clearance - 1e-3 * std::abs(std::remainder(deg - 112.5, 360.0));
-      if (score > best_clearance) {
-        best_clearance = score;
-        best_deg = deg;
-      }
-    }
-    const auto [x, y] = point(best_deg, mm);
+    const std::string label = svg::tick_label(mm, f.ring_step) + " mm";
+    const double half_span_deg = rad_to_deg(0.5 * svg::text_width(label, kMinFont) / f.radius(mm)) + 2.5;
+    const auto [x, y] = f.point(ring_label_deg(f, curves, mm, half_span_deg), mm);
     c.text(x, y + 4.0, label, kMinFont, "middle", R"(class="ring-label" )" + halo);
   }
-  c.text(cx, cy + r_out + 44.0, "Distance from the reference drawn outward from the 0 mm ring", 12.0, "middle",
-         R"(fill="#444")");
-  c.text(cx, cy + r_out + 60.0, fmt::format("(1 mm = {:.0f} px); angle as in the per-lap figure", px_per_mm), 12.0,
-         "middle", R"(fill="#444")");
-  return c.str();
 }
 
-std::string svg_signed_error(const PathPlot& plot) {
-  const double width = svg::kMaxWidth, height = 470.0;
+}  // namespace
+
+std::string svg_polar_deviation(const PathPlot& plot) {
+  const double width = 500.0, height = 640.0;
   Canvas c(width, height);
-  titles(c, "Signed error of the compensated run along the uncompensated deflection", plot.title);
+  titles(c, "Distance from the reference around the circle", plot.title);
   const std::optional<Reference> ref = reference_of(plot);
   if (!ref || !ref->closed) {
     no_data(c, !ref ? "no unloaded path to plot (fewer than 2 samples)" : "the path is not closed: no angle to plot");
     return c.str();
   }
-  // The direction the load pushed the arm, per direction of travel and sector: the UC laps' mean
-  // deviation there. Each C sample's deviation is projected on it.
-  const SectorVectors uc = sector_vectors(laps_or_last(plot.uc_laps, plot.uc, *ref), *ref);
-  const std::vector<DirectedLap> c_laps = laps_or_last(plot.c_laps, plot.c, *ref);
+  double max_mm = 0.0;
+  const std::vector<PolarCurve> curves = polar_curves(plot, *ref, max_mm);
+  const double ly = polar_legend(c, curves);
+  const PolarFrame f = polar_frame(250.0, std::max(ly + 196.0, 340.0), max_mm);
+  polar_spokes(c, f, ref->horizontal);
+  const std::vector<double> rings = polar_rings(c, f);
+  for (const auto& cv : curves) {
+    const std::string d = sector_path(cv.mean_mm, static_cast<std::size_t>(kSectors) + 1,
+                                      [&](std::size_t s, double m) { return f.point(sector_centre_deg(s), m); });
+    c.path(d, cv.colour, 1.6,
+           fmt::format(R"({} class="polar" data-run="{}" data-direction="{}")", direction_dash(cv.clockwise), cv.run,
+                       cv.clockwise ? "cw" : "ccw"));
+  }
+  polar_ring_labels(c, f, curves, rings);
+  c.text(f.cx, f.cy + f.r_out + 44.0, "Distance from the reference drawn outward from the 0 mm ring", 12.0, "middle",
+         R"(fill="#444")");
+  c.text(f.cx, f.cy + f.r_out + 60.0, fmt::format("(1 mm = {:.0f} px); angle as in the per-lap figure", f.px_per_mm),
+         12.0, "middle", R"(fill="#444")");
+  return c.str();
+}
+
+namespace {
+
+// The compensated run's signed error per direction of travel (index 1: clockwise): its sector means
+// (NaN where no sample fell), its mean over its samples, and the largest sector mean's size (mm).
+struct SignedError {
+  std::vector<double> means[2];
+  double overall[2] = {kNaN, kNaN};
+  double max_abs = 0.0;
+};
+
+// Each C sample's deviation projected on the UC laps' mean deviation in its sector and direction.
+SignedError signed_error_of(const std::vector<DirectedLap>& c_laps, const SectorVectors& uc, const Reference& ref) {
   std::vector<double> sum[2] = {std::vector<double>(kSectors, 0.0), std::vector<double>(kSectors, 0.0)};
   std::vector<int> n[2] = {std::vector<int>(kSectors, 0), std::vector<int>(kSectors, 0)};
   for (const auto& lap : c_laps) {
     const int d = lap.clockwise ? 1 : 0;
     for (const auto& sample : lap.trace) {
       if (!sample.p_m.allFinite()) continue;
-      const std::size_t s = sector_of(angle_deg(*ref, sample.p_m));
+      const std::size_t s = sector_of(angle_deg(ref, sample.p_m));
       const Vector3 along = uc.mean(lap.clockwise, s);
       if (!(along.norm() > 0.0)) continue;
-      const Vector3 dev = sample.p_m - ref->index->nearest(sample.p_m).point_m;
+      const Vector3 dev = sample.p_m - ref.index->nearest(sample.p_m).point_m;
       sum[d][s] += dev.dot(along.normalized()) * 1e3;
       ++n[d][s];
     }
   }
-  // Sector means (NaN where no sample fell) and each direction's mean over its samples.
-  std::vector<double> means[2];
-  double overall[2] = {kNaN, kNaN}, max_abs = 0.0;
+  SignedError e;
   for (int d = 0; d < 2; ++d) {
-    means[d].assign(kSectors, kNaN);
+    e.means[d].assign(kSectors, kNaN);
     double total = 0.0;
     int count = 0;
     for (std::size_t s = 0; s < kSectors; ++s) {
       if (n[d][s] == 0) continue;
-      means[d][s] = sum[d][s] / n[d][s];
-      max_abs = std::max(max_abs, std::abs(means[d][s]));
+      e.means[d][s] = sum[d][s] / n[d][s];
+      e.max_abs = std::max(e.max_abs, std::abs(e.means[d][s]));
       total += sum[d][s];
       count += n[d][s];
     }
-    if (count > 0) overall[d] = total / count;
+    if (count > 0) e.overall[d] = total / count;
   }
-  if (!std::isfinite(overall[0]) && !std::isfinite(overall[1])) {
-    no_data(c, "no compensated lap with an uncompensated one to compare with");
-    return c.str();
-  }
-  // UC's own size along its direction, for scale.
+  return e;
+}
+
+// The legend, a row a direction with C laps; beside it UC's own size along its direction, for scale.
+// Returns the baseline below the last row.
+double signed_error_legend(Canvas& c, const SignedError& e, const SectorVectors& uc) {
   double uc_sum = 0.0;
   int uc_n = 0;
   for (int d = 0; d < 2; ++d) {
@@ -717,9 +831,9 @@ std::string svg_signed_error(const PathPlot& plot) {
   double ly = 70.0;
   for (const bool cw : {true, false}) {
     const int d = cw ? 1 : 0;
-    if (!std::isfinite(overall[d])) continue;
+    if (!std::isfinite(e.overall[d])) continue;
     c.line(80.0, ly - 4.0, 98.0, ly - 4.0, direction_colour(cw), 2.4, direction_dash(cw));
-    c.text(104.0, ly, fmt::format("C, {} laps (5 deg sector means): mean {:+.3f} mm", direction_name(cw), overall[d]),
+    c.text(104.0, ly, fmt::format("C, {} laps (5 deg sector means): mean {:+.3f} mm", direction_name(cw), e.overall[d]),
            12.0);
     ly += 18.0;
   }
@@ -727,10 +841,12 @@ std::string svg_signed_error(const PathPlot& plot) {
     c.text(590.0, 70.0, fmt::format("for scale: the UC deflection itself, {:.3f} mm on average", uc_sum / uc_n), 12.0,
            "start", R"(fill="#444")");
   }
-  const double left = 90.0, right = width - 30.0, top = std::max(ly + 14.0, 118.0), bottom = height - 96.0;
-  const double r = svg::nice_ceiling(std::max(max_abs, 1e-6) * 1.1);
-  const Scale x{0.0, 360.0, left, right};
-  const Scale y{-r, r, bottom, top};
+  return ly;
+}
+
+// The value axis about zero, its two halves shaded and named (under- and over-compensated).
+void signed_error_frame(Canvas& c, const Scale& x, const Scale& y) {
+  const double left = x.p0, right = x.p1, top = y.p1, bottom = y.p0;
   c.rect(left, top, right - left, y(0.0) - top, "#fdecea");
   c.rect(left, y(0.0), right - left, bottom - y(0.0), "#e8f1fb");
   svg::value_axis(c, y, left, right, "C along the UC deflection (mm)", 1.0, 56.0);
@@ -739,32 +855,43 @@ std::string svg_signed_error(const PathPlot& plot) {
          R"(fill="#8a1c1c")");
   c.text(left + 8.0, bottom - 8.0, "- over-compensated: pushed past the unloaded path, against the load", 12.0, "start",
          R"(fill="#1c4f8a")");
-  c.line(left, bottom, right, bottom, "#444", 1.0);
-  for (int deg = 0; deg <= 360; deg += 45) {
-    c.line(x(deg), bottom, x(deg), bottom + 5.0, "#444", 1.0);
-    c.text(x(deg), bottom + 18.0, fmt::format("{}", deg), kMinFont, "middle");
-    if (ref->horizontal && deg % 90 == 0) {
-      c.text(x(deg), bottom + 32.0, compass(deg % 360), kMinFont, "middle", R"(fill="#666")");
-    }
+}
+
+}  // namespace
+
+std::string svg_signed_error(const PathPlot& plot) {
+  const double width = svg::kMaxWidth, height = 470.0;
+  Canvas c(width, height);
+  titles(c, "Signed error of the compensated run along the uncompensated deflection", plot.title);
+  const std::optional<Reference> ref = reference_of(plot);
+  if (!ref || !ref->closed) {
+    no_data(c, !ref ? "no unloaded path to plot (fewer than 2 samples)" : "the path is not closed: no angle to plot");
+    return c.str();
   }
-  c.text((left + right) / 2.0, bottom + 50.0, "angle about the circle's centre (deg)", 12.0, "middle");
+  // The direction the load pushed the arm, per direction of travel and sector: the UC laps' mean
+  // deviation there. Each C sample's deviation is projected on it.
+  const SectorVectors uc = sector_vectors(laps_or_last(plot.uc_laps, plot.uc, *ref), *ref);
+  const SignedError e = signed_error_of(laps_or_last(plot.c_laps, plot.c, *ref), uc, *ref);
+  if (!std::isfinite(e.overall[0]) && !std::isfinite(e.overall[1])) {
+    no_data(c, "no compensated lap with an uncompensated one to compare with");
+    return c.str();
+  }
+  const double ly = signed_error_legend(c, e, uc);
+  const double left = 90.0, right = width - 30.0, top = std::max(ly + 14.0, 118.0), bottom = height - 96.0;
+  const double r = svg::nice_ceiling(std::max(e.max_abs, 1e-6) * 1.1);
+  const Scale x{0.0, 360.0, left, right};
+  const Scale y{-r, r, bottom, top};
+  signed_error_frame(c, x, y);
+  angle_axis(c, x, top, bottom, ref->horizontal, false);
   for (const bool cw : {true, false}) {
     const int d = cw ? 1 : 0;
-    if (!std::isfinite(overall[d])) continue;
-    std::string path;
-    bool pen = false;
-    for (std::size_t s = 0; s < kSectors; ++s) {
-      if (!std::isfinite(means[d][s])) {
-        pen = false;
-        continue;
-      }
-      path += fmt::format("{}{:.1f},{:.1f}", pen ? " L" : (path.empty() ? "M" : " M"), x(sector_centre_deg(s)),
-                          y(means[d][s]));
-      pen = true;
-    }
+    if (!std::isfinite(e.overall[d])) continue;
+    const std::string path = sector_path(e.means[d], e.means[d].size(), [&](std::size_t s, double m) {
+      return std::pair{x(sector_centre_deg(s)), y(m)};
+    });
     c.path(path, direction_colour(cw), 2.2,
            fmt::format(R"({} class="signed-error" data-direction="{}" data-mean-mm="{:.6g}")", direction_dash(cw),
-                       cw ? "cw" : "ccw", overall[d]));
+                       cw ? "cw" : "ccw", e.overall[d]));
   }
   c.text(width / 2.0, height - 18.0,
          "Each C sample's deviation from the reference projected on the UC laps' mean deviation in its 5 deg sector "

@@ -137,27 +137,12 @@ bool paper_has_setup(const std::string& setup) { return paper_reference().table_
 
 bool paper_has_setup(const SetupResult& setup) { return paper_table_of(paper_reference(), setup) != nullptr; }
 
-std::string svg_figure5(const StudyResult& study, SetupSelection which) {
-  const std::vector<int> speeds = study_speeds_mm_s(study);
-  const PaperFigures paper = paper_reference();
-  const std::vector<Group> groups = groups_of(study, which, paper);
-  const double width = svg::kMaxWidth, height = 668.0;
-  const double left = 84.0, right = 16.0;
-  Canvas c(width, height);
-  c.title(which == SetupSelection::kBeyondPaper
-              ? "Mean deformation after compensation: the setups beyond the paper"
-              : "Mean deformation after compensation (the paper's Figure 5, ours beside the paper's)");
-  if (groups.empty() || speeds.empty()) {
-    c.text(width / 2.0, height / 2.0, "no results to plot", 14.0, "middle");
-    return c.str();
-  }
-  // The axes span every setup's figures, so the figure of the paper's setups and the one of the
-  // others share their scales and can be compared bar for bar.
-  bool any_paper = false;
-  for (const auto& g : groups) {
-    any_paper = any_paper || g.paper != nullptr;
-  }
-  std::vector<double> c_values, uc_values;
+namespace {
+
+// Every setup's C and UC figures (ours and the paper's), so the figure of the paper's setups and the
+// one of the others share their scales and can be compared bar for bar.
+void fig5_values(const StudyResult& study, const PaperFigures& paper, const std::vector<int>& speeds,
+                 std::vector<double>& c_values, std::vector<double>& uc_values) {
   for (const auto& g : groups_of(study, SetupSelection::kAll, paper)) {
     for (const int v : speeds) {
       const Spread s = g.load->c_spread(v);
@@ -172,15 +157,12 @@ std::string svg_figure5(const StudyResult& study, SetupSelection which) {
       uc_values.push_back(g.paper->uc_mm);
     }
   }
-  const double c_top = 96.0, c_bottom = 386.0, uc_top = 420.0, uc_bottom = 548.0;
-  const svg::Range cr = svg::fitted_range(c_values, true, 0.05);
-  const svg::Range ur = svg::fitted_range(uc_values, true, 0.05);
-  const Scale yc{cr.lo, cr.hi, c_bottom, c_top};
-  const Scale yu{ur.lo, ur.hi, uc_bottom, uc_top};
-  svg::value_axis(c, yc, left, width - right, "C, after compensation (mm)", 1.0, 56.0);
-  svg::value_axis(c, yu, left, width - right, "UC, before (mm)", 1.0, 56.0);
+}
 
-  // Legend, two rows.
+// The legend, two rows: a colour a speed (and the paper's if shown), then UC and the whisker note.
+void fig5_legend(Canvas& c, const StudyResult& study, const std::vector<int>& speeds, const std::vector<Group>& groups,
+                 double left) {
+  const bool any_paper = std::any_of(groups.begin(), groups.end(), [](const Group& g) { return g.paper != nullptr; });
   double lx = left;
   for (std::size_t k = 0; k < speeds.size(); ++k) {
     lx = svg::legend_entry(c, lx, 50.0, "bar", svg::colour(k), fmt::format("C at {} mm/s", speeds[k]));
@@ -190,48 +172,88 @@ std::string svg_figure5(const StudyResult& study, SetupSelection which) {
   }
   lx = svg::legend_entry(c, left, 72.0, "bar", svg::pale(svg::kUcColour), "UC, uncompensated: mean over the speeds");
   c.text(lx, 72.0, whisker_note(study), 12.0, "start", R"(fill="#444")");
+}
+
+// C of one load at each speed: our bar with its whisker, the paper's beside it.
+void fig5_c_bars(Canvas& c, const std::string& setup, const Group& group, const std::vector<int>& speeds,
+                 const Scale& yc, double xc, double slot_w) {
+  const LoadResult& l = *group.load;
+  const bool with_paper = group.paper != nullptr;
+  const double n_speeds = static_cast<double>(speeds.size());
+  const double ours_w = with_paper ? slot_w * 0.56 : slot_w * 0.8;
+  const double paper_w = slot_w * 0.3;
+  for (std::size_t k = 0; k < speeds.size(); ++k) {
+    const double x0 = xc + (static_cast<double>(k) - n_speeds / 2.0) * slot_w + slot_w * 0.05;
+    const Spread s = l.c_spread(speeds[k]);
+    const double pv = with_paper ? value_at_speed(group.paper->c_mm, speeds[k]) : kNaN;
+    c.group_begin(fmt::format("{} {:g} N, C at {} mm/s: {}{}", setup, l.load_N, speeds[k],
+                              spread_text(s, 1.0, " mm", 3),
+                              std::isfinite(pv) ? fmt::format("; the paper's {:.2f} mm", pv) : ""));
+    value_bar(c, yc, x0, ours_w, s.mean, svg::colour(k),
+              fmt::format(R"(data-value="{:.6g}" data-min="{:.6g}" data-max="{:.6g}")", s.mean, s.min, s.max));
+    spread_whisker(c, yc, x0 + ours_w / 2.0, s);
+    if (with_paper) {
+      paper_bar(c, yc, x0 + ours_w + 1.5, paper_w, pv);
+    }
+    c.group_end();
+  }
+}
+
+// UC of one load: one pale bar (the paper's UC is the mean over the speeds), the paper's beside it.
+void fig5_uc_bar(Canvas& c, const std::string& setup, const Group& group, const Scale& yu, double xc, double group_w) {
+  const LoadResult& l = *group.load;
+  const bool with_paper = group.paper != nullptr;
+  const Spread u = l.uc_mean_spread();
+  const double uc_w = std::min(48.0, group_w * 0.34);
+  const double uc_paper_w = uc_w * 0.55;
+  const double x0 = xc - (with_paper ? (uc_w + 1.5 + uc_paper_w) : uc_w) / 2.0;
+  c.group_begin(fmt::format("{} {:g} N, UC (mean over the speeds): {}{}", setup, l.load_N,
+                            spread_text(u, 1.0, " mm", 3),
+                            with_paper ? fmt::format("; the paper's {:.2f} mm", group.paper->uc_mm) : ""));
+  value_bar(c, yu, x0, uc_w, u.mean, svg::pale(svg::kUcColour),
+            fmt::format(R"(data-uc="{:.6g}" data-min="{:.6g}" data-max="{:.6g}")", u.mean, u.min, u.max));
+  spread_whisker(c, yu, x0 + uc_w / 2.0, u);
+  if (with_paper) {
+    paper_bar(c, yu, x0 + uc_w + 1.5, uc_paper_w, group.paper->uc_mm);
+  }
+  c.group_end();
+}
+
+}  // namespace
+
+std::string svg_figure5(const StudyResult& study, SetupSelection which) {
+  const std::vector<int> speeds = study_speeds_mm_s(study);
+  const PaperFigures paper = paper_reference();
+  const std::vector<Group> groups = groups_of(study, which, paper);
+  const double width = svg::kMaxWidth, height = 668.0;
+  const double left = 84.0, right = 16.0;
+  Canvas c(width, height);
+  c.title(which == SetupSelection::kBeyondPaper
+              ? "Mean deformation after compensation: the setups beyond the paper"
+              : "Mean deformation after compensation (the paper's Figure 5, ours beside the paper's)");
+  if (groups.empty() || speeds.empty()) {
+    c.text(width / 2.0, height / 2.0, "no results to plot", 14.0, "middle");
+    return c.str();
+  }
+  std::vector<double> c_values, uc_values;
+  fig5_values(study, paper, speeds, c_values, uc_values);
+  const double c_top = 96.0, c_bottom = 386.0, uc_top = 420.0, uc_bottom = 548.0;
+  const svg::Range cr = svg::fitted_range(c_values, true, 0.05);
+  const svg::Range ur = svg::fitted_range(uc_values, true, 0.05);
+  const Scale yc{cr.lo, cr.hi, c_bottom, c_top};
+  const Scale yu{ur.lo, ur.hi, uc_bottom, uc_top};
+  svg::value_axis(c, yc, left, width - right, "C, after compensation (mm)", 1.0, 56.0);
+  svg::value_axis(c, yu, left, width - right, "UC, before (mm)", 1.0, 56.0);
+  fig5_legend(c, study, speeds, groups, left);
 
   const double plot_w = width - left - right;
   const double group_w = plot_w / static_cast<double>(groups.size());
-  const double n_speeds = static_cast<double>(speeds.size());
-  const double slot_w = std::min(64.0, group_w * 0.86 / n_speeds);
+  const double slot_w = std::min(64.0, group_w * 0.86 / static_cast<double>(speeds.size()));
   for (std::size_t g = 0; g < groups.size(); ++g) {
     const double xc = left + group_w * (static_cast<double>(g) + 0.5);
-    const LoadResult& l = *groups[g].load;
     const std::string& setup = study.setups[groups[g].setup].setup;
-    const bool with_paper = groups[g].paper != nullptr;
-    const double ours_w = with_paper ? slot_w * 0.56 : slot_w * 0.8;
-    const double paper_w = slot_w * 0.3;
-    for (std::size_t k = 0; k < speeds.size(); ++k) {
-      const double x0 = xc + (static_cast<double>(k) - n_speeds / 2.0) * slot_w + slot_w * 0.05;
-      const Spread s = l.c_spread(speeds[k]);
-      const double pv = with_paper ? value_at_speed(groups[g].paper->c_mm, speeds[k]) : kNaN;
-      c.group_begin(fmt::format("{} {:g} N, C at {} mm/s: {}{}", setup, l.load_N, speeds[k],
-                                spread_text(s, 1.0, " mm", 3),
-                                std::isfinite(pv) ? fmt::format("; the paper's {:.2f} mm", pv) : ""));
-      value_bar(c, yc, x0, ours_w, s.mean, svg::colour(k),
-                fmt::format(R"(data-value="{:.6g}" data-min="{:.6g}" data-max="{:.6g}")", s.mean, s.min, s.max));
-      spread_whisker(c, yc, x0 + ours_w / 2.0, s);
-      if (with_paper) {
-        paper_bar(c, yc, x0 + ours_w + 1.5, paper_w, pv);
-      }
-      c.group_end();
-    }
-    // UC: one pale bar a load (the paper's UC is the mean over the speeds), the paper's beside it.
-    const Spread u = l.uc_mean_spread();
-    const double uc_w = std::min(48.0, group_w * 0.34);
-    const double uc_paper_w = uc_w * 0.55;
-    const double x0 = xc - (with_paper ? (uc_w + 1.5 + uc_paper_w) : uc_w) / 2.0;
-    c.group_begin(fmt::format("{} {:g} N, UC (mean over the speeds): {}{}", setup, l.load_N,
-                              spread_text(u, 1.0, " mm", 3),
-                              with_paper ? fmt::format("; the paper's {:.2f} mm", groups[g].paper->uc_mm) : ""));
-    value_bar(c, yu, x0, uc_w, u.mean, svg::pale(svg::kUcColour),
-              fmt::format(R"(data-uc="{:.6g}" data-min="{:.6g}" data-max="{:.6g}")", u.mean, u.min, u.max));
-    spread_whisker(c, yu, x0 + uc_w / 2.0, u);
-    if (with_paper) {
-      paper_bar(c, yu, x0 + uc_w + 1.5, uc_paper_w, groups[g].paper->uc_mm);
-    }
-    c.group_end();
+    fig5_c_bars(c, setup, groups[g], speeds, yc, xc, slot_w);
+    fig5_uc_bar(c, setup, groups[g], yu, xc, group_w);
   }
   c.line(left, yc(yc.d0), width - right, yc(yc.d0), "#444", 1.0);
   c.line(left, yu(yu.d0), width - right, yu(yu.d0), "#444", 1.0);
@@ -631,25 +653,22 @@ std::string svg_parity(const StudyResult& study) {
   return c.str();
 }
 
-std::string svg_speed_sweep(const StudyResult& study) {
-  const double width = svg::kMaxWidth, height = 680.0;
-  Canvas c(width, height);
-  c.title("Speed sweep: compensation, residual and lag against TCP speed");
-  if (study.speed_sweep.empty()) {
-    c.text(width / 2.0, height / 2.0, "no speed sweep in this study", 14.0, "middle");
-    return c.str();
-  }
-  // One series per setup and load, in order of first appearance.
-  struct Series {
-    std::string setup;
-    double load_N;
-    std::vector<const SweepPoint*> points;
-  };
-  std::vector<Series> series;
-  double max_speed = 0.0;
+namespace {
+
+// One series of the speed sweep: a setup under one load, its points in order of speed.
+struct SweepSeries {
+  std::string setup;
+  double load_N;
+  std::vector<const SweepPoint*> points;
+};
+
+// One series per setup and load, in order of first appearance; `max_speed` gets the fastest point.
+std::vector<SweepSeries> sweep_series(const StudyResult& study, double& max_speed) {
+  std::vector<SweepSeries> series;
+  max_speed = 0.0;
   for (const auto& p : study.speed_sweep) {
     auto it = std::find_if(series.begin(), series.end(),
-                           [&](const Series& s) { return s.setup == p.setup && s.load_N == p.load_N; });
+                           [&](const SweepSeries& s) { return s.setup == p.setup && s.load_N == p.load_N; });
     if (it == series.end()) {
       series.push_back({p.setup, p.load_N, {}});
       it = series.end() - 1;
@@ -659,51 +678,73 @@ std::string svg_speed_sweep(const StudyResult& study) {
       max_speed = std::max(max_speed, p.speed_mm_s);
     }
   }
-  // The four figures of a point: its mean and its seeds' values.
-  struct Quantity {
-    const char* label;
-    double scale_to_label;
-    bool from_zero;
-  };
-  const Quantity quantities[] = {{"compensation 1 - C/UC (%)", 100.0, false},
-                                 {"C, nearest-point (mm)", 1.0, false},
-                                 {"C, time-synchronous (mm)", 1.0, false},
-                                 {"UC, nearest-point (mm)", 1.0, false}};
-  auto values_of = [](const SweepPoint& p, int q) {
-    std::vector<double> seeds;
-    double mean = kNaN;
-    switch (q) {
-      case 0:
-        mean = p.compensation;
-        for (std::size_t k = 0; k < p.c_mm_by_seed.size() && k < p.uc_mm_by_seed.size(); ++k) {
-          seeds.push_back(compensation_ratio(p.uc_mm_by_seed[k], p.c_mm_by_seed[k]));
-        }
-        break;
-      case 1:
-        mean = p.c_mm;
-        seeds = p.c_mm_by_seed;
-        break;
-      case 2:
-        mean = p.c_sync_mm;
-        seeds = p.c_sync_mm_by_seed;
-        break;
-      default:
-        mean = p.uc_mm;
-        seeds = p.uc_mm_by_seed;
-    }
-    Spread s = spread_of(seeds);
-    s.mean = mean;
-    return s;
-  };
+  return series;
+}
+
+// The four figures of a point, one a panel.
+struct SweepQuantity {
+  const char* label;
+  double scale_to_label;
+  bool from_zero;
+};
+constexpr SweepQuantity kSweepQuantities[] = {{"compensation 1 - C/UC (%)", 100.0, false},
+                                              {"C, nearest-point (mm)", 1.0, false},
+                                              {"C, time-synchronous (mm)", 1.0, false},
+                                              {"UC, nearest-point (mm)", 1.0, false}};
+
+// Quantity `q` of a point: its mean and its seeds' values.
+Spread sweep_values(const SweepPoint& p, int q) {
+  std::vector<double> seeds;
+  double mean = kNaN;
+  switch (q) {
+    case 0:
+      mean = p.compensation;
+      for (std::size_t k = 0; k < p.c_mm_by_seed.size() && k < p.uc_mm_by_seed.size(); ++k) {
+        seeds.push_back(compensation_ratio(p.uc_mm_by_seed[k], p.c_mm_by_seed[k]));
+      }
+      break;
+    case 1:
+      mean = p.c_mm;
+      seeds = p.c_mm_by_seed;
+      break;
+    case 2:
+      mean = p.c_sync_mm;
+      seeds = p.c_sync_mm_by_seed;
+      break;
+    default:
+      mean = p.uc_mm;
+      seeds = p.uc_mm_by_seed;
+  }
+  Spread s = spread_of(seeds);
+  s.mean = mean;
+  return s;
+}
+
+// How each series is drawn: a colour per setup, a dash per load within its setup.
+struct SweepStyle {
+  std::vector<std::string> colour;
+  std::vector<std::string> dash;
+};
+
+SweepStyle sweep_style(const std::vector<SweepSeries>& series) {
+  const char* const dashes[] = {"", R"(stroke-dasharray="6 3")", R"(stroke-dasharray="2 3")",
+                                R"(stroke-dasharray="8 3 2 3")"};
   std::map<std::string, std::size_t> setup_colour;
   for (const auto& s : series) {
     setup_colour.emplace(s.setup, setup_colour.size());
   }
-  // Legend rows first: the panels start below however many rows it takes.
-  const char* const dashes[] = {"", R"(stroke-dasharray="6 3")", R"(stroke-dasharray="2 3")",
-                                R"(stroke-dasharray="8 3 2 3")"};
   std::map<std::string, std::size_t> load_rank;
-  std::vector<std::string> series_dash;
+  SweepStyle style;
+  for (const auto& s : series) {
+    style.dash.emplace_back(dashes[load_rank[s.setup]++ % 4]);
+    style.colour.push_back(svg::colour(setup_colour[s.setup]));
+  }
+  return style;
+}
+
+// The legend, wrapped into rows across the chart; returns the baseline of its last row.
+double sweep_legend(Canvas& c, const StudyResult& study, const std::vector<SweepSeries>& series,
+                    const SweepStyle& style, double width) {
   double lx = 90.0, ly = 52.0;
   auto next_entry = [&](double w) {
     if (lx + w > width - 16.0) {
@@ -711,14 +752,11 @@ std::string svg_speed_sweep(const StudyResult& study) {
       ly += 20.0;
     }
   };
-  for (const auto& s : series) {
-    const std::size_t rank = load_rank[s.setup]++;
-    series_dash.push_back(dashes[rank % 4]);
-    const std::string col = svg::colour(setup_colour[s.setup]);
-    const std::string label = fmt::format("{} {:g} N", s.setup, s.load_N);
+  for (std::size_t si = 0; si < series.size(); ++si) {
+    const std::string label = fmt::format("{} {:g} N", series[si].setup, series[si].load_N);
     next_entry(24.0 + svg::text_width(label, 12.0) + 18.0);
-    c.line(lx, ly - 4.0, lx + 18.0, ly - 4.0, col, 2.0, series_dash.back());
-    c.circle(lx + 9.0, ly - 4.0, 3.0, col);
+    c.line(lx, ly - 4.0, lx + 18.0, ly - 4.0, style.colour[si], 2.0, style.dash[si]);
+    c.circle(lx + 9.0, ly - 4.0, 3.0, style.colour[si]);
     c.text(lx + 24.0, ly, label, 12.0);
     lx += 24.0 + svg::text_width(label, 12.0) + 18.0;
   }
@@ -727,8 +765,71 @@ std::string svg_speed_sweep(const StudyResult& study) {
   lx = svg::legend_entry(c, lx, ly, "band", "#ececec", band_label);
   next_entry(svg::text_width(whisker_note(study), 12.0));
   c.text(lx, ly, whisker_note(study), 12.0, "start", R"(fill="#444")");
+  return ly;
+}
 
-  const double top0 = ly + 36.0;
+// Quantity `q` of every series against speed: a whisker per point over seeds, the means joined.
+void sweep_marks(Canvas& c, const std::vector<SweepSeries>& series, const SweepStyle& style, int q, const Scale& x,
+                 const Scale& y) {
+  for (std::size_t si = 0; si < series.size(); ++si) {
+    const std::string& col = style.colour[si];
+    // Side by side, so whiskers at the same speed do not hide each other.
+    const double dodge = (static_cast<double>(si) - (static_cast<double>(series.size()) - 1.0) / 2.0) * 3.0;
+    std::vector<double> xy;
+    for (const auto* p : series[si].points) {
+      const Spread s = sweep_values(*p, q);
+      if (!std::isfinite(s.mean) || !std::isfinite(p->speed_mm_s)) {
+        continue;
+      }
+      const double px = x(p->speed_mm_s) + dodge;
+      if (s.n > 1) {
+        svg::whisker(c, px, y(s.min), y(s.max), col, 5.0);
+      }
+      c.circle(px, y(s.mean), 3.0, col, fmt::format(R"(data-value="{:.6g}")", s.mean));
+      xy.push_back(px);
+      xy.push_back(y(s.mean));
+    }
+    if (xy.size() >= 4) {
+      c.polyline(xy, col, 2.0, style.dash[si]);
+    }
+  }
+}
+
+// One panel: the paper's speed band, both axes fitted to quantity `q` over the whole sweep, the marks.
+void sweep_panel(Canvas& c, const StudyResult& study, const std::vector<SweepSeries>& series, const SweepStyle& style,
+                 int q, const Scale& x, double top, double panel_h) {
+  std::vector<double> all;
+  for (const auto& p : study.speed_sweep) {
+    const Spread s = sweep_values(p, q);
+    all.insert(all.end(), {s.mean, s.min, s.max});
+  }
+  svg::Range r = svg::fitted_range(all, kSweepQuantities[q].from_zero, 0.08);
+  if (q == 0) {
+    r.hi = std::min(r.hi, 1.0);  // compensation cannot pass 100%
+  }
+  const Scale y{r.lo, r.hi, top + panel_h, top};
+  const double band_lo = x(std::min(10.0, x.d1)), band_hi = x(std::min(50.0, x.d1));
+  c.rect(band_lo, top, band_hi - band_lo, panel_h, "#ececec");
+  svg::value_axis(c, y, x.p0, x.p1, kSweepQuantities[q].label, kSweepQuantities[q].scale_to_label, 50.0);
+  svg::position_axis(c, x, top + panel_h, "TCP speed (mm/s)");
+  sweep_marks(c, series, style, q, x, y);
+}
+
+}  // namespace
+
+std::string svg_speed_sweep(const StudyResult& study) {
+  const double width = svg::kMaxWidth, height = 680.0;
+  Canvas c(width, height);
+  c.title("Speed sweep: compensation, residual and lag against TCP speed");
+  if (study.speed_sweep.empty()) {
+    c.text(width / 2.0, height / 2.0, "no speed sweep in this study", 14.0, "middle");
+    return c.str();
+  }
+  double max_speed = 0.0;
+  const std::vector<SweepSeries> series = sweep_series(study, max_speed);
+  const SweepStyle style = sweep_style(series);
+  // Legend rows first: the panels start below however many rows it takes.
+  const double top0 = sweep_legend(c, study, series, style, width) + 36.0;
   const double panel_h = (height - top0 - 2.0 * 56.0) / 2.0;
   const double xs_left[] = {90.0, 600.0};
   const double panel_w = 400.0;
@@ -737,43 +838,7 @@ std::string svg_speed_sweep(const StudyResult& study) {
     const double x_left = xs_left[q % 2];
     const int row = q / 2;  // the panel's row
     const double top = top0 + row * (panel_h + 56.0);
-    const Scale x{0.0, x_max, x_left, x_left + panel_w};
-    std::vector<double> all;
-    for (const auto& p : study.speed_sweep) {
-      const Spread s = values_of(p, q);
-      all.insert(all.end(), {s.mean, s.min, s.max});
-    }
-    svg::Range r = svg::fitted_range(all, quantities[q].from_zero, 0.08);
-    if (q == 0) {
-      r.hi = std::min(r.hi, 1.0);  // compensation cannot pass 100%
-    }
-    const Scale y{r.lo, r.hi, top + panel_h, top};
-    const double band_lo = x(std::min(10.0, x_max)), band_hi = x(std::min(50.0, x_max));
-    c.rect(band_lo, top, band_hi - band_lo, panel_h, "#ececec");
-    svg::value_axis(c, y, x.p0, x.p1, quantities[q].label, quantities[q].scale_to_label, 50.0);
-    svg::position_axis(c, x, top + panel_h, "TCP speed (mm/s)");
-    for (std::size_t si = 0; si < series.size(); ++si) {
-      const std::string col = svg::colour(setup_colour[series[si].setup]);
-      // Side by side, so whiskers at the same speed do not hide each other.
-      const double dodge = (static_cast<double>(si) - (static_cast<double>(series.size()) - 1.0) / 2.0) * 3.0;
-      std::vector<double> xy;
-      for (const auto* p : series[si].points) {
-        const Spread s = values_of(*p, q);
-        if (!std::isfinite(s.mean) || !std::isfinite(p->speed_mm_s)) {
-          continue;
-        }
-        const double px = x(p->speed_mm_s) + dodge;
-        if (s.n > 1) {
-          svg::whisker(c, px, y(s.min), y(s.max), col, 5.0);
-        }
-        c.circle(px, y(s.mean), 3.0, col, fmt::format(R"(data-value="{:.6g}")", s.mean));
-        xy.push_back(px);
-        xy.push_back(y(s.mean));
-      }
-      if (xy.size() >= 4) {
-        c.polyline(xy, col, 2.0, series_dash[si]);
-      }
-    }
+    sweep_panel(c, study, series, style, q, Scale{0.0, x_max, x_left, x_left + panel_w}, top, panel_h);
   }
   return c.str();
 }
