@@ -146,8 +146,10 @@ CircleFit fit_circle(const std::vector<Vector3>& points, const std::string& what
   return fit;
 }
 
-// NOLINTNEXTLINE(readability-function-size): listed in docs/architecture.md, "Functions over 80 lines"
-FrameRegistration register_frames(const RegistrationInput& in) {
+namespace {
+
+// The pairs must pair up, be finite and be enough to fix a frame.
+void check_registration_input(const RegistrationInput& in) {
   if (in.tracker_m.size() != in.base_m.size()) {
     throw InputError(fmt::format("registration: {} tracker point(s) and {} base point(s): they must pair up",
                                  in.tracker_m.size(), in.base_m.size()));
@@ -164,6 +166,29 @@ FrameRegistration register_frames(const RegistrationInput& in) {
                     "needed (or circles)",
                     np));
   }
+}
+
+// The rotation that best maps the tracker's features onto the base's, from their correlation S (the
+// sum of a' b'^T): the unit quaternion of N(S)'s largest eigenvalue (Horn's closed form, 1987).
+Matrix3 rotation_from_correlation(const Matrix3& S) {
+  Eigen::Matrix4d N;
+  const double sxx = S(0, 0), sxy = S(0, 1), sxz = S(0, 2), syx = S(1, 0), syy = S(1, 1), syz = S(1, 2);
+  const double szx = S(2, 0), szy = S(2, 1), szz = S(2, 2);
+  N << sxx + syy + szz, syz - szy, szx - sxz, sxy - syx,  //
+      syz - szy, sxx - syy - szz, sxy + syx, szx + sxz,   //
+      szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy,  //
+      sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eig(N);
+  const Eigen::Vector4d q = eig.eigenvectors().col(3);  // largest eigenvalue last
+  const Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
+  return quat.normalized().toRotationMatrix();
+}
+
+}  // namespace
+
+FrameRegistration register_frames(const RegistrationInput& in) {
+  check_registration_input(in);
+  const std::size_t np = in.tracker_m.size(), nc = in.tracker_circles.size();
   // Every point feature: the measured points and the circles' centres.
   std::vector<Vector3> a = in.tracker_m, b = in.base_m;
   std::vector<std::string> names(np);
@@ -198,18 +223,8 @@ FrameRegistration register_frames(const RegistrationInput& in) {
         "registration: the points lie on one line (and no circle axis leaves it): the rotation about that line is "
         "not fixed; measure a point off the line");
   }
-  Eigen::Matrix4d N;
-  const double sxx = S(0, 0), sxy = S(0, 1), sxz = S(0, 2), syx = S(1, 0), syy = S(1, 1), syz = S(1, 2);
-  const double szx = S(2, 0), szy = S(2, 1), szz = S(2, 2);
-  N << sxx + syy + szz, syz - szy, szx - sxz, sxy - syx,  //
-      syz - szy, sxx - syy - szz, sxy + syx, szx + sxz,   //
-      szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy,  //
-      sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eig(N);
-  const Eigen::Vector4d q = eig.eigenvectors().col(3);  // largest eigenvalue last
-  const Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
   FrameRegistration out;
-  out.base_T_tracker.linear() = quat.normalized().toRotationMatrix();
+  out.base_T_tracker.linear() = rotation_from_correlation(S);
   out.base_T_tracker.translation() = cb - out.base_T_tracker.linear() * ca;
   double ss = 0.0;
   for (std::size_t i = 0; i < a.size(); ++i) {
