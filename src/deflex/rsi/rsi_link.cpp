@@ -90,7 +90,7 @@ RsiLink::RsiLink(OnlineCompensator& compensator, OnlineStrategy& strategy, Datag
   rx_.assign(config_.max_document_bytes + 1, 0);  // one byte more: an oversized datagram shows as such
   tx_.assign(kRsiMaxEncodedBytes, 0);
   for (RsiRobotMessage* m : {&msg_, &newest_}) m->actual_deg = m->setpoint_deg = JointVector::Zero(n);
-  for (JointVector* q : {&feedback_, &planned_, &sent_offset_, &reference_, &reply_.correction_deg}) {
+  for (JointVector* q : {&feedback_, &planned_, &reference_, &reply_.correction_deg}) {
     *q = JointVector::Zero(n);
   }
 }
@@ -226,16 +226,16 @@ LinkPollResult RsiLink::poll(double timeout_s) noexcept {
     }
     cycle_.restart_from_zero(after_silence());
     cycle_.motion().restart();
-    sent_offset_.setZero();
     state_ = LinkState::kRunning;
   }
 
   // The axes' velocity and the controller's period from the actual axes and the link's clock.
   (void)cycle_.motion().observe(now, feedback_);
-  // The axes follow ASPos plus the offset AXISCORR applies (the last one answered): that sum is what
-  // the feedback shows after the delay. ASPos alone would be off the feedback by the correction.
+  // The axes follow ASPos plus the offset AXISCORR applies (the last one answered, which the cycle
+  // keeps as its step reference: zero from a restart): that sum is what the feedback shows after the
+  // delay. ASPos alone would be off the feedback by the correction.
   if (m.has_setpoint) {
-    reference_ = planned_ + sent_offset_;
+    reference_ = planned_ + cycle_.last_command();
     delay_.record_reference(now, reference_);
   }
   delay_.observe_feedback(now, feedback_);
@@ -272,7 +272,6 @@ LinkPollResult RsiLink::answer(const RsiRobotMessage& m, double now, bool sessio
     return LinkPollResult::kNotAnswered;
   }
   ++counters_.replies;
-  sent_offset_ = ak;
   cycle_.sent(compute(), receipt_age_s_ + (clock_.now_s() - taken_at_s_));
   stop_when_correction_gone();
   return LinkPollResult::kAnswered;

@@ -102,8 +102,7 @@ class RsiLink final : public ControllerLink {
 
   // The cycle (preallocated).
   JointVector feedback_, planned_;
-  JointVector sent_offset_;  // the last AK answered (rad): AXISCORR adds it to ASPos after its dead time
-  JointVector reference_;    // ASPos + that offset: where the axes are commanded to, for the delay
+  JointVector reference_;  // ASPos + the last AK answered: where the axes are commanded to, for the delay
   RsiSensorMessage reply_;
 };
 
