@@ -129,7 +129,8 @@ void BM_EgmJointLinkRoundTrip(benchmark::State& state) {
   ConstantForce force;
   UdpTransport transport("127.0.0.1", 0);
   SteadyClock clock;
-  EgmJointLink link(comp, strategy, program, transport, clock, &force);
+  EgmJointLink link(comp, strategy, program, transport, clock);
+  link.read_force_from(&force);
   run_link(state, link, transport);
 }
 BENCHMARK(BM_EgmJointLinkRoundTrip)->Arg(100000)->Iterations(1)->Unit(benchmark::kMillisecond);
@@ -143,7 +144,8 @@ void BM_EgmPathLinkRoundTrip(benchmark::State& state) {
   ConstantForce force;
   UdpTransport transport("127.0.0.1", 0);
   SteadyClock clock;
-  EgmPathLink link(comp, strategy, transport, clock, &force);
+  EgmPathLink link(comp, strategy, transport, clock);
+  link.read_force_from(&force);
   run_link(state, link, transport);
 }
 BENCHMARK(BM_EgmPathLinkRoundTrip)->Arg(100000)->Iterations(1)->Unit(benchmark::kMillisecond);

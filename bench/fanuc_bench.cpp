@@ -106,7 +106,8 @@ void BM_FanucLinkRoundTrip(benchmark::State& state) {
   FanucJ519LinkConfig config;
   config.controller = controller.local_address();
   config.stop.stop_silence_s = 30.0;
-  FanucJ519Link link(comp, strategy, program, transport, clock, &force, config);
+  FanucJ519Link link(comp, strategy, program, transport, clock, config);
+  link.read_force_from(&force);
   std::atomic<bool> stop{false};
   std::thread client([&] {
     while (!stop.load()) (void)link.poll(0.05);

@@ -114,7 +114,8 @@ void BM_Motoros2LinkRoundTrip(benchmark::State& state) {
   config.controller = controller.local_address();
   config.stop.stop_silence_s = 30.0;
   config.resend_after_s = 1.0;  // the peer answers at once; a resend would be counted as lost
-  Motoros2RtLink link(comp, strategy, program, transport, clock, &force, config);
+  Motoros2RtLink link(comp, strategy, program, transport, clock, config);
+  link.read_force_from(&force);
   std::atomic<bool> stop{false};
   std::thread client([&] {
     while (!stop.load()) (void)link.poll(0.05);

@@ -129,7 +129,8 @@ void BM_RsiLinkRoundTrip(benchmark::State& state) {
   ConstantForce force;
   UdpTransport transport("127.0.0.1", 0);
   SteadyClock clock;
-  RsiLink link(comp, strategy, transport, clock, &force);
+  RsiLink link(comp, strategy, transport, clock);
+  link.read_force_from(&force);
   std::atomic<bool> stop{false};
   std::thread server([&] {
     while (!stop.load()) (void)link.poll(0.05);

@@ -104,7 +104,8 @@ void BM_LinkPointCycleInMemory(benchmark::State& state) {
     ConstantForce force;
     auto program = std::make_shared<const JointTrajectory>(std::vector<double>{0.0, 2000.0},
                                                            std::vector<JointVector>{start_pose(), start_pose()}, robot);
-    SimpleMessageLink link(comp, strategy, program, motion.client(), state_pair.client(), clock, &force);
+    SimpleMessageLink link(comp, strategy, program, motion.client(), state_pair.client(), clock);
+    link.read_force_from(&force);
     cell::SimpleMessageServer server({}, robot, start_pose(), motion.server(), state_pair.server());
     std::vector<double> us;
     us.reserve(10000);
@@ -157,7 +158,8 @@ void BM_LinkPointRoundTripLoopbackTcp(benchmark::State& state) {
     SimpleMessageLinkConfig lc;
     lc.buffer_depth = 1;
     lc.reply_timeout_s = lc.state_timeout_s = 1e9;  // the simulated clock jumps a cycle a round trip
-    SimpleMessageLink link(comp, strategy, program, *motion, *state_stream, clock, &force, lc);
+    SimpleMessageLink link(comp, strategy, program, *motion, *state_stream, clock, lc);
+    link.read_force_from(&force);
     cell::SimpleMessageServerConfig sc;
     sc.buffer_points = 16;
     cell::SimpleMessageServer server(sc, robot, start_pose(), *motion_server, *state_server);

@@ -176,7 +176,8 @@ void BM_UrRtdeLinkRoundTrip(benchmark::State& state) {
       std::vector<double>{0.0, 2000.0}, std::vector<JointVector>{start_joints(), start_joints()}, robot, "hold");
   UrRtdeLinkConfig config;
   config.stop.stop_silence_s = 30.0;
-  UrRtdeLink link(comp, strategy, program, *client, clock, &force, config);
+  UrRtdeLink link(comp, strategy, program, *client, clock, config);
+  link.read_force_from(&force);
   std::atomic<bool> stop{false};
   std::thread loop([&] {
     while (!stop.load()) (void)link.poll(0.05);

@@ -47,16 +47,14 @@ static_assert(
                              std::shared_ptr<const JointTrajectory>, const ForceModel*, ForceSource*, ManualClock>);
 static_assert(!std::is_constructible_v<MemoryNetwork, SteadyClock>);
 static_assert(!std::is_constructible_v<MemoryStreamPair, ManualClock, double>);
+static_assert(!std::is_constructible_v<EgmJointLink, OnlineCompensator&, OnlineStrategy&,
+                                       std::shared_ptr<const JointTrajectory>, DatagramTransport&, SteadyClock>);
 static_assert(
-    !std::is_constructible_v<EgmJointLink, OnlineCompensator&, OnlineStrategy&, std::shared_ptr<const JointTrajectory>,
-                             DatagramTransport&, SteadyClock, ForceSource*>);
-static_assert(!std::is_constructible_v<EgmPathLink, OnlineCompensator&, OnlineStrategy&, DatagramTransport&,
-                                       SteadyClock, ForceSource*>);
-static_assert(!std::is_constructible_v<RsiLink, OnlineCompensator&, OnlineStrategy&, DatagramTransport&, SteadyClock,
-                                       ForceSource*>);
-static_assert(!std::is_constructible_v<SimpleMessageLink, OnlineCompensator&, OnlineStrategy&,
-                                       std::shared_ptr<const JointTrajectory>, StreamTransport&, StreamTransport&,
-                                       SteadyClock, ForceSource*>);
+    !std::is_constructible_v<EgmPathLink, OnlineCompensator&, OnlineStrategy&, DatagramTransport&, SteadyClock>);
+static_assert(!std::is_constructible_v<RsiLink, OnlineCompensator&, OnlineStrategy&, DatagramTransport&, SteadyClock>);
+static_assert(
+    !std::is_constructible_v<SimpleMessageLink, OnlineCompensator&, OnlineStrategy&,
+                             std::shared_ptr<const JointTrajectory>, StreamTransport&, StreamTransport&, SteadyClock>);
 static_assert(!std::is_constructible_v<EgmReceiver, DatagramTransport&, SteadyClock, const RobotModel&,
                                        const EgmReceiverConfig&, LinkCounters&>);
 static_assert(!std::is_constructible_v<RdtForceSource, DatagramTransport&, SteadyClock, const DatagramAddress&,
@@ -71,8 +69,18 @@ static_assert(std::is_constructible_v<runtime::Session, const runtime::SessionCo
                                       ForceSource*, const SteadyClock&>);
 static_assert(std::is_constructible_v<MemoryNetwork, const ManualClock&>);
 static_assert(std::is_constructible_v<MemoryStreamPair, ManualClock&, double>);
-static_assert(std::is_constructible_v<RsiLink, OnlineCompensator&, OnlineStrategy&, DatagramTransport&,
-                                      const SteadyClock&, ForceSource*>);
+static_assert(
+    std::is_constructible_v<RsiLink, OnlineCompensator&, OnlineStrategy&, DatagramTransport&, const SteadyClock&>);
+static_assert(
+    std::is_constructible_v<EgmPathLink, OnlineCompensator&, OnlineStrategy&, DatagramTransport&, const SteadyClock&>);
+static_assert(std::is_constructible_v<EgmJointLink, OnlineCompensator&, OnlineStrategy&,
+                                      std::shared_ptr<const JointTrajectory>, DatagramTransport&, const SteadyClock&>);
+static_assert(std::is_constructible_v<SimpleMessageLink, OnlineCompensator&, OnlineStrategy&,
+                                      std::shared_ptr<const JointTrajectory>, StreamTransport&, StreamTransport&,
+                                      const SteadyClock&>);
+// No link takes a force source: the session hands it to the cycle (ControllerLink::read_force_from).
+static_assert(!std::is_constructible_v<RsiLink, OnlineCompensator&, OnlineStrategy&, DatagramTransport&,
+                                       const SteadyClock&, ForceSource*>);
 // The path compensator copies its model (a temporary model is fine: nothing refers to it afterwards).
 static_assert(std::is_constructible_v<PathCompensator, RobotModel, const ConstantWrenchModel&>);
 static_assert(std::is_constructible_v<OnlineStrategy, const RobotModel&, StrategyKind, const ForceModel*>);

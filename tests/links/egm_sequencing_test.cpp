@@ -49,8 +49,10 @@ struct Wire {
   OnlineCompensator compensator{robot, test::bench_sensor(), test::bench_online()};
   OnlineStrategy strategy{robot, StrategyKind::kOnline, nullptr};
   test::ConstantForce force;
-  EgmPathLink link{compensator, strategy, sensor, clock, &force};
+  EgmPathLink link{compensator, strategy, sensor, clock};
   double t = 0.0;
+
+  Wire() { link.read_force_from(&force); }
 
   /// One 4 ms cycle: `packet` from `from`, the link polls; true when an answer came back to `from`.
   bool cycle(const Bytes& packet, MemoryTransport* from = nullptr) {

@@ -60,9 +60,11 @@ struct FanucBench {
       : compensator(robot, test::bench_sensor(), fanuc_online()),
         strategy(robot, StrategyKind::kOnline, nullptr),
         program(std::move(p)),
-        link(compensator, strategy, program, pc_port, clock, &force, link_config(version)),
+        link(compensator, strategy, program, pc_port, clock, link_config(version)),
         controller(controller_config(controller_version == 0 ? version : controller_version, controller_interval_s),
-                   arm, controller_port) {}
+                   arm, controller_port) {
+    link.read_force_from(&force);
+  }
 
   /// One 4 ms servo tick of the controller, then deflex answers what reached it (unless stalled).
   LinkPollResult tick() {

@@ -131,9 +131,11 @@ struct JointBench {
       : compensator(robot, bench_sensor(), bench_online()),
         strategy(robot, kind, model),
         program(std::move(p)),
-        link(compensator, strategy, program, sensor_port, clock, &force, config),
+        link(compensator, strategy, program, sensor_port, clock, config),
         controller(std::make_unique<cell::EgmPositionGuidanceController>(controller_config, arm_start, controller_port,
-                                                                         kSensorAddress)) {}
+                                                                         kSensorAddress)) {
+    link.read_force_from(&force);
+  }
 
   /// One 4 ms servo tick of the controller, then deflex answers what reached it. Returns the last
   /// poll result of the tick (kIdle when nothing came).
@@ -189,9 +191,11 @@ struct PathBench {
         compensator(robot, bench_sensor(), bench_online(period_s)),
         strategy(robot, kind, model),
         program(std::move(p)),
-        link(compensator, strategy, sensor_port, clock, &force, link_config(frame)),
+        link(compensator, strategy, sensor_port, clock, link_config(frame)),
         controller(std::make_unique<cell::EgmPathCorrectionController>(controller_config, robot, program,
-                                                                       controller_port, kSensorAddress)) {}
+                                                                       controller_port, kSensorAddress)) {
+    link.read_force_from(&force);
+  }
 
   /// One servo tick of the controller, then deflex answers what reached it.
   LinkPollResult tick() {

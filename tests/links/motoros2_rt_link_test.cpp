@@ -59,9 +59,11 @@ struct MotoBench {
         strategy(robot, StrategyKind::kOnline, nullptr),
         program(std::move(p)),
         start(arm),
-        link(compensator, strategy, program, pc_port, clock, &force, link_config(max_run, cc.status_port >= 0),
+        link(compensator, strategy, program, pc_port, clock, link_config(max_run, cc.status_port >= 0),
              cc.status_port >= 0 ? &status_port : nullptr),
-        controller(cc, arm, controller_port) {}
+        controller(cc, arm, controller_port) {
+    link.read_force_from(&force);
+  }
 
   /// One 4 ms interpolation clock of the controller, then deflex answers what reached it.
   LinkPollResult tick() {

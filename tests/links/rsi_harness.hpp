@@ -45,9 +45,11 @@ struct RsiBench {
         strategy(robot, kind, model),
         controller_config(rsi_controller_for(compensator.config())),
         program(std::move(p)),
-        link(compensator, strategy, sensor_port, clock, &force, config),
-        controller(std::make_unique<cell::RsiController>(controller_config, robot, program, controller_port,
-                                                         kSensorAddress)) {}
+        link(compensator, strategy, sensor_port, clock, config),
+        controller(
+            std::make_unique<cell::RsiController>(controller_config, robot, program, controller_port, kSensorAddress)) {
+    link.read_force_from(&force);
+  }
 
   /// The arm's axes now (the controller's motor side), without advancing anything.
   [[nodiscard]] const JointVector& arm() const { return arm_; }

@@ -105,8 +105,10 @@ struct RawWire {
   OnlineCompensator compensator{robot, test::bench_sensor(), test::bench_online()};
   OnlineStrategy strategy{robot, StrategyKind::kOnline, nullptr};
   test::ConstantForce force;
-  RsiLink link{compensator, strategy, sensor, clock, &force};
+  RsiLink link{compensator, strategy, sensor, clock};
   double t = 0.0;
+
+  RawWire() { link.read_force_from(&force); }
 
   /// Sends `doc` from `from`, lets the link poll, returns what came back to `from` (empty: nothing).
   std::string exchange(const std::string& doc, MemoryTransport* from = nullptr) {
@@ -267,7 +269,8 @@ TEST(RsiLink, CycleOverUdpDoesNotAllocateAndIsAnswered) {
   OnlineStrategy strategy(robot, StrategyKind::kOnline, nullptr);
   test::ConstantForce force;
   force.reading = test::reading_at(robot, q0, Vector3(0, 0, -400));
-  RsiLink link(comp, strategy, deflex_socket, clock, &force);
+  RsiLink link(comp, strategy, deflex_socket, clock);
+  link.read_force_from(&force);
   cell::RsiController controller(test::rsi_controller_for(comp.config()), robot, test::hold_program(robot, q0, 100.0),
                                  controller_socket, deflex_socket.local_address());
   std::size_t allocations = 0;

@@ -47,10 +47,11 @@ struct SimpleMessageBench {
         compensator(robot, bench_sensor(), bench_online_100ms()),
         strategy(robot, kind, model),
         program(std::move(p)),
-        link(compensator, strategy, program, motion.client(), state.client(), clock,
-             force_source != nullptr ? force_source : &force, config),
+        link(compensator, strategy, program, motion.client(), state.client(), clock, config),
         server(std::make_unique<cell::SimpleMessageServer>(server_config, robot, arm_start, motion.server(),
-                                                           state.server())) {}
+                                                           state.server())) {
+    link.read_force_from(force_source != nullptr ? force_source : &force);
+  }
 
   /// One 4 ms servo tick of the controller, then deflex polls until it has nothing to do. Returns the
   /// last poll result that was not kIdle (kIdle when all were).
@@ -101,12 +102,14 @@ struct ScriptedSimpleMessage {
       : compensator(robot, bench_sensor(), bench_online_100ms()),
         strategy(robot, StrategyKind::kOnline, nullptr),
         program(std::move(p)),
-        link(compensator, strategy, program, motion.client(), state.client(), clock, &force,
+        link(compensator, strategy, program, motion.client(), state.client(), clock,
              [&] {
                config.byte_order = big_endian ? simple_message::ByteOrder::kBig : simple_message::ByteOrder::kLittle;
                return config;
              }()),
-        big(big_endian) {}
+        big(big_endian) {
+    link.read_force_from(&force);
+  }
 
   void to_state(const Bytes& b) { state.server().write(b.data(), b.size()); }
   void to_motion(const Bytes& b) { motion.server().write(b.data(), b.size()); }

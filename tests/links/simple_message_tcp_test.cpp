@@ -30,7 +30,8 @@ TEST(SimpleMessageTcp, StreamsOverLoopbackWithinTheBoundConvergesAndDoesNotAlloc
   test::ConstantForce force;
   const Vector3 f_base(100.0, 0.0, -400.0);
   force.reading = test::reading_at(robot, q0, f_base);
-  SimpleMessageLink link(comp, strategy, test::hold_program(robot, q0, 1000.0), *motion, *state, clock, &force);
+  SimpleMessageLink link(comp, strategy, test::hold_program(robot, q0, 1000.0), *motion, *state, clock);
+  link.read_force_from(&force);
   cell::SimpleMessageServer server({}, robot, q0, *motion_accepted, *state_accepted);
 
   const double bound = comp.config().max_joint_correction_rad;

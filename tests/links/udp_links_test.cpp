@@ -45,7 +45,8 @@ TEST(UdpLinks, EgmJointCycleOverUdpDoesNotAllocateAndIsAnswered) {
   OnlineStrategy strategy(robot, StrategyKind::kOnline, nullptr);
   test::ConstantForce force;
   force.reading = test::reading_at(robot, start_pose(), Vector3(0, 0, -400));
-  EgmJointLink link(comp, strategy, test::hold_program(robot, start_pose(), 100.0), deflex_socket, clock, &force);
+  EgmJointLink link(comp, strategy, test::hold_program(robot, start_pose(), 100.0), deflex_socket, clock);
+  link.read_force_from(&force);
   cell::EgmPositionGuidanceController controller(cell::ControllerConfig{}, start_pose(), controller_socket,
                                                  deflex_socket.local_address());
   std::size_t allocations = 0;
@@ -64,7 +65,8 @@ TEST(UdpLinks, EgmPathCycleOverUdpDoesNotAllocateAndIsAnswered) {
   OnlineStrategy strategy(robot, StrategyKind::kOnline, nullptr);
   test::ConstantForce force;
   force.reading = test::reading_at(robot, start_pose(), Vector3(0, 0, -400));
-  EgmPathLink link(comp, strategy, deflex_socket, clock, &force);
+  EgmPathLink link(comp, strategy, deflex_socket, clock);
+  link.read_force_from(&force);
   cell::ControllerConfig cc;
   cc.path_corr_period_s = 0.004;
   cell::EgmPathCorrectionController controller(cc, robot, test::hold_program(robot, start_pose(), 100.0),

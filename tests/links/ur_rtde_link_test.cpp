@@ -54,8 +54,10 @@ struct UrBench {
         strategy(robot, StrategyKind::kOnline, nullptr),
         program(std::move(p)),
         start(arm),
-        link(compensator, strategy, program, pair.client(), clock, &force, link_config(lookahead_s)),
-        controller(cc, arm, pair.server()) {}
+        link(compensator, strategy, program, pair.client(), clock, link_config(lookahead_s)),
+        controller(cc, arm, pair.server()) {
+    link.read_force_from(&force);
+  }
 
   /// One loop cycle of the controller, then deflex answers what reached it.
   LinkPollResult tick(double period_s = kUrPeriod) {
@@ -339,7 +341,7 @@ TEST(UrRtdeLink, AControllerThatNeverAnswersTheHandshakeEndsTheSessionNamingIt) 
   const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
   UrRtdeLinkConfig config;
   config.stop.stop_silence_s = 0.5;  // the session's default for ur-rtde: the handshake still gets 2 s
-  UrRtdeLink link(compensator, strategy, test::hold_program(robot, q0, 10.0), pair.client(), clock, nullptr, config);
+  UrRtdeLink link(compensator, strategy, test::hold_program(robot, q0, 10.0), pair.client(), clock, config);
   for (int k = 0; k < 1100 && link.state() != LinkState::kStopped; ++k) {
     clock.set(k * kUrPeriod);
     (void)link.poll(0.0);

@@ -41,9 +41,9 @@ CommandLimits joint_limits(const OnlineCompensator& c, const JointTrajectory* pr
 
 EgmJointLink::EgmJointLink(OnlineCompensator& compensator, OnlineStrategy& strategy,
                            std::shared_ptr<const JointTrajectory> nominal, DatagramTransport& transport,
-                           const Clock& clock, ForceSource* force, const EgmJointLinkConfig& config)
-    : ControllerLink(compensator, strategy, force, clock, joint_limits(compensator, nominal.get(), config.stream),
-                     config.stop, config.history_cycles),
+                           const Clock& clock, const EgmJointLinkConfig& config)
+    : ControllerLink(compensator, strategy, clock, joint_limits(compensator, nominal.get(), config.stream), config.stop,
+                     config.history_cycles),
       config_(config),
       receiver_(transport, clock, compensator.model(), with_period(config.receiver, compensator.config().period_s),
                 counters_),

@@ -39,17 +39,14 @@ struct EgmJointLinkConfig {
 /// Thread safety: one thread at a time (the loop's), as every ControllerLink.
 class EgmJointLink final : public ControllerLink {
  public:
-  /// Every reference must outlive the link. `force` may be null (push samples into the compensator
-  /// yourself). The controller's cycle is the compensator's period_s. Throws InputError on a
-  /// configuration that cannot work (a program for another number of joints, a bad setting, limits
-  /// that do not fit: command_limits()).
+  /// Every reference must outlive the link. The controller's cycle is the compensator's period_s.
+  /// Throws InputError on a configuration that cannot work (a program for another number of joints,
+  /// a bad setting, limits that do not fit: command_limits()).
   EgmJointLink(OnlineCompensator& compensator, OnlineStrategy& strategy, std::shared_ptr<const JointTrajectory> nominal,
-               DatagramTransport& transport, const Clock& clock, ForceSource* force,
-               const EgmJointLinkConfig& config = {});
+               DatagramTransport& transport, const Clock& clock, const EgmJointLinkConfig& config = {});
   /// A temporary clock would dangle: it does not compile (docs/architecture.md, "Ownership").
   EgmJointLink(OnlineCompensator& compensator, OnlineStrategy& strategy, std::shared_ptr<const JointTrajectory> nominal,
-               DatagramTransport& transport, const Clock&& clock, ForceSource* force,
-               const EgmJointLinkConfig& config = {}) = delete;
+               DatagramTransport& transport, const Clock&& clock, const EgmJointLinkConfig& config = {}) = delete;
 
   LinkPollResult poll(double timeout_s) noexcept override;
   [[nodiscard]] const char* name() const override { return "egm-joint"; }

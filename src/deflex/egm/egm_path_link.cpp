@@ -51,8 +51,8 @@ CommandLimits path_limits(const OnlineCompensator& c, const EgmPathLinkConfig& c
 }  // namespace
 
 EgmPathLink::EgmPathLink(OnlineCompensator& compensator, OnlineStrategy& strategy, DatagramTransport& transport,
-                         const Clock& clock, ForceSource* force, const EgmPathLinkConfig& config)
-    : ControllerLink(compensator, strategy, force, clock, path_limits(compensator, config), config.stop,
+                         const Clock& clock, const EgmPathLinkConfig& config)
+    : ControllerLink(compensator, strategy, clock, path_limits(compensator, config), config.stop,
                      config.history_cycles),
       config_(config),
       receiver_(transport, clock, compensator.model(), with_period(config.receiver, compensator.config().period_s),

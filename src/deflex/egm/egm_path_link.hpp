@@ -48,12 +48,12 @@ struct EgmPathLinkConfig {
 /// Thread safety: one thread at a time (the loop's), as every ControllerLink.
 class EgmPathLink final : public ControllerLink {
  public:
-  /// Every reference must outlive the link. `force` may be null. Throws InputError.
+  /// Every reference must outlive the link. Throws InputError.
   EgmPathLink(OnlineCompensator& compensator, OnlineStrategy& strategy, DatagramTransport& transport,
-              const Clock& clock, ForceSource* force, const EgmPathLinkConfig& config = {});
+              const Clock& clock, const EgmPathLinkConfig& config = {});
   /// A temporary clock would dangle: it does not compile (docs/architecture.md, "Ownership").
   EgmPathLink(OnlineCompensator& compensator, OnlineStrategy& strategy, DatagramTransport& transport,
-              const Clock&& clock, ForceSource* force, const EgmPathLinkConfig& config = {}) = delete;
+              const Clock&& clock, const EgmPathLinkConfig& config = {}) = delete;
 
   LinkPollResult poll(double timeout_s) noexcept override;
   [[nodiscard]] const char* name() const override { return "egm-path"; }

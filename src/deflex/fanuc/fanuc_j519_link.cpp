@@ -193,8 +193,8 @@ void FanucJ519LinkConfig::validate() const {
 
 FanucJ519Link::FanucJ519Link(OnlineCompensator& compensator, OnlineStrategy& strategy,
                              std::shared_ptr<const JointTrajectory> nominal, DatagramTransport& transport,
-                             const Clock& clock, ForceSource* force, const FanucJ519LinkConfig& config)
-    : ControllerLink(compensator, strategy, force, clock, fanuc_limits(compensator, nominal.get(), config), config.stop,
+                             const Clock& clock, const FanucJ519LinkConfig& config)
+    : ControllerLink(compensator, strategy, clock, fanuc_limits(compensator, nominal.get(), config), config.stop,
                      config.history_cycles),
       config_(config),
       transport_(transport),

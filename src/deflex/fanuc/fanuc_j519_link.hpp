@@ -87,10 +87,10 @@ class FanucJ519Link final : public ControllerLink {
   /// and the limit), limits the smoother cannot meet.
   FanucJ519Link(OnlineCompensator& compensator, OnlineStrategy& strategy,
                 std::shared_ptr<const JointTrajectory> nominal, DatagramTransport& transport, const Clock& clock,
-                ForceSource* force, const FanucJ519LinkConfig& config);
+                const FanucJ519LinkConfig& config);
   FanucJ519Link(OnlineCompensator& compensator, OnlineStrategy& strategy,
                 std::shared_ptr<const JointTrajectory> nominal, DatagramTransport& transport, const Clock&& clock,
-                ForceSource* force, const FanucJ519LinkConfig& config) = delete;
+                const FanucJ519LinkConfig& config) = delete;
 
   LinkPollResult poll(double timeout_s) noexcept override;
   void stop() noexcept override;

@@ -70,10 +70,9 @@ const LinkStopRules& validated(const LinkStopRules& r) {
 }
 }  // namespace
 
-ControllerLink::ControllerLink(OnlineCompensator& compensator, OnlineStrategy& strategy, ForceSource* force,
-                               const Clock& clock, const CommandLimits& limits, const LinkStopRules& rules,
-                               std::size_t history_cycles)
-    : cycle_(compensator, strategy, force, limits, history_cycles, counters_),
+ControllerLink::ControllerLink(OnlineCompensator& compensator, OnlineStrategy& strategy, const Clock& clock,
+                               const CommandLimits& limits, const LinkStopRules& rules, std::size_t history_cycles)
+    : cycle_(compensator, strategy, limits, history_cycles, counters_),
       clock_(clock),
       rules_(validated(rules)),
       last_message_s_(std::numeric_limits<double>::quiet_NaN()) {}

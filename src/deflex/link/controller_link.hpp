@@ -122,14 +122,18 @@ class ControllerLink {
   [[nodiscard]] virtual std::string protocol_summary() const { return {}; }
   /// The link's measurement of its delay (command to feedback); null for a link that keeps none.
   [[nodiscard]] virtual const DelayEstimator* delay_estimator() const { return nullptr; }
+  /// The force source the cycle reads, handed over by whoever owns it (the session) before the first
+  /// poll(); null (the default): samples are pushed into the compensator directly. It must outlive the
+  /// link. No link's own code sees it.
+  void read_force_from(ForceSource* force) noexcept { cycle_.read_force_from(force); }
   /// The strategy's and the compensator's (read-only).
   [[nodiscard]] const OnlineCompensator& compensator() const { return cycle_.compensator(); }
 
  protected:
   /// Every reference must outlive the link. Throws InputError on bad limits or rules.
-  ControllerLink(OnlineCompensator& compensator, OnlineStrategy& strategy, ForceSource* force, const Clock& clock,
+  ControllerLink(OnlineCompensator& compensator, OnlineStrategy& strategy, const Clock& clock,
                  const CommandLimits& limits, const LinkStopRules& rules, std::size_t history_cycles);
-  ControllerLink(OnlineCompensator& compensator, OnlineStrategy& strategy, ForceSource* force, const Clock&& clock,
+  ControllerLink(OnlineCompensator& compensator, OnlineStrategy& strategy, const Clock&& clock,
                  const CommandLimits& limits, const LinkStopRules& rules, std::size_t history_cycles) = delete;
 
   /// Stops the link once (later calls keep the first reason): state kStopped, the cause and a

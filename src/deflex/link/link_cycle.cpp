@@ -136,11 +136,10 @@ CommandLimits command_limits(CommandForm form, const OnlineConfig& online, int d
   return l;
 }
 
-LinkCycle::LinkCycle(OnlineCompensator& compensator, OnlineStrategy& strategy, ForceSource* force,
-                     const CommandLimits& limits, std::size_t history_cycles, LinkCounters& counters)
+LinkCycle::LinkCycle(OnlineCompensator& compensator, OnlineStrategy& strategy, const CommandLimits& limits,
+                     std::size_t history_cycles, LinkCounters& counters)
     : comp_(compensator),
       strategy_(strategy),
-      force_(force),
       limits_(limits),
       counters_(counters),
       history_(history_cycles, compensator.model().dof()),

@@ -134,10 +134,14 @@ class LinkCycle {
     kGuard = -2,    ///< the final guard refused the command: guard_message() says why; send nothing
   };
 
-  /// Every reference must outlive the cycle; `force` may be null (samples pushed into the compensator
-  /// directly). Throws InputError on limits that do not fit the robot.
-  LinkCycle(OnlineCompensator& compensator, OnlineStrategy& strategy, ForceSource* force, const CommandLimits& limits,
+  /// Every reference must outlive the cycle. Throws InputError on limits that do not fit the robot.
+  LinkCycle(OnlineCompensator& compensator, OnlineStrategy& strategy, const CommandLimits& limits,
             std::size_t history_cycles, LinkCounters& counters);
+
+  /// The force source each cycle reads (step 2): the session's, handed here before the first cycle;
+  /// null (the default) when samples are pushed into the compensator directly. It must outlive the
+  /// cycle. The link never touches it: no link's code depends on where the force comes from.
+  void read_force_from(ForceSource* force) noexcept { force_ = force; }
 
   /// One cycle (steps 1-6 above). Never allocates, locks or throws.
   Verdict run(const CycleRequest& request) noexcept;
@@ -212,7 +216,7 @@ class LinkCycle {
 
   OnlineCompensator& comp_;
   OnlineStrategy& strategy_;
-  ForceSource* force_;
+  ForceSource* force_ = nullptr;
   CorrectionSmoother* smoother_ = nullptr;
   CommandLimits limits_;
   LinkCounters& counters_;

@@ -70,10 +70,9 @@ void Motoros2RtLinkConfig::validate() const {
 
 Motoros2RtLink::Motoros2RtLink(OnlineCompensator& compensator, OnlineStrategy& strategy,
                                std::shared_ptr<const JointTrajectory> nominal, DatagramTransport& transport,
-                               const Clock& clock, ForceSource* force, const Motoros2RtLinkConfig& config,
-                               DatagramTransport* status)
-    : ControllerLink(compensator, strategy, force, clock, motoros2_limits(compensator, nominal.get(), config),
-                     config.stop, config.history_cycles),
+                               const Clock& clock, const Motoros2RtLinkConfig& config, DatagramTransport* status)
+    : ControllerLink(compensator, strategy, clock, motoros2_limits(compensator, nominal.get(), config), config.stop,
+                     config.history_cycles),
       config_(config),
       transport_(transport),
       status_(status),

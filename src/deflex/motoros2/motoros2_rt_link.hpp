@@ -72,10 +72,10 @@ class Motoros2RtLink final : public ControllerLink {
   /// setting or a program for another number of joints.
   Motoros2RtLink(OnlineCompensator& compensator, OnlineStrategy& strategy,
                  std::shared_ptr<const JointTrajectory> nominal, DatagramTransport& transport, const Clock& clock,
-                 ForceSource* force, const Motoros2RtLinkConfig& config, DatagramTransport* status = nullptr);
+                 const Motoros2RtLinkConfig& config, DatagramTransport* status = nullptr);
   Motoros2RtLink(OnlineCompensator& compensator, OnlineStrategy& strategy,
                  std::shared_ptr<const JointTrajectory> nominal, DatagramTransport& transport, const Clock&& clock,
-                 ForceSource* force, const Motoros2RtLinkConfig& config, DatagramTransport* status = nullptr) = delete;
+                 const Motoros2RtLinkConfig& config, DatagramTransport* status = nullptr) = delete;
 
   LinkPollResult poll(double timeout_s) noexcept override;
   void stop() noexcept override;

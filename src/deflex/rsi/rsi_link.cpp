@@ -75,8 +75,8 @@ CommandLimits offset_limits(const OnlineCompensator& c) {
 }  // namespace
 
 RsiLink::RsiLink(OnlineCompensator& compensator, OnlineStrategy& strategy, DatagramTransport& transport,
-                 const Clock& clock, ForceSource* force, const RsiLinkConfig& config)
-    : ControllerLink(compensator, strategy, force, clock, offset_limits(compensator), validated(config).stop,
+                 const Clock& clock, const RsiLinkConfig& config)
+    : ControllerLink(compensator, strategy, clock, offset_limits(compensator), validated(config).stop,
                      config.history_cycles),
       transport_(transport),
       config_(config),

@@ -58,12 +58,12 @@ struct RsiLinkConfig {
 /// Thread safety: one thread at a time (the loop's), as every ControllerLink.
 class RsiLink final : public ControllerLink {
  public:
-  /// Every reference must outlive the link. `force` may be null. Throws InputError.
+  /// Every reference must outlive the link. Throws InputError.
   RsiLink(OnlineCompensator& compensator, OnlineStrategy& strategy, DatagramTransport& transport, const Clock& clock,
-          ForceSource* force, const RsiLinkConfig& config = {});
+          const RsiLinkConfig& config = {});
   /// A temporary clock would dangle: it does not compile (docs/architecture.md, "Ownership").
   RsiLink(OnlineCompensator& compensator, OnlineStrategy& strategy, DatagramTransport& transport, const Clock&& clock,
-          ForceSource* force, const RsiLinkConfig& config = {}) = delete;
+          const RsiLinkConfig& config = {}) = delete;
 
   LinkPollResult poll(double timeout_s) noexcept override;
   [[nodiscard]] const char* name() const override { return "rsi"; }

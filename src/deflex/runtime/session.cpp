@@ -70,7 +70,8 @@ Session::Session(const SessionConfig& config, const RobotModel& robot, const Sen
   compensator_ = std::make_unique<OnlineCompensator>(robot, sensor, config_.online);
   strategy_ = std::make_unique<OnlineStrategy>(robot, config_.strategy, force_model);
   force_ = force;
-  open_link(endpoints, force, std::move(program));
+  open_link(endpoints, std::move(program));
+  link_->read_force_from(force);  // straight to the cycle: no link's own code sees the force
 
   reporting_ = !config_.log_path.empty() || !config_.fault_dump_path.empty() || static_cast<bool>(sink_) ||
                config_.collect_cycles || config_.monitor;
@@ -124,8 +125,8 @@ Session::~Session() {
 }
 
 // FANUC Stream Motion: deflex is the client; its datagrams go to the controller's address and port.
-void Session::open_fanuc_j519(const SessionEndpoints& endpoints, ForceSource* force,
-                              std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules) {
+void Session::open_fanuc_j519(const SessionEndpoints& endpoints, std::shared_ptr<const JointTrajectory> program,
+                              const LinkStopRules& rules) {
   FanucJ519LinkConfig c = config_.fanuc_j519;
   c.stop = rules;
   c.history_cycles = config_.history_cycles;
@@ -147,14 +148,14 @@ void Session::open_fanuc_j519(const SessionEndpoints& endpoints, ForceSource* fo
     own_datagram_ = std::make_unique<UdpTransport>(net.bind_address, 0);
     t = own_datagram_.get();
   }
-  link_ = std::make_unique<FanucJ519Link>(*compensator_, *strategy_, std::move(program), *t, clock_, force, c);
+  link_ = std::make_unique<FanucJ519Link>(*compensator_, *strategy_, std::move(program), *t, clock_, c);
   where_ = fmt::format("FANUC Stream Motion to {} (protocol {}), from {}", to_string(c.controller), c.version,
                        to_string(t->local_address()));
 }
 
 // MotoROS2 real-time: deflex is the client, as for FANUC; the controller answers to the command's source.
-void Session::open_motoros2_rt(const SessionEndpoints& endpoints, ForceSource* force,
-                               std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules) {
+void Session::open_motoros2_rt(const SessionEndpoints& endpoints, std::shared_ptr<const JointTrajectory> program,
+                               const LinkStopRules& rules) {
   Motoros2RtLinkConfig c = config_.motoros2_rt;
   c.stop = rules;
   c.history_cycles = config_.history_cycles;
@@ -180,15 +181,15 @@ void Session::open_motoros2_rt(const SessionEndpoints& endpoints, ForceSource* f
     status = own_status_.get();
   }
   if (c.status_port < 0) status = nullptr;
-  link_ = std::make_unique<Motoros2RtLink>(*compensator_, *strategy_, std::move(program), *t, clock_, force, c, status);
+  link_ = std::make_unique<Motoros2RtLink>(*compensator_, *strategy_, std::move(program), *t, clock_, c, status);
   where_ = fmt::format("MotoROS2 real-time to {} (group {}), from {}{}", to_string(c.controller), c.group,
                        to_string(t->local_address()),
                        status != nullptr ? fmt::format(", its status on {}", to_string(status->local_address())) : "");
 }
 
 // Universal Robots RTDE: deflex is the client of the controller's RTDE server (one TCP connection).
-void Session::open_ur_rtde(const SessionEndpoints& endpoints, ForceSource* force,
-                           std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules) {
+void Session::open_ur_rtde(const SessionEndpoints& endpoints, std::shared_ptr<const JointTrajectory> program,
+                           const LinkStopRules& rules) {
   UrRtdeLinkConfig c = config_.ur_rtde;
   c.stop = rules;
   c.history_cycles = config_.history_cycles;
@@ -215,13 +216,13 @@ void Session::open_ur_rtde(const SessionEndpoints& endpoints, ForceSource* force
   } else {
     where_ = "UR RTDE";
   }
-  link_ = std::make_unique<UrRtdeLink>(*compensator_, *strategy_, std::move(program), *t, clock_, force, c);
+  link_ = std::make_unique<UrRtdeLink>(*compensator_, *strategy_, std::move(program), *t, clock_, c);
   where_ += fmt::format(" (servoj lookahead {:g} ms, gain {:g}, registers from {})", c.lookahead_s * 1e3, c.gain,
                         c.register_offset);
 }
 
-void Session::open_simple_message(const SessionEndpoints& endpoints, ForceSource* force,
-                                  std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules) {
+void Session::open_simple_message(const SessionEndpoints& endpoints, std::shared_ptr<const JointTrajectory> program,
+                                  const LinkStopRules& rules) {
   const NetworkConfig& net = config_.network;
   SimpleMessageLinkConfig c = config_.simple_message;
   c.stop = rules;
@@ -247,12 +248,11 @@ void Session::open_simple_message(const SessionEndpoints& endpoints, ForceSource
   } else {
     where_ = fmt::format("simple message ({}-endian)", simple_message::to_string(c.byte_order));
   }
-  link_ = std::make_unique<SimpleMessageLink>(*compensator_, *strategy_, std::move(program), *motion, *state, clock_,
-                                              force, c);
+  link_ =
+      std::make_unique<SimpleMessageLink>(*compensator_, *strategy_, std::move(program), *motion, *state, clock_, c);
 }
 
-void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
-                        std::shared_ptr<const JointTrajectory> program) {
+void Session::open_link(const SessionEndpoints& endpoints, std::shared_ptr<const JointTrajectory> program) {
   const LinkKindInfo& info = link_kind(config_.link);
   LinkStopRules rules;
   rules.stop_silence_s = config_.stop_silence_s.value_or(info.default_stop_silence_s);
@@ -273,7 +273,7 @@ void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
       c.history_cycles = config_.history_cycles;
       DatagramTransport& t =
           datagram(net.egm_port, "--egm-port", "the EGM links need the port the controller sends to");
-      link_ = std::make_unique<EgmJointLink>(*compensator_, *strategy_, std::move(program), t, clock_, force, c);
+      link_ = std::make_unique<EgmJointLink>(*compensator_, *strategy_, std::move(program), t, clock_, c);
       where_ = fmt::format("EGM on {}", to_string(t.local_address()));
       break;
     }
@@ -283,7 +283,7 @@ void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
       c.history_cycles = config_.history_cycles;
       DatagramTransport& t =
           datagram(net.egm_port, "--egm-port", "the EGM links need the port the controller sends to");
-      link_ = std::make_unique<EgmPathLink>(*compensator_, *strategy_, t, clock_, force, c);
+      link_ = std::make_unique<EgmPathLink>(*compensator_, *strategy_, t, clock_, c);
       where_ = fmt::format("EGM on {} (corrections in the {} frame)", to_string(t.local_address()), to_string(c.frame));
       break;
     }
@@ -293,21 +293,21 @@ void Session::open_link(const SessionEndpoints& endpoints, ForceSource* force,
       c.history_cycles = config_.history_cycles;
       DatagramTransport& t =
           datagram(net.rsi_port, "--rsi-port", "the RSI link needs the port the controller sends to");
-      link_ = std::make_unique<RsiLink>(*compensator_, *strategy_, t, clock_, force, c);
+      link_ = std::make_unique<RsiLink>(*compensator_, *strategy_, t, clock_, c);
       where_ = fmt::format("RSI on {}; answers <Sen Type=\"{}\">", to_string(t.local_address()), c.sentype);
       break;
     }
     case LinkKind::kSimpleMessage:
-      open_simple_message(endpoints, force, std::move(program), rules);
+      open_simple_message(endpoints, std::move(program), rules);
       break;
     case LinkKind::kFanucJ519:
-      open_fanuc_j519(endpoints, force, std::move(program), rules);
+      open_fanuc_j519(endpoints, std::move(program), rules);
       break;
     case LinkKind::kMotoros2Rt:
-      open_motoros2_rt(endpoints, force, std::move(program), rules);
+      open_motoros2_rt(endpoints, std::move(program), rules);
       break;
     case LinkKind::kUrRtde:
-      open_ur_rtde(endpoints, force, std::move(program), rules);
+      open_ur_rtde(endpoints, std::move(program), rules);
       break;
   }
 }

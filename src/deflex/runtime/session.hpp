@@ -124,15 +124,15 @@ class Session {
   [[nodiscard]] std::shared_ptr<MonitorFeed> monitor_feed() const { return monitor_; }
 
  private:
-  void open_link(const SessionEndpoints& endpoints, ForceSource* force, std::shared_ptr<const JointTrajectory> program);
-  void open_fanuc_j519(const SessionEndpoints& endpoints, ForceSource* force,
-                       std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules);
-  void open_motoros2_rt(const SessionEndpoints& endpoints, ForceSource* force,
-                        std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules);
-  void open_simple_message(const SessionEndpoints& endpoints, ForceSource* force,
-                           std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules);
-  void open_ur_rtde(const SessionEndpoints& endpoints, ForceSource* force,
-                    std::shared_ptr<const JointTrajectory> program, const LinkStopRules& rules);
+  void open_link(const SessionEndpoints& endpoints, std::shared_ptr<const JointTrajectory> program);
+  void open_fanuc_j519(const SessionEndpoints& endpoints, std::shared_ptr<const JointTrajectory> program,
+                       const LinkStopRules& rules);
+  void open_motoros2_rt(const SessionEndpoints& endpoints, std::shared_ptr<const JointTrajectory> program,
+                        const LinkStopRules& rules);
+  void open_simple_message(const SessionEndpoints& endpoints, std::shared_ptr<const JointTrajectory> program,
+                           const LinkStopRules& rules);
+  void open_ur_rtde(const SessionEndpoints& endpoints, std::shared_ptr<const JointTrajectory> program,
+                    const LinkStopRules& rules);
   void push(SessionEntry::Kind kind, double now) noexcept;
   void end(StopReason reason) noexcept;
   void reporter_loop();

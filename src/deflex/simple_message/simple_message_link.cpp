@@ -70,9 +70,8 @@ CommandLimits point_limits(const OnlineCompensator& c, const JointTrajectory* pr
 
 SimpleMessageLink::SimpleMessageLink(OnlineCompensator& compensator, OnlineStrategy& strategy,
                                      std::shared_ptr<const JointTrajectory> nominal, StreamTransport& motion,
-                                     StreamTransport& state, const Clock& clock, ForceSource* force,
-                                     const SimpleMessageLinkConfig& config)
-    : ControllerLink(compensator, strategy, force, clock, point_limits(compensator, nominal.get(), config), config.stop,
+                                     StreamTransport& state, const Clock& clock, const SimpleMessageLinkConfig& config)
+    : ControllerLink(compensator, strategy, clock, point_limits(compensator, nominal.get(), config), config.stop,
                      config.history_cycles),
       motion_(motion),
       state_port_(state),

@@ -82,16 +82,15 @@ struct SimpleMessageCounters {
 class SimpleMessageLink final : public ControllerLink {
  public:
   /// Every reference must outlive the link; `motion` and `state` are connected streams (the
-  /// controller's motion and state servers). `force` may be null (push samples into the compensator
-  /// yourself). The cycle (the points' duration and the pacing) is the compensator's period_s. Throws
-  /// InputError on a configuration that cannot work.
+  /// controller's motion and state servers). The cycle (the points' duration and the pacing) is the
+  /// compensator's period_s. Throws InputError on a configuration that cannot work.
   SimpleMessageLink(OnlineCompensator& compensator, OnlineStrategy& strategy,
                     std::shared_ptr<const JointTrajectory> nominal, StreamTransport& motion, StreamTransport& state,
-                    const Clock& clock, ForceSource* force, const SimpleMessageLinkConfig& config = {});
+                    const Clock& clock, const SimpleMessageLinkConfig& config = {});
   /// A temporary clock would dangle: it does not compile (docs/architecture.md, "Ownership").
   SimpleMessageLink(OnlineCompensator& compensator, OnlineStrategy& strategy,
                     std::shared_ptr<const JointTrajectory> nominal, StreamTransport& motion, StreamTransport& state,
-                    const Clock&& clock, ForceSource* force, const SimpleMessageLinkConfig& config = {}) = delete;
+                    const Clock&& clock, const SimpleMessageLinkConfig& config = {}) = delete;
 
   /// Waits up to timeout_s (no longer than until the next point is due) for either connection, reads
   /// what came, and sends the next point when it is due. kAnswered: a point was sent (one cycle);

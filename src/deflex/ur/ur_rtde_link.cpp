@@ -118,8 +118,8 @@ std::string ur_rtde_input_names(int o) {
 
 UrRtdeLink::UrRtdeLink(OnlineCompensator& compensator, OnlineStrategy& strategy,
                        std::shared_ptr<const JointTrajectory> nominal, StreamTransport& transport, const Clock& clock,
-                       ForceSource* force, const UrRtdeLinkConfig& config)
-    : ControllerLink(compensator, strategy, force, clock, ur_limits(compensator, nominal.get(), config), config.stop,
+                       const UrRtdeLinkConfig& config)
+    : ControllerLink(compensator, strategy, clock, ur_limits(compensator, nominal.get(), config), config.stop,
                      config.history_cycles),
       config_(config),
       output_names_(ur_rtde_output_names(config.register_offset)),

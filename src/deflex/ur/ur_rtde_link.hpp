@@ -81,10 +81,9 @@ class UrRtdeLink final : public ControllerLink {
   /// (0.002 on e-Series, 0.008 on CB3). Throws InputError on a bad setting or a program for a robot
   /// that is not six-jointed.
   UrRtdeLink(OnlineCompensator& compensator, OnlineStrategy& strategy, std::shared_ptr<const JointTrajectory> nominal,
-             StreamTransport& transport, const Clock& clock, ForceSource* force, const UrRtdeLinkConfig& config);
+             StreamTransport& transport, const Clock& clock, const UrRtdeLinkConfig& config);
   UrRtdeLink(OnlineCompensator& compensator, OnlineStrategy& strategy, std::shared_ptr<const JointTrajectory> nominal,
-             StreamTransport& transport, const Clock&& clock, ForceSource* force,
-             const UrRtdeLinkConfig& config) = delete;
+             StreamTransport& transport, const Clock&& clock, const UrRtdeLinkConfig& config) = delete;
 
   LinkPollResult poll(double timeout_s) noexcept override;
   void stop() noexcept override;
