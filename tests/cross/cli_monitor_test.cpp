@@ -412,6 +412,8 @@ TEST(CliMonitor, RecordedLogServedAndWrittenAsAReport) {
               0u)
         << dom_text(dom, "v-late-answers");
     EXPECT_NE(dom_text(dom, "v-answer-stats").find("over the run"), std::string::npos);
+    EXPECT_NE(dom.find("<td class=\"opt\">--max-joint-correction-deg</td><td class=\"n\">0.5</td><td>deg</td>"), std::string::npos)
+        << dom_between(dom, "card-settings", "</details>");
     const std::string events = dom_between(dom, "events", "card-force");
     EXPECT_NE(events.find("data-kind=\"stop\""), std::string::npos) << events;
     for (const auto& [chart, after] : std::vector<std::pair<std::string, std::string>>{
@@ -437,6 +439,24 @@ TEST(CliMonitor, RecordedLogServedAndWrittenAsAReport) {
   const std::string data = http_request(port, "GET /data?since=0");
   EXPECT_NE(data.find("\"recorded\":true"), std::string::npos);
   EXPECT_NE(data.find("\"state\":\"recorded\""), std::string::npos);
+  // The settings the session ran with came back from the log alone, each described by the settings
+  // table: its unit, its key and its help with the range.
+  const auto doc = nlohmann::json::parse(data.substr(data.find("\r\n\r\n") + 4));
+  const auto setting = [&doc](const std::string& option) {
+    for (const auto& s : doc["settings"]) {
+      if (s["option"] == option) return s;
+    }
+    return nlohmann::json();
+  };
+  const auto bound = setting("--max-joint-correction-deg");
+  EXPECT_EQ(bound["value"], "0.5") << bound;
+  EXPECT_EQ(bound["unit"], "deg") << bound;
+  EXPECT_EQ(bound["key"], "max_joint_correction_rad") << bound;
+  EXPECT_NE(bound["help"].get<std::string>().find("[deg; >0..10]"), std::string::npos) << bound;
+  EXPECT_EQ(setting("--status-interval-s")["value"], "0.5");
+  EXPECT_EQ(setting("--period-ms")["value"], "4");
+  EXPECT_EQ(setting("--force-source")["value"], "csv:" + test::kForceReplay);
+  EXPECT_TRUE(setting("--rsi-sentype").is_null()) << "an RSI setting shown for an EGM session";
   EXPECT_EQ(server.stop(), 0);
 }
 

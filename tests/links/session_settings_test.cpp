@@ -164,5 +164,38 @@ TEST(SessionSettings, SettingsThatOnlyWorkTogetherAreRefusedNamingTheMissingOne)
   EXPECT_NE(words("fanuc", {}).find("'fanuc' is not one of"), std::string::npos);
 }
 
+// What the cycle log records and the monitor lists: the link's settings alone, each in its option's
+// unit (the values below converted by hand), an unset one as its default's words.
+TEST(SessionSettings, ASessionsSettingsAreShownInTheOptionsUnitsForItsLinkAlone) {
+  const SessionConfig c =
+      make_session_config("rsi", "online",
+                          std::vector<GivenSetting>{{find_session_setting("max_joint_correction_rad"), 0.01},
+                                                    {find_session_setting("period_s"), 0.012},
+                                                    {find_session_setting("rsi_sentype"), std::string("ImFree")}});
+  const std::vector<ShownSetting> shown = settings_shown(c);
+  const auto value = [&shown](const std::string& option) -> std::string {
+    for (const ShownSetting& s : shown) {
+      if (s.option == option) return s.value;
+    }
+    return "(not shown)";
+  };
+  EXPECT_EQ(value("--max-joint-correction-deg"), "0.572958");  // 0.01 rad x 180/pi
+  EXPECT_EQ(value("--period-ms"), "12");
+  EXPECT_EQ(value("--rsi-sentype"), "ImFree");
+  EXPECT_EQ(value("--rt-cpu"), "not pinned");
+  EXPECT_EQ(value("--realtime"), "off");
+  EXPECT_EQ(value("--egm-port"), "(not shown)");  // EGM's
+  EXPECT_EQ(value("--fanuc-limits"), "(not shown)");
+  // Every row that applies to RSI, once, in the table's order.
+  std::size_t rows = 0;
+  for (const SessionSetting& s : session_settings()) {
+    if ((s.links & link_bit(LinkKind::kRsi)) == 0) continue;
+    ASSERT_LT(rows, shown.size());
+    EXPECT_EQ(shown[rows].option, s.option);
+    ++rows;
+  }
+  EXPECT_EQ(rows, shown.size());
+}
+
 }  // namespace
 }  // namespace deflex::runtime

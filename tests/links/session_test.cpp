@@ -2,6 +2,7 @@
 // fault dump, a log sink: all on the reporter's side of a lock-free ring); options that cannot work
 // are refused before anything runs, naming the option; the exit codes are the documented table
 // (docs/online.md, "Faults and exit codes", read here from the file).
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -90,11 +91,27 @@ TEST(Session, ThePollDoesNotAllocateWithTheLogTheDumpASinkAndTheMonitorOn) {
   // Every row carries the bounds, so deflex monitor --log draws them from the log alone; the first
   // line names the link, the cycle and the sensor, the last why the session ended.
   EXPECT_NE(header.find(",joint_bound_deg,tcp_bound_mm"), std::string::npos) << header;
-  ASSERT_EQ(comments.size(), 2u);
+  ASSERT_GE(comments.size(), 2u);
   EXPECT_EQ(comments[0], fmt::format("# deflex cycle log: link=egm-joint period_ms=4 force_components={} "
                                      "force_fault_N={:g}",
                                      test::bench_sensor().components, test::bench_sensor().fault_threshold_N));
-  EXPECT_EQ(comments[1], "# stop: " + s.reason_text);
+  EXPECT_EQ(comments.back(), "# stop: " + s.reason_text);
+  // Between them, the settings the session ran with, one a line, in the option's unit: every one that
+  // applies to egm-joint, none of another link's.
+  const std::vector<std::string> settings(comments.begin() + 1, comments.end() - 1);
+  const auto has = [&settings](const std::string& line) {
+    return std::find(settings.begin(), settings.end(), line) != settings.end();
+  };
+  EXPECT_TRUE(has("# setting: --period-ms=4"));
+  EXPECT_TRUE(has(fmt::format("# setting: --max-joint-correction-deg={:.6g}",
+                              c.online.max_joint_correction_rad * 180.0 / 3.14159265358979323846)));
+  EXPECT_TRUE(has("# setting: --status-interval-s=0.1"));
+  EXPECT_TRUE(has("# setting: --jacobian-at=nominal") || has("# setting: --jacobian-at=feedback"));
+  for (const std::string& line : settings) {
+    EXPECT_EQ(line.rfind("# setting: --", 0), 0u) << line;
+    EXPECT_EQ(line.find("--rsi-"), std::string::npos) << line;
+    EXPECT_EQ(line.find("--fanuc-"), std::string::npos) << line;
+  }
   ASSERT_TRUE(session.monitor_feed());
   EXPECT_EQ(session.monitor_feed()->rows_added(), s.cycles);  // every cycle reached the page's feed
 }

@@ -90,8 +90,16 @@ class LogReader {
  private:
   void comment(std::string_view line) {
     const std::string_view preamble = runtime::kCycleLogPreamble, stop = runtime::kCycleLogStop;
+    const std::string_view setting = runtime::kCycleLogSetting;
     if (header_.empty() && line.substr(0, preamble.size()) == preamble) {
       read_preamble(line, setup_);
+    } else if (header_.empty() && line.substr(0, setting.size()) == setting) {
+      // "# setting: --option=value": the value is the rest of the line (a path may hold '=').
+      const std::string_view rest = line.substr(setting.size());
+      const std::size_t eq = rest.find('=');
+      if (eq != std::string_view::npos && eq > 0) {
+        setup_.settings.push_back({std::string(rest.substr(0, eq)), std::string(rest.substr(eq + 1))});
+      }
     } else if (line.substr(0, stop.size()) == stop) {
       stop_reason_ = std::string(line.substr(stop.size()));
     }

@@ -1,6 +1,7 @@
 // The cycle log's CSV (see cycle_log.hpp).
 #include "deflex/runtime/cycle_log.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -10,9 +11,17 @@
 namespace deflex::runtime {
 
 std::string cycle_log_preamble(const CycleLogInfo& info) {
-  return fmt::format("{} link={} period_ms={:g} force_components={} force_fault_N={:g}\n", kCycleLogPreamble,
-                     info.link.empty() ? "unknown" : info.link, info.period_s * 1e3, info.force_components,
-                     info.force_fault_n);
+  std::string out = fmt::format("{} link={} period_ms={:g} force_components={} force_fault_N={:g}\n", kCycleLogPreamble,
+                                info.link.empty() ? "unknown" : info.link, info.period_s * 1e3, info.force_components,
+                                info.force_fault_n);
+  for (const ShownSetting& s : info.settings) {
+    // One line each: a value is the option's text (a path may hold anything but a line break).
+    std::string value = s.value;
+    std::replace(value.begin(), value.end(), '\n', ' ');
+    std::replace(value.begin(), value.end(), '\r', ' ');
+    fmt::format_to(std::back_inserter(out), "{}{}={}\n", kCycleLogSetting, s.option, value);
+  }
+  return out;
 }
 
 std::string cycle_log_header(int joints) {

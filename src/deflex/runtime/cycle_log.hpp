@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "deflex/runtime/record_queue.hpp"
+#include "deflex/runtime/shown_setting.hpp"
 #include "deflex/text/output_file.hpp"
 
 namespace deflex::runtime {
@@ -24,19 +25,21 @@ struct CycleLogBounds {
 
 /// What a log's first line says of its session, so a log read back on its own (`deflex monitor --log`)
 /// names its link, the cycle its answers are measured against and what the sensor measures:
-/// "# deflex cycle log: link=egm-joint period_ms=4 force_components=6 force_fault_N=5000". Its last
-/// line, written when
-/// the session ends, says why: "# stop: REASON". CSV readers that skip '#' lines (deflex's own,
-/// pandas with comment='#') read the columns alone.
+/// "# deflex cycle log: link=egm-joint period_ms=4 force_components=6 force_fault_N=5000", then a line
+/// per setting the session ran with: "# setting: --max-joint-correction-deg=0.5". Its last line,
+/// written when the session ends, says why: "# stop: REASON". CSV readers that skip '#' lines
+/// (deflex's own, pandas with comment='#') read the columns alone.
 struct CycleLogInfo {
   std::string link;
   double period_s = 0.0;
   int force_components = 0;
-  double force_fault_n = 0.0;  ///< |F| above this is a force fault (the sensor's threshold)
+  double force_fault_n = 0.0;          ///< |F| above this is a force fault (the sensor's threshold)
+  std::vector<ShownSetting> settings;  ///< as the session ran (settings_shown())
 };
 inline constexpr char kCycleLogPreamble[] = "# deflex cycle log:";
 inline constexpr char kCycleLogStop[] = "# stop: ";
-/// The first line (with its newline).
+inline constexpr char kCycleLogSetting[] = "# setting: ";
+/// The first line and the settings' (each with its newline).
 [[nodiscard]] std::string cycle_log_preamble(const CycleLogInfo& info);
 
 /// The header line (with its newline) for a robot of `joints` joints.

@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include "deflex/runtime/session_settings.hpp"
+
 namespace deflex::runtime {
 
 // Rows in fixed blocks: the writer fills a block's rows in order and readers read only the rows below
@@ -42,6 +44,29 @@ std::string json_text(const std::string& text) {
     if (ch == '"' || ch == '\\') out += '\\';
     if (static_cast<unsigned char>(ch) >= 0x20) out += ch;
   }
+  return out;
+}
+
+// The settings as the page lists them: each with its unit and help (range and links included) from the
+// settings table, found by the option; one the table does not know (a log from another version of
+// deflex) keeps its option and value alone.
+std::string settings_json(const std::vector<ShownSetting>& settings) {
+  std::string out = "\"settings\":[";
+  for (std::size_t i = 0; i < settings.size(); ++i) {
+    const ShownSetting& shown = settings[i];
+    const SessionSetting* s = find_session_setting(shown.option);
+    std::string unit, key, help;
+    if (s != nullptr) {
+      unit = std::string(s->option_unit.empty() ? s->unit : s->option_unit);
+      key = std::string(s->key);
+      help = option_help(*s);
+    }
+    fmt::format_to(std::back_inserter(out),
+                   "{}{{\"option\":\"{}\",\"key\":\"{}\",\"value\":\"{}\",\"unit\":\"{}\",\"help\":\"{}\"}}",
+                   i > 0 ? "," : "", json_text(shown.option), json_text(key), json_text(shown.value), json_text(unit),
+                   json_text(help));
+  }
+  out += "],";
   return out;
 }
 
@@ -108,7 +133,8 @@ MonitorRow monitor_row(const SessionEntry& e) {
   return row;
 }
 
-MonitorFeed::MonitorFeed(MonitorSetup setup) : setup_(std::move(setup)) {
+MonitorFeed::MonitorFeed(MonitorSetup setup)
+    : setup_(std::move(setup)), settings_json_(settings_json(setup_.settings)) {
   auto empty = std::make_shared<Snapshot>();
   empty->state = state_;
   empty->events = std::make_shared<const std::vector<MonitorEvent>>();
@@ -335,6 +361,7 @@ std::string MonitorFeed::json(std::uint64_t since, std::size_t max_rows) const {
                  setup_.joint_bound_deg, setup_.tcp_bound_mm, setup_.force_fault_n, setup_.program_duration_s,
                  setup_.window_s, setup_.recorded ? "true" : "false", json_text(setup_.source), snap->first, to,
                  to < snap->next ? "true" : "false", json_text(snap->state), json_text(snap->stop_reason));
+  out += settings_json_;
   json_events(out, *snap->events);
   json_rows(out, rows, setup_.joints);
   out += '}';

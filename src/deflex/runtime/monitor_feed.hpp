@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "deflex/runtime/record_queue.hpp"
+#include "deflex/runtime/shown_setting.hpp"
 
 namespace deflex::runtime {
 
@@ -62,6 +63,9 @@ struct MonitorSetup {
   double window_s = 30.0;           ///< history kept (a recorded log keeps everything)
   bool recorded = false;
   std::string source;  ///< the log's path for a recorded session
+  /// The settings the session ran with; the page shows each with its unit and help from the settings
+  /// table (session_settings.hpp). Empty for a log written before they were recorded.
+  std::vector<ShownSetting> settings;
 };
 
 /// The rows of the last window_s seconds, the session's state, events and stop reason, as JSON for the
@@ -103,6 +107,7 @@ class MonitorFeed {
   void publish(bool wait);
 
   MonitorSetup setup_;
+  std::string settings_json_;  // the setup's settings as the page reads them (they never change)
   // The writer's own (never read by readers).
   std::vector<std::shared_ptr<Block>> blocks_;
   std::uint64_t first_ = 0, next_ = 0;

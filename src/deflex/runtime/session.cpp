@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "deflex/online/online_strategy.hpp"
+#include "deflex/runtime/session_settings.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/transport/tcp_stream.hpp"
 #include "deflex/transport/udp_transport.hpp"
@@ -83,6 +84,9 @@ Session::Session(const SessionConfig& config, const RobotModel& robot, const Sen
     setup.period_s = config_.online.period_s;
     setup.force_components = sensor.components;
     setup.force_fault_n = sensor.fault_threshold_N;
+    SessionConfig ran = config_;  // the silence that stops it as the link resolved it, not "the link's"
+    ran.stop_silence_s = link_->stop_rules().stop_silence_s;
+    setup.settings = settings_shown(ran);
     setup.limits = link_->limits();
     setup.streams_program = info.streams_program;
     if (program_) {
@@ -108,6 +112,7 @@ Session::Session(const SessionConfig& config, const RobotModel& robot, const Sen
       ms.tcp_bound_mm = setup.limits.tcp_bound_m * 1e3;
       ms.program_duration_s = setup.program_duration_s;
       ms.window_s = config_.monitor_window_s;
+      ms.settings = setup.settings;
       monitor_ = std::make_shared<MonitorFeed>(ms);
       setup.monitor = monitor_;
     }

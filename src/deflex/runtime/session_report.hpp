@@ -47,8 +47,9 @@ struct ReportSetup {
   const char* link_name = "";
   int joints = 6;
   double period_s = 0.004;
-  int force_components = 6;    ///< what the sensor measures (the cycle log's first line says it)
-  double force_fault_n = 0.0;  ///< the sensor's fault threshold (the same)
+  int force_components = 6;            ///< what the sensor measures (the cycle log's first line says it)
+  double force_fault_n = 0.0;          ///< the sensor's fault threshold (the same)
+  std::vector<ShownSetting> settings;  ///< what the session runs with (the log's "# setting: " lines)
   CommandLimits limits;
   bool streams_program = false;
   double program_start_s = 0.0, program_duration_s = 0.0;
@@ -104,7 +105,7 @@ class SessionReporter {
     return {rad_to_deg(setup_.limits.joint_bound_rad), setup_.limits.tcp_bound_m * 1e3};
   }
   [[nodiscard]] CycleLogInfo info() const {
-    return {setup_.link_name, setup_.period_s, setup_.force_components, setup_.force_fault_n};
+    return {setup_.link_name, setup_.period_s, setup_.force_components, setup_.force_fault_n, setup_.settings};
   }
   void on_cycle(const SessionEntry& e);
   void keep(const SessionEntry& e);

@@ -905,19 +905,36 @@ std::string option_help(const SessionSetting& s) {
   return h;
 }
 
-std::string option_default(const SessionSetting& s) {
-  if (!s.default_text.empty()) return std::string(s.default_text);
-  const SessionConfig d = default_session_config(LinkKind::kEgmJoint);
+std::string setting_value_text(const SessionSetting& s, const SessionConfig& config) {
   switch (s.type) {
     case SettingType::kReal:
-    case SettingType::kInteger:
-      return fmt::format("{:.6g}", s.get_real(d) * (s.option_unit.empty() ? 1.0 : s.option_per_unit));
+    case SettingType::kInteger: {
+      const double v = s.get_real(config);
+      // Unset (a port of -1, a real of 0 where the range starts above it): what is used instead.
+      const bool unset = v < 0.0 || (s.type == SettingType::kReal && v == 0.0);
+      if (unset && !s.default_text.empty()) return std::string(s.default_text);
+      return fmt::format("{:.6g}", v * (s.option_unit.empty() ? 1.0 : s.option_per_unit));
+    }
     case SettingType::kFlag:
-      return s.get_flag(d) != s.flag_inverted ? "on" : "off";
+      return s.get_flag(config) != s.flag_inverted ? "on" : "off";
     case SettingType::kText:
-      return s.get_text(d);
+      return s.get_text(config);
   }
   return {};
+}
+
+std::vector<ShownSetting> settings_shown(const SessionConfig& config) {
+  std::vector<ShownSetting> out;
+  for (const SessionSetting& s : session_settings()) {
+    if ((s.links & link_bit(config.link)) == 0) continue;
+    out.push_back({std::string(s.option), setting_value_text(s, config)});
+  }
+  return out;
+}
+
+std::string option_default(const SessionSetting& s) {
+  if (!s.default_text.empty()) return std::string(s.default_text);
+  return setting_value_text(s, default_session_config(LinkKind::kEgmJoint));
 }
 
 }  // namespace deflex::runtime

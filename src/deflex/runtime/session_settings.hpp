@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "deflex/runtime/session_config.hpp"
+#include "deflex/runtime/shown_setting.hpp"
 
 namespace deflex::runtime {
 
@@ -77,6 +78,13 @@ struct GivenSetting {
 /// naming the setting (setting_name()) and saying why.
 [[nodiscard]] SessionConfig make_session_config(const std::string& link, const std::string& strategy,
                                                 std::span<const GivenSetting> given);
+
+/// A setting's value in `config`, in the option's unit, as text ("0.5", "on", "nominal"); one that
+/// `config` leaves unset (a port of -1, a real of 0) shows its default_text ("not read").
+[[nodiscard]] std::string setting_value_text(const SessionSetting& s, const SessionConfig& config);
+/// Every setting that applies to `config.link`, in the table's order, with its value in `config`: what
+/// the cycle log records and the monitor lists.
+[[nodiscard]] std::vector<ShownSetting> settings_shown(const SessionConfig& config);
 
 /// The help an option shows: the setting's, its unit, range and the links it applies to.
 [[nodiscard]] std::string option_help(const SessionSetting& s);
