@@ -476,108 +476,125 @@ void LoadResult::fill_compensation() {
   }
 }
 
-// NOLINTNEXTLINE(readability-function-size): listed in docs/architecture.md, "Functions over 80 lines"
-nlohmann::json study_to_json(const StudyResult& study) {
-  nlohmann::json setups = nlohmann::json::array();
-  for (const auto& s : study.setups) {
-    nlohmann::json loads = nlohmann::json::array();
-    for (const auto& l : s.loads) {
-      nlohmann::json jl{{"load_N", l.load_N},
-                        {"uc_mm", speed_map(l.uc_mm)},
-                        {"c_mm", speed_map(l.c_mm)},
-                        {"compensation", speed_map(l.compensation)}};
-      const std::pair<const char*, const std::map<int, double>*> optional[] = {
-          {"uc_std_mm", &l.uc_std_mm},
-          {"c_std_mm", &l.c_std_mm},
-          {"uc_max_mm", &l.uc_max_mm},
-          {"c_max_mm", &l.c_max_mm},
-          {"iso_accuracy_uc_mm", &l.iso_accuracy_uc_mm},
-          {"iso_accuracy_c_mm", &l.iso_accuracy_c_mm},
-          {"iso_repeatability_mm", &l.iso_repeatability_mm},
-          {"uc_sync_mm", &l.uc_sync_mm},
-          {"c_sync_mm", &l.c_sync_mm}};
-      for (const auto& [key, m] : optional) {
-        if (!m->empty()) {
-          jl[key] = speed_map(*m);
-        }
-      }
-      const std::pair<const char*, const std::map<int, std::vector<double>>*> by_seed[] = {
-          {"uc_mm_by_seed", &l.uc_mm_by_seed},
-          {"c_mm_by_seed", &l.c_mm_by_seed},
-          {"uc_sync_mm_by_seed", &l.uc_sync_mm_by_seed},
-          {"c_sync_mm_by_seed", &l.c_sync_mm_by_seed}};
-      for (const auto& [key, m] : by_seed) {
-        if (!m->empty()) jl[key] = speed_lists(*m);
-      }
-      nlohmann::json c_spread = nlohmann::json::object();
-      for (const auto& [v, c] : l.c_mm) c_spread[std::to_string(v)] = spread_json(l.c_spread(v));
-      jl["spread"] = {{"uc_mm", spread_json(l.uc_mean_spread())},
-                      {"c_mm", c_spread},
-                      {"compensation", spread_json(l.compensation_spread())}};
-      loads.push_back(jl);
+namespace {
+
+// A load's per-speed figures, one row each, read and written by the same table: its key in the saved
+// study, the field, and whether a saved study must have it (required), always has it (written even
+// when empty) or has it only when measured.
+enum class Presence { kRequired, kAlways, kWhenMeasured };
+struct LoadMapField {
+  const char* key;
+  std::map<int, double> LoadResult::*field;
+  Presence presence;
+};
+constexpr LoadMapField kLoadMaps[] = {
+    {"uc_mm", &LoadResult::uc_mm, Presence::kRequired},
+    {"c_mm", &LoadResult::c_mm, Presence::kRequired},
+    {"compensation", &LoadResult::compensation, Presence::kAlways},
+    {"uc_std_mm", &LoadResult::uc_std_mm, Presence::kWhenMeasured},
+    {"c_std_mm", &LoadResult::c_std_mm, Presence::kWhenMeasured},
+    {"uc_max_mm", &LoadResult::uc_max_mm, Presence::kWhenMeasured},
+    {"c_max_mm", &LoadResult::c_max_mm, Presence::kWhenMeasured},
+    {"iso_accuracy_uc_mm", &LoadResult::iso_accuracy_uc_mm, Presence::kWhenMeasured},
+    {"iso_accuracy_c_mm", &LoadResult::iso_accuracy_c_mm, Presence::kWhenMeasured},
+    {"iso_repeatability_mm", &LoadResult::iso_repeatability_mm, Presence::kWhenMeasured},
+    {"uc_sync_mm", &LoadResult::uc_sync_mm, Presence::kWhenMeasured},
+    {"c_sync_mm", &LoadResult::c_sync_mm, Presence::kWhenMeasured},
+};
+// Its per-seed lists (written when measured).
+struct LoadSeedField {
+  const char* key;
+  std::map<int, std::vector<double>> LoadResult::*field;
+};
+constexpr LoadSeedField kLoadSeedLists[] = {
+    {"uc_mm_by_seed", &LoadResult::uc_mm_by_seed},
+    {"c_mm_by_seed", &LoadResult::c_mm_by_seed},
+    {"uc_sync_mm_by_seed", &LoadResult::uc_sync_mm_by_seed},
+    {"c_sync_mm_by_seed", &LoadResult::c_sync_mm_by_seed},
+};
+// A sweep point's per-seed lists.
+struct SweepSeedField {
+  const char* key;
+  std::vector<double> SweepPoint::*field;
+};
+constexpr SweepSeedField kSweepSeedLists[] = {
+    {"uc_mm_by_seed", &SweepPoint::uc_mm_by_seed},
+    {"c_mm_by_seed", &SweepPoint::c_mm_by_seed},
+    {"c_sync_mm_by_seed", &SweepPoint::c_sync_mm_by_seed},
+};
+
+nlohmann::json load_to_json(const LoadResult& l) {
+  nlohmann::json jl{{"load_N", l.load_N}};
+  for (const LoadMapField& f : kLoadMaps) {
+    const std::map<int, double>& m = l.*f.field;
+    if (f.presence != Presence::kWhenMeasured || !m.empty()) jl[f.key] = speed_map(m);
+  }
+  for (const LoadSeedField& f : kLoadSeedLists) {
+    if (!(l.*f.field).empty()) jl[f.key] = speed_lists(l.*f.field);
+  }
+  nlohmann::json c_spread = nlohmann::json::object();
+  for (const auto& [v, c] : l.c_mm) c_spread[std::to_string(v)] = spread_json(l.c_spread(v));
+  jl["spread"] = {{"uc_mm", spread_json(l.uc_mean_spread())},
+                  {"c_mm", c_spread},
+                  {"compensation", spread_json(l.compensation_spread())}};
+  return jl;
+}
+
+nlohmann::json setup_to_json(const SetupResult& s) {
+  nlohmann::json loads = nlohmann::json::array();
+  for (const auto& l : s.loads) loads.push_back(load_to_json(l));
+  nlohmann::json js{{"setup", s.setup}, {"loads", loads}};
+  if (!s.description.empty()) js["description"] = s.description;
+  if (!s.paper_table.empty()) {
+    js["paper_table"] = s.paper_table;
+    js["paper_label"] = s.paper_label;
+  }
+  return js;
+}
+
+nlohmann::json sweep_to_json(const std::vector<SweepPoint>& points) {
+  nlohmann::json sweep = nlohmann::json::array();
+  for (const auto& p : points) {
+    nlohmann::json jp{{"setup", p.setup},
+                      {"load_N", p.load_N},
+                      {"speed_mm_s", p.speed_mm_s},
+                      {"uc_mm", number(p.uc_mm)},
+                      {"c_mm", number(p.c_mm)},
+                      {"compensation", number(p.compensation)},
+                      {"c_sync_mm", number(p.c_sync_mm)}};
+    if (!p.c_mm_by_seed.empty()) {
+      for (const SweepSeedField& f : kSweepSeedLists) jp[f.key] = numbers(p.*f.field);
     }
-    nlohmann::json js{{"setup", s.setup}, {"loads", loads}};
-    if (!s.description.empty()) {
-      js["description"] = s.description;
+    sweep.push_back(jp);
+  }
+  return sweep;
+}
+
+nlohmann::json budgets_to_json(const std::vector<ErrorBudget>& budgets) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& b : budgets) {
+    nlohmann::json entries = nlohmann::json::array();
+    for (const auto& e : b.entries) {
+      entries.push_back({{"effect", e.effect},
+                         {"size", e.size},
+                         {"residual_mm_without_it", number(e.residual_mm_without_it)},
+                         {"sensitivity_one_at_a_time", number(e.sensitivity)}});
     }
-    if (!s.paper_table.empty()) {
-      js["paper_table"] = s.paper_table;
-      js["paper_label"] = s.paper_label;
-    }
-    setups.push_back(js);
+    out.push_back({{"setup", b.setup},
+                   {"load_N", b.load_N},
+                   {"speed_mm_s", b.speed_mm_s},
+                   {"residual_mm_all", number(b.residual_mm_all)},
+                   {"residual_mm_all_off", number(b.residual_mm_all_off)},
+                   {"uc_mm", number(b.uc_mm)},
+                   {"seed", b.seed},
+                   {"laps", b.laps},
+                   {"entries", entries}});
   }
-  nlohmann::json doc{{"setups", setups}, {"speeds_mm_s", study_speeds_mm_s(study)}};
-  if (!study.speed_sweep.empty()) {
-    nlohmann::json sweep = nlohmann::json::array();
-    for (const auto& p : study.speed_sweep) {
-      nlohmann::json jp{{"setup", p.setup},
-                        {"load_N", p.load_N},
-                        {"speed_mm_s", p.speed_mm_s},
-                        {"uc_mm", number(p.uc_mm)},
-                        {"c_mm", number(p.c_mm)},
-                        {"compensation", number(p.compensation)},
-                        {"c_sync_mm", number(p.c_sync_mm)}};
-      if (!p.c_mm_by_seed.empty()) {
-        jp["uc_mm_by_seed"] = numbers(p.uc_mm_by_seed);
-        jp["c_mm_by_seed"] = numbers(p.c_mm_by_seed);
-        jp["c_sync_mm_by_seed"] = numbers(p.c_sync_mm_by_seed);
-      }
-      sweep.push_back(jp);
-    }
-    doc["speed_sweep"] = sweep;
-  }
-  if (!study.error_budgets.empty()) {
-    nlohmann::json budgets = nlohmann::json::array();
-    for (const auto& b : study.error_budgets) {
-      nlohmann::json entries = nlohmann::json::array();
-      for (const auto& e : b.entries) {
-        entries.push_back({{"effect", e.effect},
-                           {"size", e.size},
-                           {"residual_mm_without_it", number(e.residual_mm_without_it)},
-                           {"sensitivity_one_at_a_time", number(e.sensitivity)}});
-      }
-      budgets.push_back({{"setup", b.setup},
-                         {"load_N", b.load_N},
-                         {"speed_mm_s", b.speed_mm_s},
-                         {"residual_mm_all", number(b.residual_mm_all)},
-                         {"residual_mm_all_off", number(b.residual_mm_all_off)},
-                         {"uc_mm", number(b.uc_mm)},
-                         {"seed", b.seed},
-                         {"laps", b.laps},
-                         {"entries", entries}});
-    }
-    doc["error_budget"] = budgets;
-  }
-  if (!study.seeds.empty()) {
-    doc["seeds"] = study.seeds;
-  }
-  if (!study.case_name.empty()) {
-    doc["case"] = study.case_name;
-  }
-  doc["seed"] = study.seed;
-  if (study.wall_time_s > 0.0) {
-    doc["wall_time_s"] = study.wall_time_s;
-  }
+  return out;
+}
+
+// The paper's tables beside ours, so a saved study is read with what it is compared against.
+nlohmann::json paper_to_json() {
   nlohmann::json paper = nlohmann::json::object();
   for (const auto& t : paper_reference().tables) {
     nlohmann::json rows = nlohmann::json::array();
@@ -586,73 +603,74 @@ nlohmann::json study_to_json(const StudyResult& study) {
     }
     paper[t.setup] = rows;
   }
-  doc["paper"] = paper;
-  return doc;
+  return paper;
 }
 
-// NOLINTNEXTLINE(readability-function-size): listed in docs/architecture.md, "Functions over 80 lines"
-StudyResult study_from_json(const nlohmann::json& doc, const std::string& source) {
-  StudyResult study;
-  if (!doc.is_object() || !doc.contains("setups") || !doc.at("setups").is_array()) {
-    throw DataError(fmt::format("{}: missing array 'setups'", source));
+LoadResult load_from_json(const nlohmann::json& jl, const std::string& lw) {
+  LoadResult l;
+  l.load_N = read_number(jl, "load_N", lw);
+  for (const LoadMapField& f : kLoadMaps) {
+    if (jl.contains(f.key)) {
+      l.*f.field = read_speed_map(jl.at(f.key), lw + "." + f.key);
+    } else if (f.presence == Presence::kRequired) {
+      throw DataError(fmt::format("{}: missing field '{}'", lw, f.key));
+    }
   }
-  std::size_t si = 0;
-  for (const auto& js : doc.at("setups")) {
-    const std::string where = fmt::format("{}: setups[{}]", source, si++);
-    if (!js.is_object() || !js.contains("setup") || !js.at("setup").is_string()) {
-      throw DataError(fmt::format("{}: missing string field 'setup'", where));
-    }
-    SetupResult s;
-    s.setup = js.at("setup").get<std::string>();
-    if (js.contains("description") && js.at("description").is_string()) {
-      s.description = js.at("description").get<std::string>();
-    }
-    const std::pair<const char*, std::string*> text_fields[] = {{"paper_table", &s.paper_table},
-                                                                {"paper_label", &s.paper_label}};
-    for (const auto& [key, field] : text_fields) {
-      if (!js.contains(key)) continue;
-      if (!js.at(key).is_string()) throw DataError(fmt::format("{}.{}: not a string", where, key));
-      *field = js.at(key).get<std::string>();
-    }
-    if (!js.contains("loads") || !js.at("loads").is_array()) {
-      throw DataError(fmt::format("{}: missing array 'loads'", where));
-    }
-    std::size_t li = 0;
-    for (const auto& jl : js.at("loads")) {
-      const std::string lw = fmt::format("{}.loads[{}]", where, li++);
-      LoadResult l;
-      l.load_N = read_number(jl, "load_N", lw);
-      const std::pair<const char*, std::map<int, double>*> maps[] = {{"uc_mm", &l.uc_mm},
-                                                                     {"c_mm", &l.c_mm},
-                                                                     {"compensation", &l.compensation},
-                                                                     {"uc_std_mm", &l.uc_std_mm},
-                                                                     {"c_std_mm", &l.c_std_mm},
-                                                                     {"uc_max_mm", &l.uc_max_mm},
-                                                                     {"c_max_mm", &l.c_max_mm},
-                                                                     {"iso_accuracy_uc_mm", &l.iso_accuracy_uc_mm},
-                                                                     {"iso_accuracy_c_mm", &l.iso_accuracy_c_mm},
-                                                                     {"iso_repeatability_mm", &l.iso_repeatability_mm},
-                                                                     {"uc_sync_mm", &l.uc_sync_mm},
-                                                                     {"c_sync_mm", &l.c_sync_mm}};
-      for (const auto& [key, m] : maps) {
-        if (jl.contains(key)) {
-          *m = read_speed_map(jl.at(key), lw + "." + key);
-        } else if (std::string(key) == "uc_mm" || std::string(key) == "c_mm") {
-          throw DataError(fmt::format("{}: missing field '{}'", lw, key));
-        }
-      }
-      const std::pair<const char*, std::map<int, std::vector<double>>*> by_seed[] = {
-          {"uc_mm_by_seed", &l.uc_mm_by_seed},
-          {"c_mm_by_seed", &l.c_mm_by_seed},
-          {"uc_sync_mm_by_seed", &l.uc_sync_mm_by_seed},
-          {"c_sync_mm_by_seed", &l.c_sync_mm_by_seed}};
-      for (const auto& [key, m] : by_seed) {
-        if (jl.contains(key)) *m = read_speed_lists(jl.at(key), lw + "." + key);
-      }
-      s.loads.push_back(l);
-    }
-    study.setups.push_back(s);
+  for (const LoadSeedField& f : kLoadSeedLists) {
+    if (jl.contains(f.key)) l.*f.field = read_speed_lists(jl.at(f.key), lw + "." + f.key);
   }
+  return l;
+}
+
+SetupResult setup_from_json(const nlohmann::json& js, const std::string& where) {
+  if (!js.is_object() || !js.contains("setup") || !js.at("setup").is_string()) {
+    throw DataError(fmt::format("{}: missing string field 'setup'", where));
+  }
+  SetupResult s;
+  s.setup = js.at("setup").get<std::string>();
+  if (js.contains("description") && js.at("description").is_string()) {
+    s.description = js.at("description").get<std::string>();
+  }
+  const std::pair<const char*, std::string*> text_fields[] = {{"paper_table", &s.paper_table},
+                                                              {"paper_label", &s.paper_label}};
+  for (const auto& [key, field] : text_fields) {
+    if (!js.contains(key)) continue;
+    if (!js.at(key).is_string()) throw DataError(fmt::format("{}.{}: not a string", where, key));
+    *field = js.at(key).get<std::string>();
+  }
+  if (!js.contains("loads") || !js.at("loads").is_array()) {
+    throw DataError(fmt::format("{}: missing array 'loads'", where));
+  }
+  std::size_t li = 0;
+  for (const auto& jl : js.at("loads")) s.loads.push_back(load_from_json(jl, fmt::format("{}.loads[{}]", where, li++)));
+  return s;
+}
+
+// A number that may be saved as null (not measured).
+double read_number_or_nan(const nlohmann::json& j, const char* key, const std::string& where) {
+  return j.contains(key) && j.at(key).is_null() ? kNaN : read_number(j, key, where);
+}
+
+SweepPoint sweep_point_from_json(const nlohmann::json& jp, const std::string& pw) {
+  SweepPoint p;
+  if (!jp.contains("setup") || !jp.at("setup").is_string()) {
+    throw DataError(fmt::format("{}: missing string field 'setup'", pw));
+  }
+  p.setup = jp.at("setup").get<std::string>();
+  p.load_N = read_number(jp, "load_N", pw);
+  p.speed_mm_s = read_number(jp, "speed_mm_s", pw);
+  p.uc_mm = read_number_or_nan(jp, "uc_mm", pw);
+  p.c_mm = read_number_or_nan(jp, "c_mm", pw);
+  p.compensation = compensation_ratio(p.uc_mm, p.c_mm);
+  if (jp.contains("c_sync_mm")) p.c_sync_mm = read_number_or_nan(jp, "c_sync_mm", pw);
+  for (const SweepSeedField& f : kSweepSeedLists) {
+    if (jp.contains(f.key)) p.*f.field = read_numbers(jp.at(f.key), pw + "." + f.key);
+  }
+  return p;
+}
+
+// The study's own fields beside its setups: the speeds, the case, the seeds, the wall time.
+void read_study_fields(const nlohmann::json& doc, const std::string& source, StudyResult& study) {
   if (doc.contains("speeds_mm_s")) {
     for (const auto& v : doc.at("speeds_mm_s")) {
       if (!v.is_number_integer()) {
@@ -661,37 +679,8 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
       study.speeds_mm_s.push_back(v.get<int>());
     }
   }
-  if (doc.contains("speed_sweep")) {
-    std::size_t pi = 0;
-    for (const auto& jp : doc.at("speed_sweep")) {
-      const std::string pw = fmt::format("{}: speed_sweep[{}]", source, pi++);
-      SweepPoint p;
-      if (!jp.contains("setup") || !jp.at("setup").is_string()) {
-        throw DataError(fmt::format("{}: missing string field 'setup'", pw));
-      }
-      p.setup = jp.at("setup").get<std::string>();
-      p.load_N = read_number(jp, "load_N", pw);
-      p.speed_mm_s = read_number(jp, "speed_mm_s", pw);
-      p.uc_mm = jp.contains("uc_mm") && jp.at("uc_mm").is_null() ? kNaN : read_number(jp, "uc_mm", pw);
-      p.c_mm = jp.contains("c_mm") && jp.at("c_mm").is_null() ? kNaN : read_number(jp, "c_mm", pw);
-      p.compensation = compensation_ratio(p.uc_mm, p.c_mm);
-      if (jp.contains("c_sync_mm")) {
-        p.c_sync_mm = jp.at("c_sync_mm").is_null() ? kNaN : read_number(jp, "c_sync_mm", pw);
-      }
-      if (jp.contains("c_mm_by_seed")) p.c_mm_by_seed = read_numbers(jp.at("c_mm_by_seed"), pw + ".c_mm_by_seed");
-      if (jp.contains("uc_mm_by_seed")) p.uc_mm_by_seed = read_numbers(jp.at("uc_mm_by_seed"), pw + ".uc_mm_by_seed");
-      if (jp.contains("c_sync_mm_by_seed")) {
-        p.c_sync_mm_by_seed = read_numbers(jp.at("c_sync_mm_by_seed"), pw + ".c_sync_mm_by_seed");
-      }
-      study.speed_sweep.push_back(p);
-    }
-  }
-  if (doc.contains("case") && doc.at("case").is_string()) {
-    study.case_name = doc.at("case").get<std::string>();
-  }
-  if (doc.contains("seed") && doc.at("seed").is_number_unsigned()) {
-    study.seed = doc.at("seed").get<std::uint64_t>();
-  }
+  if (doc.contains("case") && doc.at("case").is_string()) study.case_name = doc.at("case").get<std::string>();
+  if (doc.contains("seed") && doc.at("seed").is_number_unsigned()) study.seed = doc.at("seed").get<std::uint64_t>();
   if (doc.contains("wall_time_s") && doc.at("wall_time_s").is_number()) {
     study.wall_time_s = doc.at("wall_time_s").get<double>();
   }
@@ -699,6 +688,40 @@ StudyResult study_from_json(const nlohmann::json& doc, const std::string& source
     for (const auto& v : doc.at("seeds")) {
       if (!v.is_number_unsigned()) throw DataError(fmt::format("{}: seeds: not a seed", source));
       study.seeds.push_back(v.get<std::uint64_t>());
+    }
+  }
+}
+
+}  // namespace
+
+nlohmann::json study_to_json(const StudyResult& study) {
+  nlohmann::json setups = nlohmann::json::array();
+  for (const auto& s : study.setups) setups.push_back(setup_to_json(s));
+  nlohmann::json doc{{"setups", setups}, {"speeds_mm_s", study_speeds_mm_s(study)}};
+  if (!study.speed_sweep.empty()) doc["speed_sweep"] = sweep_to_json(study.speed_sweep);
+  if (!study.error_budgets.empty()) doc["error_budget"] = budgets_to_json(study.error_budgets);
+  if (!study.seeds.empty()) doc["seeds"] = study.seeds;
+  if (!study.case_name.empty()) doc["case"] = study.case_name;
+  doc["seed"] = study.seed;
+  if (study.wall_time_s > 0.0) doc["wall_time_s"] = study.wall_time_s;
+  doc["paper"] = paper_to_json();
+  return doc;
+}
+
+StudyResult study_from_json(const nlohmann::json& doc, const std::string& source) {
+  StudyResult study;
+  if (!doc.is_object() || !doc.contains("setups") || !doc.at("setups").is_array()) {
+    throw DataError(fmt::format("{}: missing array 'setups'", source));
+  }
+  std::size_t si = 0;
+  for (const auto& js : doc.at("setups")) {
+    study.setups.push_back(setup_from_json(js, fmt::format("{}: setups[{}]", source, si++)));
+  }
+  read_study_fields(doc, source, study);
+  if (doc.contains("speed_sweep")) {
+    std::size_t pi = 0;
+    for (const auto& jp : doc.at("speed_sweep")) {
+      study.speed_sweep.push_back(sweep_point_from_json(jp, fmt::format("{}: speed_sweep[{}]", source, pi++)));
     }
   }
   if (doc.contains("error_budget")) {
