@@ -13,6 +13,7 @@
 #include "command.hpp"
 #include "deflex/link/controller_file.hpp"
 #include "deflex/runtime/controller_setup.hpp"
+#include "deflex/runtime/session_settings.hpp"
 #include "deflex/text/output_file.hpp"
 
 namespace deflex::cli {
@@ -25,6 +26,17 @@ struct ControllerSetupOpts : runtime::ControllerSetupSettings {
   bool json = false;
 };
 
+// An option `deflex online` has too: its help is the settings table's (unit, range, the links it applies
+// to), as online's --help gives it, and the library checks its value as online does.
+template <typename T>
+CLI::Option* add_shared(CLI::App& sub, const char* option, T& value, const char* note = "") {
+  const runtime::SessionSetting* s = runtime::find_session_setting(option);
+  std::string help = "deflex online " + std::string(option);
+  if (s != nullptr) help += ": " + runtime::option_help(*s);
+  if (*note != '\0') help += fmt::format(" ({})", note);
+  return sub.add_option(option, value, help);
+}
+
 // The link, where the files go, and the settings every link shares.
 void add_controller_link_options(CLI::App& sub, ControllerSetupOpts& o) {
   sub.add_option("--link", o.link,
@@ -35,27 +47,20 @@ void add_controller_link_options(CLI::App& sub, ControllerSetupOpts& o) {
       ->required();
   sub.add_option("-o,--output-dir", o.output_dir, "Directory the files are written to (made when missing)")
       ->capture_default_str();
-  sub.add_option("--egm-port", o.egm_port, "EGM: deflex online --egm-port")->capture_default_str();
-  sub.add_option("--rsi-port", o.rsi_port, "rsi: deflex online --rsi-port (the Ethernet config's PORT)")
+  add_shared(sub, "--egm-port", o.egm_port)->capture_default_str();
+  add_shared(sub, "--rsi-port", o.rsi_port)->capture_default_str();
+  add_shared(sub, "--rsi-sentype", o.sentype)->capture_default_str();
+  add_shared(sub, "--period-ms", o.period_ms,
+             "egm-path: the EGMActMove SampleRate; rsi: 4 with #IPO_FAST, 12 with #IPO");
+  add_shared(sub, "--max-joint-correction-deg", o.max_joint_deg, "rsi: AXISCORR's limits on every axis")
       ->capture_default_str();
-  sub.add_option("--rsi-sentype", o.sentype, "rsi: deflex online --rsi-sentype (the Ethernet config's SENTYPE)")
-      ->capture_default_str();
-  sub.add_option("--period-ms", o.period_ms,
-                 "deflex online --period-ms: egm-joint 4; egm-path the EGMActMove SampleRate (default 48); rsi 4 "
-                 "(#IPO_FAST) or 12 (#IPO)");
-  sub.add_option("--max-joint-correction-deg", o.max_joint_deg,
-                 "deflex online --max-joint-correction-deg (rsi: AXISCORR's limits on every axis)")
-      ->capture_default_str();
-  sub.add_option("--max-tcp-correction-mm", o.max_tcp_mm, "deflex online --max-tcp-correction-mm")
-      ->capture_default_str();
+  add_shared(sub, "--max-tcp-correction-mm", o.max_tcp_mm)->capture_default_str();
 }
 
 // ABB EGM's RAPID and UdpUc settings.
 void add_controller_egm_options(CLI::App& sub, ControllerSetupOpts& o) {
-  sub.add_option("--ramp-in-s", o.ramp_in_s, "egm-joint: deflex online --ramp-in-s (EGMRunJoint \\RampInTime)")
-      ->capture_default_str();
-  sub.add_option("--path-corr-frame", o.path_frame, "egm-path: deflex online --path-corr-frame (tool, flange, path)")
-      ->capture_default_str();
+  add_shared(sub, "--ramp-in-s", o.ramp_in_s, "egm-joint: EGMRunJoint \\RampInTime")->capture_default_str();
+  add_shared(sub, "--path-corr-frame", o.path_frame)->capture_default_str();
   sub.add_option("--egm-device", o.device, "EGM: the UdpUc device's name")->capture_default_str();
   sub.add_option("--egm-config", o.egm_config, "EGM: the External Motion Interface Data entry EGMSetupUC names")
       ->capture_default_str();
@@ -63,9 +68,8 @@ void add_controller_egm_options(CLI::App& sub, ControllerSetupOpts& o) {
   sub.add_option("--tool", o.tool, "EGM: the tooldata the program moves with")->capture_default_str();
   sub.add_option("--comm-timeout-s", o.comm_timeout_s,
                  "EGM: EGMSetupUC \\CommTimeout, s (default: --stop-silence-s, deflex's own)");
-  sub.add_option("--stop-silence-s", o.stop_silence_s, "EGM: deflex online --stop-silence-s (default: the link's, 3)");
-  sub.add_option("--max-rate-deg-s", o.max_rate_deg_s, "egm-joint: deflex online --max-rate-deg-s")
-      ->capture_default_str();
+  add_shared(sub, "--stop-silence-s", o.stop_silence_s);
+  add_shared(sub, "--max-rate-deg-s", o.max_rate_deg_s)->capture_default_str();
   sub.add_option("--program", o.program,
                  "egm-joint: deflex online --program: its peak joint speeds make \\MaxSpeedDeviation and "
                  "\\MaxPosDeviation tight (without it the robot's speed limits stand in)");
@@ -85,35 +89,23 @@ void add_controller_egm_options(CLI::App& sub, ControllerSetupOpts& o) {
 // KUKA RSI, FANUC J519, MotoROS2 and UR RTDE settings.
 void add_controller_other_options(CLI::App& sub, ControllerSetupOpts& o) {
   sub.add_option("--context", o.context, "rsi: base name of the files and the KRL program")->capture_default_str();
-  sub.add_option("--rsi-timeout", o.rsi_timeout, "rsi: ETHERNET Timeout, late answers before RSI stops")
-      ->capture_default_str();
+  add_shared(sub, "--rsi-timeout", o.rsi_timeout)->capture_default_str();
   sub.add_option("--rsi-precision", o.rsi_precision, "rsi: ETHERNET Precision, decimals the controller sends")
       ->capture_default_str();
   sub.add_option("--rsi-monitor-factor", o.monitor_factor,
                  "rsi: AXISCORRMON's MaxAi as a multiple of --max-joint-correction-deg")
       ->capture_default_str();
   sub.add_option("--tp-program", o.tp_program, "fanuc-j519: the TP program's name")->capture_default_str();
-  sub.add_option("--fanuc-version", o.fanuc_version, "fanuc-j519: deflex online --fanuc-version")
-      ->capture_default_str();
-  sub.add_option("--fanuc-limits", o.fanuc_limits, "fanuc-j519: deflex online --fanuc-limits (deg/s, deg/s^2, deg/s^3)")
-      ->capture_default_str();
-  sub.add_option("--fanuc-correction-share", o.fanuc_correction_share,
-                 "fanuc-j519: deflex online --fanuc-correction-share")
-      ->capture_default_str();
-  sub.add_option("--robot-port", o.robot_port,
-                 "fanuc-j519, motoros2-rt, ur-rtde: deflex online --robot-port (default 60015, 22000, 30004)");
-  sub.add_option("--motoros2-group", o.motoros2_group, "motoros2-rt: deflex online --motoros2-group")
-      ->capture_default_str();
-  sub.add_option("--motoros2-resend-ms", o.motoros2_resend_ms, "motoros2-rt: deflex online --motoros2-resend-ms")
-      ->capture_default_str();
-  sub.add_option("--motoros2-max-truncations", o.motoros2_max_truncations,
-                 "motoros2-rt: deflex online --motoros2-max-truncations")
-      ->capture_default_str();
-  sub.add_option("--ur-lookahead-ms", o.ur_lookahead_ms, "ur-rtde: deflex online --ur-lookahead-ms")
-      ->capture_default_str();
-  sub.add_option("--ur-gain", o.ur_gain, "ur-rtde: deflex online --ur-gain")->capture_default_str();
-  sub.add_option("--ur-register-offset", o.ur_register_offset, "ur-rtde: deflex online --ur-register-offset")
-      ->capture_default_str();
+  add_shared(sub, "--fanuc-version", o.fanuc_version)->capture_default_str();
+  add_shared(sub, "--fanuc-limits", o.fanuc_limits)->capture_default_str();
+  add_shared(sub, "--fanuc-correction-share", o.fanuc_correction_share)->capture_default_str();
+  add_shared(sub, "--robot-port", o.robot_port);
+  add_shared(sub, "--motoros2-group", o.motoros2_group)->capture_default_str();
+  add_shared(sub, "--motoros2-resend-ms", o.motoros2_resend_ms)->capture_default_str();
+  add_shared(sub, "--motoros2-max-truncations", o.motoros2_max_truncations)->capture_default_str();
+  add_shared(sub, "--ur-lookahead-ms", o.ur_lookahead_ms)->capture_default_str();
+  add_shared(sub, "--ur-gain", o.ur_gain)->capture_default_str();
+  add_shared(sub, "--ur-register-offset", o.ur_register_offset)->capture_default_str();
   sub.add_option("--uframe", o.uframe, "fanuc-j519: the user frame the TP program sets")->capture_default_str();
   sub.add_option("--utool", o.utool, "fanuc-j519: the tool frame the TP program sets")->capture_default_str();
   sub.add_option("--move-speed-pct", o.move_speed_pct,

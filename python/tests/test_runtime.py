@@ -222,3 +222,16 @@ def test_the_command_line_and_python_refuse_the_same_settings_with_the_same_word
         words = str(python_error.value)
         assert words.startswith("setting "), words
         assert f"deflex online: error: {words}\n" in cli.stderr, (words, cli.stderr)
+        # controller-setup writes the controller's side from the same settings: it refuses them alike
+        # (before writing anything).
+        if options[0] in CONTROLLER_SETUP_SHARES and link != "simple-message":
+            out = tmp_path / f"setup_{link}_{options[0].strip('-')}"
+            setup = run_cli("controller-setup", "--link", link, "--sensor-ip", "10.0.0.2", "-o", str(out),
+                            *options, check=False)
+            assert setup.returncode == 2, setup.stderr
+            assert f"deflex controller-setup: error: {words}\n" in setup.stderr, (words, setup.stderr)
+            assert not out.exists()
+
+
+# The options `deflex controller-setup` shares with `deflex online` (checked by the same table).
+CONTROLLER_SETUP_SHARES = {"--max-joint-correction-deg", "--period-ms", "--fanuc-correction-share", "--rsi-sentype"}

@@ -107,5 +107,29 @@ TEST(ControllerSetupByKind, AKindWithoutAControllerSetupIsRefusedNamingTheLink) 
   EXPECT_THROW((void)runtime::controller_setup_files(settings_for("simple-message")), InputError);
 }
 
+// The settings controller-setup shares with deflex online are checked by the settings table, so the
+// controller's side is never written for a value the session would refuse, and the words are online's.
+TEST(ControllerSetupByKind, SharedSettingsAreCheckedByTheSessionsTableWithItsWords) {
+  ControllerSetupSettings s = settings_for("rsi");
+  s.max_joint_deg = 57.0;
+  EXPECT_EQ(test::error_of([&] { (void)runtime::controller_setup_files(s); }),
+            "setting max_joint_correction_rad (--max-joint-correction-deg): 0.994838 rad (57 deg) is outside 0 rad (0 "
+            "deg) < value <= 0.174533 rad (10 deg): a compliance correction is a fraction of a degree");
+  s = settings_for("egm-joint");
+  s.period_ms = 0.2;  // the table's cycles start at 0.5 ms
+  EXPECT_NE(test::error_of([&] { (void)runtime::controller_setup_files(s); }).find("setting period_s (--period-ms)"),
+            std::string::npos);
+  s = settings_for("ur-rtde");
+  s.ur_gain = 5.0;  // servoj's gain is 100..2000
+  EXPECT_NE(test::error_of([&] {
+              (void)runtime::controller_setup_files(s);
+            }).find("setting ur_gain (--ur-gain): 5 is outside 100"),
+            std::string::npos);
+  // Another link's setting is not this link's business: an RSI value is not checked for egm-joint.
+  s = settings_for("egm-joint");
+  s.sentype = "9lives";
+  EXPECT_NO_THROW((void)runtime::controller_setup_files(s));
+}
+
 }  // namespace
 }  // namespace deflex

@@ -1,9 +1,12 @@
 // The controller's side of a link by link kind (controller_setup.hpp).
 #include "deflex/runtime/controller_setup.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <memory>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -16,6 +19,7 @@
 #include "deflex/robotfile/robot_io.hpp"
 #include "deflex/rsi/rsi_controller_setup.hpp"
 #include "deflex/rsi/rsi_link.hpp"
+#include "deflex/runtime/session_settings.hpp"
 #include "deflex/text/errors.hpp"
 #include "deflex/ur/ur_controller_setup.hpp"
 
@@ -167,18 +171,68 @@ std::vector<ControllerFile> ur_setup_files(const ControllerSetupSettings& o, con
   return ur_controller_setup(u);
 }
 
+/// The settings controller-setup shares with `deflex online`, as (option, value in the option's unit or
+/// words); an unset one (a period of 0, a silence of NaN, a port of -1: the link's) is left out.
+std::vector<std::pair<const char*, std::string>> shared_settings(const ControllerSetupSettings& o) {
+  std::vector<std::pair<const char*, std::string>> out;
+  const auto number = [&out](const char* option, double v) {
+    if (!std::isnan(v)) out.emplace_back(option, fmt::format("{:.17g}", v));
+  };
+  if (o.period_ms != 0.0) number("--period-ms", o.period_ms);
+  number("--max-joint-correction-deg", o.max_joint_deg);
+  number("--max-tcp-correction-mm", o.max_tcp_mm);
+  number("--max-rate-deg-s", o.max_rate_deg_s);
+  number("--ramp-in-s", o.ramp_in_s);
+  number("--stop-silence-s", o.stop_silence_s);
+  number("--egm-port", o.egm_port);
+  number("--rsi-port", o.rsi_port);
+  number("--rsi-timeout", o.rsi_timeout);
+  out.emplace_back("--rsi-sentype", o.sentype);
+  out.emplace_back("--path-corr-frame", o.path_frame);
+  number("--fanuc-version", o.fanuc_version);
+  out.emplace_back("--fanuc-limits", o.fanuc_limits);
+  number("--fanuc-correction-share", o.fanuc_correction_share);
+  if (o.robot_port != -1) number("--robot-port", o.robot_port);
+  number("--motoros2-group", o.motoros2_group);
+  number("--motoros2-resend-ms", o.motoros2_resend_ms);
+  number("--motoros2-max-truncations", o.motoros2_max_truncations);
+  number("--ur-lookahead-ms", o.ur_lookahead_ms);
+  number("--ur-gain", o.ur_gain);
+  number("--ur-register-offset", o.ur_register_offset);
+  return out;
+}
+
+/// Checks the shared settings that apply to the link as `deflex online` checks them (the settings
+/// table: the same ranges, the same sentence), so the controller's side is never written for a value
+/// the session would refuse.
+void check_shared_settings(const ControllerSetupSettings& o) {
+  const LinkKind kind = parse_link_kind(o.link);
+  std::vector<GivenSetting> given;
+  for (const auto& [option, text] : shared_settings(o)) {
+    const SessionSetting* s = find_session_setting(option);
+    if (s == nullptr) throw std::logic_error(fmt::format("controller-setup: {} is not in the settings table", option));
+    if ((s->links & link_bit(kind)) == 0) continue;
+    given.push_back({s, option_value(*s, text)});
+  }
+  (void)make_session_config(o.link, "online", given);
+}
+
 }  // namespace
 
 std::vector<ControllerFile> controller_setup_files(const ControllerSetupSettings& settings,
                                                    const RobotLoader& load_robot) {
   const std::string& link = settings.link;
+  constexpr const char* kLinks[] = {"egm-joint", "egm-path", "rsi", "fanuc-j519", "motoros2-rt", "ur-rtde"};
+  if (std::find(std::begin(kLinks), std::end(kLinks), link) == std::end(kLinks)) {
+    throw InputError(
+        fmt::format("option --link: '{}' is not egm-joint, egm-path, rsi, fanuc-j519, motoros2-rt or ur-rtde", link));
+  }
+  check_shared_settings(settings);
   if (link == "egm-joint" || link == "egm-path") return egm_setup_files(settings, load_robot);
   if (link == "rsi") return rsi_setup_files(settings);
   if (link == "fanuc-j519") return fanuc_setup_files(settings, load_robot);
   if (link == "motoros2-rt") return motoros2_setup_files(settings, load_robot);
-  if (link == "ur-rtde") return ur_setup_files(settings, load_robot);
-  throw InputError(
-      fmt::format("option --link: '{}' is not egm-joint, egm-path, rsi, fanuc-j519, motoros2-rt or ur-rtde", link));
+  return ur_setup_files(settings, load_robot);
 }
 
 }  // namespace deflex::runtime
