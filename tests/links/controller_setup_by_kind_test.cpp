@@ -2,6 +2,7 @@
 // runs it: each kind's files with the link's own period where none is given (EGM's 4 ms sensor cycle,
 // egm-path's 48 ms EGMActMove sample rate, RSI's #IPO_FAST 4 ms, FANUC's 8 ms interval), the robot read
 // only where the link needs it, and settings that do not apply to a kind refused naming the option.
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -124,6 +125,12 @@ TEST(ControllerSetupByKind, SharedSettingsAreCheckedByTheSessionsTableWithItsWor
   EXPECT_NE(test::error_of([&] {
               (void)runtime::controller_setup_files(s);
             }).find("setting ur_gain (--ur-gain): 5 is outside 100"),
+            std::string::npos);
+  s = settings_for("egm-joint");
+  s.max_tcp_mm = std::numeric_limits<double>::quiet_NaN();  // NaN is never a bound
+  EXPECT_NE(test::error_of([&] {
+              (void)runtime::controller_setup_files(s);
+            }).find("setting max_tcp_correction_m (--max-tcp-correction-mm)"),
             std::string::npos);
   // Another link's setting is not this link's business: an RSI value is not checked for egm-joint.
   s = settings_for("egm-joint");

@@ -175,15 +175,16 @@ std::vector<ControllerFile> ur_setup_files(const ControllerSetupSettings& o, con
 /// words); an unset one (a period of 0, a silence of NaN, a port of -1: the link's) is left out.
 std::vector<std::pair<const char*, std::string>> shared_settings(const ControllerSetupSettings& o) {
   std::vector<std::pair<const char*, std::string>> out;
-  const auto number = [&out](const char* option, double v) {
-    if (!std::isnan(v)) out.emplace_back(option, fmt::format("{:.17g}", v));
+  // A NaN is passed on for the table to refuse, except where it means "unset" (the silence).
+  const auto number = [&out](const char* option, double v, bool nan_is_unset = false) {
+    if (!(nan_is_unset && std::isnan(v))) out.emplace_back(option, fmt::format("{:.17g}", v));
   };
   if (o.period_ms != 0.0) number("--period-ms", o.period_ms);
   number("--max-joint-correction-deg", o.max_joint_deg);
   number("--max-tcp-correction-mm", o.max_tcp_mm);
   number("--max-rate-deg-s", o.max_rate_deg_s);
   number("--ramp-in-s", o.ramp_in_s);
-  number("--stop-silence-s", o.stop_silence_s);
+  number("--stop-silence-s", o.stop_silence_s, true);
   number("--egm-port", o.egm_port);
   number("--rsi-port", o.rsi_port);
   number("--rsi-timeout", o.rsi_timeout);
