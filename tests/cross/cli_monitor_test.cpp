@@ -412,7 +412,8 @@ TEST(CliMonitor, RecordedLogServedAndWrittenAsAReport) {
               0u)
         << dom_text(dom, "v-late-answers");
     EXPECT_NE(dom_text(dom, "v-answer-stats").find("over the run"), std::string::npos);
-    EXPECT_NE(dom.find("<td class=\"opt\">--max-joint-correction-deg</td><td class=\"n\">0.5</td><td>deg</td>"), std::string::npos)
+    EXPECT_NE(dom.find("<td class=\"opt\">--max-joint-correction-deg</td><td class=\"n\">0.5</td><td>deg</td>"),
+              std::string::npos)
         << dom_between(dom, "card-settings", "</details>");
     const std::string events = dom_between(dom, "events", "card-force");
     EXPECT_NE(events.find("data-kind=\"stop\""), std::string::npos) << events;
