@@ -718,8 +718,8 @@ std::string fanuc_threshold_summary(const FanucJ519LinkConfig& config, const Fan
         t.read, t.asked);
   }
   if (t.rejected > 0) where += fmt::format(", {} threshold replies rejected", t.rejected);
-  return fmt::format("{} (strictest joint: {:g} deg/s, {:g} deg/s^2, {:g} deg/s^3)", where, strictest.velocity,
-                     strictest.acceleration, strictest.jerk);
+  return fmt::format("{} (the strictest over the joints: {:g} deg/s, {:g} deg/s^2, {:g} deg/s^3)", where,
+                     strictest.velocity, strictest.acceleration, strictest.jerk);
 }
 
 }  // namespace
