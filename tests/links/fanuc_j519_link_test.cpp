@@ -6,6 +6,10 @@
 // with the link stopped for a named reason and nothing beyond the bound or the step limit sent.
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
+#include <limits>
+
 #include "deflex/cell/fanuc_j519_controller.hpp"
 #include "deflex/fanuc/fanuc_j519_link.hpp"
 #include "deflex/text/errors.hpp"
@@ -57,12 +61,15 @@ struct FanucBench {
 
   FanucBench(std::shared_ptr<const JointTrajectory> p, const JointVector& arm, std::uint32_t version = 1,
              std::uint32_t controller_version = 0, double controller_interval_s = 0.008)
+      : FanucBench(std::move(p), arm, link_config(version),
+                   controller_config(controller_version == 0 ? version : controller_version, controller_interval_s)) {}
+  FanucBench(std::shared_ptr<const JointTrajectory> p, const JointVector& arm, const FanucJ519LinkConfig& link_settings,
+             const cell::FanucJ519ControllerConfig& controller_settings)
       : compensator(robot, test::bench_sensor(), fanuc_online()),
         strategy(robot, StrategyKind::kOnline, nullptr),
         program(std::move(p)),
-        link(compensator, strategy, program, pc_port, clock, link_config(version)),
-        controller(controller_config(controller_version == 0 ? version : controller_version, controller_interval_s),
-                   arm, controller_port) {
+        link(compensator, strategy, program, pc_port, clock, link_settings),
+        controller(controller_settings, arm, controller_port) {
     link.read_force_from(&force);
   }
 
@@ -386,6 +393,265 @@ TEST(FanucJ519Link, PollDoesNotAllocate) {
     ASSERT_EQ(guard.allocations(), 0u) << k;
   }
   EXPECT_EQ(bench.link.state(), LinkState::kRunning);
+}
+
+// ---- The controller's threshold tables, read before the start packet ---------------------------------
+
+using Limits = std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes>;
+
+void expect_limits(const Limits& got, const Limits& want, int joints) {
+  for (int j = 0; j < joints; ++j) {
+    const auto i = static_cast<std::size_t>(j);
+    EXPECT_DOUBLE_EQ(got[i].velocity, want[i].velocity) << "joint " << j + 1;
+    EXPECT_DOUBLE_EQ(got[i].acceleration, want[i].acceleration) << "joint " << j + 1;
+    EXPECT_DOUBLE_EQ(got[i].jerk, want[i].jerk) << "joint " << j + 1;
+  }
+}
+
+// A controller far stricter than the limits given (50 deg/s^3 of jerk, where a CRX-10iA/L allows 1240),
+// so that one force step shows the difference, with the correction given half of each limit. Its
+// smoother, sized from the limits given (half of 1240 deg/s^3), averages over
+// N = ceil(sqrt(4 s / (620 deg/s^3 x T^3))) = 18 intervals (s = 3 deg/s x 8 ms = 0.024 deg, T = 8 ms)
+// and lets a force step through with more jerk than 50; sized from the tables (half of 50 deg/s^3) it
+// needs N = ceil(sqrt(4 s / (25 deg/s^3 x T^3))) = 87 and never exceeds 4 s / (N^2 T^3) = 24.8.
+// Protocol 3 (float64 targets: float32 rounding alone is worth ~60 deg/s^3 at 8 ms) and a 4 s ramp-in
+// (the blend's budget, 6 d / (R^2 T) = 9.4 deg/s^3) leave the program room under such limits.
+struct StrictController {
+  Limits standin{};
+  Limits expected{};  // the stricter of the given (120, 265, 1240) and the stand-in's, per joint and kind
+  StrictController() {
+    standin.fill({60.0, 40.0, 50.0});
+    standin[1] = {150.0, 45.0, 55.0};    // joint 2's velocity is laxer than the one given: that one holds
+    standin[4] = {90.0, 300.0, 1500.0};  // joint 5's acceleration and jerk laxer than given
+    expected.fill({60.0, 40.0, 50.0});
+    expected[1] = {120.0, 45.0, 55.0};
+    expected[4] = {90.0, 265.0, 1240.0};
+  }
+  FanucJ519LinkConfig link(bool read) const {
+    FanucJ519LinkConfig c = FanucBench::link_config(3);
+    c.stream.ramp_in_s = 4.0;
+    c.correction_share = 0.5;
+    c.read_thresholds = read;
+    return c;
+  }
+  cell::FanucJ519ControllerConfig controller() const {
+    cell::FanucJ519ControllerConfig c = FanucBench::controller_config(3, 0.008);
+    c.limits = standin;
+    return c;
+  }
+};
+
+void run_with_force_step(FanucBench& bench, double seconds) {
+  for (int k = 0; k < static_cast<int>(seconds / 0.004); ++k) {
+    const Vector3 f = bench.t_s > 1.0 ? Vector3(0.0, 0.0, -650.0) : Vector3::Zero();
+    bench.force.reading = test::reading_at(bench.robot, bench.controller.position(), f);
+    bench.tick();
+    if (!bench.controller.alarm().empty()) return;
+  }
+}
+
+TEST(FanucJ519Link, TheControllersStricterThresholdTablesHoldTheStreamWhereTheLimitsGivenWouldNot) {
+  const JointVector q0 = pose_deg(5, 25, -5, 20, 35, -15);
+  const StrictController strict;
+  const Limits given = FanucJ519LinkConfig::default_limits();
+  FanucBench bench(test::hold_program(test::bench_robot(), q0, 60.0), q0, strict.link(true), strict.controller());
+  run_with_force_step(bench, 12.0);
+  EXPECT_EQ(bench.controller.alarm(), "");
+  ASSERT_EQ(bench.link.state(), LinkState::kRunning) << bench.link.stop_reason();
+  EXPECT_EQ(bench.link.thresholds().asked, 18u);
+  EXPECT_EQ(bench.link.thresholds().read, 18u);
+  EXPECT_EQ(bench.link.thresholds().rejected, 0u);
+  EXPECT_FALSE(bench.link.thresholds().unanswered);
+  EXPECT_EQ(bench.controller.counters().threshold_replies, 18u);
+  expect_limits(bench.link.effective_limits(), strict.expected, 6);
+  EXPECT_EQ(bench.link.smoother().taps(), 87u);
+  // What the controller took stayed within its own strictest limits, and the correction did move it.
+  const fanuc_j519::AxisLimits& peak = bench.controller.check().peak();
+  EXPECT_LE(peak.jerk, 50.0);
+  EXPECT_LE(peak.acceleration, 40.0);
+  EXPECT_GT(peak.jerk, 1.0);
+  EXPECT_EQ(bench.link.counters().guard_trips, 0u);
+  EXPECT_NE(bench.link.protocol_summary().find("18 threshold tables were read"), std::string::npos)
+      << bench.link.protocol_summary();
+  expect_wire_invariants(bench);
+
+  // The control: the same run held to the limits given alone (the tables not asked for) makes the
+  // controller stop the stream on a joint's jerk or acceleration.
+  FanucBench control(test::hold_program(test::bench_robot(), q0, 60.0), q0, strict.link(false), strict.controller());
+  run_with_force_step(control, 12.0);
+  EXPECT_NE(control.controller.alarm().find("MOTN-61"), std::string::npos)
+      << control.controller.alarm() << " peak " << control.controller.check().peak().jerk << " "
+      << control.controller.check().peak().acceleration << " taken " << control.controller.taken().size() << " "
+      << (q0 - control.controller.taken().back()).transpose();
+  EXPECT_EQ(control.controller.counters().threshold_requests, 0u);
+  expect_limits(control.link.effective_limits(), given, 6);
+  EXPECT_EQ(control.link.smoother().taps(), 18u);
+  EXPECT_DOUBLE_EQ(bench.link.effective_limits()[0].jerk / control.link.effective_limits()[0].jerk, 50.0 / 1240.0);
+}
+
+// Older system software answers no threshold request: after one request and its two retries, 0.1 s
+// each, the link starts with the limits given and says so.
+TEST(FanucJ519Link, AControllerThatDoesNotAnswerThresholdRequestsGetsTheLimitsGivenAfterTheTimeout) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  cell::FanucJ519ControllerConfig old_software = FanucBench::controller_config(1, 0.008);
+  old_software.answer_thresholds = false;
+  FanucBench bench(test::sweep_program(test::bench_robot(), q0, pose_deg(5, 5, 5, 5, 5, 5), 8.0), q0,
+                   FanucBench::link_config(1), old_software);
+  bench.force.reading = test::reading_at(bench.robot, q0, Vector3(0, 0, -400));
+  double started_s = -1.0;
+  double done_s = -1.0;
+  while (bench.t_s < 1.0) {
+    bench.tick();
+    if (done_s < 0.0 && bench.link.thresholds_done()) done_s = bench.t_s;
+    if (bench.controller.counters().starts == 0) {
+      EXPECT_EQ(bench.controller.counters().commands, 0u);
+    } else if (started_s < 0.0) {
+      started_s = bench.t_s;  // the controller read the start packet at this tick
+    }
+  }
+  EXPECT_GE(done_s, 0.3);
+  EXPECT_LE(done_s, 0.3 + 0.008);
+  // The first request at 4.2 ms, again at 104.2 and 204.2 ms, given up at 304.2 ms with the start packet.
+  EXPECT_GE(started_s, 0.3);
+  EXPECT_LE(started_s, 0.3 + 0.012);
+  EXPECT_EQ(bench.controller.counters().threshold_requests, 3u);
+  EXPECT_EQ(bench.controller.counters().threshold_replies, 0u);
+  EXPECT_TRUE(bench.link.thresholds().unanswered);
+  EXPECT_EQ(bench.link.thresholds().resent, 2u);
+  EXPECT_EQ(bench.link.thresholds().read, 0u);
+  Limits given{};
+  given.fill({120.0, 265.0, 1240.0});
+  expect_limits(bench.link.effective_limits(), given, 6);
+  bench.run(3.0);
+  EXPECT_EQ(bench.controller.alarm(), "");
+  EXPECT_EQ(bench.link.state(), LinkState::kRunning) << bench.link.stop_reason();
+  EXPECT_GT(bench.controller.counters().taken, 300u);
+  EXPECT_NE(bench.link.protocol_summary().find("answered no threshold request (3 tries of 0.1 s"), std::string::npos)
+      << bench.link.protocol_summary();
+  expect_wire_invariants(bench);
+}
+
+// A threshold reply built byte by byte (big-endian, the layout of the reference notes): type 3, version 1,
+// axis, kind, 2000 mm/s, 8 ms, then 20 no-load and 20 full-load float32 all `value`.
+std::vector<unsigned char> threshold_reply(std::uint32_t axis, std::uint32_t kind, float value) {
+  std::vector<unsigned char> b(184, 0);
+  const auto put = [&](std::size_t at, std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) b[at + static_cast<std::size_t>(i)] = static_cast<unsigned char>(v >> (24 - 8 * i));
+  };
+  put(0, 3);
+  put(4, 1);
+  put(8, axis);
+  put(12, kind);
+  put(16, 2000);
+  put(20, 8);
+  for (std::size_t i = 0; i < 40; ++i) put(24 + 4 * i, std::bit_cast<std::uint32_t>(value));
+  return b;
+}
+
+void set_column(std::vector<unsigned char>& b, std::size_t column, float value) {
+  const auto v = std::bit_cast<std::uint32_t>(value);
+  for (int i = 0; i < 4; ++i)
+    b[24 + 4 * column + static_cast<std::size_t>(i)] = static_cast<unsigned char>(v >> (24 - 8 * i));
+}
+
+TEST(FanucJ519Link, BadThresholdRepliesAreRejectedCountedAndNeverUsed) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  cell::FanucJ519ControllerConfig silent = FanucBench::controller_config(1, 0.008);
+  silent.answer_thresholds = false;  // every reply comes from the test
+  FanucBench bench(test::hold_program(test::bench_robot(), q0, 30.0), q0, FanucBench::link_config(1), silent);
+  bench.tick();  // the link asks for joint 1's velocity table
+  ASSERT_EQ(bench.controller.counters().threshold_requests, 0u);
+  bench.tick();
+  ASSERT_EQ(bench.controller.counters().threshold_requests, 1u);
+  // Every bad reply says 10 deg/s: had one been used, joint 1's velocity limit would be 10.
+  std::vector<std::vector<unsigned char>> bad = {
+      threshold_reply(2, 0, 10.0f),  // another axis
+      threshold_reply(1, 1, 10.0f),  // another kind
+      threshold_reply(1, 0, 10.0f), threshold_reply(1, 0, 10.0f), threshold_reply(1, 0, 10.0f),
+      threshold_reply(1, 0, 10.0f), threshold_reply(1, 0, 10.0f), threshold_reply(1, 0, 10.0f),
+  };
+  set_column(bad[2], 7, std::numeric_limits<float>::quiet_NaN());
+  set_column(bad[3], 25, 0.0f);
+  set_column(bad[4], 39, -5.0f);
+  set_column(bad[5], 0, std::numeric_limits<float>::infinity());
+  bad[6].resize(183);   // truncated
+  bad[7].push_back(0);  // one byte too many
+  for (const auto& b : bad) bench.controller_port.send_to(b.data(), b.size(), test::kSensorAddress);
+  bench.clock.set(bench.t_s + 0.001);
+  while (bench.link.poll(0.0) != LinkPollResult::kIdle) {
+  }
+  EXPECT_EQ(bench.link.thresholds().rejected, 8u);
+  EXPECT_EQ(bench.link.thresholds().read, 0u);
+  EXPECT_EQ(bench.link.tables()[0].velocity, 0.0);
+  // The right reply (hand-built the same way) is taken: the builder makes valid bytes.
+  const auto good = threshold_reply(1, 0, 100.0f);
+  bench.controller_port.send_to(good.data(), good.size(), test::kSensorAddress);
+  bench.clock.set(bench.t_s + 0.002);
+  while (bench.link.poll(0.0) != LinkPollResult::kIdle) {
+  }
+  EXPECT_EQ(bench.link.thresholds().read, 1u);
+  EXPECT_EQ(bench.link.tables()[0].velocity, 100.0);
+  // No one answers joint 1's acceleration: the reading ends and the session runs.
+  bench.run(2.0);
+  EXPECT_TRUE(bench.link.thresholds().unanswered);
+  EXPECT_EQ(bench.link.thresholds().rejected, 8u);
+  Limits want{};
+  want.fill({120.0, 265.0, 1240.0});
+  want[0].velocity = 100.0;
+  expect_limits(bench.link.effective_limits(), want, 6);
+  EXPECT_EQ(bench.link.state(), LinkState::kRunning) << bench.link.stop_reason();
+  EXPECT_EQ(bench.controller.alarm(), "");
+  EXPECT_NE(bench.link.protocol_summary().find("1 of the controller's 18 threshold tables"), std::string::npos)
+      << bench.link.protocol_summary();
+  EXPECT_NE(bench.link.protocol_summary().find("8 threshold replies rejected"), std::string::npos)
+      << bench.link.protocol_summary();
+}
+
+// A table stricter than the program can follow: the link stops before the start packet, naming the
+// joint, the limit and the value.
+TEST(FanucJ519Link, AThresholdTableTheProgramExceedsStopsTheLinkBeforeAnythingIsSent) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  // 10 deg on joint 1 in 4 s (a half-cosine sweep): a peak acceleration of 10 (pi/4)^2 / 2 = 3.1 deg/s^2,
+  // well under the 265 given, over what a table's 3 deg/s^2 leaves the program (75 % of it, less the
+  // ramp-in blend's 6 x 0.2 deg / (1 s)^2 and float32 rounding: under 1.1).
+  cell::FanucJ519ControllerConfig strict = FanucBench::controller_config(1, 0.008);
+  strict.limits[0] = {120.0, 3.0, 1240.0};
+  FanucBench bench(test::sweep_program(test::bench_robot(), q0, pose_deg(10, 0, 0, 0, 0, 0), 4.0, 161), q0,
+                   FanucBench::link_config(1), strict);
+  bench.run(1.0);
+  EXPECT_EQ(bench.link.state(), LinkState::kStopped);
+  EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kController) << bench.link.stop_reason();
+  const std::string why = bench.link.stop_reason();
+  EXPECT_NE(why.find("threshold tables"), std::string::npos) << why;
+  EXPECT_NE(why.find("joint acceleration"), std::string::npos) << why;
+  EXPECT_NE(why.find("joint 1"), std::string::npos) << why;
+  EXPECT_EQ(bench.controller.counters().starts, 0u);
+  EXPECT_EQ(bench.controller.counters().commands, 0u);
+}
+
+// The threshold phase runs in poll(): reading stricter tables, checking the program again and sizing
+// the smoother again allocate nothing either.
+TEST(FanucJ519Link, ReadingStricterThresholdTablesDoesNotAllocate) {
+  const JointVector q0 = pose_deg(5, 25, -5, 20, 35, -15);
+  const StrictController strict;
+  FanucBench bench(test::hold_program(test::bench_robot(), q0, 60.0), q0, strict.link(true), strict.controller());
+  std::size_t allocations = 0;
+  while (bench.t_s < 2.0) {
+    bench.t_s += 0.004;
+    bench.clock.set(bench.t_s);
+    bench.controller.tick(bench.t_s);
+    bench.clock.set(bench.t_s + 0.0002);
+    for (;;) {
+      test::AllocationGuard guard;
+      const LinkPollResult r = bench.link.poll(0.0);
+      allocations += guard.allocations();
+      if (r == LinkPollResult::kIdle || bench.link.state() == LinkState::kStopped) break;
+    }
+  }
+  EXPECT_EQ(bench.link.thresholds().read, 18u);
+  EXPECT_EQ(bench.link.smoother().taps(), 87u);
+  EXPECT_EQ(bench.link.state(), LinkState::kRunning) << bench.link.stop_reason();
+  EXPECT_EQ(allocations, 0u);
 }
 
 }  // namespace

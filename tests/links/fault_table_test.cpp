@@ -6,6 +6,7 @@
 // the per-cycle limit the test computes itself; and every stop has a named reason and its exit code.
 #include <gtest/gtest.h>
 
+#include "deflex/fanuc/fanuc_j519_link.hpp"
 #include "support/poses.hpp"
 
 #include "links/fault_bench.hpp"
@@ -592,6 +593,11 @@ TEST(FaultTable, FanucJ519RunsTheProgramToItsEndWithLastDataAndNoAlarm) {
   for (int k = 0; k < 10; ++k) b.standin->tick();
   EXPECT_TRUE(b.standin->fanuc()->ended());
   EXPECT_EQ(b.standin->fanuc()->alarm(), "");
+  // The stand-in's threshold tables (3 a joint) were read before the stream began.
+  const auto* link = dynamic_cast<const FanucJ519Link*>(&b.session->link());
+  ASSERT_NE(link, nullptr);
+  EXPECT_EQ(link->thresholds().read, 18u);
+  EXPECT_EQ(b.standin->fanuc()->counters().threshold_replies, 18u);
   expect_invariants(b, "fanuc to the end");
 }
 

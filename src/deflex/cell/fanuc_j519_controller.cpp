@@ -38,6 +38,38 @@ void FanucJ519Controller::restart(double t_s) {
   next_status_s_ = t_s;
 }
 
+// The table of the limit it enforces (the profile in the header): its strictest value is that limit.
+void FanucJ519Controller::answer_threshold(std::size_t size, const DatagramAddress& from) {
+  j519::ThresholdRequest rq;
+  if (j519::decode(buffer_.data(), size, rq) != j519::DecodeStatus::kOk) {
+    ++counters_.ignored;
+    return;
+  }
+  ++counters_.threshold_requests;
+  if (!config_.answer_thresholds || streaming_) return;
+  const j519::AxisLimits& l = config_.limits[rq.axis - 1];
+  const double limit = rq.kind == j519::LimitKind::kVelocity       ? l.velocity
+                       : rq.kind == j519::LimitKind::kAcceleration ? l.acceleration
+                                                                   : l.jerk;
+  j519::ThresholdReply reply;
+  reply.axis = rq.axis;
+  reply.kind = rq.kind;
+  reply.max_cartesian_speed_mm_s = config_.max_cartesian_speed_mm_s;
+  reply.interval_ms = static_cast<std::uint32_t>(std::lround(config_.interval_s * 1e3));
+  // float32 on the wire, rounded down: the table never allows more than the limit enforced.
+  const auto down = [](double v) {
+    const auto f = static_cast<float>(v);
+    return static_cast<double>(f) > v ? std::nextafter(f, 0.0f) : f;
+  };
+  for (std::size_t i = 0; i < reply.full_load.size(); ++i) {
+    const double full = limit * (1.0 + static_cast<double>(reply.full_load.size() - 1 - i) / 19.0);
+    reply.full_load[i] = down(full);
+    reply.no_load[i] = down(1.25 * full);
+  }
+  const std::size_t n = j519::encode(reply, buffer_.data(), buffer_.size());
+  if (n > 0 && transport_.send_to(buffer_.data(), n, from)) ++counters_.threshold_replies;
+}
+
 void FanucJ519Controller::read_packets(double t_s) {
   DatagramAddress from;
   for (;;) {
@@ -63,6 +95,10 @@ void FanucJ519Controller::read_packets(double t_s) {
       ++counters_.stops;
       streaming_ = false;
       stop_stream("stream stopped by the stop packet");
+      continue;
+    }
+    if (type == j519::kTypeThreshold) {
+      answer_threshold(size, from);
       continue;
     }
     j519::Command c;

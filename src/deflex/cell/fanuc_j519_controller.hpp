@@ -16,7 +16,14 @@
 //     until a stop packet (unconfirmed in FANUC's text: the strict reading keeps reporting);
 //   - a command flagged last-data ends the session as planned once it is taken (the TP program leaves
 //     IBGN: the ready bit clears, no alarm; FANUC's text does not say when the bit clears);
-//   - the arm follows the targets taken after a dead time, through a first-order servo lag.
+//   - the arm follows the targets taken after a dead time, through a first-order servo lag;
+//   - a threshold request (axis, kind) is answered with the table of the limits it enforces, while no
+//     stream runs (before the start packet or after a stop packet: FANUC's own driver asks before the
+//     start; whether the controller answers during a stream is not published, so it does not);
+//     `answer_thresholds` off is older system software, which answers none. FANUC publishes no table, so
+//     its 20 speed columns are a made-up profile whose strictest value is the enforced limit: full payload
+//     at 100 % of the maximum Cartesian speed is the limit, each 5 % slower allows limit / 19 more (twice
+//     the limit at 5 %), and no payload allows 1.25 times full payload's.
 // Faults on request (tests): an alarm now (an e-stop), a restart of the TP program (a new session,
 // numbered from 1 again). A network outage is the network's. It knows nothing of deflex.
 #pragma once
@@ -47,6 +54,8 @@ struct FanucJ519ControllerConfig {
   double servo_lag_s = 0.01;  ///< first-order lag of the drives following the delayed target
   /// The limits it holds the stream to (deg/s, deg/s^2, deg/s^3): a CRX-10iA/L's strictest.
   std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> limits = strict_crx();
+  bool answer_thresholds = true;                  ///< false: older system software, threshold requests go unanswered
+  std::uint32_t max_cartesian_speed_mm_s = 2000;  ///< $STMO_GRP's $MAX_SPD, the tables' 100 % column
 
   static std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> strict_crx() {
     std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> l{};
@@ -61,6 +70,8 @@ struct FanucJ519ControllerCounters {
   std::uint64_t taken = 0;     ///< targets taken (one an interval once moving)
   std::uint64_t ignored = 0;   ///< datagrams that were not a packet it takes
   std::uint64_t starts = 0, stops = 0;
+  std::uint64_t threshold_requests = 0;  ///< threshold requests received (answered or not)
+  std::uint64_t threshold_replies = 0;   ///< threshold tables sent
 };
 
 /// Thread safety: one thread at a time (the simulation's), with its transport.
@@ -94,6 +105,7 @@ class FanucJ519Controller final : public RobotController {
 
  private:
   void read_packets(double t_s);
+  void answer_threshold(std::size_t size, const DatagramAddress& from);
   void take_command(double t_s);
   void send_status(double t_s, double stamp_s);
   void stop_stream(const std::string& alarm);

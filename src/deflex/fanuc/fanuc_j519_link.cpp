@@ -35,21 +35,32 @@ CommandLimits fanuc_limits(const OnlineCompensator& c, const JointTrajectory* pr
   return l;
 }
 
+using Limits = std::array<j519::AxisLimits, j519::kAxes>;
+
 // The smoother's limits: the correction's share of the strictest joint's acceleration and jerk (rad),
 // its step the compensator's rate bound over one interval.
-SmootherLimits smoother_limits(const OnlineCompensator& c, const FanucJ519LinkConfig& f) {
+SmootherLimits smoother_limits(const OnlineCompensator& c, const FanucJ519LinkConfig& f, const Limits& limits) {
   SmootherLimits s;
   s.cycle_s = c.config().period_s;
   s.step_rad = c.config().max_correction_rate_rad_s * s.cycle_s;
   double acc = std::numeric_limits<double>::infinity();
   double jerk = acc;
   for (int j = 0; j < c.model().dof(); ++j) {
-    acc = std::min(acc, f.limits[static_cast<std::size_t>(j)].acceleration);
-    jerk = std::min(jerk, f.limits[static_cast<std::size_t>(j)].jerk);
+    acc = std::min(acc, limits[static_cast<std::size_t>(j)].acceleration);
+    jerk = std::min(jerk, limits[static_cast<std::size_t>(j)].jerk);
   }
   s.acceleration = deg_to_rad(acc) * f.correction_share;
   s.jerk = deg_to_rad(jerk) * f.correction_share;
   return s;
+}
+
+// The averaging CorrectionSmoother::taps_for() would choose (its closed forms), without its throw: the
+// threshold phase runs in poll(), which must not throw.
+double smoother_taps_needed(const SmootherLimits& s) noexcept {
+  const double t = s.cycle_s;
+  const double for_acceleration = 2.0 * s.step_rad / (s.acceleration * t * t);
+  const double for_jerk = std::sqrt(4.0 * s.step_rad / (s.jerk * t * t * t));
+  return std::ceil(std::max({1.0, for_acceleration, for_jerk}) - 1e-12);
 }
 
 // What the rest of the stream takes of each limit, per the closed forms (deg/s, deg/s^2, deg/s^3):
@@ -59,46 +70,50 @@ SmootherLimits smoother_limits(const OnlineCompensator& c, const FanucJ519LinkCo
 //     12 d/R^3;
 //   protocol 1's float32 degrees: rounding errors of half an ulp u at the largest joint value give up to
 //     u/T, 2u/T^2 and 4u/T^3.
-// The program may use what is left; nothing left is an InputError naming the culprit.
-struct Budget {
-  double velocity, acceleration, jerk;
-};
-
-Budget program_budget(const j519::AxisLimits& l, const OnlineCompensator& c, const FanucJ519LinkConfig& f,
-                      double largest_deg) {
+// The program may use what is left (nothing left: a ProgramFault naming the culprit).
+j519::AxisLimits program_budget(const j519::AxisLimits& l, const OnlineCompensator& c, const FanucJ519LinkConfig& f,
+                                double largest_deg) noexcept {
   const double t = c.config().period_s;
   const double d = rad_to_deg(f.stream.start_tolerance_rad);
   const double r = f.stream.ramp_in_s;
   const double u = f.version == 1
                        ? std::nextafter(static_cast<float>(largest_deg), HUGE_VALF) - static_cast<float>(largest_deg)
                        : 0.0;
-  Budget b;
+  j519::AxisLimits b;
   b.velocity = l.velocity - rad_to_deg(c.config().max_correction_rate_rad_s) - (r > 0 ? 1.5 * d / r : 0.0) - u / t;
   b.acceleration = l.acceleration * (1.0 - f.correction_share) - (r > 0 ? 6.0 * d / (r * r) : 0.0) - 2.0 * u / (t * t);
   b.jerk = l.jerk * (1.0 - f.correction_share) - (r > 0 ? 6.0 * d / (r * r * t) + 12.0 * d / (r * r * r) : 0.0) -
            4.0 * u / (t * t * t);
-  if (b.velocity <= 0.0 || b.acceleration <= 0.0 || b.jerk <= 0.0) {
-    throw InputError(fmt::format(
-        "FANUC J519 link: at a {:g} ms interval the correction (--max-rate-deg-s, --fanuc-correction-share), the "
-        "ramp-in blend (--ramp-in-s {:g} from up to {:g} deg away){} leave the program nothing of the limits "
-        "{:g} deg/s, {:g} deg/s^2, {:g} deg/s^3: lengthen --ramp-in-s{}, lower --max-rate-deg-s",
-        t * 1e3, r, d, f.version == 1 ? " and protocol 1's float32 rounding" : "", l.velocity, l.acceleration, l.jerk,
-        f.version == 1 ? ", use --fanuc-version 3" : ""));
-  }
   return b;
 }
 
-// The program alone, sampled at the interval as the controller will see it, within what the budget
-// leaves it; throws InputError naming the first joint and time that is not.
-void check_program(const JointTrajectory& program, const OnlineCompensator& c, const FanucJ519LinkConfig& f) {
+// Why a program cannot be streamed within the limits: nothing of a joint's limits left beside the rest of
+// the stream (`budget`), or the program alone over what is left (`hit` on `joint` at `time_s`).
+struct ProgramFault {
+  bool budget = false;
+  j519::LimitExceeded hit = j519::LimitExceeded::kNone;
+  std::size_t joint = 0;  // 0-based
+  double value = 0.0, limit = 0.0, time_s = 0.0;
+  [[nodiscard]] bool any() const { return budget || hit != j519::LimitExceeded::kNone; }
+};
+
+// The program alone, sampled at the interval as the controller will see it, against what the budget
+// leaves it of `limits`. Allocates nothing (the threshold phase runs it inside poll()).
+ProgramFault find_program_fault(const JointTrajectory& program, const OnlineCompensator& c,
+                                const FanucJ519LinkConfig& f, const Limits& limits) noexcept {
   const double interval_s = c.config().period_s;
   double largest = 0.0;
   for (const JointVector& q : program.points()) largest = std::max(largest, rad_to_deg(q.cwiseAbs().maxCoeff()));
   largest += rad_to_deg(c.config().max_joint_correction_rad) + rad_to_deg(f.stream.start_tolerance_rad);
-  std::array<j519::AxisLimits, j519::kAxes> rest = f.limits;
+  ProgramFault fault;
+  Limits rest = limits;
   for (std::size_t j = 0; j < static_cast<std::size_t>(program.dof()); ++j) {
-    const Budget b = program_budget(f.limits[j], c, f, largest);
-    rest[j] = {b.velocity, b.acceleration, b.jerk};
+    rest[j] = program_budget(limits[j], c, f, largest);
+    if (rest[j].velocity <= 0.0 || rest[j].acceleration <= 0.0 || rest[j].jerk <= 0.0) {
+      fault.budget = true;
+      fault.joint = j;
+      return fault;
+    }
   }
   j519::MotionCheck check(interval_s, static_cast<std::size_t>(program.dof()), rest);
   JointVector q(program.dof());
@@ -113,22 +128,42 @@ void check_program(const JointTrajectory& program, const OnlineCompensator& c, c
   for (long k = 1; k <= steps + 3; ++k) {
     program.sample(std::min(program.start_time_s() + static_cast<double>(k) * interval_s, program.end_time_s()), q);
     to_deg();
-    std::size_t axis = 0;
-    double value = 0.0;
-    const j519::LimitExceeded hit = check.push(deg, axis, value);
-    if (hit == j519::LimitExceeded::kNone) continue;
-    const j519::AxisLimits& l = rest[axis];
-    const double limit = hit == j519::LimitExceeded::kVelocity       ? l.velocity
-                         : hit == j519::LimitExceeded::kAcceleration ? l.acceleration
-                                                                     : l.jerk;
-    throw InputError(fmt::format(
-        "FANUC J519 link: the program alone reaches a {} of {:.6g} on joint {} at {:.3f} s, over the {:.6g} the "
-        "controller's limit leaves it beside the correction ({:.0f} % of acceleration and jerk), the ramp-in blend "
-        "and the wire's rounding at a {:.0f} ms interval: the controller would stop the stream; slow the program "
-        "down (or give it more points where it turns) or give the controller's own limits",
-        j519::to_string(hit), std::abs(value), axis + 1, static_cast<double>(k) * interval_s, limit,
-        100.0 * f.correction_share, interval_s * 1e3));
+    fault.hit = check.push(deg, fault.joint, fault.value);
+    if (fault.hit == j519::LimitExceeded::kNone) continue;
+    const j519::AxisLimits& l = rest[fault.joint];
+    fault.limit = fault.hit == j519::LimitExceeded::kVelocity       ? l.velocity
+                  : fault.hit == j519::LimitExceeded::kAcceleration ? l.acceleration
+                                                                    : l.jerk;
+    fault.value = std::abs(fault.value);
+    fault.time_s = static_cast<double>(k) * interval_s;
+    return fault;
   }
+  return fault;
+}
+
+// The configured limits at construction: a program they cannot carry is an InputError naming the culprit.
+void check_program(const JointTrajectory& program, const OnlineCompensator& c, const FanucJ519LinkConfig& f) {
+  const ProgramFault fault = find_program_fault(program, c, f, f.limits);
+  if (!fault.any()) return;
+  const double t = c.config().period_s;
+  if (fault.budget) {
+    const j519::AxisLimits& l = f.limits[fault.joint];
+    const double r = f.stream.ramp_in_s;
+    throw InputError(fmt::format(
+        "FANUC J519 link: at a {:g} ms interval the correction (--max-rate-deg-s, --fanuc-correction-share), the "
+        "ramp-in blend (--ramp-in-s {:g} from up to {:g} deg away){} leave the program nothing of the limits "
+        "{:g} deg/s, {:g} deg/s^2, {:g} deg/s^3: lengthen --ramp-in-s{}, lower --max-rate-deg-s",
+        t * 1e3, r, rad_to_deg(f.stream.start_tolerance_rad),
+        f.version == 1 ? " and protocol 1's float32 rounding" : "", l.velocity, l.acceleration, l.jerk,
+        f.version == 1 ? ", use --fanuc-version 3" : ""));
+  }
+  throw InputError(fmt::format(
+      "FANUC J519 link: the program alone reaches a {} of {:.6g} on joint {} at {:.3f} s, over the {:.6g} the "
+      "controller's limit leaves it beside the correction ({:.0f} % of acceleration and jerk), the ramp-in blend "
+      "and the wire's rounding at a {:.0f} ms interval: the controller would stop the stream; slow the program "
+      "down (or give it more points where it turns) or give the controller's own limits",
+      j519::to_string(fault.hit), fault.value, fault.joint + 1, fault.time_s, fault.limit, 100.0 * f.correction_share,
+      t * 1e3));
 }
 
 }  // namespace
@@ -189,6 +224,11 @@ void FanucJ519LinkConfig::validate() const {
   if (!(start_resend_s > 0.0) || max_catch_up < 0 || max_catch_up > 9) {
     throw InputError("FANUC J519 link: start_resend_s must be > 0 and max_catch_up (--fanuc-catch-up) in 0..9");
   }
+  if (!(threshold_timeout_s > 0.0 && threshold_timeout_s <= 10.0) || threshold_retries < 0 || threshold_retries > 10) {
+    throw InputError(
+        "FANUC J519 link: threshold_timeout_s must be in (0, 10] s and threshold_retries in 0..10 (the threshold "
+        "tables' requests)");
+  }
 }
 
 FanucJ519Link::FanucJ519Link(OnlineCompensator& compensator, OnlineStrategy& strategy,
@@ -204,10 +244,12 @@ FanucJ519Link::FanucJ519Link(OnlineCompensator& compensator, OnlineStrategy& str
         return g;
       }()),
       stream_(std::move(nominal), config.stream),
-      smoother_(smoother_limits(compensator, config), compensator.model().dof()),
+      smoother_(smoother_limits(compensator, config, config.limits), compensator.model().dof()),
       delay_(config.initial_delay_s),
-      period_s_(compensator.config().period_s) {
+      period_s_(compensator.config().period_s),
+      limits_(config.limits) {
   check_program(stream_.trajectory(), compensator, config_);
+  if (!config_.read_thresholds) tables_done_ = true;
   const int n = compensator.model().dof();
   for (JointVector* q : {&feedback_, &program_, &program_velocity_, &blend_, &blend_velocity_, &nominal_}) {
     *q = JointVector::Zero(n);
@@ -327,6 +369,141 @@ bool FanucJ519Link::start_session(const j519::Status& s) noexcept {
   return true;
 }
 
+// ---- The threshold tables, before the start packet ------------------------------------------------------
+// One request in flight at a time, as FANUC's own driver asks (it sends each and waits for its reply
+// before the next): nothing published says the controller queues several, and a reply names its axis and
+// kind anyway, so a late one is told apart. The tables are read at their strictest column (the lowest
+// value at any Cartesian speed, with or without payload): a stream held to that is within the table
+// whatever speed and payload the controller computes its limit for ($LMT_MODE), at the price of some
+// margin at low speed.
+
+void FanucJ519Link::send_threshold_request(double now) noexcept {
+  j519::ThresholdRequest rq;
+  rq.axis = static_cast<std::uint32_t>(table_next_ / 3 + 1);
+  rq.kind = static_cast<j519::LimitKind>(table_next_ % 3);
+  const std::size_t n = j519::encode(rq, tx_.data(), tx_.size());
+  if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) ++counters_.send_errors;
+  if (table_attempts_ > 0) ++thresholds_.resent;
+  ++table_attempts_;
+  table_sent_s_ = now;
+}
+
+// A datagram from the controller in the threshold phase (in rx_): the table asked for is taken; any other
+// threshold reply (another axis or kind, a wrong size, a value not finite or not > 0) is rejected and
+// counted; anything else is not answered (nothing is before the start packet).
+void FanucJ519Link::take_threshold_reply(std::size_t size) noexcept {
+  std::uint32_t type = 0;
+  std::uint32_t version = 0;
+  if (!j519::peek_header(rx_.data(), size, type, version) || type != j519::kTypeThreshold) {
+    ++counters_.not_running;
+    return;
+  }
+  j519::ThresholdReply reply;
+  if (j519::decode(rx_.data(), size, reply) != j519::DecodeStatus::kOk ||
+      reply.axis != static_cast<std::uint32_t>(table_next_ / 3 + 1) ||
+      static_cast<std::size_t>(reply.kind) != table_next_ % 3) {
+    ++thresholds_.rejected;
+    return;
+  }
+  const auto value = static_cast<double>(reply.strictest());
+  if (!std::isfinite(value) || value <= 0.0) {  // decode() refuses these already; never a limit of 0
+    ++thresholds_.rejected;
+    return;
+  }
+  j519::AxisLimits& t = tables_[table_next_ / 3];
+  (reply.kind == j519::LimitKind::kVelocity       ? t.velocity
+   : reply.kind == j519::LimitKind::kAcceleration ? t.acceleration
+                                                  : t.jerk) = value;
+  ++thresholds_.read;
+  ++table_next_;
+  table_attempts_ = 0;
+}
+
+// True once the phase is over (the start packet may go out in this poll).
+bool FanucJ519Link::read_thresholds(double timeout_s) noexcept {
+  const std::size_t total = 3 * static_cast<std::size_t>(compensator().model().dof());
+  thresholds_.asked = total;
+  double now = clock_.now_s();
+  if (table_attempts_ == 0) send_threshold_request(now);
+  const double left = table_sent_s_ + config_.threshold_timeout_s - now;
+  if (transport_.wait_readable(std::max(0.0, std::min(timeout_s, left)))) {
+    DatagramAddress from;
+    for (int i = 0; i < 64 && table_next_ < total; ++i) {
+      const long n = transport_.receive(rx_.data(), rx_.size(), from);
+      if (n < 0) break;
+      ++counters_.datagrams;
+      if (!(from == config_.controller)) {
+        ++counters_.foreign_sender;
+      } else if (static_cast<std::size_t>(n) > config_.max_packet_bytes) {
+        ++counters_.oversized;
+      } else {
+        const std::size_t before = table_next_;
+        take_threshold_reply(static_cast<std::size_t>(n));
+        if (table_next_ != before && table_next_ < total) send_threshold_request(clock_.now_s());
+      }
+    }
+  }
+  now = clock_.now_s();
+  if (table_next_ < total && now - table_sent_s_ >= config_.threshold_timeout_s) {
+    if (table_attempts_ <= config_.threshold_retries) {
+      send_threshold_request(now);
+    } else {
+      thresholds_.unanswered = true;  // older system software: no tables; the limits given hold
+    }
+  }
+  if (table_next_ < total && !thresholds_.unanswered) return false;
+  apply_tables();
+  return true;
+}
+
+// Per joint and kind, the stricter of the configured limit and the table's; stricter than configured
+// changes what the program may use and what the smoother is sized from, so both are done again (without
+// allocating: the program's check and the smoother are fixed-size).
+void FanucJ519Link::apply_tables() noexcept {
+  tables_done_ = true;
+  const auto dof = static_cast<std::size_t>(compensator().model().dof());
+  bool stricter = false;
+  for (std::size_t j = 0; j < dof; ++j) {
+    const j519::AxisLimits& t = tables_[j];
+    j519::AxisLimits& l = limits_[j];
+    for (auto [limit, table] :
+         {std::pair{&l.velocity, t.velocity}, std::pair{&l.acceleration, t.acceleration}, std::pair{&l.jerk, t.jerk}}) {
+      if (table > 0.0 && table < *limit) {
+        *limit = table;
+        stricter = true;
+      }
+    }
+  }
+  if (!stricter) return;
+  const ProgramFault fault = find_program_fault(stream_.trajectory(), compensator(), config_, limits_);
+  if (fault.any()) {
+    const j519::AxisLimits& l = limits_[fault.joint];
+    if (fault.budget) {
+      stop_link(LinkStopCause::kController,
+                "the controller's threshold tables limit joint %zu to %.6g deg/s, %.6g deg/s^2, %.6g deg/s^3: the "
+                "correction and the ramp-in blend leave the program nothing of them; nothing was sent",
+                fault.joint + 1, l.velocity, l.acceleration, l.jerk);
+    } else {
+      stop_link(LinkStopCause::kController,
+                "the controller's threshold tables: the program alone reaches a %s of %.6g on joint %zu at %.3f s, "
+                "over the %.6g its limit leaves it beside the correction; nothing was sent: slow the program down",
+                j519::to_string(fault.hit), fault.value, fault.joint + 1, fault.time_s, fault.limit);
+    }
+    return;
+  }
+  const SmootherLimits sl = smoother_limits(compensator(), config_, limits_);
+  if (smoother_taps_needed(sl) > static_cast<double>(CorrectionSmoother::kMaxTaps)) {
+    stop_link(LinkStopCause::kController,
+              "the controller's threshold tables (acceleration %.6g deg/s^2, jerk %.6g deg/s^3 at their strictest) "
+              "would need more than %zu intervals of smoothing for the correction's rate bound: lower "
+              "--max-rate-deg-s; nothing was sent",
+              rad_to_deg(sl.acceleration / config_.correction_share), rad_to_deg(sl.jerk / config_.correction_share),
+              CorrectionSmoother::kMaxTaps);
+    return;
+  }
+  smoother_ = CorrectionSmoother(sl, static_cast<int>(dof));
+}
+
 LinkPollResult FanucJ519Link::poll(double timeout_s) noexcept {
   const LinkPollResult r = poll_once(timeout_s);
   // However the link stopped, the controller's status output ends with the stop packet.
@@ -367,6 +544,15 @@ LinkPollResult FanucJ519Link::poll_once(double timeout_s) noexcept {
     bool starts = false;
     if (drain(0.0, ignored, starts) && state_ == LinkState::kRefused) ++counters_.refused;
     return announce_terminal();
+  }
+  if (!tables_done_) {
+    const std::uint64_t before = counters_.datagrams;
+    if (!read_thresholds(timeout_s)) {
+      // A table taken is not a message answered (no cycle record): as the poll loop sees it, datagrams came.
+      return counters_.datagrams > before ? LinkPollResult::kRejected : LinkPollResult::kIdle;
+    }
+    if (state_ == LinkState::kStopped) return announce_terminal();
+    timeout_s = 0.0;  // this poll has waited already
   }
   double now = clock_.now_s();
   if (!ready_seen_ && now - last_start_s_ >= config_.start_resend_s) {
@@ -500,12 +686,52 @@ void FanucJ519Link::stop() noexcept {
   stop_link(LinkStopCause::kRequested, "stop requested: the stop packet went out");
 }
 
+namespace {
+
+// What the threshold phase gave: which limits the stream was held to and where they came from.
+std::string fanuc_threshold_summary(const FanucJ519LinkConfig& config, const FanucThresholdCounters& t, bool done,
+                                    const std::array<j519::AxisLimits, j519::kAxes>& limits, std::size_t dof) {
+  j519::AxisLimits strictest{1e300, 1e300, 1e300};
+  for (std::size_t j = 0; j < dof; ++j) {
+    strictest = {std::min(strictest.velocity, limits[j].velocity),
+                 std::min(strictest.acceleration, limits[j].acceleration), std::min(strictest.jerk, limits[j].jerk)};
+  }
+  std::string where;
+  if (!config.read_thresholds) {
+    where = "the threshold tables were not asked for: the limits given (--fanuc-limits) hold";
+  } else if (!done) {
+    where = fmt::format("the link stopped while the threshold tables were read ({} of {})", t.read, t.asked);
+  } else if (t.read == t.asked) {
+    where = fmt::format(
+        "the controller's {} threshold tables were read: each joint's limit is the stricter of the table's strictest "
+        "value and the one given",
+        t.read);
+  } else if (t.read == 0) {
+    where = fmt::format(
+        "the controller answered no threshold request ({} tries of {:g} s; older system software does not): the "
+        "limits given (--fanuc-limits) hold",
+        config.threshold_retries + 1, config.threshold_timeout_s);
+  } else {
+    where = fmt::format(
+        "{} of the controller's {} threshold tables were read before it stopped answering: the limits given hold "
+        "for the rest",
+        t.read, t.asked);
+  }
+  if (t.rejected > 0) where += fmt::format(", {} threshold replies rejected", t.rejected);
+  return fmt::format("{} (the strictest over the joints: {:g} deg/s, {:g} deg/s^2, {:g} deg/s^3)", where,
+                     strictest.velocity, strictest.acceleration, strictest.jerk);
+}
+
+}  // namespace
+
 std::string FanucJ519Link::protocol_summary() const {
   return fmt::format(
       "FANUC J519 (protocol {}): {} commands sent, {} to catch up lost statuses; the correction smoothed over {} "
-      "intervals ({:.0f} ms) to stay within {:.0f} % of the acceleration and jerk limits",
+      "intervals ({:.0f} ms) to stay within {:.0f} % of the acceleration and jerk limits; {}",
       config_.version, counters_.replies, caught_up_, smoother_.taps(), smoother_.delay_s() * 1e3,
-      100.0 * config_.correction_share);
+      100.0 * config_.correction_share,
+      fanuc_threshold_summary(config_, thresholds_, tables_done_, limits_,
+                              static_cast<std::size_t>(compensator().model().dof())));
 }
 
 }  // namespace deflex

@@ -5,9 +5,11 @@
 //     target = program(p) + blend - dtheta_smoothed,   |target_i - (program_i(p) + blend_i)| <= bound.
 // The controller checks every joint's velocity, acceleration and jerk from successive commands and
 // stops the stream at the first over its limits (MOTN-609..611 / 720..722), so the correction passes
-// through a smoother with closed-form bounds (link/correction_smoother.hpp) sized from the limits the
-// user gives for the controller and the share of them the correction may take, and the program is
-// checked against the rest of them before the session starts.
+// through a smoother with closed-form bounds (link/correction_smoother.hpp) sized from the controller's
+// limits and the share of them the correction may take, and the program is checked against the rest of
+// them before the session starts. Those limits are, per joint and kind, the stricter of the ones the
+// user gives and the controller's own threshold table, read before the start packet (a controller that
+// does not answer: the user's, and the summary says so).
 //
 // The program's clock is the controller's: it moves on one interval per command, and a status whose
 // number skips some (a status lost on the way) is answered with one command for each number missed,
@@ -58,6 +60,13 @@ struct FanucJ519LinkConfig {
   double start_resend_s = 0.5;  ///< the start packet again while no status comes
   int max_catch_up = 8;         ///< statuses missed in a row that are caught up (0..9); more: kTooSlow
   std::size_t max_packet_bytes = 1400;
+  /// Ask the controller for its threshold tables before the start packet (joints 1..dof: velocity,
+  /// acceleration, jerk): one request at a time, each answered within `threshold_timeout_s` or sent
+  /// again, at most `threshold_retries` times; a request still unanswered then ends the reading (older
+  /// system software does not answer) and the limits above are used as given.
+  bool read_thresholds = true;
+  double threshold_timeout_s = 0.1;
+  int threshold_retries = 2;
 
   static JointStreamConfig fanuc_stream() {
     JointStreamConfig s;
@@ -77,6 +86,15 @@ struct FanucJ519LinkConfig {
 /// deflex online --fanuc-limits takes them). Throws InputError naming `option` and the triple.
 [[nodiscard]] std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> parse_fanuc_limits(const std::string& text,
                                                                                        const char* option);
+
+/// How the reading of the controller's threshold tables went.
+struct FanucThresholdCounters {
+  std::size_t asked = 0;       ///< tables to read (3 a joint); 0 when reading is off
+  std::size_t read = 0;        ///< tables read and used
+  std::uint64_t rejected = 0;  ///< replies that were not the table asked for, or not a valid one: never used
+  std::uint64_t resent = 0;    ///< requests sent again after their timeout
+  bool unanswered = false;     ///< a request went unanswered after every retry: the rest were not asked
+};
 
 /// Thread safety: one thread at a time (the loop's), as every ControllerLink.
 class FanucJ519Link final : public ControllerLink {
@@ -102,8 +120,22 @@ class FanucJ519Link final : public ControllerLink {
   [[nodiscard]] const CorrectionSmoother& smoother() const { return smoother_; }
   /// Commands sent as catch-up for statuses that never arrived.
   [[nodiscard]] std::uint64_t caught_up() const { return caught_up_; }
+  /// The limits the stream is held to (deg/s, deg/s^2, deg/s^3): the configured ones until the
+  /// threshold tables are read, then per joint and kind the stricter of the two.
+  [[nodiscard]] const std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes>& effective_limits() const {
+    return limits_;
+  }
+  /// The strictest value of each table read (0 where none was read).
+  [[nodiscard]] const std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes>& tables() const { return tables_; }
+  [[nodiscard]] const FanucThresholdCounters& thresholds() const { return thresholds_; }
+  /// True once the threshold phase is over (read, unanswered or off): the start packet may go out.
+  [[nodiscard]] bool thresholds_done() const { return tables_done_; }
 
  private:
+  bool read_thresholds(double timeout_s) noexcept;
+  void send_threshold_request(double now) noexcept;
+  void take_threshold_reply(std::size_t size) noexcept;
+  void apply_tables() noexcept;
   LinkPollResult poll_once(double timeout_s) noexcept;
   void send_stop_packet() noexcept;
   bool interval_agrees(const fanuc_j519::Status& s) noexcept;
@@ -130,6 +162,15 @@ class FanucJ519Link final : public ControllerLink {
   bool have_previous_status_ = false;  // the status before the first ready one answered (its interval)
   std::uint32_t previous_sequence_ = 0, previous_stamp_ms_ = 0;
   double last_data_s_ = 0.0;
+
+  // The threshold phase, before the start packet.
+  std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> limits_;  // what the stream is held to
+  std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> tables_{};
+  FanucThresholdCounters thresholds_;
+  bool tables_done_ = false;
+  std::size_t table_next_ = 0;  // the table asked for: joint * 3 + kind
+  int table_attempts_ = 0;      // requests sent for it
+  double table_sent_s_ = 0.0;
 
   // Preallocated per-cycle buffers.
   std::vector<unsigned char> rx_, tx_;
