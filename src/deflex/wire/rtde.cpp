@@ -292,6 +292,24 @@ DecodeStatus decode(const unsigned char* package, std::size_t size, TextMessage&
   return DecodeStatus::kOk;
 }
 
+DecodeStatus decode_text(const unsigned char* package, std::size_t size, std::uint16_t protocol_version,
+                         TextMessage& out) noexcept {
+  if (protocol_version == 2) return decode(package, size, out);
+  if (protocol_version != 1) return DecodeStatus::kBadField;
+  const unsigned char* payload = nullptr;
+  std::size_t bytes = 0;
+  const DecodeStatus status = payload_of(package, size, PackageType::kTextMessage, payload, bytes);
+  if (status != DecodeStatus::kOk) return status;
+  if (bytes < 1) return DecodeStatus::kWrongSize;
+  if (payload[0] > 3) return DecodeStatus::kBadField;
+  TextMessage t;
+  t.level = payload[0];
+  t.message = std::string_view(reinterpret_cast<const char*>(payload + 1), bytes - 1);
+  if (!is_ascii_text(t.message)) return DecodeStatus::kBadField;
+  out = t;
+  return DecodeStatus::kOk;
+}
+
 bool make_recipe(std::uint8_t id, const FieldType* types, std::size_t count, Recipe& recipe) noexcept {
   if (count > kMaxRecipeFields) return false;
   Recipe r;

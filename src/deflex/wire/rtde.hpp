@@ -96,7 +96,8 @@ struct UrControlVersion {
   std::uint32_t build = 0;
 };
 
-/// A text message (protocol 2): the texts point into the caller's buffer.
+/// A text message: the texts point into the caller's buffer, bytes as the controller sent them (not
+/// necessarily printable). Protocol 1 has no source (it is empty).
 struct TextMessage {
   std::string_view message;
   std::string_view source;
@@ -124,7 +125,12 @@ std::size_t encode(const TextMessage& text, unsigned char* out, std::size_t capa
 DecodeStatus decode_accepted(const unsigned char* package, std::size_t size, PackageType type, bool& accepted) noexcept;
 DecodeStatus decode_protocol_request(const unsigned char* package, std::size_t size, std::uint16_t& version) noexcept;
 DecodeStatus decode(const unsigned char* package, std::size_t size, UrControlVersion& out) noexcept;
+/// A text message in protocol 2's layout (lengths before message and source, the level last).
 DecodeStatus decode(const unsigned char* package, std::size_t size, TextMessage& out) noexcept;
+/// A text message in the layout of the protocol in force: 1 (the level, then the message to the end)
+/// until the controller accepted 2; kBadField for another version.
+DecodeStatus decode_text(const unsigned char* package, std::size_t size, std::uint16_t protocol_version,
+                         TextMessage& out) noexcept;
 /// A setup reply into `recipe`; on kFieldNotFound / kFieldInUse / kBadField `field` is the index
 /// of the field the controller refused (so the caller can name it).
 DecodeStatus decode_setup_reply(const unsigned char* package, std::size_t size, PackageType type, Recipe& recipe,
