@@ -1,9 +1,11 @@
-// RTDE packages against images written here by hand from Universal Robots' RTDE guide and the
-// facts in ../shared/reference/ur_rtde.md: uint16 size (header included), uint8 type ('V' 56, 'O'
-// 4F, 'I' 49, 'U' 55, 'S' 53, 'P' 50, 'M' 4D, 'v' 76), big-endian payloads, doubles as their IEEE bit
-// patterns (125.0 = 405F400000000000, 0.5 = 3FE0000000000000, -1.5 = BFF8000000000000). The handshake
-// both ways, recipes with refusals named by field, data packages read and written in place,
-// framing on a stream cut anywhere, garbage refused; no allocation on the data path.
+// RTDE packages against images written here by hand from Universal Robots' RTDE guide, the facts in
+// ../shared/reference/ur_rtde.md and the layouts of UR's own client (UniversalRobots/
+// RTDE_Python_Client_Library, rtde/rtde.py and rtde/serialize.py, cited at each test that relies on
+// them): uint16 size (header included), uint8 type ('V' 56, 'O' 4F, 'I' 49, 'U' 55, 'S' 53, 'P' 50,
+// 'M' 4D, 'v' 76), big-endian payloads, doubles as their IEEE bit patterns (125.0 = 405F400000000000,
+// 0.5 = 3FE0000000000000, -1.5 = BFF8000000000000). The handshake both ways, recipes with refusals
+// named by field, data packages read and written in place, framing on a stream cut anywhere, garbage
+// refused; no allocation on the data path.
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -96,6 +98,46 @@ TEST(Rtde, ControllerRepliesDecoded) {
   Bytes short_source = text;
   short_source[3 + 1 + 6] = 11;  // the source's length runs past the package
   EXPECT_EQ(rtde::decode(short_source.data(), short_source.size(), t), rtde::DecodeStatus::kWrongSize);
+}
+
+// UR's client takes the reply byte of a protocol version, start or pause request as a truth value:
+// any byte but 0 is accepted (UniversalRobots/RTDE_Python_Client_Library, rtde/serialize.py,
+// ReturnValue: bool of a '>B').
+TEST(Rtde, AnyNonZeroReplyByteIsAccepted) {
+  bool accepted = false;
+  const Bytes two = hex("0004 56 02");
+  ASSERT_EQ(rtde::decode_accepted(two.data(), two.size(), rtde::PackageType::kRequestProtocolVersion, accepted),
+            rtde::DecodeStatus::kOk);
+  EXPECT_TRUE(accepted);
+  accepted = false;
+  const Bytes all_ones = hex("0004 53 FF");
+  ASSERT_EQ(rtde::decode_accepted(all_ones.data(), all_ones.size(), rtde::PackageType::kStart, accepted),
+            rtde::DecodeStatus::kOk);
+  EXPECT_TRUE(accepted);
+  const Bytes zero = hex("0004 50 00");
+  ASSERT_EQ(rtde::decode_accepted(zero.data(), zero.size(), rtde::PackageType::kPause, accepted),
+            rtde::DecodeStatus::kOk);
+  EXPECT_FALSE(accepted);
+}
+
+// A text message's texts are bytes of the lengths given, taken as sent (UR's client slices them
+// without looking at them: UniversalRobots/RTDE_Python_Client_Library, rtde/serialize.py, Message):
+// a controller's error naming a temperature in degrees is still the controller's error.
+TEST(Rtde, TextMessageBytesAreTakenAsSent) {
+  // "J3 71\xB0C\n" (8 bytes), source "URControl" (9), level 1: 3 + 1 + 8 + 1 + 9 + 1 = 23.
+  const Bytes text =
+      cat(cat(cat(hex("0017 4D 08"), ascii("J3 71")), hex("B0 43 0A 09")), cat(ascii("URControl"), hex("01")));
+  ASSERT_EQ(text.size(), 23u);
+  rtde::TextMessage t;
+  ASSERT_EQ(rtde::decode(text.data(), text.size(), t), rtde::DecodeStatus::kOk);
+  EXPECT_EQ(t.message, std::string_view("J3 71\xB0"
+                                        "C\n"));
+  EXPECT_EQ(t.source, "URControl");
+  EXPECT_EQ(t.level, 1);
+  Bytes level_4 = text;
+  level_4.back() = 4;
+  EXPECT_EQ(rtde::decode(level_4.data(), level_4.size(), t), rtde::DecodeStatus::kBadField)
+      << "levels are 0 exception, 1 error, 2 warning, 3 info; another is not one of them";
 }
 
 // Protocol 1's text message is a level, then the message to the package's end, no source; protocol 2's

@@ -7,9 +7,10 @@
 // program on the controller hands to servoj each cycle.
 //
 // Written from Universal Robots' RTDE guide and the facts gathered with their sources in the
-// project's reference notes, not from a client library's code. Recipes are set up once (parsing
-// their text may run off the real-time path); data packages are read and written without
-// allocating or throwing.
+// project's reference notes, then checked field by field against the layouts UR's own client reads
+// and writes (UniversalRobots/RTDE_Python_Client_Library, rtde/rtde.py and rtde/serialize.py; facts,
+// not code). Recipes are set up once (parsing their text may run off the real-time path); data
+// packages are read and written without allocating or throwing.
 #pragma once
 
 #include <array>
@@ -84,7 +85,7 @@ enum class DecodeStatus {
   kWrongRecipe,    ///< a data package of another recipe id
   kFieldNotFound,  ///< a recipe reply naming NOT_FOUND: the controller has no such field
   kFieldInUse,     ///< a recipe reply naming IN_USE: another client writes that input
-  kBadField,       ///< an unknown type name, too many fields, a text that is not ASCII
+  kBadField,       ///< an unknown type name, too many fields, a name that is not ASCII, a text's unknown level
   kNonFinite,      ///< a NaN or infinite double in a data package
 };
 [[nodiscard]] const char* to_string(DecodeStatus status) noexcept;
@@ -113,7 +114,7 @@ std::size_t encode_request(PackageType type, unsigned char* out, std::size_t cap
 std::size_t encode_setup_outputs(double frequency_hz, std::string_view names_csv, unsigned char* out,
                                  std::size_t capacity) noexcept;
 std::size_t encode_setup_inputs(std::string_view names_csv, unsigned char* out, std::size_t capacity) noexcept;
-/// The controller's answer to V, S or P: one byte, accepted or not.
+/// The controller's answer to V, S or P: one byte, 1 accepted, 0 not (any byte but 0 reads as accepted).
 std::size_t encode_accepted(PackageType type, bool accepted, unsigned char* out, std::size_t capacity) noexcept;
 std::size_t encode(const UrControlVersion& version, unsigned char* out, std::size_t capacity) noexcept;
 /// The controller's answer to a setup: the recipe id, then the types (or NOT_FOUND / IN_USE), comma separated.
