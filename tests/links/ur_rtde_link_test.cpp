@@ -239,6 +239,70 @@ TEST(UrRtdeLink, AnErrorTextMessageEndsTheSessionNamingIt) {
   EXPECT_EQ(bench.link.text_messages()[1], 1u);
 }
 
+// The controller's texts are bytes (UR's own client takes them as sent: UniversalRobots/
+// RTDE_Python_Client_Library, rtde/serialize.py, Message): an error with a byte beyond ASCII, written
+// into the stream by hand, still ends the session, the byte shown as '?'.
+TEST(UrRtdeLink, AnErrorTextWithBytesThatDoNotPrintStillEndsTheSession) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  UrBench bench(test::hold_program(test::bench_robot(), q0, 10.0), q0);
+  bench.run(0.5);
+  ASSERT_EQ(bench.link.state(), LinkState::kRunning);
+  // 22 bytes: the size, 'M', "J3 71\xB0C" (7), source "URControl" (9), level 1 (error).
+  const unsigned char text[22] = {0, 22,  'M', 7,   'J', '3', ' ', '7', '1', 0xB0, 'C',
+                                  9, 'U', 'R', 'C', 'o', 'n', 't', 'r', 'o', 'l',  1};
+  ASSERT_EQ(bench.pair.server().write(text, sizeof text), 22);
+  bench.run(0.01);
+  EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kController);
+  EXPECT_TRUE(ur_says(bench.link, "RTDE error message: J3 71?C")) << bench.link.stop_reason();
+}
+
+// The handshake read as UR's own client reads it (UniversalRobots/RTDE_Python_Client_Library,
+// rtde/rtde.py and rtde/serialize.py): the version reply's byte is a truth value, and until the
+// controller accepted protocol 2 its text messages are protocol 1's (the level, then the text).
+TEST(UrRtdeLink, TheHandshakeTakesAnyNonZeroAcceptAndProtocol1TextsBeforeVersion2) {
+  const RobotModel robot = test::bench_robot();
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  UrRtdeLinkConfig config;
+  config.stop.stop_silence_s = 0.5;
+  const auto exchange = [](ManualClock& clock, MemoryStreamPair& pair, UrRtdeLink& link, double& t,
+                           const std::vector<unsigned char>& reply) {
+    if (!reply.empty()) {
+      EXPECT_EQ(pair.server().write(reply.data(), reply.size()), static_cast<long>(reply.size()));
+    }
+    for (int k = 0; k < 5; ++k) {
+      clock.set(t += kUrPeriod);
+      (void)link.poll(0.0);
+    }
+    std::array<unsigned char, 64> got{};
+    const long n = pair.server().read(got.data(), got.size());
+    return std::vector<unsigned char>(got.begin(), got.begin() + std::max(n, 0L));
+  };
+  {
+    ManualClock clock;
+    MemoryStreamPair pair(clock, 0.0001);
+    OnlineCompensator compensator(robot, test::bench_sensor(), test::bench_online(kUrPeriod));
+    OnlineStrategy strategy(robot, StrategyKind::kOnline, nullptr);
+    UrRtdeLink link(compensator, strategy, test::hold_program(robot, q0, 10.0), pair.client(), clock, config);
+    double t = 0.0;
+    EXPECT_EQ(exchange(clock, pair, link, t, {}), (std::vector<unsigned char>{0, 5, 'V', 0, 2}));
+    EXPECT_EQ(exchange(clock, pair, link, t, {0, 4, 'V', 2}), (std::vector<unsigned char>{0, 3, 'v'}))
+        << "the version reply's byte 2 is accepted: the next request is the controller's version";
+    EXPECT_NE(link.state(), LinkState::kStopped) << link.stop_reason();
+  }
+  {
+    ManualClock clock;
+    MemoryStreamPair pair(clock, 0.0001);
+    OnlineCompensator compensator(robot, test::bench_sensor(), test::bench_online(kUrPeriod));
+    OnlineStrategy strategy(robot, StrategyKind::kOnline, nullptr);
+    UrRtdeLink link(compensator, strategy, test::hold_program(robot, q0, 10.0), pair.client(), clock, config);
+    double t = 0.0;
+    (void)exchange(clock, pair, link, t, {});
+    (void)exchange(clock, pair, link, t, {0, 10, 'M', 1, 'C', '2', '0', '4', 'A', '3'});
+    EXPECT_EQ(link.stop_cause(), LinkStopCause::kController);
+    EXPECT_TRUE(ur_says(link, "RTDE error message: C204A3")) << link.stop_reason();
+  }
+}
+
 TEST(UrRtdeLink, ARefusedRecipeOrARateTheControllerCannotGiveStopsTheHandshake) {
   const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
   {

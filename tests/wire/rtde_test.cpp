@@ -1,9 +1,11 @@
-// RTDE packages against images written here by hand from Universal Robots' RTDE guide and the
-// facts in ../shared/reference/ur_rtde.md: uint16 size (header included), uint8 type ('V' 56, 'O'
-// 4F, 'I' 49, 'U' 55, 'S' 53, 'P' 50, 'M' 4D, 'v' 76), big-endian payloads, doubles as their IEEE bit
-// patterns (125.0 = 405F400000000000, 0.5 = 3FE0000000000000, -1.5 = BFF8000000000000). The handshake
-// both ways, recipes with refusals named by field, data packages read and written in place,
-// framing on a stream cut anywhere, garbage refused; no allocation on the data path.
+// RTDE packages against images written here by hand from Universal Robots' RTDE guide, the facts in
+// ../shared/reference/ur_rtde.md and the layouts of UR's own client (UniversalRobots/
+// RTDE_Python_Client_Library, rtde/rtde.py and rtde/serialize.py, cited at each test that relies on
+// them): uint16 size (header included), uint8 type ('V' 56, 'O' 4F, 'I' 49, 'U' 55, 'S' 53, 'P' 50,
+// 'M' 4D, 'v' 76), big-endian payloads, doubles as their IEEE bit patterns (125.0 = 405F400000000000,
+// 0.5 = 3FE0000000000000, -1.5 = BFF8000000000000). The handshake both ways, recipes with refusals
+// named by field, data packages read and written in place, framing on a stream cut anywhere, garbage
+// refused; no allocation on the data path.
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -98,6 +100,78 @@ TEST(Rtde, ControllerRepliesDecoded) {
   EXPECT_EQ(rtde::decode(short_source.data(), short_source.size(), t), rtde::DecodeStatus::kWrongSize);
 }
 
+// UR's client takes the reply byte of a protocol version, start or pause request as a truth value:
+// any byte but 0 is accepted (UniversalRobots/RTDE_Python_Client_Library, rtde/serialize.py,
+// ReturnValue: bool of a '>B').
+TEST(Rtde, AnyNonZeroReplyByteIsAccepted) {
+  bool accepted = false;
+  const Bytes two = hex("0004 56 02");
+  ASSERT_EQ(rtde::decode_accepted(two.data(), two.size(), rtde::PackageType::kRequestProtocolVersion, accepted),
+            rtde::DecodeStatus::kOk);
+  EXPECT_TRUE(accepted);
+  accepted = false;
+  const Bytes all_ones = hex("0004 53 FF");
+  ASSERT_EQ(rtde::decode_accepted(all_ones.data(), all_ones.size(), rtde::PackageType::kStart, accepted),
+            rtde::DecodeStatus::kOk);
+  EXPECT_TRUE(accepted);
+  const Bytes zero = hex("0004 50 00");
+  ASSERT_EQ(rtde::decode_accepted(zero.data(), zero.size(), rtde::PackageType::kPause, accepted),
+            rtde::DecodeStatus::kOk);
+  EXPECT_FALSE(accepted);
+}
+
+// A text message's texts are bytes of the lengths given, taken as sent (UR's client slices them
+// without looking at them: UniversalRobots/RTDE_Python_Client_Library, rtde/serialize.py, Message):
+// a controller's error naming a temperature in degrees is still the controller's error.
+TEST(Rtde, TextMessageBytesAreTakenAsSent) {
+  // "J3 71\xB0C\n" (8 bytes), source "URControl" (9), level 1: 3 + 1 + 8 + 1 + 9 + 1 = 23.
+  const Bytes text =
+      cat(cat(cat(hex("0017 4D 08"), ascii("J3 71")), hex("B0 43 0A 09")), cat(ascii("URControl"), hex("01")));
+  ASSERT_EQ(text.size(), 23u);
+  rtde::TextMessage t;
+  ASSERT_EQ(rtde::decode(text.data(), text.size(), t), rtde::DecodeStatus::kOk);
+  EXPECT_EQ(t.message, std::string_view("J3 71\xB0"
+                                        "C\n"));
+  EXPECT_EQ(t.source, "URControl");
+  EXPECT_EQ(t.level, 1);
+  Bytes level_4 = text;
+  level_4.back() = 4;
+  EXPECT_EQ(rtde::decode(level_4.data(), level_4.size(), t), rtde::DecodeStatus::kBadField)
+      << "levels are 0 exception, 1 error, 2 warning, 3 info; another is not one of them";
+}
+
+// Protocol 1's text message is a level, then the message to the package's end, no source; protocol 2's
+// has a length before the message and the source and the level last (UniversalRobots/
+// RTDE_Python_Client_Library, rtde/serialize.py, MessageV1 and Message; rtde/rtde.py reads protocol 1
+// until the controller accepted protocol 2).
+TEST(Rtde, TextMessageInEachProtocolVersion) {
+  const Bytes v1 = cat(hex("000A 4D 01"), ascii("C204A3"));  // error "C204A3": 3 + 1 + 6 = 10
+  rtde::TextMessage t;
+  ASSERT_EQ(rtde::decode_text(v1.data(), v1.size(), 1, t), rtde::DecodeStatus::kOk);
+  EXPECT_EQ(t.level, 1);
+  EXPECT_EQ(t.message, "C204A3");
+  EXPECT_EQ(t.source, "");
+  EXPECT_NE(rtde::decode_text(v1.data(), v1.size(), 2, t), rtde::DecodeStatus::kOk)
+      << "read as protocol 2, its first byte would be a length";
+  const Bytes v1_empty = hex("0004 4D 03");
+  ASSERT_EQ(rtde::decode_text(v1_empty.data(), v1_empty.size(), 1, t), rtde::DecodeStatus::kOk);
+  EXPECT_EQ(t.level, 3);
+  EXPECT_EQ(t.message, "");
+  const Bytes v1_nothing = hex("0003 4D");
+  EXPECT_EQ(rtde::decode_text(v1_nothing.data(), v1_nothing.size(), 1, t), rtde::DecodeStatus::kWrongSize);
+  Bytes v1_level_9 = v1;
+  v1_level_9[3] = 9;
+  EXPECT_EQ(rtde::decode_text(v1_level_9.data(), v1_level_9.size(), 1, t), rtde::DecodeStatus::kBadField);
+
+  const Bytes v2 = cat(cat(hex("0014 4D 06"), ascii("C204A3")), cat(cat(hex("08"), ascii("URScript")), hex("00")));
+  ASSERT_EQ(rtde::decode_text(v2.data(), v2.size(), 2, t), rtde::DecodeStatus::kOk);
+  EXPECT_EQ(t.level, 0);
+  EXPECT_EQ(t.message, "C204A3");
+  EXPECT_EQ(t.source, "URScript");
+  EXPECT_EQ(rtde::decode_text(v2.data(), v2.size(), 3, t), rtde::DecodeStatus::kBadField)
+      << "a protocol deflex does not speak";
+}
+
 TEST(Rtde, RecipeRepliesGiveTypesAndOffsetsOrNameTheRefusedField) {
   const Bytes reply = cat(hex("0019 4F 01"), ascii("DOUBLE,VECTOR6D,INT32"));
   rtde::Recipe recipe;
@@ -179,6 +253,108 @@ TEST(Rtde, DataPackagesReadAndWrittenInPlace) {
   EXPECT_EQ(view.reset(recipe, shorter.data(), shorter.size()), rtde::DecodeStatus::kWrongSize);
 }
 
+// Every type the controller names, at its offset: the sizes are the struct formats UR's own client
+// builds from a recipe reply, big-endian with standard sizes and no padding, the recipe id first
+// (UniversalRobots/RTDE_Python_Client_Library, rtde/serialize.py, DataConfig.unpack_recipe: BOOL '?',
+// UINT8 'B', UINT32 'I', UINT64 'Q', INT32 'i', DOUBLE 'd', VECTOR3D 3 'd', VECTOR6D 6 'd',
+// VECTOR6INT32 6 'i', VECTOR6UINT32 6 'I', after '>B'). Offsets after the id: 0 1 2 6 14 18 26 50 98 122.
+TEST(Rtde, EveryTypeAtItsOffsetInADataPackage) {
+  const std::string_view names = "BOOL,UINT8,UINT32,UINT64,INT32,DOUBLE,VECTOR3D,VECTOR6D,VECTOR6INT32,VECTOR6UINT32";
+  ASSERT_EQ(names.size(), 82u);
+  const Bytes reply = cat(hex("0056 4F 05"), ascii(names));  // 3 + 1 + 82 = 86
+  rtde::Recipe recipe;
+  std::size_t field = 99;
+  ASSERT_EQ(rtde::decode_setup_reply(reply.data(), reply.size(), rtde::PackageType::kSetupOutputs, recipe, field),
+            rtde::DecodeStatus::kOk);
+  EXPECT_EQ(recipe.id, 5);
+  ASSERT_EQ(recipe.count, 10u);
+  const std::array<std::size_t, 10> offsets{0, 1, 2, 6, 14, 18, 26, 50, 98, 122};
+  for (std::size_t i = 0; i < offsets.size(); ++i) EXPECT_EQ(recipe.offsets[i], offsets[i]) << "field " << i;
+  EXPECT_EQ(recipe.payload_bytes, 146u);
+
+  Bytes package = hex("0096 55 05");                                                  // 3 + 1 + 146 = 150, recipe 5
+  package = cat(package, hex("01 7F DEADBEEF 0000000100000002 FFFFFF85"));            // true, 127, uint32, uint64, -123
+  package = cat(package, hex("4000000000000000"));                                    // DOUBLE 2.0
+  package = cat(package, hex("3FF0000000000000 BFF0000000000000 0000000000000000"));  // VECTOR3D 1, -1, 0
+  package = cat(package, hex("3FE0000000000000"));                                    // VECTOR6D 0.5, 0, 0, 0, 0, -2
+  package = test::zeros_after(package, 4 * 8);
+  package = cat(package, hex("C000000000000000"));
+  package = cat(package, hex("00000001 FFFFFFFF 00000000 00000000 00000000 7FFFFFFF"));  // VECTOR6INT32
+  package = cat(package, hex("FFFFFFFF 00000000 00000000 00000000 00000000 00000000"));  // VECTOR6UINT32
+  ASSERT_EQ(package.size(), 150u);
+
+  rtde::DataView view;
+  ASSERT_EQ(view.reset(recipe, package.data(), package.size()), rtde::DecodeStatus::kOk);
+  EXPECT_EQ(view.get_uint32(2), 0xDEADBEEFu);
+  EXPECT_EQ(view.get_int32(4), -123);
+  EXPECT_EQ(view.get_double(5), 2.0);
+  EXPECT_EQ(view.get_vector6d(7), (std::array<double, 6>{0.5, 0, 0, 0, 0, -2.0}));
+
+  // The fields deflex writes, the others left zero, give the same bytes.
+  Bytes expected = package;
+  for (const std::size_t at : {0u, 1u, 6u, 7u, 8u, 9u, 10u, 11u, 12u, 13u})
+    expected[4 + at] = 0;                                          // BOOL, UINT8, UINT64
+  for (std::size_t at = 26; at < 50; ++at) expected[4 + at] = 0;   // VECTOR3D
+  for (std::size_t at = 98; at < 146; ++at) expected[4 + at] = 0;  // VECTOR6INT32, VECTOR6UINT32
+  unsigned char out[256];
+  rtde::DataBuilder builder(recipe, out, sizeof out);
+  EXPECT_TRUE(builder.set(2, std::uint32_t{0xDEADBEEF}));
+  EXPECT_TRUE(builder.set(4, std::int32_t{-123}));
+  EXPECT_TRUE(builder.set(5, 2.0));
+  EXPECT_TRUE(builder.set(7, std::array<double, 6>{0.5, 0, 0, 0, 0, -2.0}));
+  ASSERT_EQ(builder.finish(), expected.size());
+  EXPECT_EQ(Bytes(out, out + expected.size()), expected);
+
+  // Doubles inside a VECTOR3D are checked; a NaN's bit pattern in integer fields is just an integer.
+  Bytes nan_in_vector3d = package;
+  nan_in_vector3d[4 + 26 + 8] = 0x7F;
+  nan_in_vector3d[4 + 26 + 9] = 0xF8;
+  EXPECT_EQ(view.reset(recipe, nan_in_vector3d.data(), nan_in_vector3d.size()), rtde::DecodeStatus::kNonFinite);
+  Bytes nan_bits_in_ints = package;
+  nan_bits_in_ints[4 + 98 + 4] = 0x7F;
+  nan_bits_in_ints[4 + 98 + 5] = 0xF8;
+  nan_bits_in_ints[4 + 6] = 0x7F;  // UINT64
+  nan_bits_in_ints[4 + 7] = 0xF8;
+  EXPECT_EQ(view.reset(recipe, nan_bits_in_ints.data(), nan_bits_in_ints.size()), rtde::DecodeStatus::kOk);
+}
+
+// The setup requests as UR's client sends them (UniversalRobots/RTDE_Python_Client_Library,
+// rtde/rtde.py: send_output_setup packs the frequency as '>d' then the names joined by commas;
+// send_input_setup the names alone; negotiate_protocol_version '>H'), read on the controller's side.
+TEST(Rtde, SetupRequestsReadOnTheControllersSide) {
+  const Bytes outputs = cat(hex("0014 4F 407F400000000000"), ascii("timestamp"));  // 500 Hz, 3 + 8 + 9 = 20
+  double frequency = 0.0;
+  std::string_view names;
+  ASSERT_EQ(
+      rtde::decode_setup_request(outputs.data(), outputs.size(), rtde::PackageType::kSetupOutputs, frequency, names),
+      rtde::DecodeStatus::kOk);
+  EXPECT_EQ(frequency, 500.0);
+  EXPECT_EQ(names, "timestamp");
+  unsigned char out[64];
+  ASSERT_EQ(rtde::encode_setup_outputs(500.0, "timestamp", out, sizeof out), outputs.size());
+  EXPECT_EQ(Bytes(out, out + outputs.size()), outputs);
+  const Bytes no_names = hex("000B 4F 407F400000000000");
+  EXPECT_EQ(
+      rtde::decode_setup_request(no_names.data(), no_names.size(), rtde::PackageType::kSetupOutputs, frequency, names),
+      rtde::DecodeStatus::kWrongSize);
+  const Bytes version_1 = hex("0005 56 0001");
+  std::uint16_t version = 0;
+  ASSERT_EQ(rtde::decode_protocol_request(version_1.data(), version_1.size(), version), rtde::DecodeStatus::kOk);
+  EXPECT_EQ(version, 1);
+  ASSERT_EQ(rtde::encode_protocol_request(1, out, sizeof out), version_1.size());
+  EXPECT_EQ(Bytes(out, out + version_1.size()), version_1);
+  // Start and pause replies as the controller sends them: one byte each, both ways.
+  ASSERT_EQ(rtde::encode_accepted(rtde::PackageType::kPause, true, out, sizeof out), 4u);
+  EXPECT_EQ(Bytes(out, out + 4), hex("0004 50 01"));
+  ASSERT_EQ(rtde::encode_accepted(rtde::PackageType::kStart, false, out, sizeof out), 4u);
+  EXPECT_EQ(Bytes(out, out + 4), hex("0004 53 00"));
+  const Bytes two_bytes = hex("0005 53 0100");
+  bool accepted = false;
+  EXPECT_EQ(rtde::decode_accepted(two_bytes.data(), two_bytes.size(), rtde::PackageType::kStart, accepted),
+            rtde::DecodeStatus::kWrongSize)
+      << "the reply is exactly one byte (rtde.py: 'Wrong payload size' otherwise)";
+}
+
 TEST(Rtde, FramingOnAStreamCutAnywhere) {
   const Bytes a = hex("0004 56 01");
   const Bytes b = cat(hex("000D 4F 01"), ascii("NOT_FOUND"));
@@ -206,6 +382,9 @@ TEST(Rtde, FramingOnAStreamCutAnywhere) {
   EXPECT_EQ(bytes, 0xFFFFu) << "the size is reported so the caller can name it";
   EXPECT_TRUE(rtde::known_package_type('U'));
   EXPECT_FALSE(rtde::known_package_type('X'));
+  // READ_PROPERTIES ('R' 82) is protocol 3's (UniversalRobots/RTDE_Python_Client_Library, rtde/rtde.py);
+  // deflex asks for protocol 2, so a controller never sends it one.
+  EXPECT_FALSE(rtde::known_package_type('R'));
 }
 
 TEST(Rtde, FieldTypeNamesBothWays) {

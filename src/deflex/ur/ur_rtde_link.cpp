@@ -270,17 +270,23 @@ bool UrRtdeLink::handshake(const unsigned char* p, std::size_t size, std::uint8_
 }
 
 // A text message: exceptions and errors end the session (the controller is telling why it will not
-// go on), warnings and information are counted and the last kept.
+// go on), warnings and information are counted and the last kept. Until the controller accepted
+// protocol 2 its messages are in protocol 1's layout. The text is the controller's bytes: any that
+// would not print is kept as '?', so the reason stays one readable line.
 bool UrRtdeLink::text(const unsigned char* p, std::size_t size) noexcept {
   rtde::TextMessage m;
-  if (rtde::decode(p, size, m) != rtde::DecodeStatus::kOk) {
+  const std::uint16_t protocol = phase_ == Phase::kVersion ? 1 : rtde::kProtocolVersion;
+  if (rtde::decode_text(p, size, protocol, m) != rtde::DecodeStatus::kOk) {
     ++counters_.malformed;
     return true;
   }
   const std::size_t level = std::min<std::size_t>(m.level, 3);
   ++texts_[level];
   const std::size_t n = std::min(m.message.size(), last_text_.size() - 1);
-  std::memcpy(last_text_.data(), m.message.data(), n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = static_cast<unsigned char>(m.message[i]);
+    last_text_[i] = c >= 0x20 && c <= 0x7e ? static_cast<char>(c) : '?';
+  }
   last_text_[n] = '\0';
   if (level > 1) return true;
   stop_link(LinkStopCause::kController, "the controller sent an RTDE %s message: %s",

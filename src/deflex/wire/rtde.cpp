@@ -244,8 +244,8 @@ DecodeStatus decode_accepted(const unsigned char* package, std::size_t size, Pac
   std::size_t bytes = 0;
   const DecodeStatus status = payload_of(package, size, type, payload, bytes);
   if (status != DecodeStatus::kOk) return status;
-  if (bytes != 1 || payload[0] > 1) return DecodeStatus::kWrongSize;
-  accepted = payload[0] == 1;
+  if (bytes != 1) return DecodeStatus::kWrongSize;
+  accepted = payload[0] != 0;  // a truth value, as UR's own client reads it
   return DecodeStatus::kOk;
 }
 
@@ -287,7 +287,24 @@ DecodeStatus decode(const unsigned char* package, std::size_t size, TextMessage&
   t.message = std::string_view(chars + 1, message_bytes);
   t.source = std::string_view(chars + 2 + message_bytes, source_bytes);
   t.level = payload[bytes - 1];
-  if (t.level > 3 || !is_ascii_text(t.message) || !is_ascii_text(t.source)) return DecodeStatus::kBadField;
+  if (t.level > 3) return DecodeStatus::kBadField;
+  out = t;
+  return DecodeStatus::kOk;
+}
+
+DecodeStatus decode_text(const unsigned char* package, std::size_t size, std::uint16_t protocol_version,
+                         TextMessage& out) noexcept {
+  if (protocol_version == 2) return decode(package, size, out);
+  if (protocol_version != 1) return DecodeStatus::kBadField;
+  const unsigned char* payload = nullptr;
+  std::size_t bytes = 0;
+  const DecodeStatus status = payload_of(package, size, PackageType::kTextMessage, payload, bytes);
+  if (status != DecodeStatus::kOk) return status;
+  if (bytes < 1) return DecodeStatus::kWrongSize;
+  if (payload[0] > 3) return DecodeStatus::kBadField;
+  TextMessage t;
+  t.level = payload[0];
+  t.message = std::string_view(reinterpret_cast<const char*>(payload + 1), bytes - 1);
   out = t;
   return DecodeStatus::kOk;
 }

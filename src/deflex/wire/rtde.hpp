@@ -7,9 +7,10 @@
 // program on the controller hands to servoj each cycle.
 //
 // Written from Universal Robots' RTDE guide and the facts gathered with their sources in the
-// project's reference notes, not from a client library's code. Recipes are set up once (parsing
-// their text may run off the real-time path); data packages are read and written without
-// allocating or throwing.
+// project's reference notes, then checked field by field against the layouts UR's own client reads
+// and writes (UniversalRobots/RTDE_Python_Client_Library, rtde/rtde.py and rtde/serialize.py; facts,
+// not code). Recipes are set up once (parsing their text may run off the real-time path); data
+// packages are read and written without allocating or throwing.
 #pragma once
 
 #include <array>
@@ -84,7 +85,7 @@ enum class DecodeStatus {
   kWrongRecipe,    ///< a data package of another recipe id
   kFieldNotFound,  ///< a recipe reply naming NOT_FOUND: the controller has no such field
   kFieldInUse,     ///< a recipe reply naming IN_USE: another client writes that input
-  kBadField,       ///< an unknown type name, too many fields, a text that is not ASCII
+  kBadField,       ///< an unknown type name, too many fields, a name that is not ASCII, a text's unknown level
   kNonFinite,      ///< a NaN or infinite double in a data package
 };
 [[nodiscard]] const char* to_string(DecodeStatus status) noexcept;
@@ -96,7 +97,8 @@ struct UrControlVersion {
   std::uint32_t build = 0;
 };
 
-/// A text message (protocol 2): the texts point into the caller's buffer.
+/// A text message: the texts point into the caller's buffer, bytes as the controller sent them (not
+/// necessarily printable). Protocol 1 has no source (it is empty).
 struct TextMessage {
   std::string_view message;
   std::string_view source;
@@ -112,7 +114,7 @@ std::size_t encode_request(PackageType type, unsigned char* out, std::size_t cap
 std::size_t encode_setup_outputs(double frequency_hz, std::string_view names_csv, unsigned char* out,
                                  std::size_t capacity) noexcept;
 std::size_t encode_setup_inputs(std::string_view names_csv, unsigned char* out, std::size_t capacity) noexcept;
-/// The controller's answer to V, S or P: one byte, accepted or not.
+/// The controller's answer to V, S or P: one byte, 1 accepted, 0 not (any byte but 0 reads as accepted).
 std::size_t encode_accepted(PackageType type, bool accepted, unsigned char* out, std::size_t capacity) noexcept;
 std::size_t encode(const UrControlVersion& version, unsigned char* out, std::size_t capacity) noexcept;
 /// The controller's answer to a setup: the recipe id, then the types (or NOT_FOUND / IN_USE), comma separated.
@@ -124,7 +126,12 @@ std::size_t encode(const TextMessage& text, unsigned char* out, std::size_t capa
 DecodeStatus decode_accepted(const unsigned char* package, std::size_t size, PackageType type, bool& accepted) noexcept;
 DecodeStatus decode_protocol_request(const unsigned char* package, std::size_t size, std::uint16_t& version) noexcept;
 DecodeStatus decode(const unsigned char* package, std::size_t size, UrControlVersion& out) noexcept;
+/// A text message in protocol 2's layout (lengths before message and source, the level last).
 DecodeStatus decode(const unsigned char* package, std::size_t size, TextMessage& out) noexcept;
+/// A text message in the layout of the protocol in force: 1 (the level, then the message to the end)
+/// until the controller accepted 2; kBadField for another version.
+DecodeStatus decode_text(const unsigned char* package, std::size_t size, std::uint16_t protocol_version,
+                         TextMessage& out) noexcept;
 /// A setup reply into `recipe`; on kFieldNotFound / kFieldInUse / kBadField `field` is the index
 /// of the field the controller refused (so the caller can name it).
 DecodeStatus decode_setup_reply(const unsigned char* package, std::size_t size, PackageType type, Recipe& recipe,
