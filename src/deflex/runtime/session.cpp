@@ -354,7 +354,14 @@ LinkPollResult Session::poll(double timeout_s) noexcept {
   const LinkPollResult r = link_->poll(timeout_s);
   const double now = clock_.now_s();
   if (reporting_) {
-    if (r == LinkPollResult::kAnswered || r == LinkPollResult::kNotAnswered) {
+    // A cycle entry for every answer (a FANUC stream's last-data command repeats the last cycle's) and
+    // for a message left unanswered by a cycle; one left unanswered without a cycle (a controller not
+    // ready yet, before the first) has no record of its own, and a blank one would read as a silence
+    // from time 0 to the first cycle.
+    const std::uint64_t cycles = link_->cycle_stats().cycles;
+    const bool new_cycle = cycles != pushed_cycles_;
+    if (r == LinkPollResult::kAnswered || (r == LinkPollResult::kNotAnswered && new_cycle)) {
+      pushed_cycles_ = cycles;
       push(SessionEntry::Kind::kCycle, now);
     } else if (now - last_push_s_ >= 0.05) {
       push(SessionEntry::Kind::kHeartbeat, now);

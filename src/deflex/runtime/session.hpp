@@ -157,6 +157,7 @@ class Session {
   StopReason reason_ = StopReason::kRunning;
   std::string reason_text_;
   double start_s_ = 0.0, last_push_s_ = -1.0;
+  std::uint64_t pushed_cycles_ = 0;  // the link's cycle count at the last cycle entry
   std::atomic<int> stop_requests_{0};
   std::atomic<bool> output_failed_{false};
   std::mutex output_failure_mutex_;  // never taken on the loop's thread
