@@ -41,4 +41,6 @@ assert s["counters"]["guard_trips"] == 0, s["counters"]
 assert s["exit_code"] == 0, (s["exit_code"], s["stop_reason"])
 print("deflex: %d commands, exit %d (%s)" % (s["counters"]["replies"], s["exit_code"], s["stop_reason"]))
 PY
+# deflex read the stand-in's threshold tables (6 joints x velocity, acceleration, jerk) before starting.
+grep -q "the controller's 18 threshold tables were read" "$OUT/online.log"
 exit "$STATUS"

@@ -3,6 +3,9 @@
 try `deflex online --link fanuc-j519` without a robot. It behaves as the real controller does, never
 more kindly (docs/online.md, "FANUC Stream Motion"):
 
+- before a stream it answers threshold requests (type 3, 16 bytes) with the 184-byte table of the
+  joint and kind asked, every one of its 20 speed columns, with and without payload, at the limit it
+  enforces (a real table allows more at low speed; this one is as strict as its own check);
 - it listens on --port; nothing is sent until a start packet (type 0, version 1, 8 bytes) comes, then a
   132-byte status every --interval-ms to its sender, numbered from 1, big-endian: the ready bit once the
   TP program waits in IBGN, the joints (degrees) where the arm is;
@@ -32,6 +35,8 @@ import time
 
 STATUS = struct.Struct(">IIIBBHHHI9f9f9f")  # 132 bytes
 COMMAND = struct.Struct(">IIIBBHHBBHHHH9f")  # 64 bytes
+THRESHOLD_REQUEST = struct.Struct(">IIII")  # 16 bytes: type 3, version, axis 1..9, kind 0..2
+THRESHOLD_REPLY = struct.Struct(">IIIIII20f20f")  # 184 bytes
 
 
 def first_point(path):
@@ -61,7 +66,20 @@ class Controller:
         self.taken = 0
         self.ready_at = None
 
+    def threshold_reply(self, data):
+        """The table a threshold request asks for, or None (not one, or a stream runs)."""
+        kind, version, axis, limit_kind = THRESHOLD_REQUEST.unpack(data)
+        if kind != 3 or not 1 <= axis <= 9 or limit_kind > 2 or self.pc is not None:
+            return None
+        value = self.limits[limit_kind]
+        # axis, kind, $MAX_SPD (mm/s), the interval (ms), then no payload and full payload at 5..100 %
+        return THRESHOLD_REPLY.pack(3, version, axis, limit_kind, 2000, int(round(self.interval * 1e3)),
+                                    *([value] * 20), *([value] * 20))
+
     def receive(self, data, sender, now):
+        """Takes a datagram; returns the bytes to answer it with at once (a threshold table), or None."""
+        if len(data) == THRESHOLD_REQUEST.size:
+            return self.threshold_reply(data)
         if len(data) == 8:
             kind, version = struct.unpack(">II", data)
             if kind == 0 and self.pc is None:
@@ -144,7 +162,9 @@ def main():
         readable, _, _ = select.select([sock], [], [], wait)
         if readable:
             data, sender = sock.recvfrom(2048)
-            c.receive(data, sender, now)
+            reply = c.receive(data, sender, now)
+            if reply is not None:
+                sock.sendto(reply, sender)
             if c.pc is not None and next_status is None:
                 next_status = now
             continue
