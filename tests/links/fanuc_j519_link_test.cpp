@@ -268,6 +268,8 @@ TEST(FanucJ519Link, AVersionMismatchStopsTheLinkNamingBoth) {
   EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kProtocol);
   EXPECT_NE(std::string(bench.link.stop_reason()).find("version 3"), std::string::npos) << bench.link.stop_reason();
   EXPECT_EQ(bench.controller.counters().taken, 0u);
+  // The controller alarms on the start packet of another version, as the reference's MOTN-607 names both.
+  EXPECT_EQ(bench.controller.alarm(), "MOTN-607 ST: Protocol version mismatch PC 1, Rob 3");
 }
 
 TEST(FanucJ519Link, ProtocolThreeCarriesDoublesAndRunsTheSame) {
