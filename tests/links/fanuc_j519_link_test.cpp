@@ -10,6 +10,8 @@
 #include <cmath>
 #include <limits>
 
+#include <fmt/format.h>
+
 #include "deflex/cell/fanuc_j519_controller.hpp"
 #include "deflex/fanuc/fanuc_j519_link.hpp"
 #include "deflex/text/errors.hpp"
@@ -266,6 +268,8 @@ TEST(FanucJ519Link, AVersionMismatchStopsTheLinkNamingBoth) {
   EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kProtocol);
   EXPECT_NE(std::string(bench.link.stop_reason()).find("version 3"), std::string::npos) << bench.link.stop_reason();
   EXPECT_EQ(bench.controller.counters().taken, 0u);
+  // The controller alarms on the start packet of another version, as the reference's MOTN-607 names both.
+  EXPECT_EQ(bench.controller.alarm(), "MOTN-607 ST: Protocol version mismatch PC 1, Rob 3");
 }
 
 TEST(FanucJ519Link, ProtocolThreeCarriesDoublesAndRunsTheSame) {
@@ -648,10 +652,215 @@ TEST(FanucJ519Link, ReadingStricterThresholdTablesDoesNotAllocate) {
       if (r == LinkPollResult::kIdle || bench.link.state() == LinkState::kStopped) break;
     }
   }
+  EXPECT_TRUE(bench.link.capability_counters().read);  // the capability exchange ran in poll() too
   EXPECT_EQ(bench.link.thresholds().read, 18u);
   EXPECT_EQ(bench.link.smoother().taps(), 87u);
   EXPECT_EQ(bench.link.state(), LinkState::kRunning) << bench.link.stop_reason();
   EXPECT_EQ(allocations, 0u);
+}
+
+// ---- The capability exchange (protocol 3 and 4) ------------------------------------------------------
+
+// A capability packet built byte by byte (big-endian uint32s, the layout of the reference notes): type,
+// version 3, id, sampling rate ms, start_move, available_version, rob_status_use_tcp 0; `size` bytes
+// (28 is the packet's, the rest zero or cut off).
+std::vector<unsigned char> capability_bytes(std::uint32_t type, std::uint32_t id, std::uint32_t rate_ms,
+                                            std::uint32_t start_move, std::uint32_t available, std::size_t size = 28) {
+  std::vector<unsigned char> b(std::max<std::size_t>(size, 28), 0);
+  const auto put = [&](std::size_t at, std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) b[at + static_cast<std::size_t>(i)] = static_cast<unsigned char>(v >> (24 - 8 * i));
+  };
+  put(0, type);
+  put(4, 3);
+  put(8, id);
+  put(12, rate_ms);
+  put(16, start_move);
+  put(20, available);
+  b.resize(size);
+  return b;
+}
+
+// Delivers `bytes` from the controller's address to the link and lets it read them.
+void from_controller(FanucBench& bench, const std::vector<unsigned char>& bytes) {
+  bench.controller_port.send_to(bytes.data(), bytes.size(), test::kSensorAddress);
+  bench.clock.set(bench.clock.now_s() + 0.001);
+  while (bench.link.poll(0.0) != LinkPollResult::kIdle && bench.link.state() != LinkState::kStopped) {
+  }
+}
+
+// A protocol 3 (and 4) controller answers the capability request before the threshold tables are asked;
+// the link records what it reported (the stand-in's 8 ms interval, its 2 buffered commands, its version)
+// and runs as before.
+TEST(FanucJ519Link, ProtocolThreeAndFourAskTheCapabilityFirstAndRecordTheControllers) {
+  for (const std::uint32_t version : {3U, 4U}) {
+    SCOPED_TRACE(version);
+    const JointVector q0 = pose_deg(5, 25, -5, 20, 35, -15);
+    FanucBench bench(test::hold_program(test::bench_robot(), q0, 60.0), q0, version);
+    const Vector3 f_base(0.0, 200.0, -300.0);
+    for (int k = 0; k < 750; ++k) {  // 3 s
+      bench.force.reading = test::reading_at(bench.robot, bench.controller.position(), f_base);
+      bench.tick();
+      // No threshold request before the capability's reply, no start packet before the tables.
+      if (bench.controller.counters().threshold_requests > 0) {
+        ASSERT_EQ(bench.controller.counters().capability_replies, 1u);
+      }
+      if (bench.controller.counters().starts > 0) {
+        ASSERT_EQ(bench.controller.counters().threshold_replies, 18u);
+      }
+    }
+    EXPECT_EQ(bench.controller.alarm(), "");
+    ASSERT_EQ(bench.link.state(), LinkState::kRunning) << bench.link.stop_reason();
+    EXPECT_GT(bench.controller.counters().taken, 300u);
+    EXPECT_EQ(bench.controller.counters().capability_requests, 1u);
+    const FanucCapabilityCounters& k = bench.link.capability_counters();
+    EXPECT_TRUE(k.asked);
+    EXPECT_TRUE(k.read);
+    EXPECT_FALSE(k.unanswered);
+    EXPECT_EQ(k.rejected, 0u);
+    EXPECT_EQ(k.resent, 0u);
+    const fanuc_j519::Capability& c = bench.link.capability();
+    EXPECT_EQ(c.type, 7u);
+    EXPECT_EQ(c.id, 1u);
+    EXPECT_EQ(c.available_version, version);
+    EXPECT_EQ(c.sampling_rate_ms, 8u);
+    EXPECT_EQ(c.start_move, 2u);
+    EXPECT_EQ(c.status_uses_tcp, 0u);
+    EXPECT_NE(
+        bench.link.protocol_summary().find(fmt::format(
+            "capability: protocol {} available, sampling rate 8 ms, start_move 2, status at the faceplate", version)),
+        std::string::npos)
+        << bench.link.protocol_summary();
+  }
+}
+
+// Version 1 has no capability packet: a version 1 link asks nothing.
+TEST(FanucJ519Link, ProtocolOneAsksNoCapability) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  FanucBench bench(test::hold_program(test::bench_robot(), q0, 30.0), q0, 1);
+  bench.run(1.0);
+  EXPECT_EQ(bench.link.state(), LinkState::kRunning) << bench.link.stop_reason();
+  EXPECT_EQ(bench.controller.counters().capability_requests, 0u);
+  EXPECT_FALSE(bench.link.capability_counters().asked);
+  EXPECT_NE(bench.link.protocol_summary().find("protocol 1 has no capability exchange"), std::string::npos);
+}
+
+// The reference's MOTN-607 case: a version 3 client on a version 1 controller, which does not answer the
+// capability request. After the request and its two retries (0.1 s each) the link stops, nothing else sent.
+TEST(FanucJ519Link, AProtocolThreeLinkOnAVersionOneControllerStopsBeforeAnyStartPacket) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  FanucBench bench(test::hold_program(test::bench_robot(), q0, 30.0), q0, 3, 1);
+  double stopped_s = -1.0;
+  while (bench.t_s < 1.0) {
+    bench.tick();
+    if (stopped_s < 0.0 && bench.link.state() == LinkState::kStopped) stopped_s = bench.t_s;
+  }
+  EXPECT_GE(stopped_s, 0.3);
+  EXPECT_LE(stopped_s, 0.3 + 0.008);
+  EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kController);
+  const std::string why = bench.link.stop_reason();
+  EXPECT_NE(why.find("MOTN-607"), std::string::npos) << why;
+  EXPECT_NE(why.find("PC 3, Rob 1"), std::string::npos) << why;
+  EXPECT_NE(why.find("--fanuc-version 1"), std::string::npos) << why;
+  EXPECT_TRUE(bench.link.capability_counters().unanswered);
+  EXPECT_EQ(bench.link.capability_counters().resent, 2u);
+  EXPECT_EQ(bench.controller.counters().capability_requests, 3u);
+  EXPECT_EQ(bench.controller.counters().capability_replies, 0u);
+  EXPECT_EQ(bench.controller.counters().threshold_requests, 0u);
+  EXPECT_EQ(bench.controller.counters().starts, 0u);
+  EXPECT_EQ(bench.controller.counters().stops, 0u);
+  EXPECT_EQ(bench.controller.counters().commands, 0u);
+  EXPECT_EQ(bench.controller.counters().statuses, 0u);
+  EXPECT_EQ(bench.controller.alarm(), "");
+}
+
+// A controller that answers with an older available_version than the link speaks: stopped before the
+// tables and the start packet, naming both and the option that fits.
+TEST(FanucJ519Link, ACapabilityOfferingAnOlderVersionStopsNamingBoth) {
+  struct Case {
+    std::uint32_t link, available;
+    const char* option;
+  };
+  for (const Case& c :
+       {Case{3, 1, "--fanuc-version 1"}, Case{4, 3, "--fanuc-version 3"}, Case{3, 2, "--fanuc-version 1"}}) {
+    SCOPED_TRACE(c.option);
+    const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+    // A version 1 stand-in does not answer: the reply comes from the test.
+    FanucBench bench(test::hold_program(test::bench_robot(), q0, 30.0), q0, c.link, 1);
+    bench.tick();
+    from_controller(bench, capability_bytes(7, 1, 8, 2, c.available));
+    ASSERT_EQ(bench.link.state(), LinkState::kStopped);
+    EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kController);
+    const std::string why = bench.link.stop_reason();
+    EXPECT_NE(
+        why.find(fmt::format("offers J519 protocol version {}, deflex was set to version {}", c.available, c.link)),
+        std::string::npos)
+        << why;
+    EXPECT_NE(why.find(c.option), std::string::npos) << why;
+    EXPECT_EQ(bench.link.capability().available_version, c.available);
+    bench.run(0.5);
+    EXPECT_EQ(bench.controller.counters().threshold_requests, 0u);
+    EXPECT_EQ(bench.controller.counters().starts, 0u);
+  }
+}
+
+// A sampling rate that is not the compensator's period: stopped naming both (a 4 ms controller, 8 ms deflex).
+TEST(FanucJ519Link, ACapabilitySamplingRateOtherThanThePeriodStopsNamingBoth) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  FanucBench bench(test::hold_program(test::bench_robot(), q0, 30.0), q0, 3, 3, 0.004);
+  bench.run(0.5);
+  ASSERT_EQ(bench.link.state(), LinkState::kStopped);
+  EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kProtocol);
+  const std::string why = bench.link.stop_reason();
+  EXPECT_NE(why.find("sampling rate of 4 ms, deflex runs at 8 ms (--period-ms)"), std::string::npos) << why;
+  EXPECT_EQ(bench.link.capability().sampling_rate_ms, 4u);
+  EXPECT_EQ(bench.controller.counters().capability_replies, 1u);
+  EXPECT_EQ(bench.controller.counters().threshold_requests, 0u);
+  EXPECT_EQ(bench.controller.counters().starts, 0u);
+}
+
+// The request on the wire, byte for byte; then replies that are not a valid one are rejected, counted and
+// never used (each says version 1 at 4 ms: had one been taken, the link would have stopped).
+TEST(FanucJ519Link, TheCapabilityRequestsBytesAndBadRepliesRejectedAndCounted) {
+  const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
+  FanucBench bench(test::hold_program(test::bench_robot(), q0, 30.0), q0, 3, 1);
+  bench.clock.set(0.001);
+  ASSERT_EQ(bench.link.poll(0.0), LinkPollResult::kIdle);
+  bench.clock.set(0.002);
+  std::vector<unsigned char> got(64, 0);
+  DatagramAddress from;
+  const long n = bench.controller_port.receive(got.data(), got.size(), from);
+  ASSERT_EQ(n, 28);
+  got.resize(28);
+  const std::vector<unsigned char> want = {0, 0, 0, 7, 0, 0, 0, 3, 0, 0, 0, 1, 0, 0,
+                                           0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+  EXPECT_EQ(got, want);
+
+  std::vector<std::vector<unsigned char>> bad = {
+      capability_bytes(7, 1, 4, 2, 1, 27),       // truncated
+      capability_bytes(7, 1, 4, 2, 1, 29),       // one byte too many
+      capability_bytes(8, 1, 4, 2, 1),           // a capability set, not the get's reply
+      capability_bytes(3, 1, 4, 2, 1),           // a threshold type
+      capability_bytes(7, 0, 4, 2, 1),           // id 0
+      capability_bytes(7, 2, 4, 2, 1),           // another id
+      capability_bytes(7, 1, 4, 12, 1),          // start_move over 9
+      capability_bytes(7, 1, 0, 2, 1),           // no sampling rate
+      capability_bytes(7, 1, 4, 2, 0),           // no available version
+      capability_bytes(7, 1, 0xDEADBEEF, 2, 1),  // garbage rate
+      capability_bytes(7, 1, 4, 2, 0x5A17C0DE),  // garbage version
+  };
+  for (const auto& b : bad) from_controller(bench, b);
+  EXPECT_EQ(bench.link.capability_counters().rejected, bad.size());
+  EXPECT_FALSE(bench.link.capability_counters().read);
+  EXPECT_EQ(bench.link.state(), LinkState::kWaiting) << bench.link.stop_reason();
+  // The right reply (hand-built the same way) is taken: the builder makes valid bytes.
+  from_controller(bench, capability_bytes(7, 1, 8, 3, 4));
+  EXPECT_TRUE(bench.link.capability_counters().read);
+  EXPECT_EQ(bench.link.capability().available_version, 4u);
+  EXPECT_EQ(bench.link.capability().sampling_rate_ms, 8u);
+  EXPECT_EQ(bench.link.capability().start_move, 3u);
+  EXPECT_NE(bench.link.state(), LinkState::kStopped) << bench.link.stop_reason();
+  EXPECT_NE(bench.link.protocol_summary().find("11 capability replies rejected"), std::string::npos)
+      << bench.link.protocol_summary();
 }
 
 }  // namespace

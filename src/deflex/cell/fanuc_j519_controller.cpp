@@ -1,7 +1,9 @@
 // The controller side of FANUC Stream Motion (see fanuc_j519_controller.hpp).
 #include "deflex/cell/fanuc_j519_controller.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace deflex::cell {
 
@@ -70,6 +72,32 @@ void FanucJ519Controller::answer_threshold(std::size_t size, const DatagramAddre
   if (n > 0 && transport_.send_to(buffer_.data(), n, from)) ++counters_.threshold_replies;
 }
 
+// Its version, interval and command buffer; a get of protocol 1's controller goes unanswered.
+void FanucJ519Controller::answer_capability(std::size_t size, const DatagramAddress& from) {
+  j519::Capability rq;
+  if (j519::decode(buffer_.data(), size, rq) != j519::DecodeStatus::kOk || rq.type != j519::kTypeCapabilityGet) {
+    ++counters_.ignored;
+    return;
+  }
+  ++counters_.capability_requests;
+  if (config_.version < 3 || streaming_) return;
+  j519::Capability reply;
+  reply.type = j519::kTypeCapabilityGet;
+  reply.version = config_.version;
+  reply.id = rq.id;
+  reply.sampling_rate_ms = static_cast<std::uint32_t>(std::lround(config_.interval_s * 1e3));
+  reply.start_move = static_cast<std::uint32_t>(std::min<std::size_t>(config_.start_buffer, 9));
+  reply.available_version = config_.version;
+  reply.status_uses_tcp = 0;
+  const std::size_t n = j519::encode(reply, buffer_.data(), buffer_.size());
+  if (n > 0 && transport_.send_to(buffer_.data(), n, from)) ++counters_.capability_replies;
+}
+
+void FanucJ519Controller::version_mismatch(std::uint32_t pc_version) {
+  stop_stream("MOTN-607 ST: Protocol version mismatch PC " + std::to_string(pc_version) + ", Rob " +
+              std::to_string(config_.version));
+}
+
 void FanucJ519Controller::read_packets(double t_s) {
   DatagramAddress from;
   for (;;) {
@@ -88,6 +116,7 @@ void FanucJ519Controller::read_packets(double t_s) {
         streaming_ = true;
         pc_ = from;
         restart(t_s);
+        if (version != config_.version) version_mismatch(version);
       }
       continue;
     }
@@ -101,6 +130,10 @@ void FanucJ519Controller::read_packets(double t_s) {
       answer_threshold(size, from);
       continue;
     }
+    if (type == j519::kTypeCapabilityGet || type == j519::kTypeCapabilitySet) {
+      answer_capability(size, from);
+      continue;
+    }
     j519::Command c;
     std::uint32_t cv = 0;
     if (!streaming_ || !(from == pc_) || j519::decode(buffer_.data(), size, c, cv) != j519::DecodeStatus::kOk) {
@@ -109,7 +142,7 @@ void FanucJ519Controller::read_packets(double t_s) {
     }
     if (!alarm_.empty() || ended_) continue;  // the stream has stopped: commands are not taken
     if (cv != config_.version) {
-      stop_stream("MOTN-607 ST: Protocol version mismatch");
+      version_mismatch(cv);
       continue;
     }
     // The first command may answer any status sent; each later one carries the next number.

@@ -23,7 +23,14 @@
 //     `answer_thresholds` off is older system software, which answers none. FANUC publishes no table, so
 //     its 20 speed columns are a made-up profile whose strictest value is the enforced limit: full payload
 //     at 100 % of the maximum Cartesian speed is the limit, each 5 % slower allows limit / 19 more (twice
-//     the limit at 5 %), and no payload allows 1.25 times full payload's.
+//     the limit at 5 %), and no payload allows 1.25 times full payload's;
+//   - of protocol 3 or 4, a capability get (type 7, id as asked) is answered, while no stream runs (as the
+//     tables), with its version as available_version, its interval as sampling_rate and start_buffer as
+//     start_move (status at the faceplate); of protocol 1 it is not answered (version 1 documents no
+//     capability packet);
+//   - a start packet or a command of another protocol version than its own is MOTN-607 "ST: Protocol version
+//     mismatch PC n, Rob m" (the reference's v3 client on a v1 controller); the statuses it then sends are
+//     of its own version, the ready bit clear.
 // Faults on request (tests): an alarm now (an e-stop), a restart of the TP program (a new session,
 // numbered from 1 again). A network outage is the network's. It knows nothing of deflex.
 #pragma once
@@ -70,8 +77,10 @@ struct FanucJ519ControllerCounters {
   std::uint64_t taken = 0;     ///< targets taken (one an interval once moving)
   std::uint64_t ignored = 0;   ///< datagrams that were not a packet it takes
   std::uint64_t starts = 0, stops = 0;
-  std::uint64_t threshold_requests = 0;  ///< threshold requests received (answered or not)
-  std::uint64_t threshold_replies = 0;   ///< threshold tables sent
+  std::uint64_t threshold_requests = 0;   ///< threshold requests received (answered or not)
+  std::uint64_t threshold_replies = 0;    ///< threshold tables sent
+  std::uint64_t capability_requests = 0;  ///< capability gets received (answered or not)
+  std::uint64_t capability_replies = 0;   ///< capability replies sent
 };
 
 /// Thread safety: one thread at a time (the simulation's), with its transport.
@@ -106,6 +115,8 @@ class FanucJ519Controller final : public RobotController {
  private:
   void read_packets(double t_s);
   void answer_threshold(std::size_t size, const DatagramAddress& from);
+  void answer_capability(std::size_t size, const DatagramAddress& from);
+  void version_mismatch(std::uint32_t pc_version);
   void take_command(double t_s);
   void send_status(double t_s, double stamp_s);
   void stop_stream(const std::string& alarm);

@@ -224,6 +224,12 @@ void FanucJ519LinkConfig::validate() const {
   if (!(start_resend_s > 0.0) || max_catch_up < 0 || max_catch_up > 9) {
     throw InputError("FANUC J519 link: start_resend_s must be > 0 and max_catch_up (--fanuc-catch-up) in 0..9");
   }
+  if (!(capability_timeout_s > 0.0 && capability_timeout_s <= 10.0) || capability_retries < 0 ||
+      capability_retries > 10) {
+    throw InputError(
+        "FANUC J519 link: capability_timeout_s must be in (0, 10] s and capability_retries in 0..10 (the capability "
+        "request)");
+  }
   if (!(threshold_timeout_s > 0.0 && threshold_timeout_s <= 10.0) || threshold_retries < 0 || threshold_retries > 10) {
     throw InputError(
         "FANUC J519 link: threshold_timeout_s must be in (0, 10] s and threshold_retries in 0..10 (the threshold "
@@ -250,6 +256,8 @@ FanucJ519Link::FanucJ519Link(OnlineCompensator& compensator, OnlineStrategy& str
       limits_(config.limits) {
   check_program(stream_.trajectory(), compensator, config_);
   if (!config_.read_thresholds) tables_done_ = true;
+  capability_counters_.asked = config_.version >= 3;
+  capability_done_ = !capability_counters_.asked;
   const int n = compensator.model().dof();
   for (JointVector* q : {&feedback_, &program_, &program_velocity_, &blend_, &blend_velocity_, &nominal_}) {
     *q = JointVector::Zero(n);
@@ -366,6 +374,114 @@ bool FanucJ519Link::start_session(const j519::Status& s) noexcept {
   next_sequence_ = s.sequence;
   ready_seen_ = true;
   state_ = LinkState::kRunning;
+  return true;
+}
+
+// ---- The capability (protocol 3 and 4), before the threshold tables ---------------------------------------
+// FANUC's own driver asks it first (the reference notes, "Session flow"); a controller's reply names the
+// newest protocol it speaks and its interval. Version 1 documents no capability packet, so a version-1
+// link asks nothing. One request in flight, as for the tables; its id is 1, as in the reference's layout.
+
+namespace {
+constexpr std::uint32_t kCapabilityId = 1;
+
+// The newest version deflex speaks that a controller offering `available` has.
+std::uint32_t speakable(std::uint32_t available) noexcept { return available >= 4 ? 4 : available >= 3 ? 3 : 1; }
+}  // namespace
+
+void FanucJ519Link::send_capability_request(double now) noexcept {
+  j519::Capability rq;
+  rq.type = j519::kTypeCapabilityGet;
+  rq.version = config_.version;
+  rq.id = kCapabilityId;
+  const std::size_t n = j519::encode(rq, tx_.data(), tx_.size());
+  if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) ++counters_.send_errors;
+  if (capability_attempts_ > 0) ++capability_counters_.resent;
+  ++capability_attempts_;
+  capability_sent_s_ = now;
+}
+
+// A datagram from the controller in the capability phase (in rx_): a reply to the get (type 7, 28 bytes,
+// id 1) whose read-only fields are a version and an interval is taken; anything else is rejected and
+// counted, never used. The header's version is not judged: what a controller writes there in a reply is
+// not published, and available_version is the field that names what it speaks.
+bool FanucJ519Link::take_capability_reply(std::size_t size) noexcept {
+  j519::Capability c;
+  if (j519::decode(rx_.data(), size, c) != j519::DecodeStatus::kOk || c.type != j519::kTypeCapabilityGet ||
+      c.id != kCapabilityId || c.available_version < 1 || c.available_version > 99 || c.sampling_rate_ms < 1 ||
+      c.sampling_rate_ms > 100) {
+    ++capability_counters_.rejected;
+    return false;
+  }
+  capability_ = c;
+  capability_counters_.read = true;
+  return true;
+}
+
+// What the reply says against what deflex was told: an older protocol than --fanuc-version (the controller
+// would raise MOTN-607 at the start packet) or another interval than --period-ms stops the link, nothing
+// sent yet.
+void FanucJ519Link::judge_capability() noexcept {
+  const j519::Capability& c = capability_;
+  if (c.available_version < config_.version) {
+    stop_link(LinkStopCause::kController,
+              "the controller's capability reply offers J519 protocol version %u, deflex was set to version %u: its "
+              "start packet would raise MOTN-607 (ST: Protocol version mismatch PC %u, Rob %u); nothing was sent: "
+              "give --fanuc-version %u",
+              c.available_version, config_.version, config_.version, c.available_version,
+              speakable(c.available_version));
+    return;
+  }
+  if (std::abs(static_cast<double>(c.sampling_rate_ms) - period_s_ * 1e3) > 1e-6) {
+    stop_link(LinkStopCause::kProtocol,
+              "the controller's capability reply gives a sampling rate of %u ms, deflex runs at %g ms (--period-ms): "
+              "set it to the controller's $STMO.$COM_INT; nothing was sent",
+              c.sampling_rate_ms, period_s_ * 1e3);
+  }
+}
+
+// True once the phase is over: the reply taken (and judged), or the link stopped.
+bool FanucJ519Link::read_capability(double timeout_s) noexcept {
+  double now = clock_.now_s();
+  if (capability_attempts_ == 0) send_capability_request(now);
+  const double left = capability_sent_s_ + config_.capability_timeout_s - now;
+  if (transport_.wait_readable(std::max(0.0, std::min(timeout_s, left)))) {
+    DatagramAddress from;
+    for (int i = 0; i < 64 && !capability_counters_.read; ++i) {
+      const long n = transport_.receive(rx_.data(), rx_.size(), from);
+      if (n < 0) break;
+      ++counters_.datagrams;
+      if (!(from == config_.controller)) {
+        ++counters_.foreign_sender;
+      } else if (static_cast<std::size_t>(n) > config_.max_packet_bytes) {
+        ++counters_.oversized;
+      } else {
+        take_capability_reply(static_cast<std::size_t>(n));
+      }
+    }
+  }
+  if (capability_counters_.read) {
+    capability_done_ = true;
+    judge_capability();
+    return true;
+  }
+  now = clock_.now_s();
+  if (now - capability_sent_s_ < config_.capability_timeout_s) return false;
+  if (capability_attempts_ <= config_.capability_retries) {
+    send_capability_request(now);
+    return false;
+  }
+  // No reply at all is read the strict way: a controller that has protocol 3 answers the request (FANUC's
+  // own driver relies on it), and a v3 client on one that does not gets MOTN-607 "ST: Protocol version
+  // mismatch PC 3, Rob 1" (reference notes, "Versions 2, 3 and 4": fanuc_driver issue #39). Guessing the
+  // version could start a stream the controller refuses, so the link stops and names the choice.
+  capability_counters_.unanswered = true;
+  capability_done_ = true;
+  stop_link(LinkStopCause::kController,
+            "the controller answered no capability request (%d tries of %g s): a controller without J519 protocol "
+            "3 does not, and a version %u start packet on it raises MOTN-607 (ST: Protocol version mismatch PC %u, "
+            "Rob 1); nothing was sent: give --fanuc-version 1 if the controller has only version 1",
+            config_.capability_retries + 1, config_.capability_timeout_s, config_.version, config_.version);
   return true;
 }
 
@@ -545,6 +661,13 @@ LinkPollResult FanucJ519Link::poll_once(double timeout_s) noexcept {
     if (drain(0.0, ignored, starts) && state_ == LinkState::kRefused) ++counters_.refused;
     return announce_terminal();
   }
+  if (!capability_done_) {
+    const std::uint64_t before = counters_.datagrams;
+    if (!read_capability(timeout_s))
+      return counters_.datagrams > before ? LinkPollResult::kRejected : LinkPollResult::kIdle;
+    if (state_ == LinkState::kStopped) return announce_terminal();
+    timeout_s = 0.0;  // this poll has waited already
+  }
   if (!tables_done_) {
     const std::uint64_t before = counters_.datagrams;
     if (!read_thresholds(timeout_s)) {
@@ -722,14 +845,34 @@ std::string fanuc_threshold_summary(const FanucJ519LinkConfig& config, const Fan
                      strictest.velocity, strictest.acceleration, strictest.jerk);
 }
 
+// What the capability exchange gave (protocol 3 and 4).
+std::string fanuc_capability_summary(const FanucJ519LinkConfig& config, const FanucCapabilityCounters& k,
+                                     const j519::Capability& c) {
+  std::string out;
+  if (!k.asked) {
+    out = "protocol 1 has no capability exchange";
+  } else if (k.read) {
+    out = fmt::format(
+        "the controller's capability: protocol {} available, sampling rate {} ms, start_move {}, status at the {}",
+        c.available_version, c.sampling_rate_ms, c.start_move, c.status_uses_tcp == 1 ? "TCP" : "faceplate");
+  } else if (k.unanswered) {
+    out = fmt::format("the controller answered no capability request ({} tries of {:g} s)",
+                      config.capability_retries + 1, config.capability_timeout_s);
+  } else {
+    out = "the link stopped while the controller's capability was asked";
+  }
+  if (k.rejected > 0) out += fmt::format(", {} capability replies rejected", k.rejected);
+  return out;
+}
+
 }  // namespace
 
 std::string FanucJ519Link::protocol_summary() const {
   return fmt::format(
       "FANUC J519 (protocol {}): {} commands sent, {} to catch up lost statuses; the correction smoothed over {} "
-      "intervals ({:.0f} ms) to stay within {:.0f} % of the acceleration and jerk limits; {}",
+      "intervals ({:.0f} ms) to stay within {:.0f} % of the acceleration and jerk limits; {}; {}",
       config_.version, counters_.replies, caught_up_, smoother_.taps(), smoother_.delay_s() * 1e3,
-      100.0 * config_.correction_share,
+      100.0 * config_.correction_share, fanuc_capability_summary(config_, capability_counters_, capability_),
       fanuc_threshold_summary(config_, thresholds_, tables_done_, limits_,
                               static_cast<std::size_t>(compensator().model().dof())));
 }

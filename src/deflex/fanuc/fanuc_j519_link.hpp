@@ -9,7 +9,10 @@
 // limits and the share of them the correction may take, and the program is checked against the rest of
 // them before the session starts. Those limits are, per joint and kind, the stricter of the ones the
 // user gives and the controller's own threshold table, read before the start packet (a controller that
-// does not answer: the user's, and the summary says so).
+// does not answer: the user's, and the summary says so). In protocol 3 and 4 the controller's capability
+// is asked first, as FANUC's own driver does: a controller offering an older version than deflex was told
+// to speak, reporting another interval than --period-ms, or not answering at all stops the link before
+// the start packet (version 1 has no capability packet, so nothing is asked).
 //
 // The program's clock is the controller's: it moves on one interval per command, and a status whose
 // number skips some (a status lost on the way) is answered with one command for each number missed,
@@ -67,6 +70,11 @@ struct FanucJ519LinkConfig {
   bool read_thresholds = true;
   double threshold_timeout_s = 0.1;
   int threshold_retries = 2;
+  /// Protocol 3 and 4: the capability request before the threshold tables, answered within
+  /// `capability_timeout_s` or sent again, at most `capability_retries` times; still unanswered, the
+  /// link stops (a controller without protocol 3 does not answer it, and raises MOTN-607 on a v3 start).
+  double capability_timeout_s = 0.1;
+  int capability_retries = 2;
 
   static JointStreamConfig fanuc_stream() {
     JointStreamConfig s;
@@ -94,6 +102,15 @@ struct FanucThresholdCounters {
   std::uint64_t rejected = 0;  ///< replies that were not the table asked for, or not a valid one: never used
   std::uint64_t resent = 0;    ///< requests sent again after their timeout
   bool unanswered = false;     ///< a request went unanswered after every retry: the rest were not asked
+};
+
+/// How the capability exchange went (protocol 3 and 4 only).
+struct FanucCapabilityCounters {
+  bool asked = false;          ///< the link speaks protocol 3 or 4 (version 1 has no capability packet)
+  bool read = false;           ///< a valid reply was taken (FanucJ519Link::capability())
+  std::uint64_t rejected = 0;  ///< datagrams in the phase that were not a valid reply: never used
+  std::uint64_t resent = 0;    ///< requests sent again after their timeout
+  bool unanswered = false;     ///< no valid reply after every retry: the link stopped
 };
 
 /// Thread safety: one thread at a time (the loop's), as every ControllerLink.
@@ -128,10 +145,17 @@ class FanucJ519Link final : public ControllerLink {
   /// The strictest value of each table read (0 where none was read).
   [[nodiscard]] const std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes>& tables() const { return tables_; }
   [[nodiscard]] const FanucThresholdCounters& thresholds() const { return thresholds_; }
+  /// What the controller reported in its capability reply (valid when capability_counters().read).
+  [[nodiscard]] const fanuc_j519::Capability& capability() const { return capability_; }
+  [[nodiscard]] const FanucCapabilityCounters& capability_counters() const { return capability_counters_; }
   /// True once the threshold phase is over (read, unanswered or off): the start packet may go out.
   [[nodiscard]] bool thresholds_done() const { return tables_done_; }
 
  private:
+  bool read_capability(double timeout_s) noexcept;
+  void send_capability_request(double now) noexcept;
+  bool take_capability_reply(std::size_t size) noexcept;
+  void judge_capability() noexcept;
   bool read_thresholds(double timeout_s) noexcept;
   void send_threshold_request(double now) noexcept;
   void take_threshold_reply(std::size_t size) noexcept;
@@ -162,6 +186,13 @@ class FanucJ519Link final : public ControllerLink {
   bool have_previous_status_ = false;  // the status before the first ready one answered (its interval)
   std::uint32_t previous_sequence_ = 0, previous_stamp_ms_ = 0;
   double last_data_s_ = 0.0;
+
+  // The capability phase (protocol 3 and 4), before the threshold phase.
+  fanuc_j519::Capability capability_;
+  FanucCapabilityCounters capability_counters_;
+  bool capability_done_ = false;
+  int capability_attempts_ = 0;
+  double capability_sent_s_ = 0.0;
 
   // The threshold phase, before the start packet.
   std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> limits_;  // what the stream is held to
