@@ -75,6 +75,22 @@ struct FanucBench {
     link.read_force_from(&force);
   }
 
+  /// One 4 ms servo tick of the controller, then deflex polls until idle or stopped, each poll under an
+  /// allocation guard: the allocations the polls made.
+  std::size_t tick_counting_allocations() {
+    t_s += 0.004;
+    clock.set(t_s);
+    controller.tick(t_s);
+    clock.set(t_s + 0.0002);
+    std::size_t allocations = 0;
+    for (;;) {
+      test::AllocationGuard guard;
+      const LinkPollResult r = link.poll(0.0);
+      allocations += guard.allocations();
+      if (r == LinkPollResult::kIdle || link.state() == LinkState::kStopped) return allocations;
+    }
+  }
+
   /// One 4 ms servo tick of the controller, then deflex answers what reached it (unless stalled).
   LinkPollResult tick() {
     t_s += 0.004;
@@ -366,16 +382,7 @@ TEST(FanucJ519Link, NoPollFromStartToEndAllocates) {
   bench.network.add_outage(1.0005, 1.0085, test::kSensorAddress);  // one status lost: caught up
   std::size_t allocations = 0;
   for (int k = 0; k < 2000 && bench.link.state() != LinkState::kStopped; ++k) {
-    bench.t_s += 0.004;
-    bench.clock.set(bench.t_s);
-    bench.controller.tick(bench.t_s);
-    bench.clock.set(bench.t_s + 0.0002);
-    for (;;) {
-      test::AllocationGuard guard;
-      const LinkPollResult r = bench.link.poll(0.0);
-      allocations += guard.allocations();
-      if (r == LinkPollResult::kIdle || bench.link.state() == LinkState::kStopped) break;
-    }
+    allocations += bench.tick_counting_allocations();
   }
   EXPECT_EQ(bench.link.stop_cause(), LinkStopCause::kEnded) << bench.link.stop_reason();
   EXPECT_GE(bench.link.caught_up(), 1u);
@@ -641,16 +648,7 @@ TEST(FanucJ519Link, ReadingStricterThresholdTablesDoesNotAllocate) {
   FanucBench bench(test::hold_program(test::bench_robot(), q0, 60.0), q0, strict.link(true), strict.controller());
   std::size_t allocations = 0;
   while (bench.t_s < 2.0) {
-    bench.t_s += 0.004;
-    bench.clock.set(bench.t_s);
-    bench.controller.tick(bench.t_s);
-    bench.clock.set(bench.t_s + 0.0002);
-    for (;;) {
-      test::AllocationGuard guard;
-      const LinkPollResult r = bench.link.poll(0.0);
-      allocations += guard.allocations();
-      if (r == LinkPollResult::kIdle || bench.link.state() == LinkState::kStopped) break;
-    }
+    allocations += bench.tick_counting_allocations();
   }
   EXPECT_TRUE(bench.link.capability_counters().read);  // the capability exchange ran in poll() too
   EXPECT_EQ(bench.link.thresholds().read, 18u);

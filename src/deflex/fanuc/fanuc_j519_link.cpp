@@ -440,26 +440,30 @@ void FanucJ519Link::judge_capability() noexcept {
   }
 }
 
+template <typename Take>
+void FanucJ519Link::receive_before_stream(double wait_s, Take&& take) noexcept {
+  if (!transport_.wait_readable(std::max(0.0, wait_s))) return;
+  DatagramAddress from;
+  for (int i = 0; i < 64; ++i) {  // a flood cannot hold the poll
+    const long n = transport_.receive(rx_.data(), rx_.size(), from);
+    if (n < 0) break;
+    ++counters_.datagrams;
+    if (!(from == config_.controller)) {
+      ++counters_.foreign_sender;
+    } else if (static_cast<std::size_t>(n) > config_.max_packet_bytes) {
+      ++counters_.oversized;
+    } else if (!take(static_cast<std::size_t>(n))) {
+      break;
+    }
+  }
+}
+
 // True once the phase is over: the reply taken (and judged), or the link stopped.
 bool FanucJ519Link::read_capability(double timeout_s) noexcept {
   double now = clock_.now_s();
   if (capability_attempts_ == 0) send_capability_request(now);
-  const double left = capability_sent_s_ + config_.capability_timeout_s - now;
-  if (transport_.wait_readable(std::max(0.0, std::min(timeout_s, left)))) {
-    DatagramAddress from;
-    for (int i = 0; i < 64 && !capability_counters_.read; ++i) {
-      const long n = transport_.receive(rx_.data(), rx_.size(), from);
-      if (n < 0) break;
-      ++counters_.datagrams;
-      if (!(from == config_.controller)) {
-        ++counters_.foreign_sender;
-      } else if (static_cast<std::size_t>(n) > config_.max_packet_bytes) {
-        ++counters_.oversized;
-      } else {
-        take_capability_reply(static_cast<std::size_t>(n));
-      }
-    }
-  }
+  receive_before_stream(std::min(timeout_s, capability_sent_s_ + config_.capability_timeout_s - now),
+                        [this](std::size_t size) { return !take_capability_reply(size); });
   if (capability_counters_.read) {
     capability_done_ = true;
     judge_capability();
@@ -541,24 +545,13 @@ bool FanucJ519Link::read_thresholds(double timeout_s) noexcept {
   thresholds_.asked = total;
   double now = clock_.now_s();
   if (table_attempts_ == 0) send_threshold_request(now);
-  const double left = table_sent_s_ + config_.threshold_timeout_s - now;
-  if (transport_.wait_readable(std::max(0.0, std::min(timeout_s, left)))) {
-    DatagramAddress from;
-    for (int i = 0; i < 64 && table_next_ < total; ++i) {
-      const long n = transport_.receive(rx_.data(), rx_.size(), from);
-      if (n < 0) break;
-      ++counters_.datagrams;
-      if (!(from == config_.controller)) {
-        ++counters_.foreign_sender;
-      } else if (static_cast<std::size_t>(n) > config_.max_packet_bytes) {
-        ++counters_.oversized;
-      } else {
-        const std::size_t before = table_next_;
-        take_threshold_reply(static_cast<std::size_t>(n));
-        if (table_next_ != before && table_next_ < total) send_threshold_request(clock_.now_s());
-      }
-    }
-  }
+  receive_before_stream(std::min(timeout_s, table_sent_s_ + config_.threshold_timeout_s - now),
+                        [this, total](std::size_t size) {
+                          const std::size_t before = table_next_;
+                          take_threshold_reply(size);
+                          if (table_next_ != before && table_next_ < total) send_threshold_request(clock_.now_s());
+                          return table_next_ < total;
+                        });
   now = clock_.now_s();
   if (table_next_ < total && now - table_sent_s_ >= config_.threshold_timeout_s) {
     if (table_attempts_ <= config_.threshold_retries) {

@@ -160,6 +160,11 @@ class FanucJ519Link final : public ControllerLink {
   void send_threshold_request(double now) noexcept;
   void take_threshold_reply(std::size_t size) noexcept;
   void apply_tables() noexcept;
+  /// The controller's datagrams before the stream (the capability, the tables): waits up to `wait_s`,
+  /// then hands each from the controller within max_packet_bytes to `take` (its size; rx_ holds it)
+  /// until `take` returns false; foreign and oversized ones are counted.
+  template <typename Take>
+  void receive_before_stream(double wait_s, Take&& take) noexcept;
   LinkPollResult poll_once(double timeout_s) noexcept;
   void send_stop_packet() noexcept;
   bool interval_agrees(const fanuc_j519::Status& s) noexcept;
