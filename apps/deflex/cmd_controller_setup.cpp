@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <variant>
 
 #include <fmt/format.h>
 
@@ -26,15 +27,17 @@ struct ControllerSetupOpts : runtime::ControllerSetupSettings {
   bool json = false;
 };
 
-// An option `deflex online` has too: its help is the settings table's (unit, range, the links it applies
-// to), as online's --help gives it, and the library checks its value as online does.
-template <typename T>
-CLI::Option* add_shared(CLI::App& sub, const char* option, T& value, const char* note = "") {
+// An option `deflex online` has too: bound to the field the library's list of shared settings names
+// (runtime::controller_setup_shared), its help the settings table's (unit, range, the links it applies
+// to) as online's --help gives it; the library checks its value as online does.
+CLI::Option* add_shared(CLI::App& sub, ControllerSetupOpts& o, const char* option, const char* note = "") {
   const runtime::SessionSetting* s = runtime::find_session_setting(option);
   std::string help = "deflex online " + std::string(option);
   if (s != nullptr) help += ": " + runtime::option_help(*s);
   if (*note != '\0') help += fmt::format(" ({})", note);
-  return sub.add_option(option, value, help);
+  runtime::ControllerSetupSettings& settings = o;
+  return std::visit([&](auto member) { return sub.add_option(option, settings.*member, help); },
+                    runtime::controller_setup_shared(option).field);
 }
 
 // The link, where the files go, and the settings every link shares.
@@ -47,20 +50,18 @@ void add_controller_link_options(CLI::App& sub, ControllerSetupOpts& o) {
       ->required();
   sub.add_option("-o,--output-dir", o.output_dir, "Directory the files are written to (made when missing)")
       ->capture_default_str();
-  add_shared(sub, "--egm-port", o.egm_port)->capture_default_str();
-  add_shared(sub, "--rsi-port", o.rsi_port)->capture_default_str();
-  add_shared(sub, "--rsi-sentype", o.sentype)->capture_default_str();
-  add_shared(sub, "--period-ms", o.period_ms,
-             "egm-path: the EGMActMove SampleRate; rsi: 4 with #IPO_FAST, 12 with #IPO");
-  add_shared(sub, "--max-joint-correction-deg", o.max_joint_deg, "rsi: AXISCORR's limits on every axis")
-      ->capture_default_str();
-  add_shared(sub, "--max-tcp-correction-mm", o.max_tcp_mm)->capture_default_str();
+  add_shared(sub, o, "--egm-port")->capture_default_str();
+  add_shared(sub, o, "--rsi-port")->capture_default_str();
+  add_shared(sub, o, "--rsi-sentype")->capture_default_str();
+  add_shared(sub, o, "--period-ms", "egm-path: the EGMActMove SampleRate; rsi: 4 with #IPO_FAST, 12 with #IPO");
+  add_shared(sub, o, "--max-joint-correction-deg", "rsi: AXISCORR's limits on every axis")->capture_default_str();
+  add_shared(sub, o, "--max-tcp-correction-mm")->capture_default_str();
 }
 
 // ABB EGM's RAPID and UdpUc settings.
 void add_controller_egm_options(CLI::App& sub, ControllerSetupOpts& o) {
-  add_shared(sub, "--ramp-in-s", o.ramp_in_s, "egm-joint: EGMRunJoint \\RampInTime")->capture_default_str();
-  add_shared(sub, "--path-corr-frame", o.path_frame)->capture_default_str();
+  add_shared(sub, o, "--ramp-in-s", "egm-joint: EGMRunJoint \\RampInTime")->capture_default_str();
+  add_shared(sub, o, "--path-corr-frame")->capture_default_str();
   sub.add_option("--egm-device", o.device, "EGM: the UdpUc device's name")->capture_default_str();
   sub.add_option("--egm-config", o.egm_config, "EGM: the External Motion Interface Data entry EGMSetupUC names")
       ->capture_default_str();
@@ -68,8 +69,8 @@ void add_controller_egm_options(CLI::App& sub, ControllerSetupOpts& o) {
   sub.add_option("--tool", o.tool, "EGM: the tooldata the program moves with")->capture_default_str();
   sub.add_option("--comm-timeout-s", o.comm_timeout_s,
                  "EGM: EGMSetupUC \\CommTimeout, s (default: --stop-silence-s, deflex's own)");
-  add_shared(sub, "--stop-silence-s", o.stop_silence_s);
-  add_shared(sub, "--max-rate-deg-s", o.max_rate_deg_s)->capture_default_str();
+  add_shared(sub, o, "--stop-silence-s");
+  add_shared(sub, o, "--max-rate-deg-s")->capture_default_str();
   sub.add_option("--program", o.program,
                  "egm-joint: deflex online --program: its peak joint speeds make \\MaxSpeedDeviation and "
                  "\\MaxPosDeviation tight (without it the robot's speed limits stand in)");
@@ -89,23 +90,23 @@ void add_controller_egm_options(CLI::App& sub, ControllerSetupOpts& o) {
 // KUKA RSI, FANUC J519, MotoROS2 and UR RTDE settings.
 void add_controller_other_options(CLI::App& sub, ControllerSetupOpts& o) {
   sub.add_option("--context", o.context, "rsi: base name of the files and the KRL program")->capture_default_str();
-  add_shared(sub, "--rsi-timeout", o.rsi_timeout)->capture_default_str();
+  add_shared(sub, o, "--rsi-timeout")->capture_default_str();
   sub.add_option("--rsi-precision", o.rsi_precision, "rsi: ETHERNET Precision, decimals the controller sends")
       ->capture_default_str();
   sub.add_option("--rsi-monitor-factor", o.monitor_factor,
                  "rsi: AXISCORRMON's MaxAi as a multiple of --max-joint-correction-deg")
       ->capture_default_str();
   sub.add_option("--tp-program", o.tp_program, "fanuc-j519: the TP program's name")->capture_default_str();
-  add_shared(sub, "--fanuc-version", o.fanuc_version)->capture_default_str();
-  add_shared(sub, "--fanuc-limits", o.fanuc_limits)->capture_default_str();
-  add_shared(sub, "--fanuc-correction-share", o.fanuc_correction_share)->capture_default_str();
-  add_shared(sub, "--robot-port", o.robot_port);
-  add_shared(sub, "--motoros2-group", o.motoros2_group)->capture_default_str();
-  add_shared(sub, "--motoros2-resend-ms", o.motoros2_resend_ms)->capture_default_str();
-  add_shared(sub, "--motoros2-max-truncations", o.motoros2_max_truncations)->capture_default_str();
-  add_shared(sub, "--ur-lookahead-ms", o.ur_lookahead_ms)->capture_default_str();
-  add_shared(sub, "--ur-gain", o.ur_gain)->capture_default_str();
-  add_shared(sub, "--ur-register-offset", o.ur_register_offset)->capture_default_str();
+  add_shared(sub, o, "--fanuc-version")->capture_default_str();
+  add_shared(sub, o, "--fanuc-limits")->capture_default_str();
+  add_shared(sub, o, "--fanuc-correction-share")->capture_default_str();
+  add_shared(sub, o, "--robot-port");
+  add_shared(sub, o, "--motoros2-group")->capture_default_str();
+  add_shared(sub, o, "--motoros2-resend-ms")->capture_default_str();
+  add_shared(sub, o, "--motoros2-max-truncations")->capture_default_str();
+  add_shared(sub, o, "--ur-lookahead-ms")->capture_default_str();
+  add_shared(sub, o, "--ur-gain")->capture_default_str();
+  add_shared(sub, o, "--ur-register-offset")->capture_default_str();
   sub.add_option("--uframe", o.uframe, "fanuc-j519: the user frame the TP program sets")->capture_default_str();
   sub.add_option("--utool", o.utool, "fanuc-j519: the tool frame the TP program sets")->capture_default_str();
   sub.add_option("--move-speed-pct", o.move_speed_pct,

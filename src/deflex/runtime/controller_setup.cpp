@@ -7,6 +7,7 @@
 #include <iterator>
 #include <memory>
 #include <stdexcept>
+#include <type_traits>
 
 #include <fmt/format.h>
 
@@ -171,54 +172,73 @@ std::vector<ControllerFile> ur_setup_files(const ControllerSetupSettings& o, con
   return ur_controller_setup(u);
 }
 
-/// The settings controller-setup shares with `deflex online`, as (option, value in the option's unit or
-/// words); an unset one (a period of 0, a silence of NaN, a port of -1: the link's) is left out.
-std::vector<std::pair<const char*, std::string>> shared_settings(const ControllerSetupSettings& o) {
-  std::vector<std::pair<const char*, std::string>> out;
-  // A NaN is passed on for the table to refuse, except where it means "unset" (the silence).
-  const auto number = [&out](const char* option, double v, bool nan_is_unset = false) {
-    if (!(nan_is_unset && std::isnan(v))) out.emplace_back(option, fmt::format("{:.17g}", v));
-  };
-  if (o.period_ms != 0.0) number("--period-ms", o.period_ms);
-  number("--max-joint-correction-deg", o.max_joint_deg);
-  number("--max-tcp-correction-mm", o.max_tcp_mm);
-  number("--max-rate-deg-s", o.max_rate_deg_s);
-  number("--ramp-in-s", o.ramp_in_s);
-  number("--stop-silence-s", o.stop_silence_s, true);
-  number("--egm-port", o.egm_port);
-  number("--rsi-port", o.rsi_port);
-  number("--rsi-timeout", o.rsi_timeout);
-  out.emplace_back("--rsi-sentype", o.sentype);
-  out.emplace_back("--path-corr-frame", o.path_frame);
-  number("--fanuc-version", o.fanuc_version);
-  out.emplace_back("--fanuc-limits", o.fanuc_limits);
-  number("--fanuc-correction-share", o.fanuc_correction_share);
-  if (o.robot_port != -1) number("--robot-port", o.robot_port);
-  number("--motoros2-group", o.motoros2_group);
-  number("--motoros2-resend-ms", o.motoros2_resend_ms);
-  number("--motoros2-max-truncations", o.motoros2_max_truncations);
-  number("--ur-lookahead-ms", o.ur_lookahead_ms);
-  number("--ur-gain", o.ur_gain);
-  number("--ur-register-offset", o.ur_register_offset);
-  return out;
-}
-
 /// Checks the shared settings that apply to the link as `deflex online` checks them (the settings
 /// table: the same ranges, the same sentence), so the controller's side is never written for a value
 /// the session would refuse.
 void check_shared_settings(const ControllerSetupSettings& o) {
   const LinkKind kind = parse_link_kind(o.link);
   std::vector<GivenSetting> given;
-  for (const auto& [option, text] : shared_settings(o)) {
-    const SessionSetting* s = find_session_setting(option);
-    if (s == nullptr) throw std::logic_error(fmt::format("controller-setup: {} is not in the settings table", option));
+  for (const ControllerSetupShared& shared : controller_setup_shared()) {
+    const SessionSetting* s = find_session_setting(shared.option);
+    if (s == nullptr) {
+      throw std::logic_error(fmt::format("controller-setup: {} is not in the settings table", shared.option));
+    }
     if ((s->links & link_bit(kind)) == 0) continue;
-    given.push_back({s, option_value(*s, text)});
+    // The value as its option's text, for the table to read as the command line's: a number in full
+    // (a NaN included, for the table to refuse), unless it is the field's "unset".
+    const std::optional<std::string> text = std::visit(
+        [&](auto member) -> std::optional<std::string> {
+          const auto& value = o.*member;
+          if constexpr (std::is_same_v<std::decay_t<decltype(value)>, std::string>) {
+            return value;
+          } else {
+            const auto v = static_cast<double>(value);
+            if (shared.unset && (std::isnan(*shared.unset) ? std::isnan(v) : v == *shared.unset)) return std::nullopt;
+            return fmt::format("{:.17g}", v);
+          }
+        },
+        shared.field);
+    if (text) given.push_back({s, option_value(*s, *text)});
   }
   (void)make_session_config(o.link, "online", given);
 }
 
 }  // namespace
+
+std::span<const ControllerSetupShared> controller_setup_shared() {
+  using S = ControllerSetupSettings;
+  static const ControllerSetupShared table[] = {
+      {"--egm-port", &S::egm_port, {}},
+      {"--rsi-port", &S::rsi_port, {}},
+      {"--rsi-sentype", &S::sentype, {}},
+      {"--period-ms", &S::period_ms, 0.0},  // 0: the link kind's
+      {"--max-joint-correction-deg", &S::max_joint_deg, {}},
+      {"--max-tcp-correction-mm", &S::max_tcp_mm, {}},
+      {"--ramp-in-s", &S::ramp_in_s, {}},
+      {"--path-corr-frame", &S::path_frame, {}},
+      {"--stop-silence-s", &S::stop_silence_s, kNaN},  // NaN: the link kind's
+      {"--max-rate-deg-s", &S::max_rate_deg_s, {}},
+      {"--rsi-timeout", &S::rsi_timeout, {}},
+      {"--fanuc-version", &S::fanuc_version, {}},
+      {"--fanuc-limits", &S::fanuc_limits, {}},
+      {"--fanuc-correction-share", &S::fanuc_correction_share, {}},
+      {"--robot-port", &S::robot_port, -1.0},  // -1: the protocol's
+      {"--motoros2-group", &S::motoros2_group, {}},
+      {"--motoros2-resend-ms", &S::motoros2_resend_ms, {}},
+      {"--motoros2-max-truncations", &S::motoros2_max_truncations, {}},
+      {"--ur-lookahead-ms", &S::ur_lookahead_ms, {}},
+      {"--ur-gain", &S::ur_gain, {}},
+      {"--ur-register-offset", &S::ur_register_offset, {}},
+  };
+  return table;
+}
+
+const ControllerSetupShared& controller_setup_shared(std::string_view option) {
+  for (const ControllerSetupShared& shared : controller_setup_shared()) {
+    if (option == shared.option) return shared;
+  }
+  throw std::logic_error(fmt::format("controller-setup: {} is not a setting it shares with deflex online", option));
+}
 
 std::vector<ControllerFile> controller_setup_files(const ControllerSetupSettings& settings,
                                                    const RobotLoader& load_robot) {

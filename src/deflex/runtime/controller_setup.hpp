@@ -5,7 +5,11 @@
 #pragma once
 
 #include <functional>
+#include <optional>
+#include <span>
 #include <string>
+#include <string_view>
+#include <variant>
 #include <vector>
 
 #include "deflex/link/controller_file.hpp"
@@ -44,6 +48,22 @@ struct ControllerSetupSettings {
   double ur_lookahead_ms = 30.0, ur_gain = 2000.0;
   int ur_register_offset = 24;
 };
+
+/// A setting controller-setup shares with `deflex online`: its option (a row of the settings table,
+/// session_settings.hpp), the field that holds it, and the value that means "unset: the link's" (none:
+/// every value is checked; NaN: a NaN is unset).
+struct ControllerSetupShared {
+  const char* option;
+  std::variant<double ControllerSetupSettings::*, int ControllerSetupSettings::*,
+               std::string ControllerSetupSettings::*>
+      field;
+  std::optional<double> unset;
+};
+/// Every setting controller-setup shares with deflex online, once: the command line binds its options
+/// to these fields, and controller_setup_files() checks their values through the settings table.
+[[nodiscard]] std::span<const ControllerSetupShared> controller_setup_shared();
+/// The shared setting named `option`; throws std::logic_error for one that is not shared.
+[[nodiscard]] const ControllerSetupShared& controller_setup_shared(std::string_view option);
 
 /// Reads the robot file `path` ("" or "builtin": the built-in IRB 6700), as the front end reads robots
 /// (the command line prints the file's notes).
