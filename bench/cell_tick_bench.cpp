@@ -36,6 +36,7 @@ const study::CaseConfig& paper() {
     x.cell.sensor.fast_noise = true;
     x.cell.tracker.fast_noise = true;
     x.cell.robot.fixed_point_step_rad = 1e-8;
+    x.cell.robot.first_order_step_rad = 1e-5;
     x.coupled_tick.force_tolerance_n = 0.25;
     x.coupled_tick.moment_tolerance_nm = 5e-3;
     return x;

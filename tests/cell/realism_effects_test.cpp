@@ -3,13 +3,16 @@
 // force sensor's unknown sensitivity error and mounting misalignment.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "deflex/cell/cell_config.hpp"
 #include "deflex/cell/force_sensor.hpp"
 #include "deflex/cell/path_drift.hpp"
 #include "deflex/cell/true_robot.hpp"
+#include "deflex/model/detail/kinematics_count.hpp"
 #include "deflex/model/kinematics.hpp"
 
 namespace deflex::cell {
@@ -84,6 +87,51 @@ TEST(TrueRobot, HardeningGearsDeflectAlongTheirCurveFromTheGravityPreload) {
       EXPECT_GT(std::abs(h[0] / tau[0]), 1.3);
     }
   }
+}
+
+// The fast computation's first-order end: a solve whose first step is small moves the end poses along
+// the Jacobian instead of running the kinematics again. Checked against forward kinematics at the
+// configuration it solved (a workspace of its own) and against the exact fixed point, tick by tick
+// along a slow motion under 650 N; and the shortcut must really be taken (one FK a solve).
+TEST(TrueRobot, AFirstOrderEndKeepsTheKinematicsOfTheSolvedConfiguration) {
+  CellConfig c = hardening_case();
+  CellConfig exact_config = c;
+  c.robot.first_order_step_rad = 1e-5;
+  const TrueRobot robot(c, false, 7);
+  const TrueRobot exact(exact_config, false, 7);
+  Workspace ws(robot.true_model()), ws_exact(exact.true_model()), ws_check(robot.true_model());
+  JointVector q(6);
+  q << 0.1, deg_to_rad(25.0), deg_to_rad(5.0), 0.2, deg_to_rad(55.0), -0.3;
+  Wrench w;
+  w << 390.0, -325.0, 390.0, 0.0, 0.0, 0.0;
+  TrueRobotState s = robot.initial_state(q), s_exact = exact.initial_state(q);
+  (void)robot.solve(ws, q, w, s);
+  (void)exact.solve(ws_exact, q, w, s_exact);
+  detail::kinematics_count.model = &robot.true_model();
+  detail::kinematics_count.calls = 0;
+  double worst_position = 0.0, worst_turn = 0.0, worst_tcp = 0.0;
+  const int ticks = 200;
+  for (int k = 1; k <= ticks; ++k) {
+    JointVector dq(6);
+    dq << 1.0, -0.7, 0.5, 1.3, -0.4, 0.9;
+    q += 2e-5 * dq;  // ~40 um a tick at the TCP: 10 mm/s
+    const Vector3 p = robot.solve(ws, q, w, s, 0.004);
+    const Vector3 p_exact = exact.solve(ws_exact, q, w, s_exact, 0.004);
+    forward_kinematics(exact.true_model(), ws_check, s.q_actual);
+    worst_position = std::max({worst_position, (ws.base_T_tcp.translation() - ws_check.base_T_tcp.translation()).norm(),
+                               (ws.base_T_flange.translation() - ws_check.base_T_flange.translation()).norm()});
+    worst_turn = std::max({worst_turn, (ws.base_T_tcp.linear() - ws_check.base_T_tcp.linear()).cwiseAbs().maxCoeff(),
+                           (ws.base_T_flange.linear() - ws_check.base_T_flange.linear()).cwiseAbs().maxCoeff()});
+    worst_tcp = std::max(worst_tcp, (p - p_exact).norm());
+  }
+  detail::kinematics_count.model = nullptr;
+  EXPECT_EQ(detail::kinematics_count.calls, static_cast<std::uint64_t>(ticks));  // one FK a solve
+  EXPECT_LT(worst_position, 1e-9);                                               // m
+  EXPECT_LT(worst_turn, 1e-9);
+  // Against the exact fixed point: within the 30 nm the tolerance allows, and not bit-identical (the
+  // test would prove nothing if the shortcut were never taken).
+  EXPECT_LT(worst_tcp, 3e-8);
+  EXPECT_GT(worst_tcp, 0.0);
 }
 
 TEST(PathDrift, OffsetAndWanderHaveTheConfiguredStatistics) {

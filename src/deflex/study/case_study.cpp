@@ -336,6 +336,9 @@ void use_fast_computation(CaseConfig& c) {
   // 30 nm at the TCP), and a loaded tick's arm and bar agreeing to 0.25 N (0.25-0.4 um of TCP at the
   // arm's 1-1.6 um/N: 20 times below the tracker's 5 um noise, and below the bar's own 2 N of noise).
   c.cell.robot.fixed_point_step_rad = 1e-8;
+  // And a first step below 1e-5 rad ends it (error left ~1.3e-8 rad, ~30 nm at the TCP), the end
+  // poses moved along the Jacobian already taken: one forward kinematics a solve instead of two.
+  c.cell.robot.first_order_step_rad = 1e-5;
   c.coupled_tick.force_tolerance_n = 0.25;
   c.coupled_tick.moment_tolerance_nm = 5e-3;
 }
