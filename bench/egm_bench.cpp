@@ -2,7 +2,9 @@
 // message, the link (its own thread) drains, decodes, runs the strategy and the compensator on a
 // fresh force sample and answers; the sender receives the answer. Beside them, the floor: the same
 // exchange with a plain UDP echo (no decode, no compute), so the link's own cost is the difference.
-// Reports p50/p99/max over 100,000 cycles and the heap allocations counted in steady state.
+// Reports p50/p99/max over 100,000 cycles and the heap allocations counted in steady state. And each
+// of the codec's four messages alone (encode and decode, robot's and sensor's side), as a cycle of
+// the case study pays them: BM_EgmCodec/0..3.
 //   build-*/bench/egm_bench
 #include <algorithm>
 #include <atomic>
@@ -20,6 +22,7 @@
 #include "deflex/online/online_strategy.hpp"
 #include "deflex/robotfile/robot_io.hpp"
 #include "deflex/transport/udp_transport.hpp"
+#include "deflex/wire/egm_codec.hpp"
 
 #include "counting_new.hpp"
 #include "link_round_trips.hpp"
@@ -149,6 +152,49 @@ void BM_EgmPathLinkRoundTrip(benchmark::State& state) {
   run_link(state, link, transport);
 }
 BENCHMARK(BM_EgmPathLinkRoundTrip)->Arg(100000)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+// One EGM message of a 6-joint cycle coded alone: 0 the controller encodes EgmRobot, 1 deflex
+// decodes it, 2 deflex encodes its EgmSensor answer, 3 the controller decodes that.
+void BM_EgmCodec(benchmark::State& state) {
+  EgmCodec codec(6);
+  EgmRobotMessage robot;
+  robot.feedback_joints_deg = JointVector::LinSpaced(6, -12.5, 47.25);
+  robot.planned_joints_deg = JointVector::LinSpaced(6, -12.0, 47.0);
+  robot.has_planned = true;
+  robot.motor_state = 1;
+  robot.mci_state = 3;
+  robot.rapid_exec_state = 2;
+  EgmSensorMessage sensor;
+  sensor.planned_joints_deg = JointVector::LinSpaced(6, -11.9, 46.9);
+  sensor.speed_ref_joints_deg_s = JointVector::Zero(6);
+  unsigned char robot_bytes[512], sensor_bytes[512];
+  const std::size_t robot_n = codec.encode_robot(robot, robot_bytes, sizeof(robot_bytes));
+  const std::size_t sensor_n = codec.encode_sensor(sensor, sensor_bytes, sizeof(sensor_bytes));
+  EgmRobotMessage robot_back;
+  EgmSensorMessage sensor_back;
+  unsigned char out[512];
+  std::uint32_t seq = 0;
+  for (auto _ : state) {
+    switch (state.range(0)) {
+      case 0:
+        robot.seqno = ++seq;
+        benchmark::DoNotOptimize(codec.encode_robot(robot, out, sizeof(out)));
+        break;
+      case 1:
+        benchmark::DoNotOptimize(codec.decode_robot(robot_bytes, robot_n, robot_back));
+        break;
+      case 2:
+        sensor.seqno = ++seq;
+        benchmark::DoNotOptimize(codec.encode_sensor(sensor, out, sizeof(out)));
+        break;
+      default:
+        benchmark::DoNotOptimize(codec.decode_sensor(sensor_bytes, sensor_n, sensor_back));
+        break;
+    }
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_EgmCodec)->DenseRange(0, 3);
 
 }  // namespace
 }  // namespace deflex

@@ -7,6 +7,7 @@
 
 #include <google/protobuf/stubs/logging.h>
 
+#include "deflex/wire/detail/egm_fast.hpp"
 #include "egm.pb.h"
 
 namespace deflex {
@@ -35,10 +36,15 @@ const char* to_string(EgmDecodeStatus s) {
   return "unknown";
 }
 
+// Protobuf decodes what the hand-written reader does not take (detail/egm_fast.hpp) and codes path
+// correction; the joint-mode messages are written by hand, to protobuf's bytes.
 struct EgmCodec::Impl {
-  abb::egm::EgmRobot robot_in, robot_out;
-  abb::egm::EgmSensor sensor_in, sensor_out;
+  abb::egm::EgmRobot robot_in;
+  abb::egm::EgmSensor sensor_in;
   abb::egm::EgmSensorPathCorr path_in, path_out;
+  // Protobuf's reused EgmSensor kept an empty speedRef.joints once it had sent a speed reference;
+  // the hand-written encoder keeps the same bytes.
+  bool speed_ref_sent = false;
 };
 
 namespace {
@@ -74,14 +80,6 @@ bool copy_joints(const Joints& j, int expected, JointVector& out) {
     out[i] = j.joints(i);
   }
   return true;
-}
-
-template <class Joints>
-void set_joints(const JointVector& q, Joints* j) {
-  j->clear_joints();  // keeps capacity: no allocation once warm
-  for (int i = 0; i < q.size(); ++i) {
-    j->add_joints(q[i]);
-  }
 }
 
 // EgmHeader.seqno (field 1 of the header, field 1 of EgmRobot) as the varint says it: protobuf would
@@ -203,20 +201,20 @@ EgmCodec::EgmCodec(int expected_joints) : impl_(std::make_unique<Impl>()), expec
   // are counted instead (egm_protobuf_log_messages). Set once: the handler is process-wide.
   static std::once_flag silenced;
   std::call_once(silenced, [] { google::protobuf::SetLogHandler(&count_protobuf_log); });
-  // Warm the messages once so their sub-messages and repeated fields exist before the first cycle.
+  // Warm the messages once so their sub-messages and repeated fields exist before the first cycle
+  // (protobuf decodes only what the hand-written reader leaves, so it is warmed directly).
   EgmRobotMessage r;
   r.feedback_joints_deg = JointVector::Zero(expected_joints);
   r.planned_joints_deg = JointVector::Zero(expected_joints);
+  r.has_planned = true;
   unsigned char buf[1024];
   const std::size_t n = encode_robot(r, buf, sizeof(buf));
-  EgmRobotMessage back;
-  (void)decode_robot(buf, n, back);
+  (void)impl_->robot_in.ParsePartialFromArray(buf, static_cast<int>(n));
   EgmSensorMessage s;
   s.planned_joints_deg = JointVector::Zero(expected_joints);
   s.speed_ref_joints_deg_s = JointVector::Zero(expected_joints);
   const std::size_t m = encode_sensor(s, buf, sizeof(buf));
-  EgmSensorMessage sback;
-  (void)decode_sensor(buf, m, sback);
+  (void)impl_->sensor_in.ParsePartialFromArray(buf, static_cast<int>(m));
   const std::size_t k = encode_path_corr(EgmPathCorrMessage{}, buf, sizeof(buf));
   EgmPathCorrMessage pback;
   (void)decode_path_corr(buf, k, pback);
@@ -227,6 +225,9 @@ EgmCodec::~EgmCodec() = default;
 EgmDecodeStatus EgmCodec::decode_robot(const unsigned char* data, std::size_t size, EgmRobotMessage& out) noexcept {
   if (size == 0) {
     return EgmDecodeStatus::kEmpty;
+  }
+  if (egm_fast::decode_robot(data, size, expected_joints_, out)) {
+    return EgmDecodeStatus::kOk;  // a well-formed message of the common shape (it checks the wire format)
   }
   const EgmDecodeStatus wire = scan_wire_format(data, size);
   if (wire != EgmDecodeStatus::kOk) {
@@ -274,52 +275,23 @@ std::size_t EgmCodec::encode_sensor(const EgmSensorMessage& msg, unsigned char* 
   if (!msg.planned_joints_deg.allFinite() || !msg.speed_ref_joints_deg_s.allFinite()) {
     return 0;
   }
-  abb::egm::EgmSensor& m = impl_->sensor_out;
-  m.mutable_header()->set_seqno(msg.seqno);
-  m.mutable_header()->set_tm(msg.tm_ms);
-  m.mutable_header()->set_mtype(abb::egm::EgmHeader::MSGTYPE_CORRECTION);
-  set_joints(msg.planned_joints_deg, m.mutable_planned()->mutable_joints());
-  if (msg.speed_ref_joints_deg_s.size() > 0) {
-    set_joints(msg.speed_ref_joints_deg_s, m.mutable_speedref()->mutable_joints());
-  } else if (m.has_speedref()) {
-    m.mutable_speedref()->mutable_joints()->clear_joints();  // keeps the sub-message: no allocation later
-  }
-  const std::size_t n = m.ByteSizeLong();
-  if (n > capacity || !m.SerializeToArray(out, static_cast<int>(capacity))) {
-    return 0;
-  }
+  const std::size_t n = egm_fast::encode_sensor(msg, impl_->speed_ref_sent, out, capacity);
+  impl_->speed_ref_sent = impl_->speed_ref_sent || msg.speed_ref_joints_deg_s.size() > 0;
   return n;
 }
 
 std::size_t EgmCodec::encode_robot(const EgmRobotMessage& msg, unsigned char* out, std::size_t capacity) noexcept {
-  abb::egm::EgmRobot& m = impl_->robot_out;
-  m.mutable_header()->set_seqno(msg.seqno);
-  m.mutable_header()->set_tm(msg.tm_ms);
-  m.mutable_header()->set_mtype(abb::egm::EgmHeader::MSGTYPE_DATA);
-  set_joints(msg.feedback_joints_deg, m.mutable_feedback()->mutable_joints());
-  if (msg.has_planned) {
-    set_joints(msg.planned_joints_deg, m.mutable_planned()->mutable_joints());
-  } else {
-    m.clear_planned();
-  }
-  m.mutable_motorstate()->set_state(msg.motor_state == 2 ? abb::egm::EgmMotorState::MOTORS_OFF
-                                                         : abb::egm::EgmMotorState::MOTORS_ON);
-  // The controller's EGM state as the stand-in gives it (running unless it says otherwise).
-  m.mutable_mcistate()->set_state(msg.mci_state == 1   ? abb::egm::EgmMCIState::MCI_ERROR
-                                  : msg.mci_state == 2 ? abb::egm::EgmMCIState::MCI_STOPPED
-                                                       : abb::egm::EgmMCIState::MCI_RUNNING);
-  m.mutable_rapidexecstate()->set_state(msg.rapid_exec_state == 1 ? abb::egm::EgmRapidCtrlExecState::RAPID_STOPPED
-                                                                  : abb::egm::EgmRapidCtrlExecState::RAPID_RUNNING);
-  m.set_mciconvergencemet(msg.mci_convergence_met);
-  const std::size_t n = m.ByteSizeLong();
-  if (n > capacity || !m.SerializeToArray(out, static_cast<int>(capacity))) {
-    return 0;
-  }
-  return n;
+  return egm_fast::encode_robot(msg, out, capacity);
 }
 
 bool EgmCodec::decode_sensor(const unsigned char* data, std::size_t size, EgmSensorMessage& out) noexcept {
-  if (size == 0 || scan_wire_format(data, size) != EgmDecodeStatus::kOk) {
+  if (size == 0) {
+    return false;
+  }
+  if (egm_fast::decode_sensor(data, size, expected_joints_, out)) {
+    return true;
+  }
+  if (scan_wire_format(data, size) != EgmDecodeStatus::kOk) {
     return false;
   }
   abb::egm::EgmSensor& m = impl_->sensor_in;
