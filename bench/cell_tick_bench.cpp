@@ -39,6 +39,7 @@ const study::CaseConfig& paper() {
     x.cell.robot.first_order_step_rad = 1e-5;
     x.coupled_tick.force_tolerance_n = 0.25;
     x.coupled_tick.moment_tolerance_nm = 5e-3;
+    x.coupled_tick.settle_tolerance_m = 2e-8;
     return x;
   }();
   return c;

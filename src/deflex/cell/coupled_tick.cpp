@@ -11,9 +11,6 @@ namespace {
 // The process's tangent is taken by forward differences of this step (m): far below the seal's 0.1 mm
 // of pre-sliding, far above rounding.
 constexpr double kDifferenceStep = 1e-7;
-// The process settles against the arm's linear response to within this (m): 1 nm, a seal's 1.5 mN at
-// its stiffest, below what the tick's tolerance asks.
-constexpr double kSettleTolerance = 1e-9;
 constexpr int kSettleIterations = 40;
 // The tangent compliance is recomputed every this many ticks (0.26 s at 4 ms: the arm turns the
 // circle's 81 points in 16-80 s); the solves' corrections carry on across.
@@ -67,7 +64,7 @@ Vector3 CoupledTickSolver::settle_process(const ProcessForce& process, const Vec
   };
   Vector3 x = base;
   Vector3 r = residual(x, w_at);
-  for (int it = 0; it < kSettleIterations && r.cwiseAbs().maxCoeff() > kSettleTolerance; ++it) {
+  for (int it = 0; it < kSettleIterations && r.cwiseAbs().maxCoeff() > options_.settle_tolerance_m; ++it) {
     if (!*step.valid) {
       Matrix3 k;
       for (int i = 0; i < 3; ++i) {

@@ -24,6 +24,10 @@ struct CoupledTickOptions {
   /// (5 um) and 40 times below what the bar's own noise (0.3 % of 650 N) moves the arm by.
   double force_tolerance_n = 5e-2;
   double moment_tolerance_nm = 1e-3;
+  /// The process settles against the arm's linear response to within this (m) before the arm is
+  /// solved under its force: 1 nm, a seal's 0.5 mN at its stiffest (0.25 x 650 N over 0.3 mm of
+  /// pre-sliding), far below what the tolerances above ask.
+  double settle_tolerance_m = 1e-9;
   /// Solves of the arm a tick at most; a tick that reaches it keeps its last iterate and is counted.
   int max_arm_solves = 8;
 };
