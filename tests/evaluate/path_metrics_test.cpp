@@ -205,6 +205,106 @@ TEST(PathMetrics, TrackerOrderQueriesSeededByTheLastAnswerAgreeWithBruteForce) {
   }
 }
 
+// A run's samples along a reference, in time order: `steps` samples, each `step_m` on from the last
+// along the reference (wrapping at its end), at an offset that wanders from 0 to `offset_m` in all
+// three directions, with 2 um of noise.
+std::vector<Vector3> samples_along(const TrackerTrace& reference, int steps, double step_m, double offset_m,
+                                   unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 2e-6);
+  std::vector<double> cum{0.0};
+  for (std::size_t k = 1; k < reference.size(); ++k) {
+    cum.push_back(cum.back() + (reference[k].p_m - reference[k - 1].p_m).norm());
+  }
+  std::vector<Vector3> out;
+  for (int i = 0; i < steps; ++i) {
+    const double s = std::fmod(0.9 * cum.back() + i * step_m, cum.back());
+    const auto k = static_cast<std::size_t>(std::upper_bound(cum.begin(), cum.end(), s) - cum.begin()) - 1;
+    const double f = cum[k + 1] > cum[k] ? (s - cum[k]) / (cum[k + 1] - cum[k]) : 0.0;
+    const Vector3 on = reference[k].p_m + f * (reference[k + 1].p_m - reference[k].p_m);
+    const double o = offset_m * 0.5 * (1.0 - std::cos(0.01 * i));
+    out.push_back(on + o * Vector3(std::cos(0.003 * i), std::sin(0.007 * i), 0.5) +
+                  Vector3(noise(rng), noise(rng), noise(rng)));
+  }
+  return out;
+}
+
+TEST(PathMetrics, FollowerAgreesWithBruteForceAtEverySpeedAndOffset) {
+  // The follower answers most samples from the few segments about an earlier sample's: checked
+  // against the brute force on the study's closed noisy circle, a figure eight whose loops cross, two
+  // laps of a spiral 0.6 mm apart, a hairpin whose two legs run 20 um apart, a path with repeated
+  // samples (segments of no length) and a reference of two pieces, at steps from 1 um (many samples
+  // a segment) to 2 mm (many segments a sample) and offsets from 0 to 5 mm.
+  TrackerTrace ring = test::with_noise(test::closed_circle(0.13, Vector3(1.8, 0.0, 0.9), 3600), 1e-6, 5);
+  ring.push_back(ring.front());
+  TrackerTrace eight, spiral, hairpin, repeated;
+  for (int i = 0; i <= 2000; ++i) {
+    const double a = 2.0 * kPi * i / 2000;
+    eight.push_back({i * 1e-3, Vector3(1.0 + 0.1 * std::sin(a), 0.05 * std::sin(2.0 * a), 0.5)});
+  }
+  for (int i = 0; i <= 6000; ++i) {
+    const double a = 2.0 * kPi * i / 3000;
+    const double r = 0.13 + 0.6e-3 * a / (2.0 * kPi);
+    spiral.push_back({i * 1e-3, Vector3(1.8 + r * std::cos(a), r * std::sin(a), 0.9)});
+  }
+  for (int i = 0; i <= 400; ++i) {  // out along x in 10 um steps, back 20 um to the side
+    const double x = i <= 200 ? i * 1e-5 : (400 - i) * 1e-5;
+    hairpin.push_back({i * 1e-3, Vector3(x, i <= 200 ? 0.0 : 2e-5, 0.0)});
+  }
+  for (int i = 0; i <= 3000; ++i) {  // each sample three times over, on a wavy line
+    const double x = (i / 3) * 1e-4;
+    repeated.push_back({i * 1e-3, Vector3(x, 1e-3 * std::sin(50.0 * x), 0.0)});
+  }
+  const std::vector<std::vector<TrackerTrace>> references{
+      {ring},     {eight},
+      {spiral},   {hairpin},
+      {repeated}, {TrackerTrace(ring.begin(), ring.begin() + 1800), TrackerTrace(ring.begin() + 1800, ring.end())}};
+  unsigned seed = 1;
+  for (const auto& pieces : references) {
+    const PolylineIndex index(pieces);
+    for (const double step : {1e-6, 1e-5, 2e-4, 2e-3}) {
+      for (const double offset : {0.0, 5e-4, 5e-3}) {
+        PolylineIndex::Follower follower(index);
+        std::size_t i = 0;
+        for (const Vector3& p : samples_along(pieces.front(), 800, step, offset, ++seed)) {
+          const double d = follower.next(p).distance_m;
+          ASSERT_NEAR(d, brute_force_distance(pieces, p), 1e-15)
+              << "step " << step << " offset " << offset << " sample " << i;
+          ASSERT_EQ(d, index.nearest(p).distance_m) << "step " << step << " offset " << offset << " sample " << i;
+          ++i;
+        }
+      }
+    }
+  }
+}
+
+TEST(PathMetrics, FollowerAgreesWithBruteForceOnRandomJumps) {
+  // Samples that jump about at random between runs of nearby ones (a drop-out, a new lap), on random
+  // polylines: each answer the brute force's, the anchor of a far sample never trusted.
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    TrackerTrace path;
+    Vector3 p = Vector3::Zero();
+    for (int i = 0; i < 500; ++i) {
+      p += 1e-3 * Vector3(u(rng), u(rng), 0.2 * u(rng));
+      path.push_back({i * 1e-3, p});
+    }
+    const std::vector<TrackerTrace> pieces{path};
+    const PolylineIndex index(path);
+    PolylineIndex::Follower follower(index);
+    Vector3 q = path[0].p_m;
+    for (int i = 0; i < 3000; ++i) {
+      q = i % 50 == 0 ? path[static_cast<std::size_t>(250 + 250 * u(rng))].p_m
+                      : q + 2e-4 * Vector3(u(rng), u(rng), u(rng));
+      ASSERT_NEAR(follower.next(q).distance_m, brute_force_distance(pieces, q), 1e-15)
+          << "trial " << trial << " sample " << i;
+    }
+    EXPECT_TRUE(std::isnan(follower.next(Vector3::Constant(std::nan(""))).distance_m));
+    ASSERT_NEAR(follower.next(q).distance_m, brute_force_distance(pieces, q), 1e-15);
+  }
+}
+
 TEST(PathMetrics, PiecesAreNotJoined) {
   // Two parallel lines as separate pieces: a point between their ends is far from both, though it
   // would lie on a segment joining the end of one to the start of the other.

@@ -261,6 +261,31 @@ struct PolylineIndex::Impl {
     }
   }
 
+  // A lower bound on the distance from q to every segment more than `span` places from place k
+  // (d_k: q's distance to place k): the rings of places span + 1, span + 2, ... away one by one, the
+  // rest by the clearance of a window (C_w - d_k, as in certified()), the ring widened while the
+  // clearance bounds less than the nearest ring. 0 when nothing is bounded (a long path keeps no
+  // clearances).
+  double ring_clearance(std::uint32_t k, std::uint32_t span, const Vector3& q, double dk) const {
+    if (clearance.empty()) return 0.0;
+    const auto n = static_cast<std::int64_t>(path_slot.size());
+    double ring = std::numeric_limits<double>::infinity();
+    double bound = 0.0;
+    for (std::size_t w = 0; w < kWindows.size(); ++w) {
+      if (kWindows[w] < span) continue;
+      const std::int64_t from = w == 0 || kWindows[w - 1] < span ? span + 1 : kWindows[w - 1] + 1;
+      for (std::int64_t m = from; m <= kWindows[w]; ++m) {
+        for (const std::int64_t j : {static_cast<std::int64_t>(k) - m, static_cast<std::int64_t>(k) + m}) {
+          if (j >= 0 && j < n) ring = std::min(ring, std::sqrt(place_distance2(static_cast<std::uint32_t>(j), q)));
+        }
+      }
+      const double beyond = static_cast<double>(clearance[k][w]) - dk;
+      bound = std::max(bound, std::min(ring, beyond));
+      if (beyond >= ring) break;  // the ring, which only shrinks, bounds it from here on
+    }
+    return bound;
+  }
+
   double closest_d2(std::uint32_t i, const Vector3& q) const {
     double f;
     Vector3 c;
@@ -396,6 +421,51 @@ PolylineIndex::Nearest PolylineIndex::nearest(const Vector3& p_m, const Nearest*
   return best;
 }
 
+PolylineIndex::Nearest PolylineIndex::Follower::next(const Vector3& p_m) {
+  if (!p_m.allFinite()) return index_->nearest(p_m);  // NaN; the anchor and the last answer still hold
+  if (clearance_m_ > 0.0 && from_anchor(p_m)) return last_;
+  const Impl& m = *index_->impl_;
+  if (has_last_ && !m.path_place.empty()) {
+    // Anchored again at p, around the place the walk from the last answer reaches: at a sample a
+    // segment or more from the last, this usually proves the answer without a search.
+    double d2 = 0.0;
+    const std::uint32_t k = m.walk(m.path_place[last_.segment], p_m, d2);
+    anchor(p_m, k, std::sqrt(d2));
+    if (clearance_m_ > 0.0 && from_anchor(p_m)) return last_;
+  }
+  last_ = index_->nearest(p_m, has_last_ ? &last_ : nullptr);
+  has_last_ = true;
+  clearance_m_ = 0.0;
+  if (!m.path_place.empty()) anchor(p_m, m.path_place[last_.segment], last_.distance_m);
+  return last_;
+}
+
+bool PolylineIndex::Follower::from_anchor(const Vector3& p_m) {
+  // Every other segment is at least clearance_m_ - |p - anchor| from p (triangle inequality); the
+  // margin covers the rounding of the distances, as the picometre of the clearances does.
+  const double margin = 1e-12 + 1e-14 * p_m.cwiseAbs().maxCoeff();
+  const double reach = clearance_m_ - (p_m - anchor_m_).norm() - margin;
+  if (!(reach > 0.0)) return false;
+  const Impl& m = *index_->impl_;
+  Nearest best;
+  double best2 = std::numeric_limits<double>::infinity();
+  for (std::uint32_t k = first_; k <= last_place_; ++k) m.consider_place(k, p_m, best, best2);
+  if (!(best2 <= reach * reach)) return false;
+  best.distance_m = std::sqrt(best2);
+  last_ = best;
+  has_last_ = true;
+  return true;
+}
+
+void PolylineIndex::Follower::anchor(const Vector3& p_m, std::uint32_t k, double dk) {
+  const Impl& m = *index_->impl_;
+  const auto n = static_cast<std::uint32_t>(m.path_slot.size());
+  first_ = k > kSpan ? k - kSpan : 0;
+  last_place_ = std::min(n - 1, k + kSpan);
+  anchor_m_ = p_m;
+  clearance_m_ = m.ring_clearance(k, kSpan, p_m, dk);
+}
+
 namespace {
 
 // Mean, max, RMS and sample standard deviation of a set of distances (m).
@@ -422,7 +492,7 @@ PathDeviationStats stats_of(const std::vector<const TrackerTrace*>& loaded, cons
   std::size_t total = 0;
   for (const auto* trace_ptr : loaded) total += trace_ptr->size();
   d.reserve(total);
-  PolylineIndex::Nearest hint;
+  PolylineIndex::Follower follower(index);
   for (const auto* trace_ptr : loaded) {
     const TrackerTrace& trace = *trace_ptr;
     for (std::size_t i = 0; i < trace.size(); ++i) {
@@ -430,8 +500,7 @@ PathDeviationStats stats_of(const std::vector<const TrackerTrace*>& loaded, cons
         throw InputError(
             fmt::format("loaded path: sample {} (t = {} s) has a position that is not finite", i, trace[i].t_s));
       }
-      hint = index.nearest(trace[i].p_m, i > 0 ? &hint : nullptr);
-      d.push_back(hint.distance_m);
+      d.push_back(follower.next(trace[i].p_m).distance_m);
     }
   }
   if (d.empty()) {

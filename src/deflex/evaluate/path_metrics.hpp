@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "deflex/model/tracker_trace.hpp"
@@ -38,6 +39,28 @@ class PolylineIndex {
   [[nodiscard]] Nearest nearest(const Vector3& p_m, const Nearest* hint) const;
   /// Vertices of all pieces, concatenated in order.
   [[nodiscard]] const std::vector<Vector3>& vertices() const;
+
+  /// The nearest points of a sequence of nearby points (a tracker trace, sample by sample): the
+  /// same distances as nearest(), most found from three segments. Each full query leaves an anchor:
+  /// the point, its segment with the two beside it, and a lower bound on the distance from the point
+  /// to every other segment; a later point within that bound of the anchor (less its nearest distance
+  /// among the three) cannot be nearer to any other segment. One per thread; the index must outlive it.
+  class Follower {
+   public:
+    explicit Follower(const PolylineIndex& index) : index_(&index) {}
+    [[nodiscard]] Nearest next(const Vector3& p_m);
+
+   private:
+    bool from_anchor(const Vector3& p_m);
+    void anchor(const Vector3& p_m, std::uint32_t place, double distance_m);
+    static constexpr std::uint32_t kSpan = 2;  ///< places checked either side of the anchor's
+    const PolylineIndex* index_;
+    Nearest last_;
+    bool has_last_ = false;
+    Vector3 anchor_m_ = Vector3::Zero();
+    double clearance_m_ = 0.0;                  ///< lower bound on the anchor's distance to the other segments; 0: none
+    std::uint32_t first_ = 0, last_place_ = 0;  ///< the anchor's segments, as places along the path
+  };
 
  private:
   void init(const std::vector<const TrackerTrace*>& pieces);
