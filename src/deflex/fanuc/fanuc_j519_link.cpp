@@ -394,11 +394,14 @@ void FanucJ519Link::send_capability_request(double now) noexcept {
   rq.type = j519::kTypeCapabilityGet;
   rq.version = config_.version;
   rq.id = kCapabilityId;
-  const std::size_t n = j519::encode(rq, tx_.data(), tx_.size());
+  send_request(j519::encode(rq, tx_.data(), tx_.size()), capability_request_, capability_counters_.resent, now);
+}
+
+void FanucJ519Link::send_request(std::size_t n, PendingRequest& request, std::uint64_t& resent, double now) noexcept {
   if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) ++counters_.send_errors;
-  if (capability_attempts_ > 0) ++capability_counters_.resent;
-  ++capability_attempts_;
-  capability_sent_s_ = now;
+  if (request.attempts > 0) ++resent;
+  ++request.attempts;
+  request.sent_s = now;
 }
 
 // A datagram from the controller in the capability phase (in rx_): a reply to the get (type 7, 28 bytes,
@@ -461,8 +464,8 @@ void FanucJ519Link::receive_before_stream(double wait_s, Take&& take) noexcept {
 // True once the phase is over: the reply taken (and judged), or the link stopped.
 bool FanucJ519Link::read_capability(double timeout_s) noexcept {
   double now = clock_.now_s();
-  if (capability_attempts_ == 0) send_capability_request(now);
-  receive_before_stream(std::min(timeout_s, capability_sent_s_ + config_.capability_timeout_s - now),
+  if (capability_request_.attempts == 0) send_capability_request(now);
+  receive_before_stream(std::min(timeout_s, capability_request_.sent_s + config_.capability_timeout_s - now),
                         [this](std::size_t size) { return !take_capability_reply(size); });
   if (capability_counters_.read) {
     capability_done_ = true;
@@ -470,8 +473,8 @@ bool FanucJ519Link::read_capability(double timeout_s) noexcept {
     return true;
   }
   now = clock_.now_s();
-  if (now - capability_sent_s_ < config_.capability_timeout_s) return false;
-  if (capability_attempts_ <= config_.capability_retries) {
+  if (now - capability_request_.sent_s < config_.capability_timeout_s) return false;
+  if (capability_request_.attempts <= config_.capability_retries) {
     send_capability_request(now);
     return false;
   }
@@ -501,11 +504,7 @@ void FanucJ519Link::send_threshold_request(double now) noexcept {
   j519::ThresholdRequest rq;
   rq.axis = static_cast<std::uint32_t>(table_next_ / 3 + 1);
   rq.kind = static_cast<j519::LimitKind>(table_next_ % 3);
-  const std::size_t n = j519::encode(rq, tx_.data(), tx_.size());
-  if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) ++counters_.send_errors;
-  if (table_attempts_ > 0) ++thresholds_.resent;
-  ++table_attempts_;
-  table_sent_s_ = now;
+  send_request(j519::encode(rq, tx_.data(), tx_.size()), table_request_, thresholds_.resent, now);
 }
 
 // A datagram from the controller in the threshold phase (in rx_): the table asked for is taken; any other
@@ -536,7 +535,7 @@ void FanucJ519Link::take_threshold_reply(std::size_t size) noexcept {
                                                   : t.jerk) = value;
   ++thresholds_.read;
   ++table_next_;
-  table_attempts_ = 0;
+  table_request_.attempts = 0;
 }
 
 // True once the phase is over (the start packet may go out in this poll).
@@ -544,8 +543,8 @@ bool FanucJ519Link::read_thresholds(double timeout_s) noexcept {
   const std::size_t total = 3 * static_cast<std::size_t>(compensator().model().dof());
   thresholds_.asked = total;
   double now = clock_.now_s();
-  if (table_attempts_ == 0) send_threshold_request(now);
-  receive_before_stream(std::min(timeout_s, table_sent_s_ + config_.threshold_timeout_s - now),
+  if (table_request_.attempts == 0) send_threshold_request(now);
+  receive_before_stream(std::min(timeout_s, table_request_.sent_s + config_.threshold_timeout_s - now),
                         [this, total](std::size_t size) {
                           const std::size_t before = table_next_;
                           take_threshold_reply(size);
@@ -553,8 +552,8 @@ bool FanucJ519Link::read_thresholds(double timeout_s) noexcept {
                           return table_next_ < total;
                         });
   now = clock_.now_s();
-  if (table_next_ < total && now - table_sent_s_ >= config_.threshold_timeout_s) {
-    if (table_attempts_ <= config_.threshold_retries) {
+  if (table_next_ < total && now - table_request_.sent_s >= config_.threshold_timeout_s) {
+    if (table_request_.attempts <= config_.threshold_retries) {
       send_threshold_request(now);
     } else {
       thresholds_.unanswered = true;  // older system software: no tables; the limits given hold

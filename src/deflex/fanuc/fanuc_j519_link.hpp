@@ -158,6 +158,14 @@ class FanucJ519Link final : public ControllerLink {
   void judge_capability() noexcept;
   bool read_thresholds(double timeout_s) noexcept;
   void send_threshold_request(double now) noexcept;
+  /// A request before the stream: what it has been sent so far, and when last.
+  struct PendingRequest {
+    int attempts = 0;
+    double sent_s = 0.0;
+  };
+  /// Sends the `n` bytes in tx_ to the controller (n == 0: encoding failed, counted as a send error),
+  /// counting a repeat in `resent`, and notes the attempt in `request`.
+  void send_request(std::size_t n, PendingRequest& request, std::uint64_t& resent, double now) noexcept;
   void take_threshold_reply(std::size_t size) noexcept;
   void apply_tables() noexcept;
   /// The controller's datagrams before the stream (the capability, the tables): waits up to `wait_s`,
@@ -196,17 +204,15 @@ class FanucJ519Link final : public ControllerLink {
   fanuc_j519::Capability capability_;
   FanucCapabilityCounters capability_counters_;
   bool capability_done_ = false;
-  int capability_attempts_ = 0;
-  double capability_sent_s_ = 0.0;
+  PendingRequest capability_request_;
 
   // The threshold phase, before the start packet.
   std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> limits_;  // what the stream is held to
   std::array<fanuc_j519::AxisLimits, fanuc_j519::kAxes> tables_{};
   FanucThresholdCounters thresholds_;
   bool tables_done_ = false;
-  std::size_t table_next_ = 0;  // the table asked for: joint * 3 + kind
-  int table_attempts_ = 0;      // requests sent for it
-  double table_sent_s_ = 0.0;
+  std::size_t table_next_ = 0;    // the table asked for: joint * 3 + kind
+  PendingRequest table_request_;  // for the table asked for
 
   // Preallocated per-cycle buffers.
   std::vector<unsigned char> rx_, tx_;
