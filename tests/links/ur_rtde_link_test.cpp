@@ -264,42 +264,45 @@ TEST(UrRtdeLink, TheHandshakeTakesAnyNonZeroAcceptAndProtocol1TextsBeforeVersion
   const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
   UrRtdeLinkConfig config;
   config.stop.stop_silence_s = 0.5;
-  const auto exchange = [](ManualClock& clock, MemoryStreamPair& pair, UrRtdeLink& link, double& t,
-                           const std::vector<unsigned char>& reply) {
-    if (!reply.empty()) {
-      EXPECT_EQ(pair.server().write(reply.data(), reply.size()), static_cast<long>(reply.size()));
+  // A link from its first byte, and one exchange: the controller's reply (if any) written, five cycles
+  // polled, what the link sent back read.
+  struct Handshake {
+    ManualClock clock;
+    MemoryStreamPair pair{clock, 0.0001};
+    OnlineCompensator compensator;
+    OnlineStrategy strategy;
+    UrRtdeLink link;
+    double t = 0.0;
+    Handshake(const RobotModel& robot, const JointVector& q0, const UrRtdeLinkConfig& config)
+        : compensator(robot, test::bench_sensor(), test::bench_online(kUrPeriod)),
+          strategy(robot, StrategyKind::kOnline, nullptr),
+          link(compensator, strategy, test::hold_program(robot, q0, 10.0), pair.client(), clock, config) {}
+    std::vector<unsigned char> exchange(const std::vector<unsigned char>& reply) {
+      if (!reply.empty()) {
+        EXPECT_EQ(pair.server().write(reply.data(), reply.size()), static_cast<long>(reply.size()));
+      }
+      for (int k = 0; k < 5; ++k) {
+        clock.set(t += kUrPeriod);
+        (void)link.poll(0.0);
+      }
+      std::array<unsigned char, 64> got{};
+      const long n = pair.server().read(got.data(), got.size());
+      return std::vector<unsigned char>(got.begin(), got.begin() + std::max(n, 0L));
     }
-    for (int k = 0; k < 5; ++k) {
-      clock.set(t += kUrPeriod);
-      (void)link.poll(0.0);
-    }
-    std::array<unsigned char, 64> got{};
-    const long n = pair.server().read(got.data(), got.size());
-    return std::vector<unsigned char>(got.begin(), got.begin() + std::max(n, 0L));
   };
   {
-    ManualClock clock;
-    MemoryStreamPair pair(clock, 0.0001);
-    OnlineCompensator compensator(robot, test::bench_sensor(), test::bench_online(kUrPeriod));
-    OnlineStrategy strategy(robot, StrategyKind::kOnline, nullptr);
-    UrRtdeLink link(compensator, strategy, test::hold_program(robot, q0, 10.0), pair.client(), clock, config);
-    double t = 0.0;
-    EXPECT_EQ(exchange(clock, pair, link, t, {}), (std::vector<unsigned char>{0, 5, 'V', 0, 2}));
-    EXPECT_EQ(exchange(clock, pair, link, t, {0, 4, 'V', 2}), (std::vector<unsigned char>{0, 3, 'v'}))
+    Handshake h(robot, q0, config);
+    EXPECT_EQ(h.exchange({}), (std::vector<unsigned char>{0, 5, 'V', 0, 2}));
+    EXPECT_EQ(h.exchange({0, 4, 'V', 2}), (std::vector<unsigned char>{0, 3, 'v'}))
         << "the version reply's byte 2 is accepted: the next request is the controller's version";
-    EXPECT_NE(link.state(), LinkState::kStopped) << link.stop_reason();
+    EXPECT_NE(h.link.state(), LinkState::kStopped) << h.link.stop_reason();
   }
   {
-    ManualClock clock;
-    MemoryStreamPair pair(clock, 0.0001);
-    OnlineCompensator compensator(robot, test::bench_sensor(), test::bench_online(kUrPeriod));
-    OnlineStrategy strategy(robot, StrategyKind::kOnline, nullptr);
-    UrRtdeLink link(compensator, strategy, test::hold_program(robot, q0, 10.0), pair.client(), clock, config);
-    double t = 0.0;
-    (void)exchange(clock, pair, link, t, {});
-    (void)exchange(clock, pair, link, t, {0, 10, 'M', 1, 'C', '2', '0', '4', 'A', '3'});
-    EXPECT_EQ(link.stop_cause(), LinkStopCause::kController);
-    EXPECT_TRUE(ur_says(link, "RTDE error message: C204A3")) << link.stop_reason();
+    Handshake h(robot, q0, config);
+    (void)h.exchange({});
+    (void)h.exchange({0, 10, 'M', 1, 'C', '2', '0', '4', 'A', '3'});
+    EXPECT_EQ(h.link.stop_cause(), LinkStopCause::kController);
+    EXPECT_TRUE(ur_says(h.link, "RTDE error message: C204A3")) << h.link.stop_reason();
   }
 }
 
