@@ -49,27 +49,6 @@ struct EgmCodec::Impl {
 
 namespace {
 
-// Reads a varint; false when it runs past `end` (truncated) and sets `bad` when longer than 10 bytes.
-bool read_varint(const unsigned char*& p, const unsigned char* end, std::uint64_t& v, bool& bad) {
-  v = 0;
-  for (int shift = 0; shift < 70; shift += 7) {
-    if (p >= end) {
-      return false;
-    }
-    const unsigned char b = *p++;
-    if (shift == 63 && b > 1) {
-      bad = true;
-      return true;
-    }
-    v |= static_cast<std::uint64_t>(b & 0x7f) << shift;
-    if ((b & 0x80) == 0) {
-      return true;
-    }
-  }
-  bad = true;
-  return true;
-}
-
 template <class Joints>
 bool copy_joints(const Joints& j, int expected, JointVector& out) {
   if (j.joints_size() != expected) {
@@ -91,10 +70,10 @@ bool header_seqno_fits(const unsigned char* data, std::size_t size) {
   while (p < end) {
     std::uint64_t tag = 0, len = 0;
     bool bad = false;
-    if (!read_varint(p, end, tag, bad) || bad) return true;
+    if (!egm_fast::read_varint(p, end, tag, bad) || bad) return true;
     switch (tag & 7) {
       case 0:
-        if (!read_varint(p, end, len, bad) || bad) return true;
+        if (!egm_fast::read_varint(p, end, len, bad) || bad) return true;
         break;
       case 1:
         p += 8;
@@ -103,16 +82,16 @@ bool header_seqno_fits(const unsigned char* data, std::size_t size) {
         p += 4;
         break;
       case 2: {
-        if (!read_varint(p, end, len, bad) || bad || len > static_cast<std::uint64_t>(end - p)) return true;
+        if (!egm_fast::read_varint(p, end, len, bad) || bad || len > static_cast<std::uint64_t>(end - p)) return true;
         const unsigned char* h = p;
         const unsigned char* h_end = p + len;
         p = h_end;
         if ((tag >> 3) != 1) break;
         while (h < h_end) {
           std::uint64_t htag = 0, value = 0;
-          if (!read_varint(h, h_end, htag, bad) || bad) break;
+          if (!egm_fast::read_varint(h, h_end, htag, bad) || bad) break;
           if ((htag & 7) != 0) break;  // seqno and tm are varints; anything else is protobuf's to judge
-          if (!read_varint(h, h_end, value, bad) || bad) break;
+          if (!egm_fast::read_varint(h, h_end, value, bad) || bad) break;
           if ((htag >> 3) == 1 && value > 0xFFFFFFFFULL) return false;
         }
         break;
@@ -149,7 +128,7 @@ EgmDecodeStatus scan_wire_format(const unsigned char* data, std::size_t size) no
   while (p < end) {
     std::uint64_t tag = 0;
     bool bad = false;
-    if (!read_varint(p, end, tag, bad)) {
+    if (!egm_fast::read_varint(p, end, tag, bad)) {
       return EgmDecodeStatus::kTruncated;
     }
     if (bad || (tag >> 3) == 0) {
@@ -158,7 +137,7 @@ EgmDecodeStatus scan_wire_format(const unsigned char* data, std::size_t size) no
     std::uint64_t len = 0;
     switch (tag & 7) {
       case 0:
-        if (!read_varint(p, end, len, bad)) {
+        if (!egm_fast::read_varint(p, end, len, bad)) {
           return EgmDecodeStatus::kTruncated;
         }
         if (bad) {
@@ -172,7 +151,7 @@ EgmDecodeStatus scan_wire_format(const unsigned char* data, std::size_t size) no
         p += 8;
         break;
       case 2:
-        if (!read_varint(p, end, len, bad)) {
+        if (!egm_fast::read_varint(p, end, len, bad)) {
           return EgmDecodeStatus::kTruncated;
         }
         if (bad) {

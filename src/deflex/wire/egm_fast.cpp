@@ -105,15 +105,8 @@ struct Cursor {
   [[nodiscard]] bool done() const { return p >= end; }
   // A varint of at most 10 bytes that fits 64 bits; false when truncated or wider.
   bool varint(std::uint64_t& v) {
-    v = 0;
-    for (int shift = 0; shift < 64; shift += 7) {
-      if (p >= end) return false;
-      const unsigned char b = *p++;
-      if (shift == 63 && b > 1) return false;
-      v |= static_cast<std::uint64_t>(b & 0x7fU) << shift;
-      if ((b & 0x80U) == 0) return true;
-    }
-    return false;
+    bool bad = false;
+    return read_varint(p, end, v, bad) && !bad;
   }
   // The body of a length-delimited field whose tag was read.
   bool body(Cursor& out) {

@@ -12,10 +12,33 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 
 #include "deflex/wire/egm_codec.hpp"
 
 namespace deflex::egm_fast {
+
+// Protobuf's varint at p (moved past it). False when it runs past `end` (truncated); `bad` set when
+// it is longer than 10 bytes or wider than 64 bits. The one reader of both coders (egm_codec.cpp too).
+inline bool read_varint(const unsigned char*& p, const unsigned char* end, std::uint64_t& v, bool& bad) noexcept {
+  v = 0;
+  for (int shift = 0; shift < 70; shift += 7) {
+    if (p >= end) {
+      return false;
+    }
+    const unsigned char b = *p++;
+    if (shift == 63 && b > 1) {
+      bad = true;
+      return true;
+    }
+    v |= static_cast<std::uint64_t>(b & 0x7f) << shift;
+    if ((b & 0x80) == 0) {
+      return true;
+    }
+  }
+  bad = true;
+  return true;
+}
 
 /// EgmRobot as protobuf serialises EgmCodec::encode_robot's message; 0 when it needs more than
 /// `capacity` bytes.
