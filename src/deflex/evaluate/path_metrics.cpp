@@ -70,6 +70,12 @@ struct PolylineIndex::Impl {
   static constexpr std::array<std::uint32_t, 8> kWindows{1, 2, 3, 4, 6, 8, 11, 16};
   std::vector<std::uint32_t> path_slot, path_place;
   std::vector<std::array<float, kWindows.size()>> clearance;
+  // Per place, copies of its segment's start, direction, squared length and first vertex: the walk
+  // and the follower read a few neighbouring places a sample, in a row here rather than scattered
+  // over the tree's order (the same doubles, so the same answers).
+  std::vector<Vector3> place_a, place_ab;
+  std::vector<double> place_len2;
+  std::vector<std::uint32_t> place_vertex;
 
   // The closest point of a segment (start a, direction ab, squared length len2) to q: its fraction
   // along it and its squared distance. One expression for every search, so all agree to the bit.
@@ -81,8 +87,7 @@ struct PolylineIndex::Impl {
   double place_distance2(std::uint32_t k, const Vector3& q) const {
     double f;
     Vector3 c;
-    const std::uint32_t i = path_slot[k];
-    return closest(seg_a[i], seg_ab[i], seg_len2[i], q, f, c);
+    return closest(place_a[k], place_ab[k], place_len2[k], q, f, c);
   }
 
   std::uint32_t build(std::uint32_t start, std::uint32_t end) {
@@ -156,12 +161,11 @@ struct PolylineIndex::Impl {
   void consider_place(std::uint32_t k, const Vector3& q, Nearest& best, double& best2) const {
     double f;
     Vector3 c;
-    const std::uint32_t i = path_slot[k];
-    const double d2 = closest(seg_a[i], seg_ab[i], seg_len2[i], q, f, c);
+    const double d2 = closest(place_a[k], place_ab[k], place_len2[k], q, f, c);
     if (d2 < best2) {
       best2 = d2;
       best.point_m = c;
-      best.segment = segments[i].a;
+      best.segment = place_vertex[k];
       best.fraction = f;
     }
   }
@@ -223,6 +227,10 @@ struct PolylineIndex::Impl {
       if (i == kNone) continue;
       path_place[v] = static_cast<std::uint32_t>(path_slot.size());
       path_slot.push_back(i);
+      place_a.push_back(seg_a[i]);
+      place_ab.push_back(seg_ab[i]);
+      place_len2.push_back(seg_len2[i]);
+      place_vertex.push_back(segments[i].a);
     }
     build_clearances();
   }
