@@ -363,6 +363,44 @@ TEST(FanucJ519Link, ANewSessionWhileTheStreamRunsIsNotResumed) {
   EXPECT_EQ(bench.controller.counters().taken, taken);
 }
 
+// deflex's PC went away mid-stream (a crash, a pulled cable): the controller alarms for the missing
+// commands but keeps sending statuses to the old address, and while it does it answers no capability
+// request and takes no start. A new protocol-3 session's first packet is a stop, as FANUC's own driver
+// begins, so it starts where it would otherwise have stopped for an unanswered capability request.
+TEST(FanucJ519Link, ANewSessionClearsTheStreamAnEarlierPcLeftRunning) {
+  const JointVector q0 = pose_deg(5, 25, -5, 20, 35, -15);
+  FanucBench bench(test::hold_program(test::bench_robot(), q0, 60.0), q0, 3);
+  bench.run(2.0);
+  ASSERT_EQ(bench.link.state(), LinkState::kRunning) << bench.link.stop_reason();
+  bench.stalled = true;  // the first PC answers no more
+  bench.run(0.5);
+  ASSERT_NE(bench.controller.alarm(), "");
+  const std::uint64_t old_statuses = bench.pc_port.queued();
+  ASSERT_GT(old_statuses, 0u);  // its statuses still reach the old address
+
+  // The second `deflex online` on another port of the same PC, its own compensator and settings.
+  MemoryTransport& second_port = bench.network.add_endpoint(make_datagram_address("127.0.0.1", 50999), 0.0002);
+  OnlineCompensator compensator(bench.robot, test::bench_sensor(), fanuc_online());
+  OnlineStrategy strategy(bench.robot, StrategyKind::kOnline, nullptr);
+  FanucJ519Link second(compensator, strategy, bench.program, second_port, bench.clock, FanucBench::link_config(3));
+  second.read_force_from(&bench.force);
+  const std::uint64_t taken = bench.controller.counters().taken;
+  for (int k = 0; k < 750; ++k) {  // 3 s
+    bench.t_s += 0.004;
+    bench.clock.set(bench.t_s);
+    bench.controller.tick(bench.t_s);
+    bench.clock.set(bench.t_s + 0.0002);
+    while (second.poll(0.0) != LinkPollResult::kIdle && second.state() != LinkState::kStopped) {
+    }
+  }
+  ASSERT_EQ(second.state(), LinkState::kRunning) << second.stop_reason();
+  EXPECT_TRUE(second.capability_counters().cleared);
+  EXPECT_TRUE(second.capability_counters().read);
+  EXPECT_EQ(bench.controller.alarm(), "");
+  EXPECT_GT(bench.controller.counters().taken, taken + 300);
+  EXPECT_EQ(bench.pc_port.queued(), old_statuses);  // nothing more went to the PC that left
+}
+
 // deflex runs 8 ms, the controller 4 ms: its time stamps say so before anything is sent.
 TEST(FanucJ519Link, AControllerAtAnotherIntervalIsRefusedBeforeAnyCommand) {
   const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
@@ -743,7 +781,8 @@ TEST(FanucJ519Link, ProtocolOneAsksNoCapability) {
 }
 
 // The reference's MOTN-607 case: a version 3 client on a version 1 controller, which does not answer the
-// capability request. After the request and its two retries (0.1 s each) the link stops, nothing else sent.
+// capability request. After the request and its two retries (0.1 s each) the link stops; nothing but the
+// stop packet a protocol-3 client begins with and the requests was sent.
 TEST(FanucJ519Link, AProtocolThreeLinkOnAVersionOneControllerStopsBeforeAnyStartPacket) {
   const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
   FanucBench bench(test::hold_program(test::bench_robot(), q0, 30.0), q0, 3, 1);
@@ -765,7 +804,7 @@ TEST(FanucJ519Link, AProtocolThreeLinkOnAVersionOneControllerStopsBeforeAnyStart
   EXPECT_EQ(bench.controller.counters().capability_replies, 0u);
   EXPECT_EQ(bench.controller.counters().threshold_requests, 0u);
   EXPECT_EQ(bench.controller.counters().starts, 0u);
-  EXPECT_EQ(bench.controller.counters().stops, 0u);
+  EXPECT_EQ(bench.controller.counters().stops, 1u);  // the one a protocol-3 client sends first
   EXPECT_EQ(bench.controller.counters().commands, 0u);
   EXPECT_EQ(bench.controller.counters().statuses, 0u);
   EXPECT_EQ(bench.controller.alarm(), "");
@@ -816,8 +855,8 @@ TEST(FanucJ519Link, ACapabilitySamplingRateOtherThanThePeriodStopsNamingBoth) {
   EXPECT_EQ(bench.controller.counters().starts, 0u);
 }
 
-// The request on the wire, byte for byte; then replies that are not a valid one are rejected, counted and
-// never used (each says version 1 at 4 ms: had one been taken, the link would have stopped).
+// The stop packet and the request on the wire, byte for byte; then replies that are not a valid one are rejected,
+// counted and never used (each says version 1 at 4 ms: had one been taken, the link would have stopped).
 TEST(FanucJ519Link, TheCapabilityRequestsBytesAndBadRepliesRejectedAndCounted) {
   const JointVector q0 = pose_deg(0, 20, 10, 0, 60, 0);
   FanucBench bench(test::hold_program(test::bench_robot(), q0, 30.0), q0, 3, 1);
@@ -826,6 +865,10 @@ TEST(FanucJ519Link, TheCapabilityRequestsBytesAndBadRepliesRejectedAndCounted) {
   bench.clock.set(0.002);
   std::vector<unsigned char> got(64, 0);
   DatagramAddress from;
+  // First the stop packet that clears a session an earlier PC left running (type 2, version 3).
+  ASSERT_EQ(bench.controller_port.receive(got.data(), got.size(), from), 8);
+  EXPECT_EQ(std::vector<unsigned char>(got.begin(), got.begin() + 8),
+            std::vector<unsigned char>({0, 0, 0, 2, 0, 0, 0, 3}));
   const long n = bench.controller_port.receive(got.data(), got.size(), from);
   ASSERT_EQ(n, 28);
   got.resize(28);

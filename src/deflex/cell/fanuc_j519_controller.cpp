@@ -122,8 +122,10 @@ void FanucJ519Controller::read_packets(double t_s) {
     }
     if (size == j519::kStartStopBytes && type == j519::kTypeStop) {
       ++counters_.stops;
+      // Its status output ends; with no stream running there is nothing to stop (a PC's client may
+      // begin with a stop packet to clear what an earlier session left running).
+      if (streaming_) stop_stream("stream stopped by the stop packet");
       streaming_ = false;
-      stop_stream("stream stopped by the stop packet");
       continue;
     }
     if (type == j519::kTypeThreshold) {

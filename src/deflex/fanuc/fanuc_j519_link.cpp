@@ -464,7 +464,16 @@ void FanucJ519Link::receive_before_stream(double wait_s, Take&& take) noexcept {
 // True once the phase is over: the reply taken (and judged), or the link stopped.
 bool FanucJ519Link::read_capability(double timeout_s) noexcept {
   double now = clock_.now_s();
-  if (capability_request_.attempts == 0) send_capability_request(now);
+  if (capability_request_.attempts == 0) {
+    // A stop packet first, as FANUC's own protocol-3 driver begins (the reference notes, "Session flow"):
+    // a session whose PC went away (a crash, a pulled cable) leaves the controller sending statuses to
+    // it, and while it does it answers no capability request and takes no new start. Before any start
+    // packet of this link, so nothing of this session is stopped by it.
+    const std::size_t n = j519::encode_stop(config_.version, tx_.data(), tx_.size());
+    if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) ++counters_.send_errors;
+    capability_counters_.cleared = true;
+    send_capability_request(now);
+  }
   receive_before_stream(std::min(timeout_s, capability_request_.sent_s + config_.capability_timeout_s - now),
                         [this](std::size_t size) { return !take_capability_reply(size); });
   if (capability_counters_.read) {

@@ -107,6 +107,7 @@ struct FanucThresholdCounters {
 /// How the capability exchange went (protocol 3 and 4 only).
 struct FanucCapabilityCounters {
   bool asked = false;          ///< the link speaks protocol 3 or 4 (version 1 has no capability packet)
+  bool cleared = false;        ///< a stop packet went first, to end a session a PC left running
   bool read = false;           ///< a valid reply was taken (FanucJ519Link::capability())
   std::uint64_t rejected = 0;  ///< datagrams in the phase that were not a valid reply: never used
   std::uint64_t resent = 0;    ///< requests sent again after their timeout
