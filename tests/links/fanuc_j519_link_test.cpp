@@ -92,14 +92,16 @@ struct FanucBench {
   }
 
   /// One 4 ms servo tick of the controller, then deflex answers what reached it (unless stalled).
-  LinkPollResult tick() {
+  LinkPollResult tick() { return tick(stalled ? nullptr : &link); }
+  /// The same with `polled` answering (nullptr: no PC answers).
+  LinkPollResult tick(FanucJ519Link* polled) {
     t_s += 0.004;
     clock.set(t_s);
     controller.tick(t_s);
     clock.set(t_s + 0.0002);
     LinkPollResult last = LinkPollResult::kIdle;
-    while (!stalled) {
-      const LinkPollResult r = link.poll(0.0);
+    while (polled != nullptr) {
+      const LinkPollResult r = polled->poll(0.0);
       if (r == LinkPollResult::kIdle) break;
       last = r;
     }
@@ -385,14 +387,7 @@ TEST(FanucJ519Link, ANewSessionClearsTheStreamAnEarlierPcLeftRunning) {
   FanucJ519Link second(compensator, strategy, bench.program, second_port, bench.clock, FanucBench::link_config(3));
   second.read_force_from(&bench.force);
   const std::uint64_t taken = bench.controller.counters().taken;
-  for (int k = 0; k < 750; ++k) {  // 3 s
-    bench.t_s += 0.004;
-    bench.clock.set(bench.t_s);
-    bench.controller.tick(bench.t_s);
-    bench.clock.set(bench.t_s + 0.0002);
-    while (second.poll(0.0) != LinkPollResult::kIdle && second.state() != LinkState::kStopped) {
-    }
-  }
+  for (int k = 0; k < 750; ++k) bench.tick(&second);  // 3 s
   ASSERT_EQ(second.state(), LinkState::kRunning) << second.stop_reason();
   EXPECT_TRUE(second.capability_counters().cleared);
   EXPECT_TRUE(second.capability_counters().read);

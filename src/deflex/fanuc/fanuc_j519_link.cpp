@@ -469,8 +469,7 @@ bool FanucJ519Link::read_capability(double timeout_s) noexcept {
     // a session whose PC went away (a crash, a pulled cable) leaves the controller sending statuses to
     // it, and while it does it answers no capability request and takes no new start. Before any start
     // packet of this link, so nothing of this session is stopped by it.
-    const std::size_t n = j519::encode_stop(config_.version, tx_.data(), tx_.size());
-    if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) ++counters_.send_errors;
+    transmit_stop();
     capability_counters_.cleared = true;
     send_capability_request(now);
   }
@@ -632,6 +631,10 @@ LinkPollResult FanucJ519Link::poll(double timeout_s) noexcept {
 
 void FanucJ519Link::send_stop_packet() noexcept {
   stop_sent_ = true;
+  transmit_stop();
+}
+
+void FanucJ519Link::transmit_stop() noexcept {
   const std::size_t n = j519::encode_stop(config_.version, tx_.data(), tx_.size());
   if (n == 0 || !transport_.send_to(tx_.data(), n, config_.controller)) ++counters_.send_errors;
 }

@@ -175,7 +175,8 @@ class FanucJ519Link final : public ControllerLink {
   template <typename Take>
   void receive_before_stream(double wait_s, Take&& take) noexcept;
   LinkPollResult poll_once(double timeout_s) noexcept;
-  void send_stop_packet() noexcept;
+  void send_stop_packet() noexcept;  // the session's end: at most once after its start packet
+  void transmit_stop() noexcept;     // a stop packet on the wire, nothing recorded
   bool interval_agrees(const fanuc_j519::Status& s) noexcept;
   bool drain(double timeout_s, fanuc_j519::Status& newest, bool& session_start) noexcept;
   bool controller_state(const fanuc_j519::Status& s) noexcept;
