@@ -3,13 +3,12 @@
 // with heap allocations counted.
 //   build-*/bench/online_bench --benchmark_repetitions=10 --benchmark_report_aggregates_only=true
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <new>
 #include <vector>
 
 #include <benchmark/benchmark.h>
-
-#include <cmath>
 
 #include "deflex/online/delay_estimator.hpp"
 #include "deflex/online/online_compensator.hpp"
